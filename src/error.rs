@@ -1,0 +1,197 @@
+//! The crate's one error type. Every bad input has a named variant that says which field or link
+//! is wrong; numerical trouble inside a solver is a reported termination, not an error.
+
+use alloc::string::String;
+use core::fmt;
+
+/// A named error. `Display` gives one line that names the offending field.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Error {
+    /// The scenario JSON could not be parsed (syntax, a missing or unknown field, a wrong type).
+    Parse {
+        /// serde_json's message (it names the field and the line/column).
+        message: String,
+    },
+    /// A number that must be finite is NaN or infinite.
+    NonFinite {
+        /// Path of the field, e.g. `receivers[2].position_m`.
+        field: String,
+    },
+    /// A quantity that must be strictly positive is not (bandwidth, carrier, RCS, beamwidth, …).
+    NotPositive {
+        /// Path of the field.
+        field: String,
+        /// The value found.
+        value: f64,
+    },
+    /// A quantity is outside its allowed range.
+    OutOfRange {
+        /// Path of the field.
+        field: String,
+        /// The value found.
+        value: f64,
+        /// What is allowed, in words.
+        allowed: &'static str,
+    },
+    /// A node list that must not be empty is empty.
+    EmptyNodeList {
+        /// `transmitters` or `receivers`.
+        field: &'static str,
+    },
+    /// The explicit link list is empty.
+    EmptyLinkList,
+    /// Two nodes share a name (names must be unique across transmitters and receivers).
+    DuplicateName {
+        /// The repeated name.
+        name: String,
+    },
+    /// A link names a node that does not exist (or a receiver where a transmitter is expected).
+    UnknownNode {
+        /// Path of the field, e.g. `links[1][0]`.
+        field: String,
+        /// The unknown name.
+        name: String,
+    },
+    /// The same (Tx, Rx) pair appears twice in the link list.
+    DuplicateLink {
+        /// Transmitter name.
+        tx: String,
+        /// Receiver name.
+        rx: String,
+    },
+    /// An area whose minimum is not below its maximum.
+    InvertedArea {
+        /// `area_m.x` or `area_m.y`.
+        field: &'static str,
+        /// Lower bound given.
+        min: f64,
+        /// Upper bound given.
+        max: f64,
+    },
+    /// Both `noise_figure_db` and `noise_power_dbm` were given.
+    AmbiguousNoise,
+    /// A vector has the wrong length (e.g. one delay per link expected).
+    LengthMismatch {
+        /// What was being read.
+        field: &'static str,
+        /// Expected length.
+        expected: usize,
+        /// Length found.
+        found: usize,
+    },
+    /// Fewer links carry a measurement than the method needs (LM needs 3, spec §5).
+    TooFewLinks {
+        /// Links with a measurement.
+        available: usize,
+        /// Links needed.
+        required: usize,
+    },
+    /// A measured delay is NaN or infinite.
+    NonFiniteDelay {
+        /// Index of the link in scenario link order.
+        link: usize,
+    },
+    /// A delay standard deviation is not a finite number > 0.
+    InvalidSigma {
+        /// Index of the link in scenario link order.
+        link: usize,
+        /// The value found.
+        value: f64,
+    },
+    /// A requested grid or Monte Carlo size exceeds the documented cap, or is zero.
+    SizeLimit {
+        /// What was requested (e.g. `nx`).
+        field: &'static str,
+        /// The requested value.
+        value: usize,
+        /// Smallest allowed value.
+        min: usize,
+        /// Largest allowed value.
+        max: usize,
+    },
+    /// A name that is not one of the known presets.
+    UnknownPreset {
+        /// The name asked for.
+        name: String,
+    },
+}
+
+impl fmt::Display for Error {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Error::Parse { message } => write!(f, "invalid JSON: {message}"),
+            Error::NonFinite { field } => write!(f, "{field}: not a finite number"),
+            Error::NotPositive { field, value } => write!(f, "{field}: must be > 0 (got {value})"),
+            Error::OutOfRange {
+                field,
+                value,
+                allowed,
+            } => {
+                write!(f, "{field}: {value} is out of range ({allowed})")
+            }
+            Error::EmptyNodeList { field } => write!(f, "{field}: at least one node is required"),
+            Error::EmptyLinkList => write!(f, "links: the link list is empty"),
+            Error::DuplicateName { name } => write!(f, "duplicate node name \"{name}\""),
+            Error::UnknownNode { field, name } => write!(f, "{field}: unknown node \"{name}\""),
+            Error::DuplicateLink { tx, rx } => {
+                write!(f, "links: the link [\"{tx}\", \"{rx}\"] appears twice")
+            }
+            Error::InvertedArea { field, min, max } => {
+                write!(
+                    f,
+                    "{field}: the minimum {min} must be below the maximum {max}"
+                )
+            }
+            Error::AmbiguousNoise => write!(
+                f,
+                "radio: give either noise_figure_db or noise_power_dbm, not both"
+            ),
+            Error::LengthMismatch {
+                field,
+                expected,
+                found,
+            } => {
+                write!(
+                    f,
+                    "{field}: expected {expected} values (one per link), found {found}"
+                )
+            }
+            Error::TooFewLinks {
+                available,
+                required,
+            } => write!(
+                f,
+                "delays_s: {available} link(s) carry a measurement, at least {required} are needed"
+            ),
+            Error::NonFiniteDelay { link } => write!(f, "delays_s[{link}]: not a finite number"),
+            Error::InvalidSigma { link, value } => {
+                write!(
+                    f,
+                    "sigma_s[{link}]: must be a finite number > 0 (got {value})"
+                )
+            }
+            Error::SizeLimit {
+                field,
+                value,
+                min,
+                max,
+            } => {
+                write!(
+                    f,
+                    "{field}: {value} is outside the allowed range {min}..={max}"
+                )
+            }
+            Error::UnknownPreset { name } => write!(
+                f,
+                "unknown preset \"{name}\" (known: {})",
+                crate::presets::PRESET_NAMES.join(", ")
+            ),
+        }
+    }
+}
+
+#[cfg(feature = "std")]
+impl std::error::Error for Error {}
+
+/// Result with the crate's [`Error`].
+pub type Result<T> = core::result::Result<T, Error>;

@@ -1,0 +1,49 @@
+//! # scatterloc
+//!
+//! Localization and tracking of non-cooperative scatterers (people, cars) from bistatic radio
+//! propagation delays measured on a network of transmitters and receivers.
+//!
+//! The core is `no_std` + `alloc` (with `libm` math) and follows the project spec
+//! (`shared/spec/delay-localization.md`); equation tags such as (E3) refer to it.
+//!
+//! - [`scenario`]: scenario JSON (schema v1) and validation.
+//! - [`geometry`]: bistatic delays (E1), Jacobian (E3), iso-delay ellipses.
+//! - [`model`]: link budget, SNR and delay standard deviations (E8).
+//! - [`crlb`]: Fisher matrix, CRLB and the fast map kernel (E8, S18–S24).
+//! - [`lm`]: weighted Levenberg–Marquardt snapshot fix (E5–E6).
+//! - [`simulate`]: seeded noisy delays.
+//! - [`presets`]: the `sensors2019` and `iclgnss2019` case studies.
+#![cfg_attr(not(feature = "std"), no_std)]
+
+extern crate alloc;
+
+pub mod colormap;
+pub mod crlb;
+pub mod ellipse;
+pub mod error;
+pub mod geometry;
+pub mod lm;
+pub mod math;
+pub mod model;
+pub mod pattern;
+pub mod presets;
+pub mod scenario;
+pub mod simulate;
+
+#[cfg(all(feature = "std", target_arch = "wasm32"))]
+pub mod wasm;
+
+pub use error::{Error, Result};
+pub use math::{Mat2, Real, Vec2};
+pub use model::Model;
+pub use scenario::Scenario;
+
+#[cfg(all(not(feature = "std"), target_family = "wasm"))]
+#[global_allocator]
+static ALLOCATOR: dlmalloc::GlobalDlmalloc = dlmalloc::GlobalDlmalloc;
+
+#[cfg(all(not(feature = "std"), not(test), target_family = "wasm"))]
+#[panic_handler]
+fn panic(_: &core::panic::PanicInfo) -> ! {
+    core::arch::wasm32::unreachable()
+}
