@@ -3,12 +3,14 @@
 //! over a grid that writes into a caller-provided buffer.
 
 use alloc::vec;
+use alloc::vec::Vec;
 
 use crate::ellipse::Ellipse;
 use crate::error::{Error, Result};
-use crate::geometry::unit_from;
+use crate::geometry::{unit_from, UNIT_VECTOR_MIN_DISTANCE_M};
 use crate::math::{sqrt, Mat2, Real, Vec2, PI, SPEED_OF_LIGHT};
 use crate::model::{Model, SNR_DISTANCE_FLOOR_M};
+use crate::pattern::TxPattern;
 use crate::scenario::Area;
 
 /// A Fisher matrix whose reciprocal condition number `λ_min/λ_max` is below this is treated as
@@ -167,6 +169,10 @@ impl Grid {
 
 /// Writes the RMSE bound of every grid cell into `out` (row-major, row `j` = `y_j`, ascending y),
 /// m; unbounded cells get `+∞`. `out.len()` must equal `grid.len()`.
+///
+/// The same quantity as [`crlb_at`] per cell, computed row by row in structure-of-arrays form so
+/// the square roots and divisions vectorize; the Tx pattern goes through [`GainPolynomial`]
+/// ([`crate::pattern::GainPolynomial`], ≤ 1e-13 relative from the exact §9.3 formula) when it can be fitted, else the exact formula.
 pub fn crlb_map(model: &Model, grid: &Grid, out: &mut [Real]) -> Result<()> {
     if out.len() != grid.len() {
         return Err(Error::LengthMismatch {
@@ -176,39 +182,173 @@ pub fn crlb_map(model: &Model, grid: &Grid, out: &mut [Real]) -> Result<()> {
         });
     }
     let net = &model.network;
-    let weights: alloc::vec::Vec<Real> = link_weights(model).collect();
-    // Per-cell scratch, reused: transmitter (unit vector, gain/d²), receiver (unit vector, 1/d²).
-    let mut tx_state = vec![(Vec2::zeros(), 0.0); net.transmitters.len()];
-    let mut rx_state = vec![(Vec2::zeros(), 0.0); net.receivers.len()];
-    let floor2 = SNR_DISTANCE_FLOOR_M * SNR_DISTANCE_FLOOR_M;
-    for j in 0..grid.ny {
+    let nx = grid.nx;
+    let weights: Vec<Real> = link_weights(model).collect();
+    let xs: Vec<Real> = (0..nx).map(|i| grid.x(i)).collect();
+    // Per node and row: unit vector (ux, uy) and gain/d² (Tx) or 1/d² (Rx).
+    let mut tx_rows = vec![NodeRow::new(nx); net.transmitters.len()];
+    let mut rx_rows = vec![NodeRow::new(nx); net.receivers.len()];
+    let mut fisher = FisherRow::new(nx);
+    let mut scratch = vec![0.0; nx];
+    for (j, out_row) in out.chunks_exact_mut(nx).enumerate() {
         let y = grid.y(j);
-        let row = &mut out[j * grid.nx..(j + 1) * grid.nx];
-        for (i, cell) in row.iter_mut().enumerate() {
-            let r = Vec2::new(grid.x(i), y);
-            for (k, st) in tx_state.iter_mut().enumerate() {
-                let (u, d) = unit_from(net.transmitters[k], r);
-                *st = (u, model.patterns[k].gain_toward(u) / (d * d).max(floor2));
-            }
-            for (l, st) in rx_state.iter_mut().enumerate() {
-                let (u, d) = unit_from(net.receivers[l], r);
-                *st = (u, 1.0 / (d * d).max(floor2));
-            }
-            let (mut a, mut b, mut c) = (0.0, 0.0, 0.0);
-            for (link, w) in net.links.iter().zip(&weights) {
-                let (ut, gt) = tx_state[link.tx];
-                let (ur, gr) = rx_state[link.rx];
-                let (gx, gy) = (ut.x + ur.x, ut.y + ur.y);
-                let wp = w * gt * gr;
-                a += wp * gx * gx;
-                b += wp * gx * gy;
-                c += wp * gy * gy;
-            }
-            *cell = match bound_from_fisher(a, b, c) {
-                Some(bd) => bd.rmse_m,
-                None => Real::INFINITY,
-            };
+        for (k, row) in tx_rows.iter_mut().enumerate() {
+            row.fill(net.transmitters[k], y, &xs);
+            row.apply_pattern(&model.patterns[k], &mut scratch);
         }
+        for (l, row) in rx_rows.iter_mut().enumerate() {
+            row.fill(net.receivers[l], y, &xs);
+        }
+        fisher.clear();
+        for (link, &w) in net.links.iter().zip(&weights) {
+            fisher.accumulate(&tx_rows[link.tx], &rx_rows[link.rx], w);
+        }
+        fisher.rmse_into(out_row);
     }
     Ok(())
+}
+
+/// One grid row seen from one node.
+#[derive(Clone)]
+struct NodeRow {
+    ux: Vec<Real>,
+    uy: Vec<Real>,
+    /// `1/max(d², 1 m²)`, times the Tx gain for transmitters.
+    weight: Vec<Real>,
+}
+
+impl NodeRow {
+    fn new(n: usize) -> NodeRow {
+        NodeRow {
+            ux: vec![0.0; n],
+            uy: vec![0.0; n],
+            weight: vec![0.0; n],
+        }
+    }
+
+    /// Unit vectors node → cell (zero on the node, spec §3) and `1/max(d², 1)`.
+    fn fill(&mut self, node: Vec2, y: Real, xs: &[Real]) {
+        let dy = y - node.y;
+        let floor2 = SNR_DISTANCE_FLOOR_M * SNR_DISTANCE_FLOOR_M;
+        let n = xs.len();
+        let (ux, uy, w) = (&mut self.ux[..n], &mut self.uy[..n], &mut self.weight[..n]);
+        for i in 0..n {
+            let dx = xs[i] - node.x;
+            let d2 = dx * dx + dy * dy;
+            let d = sqrt(d2);
+            let inv = if d < UNIT_VECTOR_MIN_DISTANCE_M {
+                0.0
+            } else {
+                1.0 / d
+            };
+            ux[i] = dx * inv;
+            uy[i] = dy * inv;
+            // 1/max(d², 1 m²) without a second division.
+            w[i] = if d2 < floor2 { 1.0 / floor2 } else { inv * inv };
+        }
+    }
+
+    /// Multiplies the weights by the Tx gain toward each cell.
+    fn apply_pattern(&mut self, pattern: &TxPattern, scratch: &mut [Real]) {
+        let n = self.weight.len();
+        match (pattern.beam, pattern.polynomial.as_ref()) {
+            (None, _) => self.weight.iter_mut().for_each(|w| *w *= pattern.peak_gain),
+            (Some(_), Some(p)) => {
+                let t = &mut scratch[..n];
+                let span = 1.0 - p.floor_cos;
+                for i in 0..n {
+                    let c = self.ux[i] * p.boresight.x + self.uy[i] * p.boresight.y;
+                    t[i] = (2.0 * c - 1.0 - p.floor_cos) / span;
+                }
+                // Clenshaw on LANES cells at a time, so the recurrence lives in vector registers.
+                const LANES: usize = 4;
+                let (head, tail) = p.coefficients.split_at(1);
+                let a0 = head[0];
+                let mut i0 = 0;
+                while i0 < n {
+                    let m = LANES.min(n - i0);
+                    let mut tt = [0.0; LANES];
+                    tt[..m].copy_from_slice(&t[i0..i0 + m]);
+                    let (mut b1, mut b2) = ([0.0; LANES], [0.0; LANES]);
+                    for &a in tail.iter().rev() {
+                        for l in 0..LANES {
+                            let b0 = a + 2.0 * tt[l] * b1[l] - b2[l];
+                            b2[l] = b1[l];
+                            b1[l] = b0;
+                        }
+                    }
+                    for l in 0..m {
+                        let i = i0 + l;
+                        let (ux, uy) = (self.ux[i], self.uy[i]);
+                        let c = ux * p.boresight.x + uy * p.boresight.y;
+                        let g = if ux == 0.0 && uy == 0.0 {
+                            pattern.peak_gain
+                        } else if c <= p.floor_cos {
+                            p.floor_gain
+                        } else {
+                            (a0 + tt[l] * b1[l] - b2[l]).max(p.floor_gain)
+                        };
+                        self.weight[i] *= g;
+                    }
+                    i0 += m;
+                }
+            }
+            (Some(_), None) => {
+                for i in 0..n {
+                    self.weight[i] *= pattern.gain_toward(Vec2::new(self.ux[i], self.uy[i]));
+                }
+            }
+        }
+    }
+}
+
+/// Fisher entries `[[a, b], [b, c]]` of one grid row.
+struct FisherRow {
+    a: Vec<Real>,
+    b: Vec<Real>,
+    c: Vec<Real>,
+}
+
+impl FisherRow {
+    fn new(n: usize) -> FisherRow {
+        FisherRow {
+            a: vec![0.0; n],
+            b: vec![0.0; n],
+            c: vec![0.0; n],
+        }
+    }
+
+    fn clear(&mut self) {
+        self.a.fill(0.0);
+        self.b.fill(0.0);
+        self.c.fill(0.0);
+    }
+
+    /// Adds one link's `w·(gTx/d²)(1/d²)·(u^Tx+u^Rx)(u^Tx+u^Rx)ᵀ`.
+    fn accumulate(&mut self, tx: &NodeRow, rx: &NodeRow, w: Real) {
+        let n = self.a.len();
+        let (a, b, c) = (&mut self.a[..n], &mut self.b[..n], &mut self.c[..n]);
+        let (tux, tuy, tw) = (&tx.ux[..n], &tx.uy[..n], &tx.weight[..n]);
+        let (rux, ruy, rw) = (&rx.ux[..n], &rx.uy[..n], &rx.weight[..n]);
+        for i in 0..n {
+            let gx = tux[i] + rux[i];
+            let gy = tuy[i] + ruy[i];
+            let wp = w * tw[i] * rw[i];
+            a[i] += wp * gx * gx;
+            b[i] += wp * gx * gy;
+            c[i] += wp * gy * gy;
+        }
+    }
+
+    /// `√(σx² + σy²)` per cell, `+∞` where singular (same rule as [`bound_from_fisher`]).
+    fn rmse_into(&self, out: &mut [Real]) {
+        let n = out.len();
+        let (a, b, c) = (&self.a[..n], &self.b[..n], &self.c[..n]);
+        for i in 0..n {
+            let det = a[i] * c[i] - b[i] * b[i];
+            let tr = a[i] + c[i];
+            let ok = tr > 0.0 && det > SINGULAR_RCOND * tr * tr && det.is_finite();
+            out[i] = if ok { sqrt(tr / det) } else { Real::INFINITY };
+        }
+    }
 }

@@ -5,12 +5,14 @@ use crate::math::{acos, cos, db_to_linear, deg_to_rad, exp, sin, Real, Vec2};
 use crate::scenario::Pattern;
 
 /// A compiled Tx pattern: linear gains, boresight unit vector and the Gaussian-in-ψ exponent.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct TxPattern {
     /// Peak gain `G₀`, linear.
     pub peak_gain: Real,
     /// `None` for omni; otherwise the directional parameters.
     pub beam: Option<Beam>,
+    /// Fast form of the directional gain for the map kernel, when it fits (see [`GainPolynomial`]).
+    pub polynomial: Option<GainPolynomial>,
 }
 
 /// Parameters of the parabolic (in dB) main beam.
@@ -47,7 +49,13 @@ impl TxPattern {
                 })
             }
         };
-        TxPattern { peak_gain, beam }
+        let mut pattern = TxPattern {
+            peak_gain,
+            beam,
+            polynomial: None,
+        };
+        pattern.polynomial = GainPolynomial::fit(&pattern);
+        pattern
     }
 
     /// Linear gain toward the unit direction `u` (Tx → point). A zero `u` (point on the Tx)
@@ -60,8 +68,104 @@ impl TxPattern {
                 if u.x == 0.0 && u.y == 0.0 {
                     return self.peak_gain;
                 }
-                let c = (u.x * b.boresight.x + u.y * b.boresight.y).clamp(-1.0, 1.0);
-                let psi = acos(c);
+                self.gain_toward_cos(u.x * b.boresight.x + u.y * b.boresight.y)
+            }
+        }
+    }
+}
+
+/// Highest Chebyshev degree tried for [`GainPolynomial`].
+const MAX_POLY_DEGREE: usize = 40;
+/// Largest relative error of [`GainPolynomial`] against the exact pattern that is accepted.
+pub const GAIN_POLYNOMIAL_TOLERANCE: Real = 1e-13;
+
+/// The main-lobe gain `G₀·exp(−k·acos(c)²)` as a Chebyshev series in `c = cos ψ` on
+/// `[cos ψ_floor, 1]` (analytic there), with the floor below. Lets the CRLB map kernel evaluate the
+/// §9.3 pattern with a few multiply-adds per cell instead of `acos` and `exp`; it is only built
+/// when it matches the exact formula to [`GAIN_POLYNOMIAL_TOLERANCE`] (relative) everywhere.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GainPolynomial {
+    /// Boresight unit vector.
+    pub boresight: Vec2,
+    /// `cos ψ_floor`: below it the gain is the floor.
+    pub floor_cos: Real,
+    /// Floor gain, linear.
+    pub floor_gain: Real,
+    /// Chebyshev coefficients in `t = (2c − 1 − c_f)/(1 − c_f)`.
+    pub coefficients: alloc::vec::Vec<Real>,
+}
+
+impl GainPolynomial {
+    /// Fits the polynomial for a directional pattern; `None` for omni patterns or when no degree
+    /// up to 40 reaches the tolerance (e.g. a floor so deep that the fit interval reaches `c = −1`).
+    pub fn fit(pattern: &TxPattern) -> Option<GainPolynomial> {
+        let beam = pattern.beam?;
+        if beam.floor_angle_rad >= 0.95 * crate::math::PI {
+            return None;
+        }
+        let floor_cos = cos(beam.floor_angle_rad);
+        let exact = |c: Real| pattern.peak_gain * exp(-beam.exponent_per_rad2 * acos(c) * acos(c));
+        let to_c = |t: Real| 0.5 * (t * (1.0 - floor_cos) + 1.0 + floor_cos);
+        // Chebyshev interpolation at n first-kind nodes (discrete cosine transform).
+        let n = MAX_POLY_DEGREE + 1;
+        let pi = crate::math::PI;
+        let values: alloc::vec::Vec<Real> = (0..n)
+            .map(|j| exact(to_c(cos(pi * (j as Real + 0.5) / n as Real))))
+            .collect();
+        let mut coefficients: alloc::vec::Vec<Real> = (0..n)
+            .map(|k| {
+                let s: Real = (0..n)
+                    .map(|j| values[j] * cos(pi * k as Real * (j as Real + 0.5) / n as Real))
+                    .sum();
+                s * 2.0 / n as Real
+            })
+            .collect();
+        coefficients[0] *= 0.5;
+        let scale = coefficients.iter().fold(0.0 as Real, |m, c| m.max(c.abs()));
+        while coefficients.len() > 1 && coefficients.last().is_some_and(|c| c.abs() < 1e-15 * scale)
+        {
+            coefficients.pop();
+        }
+        let poly = GainPolynomial {
+            boresight: beam.boresight,
+            floor_cos,
+            floor_gain: beam.floor_gain,
+            coefficients,
+        };
+        // Verify against the exact formula on a dense set of directions.
+        let ok = (0..=2048).all(|i| {
+            let c = to_c(-1.0 + 2.0 * i as Real / 2048.0);
+            let e = pattern.gain_toward_cos(c);
+            (poly.gain_at_cos(c) - e).abs() <= GAIN_POLYNOMIAL_TOLERANCE * e
+        });
+        ok.then_some(poly)
+    }
+
+    /// Gain for `c = cos ψ`, linear.
+    #[inline(always)]
+    pub fn gain_at_cos(&self, c: Real) -> Real {
+        if c <= self.floor_cos {
+            return self.floor_gain;
+        }
+        let t = (2.0 * c - 1.0 - self.floor_cos) / (1.0 - self.floor_cos);
+        // Clenshaw recurrence.
+        let (mut b1, mut b2) = (0.0, 0.0);
+        for &a in self.coefficients[1..].iter().rev() {
+            let b0 = a + 2.0 * t * b1 - b2;
+            b2 = b1;
+            b1 = b0;
+        }
+        (self.coefficients[0] + t * b1 - b2).max(self.floor_gain)
+    }
+}
+
+impl TxPattern {
+    /// Exact gain for `c = cos ψ` (the §9.3 formula), linear.
+    pub fn gain_toward_cos(&self, c: Real) -> Real {
+        match &self.beam {
+            None => self.peak_gain,
+            Some(b) => {
+                let psi = acos(c.clamp(-1.0, 1.0));
                 if psi >= b.floor_angle_rad {
                     b.floor_gain
                 } else {

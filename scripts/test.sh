@@ -1,0 +1,30 @@
+#!/usr/bin/env bash
+# Sets up (idempotently) and runs every test: native cargo test, the no_std build,
+# wasm-pack test in headless Chromium, and the browser end-to-end test.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+export PATH="$HOME/.cargo/bin:$PATH"
+bash scripts/setup.sh
+export CHROMEDRIVER=/usr/bin/chromedriver WASM_BINDGEN_TEST_TIMEOUT=120
+
+step() { printf '\n==== %s\n' "$*"; }
+log=$(mktemp); trap 'rm -f "$log"' EXIT
+
+step "no_std build (wasm32v1-none has no std in its sysroot)"
+cargo build --lib --no-default-features --target wasm32v1-none
+
+step "wasm-pack test --headless --chrome"
+wasm-pack test --headless --chrome --mode no-install 2>&1 | tee -a "$log"
+
+step "build the page's wasm (dev) for the end-to-end test"
+wasm-pack build --dev --target web --out-dir www/pkg --mode no-install
+
+step "native cargo test (unit, spec checks, properties, CLI) + browser end-to-end"
+cargo test -- --include-ignored 2>&1 | tee -a "$log"
+
+# One closing line over every runner above (cargo's last binary may legitimately hold 0 tests).
+passed=$(grep -oE 'test result: [a-zA-Z]+\. [0-9]+ passed' "$log" | awk '{s+=$4} END {print s+0}')
+failed=$(grep -E 'test result:' "$log" | grep -oE '[0-9]+ failed' | awk '{s+=$1} END {print s+0}')
+echo
+echo "total: ${passed} passed, ${failed} failed"
+[ "$failed" -eq 0 ] && [ "$passed" -gt 0 ]
