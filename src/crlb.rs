@@ -172,7 +172,7 @@ impl Grid {
 ///
 /// The same quantity as [`crlb_at`] per cell, computed row by row in structure-of-arrays form so
 /// the square roots and divisions vectorize; the Tx pattern goes through [`GainPolynomial`]
-/// ([`crate::pattern::GainPolynomial`], ≤ 1e-13 relative from the exact §9.3 formula) when it can be fitted, else the exact formula.
+/// ([`crate::pattern::GainPolynomial`], ≤ 1e-12 relative from the exact §9.3 formula) when it can be fitted, else the exact formula.
 pub fn crlb_map(model: &Model, grid: &Grid, out: &mut [Real]) -> Result<()> {
     if out.len() != grid.len() {
         return Err(Error::LengthMismatch {
