@@ -1,1 +1,204 @@
-fn main() {}
+#![cfg(not(target_arch = "wasm32"))]
+#![allow(missing_docs)] // criterion_group! generates an undocumented pub fn
+//! Core benchmarks (criterion): the LM snapshot fix (ours vs the `levenberg-marquardt` crate on the
+//! same weighted problem), LM with the default grid-search start, the CRLB map kernel and a single
+//! CRLB point. Scenario: preset `sensors2019` (layout L4, 4 links), truth (4, 1) m.
+//!
+//! Run: `cargo bench --bench core` (shorter: `-- --warm-up-time 1 --measurement-time 3`).
+
+use std::hint::black_box;
+
+use criterion::{criterion_group, criterion_main, Criterion};
+use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
+use nalgebra::storage::Owned;
+use nalgebra::{DVector, Dyn, OMatrix, Vector2, U2};
+
+use scatterloc::crlb::{crlb_at, crlb_map, Grid};
+use scatterloc::geometry::unit_from;
+use scatterloc::lm::{self, DelayMeasurements, LmConfig};
+use scatterloc::math::{Real, Vec2, SPEED_OF_LIGHT};
+use scatterloc::scenario::Scenario;
+use scatterloc::{presets, simulate, Model};
+
+const TRUTH: [Real; 2] = [4.0, 1.0];
+const START_OFFSET: [Real; 2] = [2.0, 2.0];
+const SEED: u64 = 2019;
+
+/// The shared problem: L4 model, noisy delays at the truth (fixed seed), σ_p from (E8) at the truth.
+struct Setup {
+    scenario: Scenario,
+    model: Model,
+    delays: Vec<Option<Real>>,
+    sigmas: Vec<Real>,
+    start: Vec2,
+}
+
+fn setup() -> Setup {
+    let scenario = presets::sensors2019();
+    let model = Model::new(&scenario).unwrap();
+    let truth = Vec2::new(TRUTH[0], TRUTH[1]);
+    let delays = simulate::noisy_delays(&model, truth, &mut simulate::rng(SEED, 0))
+        .into_iter()
+        .map(Some)
+        .collect();
+    let sigmas = model.sigma_delays(truth);
+    Setup {
+        scenario,
+        model,
+        delays,
+        sigmas,
+        start: truth + Vec2::new(START_OFFSET[0], START_OFFSET[1]),
+    }
+}
+
+impl Setup {
+    fn ours(&self, initial: Option<Vec2>) -> lm::LmReport {
+        let m = DelayMeasurements {
+            delays_s: &self.delays,
+            sigmas_s: &self.sigmas,
+        };
+        lm::locate(
+            &self.model.network,
+            &m,
+            &LmConfig::default(),
+            initial,
+            &self.scenario.area_m,
+        )
+        .unwrap()
+    }
+
+    /// Rows of the range-domain problem: foci, measured range cτ̂ and 1/(cσ).
+    fn rows(&self) -> Vec<Row> {
+        (0..self.model.link_count())
+            .map(|p| {
+                let (tx, rx) = self.model.network.link_nodes(p);
+                Row {
+                    tx,
+                    rx,
+                    range: SPEED_OF_LIGHT * self.delays[p].unwrap(),
+                    inv_sigma: 1.0 / (SPEED_OF_LIGHT * self.sigmas[p]),
+                }
+            })
+            .collect()
+    }
+}
+
+#[derive(Clone, Copy)]
+struct Row {
+    tx: Vec2,
+    rx: Vec2,
+    range: Real,
+    inv_sigma: Real,
+}
+
+/// The same weighted NLS (E5) for the `levenberg-marquardt` crate, in range units:
+/// residual_p = (cτ̂_p − (d_Tx + d_Rx))/(cσ_p), Jacobian row −(u_Tx + u_Rx)/(cσ_p).
+#[derive(Clone)]
+struct CrateProblem<'a> {
+    rows: &'a [Row],
+    p: Vector2<Real>,
+}
+
+impl LeastSquaresProblem<Real, Dyn, U2> for CrateProblem<'_> {
+    type ResidualStorage = Owned<Real, Dyn>;
+    type JacobianStorage = Owned<Real, Dyn, U2>;
+    type ParameterStorage = Owned<Real, U2>;
+
+    fn set_params(&mut self, x: &Vector2<Real>) {
+        self.p = *x;
+    }
+
+    fn params(&self) -> Vector2<Real> {
+        self.p
+    }
+
+    fn residuals(&self) -> Option<DVector<Real>> {
+        Some(DVector::from_iterator(
+            self.rows.len(),
+            self.rows.iter().map(|r| {
+                (r.range - ((self.p - r.tx).norm() + (self.p - r.rx).norm())) * r.inv_sigma
+            }),
+        ))
+    }
+
+    fn jacobian(&self) -> Option<OMatrix<Real, Dyn, U2>> {
+        let mut j = OMatrix::<Real, Dyn, U2>::zeros(self.rows.len());
+        for (i, r) in self.rows.iter().enumerate() {
+            let g = unit_from(r.tx, self.p).0 + unit_from(r.rx, self.p).0;
+            j[(i, 0)] = -g.x * r.inv_sigma;
+            j[(i, 1)] = -g.y * r.inv_sigma;
+        }
+        Some(j)
+    }
+}
+
+/// Crate settings comparable to ours (spec §5: stop at a step < 1e-6 m or a relative cost
+/// decrease < 1e-12). The crate's xtol is relative to the (scaled) parameter norm, so
+/// 1e-6 m / |r| with |r| ≈ 4.1 m at the truth → 2.5e-7.
+fn crate_solver() -> LevenbergMarquardt<Real> {
+    LevenbergMarquardt::new().with_xtol(2.5e-7).with_ftol(1e-12)
+}
+
+fn crate_fix(rows: &[Row], start: Vec2) -> (Vec2, levenberg_marquardt::MinimizationReport<Real>) {
+    let (p, report) = crate_solver().minimize(CrateProblem { rows, p: start });
+    (p.p, report)
+}
+
+fn benches(c: &mut Criterion) {
+    let s = setup();
+    let rows = s.rows();
+    let truth = Vec2::new(TRUTH[0], TRUTH[1]);
+
+    // Untimed sanity check: both solvers (and the grid start) reach the same minimum.
+    let ours = s.ours(Some(s.start));
+    let (theirs, report) = crate_fix(&rows, s.start);
+    let grid = s.ours(None);
+    assert!(ours.termination.converged(), "{ours:?}");
+    assert!(report.termination.was_successful(), "{report:?}");
+    assert!(grid.termination.converged(), "{grid:?}");
+    let gap = (ours.position - theirs).norm();
+    assert!(gap <= 1e-6, "ours {ours:?} vs crate {theirs:?}");
+    assert!((ours.position - grid.position).norm() <= 1e-6);
+    // The crate minimises ½‖r‖², ours 𝓛 = ‖r‖² (E5).
+    assert!((2.0 * report.objective_function / ours.cost - 1.0).abs() < 1e-6);
+    eprintln!(
+        "setup: truth {truth:?}, start {:?}\n  ours : {:?} after {} it. ({:?}), cost {:.6}, error {:.3} mm\n  crate: {:?} after {} evaluations ({:?}), |ours - crate| = {gap:.2e} m\n  grid start {:?} → {} it.",
+        s.start,
+        ours.position,
+        ours.iterations,
+        ours.termination,
+        ours.cost,
+        (ours.position - truth).norm() * 1e3,
+        theirs,
+        report.number_of_evaluations,
+        report.termination,
+        grid.start,
+        grid.iterations,
+    );
+
+    let mut g = c.benchmark_group("lm_fix_4_links");
+    g.bench_function("scatterloc_lm_start_truth+(2,2)", |b| {
+        b.iter(|| s.ours(black_box(Some(s.start))))
+    });
+    g.bench_function("levenberg_marquardt_crate_start_truth+(2,2)", |b| {
+        b.iter(|| crate_fix(black_box(&rows), black_box(s.start)).0)
+    });
+    g.bench_function("scatterloc_lm_grid_start_0.5m", |b| {
+        b.iter(|| s.ours(black_box(None)))
+    });
+    g.finish();
+
+    let grid = Grid::new(s.scenario.area_m, 256, 256).unwrap();
+    let mut out = vec![0.0; grid.len()];
+    c.bench_function("crlb_map_256x256_4_links", |b| {
+        b.iter(|| crlb_map(&s.model, black_box(&grid), &mut out).unwrap())
+    });
+    assert!(out.iter().all(|v| !v.is_nan()));
+
+    c.bench_function("crlb_at_single_point", |b| {
+        b.iter(|| crlb_at(&s.model, black_box(truth)))
+    });
+}
+
+criterion_group!(core, benches);
+criterion_main!(core);

@@ -16,8 +16,8 @@ cargo build --lib --no-default-features --target wasm32v1-none
 step "wasm-pack test --headless --chrome"
 wasm-pack test --headless --chrome --mode no-install 2>&1 | tee -a "$log"
 
-step "build the page's wasm (dev) for the end-to-end test"
-wasm-pack build --dev --target web --out-dir www/pkg --mode no-install
+step "build the page's wasm (release, as served) for the end-to-end test"
+wasm-pack build --release --target web --out-dir www/pkg --mode no-install
 
 step "native cargo test (unit, spec checks, properties, CLI) + browser end-to-end"
 cargo test -- --include-ignored 2>&1 | tee -a "$log"

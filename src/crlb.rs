@@ -80,13 +80,18 @@ pub fn fisher(model: &Model, r: Vec2) -> Mat2 {
     f
 }
 
+/// Whether a 2×2 Fisher matrix with determinant `det` and trace `tr` is invertible to working
+/// precision: `det/tr² ≈ λ_min/λ_max` for an ill-conditioned matrix must exceed [`SINGULAR_RCOND`].
+#[inline(always)]
+fn is_regular(det: Real, tr: Real) -> bool {
+    tr > 0.0 && det > SINGULAR_RCOND * tr * tr && det.is_finite()
+}
+
 /// The bound from a symmetric Fisher matrix `[[a, b], [b, c]]`; `None` when singular.
 #[inline(always)]
 pub fn bound_from_fisher(a: Real, b: Real, c: Real) -> Option<Bound> {
     let det = a * c - b * b;
-    let tr = a + c;
-    // 4·det/tr² = 4 λ1 λ2 / (λ1+λ2)² ≈ 4 λ_min/λ_max for an ill-conditioned matrix.
-    if !(tr > 0.0) || !(det > SINGULAR_RCOND * tr * tr) || !det.is_finite() {
+    if !is_regular(det, a + c) {
         return None;
     }
     let (vx, vy) = (c / det, a / det);
@@ -256,9 +261,9 @@ impl NodeRow {
             (Some(_), Some(p)) => {
                 let t = &mut scratch[..n];
                 let span = 1.0 - p.floor_cos;
-                for i in 0..n {
-                    let c = self.ux[i] * p.boresight.x + self.uy[i] * p.boresight.y;
-                    t[i] = (2.0 * c - 1.0 - p.floor_cos) / span;
+                for ((t, ux), uy) in t.iter_mut().zip(&self.ux).zip(&self.uy) {
+                    *t = (2.0 * (ux * p.boresight.x + uy * p.boresight.y) - 1.0 - p.floor_cos)
+                        / span;
                 }
                 // Clenshaw on LANES cells at a time, so the recurrence lives in vector registers.
                 const LANES: usize = 4;
@@ -347,8 +352,11 @@ impl FisherRow {
         for i in 0..n {
             let det = a[i] * c[i] - b[i] * b[i];
             let tr = a[i] + c[i];
-            let ok = tr > 0.0 && det > SINGULAR_RCOND * tr * tr && det.is_finite();
-            out[i] = if ok { sqrt(tr / det) } else { Real::INFINITY };
+            out[i] = if is_regular(det, tr) {
+                sqrt(tr / det)
+            } else {
+                Real::INFINITY
+            };
         }
     }
 }

@@ -49,6 +49,31 @@ impl Ellipse {
         self.center + Vec2::new(ca * u - sa * v, sa * u + ca * v)
     }
 
+    /// `n ≥ 2` points of the arc that passes near `p`, spanning about `±1.5·radius` of arc length
+    /// around the point whose parameter matches `p`'s direction from the centre; empty when the
+    /// ellipse stays farther than `2·radius` from `p` there. For drawing a small window around `p`
+    /// (an iso-delay ellipse metres across, seen at millimetre scale) without a huge path.
+    pub fn arc_near(&self, p: Vec2, radius: Real, n: usize) -> Vec<Vec2> {
+        let (a, b) = (self.semi_major, self.semi_minor);
+        let (ca, sa) = (cos(self.angle_rad), sin(self.angle_rad));
+        let d = p - self.center;
+        let (u, v) = (ca * d.x + sa * d.y, -sa * d.x + ca * d.y);
+        let t0 = atan2(a * v, b * u);
+        if !(radius.is_finite() && radius > 0.0 && t0.is_finite() && n >= 2)
+            || (self.point(t0) - p).norm() > 2.0 * radius
+        {
+            return Vec::new();
+        }
+        let speed = sqrt(a * a * sin(t0) * sin(t0) + b * b * cos(t0) * cos(t0));
+        if speed.is_nan() || speed <= 0.0 {
+            return Vec::new();
+        }
+        let half = (1.5 * radius / speed).min(PI);
+        (0..n)
+            .map(|i| self.point(t0 - half + 2.0 * half * i as Real / (n - 1) as Real))
+            .collect()
+    }
+
     /// `n` points evenly spaced in the parameter, for drawing (closed by the caller).
     pub fn polygon(&self, n: usize) -> Vec<Vec2> {
         (0..n)

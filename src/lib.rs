@@ -13,10 +13,13 @@
 //! - [`lm`]: weighted Levenberg–Marquardt snapshot fix (E5–E6).
 //! - [`simulate`]: seeded noisy delays.
 //! - [`presets`]: the `sensors2019` and `iclgnss2019` case studies.
+//! - [`ticks`]: axis ticks and length labels shared by the front ends.
 #![cfg_attr(not(feature = "std"), no_std)]
 
 extern crate alloc;
 
+#[cfg(feature = "std")]
+pub mod chart;
 pub mod colormap;
 pub mod crlb;
 pub mod ellipse;
@@ -29,6 +32,7 @@ pub mod pattern;
 pub mod presets;
 pub mod scenario;
 pub mod simulate;
+pub mod ticks;
 
 #[cfg(all(feature = "std", target_arch = "wasm32"))]
 pub mod wasm;

@@ -70,6 +70,25 @@ pub fn log10(x: Real) -> Real {
     }
 }
 
+/// Natural logarithm.
+#[inline(always)]
+pub fn ln(x: Real) -> Real {
+    #[cfg(feature = "std")]
+    {
+        x.ln()
+    }
+    #[cfg(not(feature = "std"))]
+    {
+        libm::log(x)
+    }
+}
+
+/// Complementary error function.
+#[inline(always)]
+pub fn erfc(x: Real) -> Real {
+    libm::erfc(x)
+}
+
 /// Cosine.
 #[inline(always)]
 pub fn cos(x: Real) -> Real {

@@ -178,9 +178,7 @@ pub struct LinkIndex {
 impl Scenario {
     /// Parses and validates scenario JSON.
     pub fn from_json(text: &str) -> Result<Scenario> {
-        let s: Scenario = serde_json::from_str(text).map_err(|e| Error::Parse {
-            message: e.to_string(),
-        })?;
+        let s: Scenario = parse_json(text)?;
         s.validate()?;
         Ok(s)
     }
@@ -343,6 +341,26 @@ impl Area {
     }
 }
 
+/// Deserializes JSON, naming the path of the offending field in the error (e.g.
+/// `radio.bandwidth_hz: invalid type: string "120e6", expected f64 at line 5 column 27`).
+pub fn parse_json<T: serde::de::DeserializeOwned>(text: &str) -> Result<T> {
+    let mut de = serde_json::Deserializer::from_str(text);
+    let value: T = serde_path_to_error::deserialize(&mut de).map_err(|e| {
+        let path = e.path().to_string();
+        let inner = e.into_inner();
+        let message = if path.is_empty() || path == "." {
+            inner.to_string()
+        } else {
+            format!("{path}: {inner}")
+        };
+        Error::Parse { message }
+    })?;
+    de.end().map_err(|e| Error::Parse {
+        message: e.to_string(),
+    })?;
+    Ok(value)
+}
+
 fn finite(field: &str, v: f64) -> Result<()> {
     if v.is_finite() {
         Ok(())
@@ -401,4 +419,50 @@ fn area(a: &Area) -> Result<()> {
         });
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn with_radio(radio: &str) -> String {
+        format!(
+            r#"{{"name":"x","radio":{radio},"transmitters":[{{"name":"Tx","position_m":[0,0],"power_dbm":30,"gain_dbi":0}}],
+            "receivers":[{{"name":"Rx","position_m":[1,0],"gain_dbi":0}}],"target":{{"rcs_m2":1}},"area_m":{{"x":[0,1],"y":[0,1]}}}}"#
+        )
+    }
+
+    /// A value of the wrong type is reported with the path of its field.
+    #[test]
+    fn wrong_type_names_the_field_path() {
+        let e = Scenario::from_json(&with_radio(
+            r#"{"carrier_hz":5.2e9,"bandwidth_hz":"120e6"}"#,
+        ))
+        .unwrap_err();
+        assert!(matches!(e, Error::Parse { .. }));
+        assert!(e.to_string().contains("radio.bandwidth_hz"), "{e}");
+    }
+
+    /// A typo inside a nested object names that object and the unknown field.
+    #[test]
+    fn nested_unknown_field_is_named() {
+        let e = Scenario::from_json(&with_radio(r#"{"carrier_hz":5.2e9,"bandwith_hz":1e8}"#))
+            .unwrap_err();
+        let text = e.to_string();
+        assert!(
+            text.contains("radio") && text.contains("bandwith_hz"),
+            "{text}"
+        );
+    }
+
+    /// Trailing garbage after the object is an error, not silently ignored.
+    #[test]
+    fn trailing_characters_are_rejected() {
+        let good = with_radio(r#"{"carrier_hz":5.2e9,"bandwidth_hz":1e8}"#);
+        assert!(Scenario::from_json(&good).is_ok());
+        assert!(matches!(
+            Scenario::from_json(&(good + " x")),
+            Err(Error::Parse { .. })
+        ));
+    }
 }

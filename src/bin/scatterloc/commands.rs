@@ -1,0 +1,233 @@
+//! `preset`, `crlb` and `locate`, plus the shared input readers and stdout writer.
+
+use std::ffi::OsString;
+use std::io::{Read, Write};
+
+use serde::{Deserialize, Serialize};
+
+use scatterloc::crlb::crlb_at;
+use scatterloc::lm::{locate as lm_locate, DelayMeasurements, LmConfig};
+use scatterloc::scenario::parse_json;
+use scatterloc::{presets, Mat2, Model, Scenario, Vec2};
+
+use crate::args::{parse_xy, Args};
+use crate::{CliError, USAGE};
+
+/// Writes `text` and a newline to stdout.
+pub fn emit(text: &str) -> Result<(), CliError> {
+    let mut out = std::io::stdout().lock();
+    writeln!(out, "{text}")
+        .and_then(|_| out.flush())
+        .map_err(|e| CliError::output(format!("stdout: {e}")))
+}
+
+/// Pretty JSON on stdout (serde_json writes non-finite numbers as `null`).
+pub fn emit_json<T: Serialize>(v: &T) -> Result<(), CliError> {
+    let text = serde_json::to_string_pretty(v)
+        .map_err(|e| CliError::output(format!("encoding JSON: {e}")))?;
+    emit(&text)
+}
+
+/// Parses the subcommand's flags; `Ok(None)` when `--help` was asked (usage already printed).
+pub fn parse_args(
+    argv: &[OsString],
+    cmd: &str,
+    allowed: &[&str],
+) -> Result<Option<Args>, CliError> {
+    let args = Args::parse(argv, cmd, allowed)?;
+    if args.help {
+        emit(USAGE.trim_end())?;
+        return Ok(None);
+    }
+    Ok(Some(args))
+}
+
+/// Reads a file (or stdin for `-`) named by `--flag`.
+pub fn read_input(flag: &str, path: &str) -> Result<String, CliError> {
+    let res = if path == "-" {
+        let mut s = String::new();
+        std::io::stdin().read_to_string(&mut s).map(|_| s)
+    } else {
+        std::fs::read_to_string(path)
+    };
+    res.map_err(|e| CliError::usage(format!("--{flag}: cannot read '{path}': {e}")))
+}
+
+/// Reads and validates the scenario of `--scenario`.
+pub fn read_scenario(args: &Args) -> Result<Scenario, CliError> {
+    let path = args.required("scenario")?;
+    let text = read_input("scenario", path)?;
+    Scenario::from_json(&text).map_err(|e| CliError::usage(format!("--scenario {path}: {e}")))
+}
+
+fn model_of(s: &Scenario) -> Result<Model, CliError> {
+    Model::new(s).map_err(|e| CliError::usage(format!("--scenario: {e}")))
+}
+
+/// A symmetric 2×2 matrix as `[[a, b], [b, c]]` (upper triangle).
+fn sym(m: &Mat2) -> [[f64; 2]; 2] {
+    [[m[(0, 0)], m[(0, 1)]], [m[(0, 1)], m[(1, 1)]]]
+}
+
+/// `scatterloc preset NAME`.
+pub fn preset(argv: &[OsString]) -> Result<(), CliError> {
+    let Some(args) = parse_args(argv, "preset", &[])? else {
+        return Ok(());
+    };
+    args.expect_positional("preset", 1, "preset name (sensors2019 or iclgnss2019)")?;
+    let s = presets::preset(&args.positional[0]).map_err(|e| CliError::usage(e.to_string()))?;
+    emit(&s.to_json())
+}
+
+/// `scatterloc crlb --scenario S --at X,Y`.
+pub fn crlb(argv: &[OsString]) -> Result<(), CliError> {
+    let Some(args) = parse_args(argv, "crlb", &["scenario", "at"])? else {
+        return Ok(());
+    };
+    args.expect_positional("crlb", 0, "")?;
+    let at = parse_xy("at", args.required("at")?)?;
+    let s = read_scenario(&args)?;
+    let model = model_of(&s)?;
+    let r = Vec2::new(at[0], at[1]);
+    let pt = crlb_at(&model, r);
+    let names = s
+        .link_names()
+        .map_err(|e| CliError::usage(format!("--scenario: {e}")))?;
+    let links: Vec<LinkOut> = names
+        .iter()
+        .enumerate()
+        .map(|(p, (tx, rx))| LinkOut {
+            tx,
+            rx,
+            snr_db: 10.0 * model.snr(p, r).log10(),
+            sigma_delay_s: model.sigma_delay(p, r),
+            delay_s: model.network.delay(p, r),
+        })
+        .collect();
+    let b = pt.bound;
+    let out = CrlbOut {
+        position_m: at,
+        bounded: b.is_some(),
+        sigma_x_m: b.map(|b| b.sigma_x_m),
+        sigma_y_m: b.map(|b| b.sigma_y_m),
+        rmse_bound_m: b.map(|b| b.rmse_m),
+        fim_per_m2: sym(&pt.fisher_per_m2),
+        covariance_m2: b.map(|b| sym(&b.covariance_m2)),
+        ellipse_1sigma: pt.ellipse().map(|e| EllipseOut {
+            semi_major_m: e.semi_major,
+            semi_minor_m: e.semi_minor,
+            angle_deg: e.angle_rad.to_degrees(),
+        }),
+        links,
+    };
+    emit_json(&out)
+}
+
+/// Output of `crlb` (keys in this order).
+#[derive(Serialize)]
+struct CrlbOut<'a> {
+    position_m: [f64; 2],
+    bounded: bool,
+    sigma_x_m: Option<f64>,
+    sigma_y_m: Option<f64>,
+    rmse_bound_m: Option<f64>,
+    fim_per_m2: [[f64; 2]; 2],
+    covariance_m2: Option<[[f64; 2]; 2]>,
+    ellipse_1sigma: Option<EllipseOut>,
+    links: Vec<LinkOut<'a>>,
+}
+
+#[derive(Serialize)]
+struct EllipseOut {
+    semi_major_m: f64,
+    semi_minor_m: f64,
+    angle_deg: f64,
+}
+
+#[derive(Serialize)]
+struct LinkOut<'a> {
+    tx: &'a str,
+    rx: &'a str,
+    snr_db: f64,
+    sigma_delay_s: f64,
+    delay_s: f64,
+}
+
+/// The `--delays` file of `locate`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct DelaysFile {
+    /// One per link in scenario link order; `null` = no measurement.
+    delays_s: Vec<Option<f64>>,
+    /// One σ for all links or one per link, s.
+    sigma_s: Sigma,
+    /// Start of the iteration, m (default: grid search over the area).
+    #[serde(default)]
+    initial_m: Option<[f64; 2]>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(untagged)]
+enum Sigma {
+    One(f64),
+    PerLink(Vec<f64>),
+}
+
+/// `scatterloc locate --scenario S --delays D`.
+pub fn locate(argv: &[OsString]) -> Result<(), CliError> {
+    let Some(args) = parse_args(argv, "locate", &["scenario", "delays"])? else {
+        return Ok(());
+    };
+    args.expect_positional("locate", 0, "")?;
+    let dpath = args.required("delays")?;
+    let s = read_scenario(&args)?;
+    let text = read_input("delays", dpath)?;
+    let bad = |m: String| CliError::usage(format!("--delays {dpath}: {m}"));
+    let d: DelaysFile = parse_json(&text).map_err(|e| {
+        bad(e.to_string().replace(
+            "data did not match any variant of untagged enum Sigma",
+            "expected a number or a list of numbers (one per link)",
+        ))
+    })?;
+    let model = model_of(&s)?;
+    let n = model.link_count();
+    let sigmas = match d.sigma_s {
+        Sigma::One(v) if v.is_finite() && v > 0.0 => vec![v; n],
+        Sigma::One(v) => {
+            return Err(bad(format!(
+                "sigma_s: must be a finite number > 0 (got {v})"
+            )))
+        }
+        Sigma::PerLink(v) => v,
+    };
+    let m = DelayMeasurements {
+        delays_s: &d.delays_s,
+        sigmas_s: &sigmas,
+    };
+    let initial = d.initial_m.map(|p| Vec2::new(p[0], p[1]));
+    let rep = lm_locate(&model.network, &m, &LmConfig::default(), initial, &s.area_m)
+        .map_err(|e| bad(e.to_string()))?;
+    emit_json(&LocateOut {
+        position_m: [rep.position.x, rep.position.y],
+        covariance_m2: rep.covariance_m2.as_ref().map(sym),
+        cost: rep.cost,
+        iterations: rep.iterations,
+        termination: rep.termination.as_str(),
+        converged: rep.termination.converged(),
+        links_used: rep.links_used,
+        start_m: [rep.start.x, rep.start.y],
+    })
+}
+
+/// Output of `locate` (keys in this order).
+#[derive(Serialize)]
+struct LocateOut {
+    position_m: [f64; 2],
+    covariance_m2: Option<[[f64; 2]; 2]>,
+    cost: f64,
+    iterations: usize,
+    termination: &'static str,
+    converged: bool,
+    links_used: usize,
+    start_m: [f64; 2],
+}

@@ -1,0 +1,237 @@
+//! `scatterloc crlb-map`: the RMSE bound over a grid, written as JSON, SVG or PNG.
+
+use std::ffi::OsString;
+use std::io::{BufWriter, Write};
+use std::time::Instant;
+
+use plotters::prelude::*;
+use serde::Serialize;
+use serde_json::json;
+
+use scatterloc::chart::{
+    check_area, default_titles, draw_crlb_map, scenario_nodes, suggested_size,
+};
+use scatterloc::chart::{ChartOptions, MapData};
+use scatterloc::crlb::{crlb_map as map_kernel, Grid};
+use scatterloc::scenario::Area;
+use scatterloc::{Error, Model, Scenario};
+
+use crate::args::Args;
+use crate::commands::{emit, parse_args, read_scenario};
+use crate::CliError;
+
+const FLAGS: &[&str] = &[
+    "scenario", "out", "nx", "ny", "x-min", "x-max", "y-min", "y-max", "width", "height", "title",
+];
+/// Default grid side.
+const DEFAULT_N: usize = 256;
+
+#[derive(Clone, Copy, PartialEq)]
+enum Format {
+    Json,
+    Svg,
+    Png,
+}
+
+impl Format {
+    fn of(path: &str) -> Result<Format, CliError> {
+        let ext = std::path::Path::new(path)
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase);
+        match ext.as_deref() {
+            Some("json") => Ok(Format::Json),
+            Some("svg") => Ok(Format::Svg),
+            Some("png") => Ok(Format::Png),
+            Some(e) => Err(CliError::usage(format!(
+                "--out: unknown extension '.{e}' (use .json, .svg or .png)"
+            ))),
+            None => Err(CliError::usage(format!(
+                "--out: '{path}' has no extension (use .json, .svg or .png)"
+            ))),
+        }
+    }
+
+    fn name(self) -> &'static str {
+        match self {
+            Format::Json => "json",
+            Format::Svg => "svg",
+            Format::Png => "png",
+        }
+    }
+}
+
+/// The scenario's area with the `--x-min` … `--y-max` overrides applied.
+fn area_of(args: &Args, s: &Scenario) -> Result<Area, CliError> {
+    let mut a = s.area_m;
+    let pick =
+        |name: &str, v: f64| -> Result<f64, CliError> { Ok(args.number(name)?.unwrap_or(v)) };
+    a.x = [pick("x-min", a.x[0])?, pick("x-max", a.x[1])?];
+    a.y = [pick("y-min", a.y[0])?, pick("y-max", a.y[1])?];
+    for (axis, [lo, hi]) in [("x", a.x), ("y", a.y)] {
+        if lo >= hi {
+            return Err(CliError::usage(format!(
+                "--{axis}-min/--{axis}-max: the minimum {lo} must be below the maximum {hi} \
+                 (defaults from area_m.{axis})"
+            )));
+        }
+        if !(hi - lo).is_finite() {
+            return Err(CliError::usage(format!(
+                "--{axis}-min/--{axis}-max: the extent {hi:?} - ({lo:?}) overflows"
+            )));
+        }
+    }
+    Ok(a)
+}
+
+fn grid_of(args: &Args, area: Area) -> Result<Grid, CliError> {
+    let nx = args.integer("nx")?.unwrap_or(DEFAULT_N);
+    let ny = args.integer("ny")?.unwrap_or(DEFAULT_N);
+    Grid::new(area, nx, ny).map_err(|e| match e {
+        Error::SizeLimit { field, .. } if field == "nx" || field == "ny" => {
+            CliError::usage(format!("--{e}"))
+        }
+        Error::SizeLimit {
+            value, min, max, ..
+        } => CliError::usage(format!(
+            "--nx * --ny: {value} cells is outside the allowed range {min}..={max}"
+        )),
+        other => CliError::usage(format!("area: {other}")),
+    })
+}
+
+/// `scatterloc crlb-map`.
+pub fn crlb_map(argv: &[OsString]) -> Result<(), CliError> {
+    let Some(args) = parse_args(argv, "crlb-map", FLAGS)? else {
+        return Ok(());
+    };
+    args.expect_positional("crlb-map", 0, "")?;
+    let out = args.required("out")?;
+    let format = Format::of(out)?;
+    let s = read_scenario(&args)?;
+    let area = area_of(&args, &s)?;
+    let grid = grid_of(&args, area)?;
+    if format != Format::Json {
+        check_area(&area).map_err(|e| CliError::usage(format!("--x-min .. --y-max: {e}")))?;
+    }
+    let size = figure_size(&args, &area)?;
+    let model = Model::new(&s).map_err(|e| CliError::usage(format!("--scenario: {e}")))?;
+
+    let t0 = Instant::now();
+    let mut values = vec![0.0; grid.len()];
+    map_kernel(&model, &grid, &mut values).map_err(|e| CliError::output(e.to_string()))?;
+    let compute_ms = t0.elapsed().as_secs_f64() * 1e3;
+
+    let t1 = Instant::now();
+    match format {
+        Format::Json => write_json(out, &grid, &values)?,
+        Format::Svg | Format::Png => {
+            let (title, subtitle) = default_titles(&s, &grid);
+            let opts = ChartOptions {
+                title: args.get("title").map_or(title, str::to_string),
+                subtitle: Some(subtitle),
+                ..ChartOptions::default()
+            };
+            let map = MapData {
+                grid,
+                values_m: &values,
+            };
+            write_figure(out, format, size, &map, &s, &opts)?;
+        }
+    }
+    let write_ms = t1.elapsed().as_secs_f64() * 1e3;
+
+    let finite = values.iter().copied().filter(|v| v.is_finite());
+    let min = finite.clone().fold(f64::INFINITY, f64::min);
+    let max = finite.fold(f64::NEG_INFINITY, f64::max);
+    let summary = json!({
+        "out": out,
+        "format": format.name(),
+        "nx": grid.nx,
+        "ny": grid.ny,
+        "x_range_m": area.x,
+        "y_range_m": area.y,
+        "compute_ms": round3(compute_ms),
+        "write_ms": round3(write_ms),
+        "min_m": min,
+        "max_m": max,
+        "unbounded_cells": values.iter().filter(|v| !v.is_finite()).count(),
+    });
+    emit(&summary.to_string())
+}
+
+fn round3(v: f64) -> f64 {
+    (v * 1e3).round() / 1e3
+}
+
+fn figure_size(args: &Args, area: &Area) -> Result<(u32, u32), CliError> {
+    let dim = |name: &str, lo: usize, hi: usize| -> Result<Option<u32>, CliError> {
+        match args.integer(name)? {
+            Some(v) if (lo..=hi).contains(&v) => Ok(Some(v as u32)),
+            Some(v) => Err(CliError::usage(format!(
+                "--{name}: {v} is outside the allowed range {lo}..={hi} pixels"
+            ))),
+            None => Ok(None),
+        }
+    };
+    let w = dim("width", 200, 8000)?;
+    let h = dim("height", 150, 8000)?;
+    let (sw, sh) = suggested_size(area, w.unwrap_or(1000));
+    Ok((sw, h.unwrap_or(sh)))
+}
+
+#[derive(Serialize)]
+struct MapJson<'a> {
+    x_m: Vec<f64>,
+    y_m: Vec<f64>,
+    /// Rows of `nx` values; serde_json writes the `+∞` of unbounded cells as `null`.
+    rmse_bound_m: Vec<&'a [f64]>,
+}
+
+fn cannot_write(path: &str, e: impl std::fmt::Display) -> CliError {
+    CliError::usage(format!("--out: cannot write '{path}': {e}"))
+}
+
+fn write_json(path: &str, grid: &Grid, values: &[f64]) -> Result<(), CliError> {
+    let doc = MapJson {
+        x_m: (0..grid.nx).map(|i| grid.x(i)).collect(),
+        y_m: (0..grid.ny).map(|j| grid.y(j)).collect(),
+        rmse_bound_m: values.chunks(grid.nx).collect(),
+    };
+    let file = std::fs::File::create(path).map_err(|e| cannot_write(path, e))?;
+    let mut w = BufWriter::new(file);
+    serde_json::to_writer(&mut w, &doc).map_err(|e| cannot_write(path, e))?;
+    w.write_all(b"\n")
+        .and_then(|_| w.flush())
+        .map_err(|e| cannot_write(path, e))
+}
+
+fn write_figure(
+    path: &str,
+    format: Format,
+    size: (u32, u32),
+    map: &MapData,
+    s: &Scenario,
+    opts: &ChartOptions,
+) -> Result<(), CliError> {
+    let nodes = scenario_nodes(s);
+    let fail = |e: String| CliError::output(format!("drawing the figure: {e}"));
+    match format {
+        Format::Svg => {
+            let mut svg = String::new();
+            {
+                let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
+                draw_crlb_map(&root, map, &nodes, opts).map_err(|e| fail(e.to_string()))?;
+                root.present().map_err(|e| fail(e.to_string()))?;
+            }
+            std::fs::write(path, svg).map_err(|e| cannot_write(path, e))
+        }
+        _ => {
+            // Fail early with a clear message when the file cannot be created.
+            std::fs::File::create(path).map_err(|e| cannot_write(path, e))?;
+            let root = BitMapBackend::new(path, size).into_drawing_area();
+            draw_crlb_map(&root, map, &nodes, opts).map_err(|e| fail(e.to_string()))?;
+            root.present().map_err(|e| cannot_write(path, e))
+        }
+    }
+}

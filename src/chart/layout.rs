@@ -1,0 +1,153 @@
+//! Pixel layout of the map figure: title band, an equal-scale plot (1 m in x = 1 m in y) centred
+//! in the remaining space, and the colour bar right of it. Everything scales with the image size.
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
+
+use super::{chart_err, ChartError, ChartOptions};
+use crate::scenario::Area;
+
+/// Font sizes in pixels.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Fonts {
+    pub title: f64,
+    pub subtitle: f64,
+    pub axis: f64,
+    pub ticks: f64,
+    pub nodes: f64,
+}
+
+/// Where everything goes, in pixels of the root area.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Layout {
+    pub font: Fonts,
+    pub title_y: i32,
+    pub subtitle_y: i32,
+    pub chart_origin: (i32, i32),
+    pub chart_size: (u32, u32),
+    pub plot_margin_top: u32,
+    pub plot_margin_right: u32,
+    pub x_label_area: u32,
+    pub y_label_area: u32,
+    pub bar_origin: (i32, i32),
+    pub bar_size: (u32, u32),
+    /// Height of the title band.
+    pub title_band: f64,
+    /// Empty space kept below the axes.
+    pub bottom_pad: f64,
+}
+
+fn px(v: f64) -> u32 {
+    v.round().max(1.0) as u32
+}
+
+impl Layout {
+    /// The layout for an image of `root`'s size showing `area`.
+    pub fn new<DB: DrawingBackend>(
+        root: &DrawingArea<DB, Shift>,
+        area: &Area,
+        subtitle: bool,
+    ) -> Layout {
+        let (w, h) = root.dim_in_pixel();
+        Layout::for_size(w, h, area, subtitle)
+    }
+
+    pub fn for_size(w: u32, h: u32, area: &Area, subtitle: bool) -> Layout {
+        let (wf, hf) = (w as f64, h as f64);
+        let s = (wf / 1000.0).min(hf / 360.0).clamp(0.5, 4.0);
+        let font = Fonts {
+            title: 32.0 * s,
+            subtitle: 20.0 * s,
+            axis: 23.0 * s,
+            ticks: 20.0 * s,
+            nodes: 20.0 * s,
+        };
+        let pad = 12.0 * s;
+        let title_y = pad as i32;
+        let subtitle_y = (pad + 1.25 * font.title) as i32;
+        let title_band =
+            pad + 1.25 * font.title + if subtitle { 1.35 * font.subtitle } else { 0.0 } + 0.5 * pad;
+        let x_label_area = font.ticks + font.axis + 26.0 * s;
+        let y_label_area = 2.2 * font.ticks + font.axis + 26.0 * s;
+        let (m_top, m_right) = (10.0 * s, 12.0 * s);
+        let gap = 22.0 * s;
+        let bar_block = 24.0 * s + 10.0 * s + 4.4 * font.ticks + 12.0 * s + 1.4 * font.axis;
+        let avail_w = (wf - 2.0 * pad - y_label_area - m_right - gap - bar_block).max(10.0);
+        let avail_h = (hf - title_band - m_top - x_label_area - pad).max(10.0);
+        let (xspan, yspan) = (area.x[1] - area.x[0], area.y[1] - area.y[0]);
+        let aspect = if xspan > 0.0 && yspan > 0.0 && (xspan / yspan).is_finite() {
+            xspan / yspan
+        } else {
+            1.0
+        };
+        let (pw, ph) = if avail_w / avail_h > aspect {
+            (avail_h * aspect, avail_h)
+        } else {
+            (avail_w, avail_w / aspect)
+        };
+        let (pw, ph) = (pw.max(10.0).floor(), ph.max(10.0).floor());
+        let block_w = y_label_area + pw + m_right + gap + bar_block;
+        let x0 = ((wf - block_w) / 2.0).max(0.0);
+        let y0 = title_band + ((avail_h - ph) / 2.0).max(0.0);
+        Layout {
+            font,
+            title_y,
+            subtitle_y,
+            chart_origin: (x0 as i32, y0 as i32),
+            chart_size: (
+                px(y_label_area + pw + m_right),
+                px(m_top + ph + x_label_area),
+            ),
+            plot_margin_top: px(m_top),
+            plot_margin_right: px(m_right),
+            x_label_area: px(x_label_area),
+            y_label_area: px(y_label_area),
+            bar_origin: (
+                (x0 + y_label_area + pw + m_right + gap) as i32,
+                (y0 + m_top) as i32,
+            ),
+            bar_size: (px(bar_block), px(ph)),
+            title_band,
+            bottom_pad: pad,
+        }
+    }
+}
+
+/// A figure size `(width, height)` for an image `width` pixels wide whose equal-scale plot of
+/// `area` fills the width; the height is kept within 30 %–140 % of the width.
+pub fn suggested_size(area: &Area, width: u32) -> (u32, u32) {
+    let width = width.clamp(200, 8000);
+    let (lo, hi) = (width * 3 / 10, width * 7 / 5);
+    // Start tall (the plot is then width-limited) and keep the height it needs; the font scale
+    // depends on the height, so settle it in a few rounds.
+    let mut height = hi;
+    for _ in 0..4 {
+        let lay = Layout::for_size(width, height, area, true);
+        let needed = lay.title_band + lay.chart_size.1 as f64 + lay.bottom_pad;
+        height = (needed.ceil() as u32).clamp(lo, hi);
+    }
+    (width, height)
+}
+
+/// Title and subtitle, centred.
+pub(crate) fn draw_titles<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    lay: &Layout,
+    opts: &ChartOptions,
+) -> Result<(), ChartError> {
+    let (w, _) = root.dim_in_pixel();
+    let centre = Pos::new(HPos::Center, VPos::Top);
+    let title = TextStyle::from(("sans-serif", lay.font.title).into_font()).pos(centre);
+    root.draw_text(&opts.title, &title, (w as i32 / 2, lay.title_y))
+        .map_err(chart_err)?;
+    if let Some(sub) = &opts.subtitle {
+        let grey = RGBColor(70, 70, 70);
+        let style = TextStyle::from(("sans-serif", lay.font.subtitle).into_font())
+            .color(&grey)
+            .pos(centre);
+        root.draw_text(sub, &style, (w as i32 / 2, lay.subtitle_y))
+            .map_err(chart_err)?;
+    }
+    Ok(())
+}

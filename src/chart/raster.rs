@@ -1,0 +1,264 @@
+//! The heatmap raster, the colour bar and the node markers of the map figure.
+
+use alloc::vec::Vec;
+
+use plotters::coord::types::RangedCoordf64;
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
+
+use super::layout::Fonts;
+use super::ticks::colorbar_ticks;
+use super::{chart_err, ChartError, ChartNode, MapData, NodeKind};
+use crate::colormap::{viridis, LogScale, UNBOUNDED_RGB};
+use crate::math::Real;
+
+type Chart<'a, DB> = ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
+
+const TX_RGB: RGBColor = RGBColor(228, 26, 28);
+
+fn rgb(c: [u8; 3]) -> RGBColor {
+    RGBColor(c[0], c[1], c[2])
+}
+
+/// Fills the plotting area (pixel coordinates, origin top-left) with the map. The map is
+/// resampled (nearest cell) to at most one cell per pixel, and horizontal runs of equal colour are
+/// merged into one rectangle; each rectangle overlaps its right/upper neighbour by one pixel,
+/// which that neighbour paints over, so vector outputs show no hairline seams.
+pub(crate) fn draw_heatmap<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    map: &MapData,
+    scale: Option<&LogScale>,
+) -> Result<(), ChartError> {
+    let (w, h) = area.dim_in_pixel();
+    let (nx, ny) = (map.grid.nx, map.grid.ny);
+    let (w, h) = (w as usize, h as usize);
+    if w == 0 || h == 0 || nx == 0 || ny == 0 {
+        return Ok(());
+    }
+    let (cols, rows) = (nx.min(w), ny.min(h));
+    let pick = |k: usize, n_out: usize, n_src: usize| {
+        (((k as Real + 0.5) * n_src as Real / n_out as Real) as usize).min(n_src - 1)
+    };
+    let colour = |v: Real| match scale {
+        Some(s) => s.color(v),
+        None => UNBOUNDED_RGB,
+    };
+    let x_px = |c: usize| (c * w / cols) as i32;
+    let y_px = |r: usize| (h - r * h / rows) as i32; // lower edge of display row r
+    let src_cols: Vec<usize> = (0..cols).map(|c| pick(c, cols, nx)).collect();
+    let mut line: Vec<[u8; 3]> = Vec::with_capacity(cols);
+    for r in 0..rows {
+        let j = pick(r, rows, ny);
+        let values = &map.values_m[j * nx..(j + 1) * nx];
+        line.clear();
+        line.extend(src_cols.iter().map(|&i| colour(values[i])));
+        let bottom = y_px(r);
+        let top = y_px(r + 1) - i32::from(r + 1 < rows);
+        let mut start = 0;
+        for c in 1..=cols {
+            if c < cols && line[c] == line[start] {
+                continue;
+            }
+            let right = x_px(c) + i32::from(c < cols);
+            area.draw(&Rectangle::new(
+                [(x_px(start), top), (right, bottom)],
+                rgb(line[start]).filled(),
+            ))
+            .map_err(chart_err)?;
+            start = c;
+        }
+    }
+    Ok(())
+}
+
+/// Markers and name labels of the nodes inside the plotted area, plus a small legend.
+pub(crate) fn draw_nodes<'a, DB: DrawingBackend + 'a>(
+    chart: &mut Chart<'a, DB>,
+    nodes: &[ChartNode],
+    font_px: f64,
+) -> Result<(), ChartError> {
+    let s = font_px / 20.0;
+    let marker = (7.0 * s).round().max(3.0) as i32;
+    let (xr, yr) = (chart.x_range(), chart.y_range());
+    let (px_x, px_y) = chart.plotting_area().get_pixel_range();
+    let font = ("sans-serif", font_px).into_font();
+    let plot = chart.plotting_area().clone();
+    let visible = nodes.iter().filter(|n| {
+        let [x, y] = n.position_m;
+        x >= xr.start && x <= xr.end && y >= yr.start && y <= yr.end
+    });
+    for n in visible {
+        let at = (n.position_m[0], n.position_m[1]);
+        match n.kind {
+            NodeKind::Transmitter => {
+                plot.draw(&TriangleMarker::new(at, marker + 3, WHITE.filled()))
+                    .map_err(chart_err)?;
+                plot.draw(&TriangleMarker::new(at, marker, TX_RGB.filled()))
+                    .map_err(chart_err)?;
+            }
+            NodeKind::Receiver => {
+                plot.draw(&Circle::new(at, marker - 1, WHITE.filled()))
+                    .map_err(chart_err)?;
+                plot.draw(&Circle::new(at, marker - 1, BLACK.stroke_width(2)))
+                    .map_err(chart_err)?;
+            }
+        }
+        let (tw, th) = plot
+            .estimate_text_size(&n.name, &TextStyle::from(font.clone()))
+            .map_err(chart_err)?;
+        let (tw, th) = (tw as i32, th as i32);
+        let (bx, by) = plot.map_coordinate(&at);
+        let pad = (3.0 * s).round() as i32;
+        // Upper right of the marker unless that leaves the plot.
+        let dx = if bx + marker + 2 * pad + tw < px_x.end {
+            marker + pad
+        } else {
+            -(marker + pad + tw)
+        };
+        let dy = if by - marker - th - 2 * pad > px_y.start {
+            -(marker + th)
+        } else {
+            marker
+        };
+        let label = EmptyElement::at(at)
+            + Rectangle::new(
+                [
+                    (dx - pad, dy - pad - th / 5),
+                    (dx + tw + pad, dy + th + pad),
+                ],
+                WHITE.mix(0.8).filled(),
+            )
+            + Text::new(n.name.clone(), (dx, dy), font.clone());
+        plot.draw(&label).map_err(chart_err)?;
+    }
+    draw_legend(chart, nodes, marker, font_px)
+}
+
+fn draw_legend<'a, DB: DrawingBackend + 'a>(
+    chart: &mut Chart<'a, DB>,
+    nodes: &[ChartNode],
+    marker: i32,
+    font_px: f64,
+) -> Result<(), ChartError> {
+    let has = |k: NodeKind| nodes.iter().any(|n| n.kind == k);
+    if has(NodeKind::Transmitter) {
+        chart
+            .draw_series(core::iter::empty::<Circle<(Real, Real), i32>>())
+            .map_err(chart_err)?
+            .label("transmitter")
+            .legend(move |(x, y)| TriangleMarker::new((x, y), marker, TX_RGB.filled()));
+    }
+    if has(NodeKind::Receiver) {
+        chart
+            .draw_series(core::iter::empty::<Circle<(Real, Real), i32>>())
+            .map_err(chart_err)?
+            .label("receiver")
+            .legend(move |(x, y)| {
+                EmptyElement::at((x, y))
+                    + Circle::new((0, 0), marker - 1, WHITE.filled())
+                    + Circle::new((0, 0), marker - 1, BLACK.stroke_width(2))
+            });
+    }
+    if has(NodeKind::Transmitter) || has(NodeKind::Receiver) {
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperRight)
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .label_font(("sans-serif", font_px * 0.9).into_font())
+            .margin((8.0 * font_px / 20.0) as i32)
+            .draw()
+            .map_err(chart_err)?;
+    }
+    Ok(())
+}
+
+/// Vertical colour bar with log ticks in metres, an optional grey "unbounded" swatch below it
+/// and a rotated label on the right.
+pub(crate) fn draw_colorbar<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    scale: Option<&LogScale>,
+    has_unbounded: bool,
+    label: &str,
+    font: &Fonts,
+) -> Result<(), ChartError> {
+    let s = font.ticks / 20.0;
+    let (w, h) = area.dim_in_pixel();
+    let (w, h) = (w as i32, h as i32);
+    let bar_w = (24.0 * s).round() as i32;
+    let swatch = if has_unbounded || scale.is_none() {
+        (1.4 * font.ticks) as i32
+    } else {
+        0
+    };
+    let bar_h = if swatch > 0 {
+        h - swatch - (0.9 * font.ticks) as i32
+    } else {
+        h
+    };
+    let tick_font = TextStyle::from(("sans-serif", font.ticks).into_font())
+        .pos(Pos::new(HPos::Left, VPos::Center));
+    let draw = |e: &Rectangle<(i32, i32)>| area.draw(e).map_err(chart_err);
+    if let (Some(scale), true) = (scale, bar_h > 2) {
+        let mut start = 0;
+        let colour = |py: i32| viridis(1.0 - (py as Real + 0.5) / bar_h as Real);
+        for py in 1..=bar_h {
+            if py < bar_h && colour(py) == colour(start) {
+                continue;
+            }
+            let bottom = py + i32::from(py < bar_h);
+            draw(&Rectangle::new(
+                [(0, start), (bar_w, bottom)],
+                rgb(colour(start)).filled(),
+            ))?;
+            start = py;
+        }
+        draw(&Rectangle::new(
+            [(0, 0), (bar_w, bar_h)],
+            BLACK.stroke_width(1),
+        ))?;
+        let max_labels = (bar_h as Real / (2.0 * font.ticks)) as usize;
+        for t in colorbar_ticks(scale.min, scale.max, max_labels) {
+            let y = ((1.0 - scale.fraction(t.value_m)) * bar_h as Real).round() as i32;
+            let major = !t.label.is_empty();
+            let len = ((if major { 7.0 } else { 4.0 }) * s).round() as i32;
+            area.draw(&PathElement::new(
+                [(bar_w, y), (bar_w + len, y)],
+                BLACK.stroke_width(1),
+            ))
+            .map_err(chart_err)?;
+            if major {
+                area.draw_text(&t.label, &tick_font, (bar_w + len + (4.0 * s) as i32, y))
+                    .map_err(chart_err)?;
+            }
+        }
+    }
+    if swatch > 0 {
+        let top = h - swatch;
+        draw(&Rectangle::new(
+            [(0, top), (bar_w, h)],
+            rgb(UNBOUNDED_RGB).filled(),
+        ))?;
+        draw(&Rectangle::new(
+            [(0, top), (bar_w, h)],
+            BLACK.stroke_width(1),
+        ))?;
+        area.draw_text(
+            "unbounded",
+            &tick_font,
+            (bar_w + (6.0 * s) as i32, top + swatch / 2),
+        )
+        .map_err(chart_err)?;
+    }
+    let rotated = TextStyle::from(("sans-serif", font.axis).into_font())
+        .transform(FontTransform::Rotate270)
+        .pos(Pos::new(HPos::Center, VPos::Center));
+    area.draw_text(
+        label,
+        &rotated,
+        (w - (0.7 * font.axis) as i32, bar_h.max(h / 2) / 2),
+    )
+    .map_err(chart_err)?;
+    Ok(())
+}

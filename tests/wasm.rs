@@ -1,0 +1,292 @@
+//! Core and page-API tests inside headless Chromium (`wasm-pack test --headless --chrome`):
+//! the spec's numbers hold in wasm too, and the JS-facing API fills typed arrays, never lets NaN
+//! through and turns bad input into exceptions with the core's message.
+#![cfg(target_arch = "wasm32")]
+
+use js_sys::{Float64Array, Reflect, Uint8ClampedArray};
+use wasm_bindgen::{JsCast, JsError, JsValue};
+use wasm_bindgen_test::*;
+
+use scatterloc::crlb::{crlb_at, Grid};
+use scatterloc::lm::{locate, DelayMeasurements, LmConfig};
+use scatterloc::wasm::{self, App};
+use scatterloc::{presets, Model, Vec2};
+
+wasm_bindgen_test_configure!(run_in_browser);
+
+fn message(e: JsError) -> String {
+    let v: JsValue = e.into();
+    v.dyn_into::<js_sys::Error>()
+        .map(|e| String::from(e.message()))
+        .unwrap_or_else(|v| format!("{v:?}"))
+}
+
+fn ok<T>(r: Result<T, JsError>) -> T {
+    r.unwrap_or_else(|e| panic!("unexpected error: {}", message(e)))
+}
+
+fn err<T>(r: Result<T, JsError>) -> String {
+    match r {
+        Ok(_) => panic!("expected an error"),
+        Err(e) => message(e),
+    }
+}
+
+fn get(obj: &JsValue, key: &str) -> JsValue {
+    Reflect::get(obj, &JsValue::from_str(key)).expect("property")
+}
+
+fn num(obj: &JsValue, key: &str) -> f64 {
+    get(obj, key)
+        .as_f64()
+        .unwrap_or_else(|| panic!("{key} is not a number"))
+}
+
+fn sensors() -> App {
+    ok(App::from_preset("sensors2019"))
+}
+
+/// Spec §0 check 7: layout L4 CRLB RMSE at four points, within 0.1 %.
+#[wasm_bindgen_test]
+fn spec_check_7_l4_crlb_rmse() {
+    let model = Model::new(&presets::sensors2019()).unwrap();
+    for (x, y, cm) in [
+        (10.0, 0.0, 0.792),
+        (4.0, 1.0, 0.426),
+        (20.0, 10.0, 4.864),
+        (0.0, 20.0, 17.69),
+    ] {
+        let rmse = crlb_at(&model, Vec2::new(x, y)).bound.unwrap().rmse_m;
+        let rel = (rmse / (cm / 100.0) - 1.0).abs();
+        assert!(rel < 1e-3, "({x}, {y}): {rmse} m vs {cm} cm (rel {rel:e})");
+    }
+}
+
+/// Spec §0 check 8 (first half): noise-free delays, LM converges to the truth within 1e-6 m,
+/// from a start 3 m off and from the grid-search start.
+#[wasm_bindgen_test]
+fn noise_free_lm_fix_hits_truth() {
+    let s = presets::sensors2019();
+    let model = Model::new(&s).unwrap();
+    for truth in [
+        Vec2::new(4.0, 1.0),
+        Vec2::new(10.0, 0.0),
+        Vec2::new(-3.0, 7.5),
+    ] {
+        let delays: Vec<Option<f64>> = model.network.delays(truth).into_iter().map(Some).collect();
+        let sigmas = model.sigma_delays(truth);
+        let m = DelayMeasurements {
+            delays_s: &delays,
+            sigmas_s: &sigmas,
+        };
+        for start in [Some(truth + Vec2::new(2.1, -2.1)), None] {
+            let rep = locate(&model.network, &m, &LmConfig::default(), start, &s.area_m).unwrap();
+            let miss = (rep.position - truth).norm();
+            assert!(
+                miss < 1e-6,
+                "truth {truth:?} start {start:?}: miss {miss} m"
+            );
+            assert!(rep.termination.converged());
+        }
+    }
+}
+
+/// The map lands in the caller's Float64Array, finite where bounded; a cell equals `crlb_at` at
+/// its centre; the colouring fills 4 bytes per cell and reports its scale.
+#[wasm_bindgen_test]
+fn map_fills_float64array_and_matches_point_queries() {
+    let app = sensors();
+    let (nx, ny) = (64, 48);
+    let out = Float64Array::new_with_length((nx * ny) as u32);
+    let ms = ok(app.compute_map(nx, ny, &out));
+    assert!(ms.is_finite() && ms >= 0.0);
+    let v = out.to_vec();
+    assert!(
+        v.iter().all(|x| x.is_finite() && *x > 0.0),
+        "L4 map is bounded everywhere"
+    );
+    for (i, j) in [(0, 0), (17, 9), (63, 47), (40, 30)] {
+        let c = ok(app.cell_center(nx, ny, i, j));
+        let cell = v[j * nx + i];
+        let point = ok(app.crlb_at(c[0], c[1]));
+        assert_eq!(get(&point, "bounded"), JsValue::TRUE);
+        let rmse = num(&point, "rmse_m");
+        assert!(
+            (cell / rmse - 1.0).abs() < 1e-12,
+            "cell ({i},{j}) {cell} vs crlb_at {rmse}"
+        );
+        assert_eq!(ok(app.rmse_at(c[0], c[1])), rmse);
+        let e = get(&point, "ellipse");
+        assert!(num(&e, "a") >= num(&e, "b") && num(&e, "b") > 0.0);
+    }
+    // The same cell centres as the core's grid.
+    let g = Grid::new(presets::sensors2019().area_m, nx, ny).unwrap();
+    assert_eq!(ok(app.cell_center(nx, ny, 5, 7)), vec![g.x(5), g.y(7)]);
+
+    let rgba = Uint8ClampedArray::new_with_length((4 * nx * ny) as u32);
+    let range = ok(wasm::render_map_rgba(&out, &rgba));
+    let (lo, hi) = (range[0], range[1]);
+    assert!(v.iter().all(|x| *x >= lo && *x <= hi));
+    assert_eq!(lo, v.iter().copied().fold(f64::INFINITY, f64::min));
+    let px = rgba.to_vec();
+    assert!(px.chunks_exact(4).all(|p| p[3] == 255));
+    assert!(
+        px.chunks_exact(4).any(|p| p[..3] != px[..3]),
+        "not a flat image"
+    );
+}
+
+/// Unbounded cells are Infinity in the typed array; point queries say `bounded: false` with
+/// nulls (never NaN).
+#[wasm_bindgen_test]
+fn unbounded_is_infinity_and_null() {
+    let mut app = sensors();
+    for _ in 0..3 {
+        ok(app.remove_receiver(1));
+    }
+    assert_eq!(app.link_count(), 1);
+    let out = Float64Array::new_with_length(16 * 16);
+    ok(app.compute_map(16, 16, &out));
+    assert!(out.to_vec().iter().all(|x| *x == f64::INFINITY));
+    let p = ok(app.crlb_at(3.0, 4.0));
+    assert_eq!(get(&p, "bounded"), JsValue::FALSE);
+    assert!(get(&p, "rmse_m").is_null() && get(&p, "ellipse").is_null());
+    assert_eq!(ok(app.rmse_at(3.0, 4.0)), f64::INFINITY);
+    let rgba = Uint8ClampedArray::new_with_length(4 * 16 * 16);
+    let range = ok(wasm::render_map_rgba(&out, &rgba));
+    assert_eq!(range, vec![f64::INFINITY, f64::INFINITY]);
+    // One link is too few for a fix: a message, not a trap.
+    let f = ok(app.simulate_fix(3.0, 4.0, 1));
+    assert!(get(&f, "fix").is_null());
+    let why = get(&f, "fix_error").as_string().unwrap();
+    assert!(why.contains("at least 3"), "{why}");
+}
+
+/// Bad input crosses as an exception with the core's message naming the field; the state is
+/// unchanged afterwards.
+#[wasm_bindgen_test]
+fn errors_are_exceptions_naming_the_field() {
+    let good = ok(wasm::preset_json("sensors2019"));
+    let m = err(App::new(
+        &good.replace("\"bandwidth_hz\": 120000000.0", "\"bandwidth_hz\": -5.0"),
+    ));
+    assert!(m.contains("radio.bandwidth_hz"), "{m}");
+    let m = err(App::new(&good.replace("\"carrier_hz\"", "\"carrier_ghz\"")));
+    assert!(m.contains("carrier_ghz"), "{m}");
+    let m = err(App::new("{ \"name\": \"broken\", "));
+    assert!(m.starts_with("invalid JSON"), "{m}");
+    assert!(err(App::from_preset("nope")).contains("unknown preset"));
+
+    let mut app = sensors();
+    let before = app.scenario_json();
+    for (m, field) in [
+        (err(app.set_bandwidth_hz(-1.0)), "radio.bandwidth_hz"),
+        (err(app.set_carrier_hz(f64::NAN)), "radio.carrier_hz"),
+        (err(app.set_rcs_m2(0.0)), "target.rcs_m2"),
+        (err(app.set_noise_figure_db(500.0)), "radio.noise_figure_db"),
+        (
+            err(app.set_tx_pattern(0, "parabolic", 0.0, -3.0, 20.0)),
+            "beamwidth_deg",
+        ),
+        (
+            err(app.set_tx_pattern(0, "cardioid", 0.0, 70.0, 20.0)),
+            "pattern.kind",
+        ),
+        (err(app.move_receiver(9, 1.0, 1.0)), "receivers[9]"),
+        (
+            err(app.move_transmitter(0, f64::INFINITY, 1.0)),
+            "transmitters[0].position_m",
+        ),
+        (err(app.remove_transmitter(0)), "transmitters"),
+        (err(app.crlb_at(f64::NAN, 0.0)), "x"),
+        (
+            err(app.compute_map(1, 64, &Float64Array::new_with_length(64))),
+            "nx",
+        ),
+        (
+            err(app.compute_map(8, 8, &Float64Array::new_with_length(10))),
+            "map buffer",
+        ),
+        (err(app.set_scenario_json("[]")), "invalid JSON"),
+    ] {
+        assert!(m.contains(field), "message {m:?} should name {field}");
+    }
+    assert_eq!(
+        app.scenario_json(),
+        before,
+        "rejected edits leave the scenario unchanged"
+    );
+}
+
+/// Node editing: unique generated names, moves land in the exported JSON.
+#[wasm_bindgen_test]
+fn node_editing_round_trips_through_json() {
+    let mut app = sensors();
+    assert_eq!(ok(app.add_receiver(3.0, 4.0)), 4);
+    assert_eq!(ok(app.add_transmitter(-1.0, 2.0)), 1);
+    ok(app.move_receiver(0, 1.5, -2.25));
+    assert_eq!(app.link_count(), 10);
+    let s = scatterloc::Scenario::from_json(&app.scenario_json()).unwrap();
+    assert_eq!(s.receivers[4].name, "Rx5");
+    assert_eq!(s.transmitters[1].name, "Tx1");
+    assert_eq!(s.receivers[0].position_m, [1.5, -2.25]);
+    ok(app.remove_receiver(0));
+    assert_eq!(ok(app.add_receiver(0.0, 0.5)), 4);
+    let s = scatterloc::Scenario::from_json(&app.scenario_json()).unwrap();
+    assert_eq!(s.receivers[4].name, "Rx1", "smallest free name is reused");
+}
+
+/// A simulated snapshot: one iso-delay ellipse per link, a converged LM fix near the truth with
+/// a 1σ ellipse, and the CRLB ellipse at the truth.
+#[wasm_bindgen_test]
+fn simulated_fix_has_ellipses_and_lands_near_truth() {
+    let app = sensors();
+    let f = ok(app.simulate_fix(6.0, 4.0, 7));
+    let links = js_sys::Array::from(&get(&f, "links"));
+    assert_eq!(links.length(), 4);
+    for l in links.iter() {
+        let e = get(&l, "ellipse");
+        assert!(num(&e, "a") > num(&e, "b"));
+        assert!(num(&l, "sigma_s") > 0.0 && num(&l, "delay_s") > 0.0);
+    }
+    // The inset arcs pass through the view window around the truth.
+    let radius = num(&f, "view_radius_m");
+    for l in links.iter() {
+        let arc = js_sys::Array::from(&get(&l, "arc"));
+        assert_eq!(arc.length(), 48);
+        let mid = js_sys::Array::from(&arc.get(24));
+        let (dx, dy) = (
+            mid.get(0).as_f64().unwrap() - 6.0,
+            mid.get(1).as_f64().unwrap() - 4.0,
+        );
+        assert!((dx * dx + dy * dy).sqrt() < 2.0 * radius);
+        assert_eq!(js_sys::Array::from(&get(&l, "outline")).length(), 160);
+    }
+    let fix = get(&f, "fix");
+    assert_eq!(get(&fix, "converged"), JsValue::TRUE);
+    let crlb = get(&f, "crlb");
+    let rmse = num(&crlb, "rmse_m");
+    assert!(num(&fix, "error_m") < 6.0 * rmse, "fix within a few σ");
+    assert!(num(&get(&fix, "ellipse"), "a") > 0.0);
+    assert!(num(&get(&crlb, "ellipse"), "a") > 0.0);
+    assert!(num(&f, "view_radius_m") >= num(&get(&crlb, "ellipse"), "a"));
+    // Same seed, same snapshot.
+    let again = ok(app.simulate_fix(6.0, 4.0, 7));
+    assert_eq!(num(&get(&again, "fix"), "x"), num(&fix, "x"));
+}
+
+/// Presentation helpers come from the core.
+#[wasm_bindgen_test]
+fn labels_and_ticks() {
+    assert_eq!(wasm::format_length(0.004258, 3), "4.26 mm");
+    assert_eq!(wasm::format_length(f64::INFINITY, 3), "\u{221e}");
+    let t = js_sys::Array::from(&ok(wasm::colorbar_ticks(0.003, 0.5)));
+    assert_eq!(get(&t.get(1), "label").as_string().unwrap(), "1 cm");
+    assert_eq!(
+        js_sys::Array::from(&ok(wasm::colorbar_ticks(f64::NAN, 1.0))).length(),
+        0
+    );
+    assert_eq!(wasm::colorbar_rgba(16).len(), 64);
+    let bar = ok(wasm::scale_bar(0.03));
+    assert_eq!(num(&bar, "length_m"), 0.02);
+}

@@ -1,0 +1,176 @@
+// Page entry: loads the wasm core, owns the state and the refresh loop (one redraw per animation
+// frame at most). All numbers come from the core; this file only routes events and draws.
+
+import init, * as wasm from './pkg/scatterloc.js';
+import { View } from './view.js';
+import { drawScene, makeBarCanvas } from './draw.js';
+import { Panel, showError } from './panel.js';
+import { attachPointer } from './interact.js';
+
+const $ = (id) => document.getElementById(id);
+
+/** `#preset=iclgnss2019&target=6,4&seed=3&res=256` -> options. */
+function hashOptions() {
+  const h = new URLSearchParams(location.hash.slice(1));
+  const target = (h.get('target') || '').split(',').map(Number);
+  return {
+    preset: h.get('preset'),
+    target: target.length === 2 && target.every(Number.isFinite) ? { x: target[0], y: target[1] } : null,
+    seed: Number.isInteger(Number(h.get('seed'))) && h.get('seed') ? Number(h.get('seed')) : 1,
+    res: h.get('res'),
+  };
+}
+
+async function main() {
+  await init();
+  const opts = hashOptions();
+  const preset = wasm.preset_names().includes(opts.preset) ? opts.preset : 'sensors2019';
+  const app = wasm.App.from_preset(preset);
+  if (opts.res && [...$('resolution').options].some((o) => o.value === opts.res)) $('resolution').value = opts.res;
+
+  const view = new View($('plot'));
+  const rgb = wasm.unbounded_rgb();
+  const st = {
+    nodes: app.nodes(),
+    selected: { kind: 'rx', index: 0 },
+    selTx: 0,
+    selRx: 0,
+    mapCanvas: document.createElement('canvas'),
+    barCanvas: makeBarCanvas(wasm.colorbar_rgba(256)),
+    unboundedColor: `rgb(${rgb[0]},${rgb[1]},${rgb[2]})`,
+    values: null,
+    image: null,
+    range: null,
+    res: 256,
+    target: null, // { x, y, seed }
+    fix: null,
+    nextSeed: opts.seed,
+  };
+
+  const dirty = {};
+  let scheduled = false;
+
+  function computeMap() {
+    const n = Number($('resolution').value) || 256;
+    if (!st.values || st.res !== n) {
+      st.values = new Float64Array(n * n);
+      st.image = new ImageData(n, n);
+      st.mapCanvas.width = n;
+      st.mapCanvas.height = n;
+      st.res = n;
+    }
+    const ms = app.compute_map(n, n, st.values);
+    st.range = Array.from(wasm.render_map_rgba(st.values, st.image.data));
+    st.mapCanvas.getContext('2d').putImageData(st.image, 0, 0);
+    const el = $('map-ms');
+    el.dataset.ms = String(ms);
+    el.dataset.res = `${n}x${n}`;
+    el.textContent = `map ${n}×${n}: ${ms.toFixed(1)} ms`;
+  }
+
+  function updateProbe() {
+    const el = $('probe');
+    const x = Number(el.dataset.x);
+    const y = Number(el.dataset.y);
+    const rmse = app.rmse_at(x, y);
+    el.dataset.rmseM = String(rmse);
+    el.textContent = `probe (${x}, ${y}) m: ${wasm.format_length(rmse, 4)}`;
+  }
+
+  function refresh() {
+    scheduled = false;
+    const d = { ...dirty };
+    for (const k of Object.keys(dirty)) delete dirty[k];
+    try {
+      if (d.reset) {
+        view.fit(app.area());
+        st.target = null;
+        st.selTx = 0;
+        st.selRx = 0;
+        st.selected = { kind: 'rx', index: 0 };
+      }
+      if (d.map) computeMap();
+      if (d.geometry) {
+        st.nodes = app.nodes();
+        updateProbe();
+      }
+      if (d.target) {
+        st.fix = st.target ? app.simulate_fix(st.target.x, st.target.y, st.target.seed) : null;
+        panel.showTarget(st.fix);
+      }
+      if (d.panel) panel.sync();
+      drawScene(view, st, wasm);
+    } catch (e) {
+      showError(`Internal error: ${e && e.message ? e.message : e}`);
+      console.error(e);
+    }
+  }
+
+  /** Marks parts stale and schedules one refresh on the next animation frame. */
+  function changed(flags) {
+    if (flags.all || flags.reset) Object.assign(dirty, { map: true, geometry: true, target: true, panel: true });
+    Object.assign(dirty, flags);
+    if (flags.draw) dirty.panel = true;
+    if (!scheduled) {
+      scheduled = true;
+      requestAnimationFrame(refresh);
+    }
+  }
+
+  const ctx = {
+    app, wasm, st, view, changed,
+    placeTarget(x, y) {
+      st.target = { x, y, seed: st.nextSeed++ };
+      changed({ target: true });
+    },
+    resample() {
+      if (st.target) st.target.seed = st.nextSeed++;
+      changed({ target: true });
+    },
+    clearTarget() {
+      st.target = null;
+      changed({ target: true });
+    },
+  };
+  const panel = new Panel(ctx);
+  ctx.panel = panel;
+  $('preset').value = preset;
+  attachPointer(ctx);
+
+  view.resize();
+  view.fit(app.area());
+  new ResizeObserver(() => {
+    view.resize();
+    changed({ draw: true });
+  }).observe($('plot').parentElement);
+
+  if (opts.target) st.target = { x: opts.target.x, y: opts.target.y, seed: st.nextSeed++ };
+  Object.assign(dirty, { map: true, geometry: true, target: true, panel: true });
+  refresh();
+
+  // Hooks for tests and the console.
+  window.app = app;
+  window.view = view;
+  window.wasm = wasm;
+  window.pageState = st;
+  window.mapCanvas = st.mapCanvas;
+  window.pageIdle = () => !scheduled;
+  window.placeTarget = ctx.placeTarget;
+  window.importScenarioText = (text, name) => panel.importText(text, name);
+  /** Runs the map kernel `n` times at the current resolution: per-run kernel ms (core-timed). */
+  window.benchMap = (n = 9) => {
+    const r = st.res;
+    const buf = new Float64Array(r * r);
+    const kernel = [];
+    for (let i = 0; i < n; i++) kernel.push(app.compute_map(r, r, buf));
+    return { res: r, kernel_ms: kernel };
+  };
+  document.body.dataset.ready = '1';
+}
+
+main().catch((e) => {
+  const msg = e && e.message ? e.message : String(e);
+  try { showError(`The page could not start: ${msg}`); } catch (_) { /* banner missing */ }
+  document.body.dataset.error = msg;
+  console.error(e);
+});
