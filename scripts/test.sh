@@ -19,8 +19,11 @@ wasm-pack test --headless --chrome --mode no-install 2>&1 | tee -a "$log"
 step "build the page's wasm (release, as served) for the end-to-end test"
 wasm-pack build --release --target web --out-dir www/pkg --mode no-install
 
-step "native cargo test (unit, spec checks, properties, CLI) + browser end-to-end"
-cargo test -- --include-ignored 2>&1 | tee -a "$log"
+step "native cargo test (unit, spec checks, properties, CLI)"
+cargo test 2>&1 | tee -a "$log"
+
+step "browser end-to-end (Debian chromium + chromedriver; prints the page's own map timing)"
+cargo test --test e2e -- --ignored --nocapture --test-threads=1 2>&1 | tee -a "$log"
 
 # One closing line over every runner above (cargo's last binary may legitimately hold 0 tests).
 passed=$(grep -oE 'test result: [a-zA-Z]+\. [0-9]+ passed' "$log" | awk '{s+=$4} END {print s+0}')
