@@ -1,7 +1,11 @@
 //! The log colour scale of CRLB maps, shared by the page (RGBA buffer) and the CLI figures, so
 //! both show the same colours for the same values.
 
+use alloc::vec::Vec;
+
+use crate::error::{Error, Result};
 use crate::math::{log10, Real};
+use crate::ticks::{log_length_ticks, Tick};
 
 /// Colour of unbounded (∞) or missing cells: neutral grey.
 pub const UNBOUNDED_RGB: [u8; 3] = [72, 72, 80];
@@ -42,6 +46,12 @@ pub struct LogScale {
 }
 
 impl LogScale {
+    /// The scale from `min` to `max`; `None` unless both are finite and `0 < min < max`.
+    pub fn new(min: Real, max: Real) -> Option<LogScale> {
+        (min.is_finite() && max.is_finite() && min > 0.0 && max > min)
+            .then_some(LogScale { min, max })
+    }
+
     /// The scale spanning the finite positive values of `values`, widened to at least one decade
     /// ratio of 1.01 so a flat map still has a valid scale. `None` if no value is finite and > 0.
     pub fn spanning(values: &[Real]) -> Option<LogScale> {
@@ -74,6 +84,15 @@ impl LogScale {
     pub fn color(&self, v: Real) -> [u8; 3] {
         viridis(self.fraction(v))
     }
+
+    /// The labelled length ticks of a colour bar on this scale ([`log_length_ticks`]), each with
+    /// its [`fraction`](LogScale::fraction) from the dark end.
+    pub fn ticks(&self) -> Vec<(Real, Tick)> {
+        log_length_ticks(self.min, self.max)
+            .into_iter()
+            .map(|t| (self.fraction(t.value), t))
+            .collect()
+    }
 }
 
 /// Fills `rgba` (4 bytes per value, `values` order) with the colours of `values` on `scale`.
@@ -87,4 +106,71 @@ pub fn fill_rgba(values: &[Real], scale: &LogScale, rgba: &mut [u8]) -> bool {
         px.copy_from_slice(&[c[0], c[1], c[2], 255]);
     }
     true
+}
+
+/// Colours a map (`values`, m) into `rgba` (4 bytes per value) on the log scale spanning its
+/// finite values and returns that scale; `None` (and all grey) when no value is bounded.
+pub fn render_rgba(values: &[Real], rgba: &mut [u8]) -> Result<Option<LogScale>> {
+    if rgba.len() != 4 * values.len() {
+        return Err(Error::LengthMismatch {
+            field: "rgba buffer (4 bytes per map value)",
+            expected: 4 * values.len(),
+            found: rgba.len(),
+        });
+    }
+    let scale = LogScale::spanning(values);
+    match &scale {
+        Some(s) => {
+            fill_rgba(values, s, rgba);
+        }
+        None => {
+            for px in rgba.chunks_exact_mut(4) {
+                px.copy_from_slice(&[UNBOUNDED_RGB[0], UNBOUNDED_RGB[1], UNBOUNDED_RGB[2], 255]);
+            }
+        }
+    }
+    Ok(scale)
+}
+
+/// `n` RGBA pixels (`n` clamped to 2..=4096) of the colour bar gradient, dark (small error) first.
+pub fn colorbar_rgba(n: usize) -> Vec<u8> {
+    let n = n.clamp(2, 4096);
+    (0..n)
+        .flat_map(|i| {
+            let c = viridis(i as Real / (n - 1) as Real);
+            [c[0], c[1], c[2], 255]
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn render_uses_the_spanning_scale_or_grey() {
+        let values = [0.01, 0.1, Real::INFINITY];
+        let mut rgba = [0u8; 12];
+        let scale = render_rgba(&values, &mut rgba).unwrap().unwrap();
+        assert_eq!((scale.min, scale.max), (0.01, 0.1));
+        assert_eq!(rgba[8..11], UNBOUNDED_RGB);
+        assert_ne!(rgba[0..3], rgba[4..7]);
+        assert_eq!(render_rgba(&[Real::INFINITY], &mut rgba[..4]), Ok(None));
+        assert_eq!(rgba[..4], [72, 72, 80, 255]);
+        let e = render_rgba(&values, &mut rgba[..8]).unwrap_err();
+        assert!(e.to_string().starts_with("rgba buffer"), "{e}");
+    }
+
+    #[test]
+    fn bar_ticks_and_gradient() {
+        assert!(LogScale::new(Real::NAN, 1.0).is_none());
+        assert!(LogScale::new(0.5, 0.5).is_none());
+        let t = LogScale::new(0.003, 0.5).unwrap().ticks();
+        assert_eq!(t[1].1.label, "1 cm");
+        assert!(t.iter().all(|(f, _)| (0.0..=1.0).contains(f)));
+        let g = colorbar_rgba(16);
+        assert_eq!(g.len(), 64);
+        assert_eq!(g[..3], viridis(0.0));
+        assert_eq!(colorbar_rgba(0).len(), 8);
+    }
 }

@@ -6,7 +6,7 @@ use alloc::vec;
 use alloc::vec::Vec;
 
 use crate::ellipse::Ellipse;
-use crate::error::{Error, Result};
+use crate::error::{checked_index, Error, Result};
 use crate::geometry::{unit_from, UNIT_VECTOR_MIN_DISTANCE_M};
 use crate::math::{sqrt, Mat2, Real, Vec2, PI, SPEED_OF_LIGHT};
 use crate::model::{Model, SNR_DISTANCE_FLOOR_M};
@@ -52,6 +52,11 @@ impl CrlbPoint {
     pub fn ellipse(&self) -> Option<Ellipse> {
         self.bound
             .and_then(|b| Ellipse::from_covariance(self.position, &b.covariance_m2, 1.0))
+    }
+
+    /// The RMSE bound, m; `+∞` when unbounded.
+    pub fn rmse_m(&self) -> Real {
+        self.bound.map_or(Real::INFINITY, |b| b.rmse_m)
     }
 }
 
@@ -159,6 +164,13 @@ impl Grid {
     #[inline]
     pub fn y(&self, j: usize) -> Real {
         self.area.y[0] + (j as Real + 0.5) * (self.area.y[1] - self.area.y[0]) / self.ny as Real
+    }
+
+    /// Centre of cell `(i, j)`, m; [`Error::IndexOutOfRange`] outside the grid.
+    pub fn cell_center(&self, i: usize, j: usize) -> Result<Vec2> {
+        let i = checked_index("grid columns", i, self.nx)?;
+        let j = checked_index("grid rows", j, self.ny)?;
+        Ok(Vec2::new(self.x(i), self.y(j)))
     }
 
     /// Number of cells.

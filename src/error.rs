@@ -109,10 +109,39 @@ pub enum Error {
         /// Largest allowed value.
         max: usize,
     },
+    /// A covariance or information matrix that must be symmetric positive definite is not (or
+    /// stopped being so during a filter update).
+    NotPositiveDefinite {
+        /// Which matrix, e.g. `initial_covariance` or `ekf.covariance`.
+        field: String,
+    },
+    /// A long computation was cancelled by its caller (Ctrl-C, a new drag in the page).
+    Cancelled,
     /// A name that is not one of the known presets.
     UnknownPreset {
         /// The name asked for.
         name: String,
+    },
+    /// An index past the end of a list (a node, a grid column or row).
+    IndexOutOfRange {
+        /// The list, e.g. `receivers`.
+        field: &'static str,
+        /// The index asked for.
+        index: usize,
+        /// The list's length.
+        len: usize,
+    },
+    /// Removing this node would leave its list empty (at least one Tx and one Rx must remain).
+    LastNode {
+        /// `transmitters` or `receivers`.
+        field: &'static str,
+    },
+    /// An antenna pattern kind that is not known (spec §9.3: `omni`, `parabolic`).
+    UnknownPattern {
+        /// Path of the field, e.g. `transmitters[0].pattern.kind`.
+        field: String,
+        /// The kind given.
+        kind: String,
     },
 }
 
@@ -181,10 +210,25 @@ impl fmt::Display for Error {
                     "{field}: {value} is outside the allowed range {min}..={max}"
                 )
             }
+            Error::NotPositiveDefinite { field } => {
+                write!(f, "{field}: not a symmetric positive-definite matrix")
+            }
+            Error::Cancelled => write!(f, "cancelled"),
             Error::UnknownPreset { name } => write!(
                 f,
                 "unknown preset \"{name}\" (known: {})",
                 crate::presets::PRESET_NAMES.join(", ")
+            ),
+            Error::IndexOutOfRange { field, index, len } => {
+                write!(f, "{field}[{index}]: no such entry (there are {len})")
+            }
+            Error::LastNode { field } => write!(
+                f,
+                "{field}: the last one cannot be removed (at least one is required)"
+            ),
+            Error::UnknownPattern { field, kind } => write!(
+                f,
+                "{field}: unknown pattern \"{kind}\" (known: omni, parabolic)"
             ),
         }
     }
@@ -195,3 +239,12 @@ impl std::error::Error for Error {}
 
 /// Result with the crate's [`Error`].
 pub type Result<T> = core::result::Result<T, Error>;
+
+/// `index` if it is below `len`, else [`Error::IndexOutOfRange`] naming `field`.
+pub fn checked_index(field: &'static str, index: usize, len: usize) -> Result<usize> {
+    if index < len {
+        Ok(index)
+    } else {
+        Err(Error::IndexOutOfRange { field, index, len })
+    }
+}

@@ -1,0 +1,217 @@
+//! One simulated snapshot for a scatterer at a known point, as the page shows it: noisy delays
+//! (E2) with σ from the link budget at the truth (E8), each link's iso-delay ellipse (spec §2),
+//! the weighted LM fix (E5–E6) with its 1σ ellipse, the CRLB with its 1σ ellipse at the truth
+//! (§7), and a view radius around the truth that holds both ellipses (for a zoom inset).
+
+use alloc::vec::Vec;
+
+use crate::crlb::{crlb_at, CrlbPoint};
+use crate::ellipse::Ellipse;
+use crate::error::Result;
+use crate::lm::{locate, DelayMeasurements, LmConfig, LmReport};
+use crate::math::{Real, Vec2, SPEED_OF_LIGHT};
+use crate::model::Model;
+use crate::scenario::{Area, LinkIndex};
+use crate::simulate::{noisy_delays, rng};
+
+/// Points of a link's whole iso-delay ellipse outline.
+pub const OUTLINE_POINTS: usize = 160;
+/// Points of a link's iso-delay arc near the truth.
+pub const ARC_POINTS: usize = 48;
+/// The view radius is this multiple of the farthest ellipse extent from the truth.
+pub const VIEW_MARGIN: Real = 1.6;
+/// Extent used when neither ellipse exists (unbounded CRLB and no fix), m.
+pub const FALLBACK_EXTENT_M: Real = 0.05;
+
+/// One link of a snapshot.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LinkSim {
+    /// The link's transmitter and receiver indices.
+    pub link: LinkIndex,
+    /// Simulated delay `τ̂_p = h_p(r) + w_p`, s (E2).
+    pub delay_s: Real,
+    /// `σ_p(r)` at the truth, s (E8).
+    pub sigma_s: Real,
+    /// Range noise `c·σ_p`, m.
+    pub range_sigma_m: Real,
+    /// Iso-delay ellipse of `τ̂_p`; `None` when `τ̂_p` is below the line-of-sight delay.
+    pub ellipse: Option<Ellipse>,
+    /// [`OUTLINE_POINTS`] points of that ellipse (a closed polygon); empty without one.
+    pub outline: Vec<Vec2>,
+    /// [`ARC_POINTS`] points of the ellipse near the truth, within about the view radius
+    /// ([`Ellipse::arc_near`]); empty without an ellipse or when it passes farther away.
+    pub arc: Vec<Vec2>,
+}
+
+/// The LM fix of a snapshot.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SnapshotFix {
+    /// The solver's report.
+    pub report: LmReport,
+    /// The 1σ ellipse of its covariance `(JᵀR⁻¹J)⁻¹`; `None` when singular.
+    pub ellipse: Option<Ellipse>,
+    /// Distance from the truth, m.
+    pub error_m: Real,
+}
+
+/// A simulated snapshot and everything drawn for it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SnapshotSimulation {
+    /// True scatterer position, m.
+    pub truth: Vec2,
+    /// Seed of the noise stream.
+    pub seed: u64,
+    /// One entry per link, in link order.
+    pub links: Vec<LinkSim>,
+    /// The fix from the grid-search start, or why there is none (e.g. too few links).
+    pub fix: Result<SnapshotFix>,
+    /// The CRLB at the truth.
+    pub crlb: CrlbPoint,
+    /// A radius around the truth holding the CRLB and fix ellipses, with margin, m.
+    pub view_radius_m: Real,
+}
+
+/// Simulates one snapshot for a scatterer at `truth` with noise stream `seed`
+/// ([`rng`]`(seed, 0)`): delays and σ from the link budget at the truth, the LM fix with
+/// [`LmConfig::default`] from the grid-search start over `area`, and the CRLB at the truth.
+pub fn simulate_snapshot(model: &Model, area: &Area, truth: Vec2, seed: u64) -> SnapshotSimulation {
+    let net = &model.network;
+    let delays = noisy_delays(model, truth, &mut rng(seed, 0));
+    let sigmas = model.sigma_delays(truth);
+    let measured: Vec<Option<Real>> = delays.iter().copied().map(Some).collect();
+    let m = DelayMeasurements {
+        delays_s: &measured,
+        sigmas_s: &sigmas,
+    };
+    let fix = locate(net, &m, &LmConfig::default(), None, area).map(|report| SnapshotFix {
+        ellipse: report
+            .covariance_m2
+            .and_then(|c| Ellipse::from_covariance(report.position, &c, 1.0)),
+        error_m: (report.position - truth).norm(),
+        report,
+    });
+    let crlb = crlb_at(model, truth);
+    let view_radius_m = VIEW_MARGIN * view_extent(&crlb, fix.as_ref().ok());
+    let links = (0..net.link_count())
+        .map(|p| {
+            let ellipse = net.iso_delay_ellipse(p, delays[p]);
+            LinkSim {
+                link: net.links[p],
+                delay_s: delays[p],
+                sigma_s: sigmas[p],
+                range_sigma_m: SPEED_OF_LIGHT * sigmas[p],
+                ellipse,
+                outline: ellipse.map_or_else(Vec::new, |e| e.polygon(OUTLINE_POINTS)),
+                arc: ellipse
+                    .map_or_else(Vec::new, |e| e.arc_near(truth, view_radius_m, ARC_POINTS)),
+            }
+        })
+        .collect();
+    SnapshotSimulation {
+        truth,
+        seed,
+        links,
+        fix,
+        crlb,
+        view_radius_m,
+    }
+}
+
+/// How far from the truth the CRLB ellipse (semi-major axis) and the fix ellipse (miss plus
+/// semi-major axis) reach; [`FALLBACK_EXTENT_M`] when that is not a finite positive length.
+fn view_extent(crlb: &CrlbPoint, fix: Option<&SnapshotFix>) -> Real {
+    let crlb_reach = crlb.ellipse().map_or(0.0, |e| e.semi_major);
+    let fix_reach = fix.map_or(0.0, |f| f.error_m + f.ellipse.map_or(0.0, |e| e.semi_major));
+    let r = crlb_reach.max(fix_reach);
+    if r.is_finite() && r > 0.0 {
+        r
+    } else {
+        FALLBACK_EXTENT_M
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::error::Error;
+    use crate::presets::sensors2019;
+
+    fn l4() -> (Model, Area) {
+        let s = sensors2019();
+        (Model::new(&s).unwrap(), s.area_m)
+    }
+
+    #[test]
+    fn deterministic_for_a_seed() {
+        let (model, area) = l4();
+        let t = Vec2::new(6.0, 4.0);
+        let a = simulate_snapshot(&model, &area, t, 7);
+        assert_eq!(a, simulate_snapshot(&model, &area, t, 7));
+        assert_ne!(a.links, simulate_snapshot(&model, &area, t, 8).links);
+        assert_eq!(a.links.len(), 4);
+        assert!(a.links.iter().all(|l| l.outline.len() == OUTLINE_POINTS));
+        assert!(a.links.iter().all(|l| l.arc.len() == ARC_POINTS));
+    }
+
+    /// Spec §0 check 7 at L4 (4, 1): CRLB RMSE 0.426 cm; the fix lands within a few σ.
+    #[test]
+    fn fix_lands_within_a_few_sigma_at_l4() {
+        let (model, area) = l4();
+        let t = Vec2::new(4.0, 1.0);
+        for seed in 0..20 {
+            let s = simulate_snapshot(&model, &area, t, seed);
+            let rmse = s.crlb.bound.unwrap().rmse_m;
+            assert!((rmse / 0.00426 - 1.0).abs() < 1e-3, "CRLB {rmse} m");
+            let fix = s.fix.as_ref().unwrap();
+            assert!(fix.report.termination.converged());
+            assert!(fix.error_m < 5.0 * rmse, "seed {seed}: {} m", fix.error_m);
+            assert!(fix.ellipse.unwrap().semi_major > 0.0);
+            let reach = fix.error_m + fix.ellipse.unwrap().semi_major;
+            let crlb_a = s.crlb.ellipse().unwrap().semi_major;
+            assert_eq!(s.view_radius_m, VIEW_MARGIN * reach.max(crlb_a));
+            for (p, l) in s.links.iter().enumerate() {
+                assert_eq!(l.link, model.network.links[p]);
+                assert_eq!(l.sigma_s, model.sigma_delay(p, t));
+                assert_eq!(l.range_sigma_m, SPEED_OF_LIGHT * l.sigma_s);
+            }
+        }
+    }
+
+    /// On a link's baseline the true delay is the LoS delay, so noise puts the measurement on
+    /// either side: an ellipse exists exactly when the delay reaches the LoS delay.
+    #[test]
+    fn ellipses_exist_iff_delay_reaches_line_of_sight() {
+        let (model, area) = l4();
+        let (tx, rx) = model.network.link_nodes(0);
+        let on_baseline = (tx + rx) / 2.0;
+        let (mut with, mut without) = (0, 0);
+        for seed in 0..40 {
+            let s = simulate_snapshot(&model, &area, on_baseline, seed);
+            for (p, l) in s.links.iter().enumerate() {
+                let exists = l.delay_s >= model.network.los_delay(p);
+                assert_eq!(l.ellipse.is_some(), exists, "seed {seed} link {p}");
+                assert_eq!(l.outline.is_empty(), !exists);
+                if !exists {
+                    assert!(l.arc.is_empty());
+                }
+            }
+            if s.links[0].ellipse.is_some() {
+                with += 1;
+            } else {
+                without += 1;
+            }
+        }
+        assert!(with > 0 && without > 0, "{with} / {without}");
+    }
+
+    #[test]
+    fn too_few_links_is_a_named_error_not_a_panic() {
+        let mut s = sensors2019();
+        s.receivers.truncate(1);
+        let model = Model::new(&s).unwrap();
+        let snap = simulate_snapshot(&model, &s.area_m, Vec2::new(3.0, 4.0), 1);
+        assert!(matches!(snap.fix, Err(Error::TooFewLinks { .. })));
+        assert!(snap.crlb.bound.is_none());
+        assert_eq!(snap.view_radius_m, VIEW_MARGIN * FALLBACK_EXTENT_M);
+    }
+}

@@ -1,0 +1,64 @@
+//! WebAssembly bindings for the page: a thin edge over the core, no math here.
+//!
+//! [`App`] wraps a core [`Session`](crate::session::Session) (a validated scenario and its
+//! compiled model; rejected edits change nothing). This layer only checks the numbers JavaScript
+//! hands over, calls the core and converts the results: objects as parsed JSON (serde_json, whose
+//! non-finite numbers become `null`, so no NaN reaches JavaScript), maps as typed arrays
+//! (unbounded cells are `Infinity`), and errors as exceptions (`JsError`) carrying the core
+//! [`Error`]'s one-line message, which names the offending field; nothing panics on input.
+//!
+//! Files: `app.rs` (the `App` class), `render.rs` (colours, ticks and labels for drawing),
+//! `json.rs` (core results as JavaScript values).
+
+use wasm_bindgen::prelude::*;
+
+use crate::error::Error;
+use crate::{presets, Vec2};
+
+mod app;
+mod json;
+mod render;
+
+pub use app::App;
+pub use render::{
+    axis_ticks, colorbar_rgba, colorbar_ticks, format_length, render_map_rgba, scale_bar,
+    unbounded_rgb,
+};
+
+/// Module start: route Rust panics to `console.error` with their message.
+#[wasm_bindgen(start)]
+pub fn start() {
+    console_error_panic_hook::set_once();
+}
+
+/// Names of the presets.
+#[wasm_bindgen]
+pub fn preset_names() -> Vec<String> {
+    presets::PRESET_NAMES
+        .iter()
+        .map(|s| s.to_string())
+        .collect()
+}
+
+/// A preset's scenario JSON.
+#[wasm_bindgen]
+pub fn preset_json(name: &str) -> Result<String, JsError> {
+    Ok(presets::preset(name).map_err(err)?.to_json())
+}
+
+/// A core error as a JavaScript exception with its message.
+fn err(e: Error) -> JsError {
+    JsError::new(&e.to_string())
+}
+
+/// A point from JavaScript numbers, which must be finite (named `x`, `y`).
+fn point(x: f64, y: f64) -> Result<Vec2, JsError> {
+    for (field, v) in [("x", x), ("y", y)] {
+        if !v.is_finite() {
+            return Err(err(Error::NonFinite {
+                field: field.to_string(),
+            }));
+        }
+    }
+    Ok(Vec2::new(x, y))
+}

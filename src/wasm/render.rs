@@ -1,0 +1,78 @@
+//! Drawing helpers: map colouring into the caller's buffers, the colour bar, axis ticks and
+//! length labels, all computed by the core ([`crate::colormap`], [`crate::ticks`]).
+
+use js_sys::{Float64Array, Uint8ClampedArray};
+use serde_json::{json, Value};
+use wasm_bindgen::prelude::*;
+
+use super::err;
+use super::json::to_js;
+use crate::colormap::{self, LogScale, UNBOUNDED_RGB};
+use crate::ticks::{self, format_length_m, linear_ticks};
+
+/// Colours a map (`values`, m) into `rgba` (4 bytes per value, e.g. an `ImageData.data`) on the
+/// log scale spanning its finite values. Returns `[min, max]` of the scale, m; `[Infinity,
+/// Infinity]` (and all grey) when no cell is bounded.
+#[wasm_bindgen]
+pub fn render_map_rgba(
+    values: &Float64Array,
+    rgba: &Uint8ClampedArray,
+) -> Result<Vec<f64>, JsError> {
+    let mut px = vec![0u8; rgba.length() as usize];
+    let scale = colormap::render_rgba(&values.to_vec(), &mut px).map_err(err)?;
+    rgba.copy_from(&px);
+    Ok(match scale {
+        Some(s) => vec![s.min, s.max],
+        None => vec![f64::INFINITY, f64::INFINITY],
+    })
+}
+
+/// `n` RGBA pixels of the colour bar, dark (small error) first.
+#[wasm_bindgen]
+pub fn colorbar_rgba(n: usize) -> Vec<u8> {
+    colormap::colorbar_rgba(n)
+}
+
+/// The colour of unbounded cells, `[r, g, b]`.
+#[wasm_bindgen]
+pub fn unbounded_rgb() -> Vec<u8> {
+    UNBOUNDED_RGB.to_vec()
+}
+
+/// Ticks of the log colour bar for a scale `[min, max]`, m: `[{frac, value_m, label}]` with
+/// `frac ∈ [0, 1]` from the dark end. Empty for an invalid scale.
+#[wasm_bindgen]
+pub fn colorbar_ticks(min: f64, max: f64) -> Result<JsValue, JsError> {
+    let ticks: Vec<Value> = LogScale::new(min, max)
+        .map(|s| s.ticks())
+        .unwrap_or_default()
+        .into_iter()
+        .map(|(frac, t)| json!({"frac": frac, "value_m": t.value, "label": t.label}))
+        .collect();
+    to_js(&Value::Array(ticks))
+}
+
+/// Linear axis ticks over `[lo, hi]` (about `max_count`): `[{value, label}]`.
+#[wasm_bindgen]
+pub fn axis_ticks(lo: f64, hi: f64, max_count: usize) -> Result<JsValue, JsError> {
+    let t: Vec<Value> = linear_ticks(lo, hi, max_count)
+        .into_iter()
+        .map(|t| json!({"value": t.value, "label": t.label}))
+        .collect();
+    to_js(&Value::Array(t))
+}
+
+/// A length as text with a readable unit (`"4.26 mm"`, `"17.7 cm"`, `"∞"`).
+#[wasm_bindgen]
+pub fn format_length(m: f64, significant: usize) -> String {
+    format_length_m(m, significant)
+}
+
+/// A scale bar no longer than `max_len_m`: `{length_m, label}`, or null.
+#[wasm_bindgen]
+pub fn scale_bar(max_len_m: f64) -> Result<JsValue, JsError> {
+    to_js(&match ticks::scale_bar(max_len_m) {
+        Some(t) => json!({"length_m": t.value, "label": t.label}),
+        None => Value::Null,
+    })
+}
