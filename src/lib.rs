@@ -12,6 +12,8 @@
 //! - [`crlb`]: Fisher matrix, CRLB and the fast map kernel (E8, S18–S24).
 //! - [`lm`]: weighted Levenberg–Marquardt snapshot fix (E5–E6).
 //! - [`simulate`]: seeded noisy delays.
+//! - [`snapshot`]: one simulated snapshot with its ellipses, fix and CRLB (what the page draws).
+//! - [`edit`], [`session`]: validated, rolled-back scenario edits for interactive front ends.
 //! - [`presets`]: the `sensors2019` and `iclgnss2019` case studies.
 //! - [`ticks`]: axis ticks and length labels shared by the front ends.
 #![cfg_attr(not(feature = "std"), no_std)]
@@ -22,17 +24,28 @@ extern crate alloc;
 pub mod chart;
 pub mod colormap;
 pub mod crlb;
+pub mod edit;
+pub mod ekf;
 pub mod ellipse;
 pub mod error;
 pub mod geometry;
 pub mod lm;
 pub mod math;
 pub mod model;
+pub mod montecarlo;
+pub mod motion;
+#[cfg(all(feature = "std", not(target_arch = "wasm32")))]
+pub mod parallel;
 pub mod pattern;
+pub mod pcrlb;
 pub mod presets;
 pub mod scenario;
+pub mod session;
 pub mod simulate;
+pub mod snapshot;
 pub mod ticks;
+pub mod track_sim;
+pub mod trajectory;
 
 #[cfg(all(feature = "std", target_arch = "wasm32"))]
 pub mod wasm;

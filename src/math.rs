@@ -8,6 +8,10 @@ pub type Real = f64;
 pub type Vec2 = nalgebra::Vector2<Real>;
 /// A symmetric 2×2 matrix (Fisher information in 1/m², covariance in m²).
 pub type Mat2 = nalgebra::Matrix2<Real>;
+/// A tracking state `[x, y, vx, vy]ᵀ` (m, m/s) (S11).
+pub type Vec4 = nalgebra::Vector4<Real>;
+/// A 4×4 matrix over the tracking state (transition, covariance, information).
+pub type Mat4 = nalgebra::Matrix4<Real>;
 
 /// Speed of light in vacuum `c`, m/s.
 pub const SPEED_OF_LIGHT: Real = 299_792_458.0;

@@ -110,9 +110,17 @@ impl Model {
         let l = self.network.links[p];
         let (u_tx, d_tx) = unit_from(self.network.transmitters[l.tx], r);
         let (_, d_rx) = unit_from(self.network.receivers[l.rx], r);
+        self.snr_from_geometry(p, self.patterns[l.tx].gain_toward(u_tx), d_tx, d_rx)
+    }
+
+    /// `SNR_p` from already computed geometry: the Tx gain toward the scatterer (linear) and
+    /// the distances `d_Tx`, `d_Rx` (m; floored at 1 m here, E8). For hot loops that already
+    /// hold the unit vectors (EKF update, Monte Carlo).
+    #[inline]
+    pub fn snr_from_geometry(&self, p: usize, tx_gain: Real, d_tx: Real, d_rx: Real) -> Real {
         let d_tx = d_tx.max(SNR_DISTANCE_FLOOR_M);
         let d_rx = d_rx.max(SNR_DISTANCE_FLOOR_M);
-        self.snr_scale[p] * self.patterns[l.tx].gain_toward(u_tx) / (d_tx * d_tx * d_rx * d_rx)
+        self.snr_scale[p] * tx_gain / (d_tx * d_tx * d_rx * d_rx)
     }
 
     /// Received scatter power `P_r` of link `p` at `r`, W (`SNR·P_n`, without processing gain

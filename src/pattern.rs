@@ -59,7 +59,9 @@ impl TxPattern {
     }
 
     /// Linear gain toward the unit direction `u` (Tx → point). A zero `u` (point on the Tx)
-    /// gets the peak gain.
+    /// gets the peak gain. Uses the verified [`GainPolynomial`] when there is one (≤ 1e-12
+    /// relative from the exact formula [`TxPattern::gain_toward_cos`]), so every consumer — point
+    /// bound, map, simulation, EKF — sees the same gain without an `acos` and `exp` per call.
     #[inline(always)]
     pub fn gain_toward(&self, u: Vec2) -> Real {
         match &self.beam {
@@ -68,7 +70,11 @@ impl TxPattern {
                 if u.x == 0.0 && u.y == 0.0 {
                     return self.peak_gain;
                 }
-                self.gain_toward_cos(u.x * b.boresight.x + u.y * b.boresight.y)
+                let c = u.x * b.boresight.x + u.y * b.boresight.y;
+                match &self.polynomial {
+                    Some(poly) => poly.gain_at_cos(c),
+                    None => self.gain_toward_cos(c),
+                }
             }
         }
     }
