@@ -289,7 +289,7 @@ impl NodeRow {
                     let (mut b1, mut b2) = ([0.0; LANES], [0.0; LANES]);
                     for &a in tail.iter().rev() {
                         for l in 0..LANES {
-                            let b0 = a + 2.0 * tt[l] * b1[l] - b2[l];
+                            let b0 = (a - b2[l]) + 2.0 * tt[l] * b1[l];
                             b2[l] = b1[l];
                             b1[l] = b0;
                         }

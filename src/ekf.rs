@@ -4,18 +4,28 @@
 //! Joseph form and is kept symmetric, and a missing measurement simply skips its row.
 //!
 //! The update is linearised once at the *predicted* position `r̂⁻` (`H = [J(r̂⁻), 0]`, E3) and
-//! the rows of the available links are processed one scalar at a time against that fixed
-//! linearisation. With a diagonal `R` this equals the batch update `K = P⁻Hᵀ S⁻¹` exactly, needs no
-//! matrix inverse and no allocation, and the summed normalised scalar innovations equal the
-//! batch NIS `νᵀ S⁻¹ ν`. Internally ranges (`cτ`, `c²R`, `cJ`) are used, which the spec states
-//! is identical to the delay domain.
+//! is the batch update `K = P⁻Hᵀ S⁻¹`, `S = H P⁻ Hᵀ + R`. Because `H` only sees the position
+//! and `R = diag(r_p)` is diagonal, the batch update is evaluated in the 2-D position space
+//! without an `m × m` solve (push-through identity): with `C = P⁻Πᵀ` (the first two columns of
+//! `P⁻`), `P_rr = Π P⁻ Πᵀ`, the measurement's position information `M = Gᵀ R⁻¹ G` and
+//! `b = Gᵀ R⁻¹ ν` (`G` the range Jacobian rows, `ν = z − h(r̂⁻)`),
+//!
+//! - `N = (I + M P_rr)⁻¹`, so `Gᵀ S⁻¹ = N Gᵀ R⁻¹` and `K = C N Gᵀ R⁻¹`, `K ν = C N b`;
+//! - Joseph form `(I − KH) P⁻ (I − KH)ᵀ + K R Kᵀ = P⁻ − C Z Cᵀ` with
+//!   `Z = N M + (N M)ᵀ − N (M + M P_rr M) Nᵀ` (symmetric; to first order insensitive to rounding
+//!   in `N`, the property the Joseph form is chosen for), evaluated on the 10 unique entries;
+//! - `NIS = νᵀ S⁻¹ ν = νᵀ R⁻¹ ν − bᵀ P_rr N b`.
+//!
+//! No allocation, one 2 × 2 inverse per update and no per-row division: `R⁻¹` is the link's
+//! delay information from the link budget (E8). Internally ranges (`cτ`, `c²R`, `cJ`) are used,
+//! which the spec states is identical to the delay domain.
 
 use nalgebra::Cholesky;
 
 use crate::error::{Error, Result};
-use crate::geometry::unit_from;
-use crate::math::{Mat4, Real, Vec2, Vec4, SPEED_OF_LIGHT};
-use crate::model::{sigma_delay_from_snr, Model};
+use crate::geometry::UNIT_VECTOR_MIN_DISTANCE_M;
+use crate::math::{sqrt, Mat4, Real, Vec2, Vec4, PI, SPEED_OF_LIGHT};
+use crate::model::{Model, SNR_DISTANCE_FLOOR_M};
 use crate::motion::ConstantVelocity;
 
 /// Where the measurement noise `R = diag(σ_p²)` comes from (spec §6 [choice]).
@@ -47,16 +57,44 @@ pub struct Ekf {
     pub covariance: Mat4,
 }
 
-/// Rows handled per pass of [`Ekf::update`] (stack buffer; more links are done in blocks).
-const ROW_BLOCK: usize = 16;
+/// Geometry of one node as seen from a point `r`: the unit vector node → `r` (zero when they
+/// nearly coincide, as [`crate::geometry::unit_from`]), the distance and `1/max(d, 1 m)²` (the
+/// floored distance factor of the SNR, E8). One division and one square root.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct NodeView {
+    pub(crate) unit: Vec2,
+    pub(crate) distance: Real,
+    pub(crate) inv_floored_sq: Real,
+}
 
-/// One available link linearised at the predicted position, range units.
-#[derive(Debug, Clone, Copy, Default)]
-struct Row {
-    gx: Real,
-    gy: Real,
-    r_var: Real,
-    nu_pred: Real,
+impl NodeView {
+    #[inline(always)]
+    pub(crate) fn new(node: Vec2, r: Vec2) -> NodeView {
+        let (dx, dy) = (r.x - node.x, r.y - node.y);
+        let distance = sqrt(dx * dx + dy * dy);
+        let inv = 1.0 / distance;
+        let unit = if distance < UNIT_VECTOR_MIN_DISTANCE_M {
+            Vec2::zeros()
+        } else {
+            Vec2::new(dx * inv, dy * inv)
+        };
+        let inv_floored = if distance >= SNR_DISTANCE_FLOOR_M {
+            inv
+        } else {
+            1.0 / SNR_DISTANCE_FLOOR_M
+        };
+        NodeView {
+            unit,
+            distance,
+            inv_floored_sq: inv_floored * inv_floored,
+        }
+    }
+}
+
+/// `8π²β²/c²`: turns an SNR into the range-domain information `1/(cσ_p)²`, 1/m² (E8).
+#[inline(always)]
+pub(crate) fn range_information_per_snr(model: &Model) -> Real {
+    8.0 * PI * PI * model.beta2 / (SPEED_OF_LIGHT * SPEED_OF_LIGHT)
 }
 
 /// Relative asymmetry tolerated in a user-supplied covariance.
@@ -103,7 +141,8 @@ impl Ekf {
     }
 
     /// Update with delays `z` (s, one per link in scenario link order, `None` = missing; no link
-    /// = nothing to do). On error the filter is left unchanged.
+    /// = nothing to do). On error the filter is left unchanged. `P` is taken as symmetric (its
+    /// upper triangle is read).
     ///
     /// `innovations`, if given, receives `z_p − h_p(r̂⁻)` in seconds for the used links and `None`
     /// for the others.
@@ -141,99 +180,20 @@ impl Ekf {
             }
             out.fill(None);
         }
-        let predicted = self.state;
-        let r_pred = Vec2::new(predicted[0], predicted[1]);
-        let (mut x, mut p) = (predicted, self.covariance);
-        let mut summary = UpdateSummary {
-            nis: 0.0,
-            links_used: 0,
+        let innovation = |_lane: usize, link: usize, nu: Real| {
+            if let Some(out) = innovations.as_deref_mut() {
+                out[link] = Some(nu / SPEED_OF_LIGHT);
+            }
         };
-        // Tx gain toward r̂⁻ of the last transmitter seen (links of one Tx share it).
-        let mut tx_gain: Option<(usize, Real)> = None;
-        let mut rows = [Row::default(); ROW_BLOCK];
-        let mut next = 0;
-        while next < n {
-            // Pass 1: the rows of up to ROW_BLOCK available links, all at the fixed r̂⁻, so their
-            // square roots and divisions overlap instead of waiting on P.
-            let mut m = 0;
-            while next < n && m < ROW_BLOCK {
-                let link = next;
-                next += 1;
-                let Some(zi) = z[link] else { continue };
-                if !zi.is_finite() {
-                    return Err(Error::NonFiniteDelay { link });
-                }
-                let (tx, rx) = model.network.link_nodes(link);
-                let (ut, dt) = unit_from(tx, r_pred);
-                let (ur, dr) = unit_from(rx, r_pred);
-                let sigma = match noise {
-                    MeasurementNoise::Fixed(s) => s[link],
-                    MeasurementNoise::AtPrediction => {
-                        let k = model.network.links[link].tx;
-                        let gain = match tx_gain {
-                            Some((kk, g)) if kk == k => g,
-                            _ => model.patterns[k].gain_toward(ut),
-                        };
-                        tx_gain = Some((k, gain));
-                        sigma_delay_from_snr(
-                            model.beta2,
-                            model.snr_from_geometry(link, gain, dt, dr),
-                        )
-                    }
-                    MeasurementNoise::At(r) => model.sigma_delay(link, r),
-                };
-                if !(sigma.is_finite() && sigma > 0.0) {
-                    return Err(Error::InvalidSigma { link, value: sigma });
-                }
-                let nu_pred = SPEED_OF_LIGHT * zi - (dt + dr);
-                if let Some(out) = innovations.as_deref_mut() {
-                    out[link] = Some(nu_pred / SPEED_OF_LIGHT);
-                }
-                // Row of cH: [gx, gy, 0, 0]; range variance c²σ².
-                rows[m] = Row {
-                    gx: ut.x + ur.x,
-                    gy: ut.y + ur.y,
-                    r_var: (SPEED_OF_LIGHT * sigma) * (SPEED_OF_LIGHT * sigma),
-                    nu_pred,
-                };
-                m += 1;
-            }
-            // Pass 2: sequential scalar updates against the fixed linearisation (= batch).
-            for row in &rows[..m] {
-                let (gx, gy, r_var) = (row.gx, row.gy, row.r_var);
-                let nu = row.nu_pred - (gx * (x[0] - predicted[0]) + gy * (x[1] - predicted[1]));
-                let ph: Vec4 = p.column(0) * gx + p.column(1) * gy;
-                let s = gx * ph[0] + gy * ph[1] + r_var;
-                if !(s.is_finite() && s > 0.0) {
-                    return Err(Error::NotPositiveDefinite {
-                        field: "ekf.innovation_covariance".into(),
-                    });
-                }
-                let inv_s = 1.0 / s;
-                let k = ph * inv_s;
-                x += k * nu;
-                summary.nis += nu * nu * inv_s;
-                summary.links_used += 1;
-                // Joseph form (I − k h) P (I − k h)ᵀ + k r kᵀ, as products with the rank-one
-                // factor: X = P (I − k h)ᵀ = P − ph kᵀ; then (I − k h) X = X − k (h X).
-                let xm = p - ph * k.transpose();
-                let hx = xm.row(0) * gx + xm.row(1) * gy;
-                p = xm - k * hx + (k * k.transpose()) * r_var;
-            }
-        }
-        if summary.links_used > 0 {
-            p = (p + p.transpose()) * 0.5;
-            if x.iter().any(|v| !v.is_finite())
-                || (0..4).any(|i| !(p[(i, i)] > 0.0) || !p[(i, i)].is_finite())
-            {
-                return Err(Error::NotPositiveDefinite {
-                    field: "ekf.covariance".into(),
-                });
-            }
-            self.state = x;
-            self.covariance = p;
-        }
-        Ok(summary)
+        let [summary] = update_lanes(
+            core::array::from_mut(self),
+            model,
+            [z],
+            [true],
+            noise,
+            innovation,
+        );
+        summary
     }
 
     /// Predict then update (one filter step).
@@ -251,9 +211,307 @@ impl Ekf {
     }
 
     /// Normalised estimation error squared `(x̂ − x)ᵀ P⁻¹ (x̂ − x)` against a true state;
-    /// `None` if `P` is not positive definite.
+    /// `None` if `P` is not positive definite. `P` is taken as symmetric (a 4 × 4 `LDLᵀ`
+    /// factorisation of its lower triangle; all pivots must be positive).
     pub fn nees(&self, truth: &Vec4) -> Option<Real> {
-        let e = self.state - truth;
-        Cholesky::new(self.covariance).map(|c| e.dot(&c.solve(&e)))
+        spd_quadratic_form(&self.covariance, &(self.state - truth))
     }
+}
+
+/// Running sums of pass 1 of an update for one filter (module docs): `M`, `b`, `νᵀR⁻¹ν`, the
+/// number of links used and the folded input checks.
+#[derive(Debug, Clone, Copy)]
+struct Information {
+    m00: Real,
+    m01: Real,
+    m11: Real,
+    b0: Real,
+    b1: Real,
+    nu_info_nu: Real,
+    links_used: usize,
+    /// Every `σ_p` and `w` positive.
+    positive: bool,
+    /// `Σ (z_p − z_p) + w`: finite iff every used `z_p` and `w` is finite (`is_finite` becomes
+    /// an integer classification sequence in the hot loop; this is two float operations).
+    finite_sum: Real,
+}
+
+const NO_INFORMATION: Information = Information {
+    m00: 0.0,
+    m01: 0.0,
+    m11: 0.0,
+    b0: 0.0,
+    b1: 0.0,
+    nu_info_nu: 0.0,
+    links_used: 0,
+    positive: true,
+    finite_sum: 0.0,
+};
+
+const NO_VIEW: NodeView = NodeView {
+    unit: Vec2::new(0.0, 0.0),
+    distance: 0.0,
+    inv_floored_sq: 0.0,
+};
+
+/// The EKF update of `L` independent filters against the same model and noise option, each
+/// with its own delays `z[j]` (lengths checked by the caller); `active[j] = false` skips filter
+/// `j` (its result is a zero summary). `L = 1` is [`Ekf::update`]; the Monte Carlo harness
+/// advances a few noise runs together so that the processor overlaps their dependency chains
+/// (the arithmetic of each filter is the same as with `L = 1`, so results are bitwise equal).
+/// `innovation(j, p, ν_p)` receives each used link's range innovation, m.
+#[inline(always)]
+pub(crate) fn update_lanes<const L: usize>(
+    filters: &mut [Ekf; L],
+    model: &Model,
+    z: [&[Option<Real>]; L],
+    active: [bool; L],
+    noise: MeasurementNoise,
+    mut innovation: impl FnMut(usize, usize, Real),
+) -> [Result<UpdateSummary>; L] {
+    let r_pred: [Vec2; L] =
+        core::array::from_fn(|j| Vec2::new(filters[j].state[0], filters[j].state[1]));
+    let info_per_snr = range_information_per_snr(model);
+    // Pass 1: M = Σ w g gᵀ, b = Σ w ν g, νᵀR⁻¹ν over the available links, with g = cJ_p(r̂⁻),
+    // ν = cz_p − (d_Tx + d_Rx), w = 1/(cσ_p)². The links are independent (no chain through P).
+    let mut acc = [NO_INFORMATION; L];
+    // Geometry and gain toward r̂⁻ of the current transmitter (links of one Tx share it).
+    let (mut tx_seen, mut tx_view, mut tx_gain) = (usize::MAX, [NO_VIEW; L], [0.0; L]);
+    let links = model.network.links.iter().zip(&model.snr_scale);
+    for (link, (l, snr_scale)) in links.enumerate() {
+        if l.tx != tx_seen {
+            tx_seen = l.tx;
+            let tx = model.network.transmitters[l.tx];
+            for j in 0..L {
+                tx_view[j] = NodeView::new(tx, r_pred[j]);
+                if matches!(noise, MeasurementNoise::AtPrediction) {
+                    tx_gain[j] = model.patterns[l.tx].gain_toward(tx_view[j].unit);
+                }
+            }
+        }
+        let rx = model.network.receivers[l.rx];
+        for j in 0..L {
+            let (Some(zi), true) = (z[j][link], active[j]) else {
+                continue;
+            };
+            let (tv, gain, a) = (tx_view[j], tx_gain[j], &mut acc[j]);
+            let rv = NodeView::new(rx, r_pred[j]);
+            let (w, sigma_positive) = match noise {
+                MeasurementNoise::Fixed(s) => (information_from_sigma(s[link]), s[link] > 0.0),
+                MeasurementNoise::AtPrediction => (
+                    info_per_snr * (snr_scale * gain * tv.inv_floored_sq * rv.inv_floored_sq),
+                    true,
+                ),
+                MeasurementNoise::At(r) => {
+                    let sigma = model.sigma_delay(link, r);
+                    (information_from_sigma(sigma), sigma > 0.0)
+                }
+            };
+            a.positive &= sigma_positive & (w > 0.0);
+            a.finite_sum += finite_probe(zi) + w;
+            let nu = SPEED_OF_LIGHT * zi - (tv.distance + rv.distance);
+            innovation(j, link, nu);
+            let (gx, gy) = (tv.unit.x + rv.unit.x, tv.unit.y + rv.unit.y);
+            let (wgx, wgy) = (w * gx, w * gy);
+            a.m00 += wgx * gx;
+            a.m01 += wgx * gy;
+            a.m11 += wgy * gy;
+            a.b0 += wgx * nu;
+            a.b1 += wgy * nu;
+            a.nu_info_nu += w * nu * nu;
+            a.links_used += 1;
+        }
+    }
+    // Pass 2, per filter.
+    let mut out = [NO_UPDATE; L];
+    for (j, out) in out.iter_mut().enumerate() {
+        let a = &acc[j];
+        if !(a.positive && a.finite_sum < Real::INFINITY) {
+            // On failure the inputs are re-scanned in link order for the named error.
+            if let Some(e) = first_input_error(model, z[j], noise, r_pred[j]) {
+                *out = Err(e);
+                continue;
+            }
+        }
+        if active[j] && a.links_used > 0 {
+            *out = filters[j].apply_information(a);
+        }
+    }
+    out
+}
+
+/// The summary of an update without links.
+const NO_UPDATE: Result<UpdateSummary> = Ok(UpdateSummary {
+    nis: 0.0,
+    links_used: 0,
+});
+
+impl Ekf {
+    /// Pass 2 of an update: the batch update in the position space (module docs) from the
+    /// accumulated information; the filter changes only on success.
+    #[inline(always)]
+    fn apply_information(&mut self, a: &Information) -> Result<UpdateSummary> {
+        let (m00, m01, m11, b0, b1) = (a.m00, a.m01, a.m11, a.b0, a.b1);
+        let p = &self.covariance;
+        let (p00, p01, p02, p03) = (p[(0, 0)], p[(0, 1)], p[(0, 2)], p[(0, 3)]);
+        let (p11, p12, p13) = (p[(1, 1)], p[(1, 2)], p[(1, 3)]);
+        let (p22, p23, p33) = (p[(2, 2)], p[(2, 3)], p[(3, 3)]);
+        // T = I + M P_rr, N = T⁻¹.
+        let t00 = 1.0 + m00 * p00 + m01 * p01;
+        let t01 = m00 * p01 + m01 * p11;
+        let t10 = m01 * p00 + m11 * p01;
+        let t11 = 1.0 + m01 * p01 + m11 * p11;
+        let det = t00 * t11 - t01 * t10;
+        if !positive_finite(det) {
+            return Err(Error::NotPositiveDefinite {
+                field: "ekf.innovation_covariance".into(),
+            });
+        }
+        let inv_det = 1.0 / det;
+        let (n00, n01, n10, n11) = (t11 * inv_det, -t01 * inv_det, -t10 * inv_det, t00 * inv_det);
+        // N M.
+        let nm00 = n00 * m00 + n01 * m01;
+        let nm01 = n00 * m01 + n01 * m11;
+        let nm10 = n10 * m00 + n11 * m01;
+        let nm11 = n10 * m01 + n11 * m11;
+        // X = M + M P_rr M (symmetric): Y = P_rr M, X = M + M Y.
+        let y00 = p00 * m00 + p01 * m01;
+        let y01 = p00 * m01 + p01 * m11;
+        let y11 = p01 * m01 + p11 * m11;
+        let x00 = m00 + (m00 * y00 + m01 * (p01 * m00 + p11 * m01));
+        let x01 = m01 + (m00 * y01 + m01 * y11);
+        let x11 = m11 + (m01 * y01 + m11 * y11);
+        // U = N X, then N X Nᵀ.
+        let u00 = n00 * x00 + n01 * x01;
+        let u01 = n00 * x01 + n01 * x11;
+        let u10 = n10 * x00 + n11 * x01;
+        let u11 = n10 * x01 + n11 * x11;
+        let z00 = 2.0 * nm00 - (u00 * n00 + u01 * n01);
+        let z01 = (nm01 + nm10) - (u00 * n10 + u01 * n11);
+        let z11 = 2.0 * nm11 - (u10 * n10 + u11 * n11);
+        // Rows of C = P⁻Πᵀ: c_i = (P_i0, P_i1).
+        let c = [(p00, p01), (p01, p11), (p02, p12), (p03, p13)];
+        // Z c_j.
+        let zc = c.map(|(a, b)| (z00 * a + z01 * b, z01 * a + z11 * b));
+        let q = |i: usize, j: usize| c[i].0 * zc[j].0 + c[i].1 * zc[j].1;
+        let (e00, e01, e02, e03) = (p00 - q(0, 0), p01 - q(0, 1), p02 - q(0, 2), p03 - q(0, 3));
+        let (e11, e12, e13) = (p11 - q(1, 1), p12 - q(1, 2), p13 - q(1, 3));
+        let (e22, e23, e33) = (p22 - q(2, 2), p23 - q(2, 3), p33 - q(3, 3));
+        // K ν = C N b.
+        let (v0, v1) = (n00 * b0 + n01 * b1, n10 * b0 + n11 * b1);
+        let dx = c.map(|(a, b)| a * v0 + b * v1);
+        let state = self.state + Vec4::new(dx[0], dx[1], dx[2], dx[3]);
+        // NIS = νᵀR⁻¹ν − bᵀ P_rr N b; P_rr N b is the position correction (dx0, dx1).
+        let nis = (a.nu_info_nu - (b0 * dx[0] + b1 * dx[1])).max(0.0);
+        let covariance = Mat4::new(
+            e00, e01, e02, e03, //
+            e01, e11, e12, e13, //
+            e02, e12, e22, e23, //
+            e03, e13, e23, e33,
+        );
+        let state_finite = finite_probe(state[0])
+            + finite_probe(state[1])
+            + finite_probe(state[2])
+            + finite_probe(state[3]);
+        let diagonal_positive = e00 > 0.0 && e11 > 0.0 && e22 > 0.0 && e33 > 0.0;
+        if !(diagonal_positive && state_finite == 0.0 && (e00 + e11 + e22 + e33) < Real::INFINITY) {
+            return Err(Error::NotPositiveDefinite {
+                field: "ekf.covariance".into(),
+            });
+        }
+        self.state = state;
+        self.covariance = covariance;
+        Ok(UpdateSummary {
+            nis,
+            links_used: a.links_used,
+        })
+    }
+}
+
+/// `eᵀ P⁻¹ e` for a symmetric positive-definite 4 × 4 `P` via `P = L D Lᵀ` (lower triangle
+/// read); `None` unless every pivot `d_i` is finite and positive (the Cholesky criterion).
+#[inline]
+pub(crate) fn spd_quadratic_form(p: &Mat4, e: &Vec4) -> Option<Real> {
+    let pivot_ok = positive_finite;
+    let d0 = p[(0, 0)];
+    if !pivot_ok(d0) {
+        return None;
+    }
+    let i0 = 1.0 / d0;
+    // Column 0 of L times d0 (a_i0 = P_i0), then l_i0 = a_i0 / d0.
+    let (a10, a20, a30) = (p[(1, 0)], p[(2, 0)], p[(3, 0)]);
+    let (l10, l20, l30) = (a10 * i0, a20 * i0, a30 * i0);
+    let d1 = p[(1, 1)] - l10 * a10;
+    if !pivot_ok(d1) {
+        return None;
+    }
+    let i1 = 1.0 / d1;
+    let a21 = p[(2, 1)] - l20 * a10;
+    let a31 = p[(3, 1)] - l30 * a10;
+    let (l21, l31) = (a21 * i1, a31 * i1);
+    let d2 = p[(2, 2)] - l20 * a20 - l21 * a21;
+    if !pivot_ok(d2) {
+        return None;
+    }
+    let i2 = 1.0 / d2;
+    let a32 = p[(3, 2)] - l30 * a20 - l31 * a21;
+    let l32 = a32 * i2;
+    let d3 = p[(3, 3)] - l30 * a30 - l31 * a31 - l32 * a32;
+    if !pivot_ok(d3) {
+        return None;
+    }
+    // L y = e, then Σ y_i² / d_i.
+    let y0 = e[0];
+    let y1 = e[1] - l10 * y0;
+    let y2 = e[2] - l20 * y0 - l21 * y1;
+    let y3 = e[3] - l30 * y0 - l31 * y1 - l32 * y2;
+    Some(y0 * y0 * i0 + y1 * y1 * i1 + y2 * y2 * i2 + y3 * y3 / d3)
+}
+
+/// `1/(cσ)²` for a delay standard deviation `σ`, 1/m² (checked by the caller).
+#[inline(always)]
+fn information_from_sigma(sigma: Real) -> Real {
+    let r = SPEED_OF_LIGHT * sigma;
+    1.0 / (r * r)
+}
+
+/// `x > 0` and finite, as two float compares (`is_finite` becomes an integer classification
+/// sequence in the hot loop).
+#[inline(always)]
+fn positive_finite(x: Real) -> bool {
+    x > 0.0 && finite_probe(x) == 0.0
+}
+
+/// `x − x`: `0` for a finite `x`, NaN otherwise (a sum of probes is `0` iff all are finite).
+#[inline(always)]
+#[allow(clippy::eq_op)]
+fn finite_probe(x: Real) -> Real {
+    x - x
+}
+
+/// The first bad input of an update in link order (slow path, after the accumulated checks
+/// failed): a non-finite delay, or a `σ_p` that is not finite and positive (or so small that
+/// `1/(cσ_p)²` overflows). `None` if all are fine.
+#[cold]
+fn first_input_error(
+    model: &Model,
+    z: &[Option<Real>],
+    noise: MeasurementNoise,
+    r_pred: Vec2,
+) -> Option<Error> {
+    for (link, zi) in z.iter().enumerate() {
+        let Some(zi) = *zi else { continue };
+        if !zi.is_finite() {
+            return Some(Error::NonFiniteDelay { link });
+        }
+        let sigma = match noise {
+            MeasurementNoise::Fixed(s) => s[link],
+            MeasurementNoise::AtPrediction => model.sigma_delay(link, r_pred),
+            MeasurementNoise::At(r) => model.sigma_delay(link, r),
+        };
+        if !(positive_finite(sigma) && information_from_sigma(sigma).is_finite()) {
+            return Some(Error::InvalidSigma { link, value: sigma });
+        }
+    }
+    None
 }

@@ -136,6 +136,13 @@ pub enum Error {
         /// `transmitters` or `receivers`.
         field: &'static str,
     },
+    /// A tracking scenario name that is not I, II or III (spec §9.4).
+    UnknownTrajectory {
+        /// Path of the field, e.g. `trajectory`.
+        field: String,
+        /// The name given.
+        name: String,
+    },
     /// An antenna pattern kind that is not known (spec §9.3: `omni`, `parabolic`).
     UnknownPattern {
         /// Path of the field, e.g. `transmitters[0].pattern.kind`.
@@ -226,6 +233,9 @@ impl fmt::Display for Error {
                 f,
                 "{field}: the last one cannot be removed (at least one is required)"
             ),
+            Error::UnknownTrajectory { field, name } => {
+                write!(f, "{field}: unknown trajectory \"{name}\" (known: I, II, III)")
+            }
             Error::UnknownPattern { field, kind } => write!(
                 f,
                 "{field}: unknown pattern \"{kind}\" (known: omni, parabolic)"

@@ -12,14 +12,15 @@
 use alloc::vec;
 use alloc::vec::Vec;
 
-use crate::crlb::fisher;
-use crate::ekf::{Ekf, MeasurementNoise};
+use crate::ekf::{
+    range_information_per_snr, spd_quadratic_form, update_lanes, Ekf, MeasurementNoise, NodeView,
+};
 use crate::error::{Error, Result};
-use crate::math::{sqrt, Mat2, Mat4, Real, Vec2, Vec4};
-use crate::model::Model;
+use crate::math::{sqrt, Mat2, Mat4, Real, Vec2, Vec4, SPEED_OF_LIGHT};
+use crate::model::{sigma_delay_from_snr, Model};
 use crate::motion::ConstantVelocity;
 use crate::pcrlb::pcrlb_rmse;
-use crate::simulate::{rng, standard_normal};
+use crate::simulate::{rng, standard_normal, Rng};
 use crate::trajectory::{step_count, TruthSampler};
 
 /// Trajectories per chunk (the unit of parallel work and of deterministic reduction).
@@ -165,97 +166,225 @@ pub struct MonteCarloResult {
     pub seed: u64,
 }
 
+/// Per step and link of one truth trajectory: the true delay and `σ_p` at the truth (E8). Shared
+/// by all noise runs of the trajectory, interleaved so a measurement reads one cache line.
+#[derive(Debug, Clone, Copy, Default)]
+struct TruthLink {
+    delay: Real,
+    sigma: Real,
+}
+
 /// Scratch buffers reused across trajectories of a chunk.
 struct Scratch {
     truth: Vec<Vec4>,
-    delays: Vec<Real>,
-    sigmas: Vec<Real>,
+    /// `links × (steps + 1)` entries, step-major (step 0 unused).
+    table: Vec<TruthLink>,
     measurement: Vec<Option<Real>>,
     squared_error: Vec<Real>,
     nees: Vec<Real>,
+    /// Transmitter views at the current truth point (one per Tx).
+    tx_views: Vec<(NodeView, Real)>,
+    rx_views: Vec<NodeView>,
 }
+
+impl Scratch {
+    fn new(model: &Model, steps: usize, with_filter: bool) -> Scratch {
+        let links = model.link_count();
+        let table_len = if with_filter { links * (steps + 1) } else { 0 };
+        Scratch {
+            truth: Vec::with_capacity(steps + 1),
+            table: vec![TruthLink::default(); table_len],
+            measurement: vec![None; LANES * links],
+            squared_error: vec![0.0; LANES * (steps + 1)],
+            nees: vec![0.0; LANES * (steps + 1)],
+            tx_views: Vec::with_capacity(model.network.transmitters.len()),
+            rx_views: Vec::with_capacity(model.network.receivers.len()),
+        }
+    }
+}
+
+/// For truth step `n` at `r`: the delays and `σ_p(r)` of every link into `s.table` (if it is
+/// sized for them) and `F(r)` (E8). One square root per node and one Tx gain per transmitter
+/// instead of per link; equal to [`Network::delay`](crate::geometry::Network::delay),
+/// [`Model::sigma_delay`] and [`fisher`](crate::crlb::fisher) up to rounding.
+fn truth_step(model: &Model, s: &mut Scratch, n: usize, r: Vec2) -> Mat2 {
+    let net = &model.network;
+    s.tx_views.clear();
+    for (k, &tx) in net.transmitters.iter().enumerate() {
+        let v = NodeView::new(tx, r);
+        s.tx_views.push((v, model.patterns[k].gain_toward(v.unit)));
+    }
+    s.rx_views.clear();
+    s.rx_views
+        .extend(net.receivers.iter().map(|&rx| NodeView::new(rx, r)));
+    let links = net.links.len();
+    let info_per_snr = range_information_per_snr(model);
+    let fill = s.table.len() >= links * (n + 1);
+    let (mut f00, mut f01, mut f11) = (0.0, 0.0, 0.0);
+    for (p, l) in net.links.iter().enumerate() {
+        let (tv, gain) = s.tx_views[l.tx];
+        let rv = s.rx_views[l.rx];
+        let snr = model.snr_scale[p] * gain * tv.inv_floored_sq * rv.inv_floored_sq;
+        if fill {
+            s.table[n * links + p] = TruthLink {
+                delay: (tv.distance + rv.distance) / SPEED_OF_LIGHT,
+                sigma: sigma_delay_from_snr(model.beta2, snr),
+            };
+        }
+        // F += w g gᵀ, w = 8π²β² SNR / c² (range-domain information, 1/m²).
+        let w = info_per_snr * snr;
+        let (gx, gy) = (tv.unit.x + rv.unit.x, tv.unit.y + rv.unit.y);
+        f00 += w * gx * gx;
+        f01 += w * gx * gy;
+        f11 += w * gy * gy;
+    }
+    Mat2::new(f00, f01, f01, f11)
+}
+
+/// Samples truth trajectory `traj` into `s.truth`, fills its per-step tables and adds its
+/// Fisher matrices to `sums`.
+fn prepare_trajectory(
+    model: &Model,
+    cfg: &MonteCarloConfig,
+    sampler: &TruthSampler,
+    traj: usize,
+    s: &mut Scratch,
+    sums: &mut PartialSums,
+) {
+    sampler.sample(cfg.steps, &mut rng(cfg.seed, 2 * traj as u64), &mut s.truth);
+    // Per step: true delays, σ_p at the truth (E8), and F(r_true) for E[F̃].
+    for n in 1..s.truth.len() {
+        let x = s.truth[n];
+        sums.fisher[n] += truth_step(model, s, n, Vec2::new(x[0], x[1]));
+    }
+    sums.trajectories += 1;
+}
+
+/// Trajectories of chunk `chunk`.
+fn chunk_range(cfg: &MonteCarloConfig, chunk: usize) -> core::ops::Range<usize> {
+    let first = chunk * CHUNK_TRAJECTORIES;
+    first.min(cfg.trajectories)..(first + CHUNK_TRAJECTORIES).min(cfg.trajectories)
+}
+
+/// Noise runs of one trajectory that are filtered together, step by step (independent filters
+/// interleaved so the processor overlaps their dependency chains; each keeps its own stream, so
+/// results do not depend on this number).
+const LANES: usize = 4;
 
 /// Runs chunk `chunk` (trajectories `chunk·16 …`) of the study and returns its sums.
 /// Trajectory `i` uses stream `rng(seed, 2i)`; its noise run `j` uses `rng(seed, 2(i·N_noise + j) + 1)`.
 pub fn run_chunk(model: &Model, cfg: &MonteCarloConfig, chunk: usize) -> Result<PartialSums> {
-    let links = model.link_count();
     let steps = cfg.steps;
     let sampler = TruthSampler::new(cfg.motion, cfg.mean_state, &cfg.initial_covariance)?;
+    // Validated once here; every run starts from a copy.
+    let start = Ekf::new(cfg.mean_state, cfg.initial_covariance);
     let mut sums = PartialSums::new(steps);
-    let mut s = Scratch {
-        truth: Vec::with_capacity(steps + 1),
-        delays: vec![0.0; links * (steps + 1)],
-        sigmas: vec![0.0; links * (steps + 1)],
-        measurement: vec![None; links],
-        squared_error: vec![0.0; steps + 1],
-        nees: vec![0.0; steps + 1],
-    };
-    let first = chunk * CHUNK_TRAJECTORIES;
-    let last = (first + CHUNK_TRAJECTORIES).min(cfg.trajectories);
-    for traj in first..last {
-        sampler.sample(steps, &mut rng(cfg.seed, 2 * traj as u64), &mut s.truth);
-        // Per step: true delays, σ_p at the truth (E8), and F(r_true) for E[F̃].
-        for (n, x) in s.truth.iter().enumerate().skip(1) {
-            let r = Vec2::new(x[0], x[1]);
-            for p in 0..links {
-                s.delays[n * links + p] = model.network.delay(p, r);
-                s.sigmas[n * links + p] = model.sigma_delay(p, r);
-            }
-            sums.fisher[n] += fisher(model, r);
-        }
-        sums.trajectories += 1;
-        for run in 0..cfg.noise_runs {
-            let stream = 2 * (traj as u64 * cfg.noise_runs as u64 + run as u64) + 1;
-            if run_filter(model, cfg, &mut s, &mut rng(cfg.seed, stream)) {
-                for n in 0..=steps {
-                    sums.squared_error[n] += s.squared_error[n];
-                    sums.nees[n] += s.nees[n];
+    let mut s = Scratch::new(model, steps, true);
+    for traj in chunk_range(cfg, chunk) {
+        prepare_trajectory(model, cfg, &sampler, traj, &mut s, &mut sums);
+        let mut first = 0;
+        while first < cfg.noise_runs {
+            let count = (cfg.noise_runs - first).min(LANES);
+            let streams: [u64; LANES] = core::array::from_fn(|j| {
+                2 * (traj as u64 * cfg.noise_runs as u64 + (first + j) as u64) + 1
+            });
+            let ok = match start {
+                Ok(ekf) => run_filters(model, cfg, ekf, &mut s, &streams[..count]),
+                Err(_) => [false; LANES],
+            };
+            // Add the runs in run order (the reduction order does not depend on LANES).
+            for (j, &ok) in ok.iter().enumerate().take(count) {
+                if ok {
+                    let lane = j * (steps + 1)..(j + 1) * (steps + 1);
+                    for ((a, e), (b, v)) in sums
+                        .squared_error
+                        .iter_mut()
+                        .zip(&s.squared_error[lane.clone()])
+                        .zip(sums.nees.iter_mut().zip(&s.nees[lane]))
+                    {
+                        *a += e;
+                        *b += v;
+                    }
+                    sums.runs += 1;
+                } else {
+                    sums.failed_runs += 1;
                 }
-                sums.runs += 1;
-            } else {
-                sums.failed_runs += 1;
             }
+            first += count;
         }
     }
     Ok(sums)
 }
 
-/// One EKF run over the prepared truth; fills `s.squared_error` and `s.nees`. False if the
-/// filter failed numerically.
-fn run_filter(
+/// The truth half of [`run_chunk`] alone: the same trajectories (same streams) and their Fisher
+/// sums, no EKF runs (`runs = 0`). What the Monte Carlo PCRLB needs; see [`run_pcrlb_sequential`].
+pub fn run_truth_chunk(model: &Model, cfg: &MonteCarloConfig, chunk: usize) -> Result<PartialSums> {
+    let sampler = TruthSampler::new(cfg.motion, cfg.mean_state, &cfg.initial_covariance)?;
+    let mut sums = PartialSums::new(cfg.steps);
+    let mut s = Scratch::new(model, cfg.steps, false);
+    for traj in chunk_range(cfg, chunk) {
+        prepare_trajectory(model, cfg, &sampler, traj, &mut s, &mut sums);
+    }
+    Ok(sums)
+}
+
+/// EKF runs from `start` over the prepared truth, one per stream in `streams` (at most
+/// [`LANES`]), advanced together step by step (one [`update_lanes`] call updates all of them).
+/// Fills lane `j`'s `s.squared_error` and `s.nees`; `false` for a run whose filter failed
+/// numerically.
+fn run_filters(
     model: &Model,
     cfg: &MonteCarloConfig,
+    start: Ekf,
     s: &mut Scratch,
-    rng: &mut crate::simulate::Rng,
-) -> bool {
+    streams: &[u64],
+) -> [bool; LANES] {
     let links = model.link_count();
-    let Ok(mut ekf) = Ekf::new(cfg.mean_state, cfg.initial_covariance) else {
-        return false;
-    };
-    for (n, x) in s.truth.iter().enumerate() {
+    let steps = s.truth.len();
+    let count = streams.len().min(LANES);
+    let mut ekf = [start; LANES];
+    let mut rngs: [Rng; LANES] =
+        core::array::from_fn(|j| rng(cfg.seed, streams.get(j).copied().unwrap_or(0)));
+    let mut alive: [bool; LANES] = core::array::from_fn(|j| j < count);
+    let (truth, table) = (&s.truth[..steps], &s.table[..links * steps]);
+    let measurement = &mut s.measurement[..LANES * links];
+    for n in 0..steps {
+        let x = &truth[n];
         if n > 0 {
-            ekf.predict(&cfg.motion);
-            for p in 0..links {
-                let k = n * links + p;
-                s.measurement[p] = Some(s.delays[k] + s.sigmas[k] * standard_normal(rng));
+            let row = &table[n * links..(n + 1) * links];
+            for (j, z) in measurement.chunks_exact_mut(links.max(1)).enumerate() {
+                if alive[j] {
+                    ekf[j].predict(&cfg.motion);
+                    for (m, t) in z.iter_mut().zip(row) {
+                        *m = Some(t.delay + t.sigma * standard_normal(&mut rngs[j]));
+                    }
+                }
             }
             let noise = if cfg.oracle_noise {
                 MeasurementNoise::At(Vec2::new(x[0], x[1]))
             } else {
                 MeasurementNoise::AtPrediction
             };
-            if ekf.update(model, &s.measurement, noise, None).is_err() {
-                return false;
+            let zs: [&[Option<Real>]; LANES] =
+                core::array::from_fn(|j| &measurement[j * links..(j + 1) * links]);
+            let done = update_lanes(&mut ekf, model, zs, alive, noise, |_, _, _| {});
+            for (a, d) in alive.iter_mut().zip(&done) {
+                *a &= d.is_ok();
             }
         }
-        let e = ekf.position() - Vec2::new(x[0], x[1]);
-        s.squared_error[n] = e.norm_squared();
-        match ekf.nees(x) {
-            Some(v) => s.nees[n] = v,
-            None => return false,
+        for j in 0..LANES {
+            if alive[j] {
+                let e = ekf[j].state - x;
+                let k = j * steps + n;
+                s.squared_error[k] = e[0] * e[0] + e[1] * e[1];
+                match spd_quadratic_form(&ekf[j].covariance, &e) {
+                    Some(v) => s.nees[k] = v,
+                    None => alive[j] = false,
+                }
+            }
         }
     }
-    true
+    alive
 }
 
 /// Turns the combined sums into the curves (E9 with the Monte Carlo mean Fisher matrices).
@@ -301,4 +430,31 @@ pub fn run_sequential(
         }
     }
     finish(cfg, &sums)
+}
+
+/// The Monte Carlo PCRLB alone (spec §8, check 10): `ε_PCRLB(t_n)` from (E9) with `E[F̃]` the
+/// mean over the study's truth trajectories — the same trajectories (streams `rng(seed, 2i)`),
+/// chunks and merge order as [`run_sequential`], so the curve equals its `rmse_pcrlb_m`, but
+/// without the EKF runs (`noise_runs` is ignored). `on_chunk` as in [`run_sequential`].
+pub fn run_pcrlb_sequential(
+    model: &Model,
+    cfg: &MonteCarloConfig,
+    mut on_chunk: impl FnMut(usize, usize) -> bool,
+) -> Result<Vec<Option<Real>>> {
+    MonteCarloConfig {
+        noise_runs: 1,
+        ..*cfg
+    }
+    .validate()?;
+    let total = cfg.chunk_count();
+    let mut sums = PartialSums::new(cfg.steps);
+    for chunk in 0..total {
+        sums.merge(&run_truth_chunk(model, cfg, chunk)?);
+        if !on_chunk(chunk + 1, total) {
+            return Err(Error::Cancelled);
+        }
+    }
+    let trajectories = sums.trajectories.max(1) as Real;
+    let mean_fishers: Vec<Mat2> = sums.fisher[1..].iter().map(|f| f / trajectories).collect();
+    pcrlb_rmse(&cfg.motion, &cfg.initial_covariance, &mean_fishers)
 }

@@ -66,23 +66,32 @@ impl ConstantVelocity {
         Vec4::new(x[0] + t * x[2], x[1] + t * x[3], x[2], x[3])
     }
 
-    /// `P ↦ A P Aᵀ + Q`, exploiting the structure of `A` (about 30 flops instead of 128).
+    /// `P ↦ A P Aᵀ + Q` for a symmetric `P` (its upper triangle is read), exploiting the
+    /// structure of `A` (about 20 flops instead of 128); the result is exactly symmetric.
+    /// With `B = A P` (rows 0, 1 gain `T` × rows 2, 3) and `A P Aᵀ = B Aᵀ` (columns 0, 1 gain
+    /// `T` × columns 2, 3), the 10 unique entries are evaluated and mirrored.
     #[inline]
     pub fn propagate_covariance(&self, p: &Mat4) -> Mat4 {
         let t = self.dt_s;
-        // B = A P: rows 0, 1 gain t × rows 2, 3.
-        let mut b = *p;
-        for c in 0..4 {
-            b[(0, c)] += t * p[(2, c)];
-            b[(1, c)] += t * p[(3, c)];
-        }
-        // A P Aᵀ = B Aᵀ: columns 0, 1 gain t × columns 2, 3.
-        let mut out = b;
-        for r in 0..4 {
-            out[(r, 0)] += t * b[(r, 2)];
-            out[(r, 1)] += t * b[(r, 3)];
-        }
-        out + self.process_noise()
+        let q = self.process_noise();
+        let (p00, p01, p02, p03) = (p[(0, 0)], p[(0, 1)], p[(0, 2)], p[(0, 3)]);
+        let (p11, p12, p13) = (p[(1, 1)], p[(1, 2)], p[(1, 3)]);
+        let (p22, p23, p33) = (p[(2, 2)], p[(2, 3)], p[(3, 3)]);
+        // Rows 0, 1 of B (columns 2, 3 are also rows/columns of the result).
+        let (b02, b03) = (p02 + t * p22, p03 + t * p23);
+        let (b12, b13) = (p12 + t * p23, p13 + t * p33);
+        let o00 = (p00 + t * p02) + t * b02 + q[(0, 0)];
+        let o01 = (p01 + t * p12) + t * b03;
+        let o11 = (p11 + t * p13) + t * b13 + q[(1, 1)];
+        let (o02, o03) = (b02 + q[(0, 2)], b03);
+        let (o12, o13) = (b12, b13 + q[(1, 3)]);
+        let (o22, o23, o33) = (p22 + q[(2, 2)], p23, p33 + q[(3, 3)]);
+        Mat4::new(
+            o00, o01, o02, o03, //
+            o01, o11, o12, o13, //
+            o02, o12, o22, o23, //
+            o03, o13, o23, o33,
+        )
     }
 
     /// A lower-triangular `L` with `L Lᵀ = Q`, for sampling process noise: the x and y blocks are

@@ -155,10 +155,10 @@ impl GainPolynomial {
             return self.floor_gain;
         }
         let t = (2.0 * c - 1.0 - self.floor_cos) / (1.0 - self.floor_cos);
-        // Clenshaw recurrence.
+        // Clenshaw recurrence; `a − b2` first keeps the dependency chain through b1 short.
         let (mut b1, mut b2) = (0.0, 0.0);
         for &a in self.coefficients[1..].iter().rev() {
-            let b0 = a + 2.0 * t * b1 - b2;
+            let b0 = (a - b2) + 2.0 * t * b1;
             b2 = b1;
             b1 = b0;
         }

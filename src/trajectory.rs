@@ -36,10 +36,9 @@ impl TrackScenario {
             "I" | "1" => Ok(TrackScenario::I),
             "II" | "2" => Ok(TrackScenario::II),
             "III" | "3" => Ok(TrackScenario::III),
-            _ => Err(Error::OutOfRange {
+            _ => Err(Error::UnknownTrajectory {
                 field: "trajectory".into(),
-                value: Real::NAN,
-                allowed: "I, II or III",
+                name: s.into(),
             }),
         }
     }
@@ -62,7 +61,9 @@ impl TrackScenario {
         }
     }
 
-    /// Mean velocity `v̄`, m/s (|v| ≈ 1.41 m/s).
+    /// Mean velocity `v̄`, m/s (|v| ≈ 1.41 m/s), exactly as printed in the §9.4 table (the
+    /// check-9 values were computed from these 4-decimal numbers, not from cos/sin of the heading).
+    #[allow(clippy::approx_constant)]
     pub fn velocity(self) -> Vec2 {
         match self {
             TrackScenario::I => Vec2::new(1.3927, 0.2456),

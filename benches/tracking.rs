@@ -1,0 +1,217 @@
+#![cfg(not(target_arch = "wasm32"))]
+#![allow(missing_docs)] // criterion_group! generates an undocumented pub fn
+//! Tracking benchmarks (criterion): one EKF step (predict + update) with the 4 links of preset
+//! `sensors2019` on scenario I (R from the link budget at the predicted position, spec §6), timed
+//! over 256 consecutive steps of a track so the time per element is the time per step, its
+//! parts, and the Monte Carlo harness: one `run_chunk` of the fast profile (T = 0.1 s) and of
+//! the paper step (T = 2.048 ms), reported as EKF steps per second (criterion's throughput) and,
+//! in an untimed summary on stderr, as ns per EKF step including truth sampling, measurement
+//! simulation and NEES.
+//!
+//! Run: `cargo bench --bench tracking` (shorter: `-- --warm-up-time 1 --measurement-time 3`).
+
+use std::hint::black_box;
+use std::time::Instant;
+
+use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+
+use scatterloc::ekf::{Ekf, MeasurementNoise};
+use scatterloc::math::{Real, Vec2, Vec4};
+use scatterloc::montecarlo::{run_chunk, run_truth_chunk, MonteCarloConfig, CHUNK_TRAJECTORIES};
+use scatterloc::motion::ConstantVelocity;
+use scatterloc::trajectory::{
+    paper_initial_covariance, step_count, TrackScenario, TruthSampler, PAPER_INTENSITY,
+    PAPER_STEP_S,
+};
+use scatterloc::{presets, simulate, Model};
+
+const SEED: u64 = 2019;
+/// Steps run before the benchmarked ones, so `P` has its steady-state size (0.5 s at 2.048 ms).
+const WARM_STEPS: usize = 244;
+/// Consecutive steps per benchmark iteration (0.52 s of scenario I at 2.048 ms).
+const BENCH_STEPS: usize = 256;
+
+/// A filter after `WARM_STEPS` steps on a scenario-I truth, and the measurements (noisy delays
+/// at the truth, σ from E8) of the next `BENCH_STEPS` steps with their truth.
+struct StepSetup {
+    model: Model,
+    motion: ConstantVelocity,
+    ekf: Ekf,
+    z: Vec<Vec<Option<Real>>>,
+    sigmas: Vec<Vec<Real>>,
+    truth: Vec<Vec4>,
+}
+
+fn step_setup() -> StepSetup {
+    let model = Model::new(&presets::sensors2019()).unwrap();
+    let motion = ConstantVelocity::new(PAPER_STEP_S, PAPER_INTENSITY);
+    let s = TrackScenario::I;
+    let sampler = TruthSampler::new(motion, s.mean_state(), &paper_initial_covariance()).unwrap();
+    let mut truth = Vec::new();
+    sampler.sample(
+        WARM_STEPS + BENCH_STEPS,
+        &mut simulate::rng(SEED, 0),
+        &mut truth,
+    );
+    let mut noise = simulate::rng(SEED, 1);
+    let z: Vec<Vec<Option<Real>>> = truth
+        .iter()
+        .map(|x| {
+            simulate::noisy_delays(&model, Vec2::new(x[0], x[1]), &mut noise)
+                .into_iter()
+                .map(Some)
+                .collect()
+        })
+        .collect();
+    let mut ekf = Ekf::new(s.mean_state(), paper_initial_covariance()).unwrap();
+    for z in &z[1..=WARM_STEPS] {
+        ekf.step(&motion, &model, z, MeasurementNoise::AtPrediction)
+            .unwrap();
+    }
+    let bench = WARM_STEPS + 1..;
+    StepSetup {
+        sigmas: truth[bench.clone()]
+            .iter()
+            .map(|x| model.sigma_delays(Vec2::new(x[0], x[1])))
+            .collect(),
+        z: z[bench.clone()].to_vec(),
+        truth: truth[bench].to_vec(),
+        model,
+        motion,
+        ekf,
+    }
+}
+
+impl StepSetup {
+    /// `BENCH_STEPS` consecutive predict + update steps from the warm filter.
+    fn track(&self, fixed: bool) -> Ekf {
+        let mut f = self.ekf;
+        for (z, s) in self.z.iter().zip(&self.sigmas) {
+            f.predict(&self.motion);
+            let noise = if fixed {
+                MeasurementNoise::Fixed(s)
+            } else {
+                MeasurementNoise::AtPrediction
+            };
+            f.update(&self.model, black_box(z), noise, None).unwrap();
+        }
+        f
+    }
+}
+
+/// The Monte Carlo study of scenario I at step `dt_s` over `duration_s` with `noise_runs`.
+fn study(dt_s: Real, duration_s: Real, noise_runs: usize) -> MonteCarloConfig {
+    let motion = ConstantVelocity::new(dt_s, PAPER_INTENSITY);
+    MonteCarloConfig {
+        motion,
+        steps: step_count(duration_s, dt_s),
+        mean_state: TrackScenario::I.mean_state(),
+        initial_covariance: paper_initial_covariance(),
+        trajectories: CHUNK_TRAJECTORIES,
+        noise_runs,
+        seed: SEED,
+        oracle_noise: false,
+    }
+}
+
+/// EKF steps in one chunk of `cfg`.
+fn chunk_steps(cfg: &MonteCarloConfig) -> u64 {
+    (cfg.trajectories.min(CHUNK_TRAJECTORIES) * cfg.noise_runs * cfg.steps) as u64
+}
+
+/// Untimed by criterion: the best of `reps` wall-clock runs of one chunk, ns per EKF step.
+fn ns_per_step(model: &Model, cfg: &MonteCarloConfig, reps: usize) -> f64 {
+    (0..reps)
+        .map(|_| {
+            let t = Instant::now();
+            black_box(run_chunk(model, cfg, 0).unwrap());
+            t.elapsed().as_nanos() as f64 / chunk_steps(cfg) as f64
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+fn benches(c: &mut Criterion) {
+    let s = step_setup();
+    // Untimed sanity check: every benchmarked step uses all 4 links, and the filter stays near
+    // the truth (within 5 mm over the 0.5 s; the bound there is ≈ 0.2 cm).
+    let mut f = s.ekf;
+    let mut worst: Real = 0.0;
+    for (z, x) in s.z.iter().zip(&s.truth) {
+        let u = f
+            .step(&s.motion, &s.model, z, MeasurementNoise::AtPrediction)
+            .unwrap();
+        assert_eq!(u.links_used, 4);
+        worst = worst.max((f.position() - Vec2::new(x[0], x[1])).norm());
+    }
+    assert!(worst < 5e-3, "filter {worst} m off the truth");
+    eprintln!(
+        "setup: scenario I, {BENCH_STEPS} steps of {PAPER_STEP_S} s after {WARM_STEPS}, largest position error {:.3} mm",
+        worst * 1e3
+    );
+
+    // Per element = one step: consecutive dependent steps, as in a track.
+    let mut g = c.benchmark_group("ekf_step_4_links");
+    g.throughput(Throughput::Elements(BENCH_STEPS as u64));
+    g.bench_function("predict+update_R_at_prediction", |b| {
+        b.iter(|| s.track(false))
+    });
+    g.bench_function("predict+update_R_fixed", |b| b.iter(|| s.track(true)));
+    g.bench_function("predict_only", |b| {
+        b.iter(|| {
+            let mut f = s.ekf;
+            for _ in 0..BENCH_STEPS {
+                f.predict(black_box(&s.motion));
+            }
+            f
+        })
+    });
+    let filters: Vec<Ekf> = {
+        let mut f = s.ekf;
+        s.z.iter()
+            .map(|z| {
+                f.step(&s.motion, &s.model, z, MeasurementNoise::AtPrediction)
+                    .unwrap();
+                f
+            })
+            .collect()
+    };
+    g.bench_function("nees", |b| {
+        b.iter(|| {
+            filters
+                .iter()
+                .zip(&s.truth)
+                .map(|(f, x)| black_box(f).nees(x).unwrap())
+                .sum::<Real>()
+        })
+    });
+    g.finish();
+
+    let fast = study(0.1, 10.0, 10);
+    let paper = study(PAPER_STEP_S, 1.0, 50);
+    let mut g = c.benchmark_group("montecarlo_chunk");
+    g.sample_size(10);
+    g.throughput(Throughput::Elements(chunk_steps(&fast)));
+    g.bench_function("run_chunk_fast_0.1s_16x10x100", |b| {
+        b.iter(|| run_chunk(&s.model, black_box(&fast), 0).unwrap())
+    });
+    g.throughput(Throughput::Elements(chunk_steps(&paper)));
+    g.bench_function("run_chunk_paper_2.048ms_16x50x488", |b| {
+        b.iter(|| run_chunk(&s.model, black_box(&paper), 0).unwrap())
+    });
+    g.throughput(Throughput::Elements(
+        (CHUNK_TRAJECTORIES * fast.steps) as u64,
+    ));
+    g.bench_function("run_truth_chunk_fast_16x100", |b| {
+        b.iter(|| run_truth_chunk(&s.model, black_box(&fast), 0).unwrap())
+    });
+    g.finish();
+
+    eprintln!(
+        "Monte Carlo throughput (best of 5, one thread, incl. truth, measurements, NEES):\n  fast profile 0.1 s, 16x10 runs x 100 steps: {:.1} ns per EKF step\n  paper step 2.048 ms, 16x50 runs x 488 steps: {:.1} ns per EKF step",
+        ns_per_step(&s.model, &fast, 5),
+        ns_per_step(&s.model, &paper, 5)
+    );
+}
+
+criterion_group!(tracking, benches);
+criterion_main!(tracking);
