@@ -12,6 +12,11 @@ use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
 use crate::error::{Error, Result};
 
+mod validate;
+
+#[cfg(test)]
+mod tests;
+
 /// A complete scenario: nodes, links, radio parameters, target and area of interest.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -189,91 +194,6 @@ impl Scenario {
         serde_json::to_string_pretty(self).unwrap_or_default()
     }
 
-    /// Checks every field; the first problem found is returned as a named error.
-    pub fn validate(&self) -> Result<()> {
-        let r = &self.radio;
-        positive("radio.carrier_hz", r.carrier_hz)?;
-        positive("radio.bandwidth_hz", r.bandwidth_hz)?;
-        if r.noise_figure_db.is_some() && r.noise_power_dbm.is_some() {
-            return Err(Error::AmbiguousNoise);
-        }
-        if let Some(nf) = r.noise_figure_db {
-            finite("radio.noise_figure_db", nf)?;
-            if !(0.0..=100.0).contains(&nf) {
-                return Err(Error::OutOfRange {
-                    field: "radio.noise_figure_db".into(),
-                    value: nf,
-                    allowed: "0 to 100 dB",
-                });
-            }
-        }
-        if let Some(p) = r.noise_power_dbm {
-            finite("radio.noise_power_dbm", p)?;
-        }
-        if let Some(g) = r.processing_gain_db {
-            finite("radio.processing_gain_db", g)?;
-            if g < 0.0 {
-                return Err(Error::OutOfRange {
-                    field: "radio.processing_gain_db".into(),
-                    value: g,
-                    allowed: ">= 0 dB",
-                });
-            }
-        }
-        if self.transmitters.is_empty() {
-            return Err(Error::EmptyNodeList {
-                field: "transmitters",
-            });
-        }
-        if self.receivers.is_empty() {
-            return Err(Error::EmptyNodeList { field: "receivers" });
-        }
-        let mut names: Vec<&str> = Vec::new();
-        for (i, t) in self.transmitters.iter().enumerate() {
-            unique_name(&mut names, &t.name)?;
-            position(&format!("transmitters[{i}].position_m"), t.position_m)?;
-            finite(&format!("transmitters[{i}].power_dbm"), t.power_dbm)?;
-            finite(&format!("transmitters[{i}].gain_dbi"), t.gain_dbi)?;
-            if let Pattern::Parabolic {
-                boresight_deg,
-                beamwidth_deg,
-                floor_db,
-            } = t.pattern
-            {
-                finite(
-                    &format!("transmitters[{i}].pattern.boresight_deg"),
-                    boresight_deg,
-                )?;
-                let bw = format!("transmitters[{i}].pattern.beamwidth_deg");
-                finite(&bw, beamwidth_deg)?;
-                if !(beamwidth_deg > 0.0 && beamwidth_deg <= 360.0) {
-                    return Err(Error::OutOfRange {
-                        field: bw,
-                        value: beamwidth_deg,
-                        allowed: "0 < beamwidth <= 360 degrees",
-                    });
-                }
-                let fl = format!("transmitters[{i}].pattern.floor_db");
-                finite(&fl, floor_db)?;
-                if floor_db < 0.0 {
-                    return Err(Error::OutOfRange {
-                        field: fl,
-                        value: floor_db,
-                        allowed: ">= 0 dB",
-                    });
-                }
-            }
-        }
-        for (i, rx) in self.receivers.iter().enumerate() {
-            unique_name(&mut names, &rx.name)?;
-            position(&format!("receivers[{i}].position_m"), rx.position_m)?;
-            finite(&format!("receivers[{i}].gain_dbi"), rx.gain_dbi)?;
-        }
-        positive("target.rcs_m2", self.target.rcs_m2)?;
-        area(&self.area_m)?;
-        self.link_indices().map(|_| ())
-    }
-
     /// The link set as index pairs, in link order (validated names).
     pub fn link_indices(&self) -> Result<Vec<LinkIndex>> {
         match &self.links {
@@ -334,13 +254,6 @@ impl Scenario {
     }
 }
 
-impl Area {
-    /// Validates the rectangle (finite, min < max on both axes).
-    pub fn validate(&self) -> Result<()> {
-        area(self)
-    }
-}
-
 /// Deserializes JSON, naming the path of the offending field in the error (e.g.
 /// `radio.bandwidth_hz: invalid type: string "120e6", expected f64 at line 5 column 27`).
 pub fn parse_json<T: serde::de::DeserializeOwned>(text: &str) -> Result<T> {
@@ -359,110 +272,4 @@ pub fn parse_json<T: serde::de::DeserializeOwned>(text: &str) -> Result<T> {
         message: e.to_string(),
     })?;
     Ok(value)
-}
-
-fn finite(field: &str, v: f64) -> Result<()> {
-    if v.is_finite() {
-        Ok(())
-    } else {
-        Err(Error::NonFinite {
-            field: field.into(),
-        })
-    }
-}
-
-fn positive(field: &str, v: f64) -> Result<()> {
-    finite(field, v)?;
-    if v > 0.0 {
-        Ok(())
-    } else {
-        Err(Error::NotPositive {
-            field: field.into(),
-            value: v,
-        })
-    }
-}
-
-fn position(field: &str, p: [f64; 2]) -> Result<()> {
-    if p.iter().all(|v| v.is_finite()) {
-        Ok(())
-    } else {
-        Err(Error::NonFinite {
-            field: field.into(),
-        })
-    }
-}
-
-fn unique_name<'a>(names: &mut Vec<&'a str>, name: &'a str) -> Result<()> {
-    if names.contains(&name) {
-        return Err(Error::DuplicateName { name: name.into() });
-    }
-    names.push(name);
-    Ok(())
-}
-
-fn area(a: &Area) -> Result<()> {
-    position("area_m.x", a.x)?;
-    position("area_m.y", a.y)?;
-    if a.x[0] >= a.x[1] {
-        return Err(Error::InvertedArea {
-            field: "area_m.x",
-            min: a.x[0],
-            max: a.x[1],
-        });
-    }
-    if a.y[0] >= a.y[1] {
-        return Err(Error::InvertedArea {
-            field: "area_m.y",
-            min: a.y[0],
-            max: a.y[1],
-        });
-    }
-    Ok(())
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn with_radio(radio: &str) -> String {
-        format!(
-            r#"{{"name":"x","radio":{radio},"transmitters":[{{"name":"Tx","position_m":[0,0],"power_dbm":30,"gain_dbi":0}}],
-            "receivers":[{{"name":"Rx","position_m":[1,0],"gain_dbi":0}}],"target":{{"rcs_m2":1}},"area_m":{{"x":[0,1],"y":[0,1]}}}}"#
-        )
-    }
-
-    /// A value of the wrong type is reported with the path of its field.
-    #[test]
-    fn wrong_type_names_the_field_path() {
-        let e = Scenario::from_json(&with_radio(
-            r#"{"carrier_hz":5.2e9,"bandwidth_hz":"120e6"}"#,
-        ))
-        .unwrap_err();
-        assert!(matches!(e, Error::Parse { .. }));
-        assert!(e.to_string().contains("radio.bandwidth_hz"), "{e}");
-    }
-
-    /// A typo inside a nested object names that object and the unknown field.
-    #[test]
-    fn nested_unknown_field_is_named() {
-        let e = Scenario::from_json(&with_radio(r#"{"carrier_hz":5.2e9,"bandwith_hz":1e8}"#))
-            .unwrap_err();
-        let text = e.to_string();
-        assert!(
-            text.contains("radio") && text.contains("bandwith_hz"),
-            "{text}"
-        );
-    }
-
-    /// Trailing garbage after the object is an error, not silently ignored.
-    #[test]
-    fn trailing_characters_are_rejected() {
-        let good = with_radio(r#"{"carrier_hz":5.2e9,"bandwidth_hz":1e8}"#);
-        assert!(Scenario::from_json(&good).is_ok());
-        assert!(matches!(
-            Scenario::from_json(&(good + " x")),
-            Err(Error::Parse { .. })
-        ));
-    }
 }
