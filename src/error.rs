@@ -234,7 +234,10 @@ impl fmt::Display for Error {
                 "{field}: the last one cannot be removed (at least one is required)"
             ),
             Error::UnknownTrajectory { field, name } => {
-                write!(f, "{field}: unknown trajectory \"{name}\" (known: I, II, III)")
+                write!(
+                    f,
+                    "{field}: unknown trajectory \"{name}\" (known: I, II, III)"
+                )
             }
             Error::UnknownPattern { field, kind } => write!(
                 f,

@@ -13,6 +13,7 @@
 //! - [`lm`]: weighted Levenberg–Marquardt snapshot fix (E5–E6).
 //! - [`simulate`]: seeded noisy delays.
 //! - [`snapshot`]: one simulated snapshot with its ellipses, fix and CRLB (what the page draws).
+//! - [`track_view`]: a simulated track's steps as the page draws them (snapshot-shaped frames).
 //! - [`edit`], [`session`]: validated, rolled-back scenario edits for interactive front ends.
 //! - [`presets`]: the `sensors2019` and `iclgnss2019` case studies.
 //! - [`ticks`]: axis ticks and length labels shared by the front ends.
@@ -45,6 +46,7 @@ pub mod simulate;
 pub mod snapshot;
 pub mod ticks;
 pub mod track_sim;
+pub mod track_view;
 pub mod trajectory;
 
 #[cfg(all(feature = "std", target_arch = "wasm32"))]

@@ -91,21 +91,12 @@ pub fn simulate_snapshot(model: &Model, area: &Area, truth: Vec2, seed: u64) -> 
         report,
     });
     let crlb = crlb_at(model, truth);
-    let view_radius_m = VIEW_MARGIN * view_extent(&crlb, fix.as_ref().ok());
+    let fix_reach = fix
+        .as_ref()
+        .map_or(0.0, |f| f.error_m + f.ellipse.map_or(0.0, |e| e.semi_major));
+    let view_radius_m = view_radius(&crlb, fix_reach);
     let links = (0..net.link_count())
-        .map(|p| {
-            let ellipse = net.iso_delay_ellipse(p, delays[p]);
-            LinkSim {
-                link: net.links[p],
-                delay_s: delays[p],
-                sigma_s: sigmas[p],
-                range_sigma_m: SPEED_OF_LIGHT * sigmas[p],
-                ellipse,
-                outline: ellipse.map_or_else(Vec::new, |e| e.polygon(OUTLINE_POINTS)),
-                arc: ellipse
-                    .map_or_else(Vec::new, |e| e.arc_near(truth, view_radius_m, ARC_POINTS)),
-            }
-        })
+        .map(|p| link_sim(model, p, delays[p], sigmas[p], truth, view_radius_m))
         .collect();
     SnapshotSimulation {
         truth,
@@ -117,17 +108,41 @@ pub fn simulate_snapshot(model: &Model, area: &Area, truth: Vec2, seed: u64) -> 
     }
 }
 
-/// How far from the truth the CRLB ellipse (semi-major axis) and the fix ellipse (miss plus
-/// semi-major axis) reach; [`FALLBACK_EXTENT_M`] when that is not a finite positive length.
-fn view_extent(crlb: &CrlbPoint, fix: Option<&SnapshotFix>) -> Real {
-    let crlb_reach = crlb.ellipse().map_or(0.0, |e| e.semi_major);
-    let fix_reach = fix.map_or(0.0, |f| f.error_m + f.ellipse.map_or(0.0, |e| e.semi_major));
-    let r = crlb_reach.max(fix_reach);
-    if r.is_finite() && r > 0.0 {
-        r
-    } else {
-        FALLBACK_EXTENT_M
+/// Link `p` of a scatterer at `truth` measured at `delay_s` with noise `sigma_s`: its iso-delay
+/// ellipse, outline and the arc within about `view_radius_m` of the truth. Shared with the
+/// track frames of [`crate::track_view`].
+pub(crate) fn link_sim(
+    model: &Model,
+    p: usize,
+    delay_s: Real,
+    sigma_s: Real,
+    truth: Vec2,
+    view_radius_m: Real,
+) -> LinkSim {
+    let ellipse = model.network.iso_delay_ellipse(p, delay_s);
+    LinkSim {
+        link: model.network.links[p],
+        delay_s,
+        sigma_s,
+        range_sigma_m: SPEED_OF_LIGHT * sigma_s,
+        ellipse,
+        outline: ellipse.map_or_else(Vec::new, |e| e.polygon(OUTLINE_POINTS)),
+        arc: ellipse.map_or_else(Vec::new, |e| e.arc_near(truth, view_radius_m, ARC_POINTS)),
     }
+}
+
+/// [`VIEW_MARGIN`] times how far from the truth the CRLB ellipse (semi-major axis) and an
+/// estimate (`estimate_reach`: its miss plus its ellipse's semi-major axis) reach;
+/// [`FALLBACK_EXTENT_M`] instead of that extent when it is not a finite positive length.
+pub(crate) fn view_radius(crlb: &CrlbPoint, estimate_reach: Real) -> Real {
+    let crlb_reach = crlb.ellipse().map_or(0.0, |e| e.semi_major);
+    let r = crlb_reach.max(estimate_reach);
+    VIEW_MARGIN
+        * if r.is_finite() && r > 0.0 {
+            r
+        } else {
+            FALLBACK_EXTENT_M
+        }
 }
 
 #[cfg(test)]

@@ -23,6 +23,14 @@ use serde_json::{json, Value};
 use scatterloc::crlb::crlb_at;
 use scatterloc::{Model, Scenario, Vec2};
 
+/// Tracking mode: scenario II, the Web Worker Monte Carlo and its chart (issue 3).
+#[path = "e2e/tracking.rs"]
+mod tracking;
+
+/// `SCATTERLOC_SCREENSHOT=1`: writes docs/screenshot-tracking.png.
+#[path = "e2e/screenshot.rs"]
+mod screenshot;
+
 /// One browser at a time (2-core machines).
 static SERIAL: Mutex<()> = Mutex::new(());
 
@@ -159,7 +167,12 @@ async fn connect(driver: &Driver) -> Client {
 
 /// Loads the page and waits for `data-ready` (or fails fast on `data-error`).
 async fn open(c: &Client, port: u16) -> Result<(), String> {
-    c.goto(&format!("http://127.0.0.1:{port}/"))
+    open_hash(c, port, "").await
+}
+
+/// As [`open`], with a URL hash (page options such as `#mode=tracking&track=II`).
+async fn open_hash(c: &Client, port: u16, hash: &str) -> Result<(), String> {
+    c.goto(&format!("http://127.0.0.1:{port}/{hash}"))
         .await
         .map_err(|e| e.to_string())?;
     let body = c

@@ -14,6 +14,10 @@ use scatterloc::{presets, Model, Vec2};
 
 wasm_bindgen_test_configure!(run_in_browser);
 
+/// The tracking API: tracks, the worker's Monte Carlo job, the chart.
+#[path = "wasm/tracking.rs"]
+mod tracking;
+
 fn message(e: JsError) -> String {
     let v: JsValue = e.into();
     v.dyn_into::<js_sys::Error>()

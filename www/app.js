@@ -6,14 +6,31 @@ import { View } from './view.js';
 import { drawScene, makeBarCanvas } from './draw.js';
 import { Panel, showError } from './panel.js';
 import { attachPointer } from './interact.js';
+import { Tracking } from './track.js';
 
 const $ = (id) => document.getElementById(id);
 
-/** `#preset=iclgnss2019&target=6,4&seed=3&res=256` -> options. */
+/**
+ * `#preset=iclgnss2019&target=6,4&seed=3&res=256` -> options; tracking: `#mode=tracking&track=II&step=45
+ * &play=1&runs=200&ex=100&tseed=1&dt=0.1&speed=1&custom=x0,y0,x1,y1`.
+ */
 function hashOptions() {
   const h = new URLSearchParams(location.hash.slice(1));
   const target = (h.get('target') || '').split(',').map(Number);
+  const custom = (h.get('custom') || '').split(',').map(Number);
+  const int = (k) => (Number.isInteger(Number(h.get(k))) && h.get(k) ? Number(h.get(k)) : undefined);
   return {
+    mode: h.get('mode') === 'tracking' ? 'tracking' : 'snapshot',
+    track: h.get('track'),
+    step: int('step'),
+    play: h.get('play') === '1',
+    runs: h.get('runs'),
+    ex: h.get('ex'),
+    tseed: h.get('tseed'),
+    dt: h.get('dt'),
+    speed: h.get('speed'),
+    custom: custom.length === 4 && custom.every(Number.isFinite)
+      ? { x0: custom[0], y0: custom[1], x1: custom[2], y1: custom[3] } : null,
     preset: h.get('preset'),
     target: target.length === 2 && target.every(Number.isFinite) ? { x: target[0], y: target[1] } : null,
     seed: Number.isInteger(Number(h.get('seed'))) && h.get('seed') ? Number(h.get('seed')) : 1,
@@ -43,7 +60,12 @@ async function main() {
     range: null,
     res: 256,
     target: null, // { x, y, seed }
-    fix: null,
+    snap: null, // the snapshot of the placed target
+    fix: null, // what draw.js shows: the snapshot, or the track frame in tracking mode
+    mode: 'snapshot', // or 'tracking'
+    overlay: null,
+    insetTitle: 'target zoom',
+    insetAvoid: [],
     nextSeed: opts.seed,
   };
 
@@ -95,10 +117,16 @@ async function main() {
         updateProbe();
       }
       if (d.target) {
-        st.fix = st.target ? app.simulate_fix(st.target.x, st.target.y, st.target.seed) : null;
-        panel.showTarget(st.fix);
+        st.snap = st.target ? app.simulate_fix(st.target.x, st.target.y, st.target.seed) : null;
+        panel.showTarget(st.snap);
       }
+      if (d.geometry) tracking.rerun();
       if (d.panel) panel.sync();
+      const tr = st.mode === 'tracking';
+      st.fix = tr ? tracking.frame : st.snap;
+      st.overlay = tr ? (c, v) => tracking.overlay(c, v) : null;
+      st.insetTitle = tr ? 'EKF zoom · true scale' : 'target zoom';
+      st.insetAvoid = tr ? tracking.avoidPoints() : [];
       drawScene(view, st, wasm);
     } catch (e) {
       showError(`Internal error: ${e && e.message ? e.message : e}`);
@@ -134,8 +162,22 @@ async function main() {
   };
   const panel = new Panel(ctx);
   ctx.panel = panel;
+  const tracking = new Tracking(ctx, opts);
+  ctx.tracking = tracking;
+  /** Snapshot view (click to place a target) or tracking (animated EKF track + Monte Carlo). */
+  const setMode = (mode) => {
+    st.mode = mode === 'tracking' ? 'tracking' : 'snapshot';
+    document.body.classList.toggle('mode-tracking', st.mode === 'tracking');
+    $('mode-snapshot').setAttribute('aria-pressed', String(st.mode === 'snapshot'));
+    $('mode-tracking').setAttribute('aria-pressed', String(st.mode === 'tracking'));
+    tracking.setActive(st.mode === 'tracking');
+    pointer.showHint();
+    changed({ draw: true });
+  };
+  $('mode-snapshot').addEventListener('click', () => setMode('snapshot'));
+  $('mode-tracking').addEventListener('click', () => setMode('tracking'));
   $('preset').value = preset;
-  attachPointer(ctx);
+  const pointer = attachPointer(ctx);
 
   view.resize();
   view.fit(app.area());
@@ -147,6 +189,8 @@ async function main() {
   if (opts.target) st.target = { x: opts.target.x, y: opts.target.y, seed: st.nextSeed++ };
   Object.assign(dirty, { map: true, geometry: true, target: true, panel: true });
   refresh();
+  setMode(opts.mode);
+  if (opts.play) tracking.play();
 
   // Hooks for tests and the console.
   window.app = app;
@@ -156,6 +200,16 @@ async function main() {
   window.mapCanvas = st.mapCanvas;
   window.pageIdle = () => !scheduled;
   window.placeTarget = ctx.placeTarget;
+  window.tracking = {
+    state: () => tracking.state(),
+    setMode,
+    play: () => tracking.play(),
+    pause: () => tracking.pause(),
+    seek: (n) => tracking.seek(n),
+    restartMc: () => tracking.startMc(),
+    mcParams: () => tracking.mc.params,
+    mcResult: () => (tracking.mc.result ? JSON.parse(tracking.mc.result) : null),
+  };
   window.importScenarioText = (text, name) => panel.importText(text, name);
   /** Runs the map kernel `n` times at the current resolution: per-run kernel ms (core-timed). */
   window.benchMap = (n = 9) => {

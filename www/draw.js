@@ -3,7 +3,7 @@
 
 import { Zoom } from './view.js';
 
-const C = {
+export const C = {
   bg: '#141922',
   frame: '#3a4456',
   text: '#c9d2e0',
@@ -18,19 +18,22 @@ const C = {
   baseline: 'rgba(255,255,255,0.28)',
 };
 export const LINK_COLORS = ['#f4f4f0', '#ffd166', '#9be564', '#ff8fab', '#b8c0ff', '#7ee8fa', '#ffb86b', '#d0a2f7'];
-const FONT = '11.5px system-ui, -apple-system, "Segoe UI", Roboto, sans-serif';
-const FONT_B = '600 11.5px system-ui, -apple-system, "Segoe UI", Roboto, sans-serif';
-const FULL = 2 * Math.PI;
+export const FONT = '11.5px system-ui, -apple-system, "Segoe UI", Roboto, sans-serif';
+export const FONT_B = '600 11.5px system-ui, -apple-system, "Segoe UI", Roboto, sans-serif';
+export const FULL = 2 * Math.PI;
 
-/** Ellipse {cx, cy, a, b, angle} through a transform (View or Zoom); y flips the angle's sign. */
-function ellipsePath(ctx, tr, e) {
+/**
+ * Ellipse {cx, cy, a, b, angle} through a transform (View or Zoom); y flips the angle's sign.
+ * `magnify` enlarges it on screen only (a labelled exaggeration).
+ */
+export function ellipsePath(ctx, tr, e, magnify = 1) {
   const c = tr.toPixel(e.cx, e.cy);
   ctx.beginPath();
-  ctx.ellipse(c.x, c.y, tr.len(e.a), tr.len(e.b), -e.angle, 0, FULL);
+  ctx.ellipse(c.x, c.y, tr.len(e.a) * magnify, tr.len(e.b) * magnify, -e.angle, 0, FULL);
 }
 
 /** A path through points [[x, y], …] (m) via a transform. */
-function polyline(ctx, tr, points, closed) {
+export function polyline(ctx, tr, points, closed) {
   ctx.beginPath();
   points.forEach(([x, y], k) => {
     const q = tr.toPixel(x, y);
@@ -39,7 +42,7 @@ function polyline(ctx, tr, points, closed) {
   if (closed) ctx.closePath();
 }
 
-function cross(ctx, p, r, color, width) {
+export function cross(ctx, p, r, color, width) {
   ctx.strokeStyle = color;
   ctx.lineWidth = width;
   ctx.beginPath();
@@ -48,7 +51,7 @@ function cross(ctx, p, r, color, width) {
   ctx.stroke();
 }
 
-function haloText(ctx, text, x, y) {
+export function haloText(ctx, text, x, y) {
   ctx.lineWidth = 3;
   ctx.strokeStyle = 'rgba(10,12,18,0.85)';
   ctx.strokeText(text, x, y);
@@ -211,8 +214,11 @@ function drawTargetMain(ctx, view, fix) {
   }
 }
 
-/** Zoom inset around the target: iso-delay ellipses, CRLB and LM 1σ ellipses, scale bar. */
-function drawInset(ctx, view, fix, w) {
+/**
+ * Zoom inset around the target: iso-delay ellipses, CRLB and LM (or EKF) 1σ ellipses, scale bar.
+ * `title` names it; inside the plot it keeps off the `avoid` points ([[x, y, weight?], …] m) if it can.
+ */
+function drawInset(ctx, view, fix, w, title, avoid) {
   const r = view.rect;
   const t = view.toPixel(fix.truth.x, fix.truth.y);
   const pad = 10;
@@ -236,8 +242,12 @@ function drawInset(ctx, view, fix, w) {
       { x: r.x + r.w - size - pad, y: r.y + r.h - size - pad },
       { x: r.x + pad, y: r.y + r.h - size - pad },
     ];
-    // The first corner whose box keeps clear of the target marker.
-    box = corners.find((c) => t.x < c.x - 12 || t.x > c.x + size + 12 || t.y < c.y - 12 || t.y > c.y + size + 12) || corners[0];
+    // The corner whose box keeps clear of the target marker and covers the least weight of the
+    // `avoid` points ([x, y, weight = 1], m; e.g. a track), the first in this order on ties.
+    const inside = (c, p, m) => p.x > c.x - m && p.x < c.x + size + m && p.y > c.y - m && p.y < c.y + size + m;
+    const cost = (c) => avoid.reduce((sum, [x, y, wt = 1]) => sum + (inside(c, view.toPixel(x, y), 6) ? wt : 0),
+      inside(c, t, 12) ? 1e9 : 0);
+    box = corners.reduce((best, c) => (cost(c) < cost(best) ? c : best));
   }
   const z = new Zoom(box.x, box.y, size, fix.truth, fix.view_radius_m);
   // Leader line from the target to the inset.
@@ -293,13 +303,17 @@ function drawInset(ctx, view, fix, w) {
     haloText(ctx, bar.label, box.x + 16 + len, y + 4);
   }
   ctx.font = FONT_B; ctx.fillStyle = C.text; ctx.textAlign = 'left'; ctx.textBaseline = 'top';
-  haloText(ctx, 'target zoom', box.x + 8, box.y + 7);
+  haloText(ctx, title, box.x + 8, box.y + 7);
   ctx.restore();
   ctx.strokeStyle = C.frame; ctx.lineWidth = 1;
   ctx.strokeRect(box.x + 0.5, box.y + 0.5, size, size);
 }
 
-/** Redraws the whole canvas from the state. */
+/**
+ * Redraws the whole canvas from the state: `st.fix` is a snapshot (or a snapshot-shaped track
+ * frame), `st.overlay(ctx, view)` draws extra layers under the markers, `st.insetTitle` names
+ * the zoom inset and `st.insetAvoid` lists points it should not cover.
+ */
 export function drawScene(view, st, w) {
   const ctx = view.context();
   ctx.fillStyle = C.bg;
@@ -307,9 +321,10 @@ export function drawScene(view, st, w) {
   drawMap(ctx, view, st);
   drawAxes(ctx, view, w);
   drawColorbar(ctx, view, st, w);
+  if (st.overlay) st.overlay(ctx, view);
   if (st.fix) drawTargetMain(ctx, view, st.fix);
   drawNetwork(ctx, view, st);
-  if (st.fix) drawInset(ctx, view, st.fix, w);
+  if (st.fix) drawInset(ctx, view, st.fix, w, st.insetTitle || 'target zoom', st.insetAvoid || []);
 }
 
 /** A 1-pixel-wide canvas holding the colour bar gradient (dark first = bottom). */

@@ -1,4 +1,5 @@
-// Mouse/pointer handling on the plot: drag Tx/Rx markers, click to place a target, hover read-out.
+// Mouse/pointer handling on the plot: drag Tx/Rx markers, click to place a target (snapshot mode) or
+// press-and-drag a trajectory (tracking mode, "draw"), hover read-out.
 
 import { showError, clearError } from './panel.js';
 
@@ -27,7 +28,9 @@ export function attachPointer(ctx) {
 
   const hover = (p) => {
     if (!view.inPlot(p.x, p.y)) {
-      readout.textContent = 'Move over the map to read the bound · drag Tx/Rx markers · click to place a target';
+      readout.textContent = st.mode !== 'tracking'
+        ? 'Move over the map to read the bound · drag Tx/Rx markers · click to place a target'
+        : `Move over the map to read the bound · drag Tx/Rx markers${ctx.tracking.wantsDraw() ? ' · press and drag to draw a trajectory' : ''}`;
       return;
     }
     const m = view.toMetre(p.x, p.y);
@@ -45,11 +48,13 @@ export function attachPointer(ctx) {
     if (ev.button !== 0) return;
     const p = view.eventPixel(ev);
     const node = hitNode(view, st.nodes, p);
-    press = { start: p, node, moved: false };
+    const draw = !node && view.inPlot(p.x, p.y) && ctx.tracking.wantsDraw();
+    press = { start: p, node, moved: false, draw };
     if (node) {
       ctx.panel.select(node.kind, node.index);
       canvas.classList.add('dragging');
     }
+    if (draw) ctx.tracking.drawStart(view.toMetre(p.x, p.y));
     canvas.setPointerCapture(ev.pointerId);
     ev.preventDefault();
   });
@@ -69,6 +74,8 @@ export function attachPointer(ctx) {
       } catch (e) {
         showError(e.message);
       }
+    } else if (press && press.draw) {
+      ctx.tracking.drawMove(view.toMetre(p.x, p.y));
     } else if (press) {
       if (Math.hypot(p.x - press.start.x, p.y - press.start.y) > CLICK_PX) press.moved = true;
     } else {
@@ -80,7 +87,8 @@ export function attachPointer(ctx) {
   const end = (ev) => {
     if (!press) return;
     const p = view.eventPixel(ev);
-    const wasClick = !press.node && !press.moved && ev.type === 'pointerup';
+    const wasClick = !press.node && !press.moved && ev.type === 'pointerup' && st.mode !== 'tracking';
+    if (press.draw) ctx.tracking.drawEnd(view.toMetre(p.x, p.y));
     press = null;
     canvas.classList.remove('dragging');
     if (wasClick && view.inPlot(p.x, p.y)) {
@@ -91,4 +99,5 @@ export function attachPointer(ctx) {
   canvas.addEventListener('pointerup', end);
   canvas.addEventListener('pointercancel', end);
   canvas.addEventListener('pointerleave', () => { if (!press) hover({ x: -1, y: -1 }); });
+  return { showHint: () => hover({ x: -1, y: -1 }) };
 }

@@ -5,7 +5,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
-use super::{chart_err, ChartError, ChartOptions};
+use super::{chart_err, ChartError};
 use crate::scenario::Area;
 
 /// Font sizes in pixels.
@@ -18,12 +18,58 @@ pub(crate) struct Fonts {
     pub nodes: f64,
 }
 
+impl Fonts {
+    /// The sizes at scale `s` (1 = a 1000 px wide figure).
+    pub fn scaled(s: f64) -> Fonts {
+        Fonts {
+            title: 32.0 * s,
+            subtitle: 20.0 * s,
+            axis: 23.0 * s,
+            ticks: 20.0 * s,
+            nodes: 20.0 * s,
+        }
+    }
+}
+
+/// The scale of the fonts for a `w × h` figure (1 at 1000 px wide, bounded by the height).
+pub(crate) fn font_scale(w: u32, h: u32) -> f64 {
+    (w as f64 / 1000.0).min(h as f64 / 360.0).clamp(0.5, 4.0)
+}
+
+/// The title band at the top of a figure, in pixels.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct TitleBand {
+    /// Top of the title text.
+    pub title_y: i32,
+    /// Top of the subtitle text.
+    pub subtitle_y: i32,
+    /// Height of the band.
+    pub height: f64,
+    /// Outer padding of the figure.
+    pub pad: f64,
+}
+
+impl TitleBand {
+    /// The band for fonts `font` at scale `s`, with or without a subtitle.
+    pub fn new(s: f64, font: &Fonts, subtitle: bool) -> TitleBand {
+        let pad = 12.0 * s;
+        TitleBand {
+            title_y: pad as i32,
+            subtitle_y: (pad + 1.25 * font.title) as i32,
+            height: pad
+                + 1.25 * font.title
+                + if subtitle { 1.35 * font.subtitle } else { 0.0 }
+                + 0.5 * pad,
+            pad,
+        }
+    }
+}
+
 /// Where everything goes, in pixels of the root area.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Layout {
     pub font: Fonts,
-    pub title_y: i32,
-    pub subtitle_y: i32,
+    pub band: TitleBand,
     pub chart_origin: (i32, i32),
     pub chart_size: (u32, u32),
     pub plot_margin_top: u32,
@@ -32,10 +78,6 @@ pub(crate) struct Layout {
     pub y_label_area: u32,
     pub bar_origin: (i32, i32),
     pub bar_size: (u32, u32),
-    /// Height of the title band.
-    pub title_band: f64,
-    /// Empty space kept below the axes.
-    pub bottom_pad: f64,
 }
 
 fn px(v: f64) -> u32 {
@@ -55,19 +97,10 @@ impl Layout {
 
     pub fn for_size(w: u32, h: u32, area: &Area, subtitle: bool) -> Layout {
         let (wf, hf) = (w as f64, h as f64);
-        let s = (wf / 1000.0).min(hf / 360.0).clamp(0.5, 4.0);
-        let font = Fonts {
-            title: 32.0 * s,
-            subtitle: 20.0 * s,
-            axis: 23.0 * s,
-            ticks: 20.0 * s,
-            nodes: 20.0 * s,
-        };
-        let pad = 12.0 * s;
-        let title_y = pad as i32;
-        let subtitle_y = (pad + 1.25 * font.title) as i32;
-        let title_band =
-            pad + 1.25 * font.title + if subtitle { 1.35 * font.subtitle } else { 0.0 } + 0.5 * pad;
+        let s = font_scale(w, h);
+        let font = Fonts::scaled(s);
+        let band = TitleBand::new(s, &font, subtitle);
+        let (pad, title_band) = (band.pad, band.height);
         let x_label_area = font.ticks + font.axis + 26.0 * s;
         let y_label_area = 2.2 * font.ticks + font.axis + 26.0 * s;
         let (m_top, m_right) = (10.0 * s, 12.0 * s);
@@ -92,8 +125,7 @@ impl Layout {
         let y0 = title_band + ((avail_h - ph) / 2.0).max(0.0);
         Layout {
             font,
-            title_y,
-            subtitle_y,
+            band,
             chart_origin: (x0 as i32, y0 as i32),
             chart_size: (
                 px(y_label_area + pw + m_right),
@@ -108,8 +140,6 @@ impl Layout {
                 (y0 + m_top) as i32,
             ),
             bar_size: (px(bar_block), px(ph)),
-            title_band,
-            bottom_pad: pad,
         }
     }
 }
@@ -124,29 +154,31 @@ pub fn suggested_size(area: &Area, width: u32) -> (u32, u32) {
     let mut height = hi;
     for _ in 0..4 {
         let lay = Layout::for_size(width, height, area, true);
-        let needed = lay.title_band + lay.chart_size.1 as f64 + lay.bottom_pad;
+        let needed = lay.band.height + lay.chart_size.1 as f64 + lay.band.pad;
         height = (needed.ceil() as u32).clamp(lo, hi);
     }
     (width, height)
 }
 
-/// Title and subtitle, centred.
+/// Title and subtitle, centred in the band.
 pub(crate) fn draw_titles<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
-    lay: &Layout,
-    opts: &ChartOptions,
+    font: &Fonts,
+    band: &TitleBand,
+    title: &str,
+    subtitle: Option<&str>,
 ) -> Result<(), ChartError> {
     let (w, _) = root.dim_in_pixel();
     let centre = Pos::new(HPos::Center, VPos::Top);
-    let title = TextStyle::from(("sans-serif", lay.font.title).into_font()).pos(centre);
-    root.draw_text(&opts.title, &title, (w as i32 / 2, lay.title_y))
+    let style = TextStyle::from(("sans-serif", font.title).into_font()).pos(centre);
+    root.draw_text(title, &style, (w as i32 / 2, band.title_y))
         .map_err(chart_err)?;
-    if let Some(sub) = &opts.subtitle {
+    if let Some(sub) = subtitle {
         let grey = RGBColor(70, 70, 70);
-        let style = TextStyle::from(("sans-serif", lay.font.subtitle).into_font())
+        let style = TextStyle::from(("sans-serif", font.subtitle).into_font())
             .color(&grey)
             .pos(centre);
-        root.draw_text(sub, &style, (w as i32 / 2, lay.subtitle_y))
+        root.draw_text(sub, &style, (w as i32 / 2, band.subtitle_y))
             .map_err(chart_err)?;
     }
     Ok(())

@@ -5,10 +5,13 @@
 //! [`crate::colormap`] (the same colours as the page), unbounded cells in grey, a colour bar
 //! labelled in metres, the transmitters (triangles) and receivers (circles) with their names,
 //! metre axes at equal scale and a title.
+//!
+//! [`draw_tracking_rmse`] draws the tracking figure of [S] Fig. 3 (spec §10) in the same style.
 
 mod layout;
 mod raster;
 mod ticks;
+mod tracking;
 
 use alloc::string::{String, ToString};
 use alloc::vec::Vec;
@@ -23,6 +26,7 @@ use crate::math::Real;
 use crate::scenario::{Area, Scenario};
 
 pub use layout::suggested_size;
+pub use tracking::{draw_tracking_rmse, tracking_size, TrackingChartOptions, TrackingPanel};
 
 /// A computed map: the grid and its values, row-major with row `j` at `y_j` (ascending y), m;
 /// `+∞` (or any non-finite value) marks an unbounded cell. This is what [`crate::crlb::crlb_map`]
@@ -183,7 +187,13 @@ pub fn draw_crlb_map<DB: DrawingBackend>(
 
     root.fill(&WHITE).map_err(chart_err)?;
     let lay = layout::Layout::new(root, &map.grid.area, opts.subtitle.is_some());
-    layout::draw_titles(root, &lay, opts)?;
+    layout::draw_titles(
+        root,
+        &lay.font,
+        &lay.band,
+        &opts.title,
+        opts.subtitle.as_deref(),
+    )?;
 
     let area = &map.grid.area;
     let chart_area = root.clone().shrink(lay.chart_origin, lay.chart_size);

@@ -40,6 +40,11 @@ impl App {
     pub fn scenario_ref(&self) -> &Scenario {
         self.session.scenario()
     }
+
+    /// The session (scenario and model) for the other binding files.
+    pub(super) fn session(&self) -> &Session {
+        &self.session
+    }
 }
 
 #[wasm_bindgen]

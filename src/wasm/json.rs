@@ -7,8 +7,9 @@ use wasm_bindgen::prelude::*;
 use crate::crlb::CrlbPoint;
 use crate::ellipse::Ellipse;
 use crate::session::Session;
-use crate::snapshot::{SnapshotFix, SnapshotSimulation};
+use crate::snapshot::{LinkSim, SnapshotFix, SnapshotSimulation};
 use crate::ticks::format_length_m;
+use crate::track_view::{TrackEstimate, TrackFrame};
 use crate::{Scenario, Vec2};
 
 /// Parsed JSON for JavaScript (numbers that are not finite are already `null` in `Value`).
@@ -21,7 +22,7 @@ fn label(m: f64) -> String {
 }
 
 /// `{cx, cy, a, b, angle}` or null.
-fn ellipse_json(e: Option<Ellipse>) -> Value {
+pub(super) fn ellipse_json(e: Option<Ellipse>) -> Value {
     match e {
         Some(e) => json!({
             "cx": e.center.x, "cy": e.center.y,
@@ -80,6 +81,20 @@ pub(super) fn nodes_json(session: &Session) -> Value {
     json!({"transmitters": tx, "receivers": rx, "links": links})
 }
 
+/// `{tx, rx, name, delay_s, sigma_s, range_sigma_label, ellipse, outline, arc}`.
+fn link_json(l: &LinkSim, s: &Scenario) -> Value {
+    let (tx, rx) = (l.link.tx, l.link.rx);
+    json!({
+        "tx": tx, "rx": rx,
+        "name": format!("{}\u{2013}{}", s.transmitters[tx].name, s.receivers[rx].name),
+        "delay_s": l.delay_s, "sigma_s": l.sigma_s,
+        "range_sigma_label": label(l.range_sigma_m),
+        "ellipse": ellipse_json(l.ellipse),
+        "outline": points_json(&l.outline),
+        "arc": points_json(&l.arc),
+    })
+}
+
 fn fix_json(f: &SnapshotFix) -> Value {
     let r = &f.report;
     json!({
@@ -95,22 +110,7 @@ fn fix_json(f: &SnapshotFix) -> Value {
 /// `{truth: {x, y}, seed, links: [{tx, rx, name, delay_s, sigma_s, range_sigma_label, ellipse,
 /// outline, arc}], fix | null, fix_error | null, crlb, view_radius_m}`.
 pub(super) fn snapshot_json(sim: &SnapshotSimulation, s: &Scenario) -> Value {
-    let links: Vec<Value> = sim
-        .links
-        .iter()
-        .map(|l| {
-            let (tx, rx) = (l.link.tx, l.link.rx);
-            json!({
-                "tx": tx, "rx": rx,
-                "name": format!("{}\u{2013}{}", s.transmitters[tx].name, s.receivers[rx].name),
-                "delay_s": l.delay_s, "sigma_s": l.sigma_s,
-                "range_sigma_label": label(l.range_sigma_m),
-                "ellipse": ellipse_json(l.ellipse),
-                "outline": points_json(&l.outline),
-                "arc": points_json(&l.arc),
-            })
-        })
-        .collect();
+    let links: Vec<Value> = sim.links.iter().map(|l| link_json(l, s)).collect();
     let (fix, fix_error) = match &sim.fix {
         Ok(f) => (fix_json(f), Value::Null),
         Err(e) => (Value::Null, Value::String(e.to_string())),
@@ -123,5 +123,30 @@ pub(super) fn snapshot_json(sim: &SnapshotSimulation, s: &Scenario) -> Value {
         "fix_error": fix_error,
         "crlb": crlb_json(&sim.crlb),
         "view_radius_m": sim.view_radius_m,
+    })
+}
+
+/// `{x, y, vx, vy, ellipse, error_m, error_label, sigma_m, sigma_label, nis}`.
+pub(super) fn estimate_json(e: &TrackEstimate) -> Value {
+    json!({
+        "x": e.position.x, "y": e.position.y, "vx": e.velocity.x, "vy": e.velocity.y,
+        "ellipse": ellipse_json(e.ellipse),
+        "error_m": e.error_m, "error_label": label(e.error_m),
+        "sigma_m": e.sigma_m, "sigma_label": label(e.sigma_m),
+        "nis": e.nis,
+    })
+}
+
+/// A track step shaped like [`snapshot_json`], the EKF estimate in place of the fix: `{step,
+/// t_s, truth: {x, y, vx, vy}, links, fix: estimate, fix_error: null, crlb, view_radius_m}`.
+pub(super) fn frame_json(f: &TrackFrame, s: &Scenario) -> Value {
+    json!({
+        "step": f.step, "t_s": f.t_s,
+        "truth": {"x": f.truth.x, "y": f.truth.y, "vx": f.truth_velocity.x, "vy": f.truth_velocity.y},
+        "links": f.links.iter().map(|l| link_json(l, s)).collect::<Vec<_>>(),
+        "fix": estimate_json(&f.estimate),
+        "fix_error": null,
+        "crlb": crlb_json(&f.crlb),
+        "view_radius_m": f.view_radius_m,
     })
 }

@@ -8,7 +8,9 @@
 //! [`Error`]'s one-line message, which names the offending field; nothing panics on input.
 //!
 //! Files: `app.rs` (the `App` class), `render.rs` (colours, ticks and labels for drawing),
-//! `json.rs` (core results as JavaScript values).
+//! `json.rs` (core results as JavaScript values), `tracking.rs` (`App.simulate_track` and the
+//! `Track` it returns), `montecarlo.rs` (`MonteCarloJob`, run chunk by chunk in a Web Worker),
+//! `chart.rs` (the plotters ε_EKF / ε_PCRLB chart on a canvas).
 
 use wasm_bindgen::prelude::*;
 
@@ -16,14 +18,20 @@ use crate::error::Error;
 use crate::{presets, Vec2};
 
 mod app;
+mod chart;
 mod json;
+mod montecarlo;
 mod render;
+mod tracking;
 
 pub use app::App;
+pub use chart::draw_tracking_chart;
+pub use montecarlo::MonteCarloJob;
 pub use render::{
     axis_ticks, colorbar_rgba, colorbar_ticks, format_length, render_map_rgba, scale_bar,
     unbounded_rgb,
 };
+pub use tracking::{drag_velocity, track_steps, Track, MAX_TRACK_STEPS};
 
 /// Module start: route Rust panics to `console.error` with their message.
 #[wasm_bindgen(start)]

@@ -1,5 +1,5 @@
-//! A small hand-rolled parser: positional words plus `--flag VALUE` / `--flag=VALUE` options,
-//! each subcommand declaring which flags it takes. Errors name the flag.
+//! A small hand-rolled parser: positional words, `--flag VALUE` / `--flag=VALUE` options and
+//! value-less `--switch`es, each subcommand declaring which it takes. Errors name the flag.
 
 use std::ffi::OsString;
 
@@ -12,14 +12,21 @@ pub struct Args {
     pub positional: Vec<String>,
     /// `(flag, value)` pairs, flag without the leading dashes.
     flags: Vec<(String, String)>,
+    /// Switches given (names without dashes).
+    switches: Vec<String>,
     /// `--help` or `-h` was given.
     pub help: bool,
 }
 
 impl Args {
     /// Parses `argv` (without the program name and subcommand) accepting only `allowed` flags
-    /// (names without dashes); every flag takes a value.
-    pub fn parse(argv: &[OsString], command: &str, allowed: &[&str]) -> Result<Args, CliError> {
+    /// (names without dashes), each of which takes a value, and the value-less `switches`.
+    pub fn parse(
+        argv: &[OsString],
+        command: &str,
+        allowed: &[&str],
+        switches: &[&str],
+    ) -> Result<Args, CliError> {
         let mut out = Args::default();
         let mut it = argv.iter();
         while let Some(raw) = it.next() {
@@ -41,6 +48,16 @@ impl Args {
                 Some((n, v)) => (n, Some(v.to_string())),
                 None => (body, None),
             };
+            if switches.contains(&name) {
+                if inline.is_some() {
+                    return Err(CliError::usage(format!("--{name}: takes no value")));
+                }
+                if out.switch(name) {
+                    return Err(CliError::usage(format!("--{name}: given more than once")));
+                }
+                out.switches.push(name.to_string());
+                continue;
+            }
             if !allowed.contains(&name) {
                 return Err(unknown(command, arg));
             }
@@ -66,6 +83,11 @@ impl Args {
             .iter()
             .find(|(n, _)| n == name)
             .map(|(_, v)| v.as_str())
+    }
+
+    /// Whether the switch `--name` was given.
+    pub fn switch(&self, name: &str) -> bool {
+        self.switches.iter().any(|n| n == name)
     }
 
     /// The value of a required `--name`.

@@ -3,12 +3,13 @@
 use std::ffi::OsString;
 use std::io::{Read, Write};
 
+use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 
 use scatterloc::crlb::crlb_at;
 use scatterloc::lm::{locate as lm_locate, DelayMeasurements, LmConfig};
 use scatterloc::scenario::parse_json;
-use scatterloc::{presets, Mat2, Model, Scenario, Vec2};
+use scatterloc::{presets, Error, Mat2, Model, Scenario, Vec2};
 
 use crate::args::{parse_xy, Args};
 use crate::{CliError, USAGE};
@@ -28,13 +29,15 @@ pub fn emit_json<T: Serialize>(v: &T) -> Result<(), CliError> {
     emit(&text)
 }
 
-/// Parses the subcommand's flags; `Ok(None)` when `--help` was asked (usage already printed).
+/// Parses the subcommand's flags (`allowed` take a value, `switches` do not); `Ok(None)` when
+/// `--help` was asked (usage already printed).
 pub fn parse_args(
     argv: &[OsString],
     cmd: &str,
     allowed: &[&str],
+    switches: &[&str],
 ) -> Result<Option<Args>, CliError> {
-    let args = Args::parse(argv, cmd, allowed)?;
+    let args = Args::parse(argv, cmd, allowed, switches)?;
     if args.help {
         emit(USAGE.trim_end())?;
         return Ok(None);
@@ -60,7 +63,8 @@ pub fn read_scenario(args: &Args) -> Result<Scenario, CliError> {
     Scenario::from_json(&text).map_err(|e| CliError::usage(format!("--scenario {path}: {e}")))
 }
 
-fn model_of(s: &Scenario) -> Result<Model, CliError> {
+/// The model of a validated scenario.
+pub fn model_of(s: &Scenario) -> Result<Model, CliError> {
     Model::new(s).map_err(|e| CliError::usage(format!("--scenario: {e}")))
 }
 
@@ -71,7 +75,7 @@ fn sym(m: &Mat2) -> [[f64; 2]; 2] {
 
 /// `scatterloc preset NAME`.
 pub fn preset(argv: &[OsString]) -> Result<(), CliError> {
-    let Some(args) = parse_args(argv, "preset", &[])? else {
+    let Some(args) = parse_args(argv, "preset", &[], &[])? else {
         return Ok(());
     };
     args.expect_positional("preset", 1, "preset name (sensors2019 or iclgnss2019)")?;
@@ -81,7 +85,7 @@ pub fn preset(argv: &[OsString]) -> Result<(), CliError> {
 
 /// `scatterloc crlb --scenario S --at X,Y`.
 pub fn crlb(argv: &[OsString]) -> Result<(), CliError> {
-    let Some(args) = parse_args(argv, "crlb", &["scenario", "at"])? else {
+    let Some(args) = parse_args(argv, "crlb", &["scenario", "at"], &[])? else {
         return Ok(());
     };
     args.expect_positional("crlb", 0, "")?;
@@ -166,40 +170,77 @@ struct DelaysFile {
     initial_m: Option<[f64; 2]>,
 }
 
+/// `sigma_s` of a measurements file: one delay standard deviation for all links or one per link, s.
 #[derive(Debug, Deserialize)]
 #[serde(untagged)]
-enum Sigma {
+pub enum Sigma {
+    /// The same σ for every link.
     One(f64),
+    /// One σ per link in scenario link order.
     PerLink(Vec<f64>),
+}
+
+impl Sigma {
+    /// One σ per link for `n` links, each a finite number > 0 (errors name `sigma_s[k]`).
+    pub fn per_link(self, n: usize) -> Result<Vec<f64>, Error> {
+        let v = match self {
+            Sigma::One(v) => {
+                if !(v.is_finite() && v > 0.0) {
+                    return Err(Error::NotPositive {
+                        field: "sigma_s".into(),
+                        value: v,
+                    });
+                }
+                vec![v; n]
+            }
+            Sigma::PerLink(v) if v.len() != n => {
+                return Err(Error::LengthMismatch {
+                    field: "sigma_s",
+                    expected: n,
+                    found: v.len(),
+                })
+            }
+            Sigma::PerLink(v) => v,
+        };
+        match v.iter().position(|s| !(s.is_finite() && *s > 0.0)) {
+            Some(link) => Err(Error::InvalidSigma {
+                link,
+                value: v[link],
+            }),
+            None => Ok(v),
+        }
+    }
+}
+
+/// Reads and parses the JSON file named by `--flag` (errors: `--flag PATH: field: problem`).
+pub fn read_json_file<T: DeserializeOwned>(flag: &str, path: &str) -> Result<T, CliError> {
+    let text = read_input(flag, path)?;
+    parse_json(&text).map_err(|e| {
+        CliError::usage(format!(
+            "--{flag} {path}: {}",
+            e.to_string().replace(
+                "data did not match any variant of untagged enum Sigma",
+                "expected a number or a list of numbers (one per link)",
+            )
+        ))
+    })
 }
 
 /// `scatterloc locate --scenario S --delays D`.
 pub fn locate(argv: &[OsString]) -> Result<(), CliError> {
-    let Some(args) = parse_args(argv, "locate", &["scenario", "delays"])? else {
+    let Some(args) = parse_args(argv, "locate", &["scenario", "delays"], &[])? else {
         return Ok(());
     };
     args.expect_positional("locate", 0, "")?;
     let dpath = args.required("delays")?;
     let s = read_scenario(&args)?;
-    let text = read_input("delays", dpath)?;
     let bad = |m: String| CliError::usage(format!("--delays {dpath}: {m}"));
-    let d: DelaysFile = parse_json(&text).map_err(|e| {
-        bad(e.to_string().replace(
-            "data did not match any variant of untagged enum Sigma",
-            "expected a number or a list of numbers (one per link)",
-        ))
-    })?;
+    let d: DelaysFile = read_json_file("delays", dpath)?;
     let model = model_of(&s)?;
-    let n = model.link_count();
-    let sigmas = match d.sigma_s {
-        Sigma::One(v) if v.is_finite() && v > 0.0 => vec![v; n],
-        Sigma::One(v) => {
-            return Err(bad(format!(
-                "sigma_s: must be a finite number > 0 (got {v})"
-            )))
-        }
-        Sigma::PerLink(v) => v,
-    };
+    let sigmas = d
+        .sigma_s
+        .per_link(model.link_count())
+        .map_err(|e| bad(e.to_string()))?;
     let m = DelayMeasurements {
         delays_s: &d.delays_s,
         sigmas_s: &sigmas,

@@ -1,5 +1,6 @@
 //! `scatterloc`: command-line front end of the scatterloc core — presets, the CRLB at a point,
-//! CRLB maps (JSON, SVG, PNG) and Levenberg–Marquardt fixes from measured delays.
+//! CRLB maps (JSON, SVG, PNG), Levenberg–Marquardt fixes from measured delays, the EKF tracker
+//! (spec §6) and its Monte Carlo evaluation against the posterior CRLB (§8, §9.5, [S] Fig. 3).
 //!
 //! Results are JSON on stdout. Bad input exits with status 2 and one line on stderr that names the
 //! offending flag or field; nothing panics on bad input. Native only: for wasm32 targets (which
@@ -13,8 +14,17 @@ mod args;
 #[cfg(not(target_arch = "wasm32"))]
 mod commands;
 #[cfg(not(target_arch = "wasm32"))]
-#[cfg(not(target_arch = "wasm32"))]
 mod map_cmd;
+#[cfg(not(target_arch = "wasm32"))]
+mod mc_cmd;
+#[cfg(not(target_arch = "wasm32"))]
+mod output;
+#[cfg(not(target_arch = "wasm32"))]
+mod report;
+#[cfg(not(target_arch = "wasm32"))]
+mod study;
+#[cfg(not(target_arch = "wasm32"))]
+mod track_cmd;
 
 /// Usage text (`scatterloc help`).
 #[cfg(not(target_arch = "wasm32"))]
@@ -39,11 +49,36 @@ USAGE:
       Levenberg-Marquardt fix. Delays file: {\"delays_s\": [one per link in scenario link
       order, null = no measurement], \"sigma_s\": number | [per link], \"initial_m\": [x, y]
       (optional; default: best node of a 0.5 m grid over area_m)}.
+  scatterloc track --scenario FILE --measurements FILE
+      EKF (spec 6): step n predicts by dt_s, then updates with steps[n-1]. Measurements file:
+      {\"dt_s\": T, \"process_noise\": q (m^2/s^3), \"initial_state\": [x, y, vx, vy],
+      \"initial_covariance\": [[4x4]], \"sigma_s\": number | [per link] (optional; default: link
+      budget at the predicted position), \"steps\": [[one delay per link, null = missing], ..]}.
+      Prints {t_s, states, covariances, nis (null: no link), links_used}, one entry per step.
+  scatterloc montecarlo [--preset NAME | --scenario FILE] [--trajectory I|II|III|all]
+                        [--runs N] [--noise-runs N] [--dt T] [--duration S] [--process-noise Q]
+                        [--seed N] [--threads N] [--oracle-noise] [--out FIG.{svg,png}]
+                        [--json OUT.json]
+      EKF RMSE against the posterior CRLB ([S] Fig. 3, spec 9.5). Defaults: paper scale,
+      sensors2019, all three trajectories, 5000 trajectories x 50 noise runs, T = 2.048 ms,
+      10 s, q = 0.01, seed 1, all cores (0). Progress on stderr; Ctrl-C stops (exit 130, no
+      files written). --json: {t_s, rmse_ekf_m, rmse_pcrlb_m, nees, runs, seed, trajectory,
+      dt_s, noise_runs, trajectories, failed_runs, wall_time_s, ns_per_ekf_step, ..} (several
+      trajectories: {\"scenarios\": [..]}); ns_per_ekf_step = wall x threads / (runs x steps).
+      Prints a one-line summary with the values at 1, 2, 5 and 10 s (without --json and
+      --out: the whole JSON document instead).
+  scatterloc pcrlb --nominal [--preset NAME | --scenario FILE] [--trajectory I|II|III|all]
+                   [--dt T] [--duration S] [--process-noise Q] [--json OUT.json] [--out FIG]
+  scatterloc pcrlb [same flags without --nominal] [--runs N] [--seed N] [--threads N]
+      Posterior CRLB alone (spec 8): at the noise-free path (--nominal, check 9) or with
+      E[F] over N truth trajectories (default 5000, check 10). {t_s, rmse_pcrlb_m, trajectory,
+      dt_s, nominal, ..}; on stdout unless --json/--out are given (then a summary).
   scatterloc help | --help | -h      Show this text.
   scatterloc --version               Show the version.
 
 FILE may be '-' for standard input. Units: metres, seconds, hertz; dB only where named.
-Exit status: 0 success, 2 bad input (one line on stderr naming the field), 1 output failure.
+Exit status: 0 success, 2 bad input (one line on stderr naming the field), 1 output failure,
+130 cancelled (Ctrl-C). Output files are written atomically (a temporary file renamed into place).
 ";
 
 /// A failure to report: one line on stderr and an exit status.
@@ -94,7 +129,7 @@ fn main() {
 fn run(argv: &[std::ffi::OsString]) -> Result<(), CliError> {
     let Some(first) = argv.first() else {
         return Err(CliError::usage(
-            "missing subcommand (preset, crlb, crlb-map, locate, help)",
+            "missing subcommand (preset, crlb, crlb-map, locate, track, montecarlo, pcrlb, help)",
         ));
     };
     let rest = &argv[1..];
@@ -105,8 +140,12 @@ fn run(argv: &[std::ffi::OsString]) -> Result<(), CliError> {
         "crlb" => commands::crlb(rest),
         "crlb-map" => map_cmd::crlb_map(rest),
         "locate" => commands::locate(rest),
+        "track" => track_cmd::track(rest),
+        "montecarlo" => mc_cmd::montecarlo(rest),
+        "pcrlb" => mc_cmd::pcrlb(rest),
         other => Err(CliError::usage(format!(
-            "unknown subcommand '{}' (expected preset, crlb, crlb-map, locate or help)",
+            "unknown subcommand '{}' (expected preset, crlb, crlb-map, locate, track, \
+             montecarlo, pcrlb or help)",
             if other.is_empty() {
                 first.to_string_lossy()
             } else {

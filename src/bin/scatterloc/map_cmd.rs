@@ -1,9 +1,9 @@
 //! `scatterloc crlb-map`: the RMSE bound over a grid, written as JSON, SVG or PNG.
 
 use std::ffi::OsString;
-use std::io::{BufWriter, Write};
 use std::time::Instant;
 
+use plotters::coord::Shift;
 use plotters::prelude::*;
 use serde::Serialize;
 use serde_json::json;
@@ -11,13 +11,14 @@ use serde_json::json;
 use scatterloc::chart::{
     check_area, default_titles, draw_crlb_map, scenario_nodes, suggested_size,
 };
-use scatterloc::chart::{ChartOptions, MapData};
+use scatterloc::chart::{ChartError, ChartNode, ChartOptions, MapData};
 use scatterloc::crlb::{crlb_map as map_kernel, Grid};
 use scatterloc::scenario::Area;
 use scatterloc::{Error, Model, Scenario};
 
 use crate::args::Args;
 use crate::commands::{emit, parse_args, read_scenario};
+use crate::output::{write_figure, write_json_file, Figure, Format};
 use crate::CliError;
 
 const FLAGS: &[&str] = &[
@@ -25,41 +26,6 @@ const FLAGS: &[&str] = &[
 ];
 /// Default grid side.
 const DEFAULT_N: usize = 256;
-
-#[derive(Clone, Copy, PartialEq)]
-enum Format {
-    Json,
-    Svg,
-    Png,
-}
-
-impl Format {
-    fn of(path: &str) -> Result<Format, CliError> {
-        let ext = std::path::Path::new(path)
-            .extension()
-            .and_then(|e| e.to_str())
-            .map(str::to_ascii_lowercase);
-        match ext.as_deref() {
-            Some("json") => Ok(Format::Json),
-            Some("svg") => Ok(Format::Svg),
-            Some("png") => Ok(Format::Png),
-            Some(e) => Err(CliError::usage(format!(
-                "--out: unknown extension '.{e}' (use .json, .svg or .png)"
-            ))),
-            None => Err(CliError::usage(format!(
-                "--out: '{path}' has no extension (use .json, .svg or .png)"
-            ))),
-        }
-    }
-
-    fn name(self) -> &'static str {
-        match self {
-            Format::Json => "json",
-            Format::Svg => "svg",
-            Format::Png => "png",
-        }
-    }
-}
 
 /// The scenario's area with the `--x-min` … `--y-max` overrides applied.
 fn area_of(args: &Args, s: &Scenario) -> Result<Area, CliError> {
@@ -102,12 +68,12 @@ fn grid_of(args: &Args, area: Area) -> Result<Grid, CliError> {
 
 /// `scatterloc crlb-map`.
 pub fn crlb_map(argv: &[OsString]) -> Result<(), CliError> {
-    let Some(args) = parse_args(argv, "crlb-map", FLAGS)? else {
+    let Some(args) = parse_args(argv, "crlb-map", FLAGS, &[])? else {
         return Ok(());
     };
     args.expect_positional("crlb-map", 0, "")?;
     let out = args.required("out")?;
-    let format = Format::of(out)?;
+    let format = Format::of("out", out, &[Format::Json, Format::Svg, Format::Png])?;
     let s = read_scenario(&args)?;
     let area = area_of(&args, &s)?;
     let grid = grid_of(&args, area)?;
@@ -132,11 +98,15 @@ pub fn crlb_map(argv: &[OsString]) -> Result<(), CliError> {
                 subtitle: Some(subtitle),
                 ..ChartOptions::default()
             };
-            let map = MapData {
-                grid,
-                values_m: &values,
+            let figure = MapFigure {
+                map: MapData {
+                    grid,
+                    values_m: &values,
+                },
+                nodes: scenario_nodes(&s),
+                opts,
             };
-            write_figure(out, format, size, &map, &s, &opts)?;
+            write_figure("out", out, format, size, &figure)?;
         }
     }
     let write_ms = t1.elapsed().as_secs_f64() * 1e3;
@@ -188,50 +158,24 @@ struct MapJson<'a> {
     rmse_bound_m: Vec<&'a [f64]>,
 }
 
-fn cannot_write(path: &str, e: impl std::fmt::Display) -> CliError {
-    CliError::usage(format!("--out: cannot write '{path}': {e}"))
-}
-
 fn write_json(path: &str, grid: &Grid, values: &[f64]) -> Result<(), CliError> {
     let doc = MapJson {
         x_m: (0..grid.nx).map(|i| grid.x(i)).collect(),
         y_m: (0..grid.ny).map(|j| grid.y(j)).collect(),
         rmse_bound_m: values.chunks(grid.nx).collect(),
     };
-    let file = std::fs::File::create(path).map_err(|e| cannot_write(path, e))?;
-    let mut w = BufWriter::new(file);
-    serde_json::to_writer(&mut w, &doc).map_err(|e| cannot_write(path, e))?;
-    w.write_all(b"\n")
-        .and_then(|_| w.flush())
-        .map_err(|e| cannot_write(path, e))
+    write_json_file("out", path, &doc)
 }
 
-fn write_figure(
-    path: &str,
-    format: Format,
-    size: (u32, u32),
-    map: &MapData,
-    s: &Scenario,
-    opts: &ChartOptions,
-) -> Result<(), CliError> {
-    let nodes = scenario_nodes(s);
-    let fail = |e: String| CliError::output(format!("drawing the figure: {e}"));
-    match format {
-        Format::Svg => {
-            let mut svg = String::new();
-            {
-                let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
-                draw_crlb_map(&root, map, &nodes, opts).map_err(|e| fail(e.to_string()))?;
-                root.present().map_err(|e| fail(e.to_string()))?;
-            }
-            std::fs::write(path, svg).map_err(|e| cannot_write(path, e))
-        }
-        _ => {
-            // Fail early with a clear message when the file cannot be created.
-            std::fs::File::create(path).map_err(|e| cannot_write(path, e))?;
-            let root = BitMapBackend::new(path, size).into_drawing_area();
-            draw_crlb_map(&root, map, &nodes, opts).map_err(|e| fail(e.to_string()))?;
-            root.present().map_err(|e| cannot_write(path, e))
-        }
+/// The map figure of [`draw_crlb_map`] as a [`Figure`].
+struct MapFigure<'a> {
+    map: MapData<'a>,
+    nodes: Vec<ChartNode>,
+    opts: ChartOptions,
+}
+
+impl Figure for MapFigure<'_> {
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), ChartError> {
+        draw_crlb_map(root, &self.map, &self.nodes, &self.opts).map(|_| ())
     }
 }

@@ -1,0 +1,275 @@
+//! Shared machinery of `montecarlo` and `pcrlb`: the study flags (scenario, trajectories I–III of
+//! spec §9.4, step, duration, q̃), the Monte Carlo configuration of §9.5, the parallel run with a
+//! progress bar (rate, ETA) on stderr and Ctrl-C cancellation, and the curve values at the
+//! reporting times of check 9/10.
+
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
+
+use indicatif::{ProgressBar, ProgressStyle};
+use serde::Serialize;
+
+use scatterloc::montecarlo::{MonteCarloConfig, MonteCarloResult, MAX_STEPS};
+use scatterloc::motion::ConstantVelocity;
+use scatterloc::parallel::run_parallel;
+use scatterloc::trajectory::{
+    paper_initial_covariance, step_count, TrackScenario, PAPER_DURATION_S, PAPER_INTENSITY,
+    PAPER_STEP_S,
+};
+use scatterloc::{presets, Error, Model, Scenario};
+
+use crate::args::Args;
+use crate::commands::{model_of, read_scenario};
+use crate::CliError;
+
+/// Flags every study takes.
+pub const STUDY_FLAGS: &[&str] = &[
+    "preset",
+    "scenario",
+    "trajectory",
+    "dt",
+    "duration",
+    "process-noise",
+];
+/// Times at which the summaries report the curves, s (check 9, 10).
+pub const REPORT_TIMES_S: [f64; 4] = [1.0, 2.0, 5.0, 10.0];
+/// Most worker threads accepted by `--threads`.
+const MAX_THREADS: usize = 256;
+
+/// Set by Ctrl-C; the Monte Carlo driver stops after its current wave.
+static CANCEL: AtomicBool = AtomicBool::new(false);
+
+/// The scenario, trajectories and time grid of a study.
+pub struct Study {
+    /// Name of the node layout (preset or scenario file).
+    pub layout: String,
+    /// The measurement model.
+    pub model: Model,
+    /// Trajectories to evaluate, in order.
+    pub trajectories: Vec<TrackScenario>,
+    /// CV model (E7).
+    pub motion: ConstantVelocity,
+    /// Steps after `t₀`.
+    pub steps: usize,
+}
+
+/// Maps a core error to the flag that caused it.
+pub fn flag_error(e: Error) -> CliError {
+    let flag = |field: &str| {
+        match field {
+            "runs" => "--runs",
+            "noise_runs" => "--noise-runs",
+            "runs*noise_runs" => "--runs × --noise-runs",
+            "steps" => "--duration / --dt (steps)",
+            "dt_s" => "--dt",
+            "process_noise" => "--process-noise",
+            "threads" => "--threads",
+            other => other,
+        }
+        .to_string()
+    };
+    let text = match &e {
+        Error::SizeLimit { field, .. } => e.to_string().replacen(field, &flag(field), 1),
+        Error::NonFinite { field } | Error::NotPositive { field, .. } => {
+            e.to_string().replacen(field.as_str(), &flag(field), 1)
+        }
+        Error::Cancelled => return cancelled(),
+        _ => e.to_string(),
+    };
+    CliError::usage(text)
+}
+
+fn cancelled() -> CliError {
+    CliError {
+        message: "cancelled by Ctrl-C; no output files were written".into(),
+        code: 130,
+    }
+}
+
+/// Parses the study flags: `--preset` (default `sensors2019`) or `--scenario`, `--trajectory`
+/// (`I`, `II`, `III` or `all`, the default), `--dt`, `--duration`, `--process-noise`.
+pub fn parse_study(args: &Args) -> Result<Study, CliError> {
+    let (layout, scenario): (String, Scenario) = match (args.get("preset"), args.get("scenario")) {
+        (Some(_), Some(_)) => {
+            return Err(CliError::usage(
+                "--preset / --scenario: give one of them, not both",
+            ))
+        }
+        (_, Some(_)) => {
+            let s = read_scenario(args)?;
+            (s.name.clone(), s)
+        }
+        (p, None) => {
+            let name = p.unwrap_or("sensors2019");
+            let s = presets::preset(name).map_err(|e| CliError::usage(format!("--preset: {e}")))?;
+            (name.to_string(), s)
+        }
+    };
+    let trajectories = match args.get("trajectory") {
+        None => TrackScenario::ALL.to_vec(),
+        Some(t) if t.eq_ignore_ascii_case("all") => TrackScenario::ALL.to_vec(),
+        Some(t) => vec![TrackScenario::parse(t).map_err(|_| {
+            CliError::usage(format!(
+                "--trajectory: '{t}' is not one of I, II, III or all"
+            ))
+        })?],
+    };
+    let dt = args.number("dt")?.unwrap_or(PAPER_STEP_S);
+    let q = args.number("process-noise")?.unwrap_or(PAPER_INTENSITY);
+    let motion = ConstantVelocity::validated(dt, q).map_err(flag_error)?;
+    let duration = args.number("duration")?.unwrap_or(PAPER_DURATION_S);
+    if duration <= 0.0 {
+        return Err(CliError::usage(format!(
+            "--duration: must be > 0 s (got {duration})"
+        )));
+    }
+    let steps = step_count(duration, dt);
+    if steps == 0 || steps > MAX_STEPS {
+        return Err(CliError::usage(format!(
+            "--duration / --dt: {duration} s at {dt} s is {steps} steps, outside 1..={MAX_STEPS}"
+        )));
+    }
+    Ok(Study {
+        layout,
+        model: model_of(&scenario)?,
+        trajectories,
+        motion,
+        steps,
+    })
+}
+
+impl Study {
+    /// The Monte Carlo study of spec §9.5 for trajectory `t`: prior mean `x̄₀` of §9.4,
+    /// `P(t₀) = diag(0.1, 0.1, 0.01, 0.01)`, validated (errors name the flags).
+    pub fn config(
+        &self,
+        t: TrackScenario,
+        runs: usize,
+        noise_runs: usize,
+        seed: u64,
+        oracle_noise: bool,
+    ) -> Result<MonteCarloConfig, CliError> {
+        let cfg = MonteCarloConfig {
+            motion: self.motion,
+            steps: self.steps,
+            mean_state: t.mean_state(),
+            initial_covariance: paper_initial_covariance(),
+            trajectories: runs,
+            noise_runs,
+            seed,
+            oracle_noise,
+        };
+        cfg.validate().map_err(flag_error)?;
+        Ok(cfg)
+    }
+
+    /// `T = …` for titles: milliseconds below 0.1 s.
+    pub fn step_label(&self) -> String {
+        let dt = self.motion.dt_s;
+        let (v, unit) = if dt < 0.1 {
+            (dt * 1e3, "ms")
+        } else {
+            (dt, "s")
+        };
+        let text = format!("{v:.6}");
+        format!(
+            "{} {unit}",
+            text.trim_end_matches('0').trim_end_matches('.')
+        )
+    }
+}
+
+/// `--threads` (default 0 = all cores) and the number of threads that means.
+pub fn threads(args: &Args) -> Result<(usize, usize), CliError> {
+    let n = args.integer("threads")?.unwrap_or(0);
+    if n > MAX_THREADS {
+        return Err(CliError::usage(format!(
+            "--threads: {n} is outside the allowed range 0..={MAX_THREADS} (0 = all cores)"
+        )));
+    }
+    let used = if n == 0 {
+        rayon::current_num_threads()
+    } else {
+        n
+    };
+    Ok((n, used))
+}
+
+/// `--seed` (default 1).
+pub fn seed(args: &Args) -> Result<u64, CliError> {
+    Ok(args.integer("seed")?.unwrap_or(1) as u64)
+}
+
+/// Runs `cfg` on `threads` threads with a progress bar labelled `label` (drawn only when stderr
+/// is a terminal). Ctrl-C stops it: exit status 130. Returns the result and the wall time, s.
+pub fn run_with_progress(
+    model: &Model,
+    cfg: &MonteCarloConfig,
+    threads: usize,
+    label: &str,
+) -> Result<(MonteCarloResult, f64), CliError> {
+    static HANDLER: std::sync::Once = std::sync::Once::new();
+    HANDLER.call_once(|| {
+        // A second Ctrl-C leaves at once (nothing has been written yet either way).
+        let _ = ctrlc::set_handler(|| {
+            if CANCEL.swap(true, Ordering::SeqCst) {
+                std::process::exit(130);
+            }
+        });
+    });
+    let bar = ProgressBar::new(cfg.runs() as u64);
+    let style = ProgressStyle::with_template(
+        "{prefix} {elapsed_precise} [{wide_bar}] {human_pos}/{human_len} runs · {per_sec} · ETA {eta}",
+    )
+    .map(|s| s.progress_chars("=> "));
+    if let Ok(style) = style {
+        bar.set_style(style);
+    }
+    bar.set_prefix(label.to_string());
+    bar.enable_steady_tick(Duration::from_millis(250));
+    let t0 = Instant::now();
+    let res = run_parallel(model, cfg, threads, &CANCEL, |done, _| {
+        bar.set_position(done as u64)
+    });
+    let wall = t0.elapsed().as_secs_f64();
+    bar.finish_and_clear();
+    if CANCEL.load(Ordering::SeqCst) {
+        return Err(cancelled());
+    }
+    Ok((res.map_err(flag_error)?, wall))
+}
+
+/// The curves at one reporting time.
+#[derive(Serialize)]
+pub struct AtTime {
+    /// `t_n` nearest to the reporting time (step `round(t/T)`), s.
+    pub t_s: f64,
+    /// `ε_EKF`, m (absent for a bound alone).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rmse_ekf_m: Option<f64>,
+    /// `ε_PCRLB`, m (`null` if singular).
+    pub rmse_pcrlb_m: Option<f64>,
+    /// Average NEES (absent for a bound alone).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub nees: Option<f64>,
+}
+
+/// The values at [`REPORT_TIMES_S`] within the run (step `round(t/T)`, as check 9).
+pub fn at_report_times(
+    t_s: &[f64],
+    pcrlb: &[Option<f64>],
+    ekf: Option<(&[f64], &[f64])>,
+) -> Vec<AtTime> {
+    let dt = t_s.get(1).copied().unwrap_or(1.0);
+    REPORT_TIMES_S
+        .iter()
+        .map(|t| (t / dt).round() as usize)
+        .filter(|&n| n < t_s.len())
+        .map(|n| AtTime {
+            t_s: t_s[n],
+            rmse_ekf_m: ekf.map(|(e, _)| e[n]),
+            rmse_pcrlb_m: pcrlb[n],
+            nees: ekf.map(|(_, v)| v[n]),
+        })
+        .collect()
+}

@@ -1,0 +1,277 @@
+//! The tracking figure of [S] Fig. 3 (spec §10): the EKF's position RMSE `ε_EKF(t)` (§9.5)
+//! against the posterior CRLB `ε_PCRLB(t)` (§8, E9) over time, on a logarithmic metre axis, one
+//! panel per scenario side by side. Generic over the plotters [`DrawingBackend`]: SVG and PNG in
+//! the CLI, a `<canvas>` in the browser; same fonts, title band and tick labels as the map figure.
+
+use alloc::string::String;
+use alloc::vec::Vec;
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+use super::layout::{draw_titles, font_scale, Fonts, TitleBand};
+use super::ticks::colorbar_ticks;
+use super::{axis_label, chart_err, register_fonts, ChartError};
+use crate::math::Real;
+use crate::ticks::nice_below;
+
+/// Colour of the EKF curve (solid).
+const EKF_RGB: RGBColor = RGBColor(0, 94, 184);
+/// Colour of the PCRLB curve (dashed).
+const PCRLB_RGB: RGBColor = RGBColor(214, 39, 40);
+
+/// One panel: the curves of one scenario.
+#[derive(Debug, Clone, Copy)]
+pub struct TrackingPanel<'a> {
+    /// Panel caption, e.g. `Scenario II`.
+    pub title: &'a str,
+    /// Times `t_n`, s (ascending).
+    pub t_s: &'a [Real],
+    /// `ε_EKF(t_n)`, m, one per time (empty: not drawn; non-finite: a gap).
+    pub rmse_ekf_m: &'a [Real],
+    /// `ε_PCRLB(t_n)`, m, one per time (empty: not drawn; `None`: a gap).
+    pub rmse_pcrlb_m: &'a [Option<Real>],
+}
+
+/// Title and subtitle of the figure.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct TrackingChartOptions {
+    /// Title line.
+    pub title: String,
+    /// Optional smaller second line (run counts, step).
+    pub subtitle: Option<String>,
+}
+
+/// A figure size for `panels` panels side by side (1000 × 620 px for one, 620 × 580 per panel
+/// for several).
+pub fn tracking_size(panels: usize) -> (u32, u32) {
+    match panels {
+        0 | 1 => (1000, 620),
+        n => (n.min(8) as u32 * 620, 580),
+    }
+}
+
+/// The y range `[lo, hi]`, m: the positive values of every panel, with a margin, widened to
+/// 1-2-5 numbers.
+fn y_range(panels: &[TrackingPanel]) -> (Real, Real) {
+    let values = panels.iter().flat_map(|p| {
+        let ekf = p.rmse_ekf_m.iter().copied();
+        ekf.chain(p.rmse_pcrlb_m.iter().flatten().copied())
+    });
+    let (min, max) = values
+        .filter(|v| v.is_finite() && *v > 0.0)
+        .fold((Real::INFINITY, 0.0 as Real), |(a, b), v| {
+            (a.min(v), b.max(v))
+        });
+    if !(min.is_finite() && max > 0.0) {
+        return (1e-3, 1.0);
+    }
+    // A little room so that no curve runs along the frame.
+    let (min, max) = (min / 1.15, max * 1.05);
+    let lo = nice_below(min).map_or(min, |(m, k)| crate::ticks::decimal(m, k));
+    let hi = match nice_below(max) {
+        Some((m, k)) if crate::ticks::decimal(m, k) >= max => max,
+        Some((1, k)) => crate::ticks::decimal(2, k),
+        Some((2, k)) => crate::ticks::decimal(5, k),
+        Some((_, k)) => crate::ticks::decimal(1, k + 1),
+        None => max,
+    };
+    if hi > lo {
+        (lo, hi)
+    } else {
+        (lo / 2.0, lo * 2.0)
+    }
+}
+
+/// The runs of consecutive drawable points `(t, v)` (finite, `v > 0` for the log axis).
+fn segments(t_s: &[Real], values: impl Iterator<Item = Option<Real>>) -> Vec<Vec<(Real, Real)>> {
+    let mut out = Vec::new();
+    let mut run = Vec::new();
+    for (&t, v) in t_s.iter().zip(values) {
+        match v {
+            Some(v) if v.is_finite() && v > 0.0 && t.is_finite() => run.push((t, v)),
+            _ if !run.is_empty() => out.push(core::mem::take(&mut run)),
+            _ => {}
+        }
+    }
+    if !run.is_empty() {
+        out.push(run);
+    }
+    out
+}
+
+/// Draws the figure onto `root` (filled white first): the title band, then one panel per entry
+/// of `panels` side by side with a shared y range. Returns that range `(lo, hi)`, m. Does not call
+/// `present()`.
+pub fn draw_tracking_rmse<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    panels: &[TrackingPanel],
+    opts: &TrackingChartOptions,
+) -> Result<(Real, Real), ChartError> {
+    register_fonts();
+    for p in panels {
+        let lengths = [p.rmse_ekf_m.len(), p.rmse_pcrlb_m.len()];
+        if lengths.iter().any(|&n| n != 0 && n != p.t_s.len()) {
+            return Err(ChartError(alloc::format!(
+                "{}: {} times but {} EKF and {} PCRLB values",
+                p.title,
+                p.t_s.len(),
+                lengths[0],
+                lengths[1]
+            )));
+        }
+    }
+    let (w, h) = root.dim_in_pixel();
+    let n = panels.len().max(1);
+    // Panels side by side are shown scaled down as one wide figure: larger text per panel.
+    let s = if n > 1 {
+        (w as f64 / n as f64 / 520.0)
+            .min(h as f64 / 480.0)
+            .clamp(0.5, 4.0)
+    } else {
+        font_scale(w, h)
+    };
+    let font = Fonts::scaled(s);
+    let band = TitleBand::new(s, &font, opts.subtitle.is_some());
+    root.fill(&WHITE).map_err(chart_err)?;
+    draw_titles(root, &font, &band, &opts.title, opts.subtitle.as_deref())?;
+    let body = root.clone().shrink(
+        (band.pad as i32, band.height as i32),
+        (
+            w.saturating_sub(2 * band.pad as u32),
+            h.saturating_sub(band.height as u32 + band.pad as u32 / 2),
+        ),
+    );
+    let range = y_range(panels);
+    for (k, (area, panel)) in body.split_evenly((1, n)).iter().zip(panels).enumerate() {
+        // The y range is shared: its title only on the first panel.
+        let y_desc = if k == 0 { "position RMSE" } else { "" };
+        draw_panel(area, panel, range, y_desc, &font, s)?;
+    }
+    Ok(range)
+}
+
+fn draw_panel<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    p: &TrackingPanel,
+    (lo, hi): (Real, Real),
+    y_desc: &str,
+    font: &Fonts,
+    s: f64,
+) -> Result<(), ChartError> {
+    let t_max = p.t_s.last().copied().filter(|t| t.is_finite() && *t > 0.0);
+    let t_max = t_max.unwrap_or(1.0);
+    let (_, h) = area.dim_in_pixel();
+    let max_labels = ((h as f64 - 3.0 * font.ticks) / (1.6 * font.ticks)).max(2.0) as usize;
+    let ticks = colorbar_ticks(lo, hi, max_labels);
+    let (major, minor): (Vec<_>, Vec<_>) = ticks.into_iter().partition(|t| !t.label.is_empty());
+    let labels: Vec<(Real, String)> = major.iter().map(|t| (t.value_m, t.label.clone())).collect();
+    let y_axis = (lo..hi)
+        .log_scale()
+        .with_key_points(major.iter().map(|t| t.value_m).collect())
+        .with_light_points(minor.iter().map(|t| t.value_m));
+    let mut chart = ChartBuilder::on(area)
+        .caption(p.title, ("sans-serif", font.axis * 1.1).into_font())
+        .margin_top((6.0 * s) as u32)
+        .margin_right((18.0 * s) as u32)
+        .margin_left((6.0 * s) as u32)
+        .x_label_area_size((font.ticks + font.axis + 26.0 * s) as u32)
+        .y_label_area_size((2.8 * font.ticks + font.axis + 26.0 * s) as u32)
+        .build_cartesian_2d(0.0..t_max, y_axis)
+        .map_err(chart_err)?;
+    let y_label = |v: &Real| {
+        labels
+            .iter()
+            .find(|(x, _)| (x - v).abs() <= 1e-9 * x.abs())
+            .map_or_else(String::new, |(_, l)| l.clone())
+    };
+    chart
+        .configure_mesh()
+        .bold_line_style(RGBColor(200, 200, 200).stroke_width(1))
+        .light_line_style(RGBColor(235, 235, 235).stroke_width(1))
+        .x_max_light_lines(1)
+        .x_desc("time t (s)")
+        .y_desc(y_desc)
+        .label_style(("sans-serif", font.ticks).into_font())
+        .axis_desc_style(("sans-serif", font.axis).into_font())
+        .x_labels(11)
+        .set_all_tick_mark_size(font.ticks as i32 / 3 + 2)
+        .x_label_formatter(&|v| axis_label(*v))
+        .y_label_formatter(&y_label)
+        .draw()
+        .map_err(chart_err)?;
+
+    let width = (2.0 * s).round().max(1.0) as u32;
+    let ekf = EKF_RGB.stroke_width(width);
+    let pcrlb = PCRLB_RGB.stroke_width(width);
+    let (dash, gap) = ((9.0 * s) as u32, (5.0 * s) as u32);
+    let ekf_parts = segments(p.t_s, p.rmse_ekf_m.iter().map(|v| Some(*v)));
+    let pcrlb_parts = segments(p.t_s, p.rmse_pcrlb_m.iter().copied());
+    for (k, part) in ekf_parts.into_iter().enumerate() {
+        let series = chart
+            .draw_series(LineSeries::new(part, ekf))
+            .map_err(chart_err)?;
+        if k == 0 {
+            series
+                .label("EKF RMSE  ε_EKF")
+                .legend(move |(x, y)| PathElement::new([(x, y), (x + 24, y)], ekf));
+        }
+    }
+    for (k, part) in pcrlb_parts.into_iter().enumerate() {
+        let series = chart
+            .draw_series(DashedLineSeries::new(part, dash, gap, pcrlb))
+            .map_err(chart_err)?;
+        if k == 0 {
+            series
+                .label("posterior CRLB  ε_PCRLB")
+                .legend(move |(x, y)| {
+                    EmptyElement::at((x, y))
+                        + PathElement::new([(0, 0), (10, 0)], pcrlb)
+                        + PathElement::new([(14, 0), (24, 0)], pcrlb)
+                });
+        }
+    }
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperRight)
+        .background_style(WHITE.mix(0.9))
+        .border_style(BLACK)
+        .label_font(("sans-serif", font.ticks * 0.95).into_font())
+        .margin((8.0 * s) as i32)
+        .draw()
+        .map_err(chart_err)?;
+    let plot = chart.plotting_area();
+    let (pw, ph) = plot.dim_in_pixel();
+    plot.strip_coord_spec()
+        .draw(&Rectangle::new(
+            [(0, 0), (pw as i32 - 1, ph as i32 - 1)],
+            BLACK.stroke_width(1),
+        ))
+        .map_err(chart_err)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn range_and_gaps() {
+        let t = [0.0, 1.0, 2.0, 3.0];
+        let ekf = [0.447, 0.02, Real::NAN, 0.004];
+        let pcrlb = [Some(0.447), None, Some(0.01), Some(0.0022)];
+        let p = TrackingPanel {
+            title: "I",
+            t_s: &t,
+            rmse_ekf_m: &ekf,
+            rmse_pcrlb_m: &pcrlb,
+        };
+        let (lo, hi) = y_range(&[p]);
+        // 2.2 mm is within 15 % of 2 mm: one more 1-2-5 step below; 0.447 m fits under 0.5 m.
+        assert_eq!((lo, hi), (0.001, 0.5));
+        let parts = segments(&t, ekf.iter().map(|v| Some(*v)));
+        assert_eq!(parts.len(), 2);
+        assert_eq!(parts[1], [(3.0, 0.004)]);
+        assert_eq!(segments(&t, pcrlb.iter().copied()).len(), 2);
+        assert_eq!(y_range(&[]), (1e-3, 1.0));
+    }
+}

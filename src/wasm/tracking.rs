@@ -1,0 +1,179 @@
+//! Tracking for the page's animation: `App::simulate_track` runs the core's
+//! [`simulate_track`] (truth, noisy delays, EKF) and hands back a [`Track`], whose `data()` is
+//! the whole run and `frame(n)` one step shaped like a snapshot ([`crate::track_view`]).
+
+use serde_json::{json, Value};
+use wasm_bindgen::prelude::*;
+
+use super::json::{ellipse_json, estimate_json, frame_json, to_js};
+use super::{err, App};
+use crate::error::Error;
+use crate::math::{Real, Vec2, Vec4};
+use crate::motion::ConstantVelocity;
+use crate::track_sim::{simulate_track, TrackRun};
+use crate::track_view::{track_estimate, track_frame, track_mean_state, velocity_through};
+use crate::trajectory::{paper_initial_covariance, step_count, PAPER_INTENSITY};
+use crate::{Model, Scenario};
+
+/// Most steps of one simulated track or browser Monte Carlo study (keeps the JSON and the
+/// worker's memory bounded; 10 s at 1 ms).
+pub const MAX_TRACK_STEPS: usize = 10_000;
+
+/// `steps` within `1..=MAX_TRACK_STEPS`, else [`Error::SizeLimit`] naming `steps`.
+pub(super) fn checked_steps(steps: usize) -> crate::Result<usize> {
+    if (1..=MAX_TRACK_STEPS).contains(&steps) {
+        Ok(steps)
+    } else {
+        Err(Error::SizeLimit {
+            field: "steps",
+            value: steps,
+            min: 1,
+            max: MAX_TRACK_STEPS,
+        })
+    }
+}
+
+/// The prior mean of `kind` (`I`, `II`, `III`, or `custom` from `x0, y0, vx, vy`) and the CV
+/// model for step `dt_s` with the paper's intensity, both validated.
+pub(super) fn prior_and_motion(
+    kind: &str,
+    [x0, y0, vx, vy]: [Real; 4],
+    dt_s: Real,
+) -> crate::Result<(Vec4, ConstantVelocity)> {
+    let mean = track_mean_state(kind, Vec2::new(x0, y0), Vec2::new(vx, vy))?;
+    Ok((mean, ConstantVelocity::validated(dt_s, PAPER_INTENSITY)?))
+}
+
+/// A simulated track: the run and the scenario it was simulated on.
+#[wasm_bindgen]
+pub struct Track {
+    scenario: Scenario,
+    model: Model,
+    run: TrackRun,
+    kind: String,
+    seed: u32,
+    steps: usize,
+}
+
+#[wasm_bindgen]
+impl App {
+    /// Simulates one track ([`simulate_track`]): trajectory `kind` = `"I"`, `"II"`, `"III"`
+    /// (spec §9.4; `x0 … vy` ignored) or `"custom"` (prior mean start `(x0, y0)` m, velocity
+    /// `(vx, vy)` m/s), `P(t₀)` and `q̃` of §9.5, step `dt_s`, `steps` steps (1 … 10 000),
+    /// noise streams from `seed`. The EKF starts at the prior mean. Throws on bad input.
+    #[allow(clippy::too_many_arguments)]
+    pub fn simulate_track(
+        &self,
+        kind: &str,
+        x0: f64,
+        y0: f64,
+        vx: f64,
+        vy: f64,
+        dt_s: f64,
+        steps: usize,
+        seed: u32,
+    ) -> Result<Track, JsError> {
+        let (mean, motion) = prior_and_motion(kind, [x0, y0, vx, vy], dt_s).map_err(err)?;
+        let steps = checked_steps(steps).map_err(err)?;
+        let session = self.session();
+        let p0 = paper_initial_covariance();
+        let run = simulate_track(session.model(), &motion, &mean, &p0, steps, seed.into())
+            .map_err(err)?;
+        Ok(Track {
+            scenario: session.scenario().clone(),
+            model: session.model().clone(),
+            run,
+            kind: kind.to_string(),
+            seed,
+            steps,
+        })
+    }
+}
+
+#[wasm_bindgen]
+impl Track {
+    /// Number of entries (`steps + 1`, fewer if the filter failed: see `failed_at`).
+    pub fn entries(&self) -> usize {
+        self.run.truth.len()
+    }
+
+    /// The whole run: `{kind, seed, steps, dt_s, failed_at, t_s: [..], truth: [[x, y], ..],
+    /// estimates: [[x, y, vx, vy], ..], ellipses: [1σ position ellipse of P | null, ..],
+    /// sigma_m: [√(Pxx+Pyy), ..], error_m: [..], nis: [..], measurements: [[iso-delay ellipse
+    /// per link | null], ..] (empty at t₀)}`.
+    pub fn data(&self) -> Result<JsValue, JsError> {
+        let run = &self.run;
+        let est: Vec<_> = (0..run.estimates.len())
+            .map(|n| track_estimate(run, n))
+            .collect::<crate::Result<_>>()
+            .map_err(err)?;
+        let net = &self.model.network;
+        let measurements: Vec<Value> = run
+            .delays_s
+            .iter()
+            .map(|d| {
+                let per_link = d.iter().enumerate();
+                Value::Array(
+                    per_link
+                        .map(|(p, t)| ellipse_json(net.iso_delay_ellipse(p, *t)))
+                        .collect(),
+                )
+            })
+            .collect();
+        to_js(&json!({
+            "kind": self.kind, "seed": self.seed, "steps": self.steps,
+            "dt_s": run.t_s.get(1).copied(),
+            "failed_at": run.failed_at,
+            "t_s": run.t_s,
+            "truth": run.truth.iter().map(|x| [x[0], x[1]]).collect::<Vec<_>>(),
+            "estimates": run.estimates.iter().map(|x| [x[0], x[1], x[2], x[3]]).collect::<Vec<_>>(),
+            "ellipses": est.iter().map(|e| ellipse_json(e.ellipse)).collect::<Vec<_>>(),
+            "sigma_m": est.iter().map(|e| e.sigma_m).collect::<Vec<_>>(),
+            "error_m": est.iter().map(|e| e.error_m).collect::<Vec<_>>(),
+            "nis": run.nis,
+            "measurements": measurements,
+        }))
+    }
+
+    /// Step `n` shaped like `App.simulate_fix`'s snapshot (`fix` is the EKF estimate: `{x, y,
+    /// vx, vy, ellipse, error_m, error_label, sigma_m, sigma_label, nis}`), plus `step`, `t_s`
+    /// and the truth's velocity. Throws for a step past the end.
+    pub fn frame(&self, n: usize) -> Result<JsValue, JsError> {
+        let f = track_frame(&self.model, &self.run, n).map_err(err)?;
+        to_js(&frame_json(&f, &self.scenario))
+    }
+
+    /// One estimate: as `frame(n).fix`, without the measurement geometry.
+    pub fn estimate(&self, n: usize) -> Result<JsValue, JsError> {
+        to_js(&estimate_json(&track_estimate(&self.run, n).map_err(err)?))
+    }
+}
+
+/// The velocity of a trajectory drawn from `(x0, y0)` to `(x1, y1)` over `duration_s`:
+/// `[vx, vy]`, m/s.
+#[wasm_bindgen]
+pub fn drag_velocity(
+    x0: f64,
+    y0: f64,
+    x1: f64,
+    y1: f64,
+    duration_s: f64,
+) -> Result<Vec<f64>, JsError> {
+    let v = velocity_through(Vec2::new(x0, y0), Vec2::new(x1, y1), duration_s).map_err(err)?;
+    Ok(vec![v.x, v.y])
+}
+
+/// Steps covering `duration_s` at `dt_s` (`⌈duration/T⌉`, spec §9.5), validated against the
+/// cap of 10 000.
+#[wasm_bindgen]
+pub fn track_steps(duration_s: f64, dt_s: f64) -> Result<usize, JsError> {
+    ConstantVelocity::validated(dt_s, PAPER_INTENSITY).map_err(err)?;
+    if !(duration_s.is_finite() && duration_s > 0.0) {
+        return Err(err(Error::NotPositive {
+            field: "duration_s".into(),
+            value: duration_s,
+        }));
+    }
+    let n = step_count(duration_s, dt_s);
+    checked_steps(n).map_err(err)
+}

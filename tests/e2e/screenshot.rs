@@ -1,0 +1,58 @@
+//! The docs screenshot of the tracking mode (docs/screenshot-tracking.png), taken through the
+//! same browser harness as the end-to-end tests.
+
+use super::tracking::{mc_done, wait_state};
+use super::{connect, js, open_hash, runtime, settle, start_server, Driver, SERIAL};
+
+/// Writes docs/screenshot-tracking.png (tracking mode, scenario II at 4.5 s, after a warm
+/// Monte Carlo re-run) when `SCATTERLOC_SCREENSHOT=1`; otherwise does nothing.
+/// `SCATTERLOC_SCREENSHOT_HASH` (page options) and `SCATTERLOC_SCREENSHOT_OUT` (a path) override.
+#[test]
+#[ignore = "needs chromium + chromedriver and www/pkg; set SCATTERLOC_SCREENSHOT=1"]
+fn tracking_screenshot() {
+    if std::env::var("SCATTERLOC_SCREENSHOT").map_or(true, |v| v != "1") {
+        return;
+    }
+    let hash = std::env::var("SCATTERLOC_SCREENSHOT_HASH")
+        .unwrap_or_else(|_| "#mode=tracking&track=II&step=45".into());
+    let out = std::env::var("SCATTERLOC_SCREENSHOT_OUT").unwrap_or_else(|_| {
+        concat!(env!("CARGO_MANIFEST_DIR"), "/docs/screenshot-tracking.png").into()
+    });
+    let _serial = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
+    let port = start_server();
+    let driver = Driver::start();
+    let png = runtime().block_on(async {
+        let c = connect(&driver).await;
+        let r = async {
+            // A 1400 × 900 viewport, like docs/screenshot.png.
+            let chrome = js(
+                &c,
+                "return [outerWidth - innerWidth, outerHeight - innerHeight]",
+            )
+            .await?;
+            let chrome: Vec<u32> = serde_json::from_value(chrome).map_err(|e| e.to_string())?;
+            c.set_window_size(1400 + chrome[0], 900 + chrome[1])
+                .await
+                .map_err(|e| e.to_string())?;
+            open_hash(&c, port, &hash).await?;
+            if hash.contains("mode=tracking") {
+                let s = wait_state(&c, 60, mc_done).await?;
+                // Once more with the worker warm (the first run includes its start-up).
+                js(&c, "window.tracking.restartMc()").await?;
+                let gen = s["mcGeneration"].as_u64().unwrap_or(0);
+                wait_state(&c, 60, |s| {
+                    mc_done(s) && s["mcGeneration"].as_u64().unwrap_or(0) > gen
+                })
+                .await?;
+            }
+            settle(&c).await?;
+            c.screenshot().await.map_err(|e| e.to_string())
+        }
+        .await;
+        let _ = c.close().await;
+        r
+    });
+    drop(driver);
+    std::fs::write(&out, png.unwrap_or_else(|e| panic!("{e}"))).unwrap();
+    println!("wrote {out}");
+}

@@ -1,0 +1,136 @@
+// The page side of the browser Monte Carlo: one module Web Worker (worker.js) runs the study; a
+// generation number cancels a run when a newer one starts (every drag restarts it). Shows the
+// progress bar, the status line and the plotters chart (drawn by the wasm core on #track-chart).
+
+const $ = (id) => document.getElementById(id);
+
+export class MonteCarlo {
+  /** @param {object} wasm - the wasm module; @param {function} onError - shows a message. */
+  constructor(wasm, onError) {
+    this.wasm = wasm;
+    this.onError = onError;
+    this.gen = 0;
+    this.state = 'idle'; // 'running' | 'done' | 'error' | 'idle'
+    this.params = null;
+    this.result = null; // last result JSON text (partial while running)
+    this.done = 0;
+    this.total = 0;
+    this.ms = null; // wall time of the last finished run, ms (post to result)
+    this.computeMs = null; // the worker's own time for it
+    this.superseded = 0; // running jobs cancelled by a newer one
+    this.workerReady = false;
+    this.coldStart = false;
+    this.series = 0;
+    this.caption = '';
+    this.worker = new Worker(new URL('./worker.js', import.meta.url), { type: 'module' });
+    this.worker.onmessage = (e) => this.receive(e.data);
+    this.worker.onerror = (e) => this.fail(`Monte Carlo worker: ${e.message || 'failed to start'}`);
+    new ResizeObserver(() => this.drawChart()).observe($('track-chart').parentElement);
+  }
+
+  /** Starts a study: {scenario, kind, x0, y0, vx, vy, dt_s, steps, trajectories, noise_runs, seed}. */
+  start(params, caption) {
+    if (this.state === 'running') this.superseded += 1;
+    this.gen += 1;
+    this.params = params;
+    this.caption = caption;
+    this.state = 'running';
+    this.coldStart = !this.workerReady; // the time then includes compiling the worker's wasm
+    this.result = null;
+    this.done = 0;
+    this.total = 0; // known from the worker's first report
+    this.t0 = performance.now();
+    this.worker.postMessage({ type: 'run', gen: this.gen, ...params });
+    this.show();
+  }
+
+  /** Stops the current study (the worker drops it at its next slice). */
+  cancel() {
+    if (this.state === 'running') this.superseded += 1;
+    this.gen += 1;
+    this.worker.postMessage({ type: 'cancel', gen: this.gen });
+    this.state = 'idle';
+    this.show();
+  }
+
+  receive(m) {
+    if (m.type === 'ready') {
+      this.workerReady = true;
+      return;
+    }
+    if (m.gen !== this.gen) return; // a cancelled run
+    if (m.type === 'error') {
+      this.fail(`Monte Carlo: ${m.message}`);
+      return;
+    }
+    this.done = m.done;
+    this.total = m.total;
+    this.result = m.result;
+    if (m.type === 'done') {
+      this.state = 'done';
+      this.ms = performance.now() - this.t0;
+      this.computeMs = m.ms;
+    }
+    this.drawChart();
+    this.show();
+  }
+
+  fail(message) {
+    this.state = 'error';
+    this.show();
+    this.onError(message);
+    console.error(message);
+  }
+
+  /** The chart at the canvas' CSS size times the device pixel ratio. */
+  drawChart() {
+    const canvas = $('track-chart');
+    const r = canvas.getBoundingClientRect();
+    if (r.width < 10 || r.height < 10) return;
+    const dpr = window.devicePixelRatio || 1;
+    canvas.width = Math.round(r.width * dpr);
+    canvas.height = Math.round(r.height * dpr);
+    const p = this.params;
+    let sub = p ? `${p.trajectories * p.noise_runs} runs × ${p.steps} steps, T = ${p.dt_s} s` : '';
+    if (this.state === 'running') sub += ` · running, ${this.done}/${this.total} chunks`;
+    try {
+      this.series = this.wasm.draw_tracking_chart(canvas, this.result || '',
+        'Position RMSE: EKF vs posterior CRLB', sub, this.caption);
+    } catch (e) {
+      this.series = 0;
+      this.onError(`Chart: ${e.message}`);
+      console.error(e);
+    }
+    canvas.dataset.series = String(this.series);
+    canvas.dataset.generation = String(this.gen);
+  }
+
+  /** Progress bar and status line (numbers and labels from the result). */
+  show() {
+    const el = $('mc-status');
+    Object.assign(el.dataset, {
+      state: this.state, generation: String(this.gen), done: String(this.done),
+      total: String(this.total), ms: this.ms === null ? '' : String(this.ms),
+    });
+    $('mc-bar').style.width = `${this.total ? (100 * this.done) / this.total : 0}%`;
+    $('mc-bar').classList.toggle('running', this.state === 'running');
+    const p = this.params;
+    const size = p ? `${p.trajectories * p.noise_runs} runs × ${p.steps} steps` : '';
+    let text = size;
+    if (this.state === 'running') text = `${size} · running ${this.done}/${this.total} chunks…`;
+    if (this.state === 'done' && this.result) {
+      const r = JSON.parse(this.result);
+      const n = r.t_s.length - 1;
+      const fmt = (v) => (v === null ? '–' : this.wasm.format_length(v, 3));
+      const cold = this.coldStart ? ' (incl. worker start-up)' : '';
+      text = `${size} in ${this.ms.toFixed(0)} ms${cold} · at t = ${r.t_s[n]} s: ε_EKF ${fmt(r.rmse_ekf_m[n])}, `
+        + `ε_PCRLB ${fmt(r.rmse_pcrlb_m[n])}, NEES ${r.nees[n].toFixed(2)} (4 = consistent)`;
+      if (r.failed_runs) text += ` · ${r.failed_runs} failed runs excluded`;
+    }
+    if (this.state === 'error') text = `${size} · failed`;
+    el.textContent = text;
+    const ms = $('mc-ms');
+    ms.textContent = this.ms === null ? 'MC –' : `MC ${size}: ${this.ms.toFixed(0)} ms`;
+    ms.dataset.ms = this.ms === null ? '' : String(this.ms);
+  }
+}

@@ -1,0 +1,98 @@
+// Drawing of a simulated track over the CRLB map (all numbers from the wasm core's Track): the
+// truth path, the EKF track with its 1σ covariance ellipses (magnified by a labelled factor), and
+// the arrow of a drawn trajectory. The current step's markers, iso-delay ellipses and the zoom
+// inset are drawn by draw.js from the snapshot-shaped frame.
+
+import { C, FONT_B, FULL, ellipsePath, haloText, polyline } from './draw.js';
+
+const TRUTH = 'rgba(255,255,255,0.9)';
+const EKF = C.fix;
+const ARROW = '#7ee8fa';
+
+/** A dark line under a path, so it reads on every map colour. */
+function halo(ctx, view, points, width) {
+  ctx.strokeStyle = 'rgba(10,12,18,0.55)';
+  ctx.lineWidth = width;
+  polyline(ctx, view, points, false);
+  ctx.stroke();
+}
+
+/** An arrow from a to b (CSS px) with a head of `size` px. */
+function arrow(ctx, a, b, size) {
+  const ang = Math.atan2(b.y - a.y, b.x - a.x);
+  ctx.beginPath();
+  ctx.moveTo(a.x, a.y);
+  ctx.lineTo(b.x, b.y);
+  ctx.stroke();
+  ctx.beginPath();
+  ctx.moveTo(b.x, b.y);
+  ctx.lineTo(b.x - size * Math.cos(ang - 0.45), b.y - size * Math.sin(ang - 0.45));
+  ctx.lineTo(b.x - size * Math.cos(ang + 0.45), b.y - size * Math.sin(ang + 0.45));
+  ctx.closePath();
+  ctx.fill();
+}
+
+/** The drawn trajectory's prior mean: start ring and arrow to the point reached at the end. */
+function drawArrow(ctx, view, d) {
+  const a = view.toPixel(d.x0, d.y0);
+  const b = view.toPixel(d.x1, d.y1);
+  ctx.strokeStyle = ARROW;
+  ctx.fillStyle = ARROW;
+  ctx.lineWidth = 2;
+  ctx.setLineDash([]);
+  arrow(ctx, a, b, 11);
+  ctx.beginPath(); ctx.arc(a.x, a.y, 5, 0, FULL); ctx.stroke();
+  ctx.font = FONT_B;
+  ctx.textAlign = 'left';
+  ctx.textBaseline = 'bottom';
+  if (d.label) haloText(ctx, d.label, b.x + 8, b.y - 6);
+}
+
+/**
+ * The track layers. `tr` = {data (Track.data()), step, magnify, drawn: {x0, y0, x1, y1, label} | null}.
+ * Ellipses every `stride` steps up to the current one are drawn faintly, the current one bold.
+ */
+export function drawTrack(ctx, view, tr) {
+  const r = view.rect;
+  ctx.save();
+  ctx.beginPath(); ctx.rect(r.x, r.y, r.w, r.h); ctx.clip();
+  const d = tr.data;
+  if (d) {
+    const step = Math.min(tr.step, d.truth.length - 1);
+    // Truth: the whole path dashed, the part already travelled brighter, on a dark halo.
+    const travelled = d.truth.slice(0, step + 1);
+    ctx.lineJoin = 'round';
+    halo(ctx, view, d.truth, 4);
+    ctx.lineWidth = 1.5;
+    ctx.setLineDash([5, 4]);
+    ctx.strokeStyle = 'rgba(255,255,255,0.45)';
+    polyline(ctx, view, d.truth, false); ctx.stroke();
+    ctx.strokeStyle = TRUTH;
+    polyline(ctx, view, travelled, false); ctx.stroke();
+    ctx.setLineDash([]);
+    const s = view.toPixel(d.truth[0][0], d.truth[0][1]);
+    ctx.beginPath(); ctx.arc(s.x, s.y, 3.5, 0, FULL);
+    ctx.fillStyle = TRUTH; ctx.fill();
+    // EKF 1σ ellipses (magnified) along the travelled part, then the current one.
+    const stride = Math.max(1, Math.round(d.truth.length / 20));
+    ctx.lineWidth = 1;
+    ctx.strokeStyle = 'rgba(255,169,77,0.3)';
+    for (let n = stride; n < step; n += stride) {
+      if (d.ellipses[n]) { ellipsePath(ctx, view, d.ellipses[n], tr.magnify); ctx.stroke(); }
+    }
+    // EKF track up to now.
+    const track = d.estimates.slice(0, step + 1);
+    halo(ctx, view, track, 4.5);
+    ctx.strokeStyle = EKF;
+    ctx.lineWidth = 2;
+    polyline(ctx, view, track, false); ctx.stroke();
+    const e = d.ellipses[step];
+    if (e) {
+      ellipsePath(ctx, view, e, tr.magnify);
+      ctx.fillStyle = 'rgba(255,169,77,0.18)'; ctx.fill();
+      ctx.lineWidth = 2; ctx.strokeStyle = EKF; ctx.stroke();
+    }
+  }
+  if (tr.drawn) drawArrow(ctx, view, tr.drawn);
+  ctx.restore();
+}

@@ -1,0 +1,231 @@
+// Tracking mode: simulates a track with the wasm core (App.simulate_track), animates it over the
+// CRLB map (play/pause, scrub, speed), lets the user draw a trajectory (press = start, drag = where
+// it is after the run's duration) and keeps the Monte Carlo chart (montecarlo.js) in step: every
+// change of scenario, nodes or trajectory re-simulates the track and restarts the Monte Carlo.
+
+import { MonteCarlo } from './montecarlo.js';
+import { drawTrack } from './track-draw.js';
+import { showError, clearError } from './panel.js';
+
+const $ = (id) => document.getElementById(id);
+const DURATION_S = 10; // the scenarios of spec §9.4 last 10 s
+
+export class Tracking {
+  /** @param {object} ctx - {app, wasm, st, view, changed}; @param {object} opts - hash options. */
+  constructor(ctx, opts) {
+    this.ctx = ctx;
+    this.kind = ['I', 'II', 'III', 'custom'].includes(opts.track) ? opts.track : 'I';
+    this.drawn = opts.custom || { x0: -4, y0: 17, x1: 20, y1: 12 };
+    this.step = 0;
+    this.pos = 0; // fractional step while playing
+    this.playing = false;
+    this.track = null;
+    this.data = null;
+    this.frame = null;
+    this.dragging = false;
+    this.mc = new MonteCarlo(ctx.wasm, showError);
+    for (const [id, v] of [['track-kind', this.kind], ['track-dt', opts.dt], ['track-seed', opts.tseed],
+      ['track-ex', opts.ex], ['mc-runs', opts.runs], ['track-speed', opts.speed]]) {
+      if (v !== null && v !== undefined && v !== '') $(id).value = String(v);
+    }
+    const rerun = () => this.rerun();
+    $('track-kind').addEventListener('change', () => { this.kind = $('track-kind').value; rerun(); });
+    $('track-dt').addEventListener('change', rerun);
+    $('track-seed').addEventListener('change', rerun);
+    $('mc-runs').addEventListener('change', () => this.startMc());
+    $('mc-restart').addEventListener('click', () => this.startMc());
+    $('track-ex').addEventListener('change', () => this.redraw());
+    $('track-play').addEventListener('click', () => (this.playing ? this.pause() : this.play()));
+    $('track-scrub').addEventListener('input', () => { this.pause(); this.seek(Number($('track-scrub').value)); });
+    this.tickFn = (now) => this.tick(now);
+    this.startStep = opts.step;
+  }
+
+  active() { return this.ctx.st.mode === 'tracking'; }
+
+  /** The prior's parameters for the core: {kind, x0, y0, vx, vy, dt_s, steps, seed}. */
+  params() {
+    const w = this.ctx.wasm;
+    const dt = Number($('track-dt').value);
+    const steps = w.track_steps(DURATION_S, dt);
+    let v = [0, 0];
+    const d = this.drawn;
+    if (this.kind === 'custom') v = w.drag_velocity(d.x0, d.y0, d.x1, d.y1, DURATION_S);
+    const seed = Number($('track-seed').value.trim() === '' ? NaN : $('track-seed').value);
+    return { kind: this.kind, x0: d.x0, y0: d.y0, vx: v[0], vy: v[1], dt_s: dt, steps, seed };
+  }
+
+  /** Re-simulates the track (keeping the step) and restarts the Monte Carlo. */
+  rerun() {
+    if (!this.active()) return;
+    try {
+      const p = this.params();
+      if (!Number.isInteger(p.seed) || p.seed < 0 || p.seed > 0xffffffff) throw new Error('seed: an integer 0 … 4294967295');
+      const track = this.ctx.app.simulate_track(p.kind, p.x0, p.y0, p.vx, p.vy, p.dt_s, p.steps, p.seed);
+      if (this.track) this.track.free();
+      this.track = track;
+      this.p = p;
+      this.data = track.data();
+      $('track-seed').classList.remove('invalid');
+      if (this.failed) clearError();
+      this.failed = false;
+      if (this.startStep !== undefined) { this.step = this.startStep; this.startStep = undefined; }
+      $('track-scrub').max = String(track.entries() - 1);
+      this.seek(Math.min(this.step, track.entries() - 1), false);
+      this.startMc();
+    } catch (e) {
+      $('track-seed').classList.toggle('invalid', /seed/.test(e.message));
+      showError(e.message);
+      this.failed = true;
+    }
+    $('track-hint').hidden = this.kind !== 'custom';
+  }
+
+  startMc() {
+    if (!this.active() || !this.p) return;
+    const p = this.p;
+    const runs = Number($('mc-runs').value);
+    this.mc.start({ scenario: this.ctx.app.scenario_json(), ...p, trajectories: runs, noise_runs: 1 },
+      this.kind === 'custom' ? 'drawn trajectory' : `scenario ${this.kind}`);
+  }
+
+  /** Shows step `n` (frame from the core, read-outs, redraw). */
+  seek(n, redraw = true) {
+    if (!this.track) return;
+    this.step = Math.max(0, Math.min(n, this.track.entries() - 1));
+    this.pos = this.step;
+    this.frame = this.track.frame(this.step);
+    this.show();
+    if (redraw) this.redraw();
+  }
+
+  redraw() { this.ctx.changed({ frame: true }); }
+
+  play() {
+    if (!this.track) return;
+    if (this.step >= this.track.entries() - 1) this.seek(0);
+    this.playing = true;
+    this.last = performance.now();
+    requestAnimationFrame(this.tickFn);
+    this.show();
+  }
+
+  pause() {
+    this.playing = false;
+    this.show();
+  }
+
+  tick(now) {
+    if (!this.playing || !this.track) return;
+    const speed = Number($('track-speed').value);
+    this.pos += ((now - this.last) / 1000) * speed / this.p.dt_s;
+    this.last = now;
+    const end = this.track.entries() - 1;
+    const n = Math.min(Math.floor(this.pos), end);
+    if (n >= end) this.playing = false;
+    if (n !== this.step) this.seek(n); else this.show();
+    if (this.playing) requestAnimationFrame(this.tickFn);
+  }
+
+  /** Mode switch: start (track + Monte Carlo) or stop everything. */
+  setActive(on) {
+    if (on) {
+      this.rerun();
+    } else {
+      this.pause();
+      this.mc.cancel();
+    }
+  }
+
+  /** Pointer hooks from interact.js: in "draw" mode a press on the map starts a trajectory. */
+  wantsDraw() { return this.active() && this.kind === 'custom'; }
+
+  drawStart(m) {
+    this.dragging = true;
+    this.pause();
+    this.drawn = { x0: m.x, y0: m.y, x1: m.x, y1: m.y };
+    this.redraw();
+  }
+
+  drawMove(m) {
+    if (!this.dragging || (m.x === this.drawn.x1 && m.y === this.drawn.y1)) return;
+    this.drawn = { ...this.drawn, x1: m.x, y1: m.y };
+    if (this.drawn.x1 !== this.drawn.x0 || this.drawn.y1 !== this.drawn.y0) this.rerun();
+    this.redraw();
+  }
+
+  drawEnd(m) {
+    this.drawMove(m);
+    this.dragging = false;
+  }
+
+  /** The layer drawn under the markers (see draw.js drawScene). */
+  overlay(ctx, view) {
+    const magnify = Number($('track-ex').value);
+    let drawn = null;
+    if (this.kind === 'custom') {
+      const v = this.p && this.p.kind === 'custom' ? this.p : null;
+      drawn = { ...this.drawn, label: v ? `v̄ = (${v.vx.toFixed(2)}, ${v.vy.toFixed(2)}) m/s` : '' };
+    }
+    drawTrack(ctx, view, { data: this.data, step: this.step, magnify, drawn });
+  }
+
+  /** Points the zoom inset should not hide, weighted: the truth path, a drawn arrow, the nodes. */
+  avoidPoints() {
+    const pts = this.data ? [...this.data.truth] : [];
+    if (this.kind === 'custom') {
+      const d = this.drawn;
+      pts.push([d.x0, d.y0, 10], [d.x1, d.y1, 10]);
+    }
+    const n = this.ctx.st.nodes;
+    for (const p of [...n.transmitters, ...n.receivers]) pts.push([p.x, p.y, 40]);
+    return pts;
+  }
+
+  /** Transport controls and the step read-out (labels from the core). */
+  show() {
+    const f = this.frame;
+    const n = this.track ? this.track.entries() - 1 : 0;
+    $('track-play').textContent = this.playing ? '❚❚ Pause' : '▶ Play';
+    $('track-play').dataset.playing = this.playing ? '1' : '0';
+    $('track-scrub').value = String(this.step);
+    if (!f || !this.data) return;
+    const tEnd = this.data.t_s[n];
+    $('track-time').textContent = `t = ${f.t_s.toFixed(2)} s / ${tEnd.toFixed(2)} s · step ${f.step}/${n}`;
+    $('track-ex-label').textContent = `×${$('track-ex').value}`;
+    const m2 = (x, y) => `${x.toFixed(3)}, ${y.toFixed(3)} m`;
+    const rows = [
+      ['Truth', m2(f.truth.x, f.truth.y), ''],
+      ['EKF estimate', m2(f.fix.x, f.fix.y), 'fix'],
+      ['Error ‖r̂ − r‖', f.fix.error_label, 'fix'],
+      ['EKF σ √(P_xx+P_yy)', f.fix.sigma_label, 'fix'],
+      ['Snapshot CRLB here', f.crlb.rmse_label, 'crlb'],
+      ['NIS', f.step === 0 ? '–' : `${f.fix.nis.toFixed(2)} (χ²₄ mean 4)`, ''],
+    ];
+    if (this.data.failed_at !== null) rows.push(['Filter failed at step', String(this.data.failed_at), '']);
+    const dl = $('track-info');
+    dl.replaceChildren();
+    for (const [k, v, cls] of rows) {
+      const dt = document.createElement('dt');
+      dt.textContent = k;
+      const dd = document.createElement('dd');
+      dd.textContent = v;
+      if (cls) dd.className = cls;
+      dl.append(dt, dd);
+    }
+  }
+
+  /** Test and console hook. */
+  state() {
+    const f = this.frame;
+    const mc = this.mc;
+    return {
+      mode: this.ctx.st.mode, kind: this.kind, step: this.step,
+      steps: this.track ? this.track.entries() - 1 : 0, playing: this.playing,
+      t_s: f ? f.t_s : null, truth: f ? [f.truth.x, f.truth.y] : null, estimate: f ? [f.fix.x, f.fix.y] : null,
+      mcState: mc.state, mcGeneration: mc.gen, mcRuns: mc.params ? mc.params.trajectories * mc.params.noise_runs : 0,
+      mcMs: mc.ms, mcComputeMs: mc.computeMs, mcDone: mc.done, mcTotal: mc.total,
+      mcSuperseded: mc.superseded, chartSeries: mc.series, drawn: { ...this.drawn },
+    };
+  }
+}
