@@ -177,14 +177,12 @@ pub fn finish(cfg: &MonteCarloConfig, sums: &PartialSums) -> Result<MonteCarloRe
         });
     }
     let runs = sums.runs as Real;
-    let trajectories = sums.trajectories.max(1) as Real;
-    let mean_fishers: Vec<Mat2> = sums.fisher[1..].iter().map(|f| f / trajectories).collect();
     Ok(MonteCarloResult {
         t_s: (0..=cfg.steps)
             .map(|n| n as Real * cfg.motion.dt_s)
             .collect(),
         rmse_ekf_m: sums.squared_error.iter().map(|v| sqrt(v / runs)).collect(),
-        rmse_pcrlb_m: pcrlb_rmse(&cfg.motion, &cfg.initial_covariance, &mean_fishers)?,
+        rmse_pcrlb_m: pcrlb_from_sums(cfg, sums)?,
         nees: sums.nees.iter().map(|v| v / runs).collect(),
         runs: sums.runs,
         failed_runs: sums.failed_runs,
@@ -233,6 +231,11 @@ pub fn run_pcrlb_sequential(
             return Err(Error::Cancelled);
         }
     }
+    pcrlb_from_sums(cfg, &sums)
+}
+
+/// `ε_PCRLB(t_n)` (E9) with `E[F̃]` the mean of the summed truth Fisher matrices.
+pub fn pcrlb_from_sums(cfg: &MonteCarloConfig, sums: &PartialSums) -> Result<Vec<Option<Real>>> {
     let trajectories = sums.trajectories.max(1) as Real;
     let mean_fishers: Vec<Mat2> = sums.fisher[1..].iter().map(|f| f / trajectories).collect();
     pcrlb_rmse(&cfg.motion, &cfg.initial_covariance, &mean_fishers)

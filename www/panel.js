@@ -4,6 +4,19 @@
 
 import { LINK_COLORS } from './draw.js';
 
+/** Replaces the children of a <dl> with [label, value, cssClass] rows. */
+export function fillKeyValues(dl, rows) {
+  dl.replaceChildren();
+  for (const [k, v, cls] of rows) {
+    const dt = document.createElement('dt');
+    dt.textContent = k;
+    const dd = document.createElement('dd');
+    dd.textContent = v;
+    if (cls) dd.className = cls;
+    dl.append(dt, dd);
+  }
+}
+
 const $ = (id) => document.getElementById(id);
 
 /** Text -> number; empty text is NaN, so the core names the field instead of taking 0. */
@@ -224,14 +237,7 @@ export class Panel {
     box.replaceChildren();
     const dl = document.createElement('dl');
     dl.className = 'kv';
-    for (const [k, v, cls] of rows) {
-      const dt = document.createElement('dt');
-      dt.textContent = k;
-      const dd = document.createElement('dd');
-      dd.textContent = v;
-      if (cls) dd.className = cls;
-      dl.append(dt, dd);
-    }
+    fillKeyValues(dl, rows);
     box.append(dl);
     // One line per link: its colour in the plot, name and range noise cσ_τ at the target.
     const links = document.createElement('div');

@@ -5,7 +5,7 @@
 
 import { MonteCarlo } from './montecarlo.js';
 import { drawTrack } from './track-draw.js';
-import { showError, clearError } from './panel.js';
+import { showError, clearError, fillKeyValues } from './panel.js';
 
 const $ = (id) => document.getElementById(id);
 const DURATION_S = 10; // the scenarios of spec §9.4 last 10 s
@@ -203,16 +203,7 @@ export class Tracking {
       ['NIS', f.step === 0 ? '–' : `${f.fix.nis.toFixed(2)} (χ²₄ mean 4)`, ''],
     ];
     if (this.data.failed_at !== null) rows.push(['Filter failed at step', String(this.data.failed_at), '']);
-    const dl = $('track-info');
-    dl.replaceChildren();
-    for (const [k, v, cls] of rows) {
-      const dt = document.createElement('dt');
-      dt.textContent = k;
-      const dd = document.createElement('dd');
-      dd.textContent = v;
-      if (cls) dd.className = cls;
-      dl.append(dt, dd);
-    }
+    fillKeyValues($('track-info'), rows);
   }
 
   /** Test and console hook. */

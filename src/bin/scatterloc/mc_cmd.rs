@@ -12,7 +12,9 @@ use scatterloc::trajectory::paper_initial_covariance;
 
 use crate::commands::parse_args;
 use crate::report::{which, CurveDoc, Outputs};
-use crate::study::{flag_error, parse_study, run_with_progress, seed, threads, STUDY_FLAGS};
+use crate::study::{
+    flag_error, parse_study, run_pcrlb_with_progress, run_with_progress, seed, threads, STUDY_FLAGS,
+};
 use crate::CliError;
 
 /// Scalars of one Monte Carlo study, after the curves in the JSON file and in the summary.
@@ -143,20 +145,18 @@ pub fn pcrlb(argv: &[OsString]) -> Result<(), CliError> {
     let mut docs = Vec::new();
     for (t, cfg) in study.trajectories.iter().zip(&configs) {
         let start = std::time::Instant::now();
-        let (t_s, rmse, wall) = if nominal {
+        let t_s = (0..=cfg.steps)
+            .map(|n| n as f64 * cfg.motion.dt_s)
+            .collect();
+        let (rmse, wall) = if nominal {
             let (p0, mean) = (paper_initial_covariance(), t.mean_state());
             let rmse = nominal_pcrlb_rmse(&study.model, &cfg.motion, &mean, &p0, cfg.steps)
                 .map_err(flag_error)?;
-            let t_s = (0..=cfg.steps)
-                .map(|n| n as f64 * cfg.motion.dt_s)
-                .collect();
-            (t_s, rmse, start.elapsed().as_secs_f64())
+            (rmse, start.elapsed().as_secs_f64())
         } else {
-            // E[F̃] over `runs` truth trajectories; one EKF run per trajectory rides along
-            // (the core has no truth-only driver yet).
+            // E[F̃] over `runs` truth trajectories (no EKF runs).
             let label = format!("scenario {:>3} (PCRLB)", t.name());
-            let (r, wall) = run_with_progress(&study.model, cfg, threads, &label)?;
-            (r.t_s, r.rmse_pcrlb_m, wall)
+            run_pcrlb_with_progress(&study.model, cfg, threads, &label)?
         };
         let meta = PcrlbMeta {
             trajectory: t.name(),

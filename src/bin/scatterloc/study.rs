@@ -11,7 +11,7 @@ use serde::Serialize;
 
 use scatterloc::montecarlo::{MonteCarloConfig, MonteCarloResult, MAX_STEPS};
 use scatterloc::motion::ConstantVelocity;
-use scatterloc::parallel::run_parallel;
+use scatterloc::parallel::{run_parallel, run_pcrlb_parallel};
 use scatterloc::trajectory::{
     paper_initial_covariance, step_count, TrackScenario, PAPER_DURATION_S, PAPER_INTENSITY,
     PAPER_STEP_S,
@@ -208,6 +208,34 @@ pub fn run_with_progress(
     threads: usize,
     label: &str,
 ) -> Result<(MonteCarloResult, f64), CliError> {
+    with_progress(cfg.runs(), "runs", label, |cancel, progress| {
+        run_parallel(model, cfg, threads, cancel, progress)
+    })
+}
+
+/// The Monte Carlo PCRLB alone (truth trajectories only, no EKF) with the same progress bar
+/// (counting trajectories) and Ctrl-C handling as [`run_with_progress`].
+pub fn run_pcrlb_with_progress(
+    model: &Model,
+    cfg: &MonteCarloConfig,
+    threads: usize,
+    label: &str,
+) -> Result<(Vec<Option<f64>>, f64), CliError> {
+    with_progress(
+        cfg.trajectories,
+        "trajectories",
+        label,
+        |cancel, progress| run_pcrlb_parallel(model, cfg, threads, cancel, progress),
+    )
+}
+
+/// Drives `run(cancel flag, progress callback)` under a progress bar of `total` `unit`s.
+fn with_progress<T>(
+    total: usize,
+    unit: &str,
+    label: &str,
+    run: impl FnOnce(&AtomicBool, &mut dyn FnMut(usize, usize)) -> scatterloc::Result<T>,
+) -> Result<(T, f64), CliError> {
     static HANDLER: std::sync::Once = std::sync::Once::new();
     HANDLER.call_once(|| {
         // A second Ctrl-C leaves at once (nothing has been written yet either way).
@@ -217,10 +245,10 @@ pub fn run_with_progress(
             }
         });
     });
-    let bar = ProgressBar::new(cfg.runs() as u64);
-    let style = ProgressStyle::with_template(
-        "{prefix} {elapsed_precise} [{wide_bar}] {human_pos}/{human_len} runs · {per_sec} · ETA {eta}",
-    )
+    let bar = ProgressBar::new(total as u64);
+    let style = ProgressStyle::with_template(&format!(
+        "{{prefix}} {{elapsed_precise}} [{{wide_bar}}] {{human_pos}}/{{human_len}} {unit} · {{per_sec}} · ETA {{eta}}"
+    ))
     .map(|s| s.progress_chars("=> "));
     if let Ok(style) = style {
         bar.set_style(style);
@@ -228,9 +256,7 @@ pub fn run_with_progress(
     bar.set_prefix(label.to_string());
     bar.enable_steady_tick(Duration::from_millis(250));
     let t0 = Instant::now();
-    let res = run_parallel(model, cfg, threads, &CANCEL, |done, _| {
-        bar.set_position(done as u64)
-    });
+    let res = run(&CANCEL, &mut |done, _| bar.set_position(done as u64));
     let wall = t0.elapsed().as_secs_f64();
     bar.finish_and_clear();
     if CANCEL.load(Ordering::SeqCst) {
