@@ -102,10 +102,17 @@ impl Network {
 
 /// Iso-delay ellipse with foci `tx`, `rx` for delay `delay_s` (spec §2); `None` if it does not exist.
 pub fn iso_delay_ellipse(tx: Vec2, rx: Vec2, delay_s: Real) -> Option<Ellipse> {
-    if !delay_s.is_finite() {
+    iso_range_ellipse(tx, rx, SPEED_OF_LIGHT * delay_s)
+}
+
+/// Iso-range ellipse `{x : ‖x − tx‖ + ‖x − rx‖ = range_m}` (multi-target spec §5.1): semi-major
+/// `a = ρ/2`, focal half-distance `f = ‖rx − tx‖/2`, semi-minor `b = √(a² − f²)`. `None` if the
+/// range is not finite or `ρ < 2f`; a degenerate ellipse (`b = 0`, the segment) when `ρ = 2f`.
+pub fn iso_range_ellipse(tx: Vec2, rx: Vec2, range_m: Real) -> Option<Ellipse> {
+    if !range_m.is_finite() {
         return None;
     }
-    let a = SPEED_OF_LIGHT * delay_s / 2.0;
+    let a = range_m / 2.0;
     let axis = rx - tx;
     let f = axis.norm() / 2.0;
     if a < f {

@@ -35,6 +35,7 @@ pub mod math;
 pub mod model;
 pub mod montecarlo;
 pub mod motion;
+pub mod mtl;
 #[cfg(all(feature = "std", not(target_arch = "wasm32")))]
 pub mod parallel;
 pub mod pattern;

@@ -1,0 +1,602 @@
+//! Blocking vectors over TRPs (spec §3): the Kronecker form `γ = γ^R ⊗ γ^T` (M3), consistency of
+//! full and partial vectors, the unit-Hamming neighbour sets and the relaxed probability (M5),
+//! the marginal (M4) of a node-pattern model, and the blocking likelihood `L_b = −ln P`.
+//!
+//! Representation: a blocking vector is a `u64` bit mask, bit `m` = TRP `m` (0-based, TRP order of
+//! [`TrpMap`]); a node vector `a` (TXs) or `b` (RXs) is a mask over node indices. A *partial*
+//! vector ([`PartialVector`]) is a pair of masks: the processed TRP set `S` and the TRPs of `S`
+//! holding a DP (`ĝ_m = 1`).
+
+use alloc::vec::Vec;
+
+use crate::error::{Error, Result};
+use crate::math::{ln, Real, Vec2};
+use crate::mtl::trp::{low_bits, TrpMap};
+
+/// A blocking vector `ĝ` on a processed TRP set `S` (spec §3): `ones ⊆ set`, both bit masks over
+/// TRPs. With `S` = all TRPs it is a full vector.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct PartialVector {
+    set: u64,
+    ones: u64,
+}
+
+impl PartialVector {
+    /// The vector on TRP set `set` with DPs (`ĝ_m = 1`) at `ones`.
+    ///
+    /// Errors: [`Error::IndexOutOfRange`] (`trps`) when `set` has a bit at or past `M`;
+    /// [`Error::OutOfRange`] (`blocking_vector.ones`, value = the first offending 0-based TRP) when
+    /// `ones` has a bit outside `set`.
+    pub fn new(map: &TrpMap, set: u64, ones: u64) -> Result<Self> {
+        let outside = set & !map.all_trps();
+        if outside != 0 {
+            return Err(Error::IndexOutOfRange {
+                field: "trps",
+                index: outside.trailing_zeros() as usize,
+                len: map.n_trps(),
+            });
+        }
+        let stray = ones & !set;
+        if stray != 0 {
+            return Err(Error::OutOfRange {
+                field: "blocking_vector.ones".into(),
+                value: stray.trailing_zeros() as Real,
+                allowed: "DPs only at processed TRPs",
+            });
+        }
+        Ok(Self { set, ones })
+    }
+
+    /// The full vector (`S` = all TRPs) with DPs at `ones`; errors as [`PartialVector::new`].
+    pub fn full(map: &TrpMap, ones: u64) -> Result<Self> {
+        Self::new(map, map.all_trps(), ones)
+    }
+
+    /// The empty vector (`S = ∅`).
+    pub fn empty() -> Self {
+        Self { set: 0, ones: 0 }
+    }
+
+    /// This vector extended (or overwritten) at TRP `m` with `ĝ_m = dp`. Panics if `m ≥ 64`.
+    pub fn with(self, m: usize, dp: bool) -> Self {
+        let bit = 1u64 << m;
+        Self {
+            set: self.set | bit,
+            ones: if dp {
+                self.ones | bit
+            } else {
+                self.ones & !bit
+            },
+        }
+    }
+
+    /// The processed TRP set `S` as a mask.
+    pub fn set(&self) -> u64 {
+        self.set
+    }
+
+    /// The TRPs with `ĝ_m = 1` as a mask.
+    pub fn ones(&self) -> u64 {
+        self.ones
+    }
+
+    /// `|S|`.
+    pub fn len(&self) -> u32 {
+        self.set.count_ones()
+    }
+
+    /// `S = ∅`.
+    pub fn is_empty(&self) -> bool {
+        self.set == 0
+    }
+
+    /// Hamming weight `|ĝ|` (number of DPs).
+    pub fn weight(&self) -> u32 {
+        self.ones.count_ones()
+    }
+
+    /// `ĝ_m` if `m ∈ S`, else `None`.
+    pub fn get(&self, m: usize) -> Option<bool> {
+        if m < 64 && self.set >> m & 1 == 1 {
+            Some(self.ones >> m & 1 == 1)
+        } else {
+            None
+        }
+    }
+}
+
+/// `γ = b ⊗ a` (M3): bit `m` is `a_{m_t} b_{m_r}` for TX vector `a` and RX vector `b` (masks over
+/// node indices; bits past `N_t` / `N_r` are ignored).
+pub fn kron(map: &TrpMap, a: u64, b: u64) -> u64 {
+    let a = a & low_bits(map.n_tx());
+    let mut g = 0u64;
+    for r in 0..map.n_rx() {
+        if b >> r & 1 == 1 {
+            g |= a << (r * map.n_tx());
+        }
+    }
+    g
+}
+
+/// Whether `v` is consistent (spec §3): `∃ a, b` with `a_{m_t} b_{m_r} = ĝ_m ∀ m ∈ S`.
+///
+/// Exact in `O(M)`: the smallest node vectors that produce every DP are `a*` = TXs of the DPs and
+/// `b*` = RXs of the DPs; any other solution contains them, so a solution exists iff `b* ⊗ a*`
+/// has no DP on a TRP of `S` where `ĝ_m = 0`. (Agrees with enumerating all `2^{N_t+N_r}` pairs;
+/// see [`BlockingSpace::is_consistent_by_enumeration`].)
+pub fn is_consistent(map: &TrpMap, v: &PartialVector) -> bool {
+    let mut a = 0u64;
+    let mut b = 0u64;
+    let mut rest = v.ones;
+    while rest != 0 {
+        let m = rest.trailing_zeros() as usize;
+        rest &= rest - 1;
+        a |= 1 << map.tx(m);
+        b |= 1 << map.rx(m);
+    }
+    kron(map, a, b) & v.set == v.ones
+}
+
+/// `p` checked to lie in `[0, 1]`; else [`Error::OutOfRange`] naming `field` (NaN included).
+pub fn check_probability(field: &str, p: Real) -> Result<Real> {
+    if (0.0..=1.0).contains(&p) {
+        Ok(p)
+    } else {
+        Err(Error::OutOfRange {
+            field: field.into(),
+            value: p,
+            allowed: "a probability in [0, 1]",
+        })
+    }
+}
+
+/// `p^n` by repeated multiplication (`p^0 = 1`, also for `p = 0`), `no_std`-safe.
+pub fn powu(p: Real, n: u32) -> Real {
+    let mut r = 1.0;
+    for _ in 0..n {
+        r *= p;
+    }
+    r
+}
+
+/// The blocking likelihood `L_b = −ln P` (spec §3): `+∞` when `P = 0` (or is not a number),
+/// never NaN; rounding above 1 is clamped so `L_b ≥ 0`.
+pub fn blocking_likelihood(p: Real) -> Real {
+    if p > 0.0 {
+        (-ln(p)).max(0.0)
+    } else {
+        Real::INFINITY
+    }
+}
+
+/// A blocking model at node level (spec §6): `P_node(γ^T = a, γ^R = b | x)`, the probability of
+/// TX LoS vector `a` and RX LoS vector `b` (masks over node indices) for a target at `x`. Summed
+/// over all `2^{N_t+N_r}` patterns it should be 1.
+pub trait NodePatternModel {
+    /// `P_node(γ^T = a, γ^R = b | x)`.
+    fn node_pattern_probability(&self, x: &Vec2, a: u64, b: u64) -> Real;
+}
+
+/// The per-candidate blocking query shared by all blocking models (i.c.b, PPP, empirical): the
+/// probability `P(γ̂_S(x) = ĝ)` of an observed (partial) vector at `x` and `L_b = −ln P`.
+pub trait BlockingModel {
+    /// The TRP map the model was built for.
+    fn trp_map(&self) -> &TrpMap;
+
+    /// `P(γ̂_S(x) = ĝ)` for the observed vector `v` (e.g. (M5) or the i.c.b form of §6.1).
+    ///
+    /// Errors: [`Error::IndexOutOfRange`] (`trps`) when `v` names a TRP past this model's `M`.
+    fn probability(&self, x: &Vec2, v: &PartialVector) -> Result<Real>;
+
+    /// `L_b(x, S, ĝ) = −ln P(γ̂_S(x) = ĝ)`: `+∞` when the probability is 0, never NaN.
+    fn blocking_likelihood(&self, x: &Vec2, v: &PartialVector) -> Result<Real> {
+        Ok(blocking_likelihood(self.probability(x, v)?))
+    }
+}
+
+/// [`Error::IndexOutOfRange`] (`trps`) unless `v` lies within `map`'s TRPs.
+pub fn check_vector(map: &TrpMap, v: &PartialVector) -> Result<()> {
+    PartialVector::new(map, v.set, v.ones).map(|_| ())
+}
+
+/// The precomputed blocking-vector structure of one [`TrpMap`]: `b ⊗ a` for every node pattern
+/// and the sorted list of distinct consistent full vectors.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BlockingSpace {
+    map: TrpMap,
+    /// `patterns[a | b << N_t] = b ⊗ a`.
+    patterns: Vec<u64>,
+    /// Distinct consistent full vectors, ascending.
+    consistent: Vec<u64>,
+}
+
+impl BlockingSpace {
+    /// Enumerate the `2^{N_t+N_r}` node patterns of `map` (at most 65 536, see
+    /// [`crate::mtl::trp::MAX_NODES`]).
+    pub fn new(map: TrpMap) -> Self {
+        let n = map.n_tx() + map.n_rx();
+        let count = 1usize << n;
+        let mask_a = low_bits(map.n_tx());
+        let patterns: Vec<u64> = (0..count as u64)
+            .map(|i| kron(&map, i & mask_a, i >> map.n_tx()))
+            .collect();
+        let mut consistent = patterns.clone();
+        consistent.sort_unstable();
+        consistent.dedup();
+        Self {
+            map,
+            patterns,
+            consistent,
+        }
+    }
+
+    /// The TRP map.
+    pub fn map(&self) -> &TrpMap {
+        &self.map
+    }
+
+    /// Number of node patterns `2^{N_t+N_r}`.
+    pub fn n_patterns(&self) -> usize {
+        self.patterns.len()
+    }
+
+    /// `(a, b, b ⊗ a)` of node pattern index `i = a | b << N_t`.
+    pub fn pattern(&self, i: usize) -> (u64, u64, u64) {
+        let i64 = i as u64;
+        (
+            i64 & low_bits(self.map.n_tx()),
+            i64 >> self.map.n_tx(),
+            self.patterns[i],
+        )
+    }
+
+    /// The distinct consistent full vectors (masks), ascending.
+    pub fn consistent_full(&self) -> &[u64] {
+        &self.consistent
+    }
+
+    /// Whether `v` is consistent (the `O(M)` test of [`is_consistent`]).
+    pub fn is_consistent(&self, v: &PartialVector) -> bool {
+        is_consistent(&self.map, v)
+    }
+
+    /// Whether some consistent full vector agrees with `v` on `S` (the definition, by
+    /// enumeration; equal to [`BlockingSpace::is_consistent`]).
+    pub fn is_consistent_by_enumeration(&self, v: &PartialVector) -> bool {
+        self.consistent.iter().any(|g| g & v.set == v.ones)
+    }
+
+    /// The unit-Hamming neighbour set `𝒩(ĝ) = {g ∈ 𝒞_S : d_H(g, ĝ) ≤ 1}` (M5), all on the same
+    /// `S`: `ĝ` itself first if consistent, then the single-bit flips in ascending TRP order.
+    pub fn neighbours(&self, v: &PartialVector) -> Vec<PartialVector> {
+        let mut out = Vec::new();
+        self.for_each_neighbour(v, |g| out.push(g));
+        out
+    }
+
+    fn for_each_neighbour(&self, v: &PartialVector, mut f: impl FnMut(PartialVector)) {
+        if self.is_consistent(v) {
+            f(*v);
+        }
+        let mut rest = v.set;
+        while rest != 0 {
+            let bit = rest & rest.wrapping_neg();
+            rest &= rest - 1;
+            let g = PartialVector {
+                set: v.set,
+                ones: v.ones ^ bit,
+            };
+            if self.is_consistent(&g) {
+                f(g);
+            }
+        }
+    }
+
+    /// `P_node` of every node pattern at `x`, indexed like [`BlockingSpace::pattern`]; evaluate
+    /// once per location and reuse for many (M4)/(M5) queries.
+    pub fn node_table<N: NodePatternModel + ?Sized>(&self, model: &N, x: &Vec2) -> NodeTable {
+        let probs = (0..self.patterns.len())
+            .map(|i| {
+                let (a, b, _) = self.pattern(i);
+                model.node_pattern_probability(x, a, b)
+            })
+            .collect();
+        NodeTable { probs }
+    }
+
+    /// The marginal (M4) `P(γ_S(x) = g) = Σ P_node(a, b | x)` over the node patterns with
+    /// `b ⊗ a = g` on `S`, from a [`NodeTable`] of this space.
+    pub fn marginal(&self, table: &NodeTable, g: &PartialVector) -> Real {
+        self.patterns
+            .iter()
+            .zip(&table.probs)
+            .filter(|(p, _)| *p & g.set == g.ones)
+            .map(|(_, q)| q)
+            .sum()
+    }
+
+    /// The relaxed probability (M5) of the observed `ĝ` with DP detection probability `p_d`:
+    /// `Σ_{g ∈ 𝒩(ĝ), g ≥ ĝ} p_d^{|ĝ|} (1 − p_d)^{|g|−|ĝ|} P(γ_S = g)`, 0 when `𝒩(ĝ) = ∅`
+    /// (only "no error" and "one DP missed" terms enter). `p_d` is not validated here.
+    pub fn relaxed_probability(&self, table: &NodeTable, v: &PartialVector, p_d: Real) -> Real {
+        let base = powu(p_d, v.weight());
+        let mut sum = 0.0;
+        self.for_each_neighbour(v, |g| {
+            if g.ones & v.ones == v.ones {
+                let extra = g.weight() - v.weight();
+                sum += base * powu(1.0 - p_d, extra) * self.marginal(table, &g);
+            }
+        });
+        sum
+    }
+}
+
+/// `P_node(a, b | x)` of every node pattern at one location (see [`BlockingSpace::node_table`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct NodeTable {
+    probs: Vec<Real>,
+}
+
+impl NodeTable {
+    /// The probabilities, indexed `a | b << N_t`.
+    pub fn probabilities(&self) -> &[Real] {
+        &self.probs
+    }
+}
+
+/// A Bayesian blocking model built from a [`NodePatternModel`]: (M4) marginals relaxed by (M5)
+/// with detection probability `p_d`.
+#[derive(Debug, Clone)]
+pub struct NodeBlockingModel<N> {
+    space: BlockingSpace,
+    node: N,
+    p_d: Real,
+}
+
+impl<N: NodePatternModel> NodeBlockingModel<N> {
+    /// The model for `map` with node-pattern model `node` and DP detection probability `p_d`;
+    /// [`Error::OutOfRange`] (`p_d`) unless `p_d ∈ [0, 1]`.
+    pub fn new(map: TrpMap, node: N, p_d: Real) -> Result<Self> {
+        let p_d = check_probability("p_d", p_d)?;
+        Ok(Self {
+            space: BlockingSpace::new(map),
+            node,
+            p_d,
+        })
+    }
+
+    /// The precomputed blocking space.
+    pub fn space(&self) -> &BlockingSpace {
+        &self.space
+    }
+
+    /// The node-pattern model.
+    pub fn node_model(&self) -> &N {
+        &self.node
+    }
+
+    /// DP detection probability `p_d`.
+    pub fn p_d(&self) -> Real {
+        self.p_d
+    }
+
+    /// (M5) from a node table already evaluated at the candidate's location (no validation).
+    pub fn probability_with_table(&self, table: &NodeTable, v: &PartialVector) -> Real {
+        self.space.relaxed_probability(table, v, self.p_d)
+    }
+}
+
+impl<N: NodePatternModel> BlockingModel for NodeBlockingModel<N> {
+    fn trp_map(&self) -> &TrpMap {
+        self.space.map()
+    }
+
+    fn probability(&self, x: &Vec2, v: &PartialVector) -> Result<Real> {
+        check_vector(self.space.map(), v)?;
+        let table = self.space.node_table(&self.node, x);
+        Ok(self.probability_with_table(&table, v))
+    }
+}
+
+/// A simple node-pattern model: each TX `j` has LoS to the target with probability `p_tx[j]`,
+/// each RX `j` with `p_rx[j]`, all independent and independent of `x`. A reference and test
+/// model (with all probabilities equal to `p_LoS` its DPs are not independent, unlike i.c.b).
+#[derive(Debug, Clone, PartialEq)]
+pub struct IndependentNodes {
+    p_tx: Vec<Real>,
+    p_rx: Vec<Real>,
+}
+
+impl IndependentNodes {
+    /// The model with per-node LoS probabilities for the nodes of `map`.
+    ///
+    /// Errors: [`Error::LengthMismatch`] (`p_tx` / `p_rx`) when a list does not have one entry per
+    /// node; [`Error::OutOfRange`] (`p_tx[j]` / `p_rx[j]`) for a value outside `[0, 1]`.
+    pub fn new(map: &TrpMap, p_tx: Vec<Real>, p_rx: Vec<Real>) -> Result<Self> {
+        for (field, list, n) in [("p_tx", &p_tx, map.n_tx()), ("p_rx", &p_rx, map.n_rx())] {
+            if list.len() != n {
+                return Err(Error::LengthMismatch {
+                    field,
+                    expected: n,
+                    found: list.len(),
+                });
+            }
+            for (j, &p) in list.iter().enumerate() {
+                check_probability(&alloc::format!("{field}[{j}]"), p)?;
+            }
+        }
+        Ok(Self { p_tx, p_rx })
+    }
+}
+
+impl NodePatternModel for IndependentNodes {
+    fn node_pattern_probability(&self, _x: &Vec2, a: u64, b: u64) -> Real {
+        let side = |ps: &[Real], mask: u64| {
+            ps.iter()
+                .enumerate()
+                .map(|(j, &p)| if mask >> j & 1 == 1 { p } else { 1.0 - p })
+                .product::<Real>()
+        };
+        side(&self.p_tx, a) * side(&self.p_rx, b)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// 1-based TRP list → mask.
+    fn mask(trps: &[usize]) -> u64 {
+        trps.iter().fold(0, |m, &t| m | 1 << (t - 1))
+    }
+
+    #[test]
+    fn kron_matches_definition() {
+        let map = TrpMap::new(3, 2).unwrap();
+        for a in 0..8u64 {
+            for b in 0..4u64 {
+                let g = kron(&map, a, b);
+                for m in 0..6 {
+                    let want = (a >> map.tx(m) & 1) & (b >> map.rx(m) & 1);
+                    assert_eq!(g >> m & 1, want);
+                }
+                assert_eq!(g.count_ones(), a.count_ones() * b.count_ones());
+            }
+        }
+    }
+
+    #[test]
+    fn check_two_consistent_count_and_weights() {
+        let map = TrpMap::new(3, 3).unwrap();
+        let space = BlockingSpace::new(map);
+        assert_eq!(space.consistent_full().len(), 50);
+        let mut hist = [0usize; 10];
+        let mut n = 0;
+        for ones in 0..512u64 {
+            let v = PartialVector::full(&map, ones).unwrap();
+            let c = is_consistent(&map, &v);
+            assert_eq!(c, space.is_consistent_by_enumeration(&v));
+            if c {
+                n += 1;
+                hist[v.weight() as usize] += 1;
+            }
+        }
+        assert_eq!(n, 50);
+        assert_eq!(hist, [1, 9, 18, 6, 9, 0, 6, 0, 0, 1]);
+    }
+
+    #[test]
+    fn check_three_unit_hamming_sets() {
+        let map = TrpMap::new(3, 3).unwrap();
+        let space = BlockingSpace::new(map);
+        let sets = |trps: &[usize]| {
+            let v = PartialVector::full(&map, mask(trps)).unwrap();
+            let mut n: Vec<u64> = space.neighbours(&v).iter().map(|g| g.ones()).collect();
+            n.sort_unstable();
+            (space.is_consistent(&v), n)
+        };
+        let (c, n) = sets(&[1, 9]);
+        assert!(!c);
+        let mut want = alloc::vec![mask(&[1]), mask(&[9])];
+        want.sort_unstable();
+        assert_eq!(n, want);
+        let (c, n) = sets(&[1, 2, 4]);
+        assert!(!c);
+        let mut want = alloc::vec![mask(&[1, 2, 4, 5]), mask(&[1, 4]), mask(&[1, 2])];
+        want.sort_unstable();
+        assert_eq!(n, want);
+        let (c, _) = sets(&[1, 2, 4, 5]);
+        assert!(c);
+    }
+
+    #[test]
+    fn marginal_sums_and_relaxation() {
+        let map = TrpMap::new(3, 3).unwrap();
+        let node = IndependentNodes::new(
+            &map,
+            alloc::vec![0.9, 0.8, 0.7],
+            alloc::vec![0.6, 0.95, 0.5],
+        )
+        .unwrap();
+        let model = NodeBlockingModel::new(map, node, 0.9).unwrap();
+        let space = model.space();
+        let x = Vec2::zeros();
+        let table = space.node_table(model.node_model(), &x);
+        let total: Real = table.probabilities().iter().sum();
+        assert!((total - 1.0).abs() < 1e-12);
+        // Full-vector marginals sum to 1 over the consistent vectors, 0 elsewhere.
+        let mut s = 0.0;
+        for ones in 0..512u64 {
+            let v = PartialVector::full(&map, ones).unwrap();
+            let p = space.marginal(&table, &v);
+            if !space.is_consistent(&v) {
+                assert_eq!(p, 0.0);
+            }
+            s += p;
+        }
+        assert!((s - 1.0).abs() < 1e-12);
+        // Empty S: P = 1, L_b = 0.
+        let e = PartialVector::empty();
+        assert!((model.probability(&x, &e).unwrap() - 1.0).abs() < 1e-12);
+        assert_eq!(model.blocking_likelihood(&x, &e).unwrap(), 0.0);
+        // ĝ = (1,1) on {TRP1, TRP2}: P(γ=(1,1)) = p_tx0 p_tx1 p_rx0, no heavier neighbours.
+        let v = PartialVector::new(&map, mask(&[1, 2]), mask(&[1, 2])).unwrap();
+        let p = model.probability(&x, &v).unwrap();
+        assert!((p - 0.81 * 0.9 * 0.8 * 0.6).abs() < 1e-12);
+        // ĝ = (1,0) on {1,2}: P(1,0) + (1 − p_d) P(1,1), times p_d.
+        let v = PartialVector::new(&map, mask(&[1, 2]), mask(&[1])).unwrap();
+        let p10 = 0.9 * 0.2 * 0.6;
+        let p11 = 0.9 * 0.8 * 0.6;
+        let p = model.probability(&x, &v).unwrap();
+        assert!((p - 0.9 * (p10 + 0.1 * p11)).abs() < 1e-12);
+        // Inconsistent with only lighter neighbours: P = 0, L_b = ∞.
+        let v = PartialVector::full(&map, mask(&[1, 9])).unwrap();
+        assert_eq!(model.probability(&x, &v).unwrap(), 0.0);
+        assert_eq!(model.blocking_likelihood(&x, &v).unwrap(), Real::INFINITY);
+    }
+
+    #[test]
+    fn bad_inputs_are_named_errors() {
+        let map = TrpMap::new(3, 3).unwrap();
+        assert!(matches!(
+            PartialVector::new(&map, 1 << 9, 0),
+            Err(Error::IndexOutOfRange {
+                field: "trps",
+                index: 9,
+                len: 9
+            })
+        ));
+        assert!(matches!(
+            PartialVector::new(&map, 0b11, 0b100),
+            Err(Error::OutOfRange { .. })
+        ));
+        let node = IndependentNodes::new(&map, alloc::vec![0.5; 3], alloc::vec![0.5; 3]).unwrap();
+        for p_d in [-0.1, 1.5, Real::NAN] {
+            match NodeBlockingModel::new(map, node.clone(), p_d) {
+                Err(Error::OutOfRange { field, .. }) => assert_eq!(field, "p_d"),
+                other => panic!("{other:?}"),
+            }
+        }
+        assert!(matches!(
+            IndependentNodes::new(&map, alloc::vec![0.5; 2], alloc::vec![0.5; 3]),
+            Err(Error::LengthMismatch { field: "p_tx", .. })
+        ));
+        match IndependentNodes::new(&map, alloc::vec![0.5; 3], alloc::vec![0.5, 2.0, 0.5]) {
+            Err(Error::OutOfRange { field, .. }) => assert_eq!(field, "p_rx[1]"),
+            other => panic!("{other:?}"),
+        }
+        // A vector of a bigger network is refused by a smaller model.
+        let big = TrpMap::new(4, 3).unwrap();
+        let v = PartialVector::full(&big, 0).unwrap();
+        let model = NodeBlockingModel::new(map, node, 0.9).unwrap();
+        assert!(model.probability(&Vec2::zeros(), &v).is_err());
+    }
+
+    #[test]
+    fn likelihood_never_nan() {
+        assert_eq!(blocking_likelihood(0.0), Real::INFINITY);
+        assert_eq!(blocking_likelihood(Real::NAN), Real::INFINITY);
+        assert_eq!(blocking_likelihood(1.0 + 1e-16), 0.0);
+        assert!((blocking_likelihood(0.5) - core::f64::consts::LN_2).abs() < 1e-15);
+    }
+}

@@ -1,0 +1,427 @@
+//! Geometry primitives of the multi-target method (spec multi-target.md §5): the ellipse of a TRP
+//! and a range (§5.1) and the ellipse–ellipse intersection (§5.2, at most four points, grazing
+//! points dropped). No heap allocation.
+
+use core::ops::Deref;
+
+use crate::ellipse::Ellipse;
+use crate::geometry::{iso_range_ellipse, unit_from};
+use crate::math::{sqrt, Real, Vec2, PI};
+use crate::mtl::polygon::Rect;
+
+/// Samples of `h(θ)` around ellipse 1 (§5.2).
+pub const INTERSECTION_SAMPLES: usize = 720;
+/// Tangency acceptance: a local minimum of `|h|` counts as a root below this times `ρ₂` (§5.2).
+pub const TANGENCY_REL_TOL: Real = 1e-9;
+/// Roots closer than this (m) are merged (§5.2).
+pub const MERGE_DISTANCE_M: Real = 1e-6;
+/// Points whose range-gradient matrix `G` has a condition number above this are grazing and
+/// dropped (§5.2).
+pub const MAX_GRADIENT_CONDITION: Real = 1e8;
+/// Margin (m) by which the region is enlarged before points outside it are dropped (§5.2).
+pub const REGION_MARGIN_M: Real = 1.0;
+
+/// The ellipse `{x : ‖x − tx‖ + ‖x − rx‖ = ρ}` of one TRP (TX focus `tx`, RX focus `rx`) and one
+/// measured range `ρ` (§5.1, (M1)).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RangeEllipse {
+    /// TX position `u_{m_t}`, m.
+    pub tx: Vec2,
+    /// RX position `v_{m_r}`, m.
+    pub rx: Vec2,
+    /// Range `ρ`, m.
+    pub range_m: Real,
+    /// Centre, semi-axes and orientation (`a = ρ/2`, `b = √(a² − f²)`).
+    pub ellipse: Ellipse,
+}
+
+impl RangeEllipse {
+    /// The ellipse of foci `tx`, `rx` and range `range_m` (§5.1). `None` if a coordinate or the
+    /// range is not finite or `ρ < 2f` (`f = ‖rx − tx‖/2`); degenerate (the segment, `b = 0`)
+    /// when `ρ = 2f`.
+    pub fn new(tx: Vec2, rx: Vec2, range_m: Real) -> Option<RangeEllipse> {
+        if !(tx.x.is_finite() && tx.y.is_finite() && rx.x.is_finite() && rx.y.is_finite()) {
+            return None;
+        }
+        let ellipse = iso_range_ellipse(tx, rx, range_m)?;
+        Some(RangeEllipse {
+            tx,
+            rx,
+            range_m,
+            ellipse,
+        })
+    }
+
+    /// Whether the ellipse is the focal segment (`ρ = 2f`, `b = 0`).
+    pub fn is_degenerate(&self) -> bool {
+        self.ellipse.semi_minor == 0.0
+    }
+
+    /// The TRP range `d(x) = ‖x − tx‖ + ‖x − rx‖` (M1), m.
+    #[inline]
+    pub fn range_at(&self, x: Vec2) -> Real {
+        (x - self.tx).norm() + (x - self.rx).norm()
+    }
+
+    /// Residual `d(x) − ρ`, m.
+    #[inline]
+    pub fn residual(&self, x: Vec2) -> Real {
+        self.range_at(x) - self.range_m
+    }
+
+    /// Gradient of `d` at `x`: the sum of the unit vectors from the foci (zero at a focus).
+    #[inline]
+    pub fn gradient(&self, x: Vec2) -> Vec2 {
+        unit_from(self.tx, x).0 + unit_from(self.rx, x).0
+    }
+
+    /// Point at parameter `θ`: `c + a cos θ ê + b sin θ ê^⊥` (§5.2).
+    #[inline]
+    pub fn point(&self, theta: Real) -> Vec2 {
+        self.ellipse.point(theta)
+    }
+}
+
+/// At most four intersection points, without heap allocation. Dereferences to `[Vec2]`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Intersections {
+    points: [Vec2; 4],
+    len: usize,
+}
+
+impl Intersections {
+    /// No points.
+    pub fn new() -> Intersections {
+        Intersections {
+            points: [Vec2::zeros(); 4],
+            len: 0,
+        }
+    }
+
+    /// The points as a slice.
+    pub fn as_slice(&self) -> &[Vec2] {
+        &self.points[..self.len]
+    }
+
+    fn push(&mut self, p: Vec2) {
+        if self.len < 4 {
+            self.points[self.len] = p;
+            self.len += 1;
+        }
+    }
+}
+
+impl Default for Intersections {
+    fn default() -> Self {
+        Intersections::new()
+    }
+}
+
+impl Deref for Intersections {
+    type Target = [Vec2];
+    fn deref(&self) -> &[Vec2] {
+        self.as_slice()
+    }
+}
+
+/// Condition number `σ_max/σ_min` of the 2×2 matrix with rows `g1`, `g2` (∞ when singular).
+pub fn condition_number(g1: Vec2, g2: Vec2) -> Real {
+    let det = (g1.x * g2.y - g1.y * g2.x).abs();
+    let fro2 = g1.norm_squared() + g2.norm_squared();
+    if det == 0.0 || !det.is_finite() {
+        return Real::INFINITY;
+    }
+    // σ_max² + σ_min² = ‖G‖_F², σ_max σ_min = |det G|.
+    let disc = sqrt((fro2 * fro2 - 4.0 * det * det).max(0.0));
+    let smax2 = 0.5 * (fro2 + disc);
+    smax2 / det
+}
+
+fn same_point(p: Vec2, q: Vec2, scale: Real) -> bool {
+    (p - q).norm() <= 1e-12 * scale
+}
+
+/// Brent's root finder on `[a, b]` with `f(a)`, `f(b)` of opposite signs (or one zero).
+fn brent<F: Fn(Real) -> Real>(f: &F, mut a: Real, mut b: Real, mut fa: Real, mut fb: Real) -> Real {
+    if fa == 0.0 {
+        return a;
+    }
+    if fb == 0.0 {
+        return b;
+    }
+    let (mut c, mut fc) = (a, fa);
+    let mut d = b - a;
+    let mut e = d;
+    for _ in 0..200 {
+        if (fb > 0.0) == (fc > 0.0) {
+            c = a;
+            fc = fa;
+            d = b - a;
+            e = d;
+        }
+        if fc.abs() < fb.abs() {
+            a = b;
+            b = c;
+            c = a;
+            fa = fb;
+            fb = fc;
+            fc = fa;
+        }
+        let tol = 2.0 * Real::EPSILON * b.abs() + 1e-16;
+        let m = 0.5 * (c - b);
+        if m.abs() <= tol || fb == 0.0 {
+            return b;
+        }
+        if e.abs() < tol || fa.abs() <= fb.abs() {
+            d = m;
+            e = m;
+        } else {
+            let s = fb / fa;
+            let (mut p, mut q);
+            if a == c {
+                p = 2.0 * m * s;
+                q = 1.0 - s;
+            } else {
+                let q0 = fa / fc;
+                let r = fb / fc;
+                p = s * (2.0 * m * q0 * (q0 - r) - (b - a) * (r - 1.0));
+                q = (q0 - 1.0) * (r - 1.0) * (s - 1.0);
+            }
+            if p > 0.0 {
+                q = -q;
+            } else {
+                p = -p;
+            }
+            if 2.0 * p < (3.0 * m * q - (tol * q).abs()).min((e * q).abs()) {
+                e = d;
+                d = p / q;
+            } else {
+                d = m;
+                e = m;
+            }
+        }
+        a = b;
+        fa = fb;
+        b += if d.abs() > tol {
+            d
+        } else if m > 0.0 {
+            tol
+        } else {
+            -tol
+        };
+        fb = f(b);
+    }
+    b
+}
+
+/// Golden-section minimisation of `g` on `[lo, hi]`; returns the abscissa of the minimum found.
+fn golden_min<F: Fn(Real) -> Real>(g: &F, mut lo: Real, mut hi: Real) -> Real {
+    const R: Real = 0.618_033_988_749_894_8;
+    let mut x1 = hi - R * (hi - lo);
+    let mut x2 = lo + R * (hi - lo);
+    let (mut g1, mut g2) = (g(x1), g(x2));
+    for _ in 0..80 {
+        if g1 < g2 {
+            hi = x2;
+            x2 = x1;
+            g2 = g1;
+            x1 = hi - R * (hi - lo);
+            g1 = g(x1);
+        } else {
+            lo = x1;
+            x1 = x2;
+            g1 = g2;
+            x2 = lo + R * (hi - lo);
+            g2 = g(x2);
+        }
+    }
+    if g1 < g2 {
+        x1
+    } else {
+        x2
+    }
+}
+
+/// Intersection points of two TRP ellipses (§5.2, a \[P\] choice): ellipse 1 is parametrized, `h(θ) =
+/// d₂(p(θ)) − ρ₂` sampled at [`INTERSECTION_SAMPLES`] points, every sign change Brent-refined,
+/// tangencies (local minima of `|h|` below [`TANGENCY_REL_TOL`]`·ρ₂`) added, roots closer than
+/// [`MERGE_DISTANCE_M`] merged, at most four kept. Points where the matrix `G` of the two range
+/// gradients has `cond(G) >` [`MAX_GRADIENT_CONDITION`] (grazing) are dropped, and, when `region`
+/// is given, points outside it enlarged by [`REGION_MARGIN_M`]. Identical or confocal ellipses
+/// give no points.
+pub fn intersect(e1: &RangeEllipse, e2: &RangeEllipse, region: Option<&Rect>) -> Intersections {
+    let mut out = Intersections::new();
+    let scale = 1.0 + e1.range_m.abs() + e2.range_m.abs();
+    let confocal = (same_point(e1.tx, e2.tx, scale) && same_point(e1.rx, e2.rx, scale))
+        || (same_point(e1.tx, e2.rx, scale) && same_point(e1.rx, e2.tx, scale));
+    if confocal {
+        return out;
+    }
+    let h = |t: Real| e2.residual(e1.point(t));
+    let n = INTERSECTION_SAMPLES;
+    let step = 2.0 * PI / n as Real;
+    let mut theta = [0.0; INTERSECTION_SAMPLES + 1];
+    let mut hv = [0.0; INTERSECTION_SAMPLES + 1];
+    for k in 0..=n {
+        theta[k] = step * k as Real;
+        hv[k] = if k == n { hv[0] } else { h(theta[k]) };
+    }
+    // Candidate roots (θ), more than 4 only through numerical duplicates.
+    let mut cand = [0.0; 16];
+    let mut nc = 0;
+    let mut add = |t: Real, nc: &mut usize| {
+        if *nc < cand.len() {
+            cand[*nc] = t;
+            *nc += 1;
+        }
+    };
+    for k in 0..n {
+        let (h0, h1) = (hv[k], hv[k + 1]);
+        if h0 == 0.0 {
+            add(theta[k], &mut nc);
+        } else if h1 != 0.0 && (h0 > 0.0) != (h1 > 0.0) {
+            add(brent(&h, theta[k], theta[k + 1], h0, h1), &mut nc);
+        }
+    }
+    // Tangencies: local minima of |h| between samples of one sign.
+    let tang_tol = TANGENCY_REL_TOL * e2.range_m.abs();
+    for k in 0..n {
+        let prev = hv[(k + n - 1) % n];
+        let (cur, next) = (hv[k], hv[k + 1]);
+        if cur == 0.0 || !(cur.abs() <= prev.abs() && cur.abs() <= next.abs()) {
+            continue;
+        }
+        if (prev > 0.0) != (cur > 0.0) || (next > 0.0) != (cur > 0.0) {
+            continue;
+        }
+        let s = if cur > 0.0 { 1.0 } else { -1.0 };
+        let g = |t: Real| s * h(t);
+        let t = golden_min(&g, theta[k] - step, theta[k] + step);
+        if h(t).abs() < tang_tol {
+            add(t, &mut nc);
+        }
+    }
+    // Points, merged and filtered.
+    let mut pts = [Vec2::zeros(); 16];
+    let mut np = 0;
+    for &t in &cand[..nc] {
+        let p = e1.point(t);
+        if !(p.x.is_finite() && p.y.is_finite()) {
+            continue;
+        }
+        if pts[..np].iter().any(|q| (p - *q).norm() < MERGE_DISTANCE_M) {
+            continue;
+        }
+        if condition_number(e1.gradient(p), e2.gradient(p)) > MAX_GRADIENT_CONDITION {
+            continue;
+        }
+        if let Some(r) = region {
+            if !r.enlarged(REGION_MARGIN_M).contains(p) {
+                continue;
+            }
+        }
+        pts[np] = p;
+        np += 1;
+    }
+    if np > 4 {
+        // Keep the four best by total residual (only reachable through numerical noise).
+        let res = |p: &Vec2| e1.residual(*p).abs() + e2.residual(*p).abs();
+        pts[..np].sort_by(|a, b| res(a).total_cmp(&res(b)));
+        np = 4;
+    }
+    for p in &pts[..np] {
+        out.push(*p);
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn v(x: Real, y: Real) -> Vec2 {
+        Vec2::new(x, y)
+    }
+
+    fn check(e1: &RangeEllipse, e2: &RangeEllipse, pts: &[Vec2]) {
+        for p in pts {
+            assert!(e1.residual(*p).abs() < 1e-9, "{p:?}");
+            assert!(e2.residual(*p).abs() < 1e-9, "{p:?}");
+        }
+    }
+
+    #[test]
+    fn ellipse_of_trp() {
+        let e = RangeEllipse::new(v(-3.0, 0.0), v(3.0, 0.0), 10.0).unwrap();
+        assert_eq!(e.ellipse.semi_major, 5.0);
+        assert_eq!(e.ellipse.semi_minor, 4.0);
+        assert!(!e.is_degenerate());
+        assert!(RangeEllipse::new(v(-3.0, 0.0), v(3.0, 0.0), 5.9).is_none());
+        assert!(RangeEllipse::new(v(-3.0, 0.0), v(3.0, 0.0), Real::NAN).is_none());
+        assert!(RangeEllipse::new(v(-3.0, Real::NAN), v(3.0, 0.0), 10.0).is_none());
+        assert!(RangeEllipse::new(v(-3.0, 0.0), v(3.0, 0.0), 6.0)
+            .unwrap()
+            .is_degenerate());
+    }
+
+    #[test]
+    fn check7_four_points() {
+        let e1 = RangeEllipse::new(v(-3.0, 0.0), v(3.0, 0.0), 10.0).unwrap();
+        let e2 = RangeEllipse::new(v(0.0, -3.0), v(0.0, 3.0), 10.0).unwrap();
+        let pts = intersect(&e1, &e2, None);
+        assert_eq!(pts.len(), 4);
+        check(&e1, &e2, &pts);
+        let s = sqrt(400.0 / 41.0);
+        for p in pts.iter() {
+            assert!((p.x.abs() - s).abs() < 1e-9 && (p.y.abs() - s).abs() < 1e-9);
+            assert!((p.x.abs() - 3.1235).abs() < 5e-5);
+        }
+    }
+
+    #[test]
+    fn check7_two_and_none() {
+        let e1 = RangeEllipse::new(v(0.0, 0.0), v(10.0, 0.0), 14.0).unwrap();
+        let e2 = RangeEllipse::new(v(0.0, 0.0), v(0.0, 10.0), 14.0).unwrap();
+        let pts = intersect(&e1, &e2, None);
+        assert_eq!(pts.len(), 2);
+        check(&e1, &e2, &pts);
+        for want in [4.8985, -1.6108] {
+            assert!(pts
+                .iter()
+                .any(|p| (p.x - want).abs() < 5e-5 && (p.y - want).abs() < 5e-5));
+        }
+        let e3 = RangeEllipse::new(v(0.0, 0.0), v(10.0, 0.0), 12.0).unwrap();
+        let e4 = RangeEllipse::new(v(10.0, 10.0), v(0.0, 10.0), 12.0).unwrap();
+        assert!(intersect(&e3, &e4, None).is_empty());
+    }
+
+    #[test]
+    fn confocal_and_region_and_grazing() {
+        let e1 = RangeEllipse::new(v(0.0, 0.0), v(10.0, 0.0), 14.0).unwrap();
+        assert!(intersect(&e1, &e1, None).is_empty());
+        let e1b = RangeEllipse::new(v(10.0, 0.0), v(0.0, 0.0), 16.0).unwrap();
+        assert!(intersect(&e1, &e1b, None).is_empty());
+        // Region [0,10]²: (−1.6108, −1.6108) lies outside even when enlarged by 1 m.
+        let e2 = RangeEllipse::new(v(0.0, 0.0), v(0.0, 10.0), 14.0).unwrap();
+        let r = Rect::new(v(0.0, 0.0), v(10.0, 10.0)).unwrap();
+        let pts = intersect(&e1, &e2, Some(&r));
+        assert_eq!(pts.len(), 1);
+        assert!((pts[0].x - 4.8985).abs() < 5e-5);
+        // Two circles (coincident foci) touching externally: a tangency, grazing → dropped.
+        let c1 = RangeEllipse::new(v(0.0, 0.0), v(0.0, 0.0), 2.0).unwrap();
+        let c2 = RangeEllipse::new(v(2.0, 0.0), v(2.0, 0.0), 2.0).unwrap();
+        assert!(intersect(&c1, &c2, None).is_empty());
+        // Circles crossing transversally: two points.
+        let c3 = RangeEllipse::new(v(1.0, 0.0), v(1.0, 0.0), 2.0).unwrap();
+        let pts = intersect(&c1, &c3, None);
+        assert_eq!(pts.len(), 2);
+        check(&c1, &c3, &pts);
+    }
+
+    #[test]
+    fn condition() {
+        assert!((condition_number(v(1.0, 0.0), v(0.0, 1.0)) - 1.0).abs() < 1e-15);
+        assert!((condition_number(v(2.0, 0.0), v(0.0, 1.0)) - 2.0).abs() < 1e-15);
+        assert_eq!(condition_number(v(1.0, 1.0), v(2.0, 2.0)), Real::INFINITY);
+    }
+}

@@ -1,0 +1,18 @@
+//! Localization of multiple identical targets under correlated blocking (the Bayesian MTL method
+//! of `shared/spec/multi-target.md`; equation tags such as (M3) refer to it).
+//!
+//! - [`trp`]: the TRP index map (Table I) and the range function (M1).
+//! - [`blocking`]: blocking vectors (M3), consistency, unit-Hamming neighbours and the relaxed
+//!   probability (M4–M5), the blocking likelihood `L_b` and the [`blocking::BlockingModel`]
+//!   interface shared by all blocking models.
+//! - [`icb`]: the i.c.b model and its threshold (M7–M8).
+//! - [`geometry`]: ellipses per (TRP, range) and ellipse–ellipse intersection (§5).
+//! - [`polygon`]: convex polygons, clipping and areas (for §6.2).
+//! - [`ppp`]: the PPP-disc blocking model (M9–M11).
+
+pub mod blocking;
+pub mod geometry;
+pub mod icb;
+pub mod polygon;
+pub mod ppp;
+pub mod trp;

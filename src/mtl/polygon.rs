@@ -1,0 +1,331 @@
+//! Convex polygons for the PPP blocking model (multi-target spec §6.2): shoelace areas,
+//! Sutherland–Hodgman clipping of a convex polygon by a convex polygon, the width-`D` rectangle
+//! `A_n` around a segment `[x, node]`, the axis-aligned region `R`, and union areas by
+//! inclusion–exclusion over intersections obtained by successive convex clipping.
+//!
+//! Polygons are vertex lists (either orientation, no repeated closing vertex). An empty list or
+//! one with fewer than three vertices has area 0.
+
+use alloc::vec::Vec;
+
+use crate::error::{Error, Result};
+use crate::math::{Real, Vec2};
+
+/// An axis-aligned rectangle `[min.x, max.x] × [min.y, max.y]` (the region `R` of §6.2/§7).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Rect {
+    /// Lower-left corner, m.
+    pub min: Vec2,
+    /// Upper-right corner, m.
+    pub max: Vec2,
+}
+
+impl Rect {
+    /// A rectangle from its corners; [`Error::NonFinite`] for a non-finite coordinate and
+    /// [`Error::InvertedArea`] when a minimum is not below its maximum.
+    pub fn new(min: Vec2, max: Vec2) -> Result<Rect> {
+        if !(min.x.is_finite() && min.y.is_finite() && max.x.is_finite() && max.y.is_finite()) {
+            return Err(Error::NonFinite {
+                field: "region".into(),
+            });
+        }
+        if min.x >= max.x {
+            return Err(Error::InvertedArea {
+                field: "region.x",
+                min: min.x,
+                max: max.x,
+            });
+        }
+        if min.y >= max.y {
+            return Err(Error::InvertedArea {
+                field: "region.y",
+                min: min.y,
+                max: max.y,
+            });
+        }
+        Ok(Rect { min, max })
+    }
+
+    /// Whether `p` lies in the closed rectangle.
+    pub fn contains(&self, p: Vec2) -> bool {
+        p.x >= self.min.x && p.x <= self.max.x && p.y >= self.min.y && p.y <= self.max.y
+    }
+
+    /// The rectangle grown by `margin` m on every side.
+    pub fn enlarged(&self, margin: Real) -> Rect {
+        Rect {
+            min: self.min - Vec2::new(margin, margin),
+            max: self.max + Vec2::new(margin, margin),
+        }
+    }
+
+    /// Its four corners, counter-clockwise from `min`.
+    pub fn polygon(&self) -> [Vec2; 4] {
+        [
+            self.min,
+            Vec2::new(self.max.x, self.min.y),
+            self.max,
+            Vec2::new(self.min.x, self.max.y),
+        ]
+    }
+
+    /// Area, m².
+    pub fn area(&self) -> Real {
+        (self.max.x - self.min.x) * (self.max.y - self.min.y)
+    }
+}
+
+/// Signed shoelace area, m² (> 0 for counter-clockwise vertices).
+pub fn signed_area(poly: &[Vec2]) -> Real {
+    if poly.len() < 3 {
+        return 0.0;
+    }
+    let mut s = 0.0;
+    for i in 0..poly.len() {
+        let (p, q) = (poly[i], poly[(i + 1) % poly.len()]);
+        s += p.x * q.y - q.x * p.y;
+    }
+    0.5 * s
+}
+
+/// Area of a simple polygon (shoelace formula), m².
+pub fn area(poly: &[Vec2]) -> Real {
+    signed_area(poly).abs()
+}
+
+#[inline]
+fn cross(o: Vec2, a: Vec2, p: Vec2) -> Real {
+    (a.x - o.x) * (p.y - o.y) - (a.y - o.y) * (p.x - o.x)
+}
+
+/// Sutherland–Hodgman clipping of `subject` by the convex polygon `clip` (either orientation):
+/// the vertices of `subject ∩ clip`. Empty when the intersection has no area (or either input has
+/// fewer than three vertices). `subject` must be convex for the result to be one polygon.
+pub fn clip_convex(subject: &[Vec2], clip: &[Vec2]) -> Vec<Vec2> {
+    let orient = signed_area(clip);
+    if subject.len() < 3 || clip.len() < 3 || orient == 0.0 {
+        return Vec::new();
+    }
+    let sign = if orient > 0.0 { 1.0 } else { -1.0 };
+    let mut output: Vec<Vec2> = subject.to_vec();
+    let mut input: Vec<Vec2> = Vec::with_capacity(subject.len() + clip.len());
+    for i in 0..clip.len() {
+        let (a, b) = (clip[i], clip[(i + 1) % clip.len()]);
+        core::mem::swap(&mut input, &mut output);
+        output.clear();
+        if input.is_empty() {
+            break;
+        }
+        let n = input.len();
+        for j in 0..n {
+            let (p, q) = (input[j], input[(j + 1) % n]);
+            let (sp, sq) = (sign * cross(a, b, p), sign * cross(a, b, q));
+            if sp >= 0.0 {
+                output.push(p);
+            }
+            if (sp >= 0.0) != (sq >= 0.0) {
+                let t = sp / (sp - sq);
+                output.push(p + (q - p) * t);
+            }
+        }
+    }
+    if output.len() < 3 || area(&output) == 0.0 {
+        output.clear();
+    }
+    output
+}
+
+/// The rectangle of width `width` around the segment `[x, node]` (the `A_n` of §6.2, length
+/// `‖node − x‖`), counter-clockwise. Degenerate (zero area) when `x = node`.
+pub fn segment_rectangle(x: Vec2, node: Vec2, width: Real) -> [Vec2; 4] {
+    let d = node - x;
+    let len = d.norm();
+    let n = if len > 0.0 {
+        Vec2::new(-d.y, d.x) * (0.5 * width / len)
+    } else {
+        Vec2::zeros()
+    };
+    [x - n, node - n, node + n, x + n]
+}
+
+/// The rectangle `A_n` of §6.2, clipped to `region` when one is given.
+pub fn node_rectangle(x: Vec2, node: Vec2, width: Real, region: Option<&Rect>) -> Vec<Vec2> {
+    let rect = segment_rectangle(x, node, width);
+    match region {
+        Some(r) => clip_convex(&rect, &r.polygon()),
+        None => {
+            if area(&rect) > 0.0 {
+                rect.to_vec()
+            } else {
+                Vec::new()
+            }
+        }
+    }
+}
+
+/// Area of the intersection of convex polygons by successive clipping, m² (0 for an empty list).
+pub fn intersection_area(polys: &[&[Vec2]]) -> Real {
+    let Some((first, rest)) = polys.split_first() else {
+        return 0.0;
+    };
+    let mut cur: Vec<Vec2> = first.to_vec();
+    for p in rest {
+        cur = clip_convex(&cur, p);
+        if cur.is_empty() {
+            return 0.0;
+        }
+    }
+    area(&cur)
+}
+
+/// The areas `|∩_{i∈T} A_i|` of every subset `T` of `polys` (convex), indexed by the bit mask of
+/// `T` (entry 0, the empty set, is 0). Subsets whose intersection is already empty are not
+/// extended. At most 24 polygons ([`Error::SizeLimit`] otherwise).
+pub fn subset_intersection_areas<P: AsRef<[Vec2]>>(polys: &[P]) -> Result<Vec<Real>> {
+    let n = polys.len();
+    if n > 24 {
+        return Err(Error::SizeLimit {
+            field: "polygons",
+            value: n,
+            min: 0,
+            max: 24,
+        });
+    }
+    let mut out = alloc::vec![0.0; 1usize << n];
+    // Depth-first over subsets in increasing index order, carrying the running intersection.
+    let mut stack: Vec<(usize, usize, Vec<Vec2>)> = Vec::new();
+    for (i, p) in polys.iter().enumerate() {
+        let p = p.as_ref();
+        let a = area(p);
+        if p.len() >= 3 && a > 0.0 {
+            out[1 << i] = a;
+            stack.push((1 << i, i, p.to_vec()));
+        }
+    }
+    while let Some((mask, last, poly)) = stack.pop() {
+        for (j, q) in polys.iter().enumerate().skip(last + 1) {
+            let c = clip_convex(&poly, q.as_ref());
+            if !c.is_empty() {
+                let m = mask | (1 << j);
+                out[m] = area(&c);
+                stack.push((m, j, c));
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// `|∪_{i∈S} A_i|` from the subset intersection areas of [`subset_intersection_areas`], by
+/// inclusion–exclusion `Σ_{∅≠T⊆S} (−1)^{|T|+1} |∩_{i∈T} A_i|`.
+pub fn union_area_from_table(table: &[Real], set: usize) -> Real {
+    let mut sum = 0.0;
+    let mut t = set;
+    while t != 0 {
+        let v = table[t];
+        if v != 0.0 {
+            if t.count_ones() % 2 == 1 {
+                sum += v;
+            } else {
+                sum -= v;
+            }
+        }
+        t = (t - 1) & set;
+    }
+    sum
+}
+
+/// Area of the union of convex polygons by inclusion–exclusion over their intersections, m².
+pub fn union_area<P: AsRef<[Vec2]>>(polys: &[P]) -> Result<Real> {
+    let table = subset_intersection_areas(polys)?;
+    Ok(union_area_from_table(&table, (1usize << polys.len()) - 1))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn v(x: Real, y: Real) -> Vec2 {
+        Vec2::new(x, y)
+    }
+
+    fn unit_square(ox: Real, oy: Real) -> Vec<Vec2> {
+        alloc::vec![
+            v(ox, oy),
+            v(ox + 1.0, oy),
+            v(ox + 1.0, oy + 1.0),
+            v(ox, oy + 1.0)
+        ]
+    }
+
+    #[test]
+    fn areas() {
+        assert_eq!(area(&unit_square(3.0, -2.0)), 1.0);
+        let tri = [v(0.0, 0.0), v(4.0, 0.0), v(0.0, 3.0)];
+        assert_eq!(area(&tri), 6.0);
+        let mut cw = tri;
+        cw.reverse();
+        assert_eq!(signed_area(&cw), -6.0);
+        assert_eq!(area(&[v(0.0, 0.0), v(1.0, 1.0)]), 0.0);
+    }
+
+    #[test]
+    fn clipping_squares_and_triangles() {
+        let a = unit_square(0.0, 0.0);
+        let b = unit_square(0.5, 0.25);
+        assert!((area(&clip_convex(&a, &b)) - 0.375).abs() < 1e-15);
+        // Clockwise clip polygon gives the same result.
+        let mut bcw = b.clone();
+        bcw.reverse();
+        assert!((area(&clip_convex(&a, &bcw)) - 0.375).abs() < 1e-15);
+        // Disjoint and edge-touching squares: empty.
+        assert!(clip_convex(&a, &unit_square(2.0, 0.0)).is_empty());
+        assert!(clip_convex(&a, &unit_square(1.0, 0.0)).is_empty());
+        // Triangle x+y ≤ 1 in the unit square: the triangle itself.
+        let tri = [v(0.0, 0.0), v(1.0, 0.0), v(0.0, 1.0)];
+        assert!((area(&clip_convex(&a, &tri)) - 0.5).abs() < 1e-15);
+        // Two triangles: the square cut by both diagonals → quarter.
+        let tri2 = [v(1.0, 0.0), v(1.0, 1.0), v(0.0, 0.0)];
+        assert!((area(&clip_convex(&tri, &tri2)) - 0.25).abs() < 1e-15);
+    }
+
+    #[test]
+    fn rotated_rectangle() {
+        let r = segment_rectangle(v(1.0, 2.0), v(4.0, 6.0), 0.6);
+        assert!((area(&r) - 5.0 * 0.6).abs() < 1e-12);
+        assert!(signed_area(&r) > 0.0);
+        assert_eq!(area(&segment_rectangle(v(1.0, 1.0), v(1.0, 1.0), 0.6)), 0.0);
+        let region = Rect::new(v(0.0, 0.0), v(10.0, 10.0)).unwrap();
+        let r = node_rectangle(v(5.0, 5.0), v(5.0, 0.0), 0.6, Some(&region));
+        assert!((area(&r) - 3.0).abs() < 1e-12);
+        let r = node_rectangle(v(5.0, 5.0), v(5.0, 0.0), 0.6, None);
+        assert!((area(&r) - 3.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn unions() {
+        let a = unit_square(0.0, 0.0);
+        let b = unit_square(0.5, 0.0);
+        let c = unit_square(0.25, 0.5);
+        let u2 = union_area(&[a.clone(), b.clone()]).unwrap();
+        assert!((u2 - 1.5).abs() < 1e-15);
+        // Three squares: [0, 1.5]×[0, 1] ∪ [0.25, 1.25]×[1, 1.5] = 1.5 + 0.5.
+        let u3 = union_area(&[a, b, c]).unwrap();
+        assert!((u3 - 2.0).abs() < 1e-14, "{u3}");
+        assert_eq!(union_area::<Vec<Vec2>>(&[]).unwrap(), 0.0);
+    }
+
+    #[test]
+    fn bad_rect() {
+        assert!(matches!(
+            Rect::new(v(0.0, 0.0), v(0.0, 1.0)),
+            Err(Error::InvertedArea {
+                field: "region.x",
+                ..
+            })
+        ));
+        assert!(matches!(
+            Rect::new(v(0.0, Real::NAN), v(1.0, 1.0)),
+            Err(Error::NonFinite { .. })
+        ));
+    }
+}

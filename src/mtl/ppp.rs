@@ -1,0 +1,400 @@
+//! The PPP disc blocking model (spec multi-target.md §6.2, Appendix A of \[A\]): scatterers are
+//! discs of diameter `D` whose centres form a homogeneous Poisson point process of intensity `λ`.
+//! A segment of length `d` is LoS iff no centre lies in the `d × D` rectangle around it, so
+//! `p_LoS(d) = e^{−λ d D}` (M9). For a node pattern `(a, b)` at `x` the rectangles `A_n` of the
+//! unblocked nodes form the LoS polygon `A_L`, and each blocked node's NLoS polygon
+//! `A'_n = A_n \ A_L` must hold a centre: the lower bound (M10) and the exact Poisson
+//! inclusion–exclusion value (M11).
+//!
+//! Node order: TX `j` is node `j`, RX `j` is node `N_t + j`. Pattern bits: bit `j` of `a` is
+//! `γ^T_j` and bit `j` of `b` is `γ^R_j`, 1 = LoS (unblocked), 0 = blocked (§3).
+
+use alloc::format;
+use alloc::vec::Vec;
+
+use crate::error::{Error, Result};
+use crate::math::{exp, Real, Vec2};
+use crate::mtl::blocking::NodePatternModel;
+use crate::mtl::polygon::{node_rectangle, subset_intersection_areas, Rect};
+
+/// Largest `N_t + N_r` the PPP model accepts (its area tables have `2^(N_t+N_r)` entries).
+pub const MAX_PPP_NODES: usize = 20;
+
+/// LoS probability of a segment of length `distance_m` (M9): `e^{−λ d D}`.
+#[inline]
+pub fn p_los(lambda: Real, distance_m: Real, diameter_m: Real) -> Real {
+    exp(-lambda * distance_m * diameter_m)
+}
+
+/// The PPP disc blocking model (§6.2).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PppBlocking {
+    /// Intensity `λ` of the disc centres, m⁻² (≥ 0).
+    pub lambda: Real,
+    /// Disc diameter `D`, m (> 0): the width of each rectangle `A_n`.
+    pub diameter: Real,
+    /// Region `R` holding the centres; when given, every `A_n` is clipped to it (\[P\]).
+    pub region: Option<Rect>,
+    /// `true`: exact inclusion–exclusion (M11); `false`: the lower bound (M10) of \[A\].
+    pub exact: bool,
+}
+
+fn check_point(field: impl FnOnce() -> alloc::string::String, p: Vec2) -> Result<()> {
+    if p.x.is_finite() && p.y.is_finite() {
+        Ok(())
+    } else {
+        Err(Error::NonFinite { field: field() })
+    }
+}
+
+impl PppBlocking {
+    /// A validated model: [`Error::NonFinite`] / [`Error::OutOfRange`] for `λ` not finite or
+    /// negative (`lambda`), [`Error::NotPositive`] for `D ≤ 0` or not finite (`diameter`).
+    pub fn new(
+        lambda: Real,
+        diameter: Real,
+        region: Option<Rect>,
+        exact: bool,
+    ) -> Result<PppBlocking> {
+        let m = PppBlocking {
+            lambda,
+            diameter,
+            region,
+            exact,
+        };
+        m.validate()?;
+        Ok(m)
+    }
+
+    /// Checks the parameters (see [`PppBlocking::new`]; a given region must have `min < max`).
+    pub fn validate(&self) -> Result<()> {
+        if !self.lambda.is_finite() {
+            return Err(Error::NonFinite {
+                field: "lambda".into(),
+            });
+        }
+        if self.lambda < 0.0 {
+            return Err(Error::OutOfRange {
+                field: "lambda".into(),
+                value: self.lambda,
+                allowed: "λ ≥ 0 m⁻²",
+            });
+        }
+        if !(self.diameter.is_finite() && self.diameter > 0.0) {
+            return Err(Error::NotPositive {
+                field: "diameter".into(),
+                value: self.diameter,
+            });
+        }
+        if let Some(r) = self.region {
+            Rect::new(r.min, r.max)?;
+        }
+        Ok(())
+    }
+
+    /// `p_LoS(d) = e^{−λ d D}` (M9).
+    #[inline]
+    pub fn p_los(&self, distance_m: Real) -> Real {
+        p_los(self.lambda, distance_m, self.diameter)
+    }
+
+    /// The rectangles `A_n` at `x` (TXs then RXs, clipped to the region when one is set) and the
+    /// areas of all their intersections. Compute once per `x`, then evaluate any number of node
+    /// patterns with [`NodeAreas::probability`]. [`Error::NonFinite`] names a non-finite point
+    /// (`x`, `tx[j]`, `rx[j]`); [`Error::SizeLimit`] when `N_t + N_r >` [`MAX_PPP_NODES`].
+    pub fn node_areas(&self, x: Vec2, tx: &[Vec2], rx: &[Vec2]) -> Result<NodeAreas> {
+        self.validate()?;
+        check_point(|| "x".into(), x)?;
+        for (j, p) in tx.iter().enumerate() {
+            check_point(|| format!("tx[{j}]"), *p)?;
+        }
+        for (j, p) in rx.iter().enumerate() {
+            check_point(|| format!("rx[{j}]"), *p)?;
+        }
+        let n = tx.len() + rx.len();
+        if n > MAX_PPP_NODES {
+            return Err(Error::SizeLimit {
+                field: "nodes",
+                value: n,
+                min: 0,
+                max: MAX_PPP_NODES,
+            });
+        }
+        let rects: Vec<Vec<Vec2>> = tx
+            .iter()
+            .chain(rx.iter())
+            .map(|node| node_rectangle(x, *node, self.diameter, self.region.as_ref()))
+            .collect();
+        let intersections = subset_intersection_areas(&rects)?;
+        // Union areas of every node set: zeta transform of (−1)^{|T|+1} |∩_T A_n|.
+        let mut union = intersections.clone();
+        for (t, u) in union.iter_mut().enumerate() {
+            if t.count_ones() % 2 == 0 {
+                *u = -*u;
+            }
+        }
+        for i in 0..n {
+            for s in 0..union.len() {
+                if s & (1 << i) != 0 {
+                    union[s] += union[s ^ (1 << i)];
+                }
+            }
+        }
+        Ok(NodeAreas {
+            n_tx: tx.len(),
+            n_rx: rx.len(),
+            rectangles: rects,
+            intersections,
+            union,
+        })
+    }
+
+    /// `P_node(γ^T = a, γ^R = b | x)` (M11 when `exact`, else the bound M10). Bits at or above
+    /// `N_t` in `a` (`N_r` in `b`) are ignored. Errors as [`PppBlocking::node_areas`].
+    pub fn node_pattern_probability(
+        &self,
+        x: Vec2,
+        tx: &[Vec2],
+        rx: &[Vec2],
+        a_bits: u64,
+        b_bits: u64,
+    ) -> Result<Real> {
+        let areas = self.node_areas(x, tx, rx)?;
+        Ok(areas.probability(self.lambda, self.exact, a_bits, b_bits))
+    }
+}
+
+/// The rectangles `A_n` at one point and the areas of their intersections and unions (§6.2).
+#[derive(Debug, Clone, PartialEq)]
+pub struct NodeAreas {
+    /// `N_t`.
+    pub n_tx: usize,
+    /// `N_r`.
+    pub n_rx: usize,
+    /// `A_n` (TXs then RXs), possibly clipped; empty when of zero area.
+    pub rectangles: Vec<Vec<Vec2>>,
+    /// `|∩_{n∈T} A_n|` indexed by the bit mask of `T` (0 for `T = ∅`).
+    intersections: Vec<Real>,
+    /// `|∪_{n∈S} A_n|` indexed by the bit mask of `S`.
+    union: Vec<Real>,
+}
+
+impl NodeAreas {
+    /// Number of nodes `N_t + N_r`.
+    pub fn node_count(&self) -> usize {
+        self.n_tx + self.n_rx
+    }
+
+    /// `|A_n|`, m².
+    pub fn area(&self, n: usize) -> Real {
+        self.intersections[1 << n]
+    }
+
+    /// `|∩_{n∈T} A_n|` for the node mask `T`, m².
+    pub fn intersection_area(&self, mask: usize) -> Real {
+        self.intersections[mask]
+    }
+
+    /// `|∪_{n∈S} A_n|` for the node mask `S` (inclusion–exclusion), m².
+    pub fn union_area(&self, mask: usize) -> Real {
+        self.union[mask]
+    }
+
+    /// Node mask of the unblocked set `U` of pattern `(a, b)`.
+    pub fn unblocked_mask(&self, a_bits: u64, b_bits: u64) -> usize {
+        let a = (a_bits as usize) & ((1usize << self.n_tx) - 1);
+        let b = (b_bits as usize) & ((1usize << self.n_rx) - 1);
+        a | (b << self.n_tx)
+    }
+
+    /// The lower bound (M10): `e^{−λ|A_L|} Π_{n∈B} (1 − e^{−λ|A'_n|})`, with
+    /// `|A'_n| = |A_L ∪ A_n| − |A_L|`.
+    pub fn bound(&self, lambda: Real, unblocked: usize) -> Real {
+        let full = (1usize << self.node_count()) - 1;
+        let blocked = full & !unblocked;
+        let al = self.union[unblocked];
+        let mut p = exp(-lambda * al);
+        for n in 0..self.node_count() {
+            if blocked & (1 << n) != 0 {
+                let an = (self.union[unblocked | (1 << n)] - al).max(0.0);
+                p *= 1.0 - exp(-lambda * an);
+            }
+        }
+        p
+    }
+
+    /// The exact value (M11): `e^{−λ|A_L|} Σ_{T⊆B} (−1)^{|T|} e^{−λ|∪_{n∈T} A'_n|}`, with
+    /// `|∪_{n∈T} A'_n| = |A_L ∪ ∪_{n∈T} A_n| − |A_L|`.
+    pub fn exact(&self, lambda: Real, unblocked: usize) -> Real {
+        let full = (1usize << self.node_count()) - 1;
+        let blocked = full & !unblocked;
+        let al = self.union[unblocked];
+        let mut sum = 0.0;
+        let mut t = blocked;
+        loop {
+            let extra = (self.union[unblocked | t] - al).max(0.0);
+            let term = exp(-lambda * extra);
+            if t.count_ones() % 2 == 0 {
+                sum += term;
+            } else {
+                sum -= term;
+            }
+            if t == 0 {
+                break;
+            }
+            t = (t - 1) & blocked;
+        }
+        exp(-lambda * al) * sum
+    }
+
+    /// `P_node(γ^T = a, γ^R = b | x)`: (M11) when `exact`, else (M10).
+    pub fn probability(&self, lambda: Real, exact: bool, a_bits: u64, b_bits: u64) -> Real {
+        let u = self.unblocked_mask(a_bits, b_bits);
+        if exact {
+            self.exact(lambda, u)
+        } else {
+            self.bound(lambda, u)
+        }
+    }
+}
+
+/// A [`PppBlocking`] model bound to one network's node positions: the
+/// [`NodePatternModel`] the Bayesian blocking likelihood (M4–M5) consumes.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PppNodeModel {
+    /// The PPP parameters.
+    pub model: PppBlocking,
+    /// TX positions `u_j`, m.
+    pub tx: Vec<Vec2>,
+    /// RX positions `v_j`, m.
+    pub rx: Vec<Vec2>,
+}
+
+impl PppNodeModel {
+    /// Validates the model and the node positions (errors as [`PppBlocking::node_areas`]).
+    pub fn new(model: PppBlocking, tx: Vec<Vec2>, rx: Vec<Vec2>) -> Result<PppNodeModel> {
+        let centre = tx
+            .first()
+            .or(rx.first())
+            .copied()
+            .unwrap_or_else(Vec2::zeros);
+        model.node_areas(centre, &tx, &rx)?;
+        Ok(PppNodeModel { model, tx, rx })
+    }
+
+    /// The areas at `x` (see [`PppBlocking::node_areas`]).
+    pub fn node_areas(&self, x: Vec2) -> Result<NodeAreas> {
+        self.model.node_areas(x, &self.tx, &self.rx)
+    }
+
+    /// `P_node(a, b | x)` of every node pattern at `x`, indexed `a | b << N_t` (the order of
+    /// [`crate::mtl::blocking::NodeTable`]), from one area computation.
+    pub fn pattern_probabilities(&self, x: Vec2) -> Result<Vec<Real>> {
+        let areas = self.node_areas(x)?;
+        let nt = self.tx.len();
+        Ok((0..1u64 << areas.node_count())
+            .map(|i| {
+                let (a, b) = (i & ((1 << nt) - 1), i >> nt);
+                areas.probability(self.model.lambda, self.model.exact, a, b)
+            })
+            .collect())
+    }
+}
+
+impl NodePatternModel for PppNodeModel {
+    /// (M11) or (M10) at `x`; 0 when `x` is not finite (so `L_b = ∞`, never NaN).
+    fn node_pattern_probability(&self, x: &Vec2, a: u64, b: u64) -> Real {
+        match self.node_areas(*x) {
+            Ok(areas) => areas.probability(self.model.lambda, self.model.exact, a, b),
+            Err(_) => 0.0,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn v(x: Real, y: Real) -> Vec2 {
+        Vec2::new(x, y)
+    }
+
+    fn example() -> (PppBlocking, Vec<Vec2>, Vec<Vec2>) {
+        let region = Rect::new(v(0.0, 0.0), v(10.0, 10.0)).unwrap();
+        let m = PppBlocking::new(0.03, 0.6, Some(region), true).unwrap();
+        let tx = alloc::vec![v(1.0, 1.0), v(9.0, 2.0), v(2.0, 8.0)];
+        let rx = alloc::vec![v(8.0, 8.5), v(5.0, 0.5), v(0.5, 5.0)];
+        (m, tx, rx)
+    }
+
+    #[test]
+    fn check8() {
+        assert!((p_los(0.03, 5.0, 0.6) - 0.91393).abs() < 5e-6);
+    }
+
+    #[test]
+    fn check9_example() {
+        let (m, tx, rx) = example();
+        let areas = m.node_areas(v(5.0, 5.0), &tx, &rx).unwrap();
+        let want = [3.3941, 3.0000, 2.5456, 2.7659, 2.7000, 2.7000];
+        for (n, w) in want.iter().enumerate() {
+            assert!((areas.area(n) - w).abs() < 5e-5, "A_{n}: {}", areas.area(n));
+        }
+        assert!((areas.union_area(63) - 16.0805).abs() < 5e-5);
+        let p = |a, b, exact| areas.probability(0.03, exact, a, b);
+        assert!((p(0b111, 0b111, true) - 0.617291).abs() < 5e-7);
+        assert!((p(0b110, 0b111, true) - 0.059138).abs() < 5e-7);
+        assert!((p(0b100, 0b111, true) - 0.005100).abs() < 5e-7);
+        for (a, b) in [(0b111, 0b111), (0b110, 0b111), (0b100, 0b111)] {
+            assert!((p(a, b, false) - p(a, b, true)).abs() < 1e-15);
+        }
+        let total: Real = (0..64u64).map(|k| p(k & 7, k >> 3, true)).sum();
+        assert!((total - 1.0).abs() < 1e-12, "{total}");
+        for k in 0..64u64 {
+            assert!(p(k & 7, k >> 3, false) <= p(k & 7, k >> 3, true) + 1e-15);
+        }
+        assert_eq!(
+            m.node_pattern_probability(v(5.0, 5.0), &tx, &rx, 0b110, 0b111)
+                .unwrap(),
+            p(0b110, 0b111, true)
+        );
+        let nm = PppNodeModel::new(m, tx, rx).unwrap();
+        let all = nm.pattern_probabilities(v(5.0, 5.0)).unwrap();
+        assert_eq!(all.len(), 64);
+        assert_eq!(all[0b111_110], p(0b110, 0b111, true));
+        assert_eq!(
+            nm.node_pattern_probability(&v(5.0, 5.0), 0b110, 0b111),
+            p(0b110, 0b111, true)
+        );
+        assert_eq!(nm.node_pattern_probability(&v(Real::NAN, 5.0), 0, 0), 0.0);
+    }
+
+    #[test]
+    fn bad_inputs() {
+        assert!(matches!(
+            PppBlocking::new(-0.1, 0.6, None, true),
+            Err(Error::OutOfRange { .. })
+        ));
+        assert!(matches!(
+            PppBlocking::new(Real::NAN, 0.6, None, true),
+            Err(Error::NonFinite { .. })
+        ));
+        assert!(matches!(
+            PppBlocking::new(0.03, 0.0, None, true),
+            Err(Error::NotPositive { .. })
+        ));
+        let m = PppBlocking::new(0.03, 0.6, None, true).unwrap();
+        let e = m
+            .node_pattern_probability(v(0.0, 0.0), &[v(1.0, Real::NAN)], &[v(2.0, 2.0)], 1, 1)
+            .unwrap_err();
+        assert_eq!(
+            e,
+            Error::NonFinite {
+                field: "tx[0]".into()
+            }
+        );
+        assert!(m
+            .node_pattern_probability(v(Real::INFINITY, 0.0), &[], &[], 0, 0)
+            .is_err());
+    }
+}

@@ -1,0 +1,219 @@
+//! Transmitter–receiver pairs (TRPs) of the multi-target method: the TRP index map of Table I and
+//! the range function (M1) of `shared/spec/multi-target.md`.
+//!
+//! The spec numbers TRPs, TXs and RXs from 1; this module numbers them from 0. TRP `m` (0-based)
+//! uses TX `m mod N_t` and RX `m div N_t` — the TX index runs fastest (spec check 1), so spec TRP
+//! `m + 1` is TX `(m mod N_t) + 1`, RX `(m div N_t) + 1`.
+
+use crate::error::{Error, Result};
+use crate::math::{sqrt, Real, Vec2};
+
+/// Largest number of TRPs `M = N_t N_r`: blocking vectors are bit masks in a `u64`.
+pub const MAX_TRPS: usize = 64;
+
+/// Largest number of nodes `N_t + N_r`: consistency and the marginal (M4) enumerate all
+/// `2^{N_t+N_r}` node patterns, so the node count is capped to keep that table small
+/// (65 536 patterns; 6×6 and 8×8 networks fit).
+pub const MAX_NODES: usize = 16;
+
+/// The TRP index map of Table I (spec check 1): TRP `m` ↔ (TX `m mod N_t`, RX `m div N_t`), all
+/// 0-based.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct TrpMap {
+    n_tx: usize,
+    n_rx: usize,
+}
+
+impl TrpMap {
+    /// A map for `n_tx` transmitters and `n_rx` receivers.
+    ///
+    /// Errors: [`Error::EmptyNodeList`] (`transmitters` / `receivers`) when a count is 0;
+    /// [`Error::SizeLimit`] (`trps`) when `n_tx · n_rx > 64` ([`MAX_TRPS`]), (`nodes`) when
+    /// `n_tx + n_rx > 16` ([`MAX_NODES`]).
+    pub fn new(n_tx: usize, n_rx: usize) -> Result<Self> {
+        if n_tx == 0 {
+            return Err(Error::EmptyNodeList {
+                field: "transmitters",
+            });
+        }
+        if n_rx == 0 {
+            return Err(Error::EmptyNodeList { field: "receivers" });
+        }
+        let m = n_tx.saturating_mul(n_rx);
+        if m > MAX_TRPS {
+            return Err(Error::SizeLimit {
+                field: "trps",
+                value: m,
+                min: 1,
+                max: MAX_TRPS,
+            });
+        }
+        if n_tx + n_rx > MAX_NODES {
+            return Err(Error::SizeLimit {
+                field: "nodes",
+                value: n_tx + n_rx,
+                min: 2,
+                max: MAX_NODES,
+            });
+        }
+        Ok(Self { n_tx, n_rx })
+    }
+
+    /// Number of transmitters `N_t`.
+    pub fn n_tx(&self) -> usize {
+        self.n_tx
+    }
+
+    /// Number of receivers `N_r`.
+    pub fn n_rx(&self) -> usize {
+        self.n_rx
+    }
+
+    /// Number of TRPs `M = N_t N_r`.
+    pub fn n_trps(&self) -> usize {
+        self.n_tx * self.n_rx
+    }
+
+    /// The mask with one bit per TRP (bits `0..M`).
+    pub fn all_trps(&self) -> u64 {
+        low_bits(self.n_trps())
+    }
+
+    /// TX index `m_t = m mod N_t` of TRP `m` (0-based; spec check 1).
+    pub fn tx(&self, m: usize) -> usize {
+        m % self.n_tx
+    }
+
+    /// RX index `m_r = m div N_t` of TRP `m` (0-based; spec check 1).
+    pub fn rx(&self, m: usize) -> usize {
+        m / self.n_tx
+    }
+
+    /// `(m_t, m_r)` of TRP `m`; [`Error::IndexOutOfRange`] (`trps`) when `m ≥ M`.
+    pub fn pair(&self, m: usize) -> Result<(usize, usize)> {
+        crate::error::checked_index("trps", m, self.n_trps())?;
+        Ok((self.tx(m), self.rx(m)))
+    }
+
+    /// The TRP of TX `tx` and RX `rx`: `m = tx + N_t · rx`; [`Error::IndexOutOfRange`] when an
+    /// index is past its list.
+    pub fn trp(&self, tx: usize, rx: usize) -> Result<usize> {
+        crate::error::checked_index("transmitters", tx, self.n_tx)?;
+        crate::error::checked_index("receivers", rx, self.n_rx)?;
+        Ok(tx + self.n_tx * rx)
+    }
+
+    /// Range `d_m(x)` (M1) of TRP `m` with TX positions `tx` and RX positions `rx`.
+    ///
+    /// Panics if `m ≥ M` or a position slice is shorter than its node count.
+    pub fn range(&self, m: usize, x: &Vec2, tx: &[Vec2], rx: &[Vec2]) -> Real {
+        range(x, &tx[self.tx(m)], &rx[self.rx(m)])
+    }
+
+    /// Gradient `∇d_m(x)` of [`TrpMap::range`] (see [`range_gradient`]). Same panics.
+    pub fn range_gradient(&self, m: usize, x: &Vec2, tx: &[Vec2], rx: &[Vec2]) -> Vec2 {
+        range_gradient(x, &tx[self.tx(m)], &rx[self.rx(m)])
+    }
+}
+
+/// The mask of bits `0..n` (`n ≤ 64`).
+pub(crate) fn low_bits(n: usize) -> u64 {
+    if n >= 64 {
+        u64::MAX
+    } else {
+        (1u64 << n) - 1
+    }
+}
+
+/// Bistatic range `d(x) = ‖x − u‖ + ‖x − v‖` (M1) for TX at `u`, RX at `v`, in metres.
+pub fn range(x: &Vec2, u: &Vec2, v: &Vec2) -> Real {
+    norm(&(x - u)) + norm(&(x - v))
+}
+
+/// Gradient of (M1): `(x − u)/‖x − u‖ + (x − v)/‖x − v‖`. A term whose distance is 0 (`x` on a
+/// node, where (M1) is not differentiable) contributes the zero vector.
+pub fn range_gradient(x: &Vec2, u: &Vec2, v: &Vec2) -> Vec2 {
+    unit(&(x - u)) + unit(&(x - v))
+}
+
+fn norm(d: &Vec2) -> Real {
+    sqrt(d.x * d.x + d.y * d.y)
+}
+
+fn unit(d: &Vec2) -> Vec2 {
+    let n = norm(d);
+    if n > 0.0 {
+        d / n
+    } else {
+        Vec2::zeros()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn table_one_three_by_three() {
+        // Spec check 1, printed 1-based.
+        let map = TrpMap::new(3, 3).unwrap();
+        let tx: alloc::vec::Vec<usize> = (0..9).map(|m| map.tx(m) + 1).collect();
+        let rx: alloc::vec::Vec<usize> = (0..9).map(|m| map.rx(m) + 1).collect();
+        assert_eq!(tx, [1, 2, 3, 1, 2, 3, 1, 2, 3]);
+        assert_eq!(rx, [1, 1, 1, 2, 2, 2, 3, 3, 3]);
+        for m in 0..9 {
+            let (t, r) = map.pair(m).unwrap();
+            assert_eq!(map.trp(t, r).unwrap(), m);
+        }
+        assert!(map.pair(9).is_err());
+        assert!(map.trp(3, 0).is_err());
+        assert_eq!(map.all_trps(), 0x1ff);
+    }
+
+    #[test]
+    fn bad_sizes_are_named_errors() {
+        assert_eq!(
+            TrpMap::new(0, 3),
+            Err(Error::EmptyNodeList {
+                field: "transmitters"
+            })
+        );
+        assert_eq!(
+            TrpMap::new(3, 0),
+            Err(Error::EmptyNodeList { field: "receivers" })
+        );
+        assert!(matches!(
+            TrpMap::new(9, 8),
+            Err(Error::SizeLimit { field: "trps", .. })
+        ));
+        assert!(matches!(
+            TrpMap::new(1, 16),
+            Err(Error::SizeLimit { field: "nodes", .. })
+        ));
+        assert!(TrpMap::new(8, 8).is_ok());
+        assert_eq!(TrpMap::new(8, 8).unwrap().all_trps(), u64::MAX);
+    }
+
+    #[test]
+    fn range_and_gradient() {
+        let map = TrpMap::new(2, 1).unwrap();
+        let tx = [Vec2::new(0.0, 0.0), Vec2::new(10.0, 0.0)];
+        let rx = [Vec2::new(0.0, 10.0)];
+        let x = Vec2::new(3.0, 4.0);
+        let d = map.range(1, &x, &tx, &rx);
+        let expect = (49.0f64 + 16.0).sqrt() + (9.0f64 + 36.0).sqrt();
+        assert!((d - expect).abs() < 1e-12);
+        let g = map.range_gradient(1, &x, &tx, &rx);
+        let h = 1e-6;
+        let gx = (map.range(1, &Vec2::new(x.x + h, x.y), &tx, &rx)
+            - map.range(1, &Vec2::new(x.x - h, x.y), &tx, &rx))
+            / (2.0 * h);
+        let gy = (map.range(1, &Vec2::new(x.x, x.y + h), &tx, &rx)
+            - map.range(1, &Vec2::new(x.x, x.y - h), &tx, &rx))
+            / (2.0 * h);
+        assert!((g.x - gx).abs() < 1e-7 && (g.y - gy).abs() < 1e-7);
+        // On a node the singular term is dropped, never NaN.
+        let g0 = range_gradient(&tx[0], &tx[0], &rx[0]);
+        assert!(g0.x.is_finite() && g0.y.is_finite());
+    }
+}
