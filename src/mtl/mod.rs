@@ -9,10 +9,17 @@
 //! - [`geometry`]: ellipses per (TRP, range) and ellipse–ellipse intersection (§5).
 //! - [`polygon`]: convex polygons, clipping and areas (for §6.2).
 //! - [`ppp`]: the PPP-disc blocking model (M9–M11).
+//! - [`sim`]: the §7 data generator, metrics (M12) and Table II helpers.
+//! - [`algorithm`]: Algorithm 1 (§4), staged matching with the vector likelihood (M6) and
+//!   the final selection by `J` (M2).
+//! - [`brute`]: the brute-force reference over all matchings (small instances, tests).
 
+pub mod algorithm;
 pub mod blocking;
+pub mod brute;
 pub mod geometry;
 pub mod icb;
 pub mod polygon;
 pub mod ppp;
+pub mod sim;
 pub mod trp;

@@ -1,0 +1,131 @@
+//! Input validation of Algorithm 1: every bad input is a named [`Error`].
+
+use alloc::vec::Vec;
+
+use crate::error::{Error, Result};
+use crate::math::Real;
+use crate::mtl::algorithm::{Measurements, MtlConfig};
+use crate::mtl::blocking::BlockingModel;
+
+/// Check `input`, `model` and `cfg`; returns the TRP order `π`.
+///
+/// Errors: [`Error::EmptyNodeList`] (`transmitters` / `receivers`); [`Error::LengthMismatch`]
+/// (`transmitters`, `receivers`, `ranges`, `order`) against the model's TRP map;
+/// [`Error::NonFinite`] (`transmitters[j]`, `receivers[j]`, `ranges[m][i]`, `t_e`, `t_b`,
+/// `c_sigma_m`); [`Error::NotPositive`] (`c_sigma_m`); [`Error::OutOfRange`] (`t_e`, `t_b` when
+/// negative; `order` when not a permutation); [`Error::SizeLimit`] (`b_max`, `merge_shared_pairs`
+/// when 0).
+pub fn validate<B: BlockingModel + ?Sized>(
+    input: &Measurements,
+    model: &B,
+    cfg: &MtlConfig,
+) -> Result<Vec<usize>> {
+    use alloc::format;
+    let map = model.trp_map();
+    if input.tx.is_empty() {
+        return Err(Error::EmptyNodeList {
+            field: "transmitters",
+        });
+    }
+    if input.rx.is_empty() {
+        return Err(Error::EmptyNodeList { field: "receivers" });
+    }
+    for (field, len, want) in [
+        ("transmitters", input.tx.len(), map.n_tx()),
+        ("receivers", input.rx.len(), map.n_rx()),
+        ("ranges", input.ranges.len(), map.n_trps()),
+    ] {
+        if len != want {
+            return Err(Error::LengthMismatch {
+                field,
+                expected: want,
+                found: len,
+            });
+        }
+    }
+    let nodes = input.tx.iter().map(|p| ("transmitters", p));
+    let nodes = nodes.chain(input.rx.iter().map(|p| ("receivers", p)));
+    for (k, (field, p)) in nodes.enumerate() {
+        if !(p.x.is_finite() && p.y.is_finite()) {
+            let j = if field == "transmitters" {
+                k
+            } else {
+                k - input.tx.len()
+            };
+            return Err(Error::NonFinite {
+                field: format!("{field}[{j}]"),
+            });
+        }
+    }
+    for (m, rs) in input.ranges.iter().enumerate() {
+        if let Some(i) = rs.iter().position(|r| !r.is_finite()) {
+            return Err(Error::NonFinite {
+                field: format!("ranges[{m}][{i}]"),
+            });
+        }
+    }
+    check_non_negative("t_e", cfg.t_e, false)?;
+    check_non_negative("t_b", cfg.t_b, true)?;
+    if !input.c_sigma_m.is_finite() {
+        return Err(Error::NonFinite {
+            field: "c_sigma_m".into(),
+        });
+    }
+    if input.c_sigma_m <= 0.0 {
+        return Err(Error::NotPositive {
+            field: "c_sigma_m".into(),
+            value: input.c_sigma_m,
+        });
+    }
+    for (field, v) in [
+        ("b_max", cfg.b_max),
+        ("merge_shared_pairs", cfg.merge_shared_pairs),
+    ] {
+        if v == 0 {
+            return Err(Error::SizeLimit {
+                field,
+                value: 0,
+                min: 1,
+                max: usize::MAX,
+            });
+        }
+    }
+    let m = map.n_trps();
+    let order: Vec<usize> = cfg.order.clone().unwrap_or_else(|| (0..m).collect());
+    if order.len() != m {
+        return Err(Error::LengthMismatch {
+            field: "order",
+            expected: m,
+            found: order.len(),
+        });
+    }
+    let mut seen = 0u64;
+    for &t in &order {
+        if t >= m || seen >> t & 1 == 1 {
+            return Err(Error::OutOfRange {
+                field: "order".into(),
+                value: t as Real,
+                allowed: "a permutation of the TRPs 0..M",
+            });
+        }
+        seen |= 1 << t;
+    }
+    Ok(order)
+}
+
+/// `v ≥ 0` (NaN refused; `+∞` allowed only when `allow_inf`).
+fn check_non_negative(field: &str, v: Real, allow_inf: bool) -> Result<()> {
+    if v.is_nan() || (!allow_inf && v.is_infinite()) {
+        return Err(Error::NonFinite {
+            field: field.into(),
+        });
+    }
+    if v < 0.0 {
+        return Err(Error::OutOfRange {
+            field: field.into(),
+            value: v,
+            allowed: "a threshold ≥ 0",
+        });
+    }
+    Ok(())
+}
