@@ -151,18 +151,32 @@ impl GainPolynomial {
     /// Gain for `c = cos ψ`, linear.
     #[inline(always)]
     pub fn gain_at_cos(&self, c: Real) -> Real {
-        if c <= self.floor_cos {
-            return self.floor_gain;
-        }
-        let t = (2.0 * c - 1.0 - self.floor_cos) / (1.0 - self.floor_cos);
+        self.gains_at_cos([c])[0]
+    }
+
+    /// [`GainPolynomial::gain_at_cos`] for `L` directions at once (the same operations in the
+    /// same order, so each result is bitwise equal); with `L = 4` the recurrence stays in vector
+    /// registers (CRLB map kernel).
+    #[inline(always)]
+    pub fn gains_at_cos<const L: usize>(&self, c: [Real; L]) -> [Real; L] {
+        let span = 1.0 - self.floor_cos;
+        let t = c.map(|c| (2.0 * c - 1.0 - self.floor_cos) / span);
         // Clenshaw recurrence; `a − b2` first keeps the dependency chain through b1 short.
-        let (mut b1, mut b2) = (0.0, 0.0);
+        let (mut b1, mut b2) = ([0.0; L], [0.0; L]);
         for &a in self.coefficients[1..].iter().rev() {
-            let b0 = (a - b2) + 2.0 * t * b1;
-            b2 = b1;
-            b1 = b0;
+            for l in 0..L {
+                let b0 = (a - b2[l]) + 2.0 * t[l] * b1[l];
+                b2[l] = b1[l];
+                b1[l] = b0;
+            }
         }
-        (self.coefficients[0] + t * b1 - b2).max(self.floor_gain)
+        let mut out = [self.floor_gain; L];
+        for l in 0..L {
+            if c[l] > self.floor_cos {
+                out[l] = (self.coefficients[0] + t[l] * b1[l] - b2[l]).max(self.floor_gain);
+            }
+        }
+        out
     }
 }
 

@@ -2,94 +2,22 @@
 //! "exit 2 + one stderr line naming the field" contract for bad input.
 #![cfg(not(target_arch = "wasm32"))]
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::path::Path;
+use std::process::Command;
 
 use scatterloc::crlb::{crlb_at, Grid};
 use scatterloc::scenario::Area;
 use scatterloc::{presets, Model, Scenario, Vec2};
 use serde_json::{json, Value};
 
-const BIN: &str = env!("CARGO_BIN_EXE_scatterloc");
+mod cli_support;
 
-/// A fresh directory under the system temp dir, removed on drop.
-struct TempDir(PathBuf);
-
-impl TempDir {
-    fn new() -> TempDir {
-        static N: AtomicUsize = AtomicUsize::new(0);
-        let nanos = std::time::SystemTime::now()
-            .duration_since(std::time::UNIX_EPOCH)
-            .map(|d| d.subsec_nanos())
-            .unwrap_or(0);
-        let dir = std::env::temp_dir().join(format!(
-            "scatterloc-cli-{}-{}-{nanos}",
-            std::process::id(),
-            N.fetch_add(1, Ordering::SeqCst)
-        ));
-        std::fs::create_dir_all(&dir).unwrap();
-        TempDir(dir)
-    }
-
-    fn path(&self, name: &str) -> String {
-        self.0.join(name).to_string_lossy().into_owned()
-    }
-
-    fn write(&self, name: &str, text: &str) -> String {
-        let p = self.path(name);
-        std::fs::write(&p, text).unwrap();
-        p
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
-
-fn run(args: &[&str]) -> Output {
-    Command::new(BIN)
-        .args(args)
-        .output()
-        .expect("run scatterloc")
-}
-
-/// Runs, expects success, parses stdout as JSON.
-fn ok_json(args: &[&str]) -> Value {
-    let out = run(args);
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(
-        out.status.success(),
-        "{args:?} failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    assert!(
-        !stdout.contains("NaN") && !stdout.contains("inf"),
-        "{stdout}"
-    );
-    serde_json::from_str(&stdout).unwrap_or_else(|e| panic!("{e}: {stdout}"))
-}
-
-/// Runs, expects exit status 2, empty stdout and exactly one stderr line containing every needle.
-fn fails(args: &[&str], needles: &[&str]) -> String {
-    let out = run(args);
-    let err = String::from_utf8_lossy(&out.stderr).into_owned();
-    assert_eq!(out.status.code(), Some(2), "{args:?}: stderr {err}");
-    assert!(out.stdout.is_empty(), "{args:?}: stdout not empty");
-    assert_eq!(err.lines().count(), 1, "{args:?}: not one line: {err:?}");
-    assert!(err.ends_with('\n'));
-    for n in needles {
-        assert!(err.contains(n), "{args:?}: {err:?} lacks {n:?}");
-    }
-    err
-}
+use cli_support::{fails, ok_json, run, TempDir, BIN};
 
 fn preset_file(dir: &TempDir, name: &str) -> String {
     let out = run(&["preset", name]);
     assert!(out.status.success());
-    dir.write(
+    dir.write_text(
         &format!("{name}.json"),
         &String::from_utf8(out.stdout).unwrap(),
     )
@@ -158,7 +86,7 @@ fn crlb_matches_spec_check_7() {
 fn one_link_scenario(dir: &TempDir) -> String {
     let mut v = sensors_value();
     v["receivers"] = json!([{"name": "Rx", "position_m": [10.0, 0.0], "gain_dbi": 8.0}]);
-    dir.write("one.json", &v.to_string())
+    dir.write_text("one.json", &v.to_string())
 }
 
 #[test]
@@ -426,7 +354,7 @@ fn delays_file(dir: &TempDir, truth: Vec2, missing: &[usize], extra: Value) -> S
     for (k, x) in extra.as_object().unwrap() {
         v[k] = x.clone();
     }
-    dir.write(&format!("d{}.json", missing.len()), &v.to_string())
+    dir.write_text(&format!("d{}.json", missing.len()), &v.to_string())
 }
 
 fn assert_fix(v: &Value, truth: Vec2, links: u64) {
@@ -513,7 +441,7 @@ fn locate_bad_delays_files() {
         (r#"[1, 2"#, "invalid JSON"),
     ];
     for (text, field) in cases {
-        let d = dir.write("bad_delays.json", text);
+        let d = dir.write_text("bad_delays.json", text);
         fails(
             &["locate", "--scenario", &s, "--delays", &d],
             &["--delays", field],
@@ -581,7 +509,7 @@ fn broken_scenario_files_name_the_field() {
         ),
     ];
     for (i, (text, needles)) in cases.iter().enumerate() {
-        let path = dir.write(&format!("bad{i}.json"), text);
+        let path = dir.write_text(&format!("bad{i}.json"), text);
         let mut n = needles.clone();
         n.push("--scenario");
         fails(&["crlb", "--scenario", &path, "--at", "1,2"], &n);

@@ -10,7 +10,7 @@ use std::time::{Duration, Instant};
 
 use serde_json::json;
 
-use cli_support::{floats, ok_json, read_json, TempDir, BIN, FAST};
+use cli_support::{floats, ok_json_line, read_json, TempDir, BIN, FAST};
 
 #[test]
 fn montecarlo_fast_profile_writes_curves_and_figure() {
@@ -26,7 +26,7 @@ fn montecarlo_fast_profile_writes_curves_and_figure() {
         &svg,
     ];
     args.extend(FAST);
-    let summary = ok_json(&args);
+    let summary = ok_json_line(&args);
     assert_eq!(summary["trajectory"], "I");
     assert_eq!(summary["at"].as_array().unwrap().len(), 4);
     assert!(summary["ns_per_ekf_step"].as_f64().unwrap() > 0.0);
@@ -71,7 +71,7 @@ fn montecarlo_curves_do_not_depend_on_the_thread_count() {
             &path,
         ];
         args.extend(FAST);
-        ok_json(&args);
+        ok_json_line(&args);
         let text = std::fs::read_to_string(&path).unwrap();
         // The curves come first; wall time and the thread count after "runs".
         text[..text.find(",\"runs\":").unwrap()].to_string()
@@ -85,7 +85,7 @@ fn montecarlo_curves_do_not_depend_on_the_thread_count() {
 fn montecarlo_all_draws_three_panels() {
     let dir = TempDir::new();
     let (js, png) = (dir.path("all.json"), dir.path("fig3.png"));
-    let v = ok_json(&[
+    let v = ok_json_line(&[
         "montecarlo",
         "--runs",
         "16",

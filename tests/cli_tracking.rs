@@ -8,7 +8,7 @@ mod cli_support;
 use scatterloc::{presets, Model, Vec2};
 use serde_json::{json, Value};
 
-use cli_support::{fails, floats, ok_json, read_json, run, TempDir};
+use cli_support::{fails, floats, ok_json_line, read_json, run, TempDir};
 
 /// A straight path from (4, 1) at (1.4, 0.25) m/s sampled every 0.1 s.
 fn truth(n: usize) -> Vec2 {
@@ -57,7 +57,7 @@ fn track_follows_a_straight_path_through_gaps() {
     let s = scenario(&dir);
     for extra in [json!({}), json!({"sigma_s": 3e-11})] {
         let m = dir.write("m.json", &measurements(extra));
-        let v = ok_json(&["track", "--scenario", &s, "--measurements", &m]);
+        let v = ok_json_line(&["track", "--scenario", &s, "--measurements", &m]);
         let states = v["states"].as_array().unwrap();
         assert_eq!(states.len(), 50);
         assert_eq!(v["covariances"].as_array().unwrap().len(), 50);
@@ -141,7 +141,7 @@ fn track_rejects_bad_input_naming_the_field() {
 fn pcrlb_nominal_reproduces_check_9() {
     let dir = TempDir::new();
     let js = dir.path("p.json");
-    let v = ok_json(&[
+    let v = ok_json_line(&[
         "pcrlb",
         "--trajectory",
         "II",
@@ -170,7 +170,7 @@ fn pcrlb_nominal_reproduces_check_9() {
         );
     }
     // Without --json the curve goes to stdout.
-    let out = ok_json(&["pcrlb", "--trajectory", "II", "--nominal", "--dt", "0.1"]);
+    let out = ok_json_line(&["pcrlb", "--trajectory", "II", "--nominal", "--dt", "0.1"]);
     assert_eq!(out["rmse_pcrlb_m"], doc["rmse_pcrlb_m"]);
 }
 
@@ -179,10 +179,10 @@ fn pcrlb_monte_carlo_is_the_bound_of_montecarlo() {
     // E[F̃] depends on the truth trajectories only, not on the noise runs (spec §8).
     let common = ["--trajectory", "III", "--runs", "32", "--seed", "5"];
     let common = [&common[..], &["--dt", "0.1"]].concat();
-    let p = ok_json(&[&["pcrlb"][..], &common[..]].concat());
+    let p = ok_json_line(&[&["pcrlb"][..], &common[..]].concat());
     let mut args = vec!["montecarlo", "--noise-runs", "3"];
     args.extend(&common);
-    let m = ok_json(&args);
+    let m = ok_json_line(&args);
     assert_eq!(p["nominal"], json!(false));
     // Without --json and --out both print their whole curves.
     assert_eq!(p["rmse_pcrlb_m"].as_array().unwrap().len(), 101);

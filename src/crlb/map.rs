@@ -106,12 +106,11 @@ pub fn crlb_map(model: &Model, grid: &Grid, out: &mut [Real]) -> Result<()> {
     let mut tx_rows = vec![NodeRow::new(nx); net.transmitters.len()];
     let mut rx_rows = vec![NodeRow::new(nx); net.receivers.len()];
     let mut fisher = FisherRow::new(nx);
-    let mut scratch = vec![0.0; nx];
     for (j, out_row) in out.chunks_exact_mut(nx).enumerate() {
         let y = grid.y(j);
         for (k, row) in tx_rows.iter_mut().enumerate() {
             row.fill(net.transmitters[k], y, &xs);
-            row.apply_pattern(&model.patterns[k], &mut scratch);
+            row.apply_pattern(&model.patterns[k]);
         }
         for (l, row) in rx_rows.iter_mut().enumerate() {
             row.fill(net.receivers[l], y, &xs);
@@ -166,46 +165,26 @@ impl NodeRow {
     }
 
     /// Multiplies the weights by the Tx gain toward each cell.
-    fn apply_pattern(&mut self, pattern: &TxPattern, scratch: &mut [Real]) {
+    fn apply_pattern(&mut self, pattern: &TxPattern) {
         let n = self.weight.len();
         match (pattern.beam, pattern.polynomial.as_ref()) {
             (None, _) => self.weight.iter_mut().for_each(|w| *w *= pattern.peak_gain),
             (Some(_), Some(p)) => {
-                let t = &mut scratch[..n];
-                let span = 1.0 - p.floor_cos;
-                for ((t, ux), uy) in t.iter_mut().zip(&self.ux).zip(&self.uy) {
-                    *t = (2.0 * (ux * p.boresight.x + uy * p.boresight.y) - 1.0 - p.floor_cos)
-                        / span;
-                }
-                // Clenshaw on LANES cells at a time, so the recurrence lives in vector registers.
+                // LANES cells at a time, so the Clenshaw recurrence lives in vector registers.
                 const LANES: usize = 4;
-                let (head, tail) = p.coefficients.split_at(1);
-                let a0 = head[0];
                 let mut i0 = 0;
                 while i0 < n {
                     let m = LANES.min(n - i0);
-                    let mut tt = [0.0; LANES];
-                    tt[..m].copy_from_slice(&t[i0..i0 + m]);
-                    let (mut b1, mut b2) = ([0.0; LANES], [0.0; LANES]);
-                    for &a in tail.iter().rev() {
-                        for l in 0..LANES {
-                            let b0 = (a - b2[l]) + 2.0 * tt[l] * b1[l];
-                            b2[l] = b1[l];
-                            b1[l] = b0;
-                        }
+                    let mut c = [1.0; LANES];
+                    for (l, c) in c.iter_mut().enumerate().take(m) {
+                        *c = self.ux[i0 + l] * p.boresight.x + self.uy[i0 + l] * p.boresight.y;
                     }
-                    for l in 0..m {
+                    let gains = p.gains_at_cos(c);
+                    for (l, g) in gains.iter().enumerate().take(m) {
                         let i = i0 + l;
-                        let (ux, uy) = (self.ux[i], self.uy[i]);
-                        let c = ux * p.boresight.x + uy * p.boresight.y;
-                        let g = if ux == 0.0 && uy == 0.0 {
-                            pattern.peak_gain
-                        } else if c <= p.floor_cos {
-                            p.floor_gain
-                        } else {
-                            (a0 + tt[l] * b1[l] - b2[l]).max(p.floor_gain)
-                        };
-                        self.weight[i] *= g;
+                        // A cell on the Tx gets the peak gain, as in `TxPattern::gain_toward`.
+                        let on_node = self.ux[i] == 0.0 && self.uy[i] == 0.0;
+                        self.weight[i] *= if on_node { pattern.peak_gain } else { *g };
                     }
                     i0 += m;
                 }

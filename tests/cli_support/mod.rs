@@ -1,6 +1,6 @@
-//! Helpers of the CLI tests of the tracking subcommands (`cli_tracking`, `cli_montecarlo`): a
-//! temporary directory, running the binary, and the "exit 2 + one stderr line naming the
-//! field" contract for bad input.
+//! Helpers shared by the CLI tests (`cli`, `cli_tracking`, `cli_montecarlo`): a temporary
+//! directory, running the binary, and the "exit 2 + one stderr line naming the field" contract
+//! for bad input.
 #![allow(dead_code)]
 
 use std::path::PathBuf;
@@ -31,9 +31,15 @@ impl TempDir {
         self.0.join(name).to_string_lossy().into_owned()
     }
 
+    /// Writes `v` as JSON to `name`; returns the path.
     pub fn write(&self, name: &str, v: &Value) -> String {
+        self.write_text(name, &v.to_string())
+    }
+
+    /// Writes `text` to `name`; returns the path.
+    pub fn write_text(&self, name: &str, text: &str) -> String {
         let p = self.path(name);
-        std::fs::write(&p, v.to_string()).unwrap();
+        std::fs::write(&p, text).unwrap();
         p
     }
 
@@ -62,12 +68,22 @@ pub fn run(args: &[&str]) -> Output {
 }
 
 /// Runs, expects success and one line of JSON on stdout without NaN.
-pub fn ok_json(args: &[&str]) -> Value {
+pub fn ok_json_line(args: &[&str]) -> Value {
     let out = run(args);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(stdout.lines().count(), 1, "{stdout}");
+    ok_json_output(args, &out)
+}
+
+/// Runs, expects success and JSON (any layout) on stdout without NaN.
+pub fn ok_json(args: &[&str]) -> Value {
+    ok_json_output(args, &run(args))
+}
+
+fn ok_json_output(args: &[&str], out: &Output) -> Value {
     let stdout = String::from_utf8_lossy(&out.stdout);
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{args:?} failed: {err}");
-    assert_eq!(stdout.lines().count(), 1, "{stdout}");
     assert!(
         !stdout.contains("NaN") && !stdout.contains("inf"),
         "{stdout}"
@@ -75,16 +91,19 @@ pub fn ok_json(args: &[&str]) -> Value {
     serde_json::from_str(&stdout).unwrap_or_else(|e| panic!("{e}: {stdout}"))
 }
 
-/// Runs, expects exit status 2, empty stdout and one stderr line containing every needle.
-pub fn fails(args: &[&str], needles: &[&str]) {
+/// Runs, expects exit status 2, empty stdout and exactly one newline-terminated stderr line
+/// containing every needle; returns that line.
+pub fn fails(args: &[&str], needles: &[&str]) -> String {
     let out = run(args);
-    let err = String::from_utf8_lossy(&out.stderr);
+    let err = String::from_utf8_lossy(&out.stderr).into_owned();
     assert_eq!(out.status.code(), Some(2), "{args:?}: stderr {err}");
     assert!(out.stdout.is_empty(), "{args:?}: stdout not empty");
-    assert_eq!(err.lines().count(), 1, "{args:?}: {err:?}");
+    assert_eq!(err.lines().count(), 1, "{args:?}: not one line: {err:?}");
+    assert!(err.ends_with('\n'));
     for n in needles {
         assert!(err.contains(n), "{args:?}: {err:?} lacks {n:?}");
     }
+    err
 }
 
 pub fn read_json(path: &str) -> Value {
