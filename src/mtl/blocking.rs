@@ -175,6 +175,16 @@ pub fn blocking_likelihood(p: Real) -> Real {
 pub trait NodePatternModel {
     /// `P_node(γ^T = a, γ^R = b | x)`.
     fn node_pattern_probability(&self, x: &Vec2, a: u64, b: u64) -> Real;
+
+    /// `P_node` of all `2^{n_tx+n_rx}` patterns at `x`, indexed `a | b << n_tx`. The default
+    /// calls [`NodePatternModel::node_pattern_probability`] per pattern; models with a shared
+    /// per-location cost (the PPP areas) override it to pay that cost once.
+    fn pattern_probabilities_at(&self, x: &Vec2, n_tx: usize, n_rx: usize) -> Vec<Real> {
+        let mask_a = low_bits(n_tx);
+        (0..1u64 << (n_tx + n_rx))
+            .map(|i| self.node_pattern_probability(x, i & mask_a, i >> n_tx))
+            .collect()
+    }
 }
 
 /// The per-candidate blocking query shared by all blocking models (i.c.b, PPP, empirical): the
@@ -295,12 +305,9 @@ impl BlockingSpace {
     /// `P_node` of every node pattern at `x`, indexed like [`BlockingSpace::pattern`]; evaluate
     /// once per location and reuse for many (M4)/(M5) queries.
     pub fn node_table<N: NodePatternModel + ?Sized>(&self, model: &N, x: &Vec2) -> NodeTable {
-        let probs = (0..self.patterns.len())
-            .map(|i| {
-                let (a, b, _) = self.pattern(i);
-                model.node_pattern_probability(x, a, b)
-            })
-            .collect();
+        let mut probs = model.pattern_probabilities_at(x, self.map.n_tx(), self.map.n_rx());
+        // A model returning the wrong length is a bug; never index out of bounds for it.
+        probs.resize(self.patterns.len(), 0.0);
         NodeTable { probs }
     }
 

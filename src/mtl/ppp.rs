@@ -309,6 +309,13 @@ impl NodePatternModel for PppNodeModel {
             Err(_) => 0.0,
         }
     }
+
+    /// All patterns from one area computation ([`PppNodeModel::pattern_probabilities`]); all
+    /// zeros when `x` is not finite.
+    fn pattern_probabilities_at(&self, x: &Vec2, n_tx: usize, n_rx: usize) -> Vec<Real> {
+        self.pattern_probabilities(*x)
+            .unwrap_or_else(|_| alloc::vec![0.0; 1 << (n_tx + n_rx)])
+    }
 }
 
 #[cfg(test)]
