@@ -67,15 +67,7 @@ fn run_waves(
     chunk: fn(&Model, &MonteCarloConfig, usize) -> Result<PartialSums>,
     per_trajectory: usize,
 ) -> Result<PartialSums> {
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .map_err(|_| Error::SizeLimit {
-            field: "threads",
-            value: threads,
-            min: 0,
-            max: 1024,
-        })?;
+    let pool = thread_pool(threads)?;
     let chunks = cfg.chunk_count();
     let wave = (4 * pool.current_num_threads()).max(1);
     let total = cfg.trajectories * per_trajectory;
@@ -102,4 +94,18 @@ fn run_waves(
         );
     }
     Ok(sums)
+}
+
+/// A rayon pool of `threads` workers (0 = all cores); [`Error::SizeLimit`] (`threads`) when it
+/// cannot be built.
+pub fn thread_pool(threads: usize) -> Result<rayon::ThreadPool> {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|_| Error::SizeLimit {
+            field: "threads",
+            value: threads,
+            min: 0,
+            max: 1024,
+        })
 }

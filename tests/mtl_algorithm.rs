@@ -465,6 +465,13 @@ fn bad_inputs_are_named_errors() {
             },
             "t_b",
         ),
+        (
+            MtlConfig {
+                merge_radius_m: -1.0,
+                ..cfg.clone()
+            },
+            "merge_radius_m",
+        ),
     ] {
         assert!(
             matches!(err(ok, &bad), Error::OutOfRange { ref field, .. } if field == name),

@@ -9,6 +9,9 @@
 //! - [`geometry`]: ellipses per (TRP, range) and ellipse–ellipse intersection (§5).
 //! - [`polygon`]: convex polygons, clipping and areas (for §6.2).
 //! - [`ppp`]: the PPP-disc blocking model (M9–M11).
+//! - [`empirical`]: node-pattern probabilities tabulated per grid cell (§6.3).
+//! - [`experiment`]: the §8 experiments as ROC sweeps (Figs. 3–5), one realisation at a time.
+//! - `sweep` (native `std` only): the parallel, thread-count-independent experiment driver.
 //! - [`sim`]: the §7 data generator, metrics (M12) and Table II helpers.
 //! - [`algorithm`]: Algorithm 1 (§4), staged matching with the vector likelihood (M6) and
 //!   the final selection by `J` (M2).
@@ -17,9 +20,13 @@
 pub mod algorithm;
 pub mod blocking;
 pub mod brute;
+pub mod empirical;
+pub mod experiment;
 pub mod geometry;
 pub mod icb;
 pub mod polygon;
 pub mod ppp;
 pub mod sim;
+#[cfg(all(feature = "std", not(target_arch = "wasm32")))]
+pub mod sweep;
 pub mod trp;

@@ -92,6 +92,12 @@ pub struct MtlConfig {
     pub merge_final: bool,
     /// Shared pairs that make two final targets the same (\[P\], default 2).
     pub merge_shared_pairs: usize,
+    /// Only targets within this distance of each other merge, m (\[P\], default `∞`: merge on
+    /// shared pairs alone). Two ellipses meet in up to 4 points, so targets sharing two
+    /// (TRP, MPC) pairs may be far apart; a finite radius keeps a true target that a distant
+    /// ghost would otherwise suppress, at the price of many more false alarms (V-A, `N_u = 4`:
+    /// `P_FA` at `T_e = 5` doubles with 1 m), so it is off by default.
+    pub merge_radius_m: Real,
     /// Gauss–Newton settings.
     pub refinement: Refinement,
     /// Add late seeds at stages `s ≥ 3` (step 3, default on).
@@ -118,6 +124,7 @@ impl Default for MtlConfig {
             stage_blocking_test: true,
             merge_final: true,
             merge_shared_pairs: 2,
+            merge_radius_m: Real::INFINITY,
             refinement: Refinement::default(),
             late_seeds: true,
             late_seed_catch_up: true,

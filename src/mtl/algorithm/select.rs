@@ -75,7 +75,8 @@ pub fn accepted(c: &Candidate, cfg: &MtlConfig) -> bool {
 
 /// Step 5: per family the accepted candidate of smallest `J`; then, if
 /// [`MtlConfig::merge_final`], greedily in ascending `J` drop every target sharing at least
-/// [`MtlConfig::merge_shared_pairs`] pairs with a kept one (\[P\]). Targets ascend in `J`.
+/// [`MtlConfig::merge_shared_pairs`] pairs with a kept one within
+/// [`MtlConfig::merge_radius_m`] (\[P\]). Targets ascend in `J`.
 pub fn finalize(live: &[Candidate], cfg: &MtlConfig) -> Vec<Target> {
     let mut best: BTreeMap<usize, &Candidate> = BTreeMap::new();
     for c in live.iter().filter(|c| accepted(c, cfg)) {
@@ -93,6 +94,7 @@ pub fn finalize(live: &[Candidate], cfg: &MtlConfig) -> Vec<Target> {
         let clash = cfg.merge_final
             && out.iter().any(|k| {
                 Candidate::shared_pairs(&k.matching, &c.matching) >= cfg.merge_shared_pairs
+                    && (k.x - c.x).norm() <= cfg.merge_radius_m
             });
         if !clash {
             out.push(c);

@@ -66,6 +66,7 @@ pub fn validate<B: BlockingModel + ?Sized>(
     }
     check_non_negative("t_e", cfg.t_e, false)?;
     check_non_negative("t_b", cfg.t_b, true)?;
+    check_non_negative("merge_radius_m", cfg.merge_radius_m, true)?;
     if !input.c_sigma_m.is_finite() {
         return Err(Error::NonFinite {
             field: "c_sigma_m".into(),
