@@ -8,7 +8,9 @@ use scatterloc::math::{Real, Vec2};
 use scatterloc::mtl::blocking::{
     is_consistent, BlockingModel, BlockingSpace, IndependentNodes, NodeBlockingModel, PartialVector,
 };
+use scatterloc::mtl::empirical::{EmpiricalNodeModel, EmpiricalTable};
 use scatterloc::mtl::icb::IcbModel;
+use scatterloc::mtl::polygon::Rect;
 use scatterloc::mtl::trp::TrpMap;
 use scatterloc::Error;
 
@@ -178,7 +180,7 @@ proptest! {
     }
 
     /// Check 10: extending S by one TRP (a DP or ĝ_m = 0) never decreases L_b — independent
-    /// nodes with (M4)–(M5), and i.c.b.
+    /// nodes with (M4)–(M5), an empirical table with random counts (§6.3), and i.c.b.
     #[test]
     fn extending_never_decreases_lb(
         (nt, nr, p_tx, p_rx) in network(),
@@ -188,6 +190,7 @@ proptest! {
         ones in any::<u64>(),
         m in 0usize..16,
         dp in any::<bool>(),
+        counts in proptest::collection::vec(0u32..50, 256),
     ) {
         let map = TrpMap::new(nt, nr).unwrap();
         let m = m % map.n_trps();
@@ -198,7 +201,12 @@ proptest! {
         let node = IndependentNodes::new(&map, p_tx, p_rx).unwrap();
         let bayes = NodeBlockingModel::new(map, node, p_d).unwrap();
         let icb = IcbModel::from_p_u(map, p_u).unwrap();
-        let models: [&dyn BlockingModel; 2] = [&bayes, &icb];
+        let region = Rect::new(Vec2::new(0.0, 0.0), Vec2::new(4.0, 4.0)).unwrap();
+        let mut table = EmpiricalTable::new(&region, 1, 1, nt, nr).unwrap();
+        table.counts[0].copy_from_slice(&counts[..1 << (nt + nr)]);
+        let empirical = EmpiricalNodeModel::new(table).unwrap();
+        let empirical = NodeBlockingModel::new(map, empirical, p_d).unwrap();
+        let models: [&dyn BlockingModel; 3] = [&bayes, &empirical, &icb];
         for model in models {
             let before = model.blocking_likelihood(&x, &v).unwrap();
             let after = model.blocking_likelihood(&x, &w).unwrap();
