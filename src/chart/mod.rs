@@ -7,9 +7,11 @@
 //! metre axes at equal scale and a title.
 //!
 //! [`draw_tracking_rmse`] draws the tracking figure of [S] Fig. 3 (spec §10) in the same style.
+//! [`draw_curves`] draws the ROC and missed-detection curves of the multi-target experiments.
 
 mod layout;
 mod raster;
+mod roc;
 mod ticks;
 mod tracking;
 
@@ -26,6 +28,9 @@ use crate::math::Real;
 use crate::scenario::{Area, Scenario};
 
 pub use layout::suggested_size;
+pub use roc::{
+    curve_chart_size, draw_curves, CurveChartOptions, CurveSeries, LineKind, Marker, CURVE_PALETTE,
+};
 pub use tracking::{draw_tracking_rmse, tracking_size, TrackingChartOptions, TrackingPanel};
 
 /// A computed map: the grid and its values, row-major with row `j` at `y_j` (ascending y), m;

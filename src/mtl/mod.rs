@@ -6,6 +6,7 @@
 //!   probability (M4–M5), the blocking likelihood `L_b` and the [`blocking::BlockingModel`]
 //!   interface shared by all blocking models.
 //! - [`icb`]: the i.c.b model and its threshold (M7–M8).
+//! - [`input`]: serde schemas of one localization (network, ranges, model spec) and its report.
 //! - [`geometry`]: ellipses per (TRP, range) and ellipse–ellipse intersection (§5).
 //! - [`polygon`]: convex polygons, clipping and areas (for §6.2).
 //! - [`ppp`]: the PPP-disc blocking model (M9–M11).
@@ -24,6 +25,7 @@ pub mod empirical;
 pub mod experiment;
 pub mod geometry;
 pub mod icb;
+pub mod input;
 pub mod polygon;
 pub mod ppp;
 pub mod sim;

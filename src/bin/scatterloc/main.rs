@@ -18,6 +18,8 @@ mod map_cmd;
 #[cfg(not(target_arch = "wasm32"))]
 mod mc_cmd;
 #[cfg(not(target_arch = "wasm32"))]
+mod mtl_cmd;
+#[cfg(not(target_arch = "wasm32"))]
 mod output;
 #[cfg(not(target_arch = "wasm32"))]
 mod report;
@@ -73,6 +75,29 @@ USAGE:
       Posterior CRLB alone (spec 8): at the noise-free path (--nominal, check 9) or with
       E[F] over N truth trajectories (default 5000, check 10). {t_s, rmse_pcrlb_m, trajectory,
       dt_s, nominal, ..}; on stdout unless --json/--out are given (then a summary).
+  scatterloc mtl locate --network FILE --ranges FILE [--model icb|ppp|empirical]
+                        [--te T] [--tb T|inf] [--b-max N|inf] [--n-min N] [--order 0,1,..]
+                        [--p-u P | --p-d P --p-los P] [--lambda L] [--diameter D] [--exact]
+                        [--table FILE | --cells N --scenes N --seed N] [--out OUT.json]
+      Multi-target localization (spec multi-target.md, Algorithm 1). Network file:
+      {\"tx\": [[x, y], ..], \"rx\": [[x, y], ..], \"region\": {\"min_m\": [x, y], \"max_m\": [x, y]}
+      (optional), \"c_sigma_m\": 0.1 (optional)}. Ranges file: {\"ranges_m\": [[r, ..] per TRP]},
+      TRP m (0-based) = TX m mod N_t, RX m div N_t. Models: icb (p_u, or 1 - p_d p_LoS^2;
+      default p_d = p_LoS = 0.9), ppp (lambda 0.03, D 0.6 m, p_d 0.9; --exact: M11), empirical
+      (--table: EmpiricalTable JSON, else trained on the network from --lambda/--diameter).
+      Defaults T_e = 3, T_b = 20, B_max = 16, n_min = 3. Prints {model, t_e, t_b, count,
+      targets: [{position_m, matching: [[trp, mpc], ..], j, l_b, g: [0/1 per TRP], family}]}.
+  scatterloc mtl table2 [--draws N] [--seed N] [--json OUT.json]
+      Table II: DP-count distribution at target points, \"True\" from the generator (V-B
+      defaults, default 100000 draws) and i.c.b Binomial(9, 1 - 0.5329), next to the paper.
+  scatterloc mtl roc --experiment va|vb|vc [--realizations N] [--seed N] [--threads N]
+                     [--empirical] [--exact] [--out FIG.{svg,png}] [--json OUT.json]
+      The experiments of spec 8: va = Fig. 3 ROC over T_e (size rule vs Bayesian i.c.b),
+      vb = Fig. 4 ROC over T_b (PPP vs i.c.b), vc = Fig. 5 1 - P_D vs T_b (Bayesian vs genie).
+      --empirical adds the empirical model (vb, vc); --exact uses (M11) for PPP. Default 100
+      realisations, seed 1. Progress on stderr; Ctrl-C stops (exit 130, no files written).
+      Prints a summary table; --json: {config, curves: [{method, label, points: [{threshold,
+      p_d, p_fa, detections, false_alarms, estimates}]}], disagreements, ..}.
   scatterloc help | --help | -h      Show this text.
   scatterloc --version               Show the version.
 
@@ -129,7 +154,7 @@ fn main() {
 fn run(argv: &[std::ffi::OsString]) -> Result<(), CliError> {
     let Some(first) = argv.first() else {
         return Err(CliError::usage(
-            "missing subcommand (preset, crlb, crlb-map, locate, track, montecarlo, pcrlb, help)",
+            "missing subcommand (preset, crlb, crlb-map, locate, track, montecarlo, pcrlb, mtl, help)",
         ));
     };
     let rest = &argv[1..];
@@ -143,9 +168,10 @@ fn run(argv: &[std::ffi::OsString]) -> Result<(), CliError> {
         "track" => track_cmd::track(rest),
         "montecarlo" => mc_cmd::montecarlo(rest),
         "pcrlb" => mc_cmd::pcrlb(rest),
+        "mtl" => mtl_cmd::mtl(rest),
         other => Err(CliError::usage(format!(
             "unknown subcommand '{}' (expected preset, crlb, crlb-map, locate, track, \
-             montecarlo, pcrlb or help)",
+             montecarlo, pcrlb, mtl or help)",
             if other.is_empty() {
                 first.to_string_lossy()
             } else {

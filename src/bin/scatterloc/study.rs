@@ -79,7 +79,8 @@ pub fn flag_error(e: Error) -> CliError {
     CliError::usage(text)
 }
 
-fn cancelled() -> CliError {
+/// The Ctrl-C outcome: exit status 130, nothing written.
+pub fn cancelled() -> CliError {
     CliError {
         message: "cancelled by Ctrl-C; no output files were written".into(),
         code: 130,
@@ -229,13 +230,16 @@ pub fn run_pcrlb_with_progress(
     )
 }
 
-/// Drives `run(cancel flag, progress callback)` under a progress bar of `total` `unit`s.
-fn with_progress<T>(
+/// Runs `run` under a progress bar on stderr (`unit` per step, `label` as prefix, rate and ETA)
+/// with Ctrl-C cancellation through `run`'s flag: a cancelled run is exit status 130 with no
+/// output written. Returns the core result and the wall time, s. Shared by every long CLI
+/// study (Monte Carlo, PCRLB, multi-target ROC sweeps).
+pub fn run_with_bar<T>(
     total: usize,
     unit: &str,
     label: &str,
     run: impl FnOnce(&AtomicBool, &mut dyn FnMut(usize, usize)) -> scatterloc::Result<T>,
-) -> Result<(T, f64), CliError> {
+) -> Result<(scatterloc::Result<T>, f64), CliError> {
     static HANDLER: std::sync::Once = std::sync::Once::new();
     HANDLER.call_once(|| {
         // A second Ctrl-C leaves at once (nothing has been written yet either way).
@@ -262,6 +266,17 @@ fn with_progress<T>(
     if CANCEL.load(Ordering::SeqCst) {
         return Err(cancelled());
     }
+    Ok((res, wall))
+}
+
+/// [`run_with_bar`] with core errors mapped to the study flags ([`flag_error`]).
+fn with_progress<T>(
+    total: usize,
+    unit: &str,
+    label: &str,
+    run: impl FnOnce(&AtomicBool, &mut dyn FnMut(usize, usize)) -> scatterloc::Result<T>,
+) -> Result<(T, f64), CliError> {
+    let (res, wall) = run_with_bar(total, unit, label, run)?;
     Ok((res.map_err(flag_error)?, wall))
 }
 

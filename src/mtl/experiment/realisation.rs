@@ -203,7 +203,7 @@ impl Runner<'_> {
         let map = s.map()?;
         let (tx, rx) = (r.scene.tx.clone(), r.scene.rx.clone());
         let ppp = NodeBlockingModel::new(
-            map.clone(),
+            map,
             PppNodeModel::new(
                 PppBlocking::new(s.lambda, s.diameter, Some(s.region), cfg.ppp_exact)?,
                 tx.clone(),
@@ -216,7 +216,7 @@ impl Runner<'_> {
             let curve = match spec.method {
                 Method::Ppp => self.sweep_tb(&ppp, true)?,
                 Method::Icb => {
-                    let icb = IcbModel::from_p_u(map.clone(), cfg.icb_p_u)?;
+                    let icb = IcbModel::from_p_u(map, cfg.icb_p_u)?;
                     self.sweep_tb(&icb, false)?
                 }
                 Method::Empirical => {
@@ -236,11 +236,8 @@ impl Runner<'_> {
                         training.scenes,
                         &mut rng(cfg.seed, TRAINING_STREAM + index),
                     )?;
-                    let model = NodeBlockingModel::new(
-                        map.clone(),
-                        EmpiricalNodeModel::new(table)?,
-                        s.p_d,
-                    )?;
+                    let model =
+                        NodeBlockingModel::new(map, EmpiricalNodeModel::new(table)?, s.p_d)?;
                     self.sweep_tb(&model, true)?
                 }
                 Method::Genie => self.sweep_genie(r, &ppp)?,

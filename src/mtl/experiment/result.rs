@@ -58,8 +58,8 @@ pub struct Tally {
     realisations: usize,
     targets: u64,
     disagreements: u64,
-    /// `[curve][point]`: `(Σ N_D/K, Σ N_FA/max(K̂,1), Σ N_D, Σ N_FA, Σ K̂)`.
-    sums: Vec<Vec<(Real, Real, u64, u64, u64)>>,
+    /// `[curve][point]`.
+    sums: Vec<Vec<PointSums>>,
 }
 
 impl Tally {
@@ -69,7 +69,7 @@ impl Tally {
             realisations: 0,
             targets: 0,
             disagreements: 0,
-            sums: alloc::vec![alloc::vec![(0.0, 0.0, 0, 0, 0); points]; curves],
+            sums: alloc::vec![alloc::vec![PointSums::default(); points]; curves],
         }
     }
 
@@ -106,11 +106,11 @@ impl Tally {
                     .zip(sums)
                     .map(|(&threshold, s)| RocPoint {
                         threshold,
-                        p_d: s.0 / n,
-                        p_fa: s.1 / n,
-                        detections: s.2,
-                        false_alarms: s.3,
-                        estimates: s.4,
+                        p_d: s.detection_ratio / n,
+                        p_fa: s.false_alarm_ratio / n,
+                        detections: s.detections,
+                        false_alarms: s.false_alarms,
+                        estimates: s.estimates,
                     })
                     .collect(),
             })
@@ -125,10 +125,25 @@ impl Tally {
     }
 }
 
-fn add_counts(s: &mut (Real, Real, u64, u64, u64), c: &DetectionCounts) {
-    s.0 += c.detected as Real / c.targets.max(1) as Real;
-    s.1 += c.false_alarms as Real / c.estimates.max(1) as Real;
-    s.2 += c.detected as u64;
-    s.3 += c.false_alarms as u64;
-    s.4 += c.estimates as u64;
+/// Sums of one curve point over realisations.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+struct PointSums {
+    /// `Σ N_D/K`.
+    detection_ratio: Real,
+    /// `Σ N_FA/max(K̂, 1)`.
+    false_alarm_ratio: Real,
+    /// `Σ N_D`.
+    detections: u64,
+    /// `Σ N_FA`.
+    false_alarms: u64,
+    /// `Σ K̂`.
+    estimates: u64,
+}
+
+fn add_counts(s: &mut PointSums, c: &DetectionCounts) {
+    s.detection_ratio += c.detected as Real / c.targets.max(1) as Real;
+    s.false_alarm_ratio += c.false_alarms as Real / c.estimates.max(1) as Real;
+    s.detections += c.detected as u64;
+    s.false_alarms += c.false_alarms as u64;
+    s.estimates += c.estimates as u64;
 }

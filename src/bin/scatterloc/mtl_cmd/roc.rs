@@ -1,0 +1,426 @@
+//! `scatterloc mtl roc`: the §8 experiments (V-A, V-B, V-C) under a progress bar, with a summary
+//! table, JSON and a figure.
+
+use super::*;
+
+/// Runs `cfg` on `threads` threads under the shared progress bar ([`run_with_bar`]); Ctrl-C
+/// stops it with exit status 130. Returns the result and the wall time, s.
+fn run_with_progress(
+    cfg: &ExperimentConfig,
+    threads: usize,
+) -> Result<(ExperimentResult, f64), CliError> {
+    let label = format!("experiment {}", cfg.experiment.name());
+    let (res, wall) = run_with_bar(
+        cfg.realisations,
+        "realisations",
+        &label,
+        |cancel, progress| run_parallel(cfg, threads, cancel, |done, total| progress(done, total)),
+    )?;
+    Ok((res.map_err(|e| core_error(&e, "mtl roc"))?, wall))
+}
+
+/// Every setting of a run (the \[P\] parameters of §7 and §8 included) in the JSON file.
+#[derive(Serialize)]
+struct ConfigDoc {
+    experiment: &'static str,
+    swept: &'static str,
+    sweep: Vec<f64>,
+    realisations: usize,
+    seed: u64,
+    /// `N_u` values (V-A).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    n_u: Option<Vec<usize>>,
+    /// Fixed `T_e` (V-B, V-C).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    t_e: Option<f64>,
+    icb_p_u: f64,
+    ppp_exact: bool,
+    empirical: Option<EmpiricalDoc>,
+    settings: SettingsDoc,
+    algorithm: AlgorithmDoc,
+}
+
+#[derive(Serialize)]
+struct EmpiricalDoc {
+    cells: usize,
+    scenes: usize,
+}
+
+#[derive(Serialize)]
+struct SettingsDoc {
+    region_m: [[f64; 2]; 2],
+    /// `uniform` (`n_tx`, `n_rx`) or `fixed` (`tx`, `rx`).
+    nodes: NodesDoc,
+    /// `discs` or `independent`.
+    los: &'static str,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    p_los: Option<f64>,
+    lambda: f64,
+    diameter_m: f64,
+    range_sigma_m: f64,
+    resolution_m: f64,
+    detection_radius_m: f64,
+    p_d: f64,
+    targets: usize,
+    clutter_mean: f64,
+    r_max_m: f64,
+    geometric_ips: [bool; 2],
+}
+
+#[derive(Serialize)]
+#[serde(tag = "layout", rename_all = "lowercase")]
+enum NodesDoc {
+    Uniform {
+        n_tx: usize,
+        n_rx: usize,
+    },
+    Fixed {
+        tx: Vec<[f64; 2]>,
+        rx: Vec<[f64; 2]>,
+    },
+}
+
+#[derive(Serialize)]
+struct AlgorithmDoc {
+    /// `null` = ∞.
+    b_max: Option<usize>,
+    n_min: usize,
+    order: Option<Vec<usize>>,
+    region_filter: bool,
+    merge_final: bool,
+    merge_shared_pairs: usize,
+    merge_radius_m: Option<f64>,
+    refinement_max_iterations: usize,
+    refinement_step_tol_m: f64,
+    late_seeds: bool,
+    late_seed_catch_up: bool,
+}
+
+fn config_doc(cfg: &ExperimentConfig) -> ConfigDoc {
+    let s = &cfg.settings;
+    let m = &cfg.mtl;
+    let va = cfg.experiment == Experiment::Va;
+    let xy = |v: &scatterloc::Vec2| [v.x, v.y];
+    ConfigDoc {
+        experiment: cfg.experiment.name(),
+        swept: cfg.experiment.swept(),
+        sweep: cfg.sweep.clone(),
+        realisations: cfg.realisations,
+        seed: cfg.seed,
+        n_u: va.then(|| cfg.n_u.clone()),
+        t_e: (!va).then_some(cfg.t_e),
+        icb_p_u: cfg.icb_p_u,
+        ppp_exact: cfg.ppp_exact,
+        empirical: cfg.empirical.map(|e| EmpiricalDoc {
+            cells: e.cells,
+            scenes: e.scenes,
+        }),
+        settings: SettingsDoc {
+            region_m: [xy(&s.region.min), xy(&s.region.max)],
+            nodes: match &s.nodes {
+                NodeLayout::Uniform { n_tx, n_rx } => NodesDoc::Uniform {
+                    n_tx: *n_tx,
+                    n_rx: *n_rx,
+                },
+                NodeLayout::Fixed { tx, rx } => NodesDoc::Fixed {
+                    tx: tx.iter().map(xy).collect(),
+                    rx: rx.iter().map(xy).collect(),
+                },
+            },
+            los: match s.los {
+                LosModel::Discs => "discs",
+                LosModel::Independent { .. } => "independent",
+            },
+            p_los: match s.los {
+                LosModel::Independent { p_los } => Some(p_los),
+                LosModel::Discs => None,
+            },
+            lambda: s.lambda,
+            diameter_m: s.diameter,
+            range_sigma_m: s.range_sigma,
+            resolution_m: s.resolution,
+            detection_radius_m: s.detection_radius,
+            p_d: s.p_d,
+            targets: s.targets,
+            clutter_mean: s.clutter_mean,
+            r_max_m: s.r_max,
+            geometric_ips: [s.geometric_ips.kind1, s.geometric_ips.kind2],
+        },
+        algorithm: AlgorithmDoc {
+            b_max: (m.b_max != usize::MAX).then_some(m.b_max),
+            n_min: m.n_min,
+            order: m.order.clone(),
+            region_filter: m.region.is_some(),
+            merge_final: m.merge_final,
+            merge_shared_pairs: m.merge_shared_pairs,
+            merge_radius_m: m.merge_radius_m.is_finite().then_some(m.merge_radius_m),
+            refinement_max_iterations: m.refinement.max_iterations,
+            refinement_step_tol_m: m.refinement.step_tol_m,
+            late_seeds: m.late_seeds,
+            late_seed_catch_up: m.late_seed_catch_up,
+        },
+    }
+}
+
+#[derive(Serialize)]
+struct PointDoc {
+    threshold: f64,
+    p_d: f64,
+    p_fa: f64,
+    detections: u64,
+    false_alarms: u64,
+    estimates: u64,
+}
+
+#[derive(Serialize)]
+struct CurveDoc {
+    method: &'static str,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    n_u: Option<usize>,
+    label: String,
+    points: Vec<PointDoc>,
+}
+
+/// The `--json` file of `mtl roc`.
+#[derive(Serialize)]
+struct RocDoc {
+    config: ConfigDoc,
+    realisations: usize,
+    targets: u64,
+    disagreements: u64,
+    threads: usize,
+    wall_time_s: f64,
+    curves: Vec<CurveDoc>,
+}
+
+/// The figure of one experiment.
+struct RocFigure<'a> {
+    series: Vec<CurveSeries<'a>>,
+    opts: CurveChartOptions,
+}
+
+impl Figure for RocFigure<'_> {
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), ChartError> {
+        draw_curves(root, &self.series, &self.opts)
+    }
+}
+
+/// The series and axes of the figure of `r`; `xy[c]` holds the points of curve `c`.
+fn figure_of<'a>(
+    r: &ExperimentResult,
+    cfg: &ExperimentConfig,
+    xy: &'a [Vec<(f64, f64)>],
+) -> RocFigure<'a> {
+    let mut series = Vec::new();
+    let n_u_colour = |n| cfg.n_u.iter().position(|&x| x == n).unwrap_or(0);
+    for (c, pts) in r.curves.iter().zip(xy) {
+        let (colour, line, marker) = match (c.spec.method, c.spec.n_u) {
+            (Method::SizeRule, n) => (n_u_colour(n.unwrap_or(0)), LineKind::Solid, Marker::Dot),
+            (Method::Icb, Some(n)) => (n_u_colour(n), LineKind::None, Marker::Ring),
+            (Method::Ppp, _) => (0, LineKind::Solid, Marker::Dot),
+            (Method::Icb, None) => (1, LineKind::Solid, Marker::Triangle),
+            (Method::Empirical, _) => (2, LineKind::Solid, Marker::Square),
+            (Method::Genie, _) => (1, LineKind::Dashed, Marker::Cross),
+        };
+        series.push(CurveSeries {
+            label: c.label.clone(),
+            points: pts,
+            colour,
+            line,
+            marker,
+        });
+    }
+    let what = match cfg.experiment {
+        Experiment::Va => "Fig. 3 (V-A): ROC over T_e, size rule vs Bayesian MTL (i.c.b)",
+        Experiment::Vb => "Fig. 4 (V-B): ROC over T_b, PPP vs i.c.b",
+        Experiment::Vc => "Fig. 5 (V-C): missed detection vs T_b, Bayesian MTL vs genie",
+    };
+    let title = format!(
+        "Experiment {} — {} realisations",
+        cfg.experiment.name().to_uppercase(),
+        r.realisations
+    );
+    let sweep = match cfg.experiment {
+        Experiment::Va => "T_e = 0.5 … 5".to_string(),
+        _ => format!("T_e = {}, T_b swept", cfg.t_e),
+    };
+    let subtitle = Some(format!(
+        "{what} · {} targets · {sweep} · seed {}",
+        r.targets, cfg.seed
+    ));
+    let opts = match cfg.experiment {
+        Experiment::Vc => {
+            let hi = cfg.sweep.last().copied().unwrap_or(1.0).max(1e-9);
+            CurveChartOptions {
+                title,
+                subtitle,
+                x_desc: "blocking threshold T_b (nats)".into(),
+                y_desc: "missed-detection probability 1 − P_D".into(),
+                x_range: (cfg.sweep.first().copied().unwrap_or(0.0).min(hi - 1e-9), hi),
+                y_range: (0.0, 1.0),
+                legend: SeriesLabelPosition::UpperRight,
+            }
+        }
+        _ => CurveChartOptions::roc(title, subtitle),
+    };
+    RocFigure { series, opts }
+}
+
+/// The summary table: one row per threshold (every point for up to 21 thresholds, else about
+/// 21 evenly spaced ones), per curve `P_D` and `P_FA` (V-C: `1 − P_D` and `P_FA`).
+fn summary_table(r: &ExperimentResult, cfg: &ExperimentConfig, wall: f64, used: usize) -> String {
+    let vc = cfg.experiment == Experiment::Vc;
+    let mut t = String::new();
+    t.push_str(&format!(
+        "experiment {}: {} realisations, {} targets, seed {}, {} thread(s), wall {:.2} s\n",
+        cfg.experiment.name(),
+        r.realisations,
+        r.targets,
+        cfg.seed,
+        used,
+        wall
+    ));
+    for (i, c) in r.curves.iter().enumerate() {
+        t.push_str(&format!("  [{}] {}\n", i + 1, c.label));
+    }
+    let pd = if vc { "1-P_D" } else { "P_D" };
+    t.push_str(&format!("{:>7}", cfg.experiment.swept()));
+    for i in 0..r.curves.len() {
+        t.push_str(&format!(
+            " {:>8} {:>8}",
+            format!("{pd}[{}]", i + 1),
+            format!("P_FA[{}]", i + 1)
+        ));
+    }
+    t.push('\n');
+    let n = cfg.sweep.len();
+    let step = n.div_ceil(21).max(1);
+    for k in (0..n).filter(|k| k % step == 0 || *k == n - 1) {
+        t.push_str(&format!("{:>7.2}", cfg.sweep[k]));
+        for c in &r.curves {
+            let p = &c.points[k];
+            let d = if vc { 1.0 - p.p_d } else { p.p_d };
+            t.push_str(&format!(" {d:>8.3} {:>8.3}", p.p_fa));
+        }
+        t.push('\n');
+    }
+    if cfg.experiment == Experiment::Va {
+        t.push_str(&format!(
+            "disagreements between the size rule and Bayesian i.c.b (spec check 6): {}",
+            r.disagreements
+        ));
+    } else {
+        t.pop();
+    }
+    t
+}
+
+/// `scatterloc mtl roc`.
+pub(super) fn mtl_roc(argv: &[OsString]) -> Result<(), CliError> {
+    let flags = [
+        "experiment",
+        "realizations",
+        "seed",
+        "threads",
+        "out",
+        "json",
+    ];
+    let Some(args) = parse_args(argv, "mtl roc", &flags, &["empirical", "exact"])? else {
+        return Ok(());
+    };
+    args.expect_positional("mtl roc", 0, "")?;
+    let name = args.required("experiment")?;
+    let experiment = Experiment::parse(name).ok_or_else(|| {
+        CliError::usage(format!(
+            "--experiment: unknown experiment '{name}' (expected va, vb or vc)"
+        ))
+    })?;
+    let mut cfg = ExperimentConfig::new(experiment);
+    let n = args.integer("realizations")?.unwrap_or(cfg.realisations);
+    if !(1..=MAX_REALISATIONS).contains(&n) {
+        return Err(CliError::usage(format!(
+            "--realizations: {n} is outside the allowed range 1..={MAX_REALISATIONS}"
+        )));
+    }
+    cfg.realisations = n;
+    cfg.seed = seed(&args)?;
+    if experiment == Experiment::Va {
+        refuse(
+            &args,
+            &["empirical", "exact"],
+            "with --experiment va (i.c.b only)",
+        )?;
+    }
+    cfg.ppp_exact = args.switch("exact");
+    if args.switch("empirical") {
+        cfg.empirical = Some(EmpiricalTraining::default());
+    }
+    cfg.validate().map_err(|e| core_error(&e, "mtl roc"))?;
+    let (threads, used) = threads(&args)?;
+    let figure = match args.get("out") {
+        Some(p) => Some((p, Format::of("out", p, &[Format::Svg, Format::Png])?)),
+        None => None,
+    };
+    let json = match args.get("json") {
+        Some(p) => Format::of("json", p, &[Format::Json]).map(|_| Some(p))?,
+        None => None,
+    };
+    if let Some((p, _)) = figure {
+        check_writable("out", p)?;
+    }
+    if let Some(p) = json {
+        check_writable("json", p)?;
+    }
+
+    let (r, wall) = run_with_progress(&cfg, threads)?;
+    if let Some(p) = json {
+        let doc = RocDoc {
+            config: config_doc(&cfg),
+            realisations: r.realisations,
+            targets: r.targets,
+            disagreements: r.disagreements,
+            threads: used,
+            wall_time_s: wall,
+            curves: r
+                .curves
+                .iter()
+                .map(|c| CurveDoc {
+                    method: c.spec.method.name(),
+                    n_u: c.spec.n_u,
+                    label: c.label.clone(),
+                    points: c
+                        .points
+                        .iter()
+                        .map(|p| PointDoc {
+                            threshold: p.threshold,
+                            p_d: p.p_d,
+                            p_fa: p.p_fa,
+                            detections: p.detections,
+                            false_alarms: p.false_alarms,
+                            estimates: p.estimates,
+                        })
+                        .collect(),
+                })
+                .collect(),
+        };
+        write_json_file("json", p, &doc)?;
+    }
+    if let Some((p, format)) = figure {
+        let xy: Vec<Vec<(f64, f64)>> = r
+            .curves
+            .iter()
+            .map(|c| {
+                c.points
+                    .iter()
+                    .map(|p| match experiment {
+                        Experiment::Vc => (p.threshold, 1.0 - p.p_d),
+                        _ => (p.p_fa, p.p_d),
+                    })
+                    .collect()
+            })
+            .collect();
+        let fig = figure_of(&r, &cfg, &xy);
+        write_figure("out", p, format, curve_chart_size(), &fig)?;
+    }
+    emit(&summary_table(&r, &cfg, wall, used))
+}
