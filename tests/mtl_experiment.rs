@@ -3,6 +3,8 @@
 //! detections, PPP the other way round) and Fig. 5 (Bayesian MTL ≈ genie), thread-count
 //! independence, and named errors for bad configurations.
 
+#![cfg(not(target_arch = "wasm32"))]
+
 use std::sync::atomic::AtomicBool;
 
 use scatterloc::mtl::experiment::{

@@ -6,7 +6,7 @@ use core::ops::Deref;
 
 use crate::ellipse::Ellipse;
 use crate::geometry::{iso_range_ellipse, unit_from};
-use crate::math::{sqrt, Real, Vec2, PI};
+use crate::math::{cos, sin, sqrt, Real, Vec2, PI};
 use crate::mtl::polygon::Rect;
 
 /// Samples of `h(θ)` around ellipse 1 (§5.2).
@@ -250,6 +250,65 @@ fn golden_min<F: Fn(Real) -> Real>(g: &F, mut lo: Real, mut hi: Real) -> Real {
 /// is given, points outside it enlarged by [`REGION_MARGIN_M`]. Identical or confocal ellipses
 /// give no points.
 pub fn intersect(e1: &RangeEllipse, e2: &RangeEllipse, region: Option<&Rect>) -> Intersections {
+    intersect_with(e1, e2, region, &SampleTable::new())
+}
+
+/// `cos θ_k`, `sin θ_k` of the §5.2 sample angles `θ_k = 2πk/n`, `n =`
+/// [`INTERSECTION_SAMPLES`]: computed once and shared by many intersections (the sampling loop
+/// then needs no trigonometry; the values are bitwise those of `cos`/`sin` at `θ_k`).
+#[derive(Debug, Clone)]
+pub struct SampleTable {
+    cos: [Real; INTERSECTION_SAMPLES],
+    sin: [Real; INTERSECTION_SAMPLES],
+}
+
+impl SampleTable {
+    /// The table.
+    pub fn new() -> SampleTable {
+        let step = 2.0 * PI / INTERSECTION_SAMPLES as Real;
+        let mut t = SampleTable {
+            cos: [0.0; INTERSECTION_SAMPLES],
+            sin: [0.0; INTERSECTION_SAMPLES],
+        };
+        for k in 0..INTERSECTION_SAMPLES {
+            let theta = step * k as Real;
+            t.cos[k] = cos(theta);
+            t.sin[k] = sin(theta);
+        }
+        t
+    }
+}
+
+impl Default for SampleTable {
+    fn default() -> Self {
+        SampleTable::new()
+    }
+}
+
+/// Axis-aligned bounding box `(min, max)` of an ellipse, padded by `pad`.
+fn bounding_box(e: &RangeEllipse, pad: Real) -> (Vec2, Vec2) {
+    let el = &e.ellipse;
+    let (ca, sa) = (cos(el.angle_rad), sin(el.angle_rad));
+    let (a, b) = (el.semi_major, el.semi_minor);
+    let hx = sqrt(a * a * ca * ca + b * b * sa * sa) + pad;
+    let hy = sqrt(a * a * sa * sa + b * b * ca * ca) + pad;
+    let h = Vec2::new(hx, hy);
+    (el.center - h, el.center + h)
+}
+
+fn boxes_overlap(p: (Vec2, Vec2), q: (Vec2, Vec2)) -> bool {
+    p.0.x <= q.1.x && q.0.x <= p.1.x && p.0.y <= q.1.y && q.0.y <= p.1.y
+}
+
+/// [`intersect`] with a shared [`SampleTable`] (same points). Ellipses whose bounding boxes do
+/// not overlap, or (with `region`) one of which lies wholly outside the enlarged region, are
+/// rejected before sampling.
+pub fn intersect_with(
+    e1: &RangeEllipse,
+    e2: &RangeEllipse,
+    region: Option<&Rect>,
+    table: &SampleTable,
+) -> Intersections {
     let mut out = Intersections::new();
     let scale = 1.0 + e1.range_m.abs() + e2.range_m.abs();
     let confocal = (same_point(e1.tx, e2.tx, scale) && same_point(e1.rx, e2.rx, scale))
@@ -257,14 +316,39 @@ pub fn intersect(e1: &RangeEllipse, e2: &RangeEllipse, region: Option<&Rect>) ->
     if confocal {
         return out;
     }
-    let h = |t: Real| e2.residual(e1.point(t));
+    // Exact rejections: every intersection lies on both ellipses (so in both boxes) and, to be
+    // kept, in the enlarged region.
+    let pad = 1e-9 * scale;
+    let (b1, b2) = (bounding_box(e1, pad), bounding_box(e2, pad));
+    if !boxes_overlap(b1, b2) {
+        return out;
+    }
+    if let Some(r) = region {
+        let r = r.enlarged(REGION_MARGIN_M);
+        let rb = (r.min, r.max);
+        if !boxes_overlap(b1, rb) || !boxes_overlap(b2, rb) {
+            return out;
+        }
+    }
+    // p(θ) as Ellipse::point, with the axis rotation and the sample angles' cos/sin hoisted.
+    let el = &e1.ellipse;
+    let (ca, sa) = (cos(el.angle_rad), sin(el.angle_rad));
+    let at = |ct: Real, st: Real| {
+        let (u, v) = (el.semi_major * ct, el.semi_minor * st);
+        el.center + Vec2::new(ca * u - sa * v, sa * u + ca * v)
+    };
+    let h = |t: Real| e2.residual(at(cos(t), sin(t)));
     let n = INTERSECTION_SAMPLES;
     let step = 2.0 * PI / n as Real;
     let mut theta = [0.0; INTERSECTION_SAMPLES + 1];
     let mut hv = [0.0; INTERSECTION_SAMPLES + 1];
     for k in 0..=n {
         theta[k] = step * k as Real;
-        hv[k] = if k == n { hv[0] } else { h(theta[k]) };
+        hv[k] = if k == n {
+            hv[0]
+        } else {
+            e2.residual(at(table.cos[k], table.sin[k]))
+        };
     }
     // Candidate roots (θ), more than 4 only through numerical duplicates.
     let mut cand = [0.0; 16];

@@ -102,37 +102,60 @@ fn cross(o: Vec2, a: Vec2, p: Vec2) -> Real {
 /// the vertices of `subject ∩ clip`. Empty when the intersection has no area (or either input has
 /// fewer than three vertices). `subject` must be convex for the result to be one polygon.
 pub fn clip_convex(subject: &[Vec2], clip: &[Vec2]) -> Vec<Vec2> {
-    let orient = signed_area(clip);
-    if subject.len() < 3 || clip.len() < 3 || orient == 0.0 {
-        return Vec::new();
+    let mut out = Vec::with_capacity(subject.len() + clip.len());
+    let mut tmp = Vec::with_capacity(subject.len() + clip.len());
+    if !clip_into(subject, clip, orientation(clip), &mut out, &mut tmp) {
+        out.clear();
     }
-    let sign = if orient > 0.0 { 1.0 } else { -1.0 };
-    let mut output: Vec<Vec2> = subject.to_vec();
-    let mut input: Vec<Vec2> = Vec::with_capacity(subject.len() + clip.len());
+    out
+}
+
+/// `±1`: the orientation of `poly` as a clipper; 0 when it has no area or < 3 vertices.
+fn orientation(poly: &[Vec2]) -> Real {
+    let a = signed_area(poly);
+    if poly.len() < 3 || a == 0.0 {
+        0.0
+    } else {
+        a.signum()
+    }
+}
+
+/// Sutherland–Hodgman of `subject` by the convex `clip` of orientation `sign` ([`orientation`])
+/// into `out`, with `tmp` as scratch (both reused across calls: no allocation once they have
+/// grown). `false` when the result has no area.
+fn clip_into(
+    subject: &[Vec2],
+    clip: &[Vec2],
+    sign: Real,
+    out: &mut Vec<Vec2>,
+    tmp: &mut Vec<Vec2>,
+) -> bool {
+    out.clear();
+    if subject.len() < 3 || sign == 0.0 {
+        return false;
+    }
+    out.extend_from_slice(subject);
     for i in 0..clip.len() {
         let (a, b) = (clip[i], clip[(i + 1) % clip.len()]);
-        core::mem::swap(&mut input, &mut output);
-        output.clear();
-        if input.is_empty() {
-            break;
+        core::mem::swap(out, tmp);
+        out.clear();
+        let n = tmp.len();
+        if n == 0 {
+            return false;
         }
-        let n = input.len();
         for j in 0..n {
-            let (p, q) = (input[j], input[(j + 1) % n]);
+            let (p, q) = (tmp[j], tmp[(j + 1) % n]);
             let (sp, sq) = (sign * cross(a, b, p), sign * cross(a, b, q));
             if sp >= 0.0 {
-                output.push(p);
+                out.push(p);
             }
             if (sp >= 0.0) != (sq >= 0.0) {
                 let t = sp / (sp - sq);
-                output.push(p + (q - p) * t);
+                out.push(p + (q - p) * t);
             }
         }
     }
-    if output.len() < 3 || area(&output) == 0.0 {
-        output.clear();
-    }
-    output
+    out.len() >= 3 && area(out) != 0.0
 }
 
 /// The rectangle of width `width` around the segment `[x, node]` (the `A_n` of §6.2, length
@@ -192,23 +215,31 @@ pub fn subset_intersection_areas<P: AsRef<[Vec2]>>(polys: &[P]) -> Result<Vec<Re
         });
     }
     let mut out = alloc::vec![0.0; 1usize << n];
+    let signs: Vec<Real> = polys.iter().map(|p| orientation(p.as_ref())).collect();
     // Depth-first over subsets in increasing index order, carrying the running intersection.
-    let mut stack: Vec<(usize, usize, Vec<Vec2>)> = Vec::new();
+    // Polygons live in one arena: the top stack entry's polygon is always the arena's tail.
+    let mut stack: Vec<(usize, usize, usize, usize)> = Vec::new();
+    let mut arena: Vec<Vec2> = Vec::new();
     for (i, p) in polys.iter().enumerate() {
         let p = p.as_ref();
         let a = area(p);
         if p.len() >= 3 && a > 0.0 {
             out[1 << i] = a;
-            stack.push((1 << i, i, p.to_vec()));
+            stack.push((1 << i, i, arena.len(), p.len()));
+            arena.extend_from_slice(p);
         }
     }
-    while let Some((mask, last, poly)) = stack.pop() {
+    let (mut cur, mut res, mut tmp) = (Vec::new(), Vec::new(), Vec::new());
+    while let Some((mask, last, start, len)) = stack.pop() {
+        cur.clear();
+        cur.extend_from_slice(&arena[start..start + len]);
+        arena.truncate(start);
         for (j, q) in polys.iter().enumerate().skip(last + 1) {
-            let c = clip_convex(&poly, q.as_ref());
-            if !c.is_empty() {
+            if clip_into(&cur, q.as_ref(), signs[j], &mut res, &mut tmp) {
                 let m = mask | (1 << j);
-                out[m] = area(&c);
-                stack.push((m, j, c));
+                out[m] = area(&res);
+                stack.push((m, j, arena.len(), res.len()));
+                arena.extend_from_slice(&res);
             }
         }
     }

@@ -247,6 +247,51 @@ impl NodeAreas {
         exp(-lambda * al) * sum
     }
 
+    /// (M11) when `exact`, else (M10), for every node pattern, indexed by the unblocked mask
+    /// `a | b << N_t`. With `E[S] = e^{−λ|∪_{n∈S} A_n|}` tabulated once (`2^N` exponentials):
+    /// (M11) is `Σ_{T⊆B} (−1)^{|T|} E[U ∪ T]`, a signed superset sum over the blocked set,
+    /// evaluated for all patterns by one `O(N 2^N)` transform; (M10) is
+    /// `E[U] Π_{n∈B} (1 − E[U ∪ {n}]/E[U])`. Equal to [`NodeAreas::probability`] per pattern up
+    /// to rounding.
+    pub fn all_patterns(&self, lambda: Real, exact: bool) -> Vec<Real> {
+        let n = self.node_count();
+        let e: Vec<Real> = self.union.iter().map(|&u| exp(-lambda * u)).collect();
+        if exact {
+            // f[S] = Σ_{T ⊆ ~S} (−1)^{|T|} e[S ∪ T]: for each node, f[S] -= f[S | bit] when the
+            // bit is not in S (in-place superset transform with signs).
+            let mut f = e;
+            for i in 0..n {
+                let bit = 1usize << i;
+                for s in 0..f.len() {
+                    if s & bit == 0 {
+                        f[s] -= f[s | bit];
+                    }
+                }
+            }
+            // Rounding can leave tiny negatives for near-impossible patterns.
+            f.iter_mut().for_each(|v| *v = v.max(0.0));
+            f
+        } else {
+            let full = (1usize << n) - 1;
+            (0..=full)
+                .map(|u| {
+                    let eu = e[u];
+                    if eu == 0.0 {
+                        return 0.0;
+                    }
+                    let mut p = eu;
+                    for k in 0..n {
+                        let bit = 1usize << k;
+                        if u & bit == 0 {
+                            p *= (1.0 - e[u | bit] / eu).max(0.0);
+                        }
+                    }
+                    p
+                })
+                .collect()
+        }
+    }
+
     /// `P_node(γ^T = a, γ^R = b | x)`: (M11) when `exact`, else (M10).
     pub fn probability(&self, lambda: Real, exact: bool, a_bits: u64, b_bits: u64) -> Real {
         let u = self.unblocked_mask(a_bits, b_bits);
@@ -288,16 +333,10 @@ impl PppNodeModel {
     }
 
     /// `P_node(a, b | x)` of every node pattern at `x`, indexed `a | b << N_t` (the order of
-    /// [`crate::mtl::blocking::NodeTable`]), from one area computation.
+    /// [`crate::mtl::blocking::NodeTable`]), from one area computation ([`NodeAreas::all_patterns`]).
     pub fn pattern_probabilities(&self, x: Vec2) -> Result<Vec<Real>> {
         let areas = self.node_areas(x)?;
-        let nt = self.tx.len();
-        Ok((0..1u64 << areas.node_count())
-            .map(|i| {
-                let (a, b) = (i & ((1 << nt) - 1), i >> nt);
-                areas.probability(self.model.lambda, self.model.exact, a, b)
-            })
-            .collect())
+        Ok(areas.all_patterns(self.model.lambda, self.model.exact))
     }
 }
 
@@ -368,7 +407,22 @@ mod tests {
         let nm = PppNodeModel::new(m, tx, rx).unwrap();
         let all = nm.pattern_probabilities(v(5.0, 5.0)).unwrap();
         assert_eq!(all.len(), 64);
-        assert_eq!(all[0b111_110], p(0b110, 0b111, true));
+        // The all-pattern transform equals the per-pattern formula up to rounding, for (M11)
+        // and (M10), on every pattern.
+        for k in 0..64u64 {
+            assert!((all[k as usize] - p(k & 7, k >> 3, true)).abs() < 1e-15);
+        }
+        let bound = PppNodeModel::new(
+            PppBlocking { exact: false, ..m },
+            nm.tx.clone(),
+            nm.rx.clone(),
+        )
+        .unwrap()
+        .pattern_probabilities(v(5.0, 5.0))
+        .unwrap();
+        for k in 0..64u64 {
+            assert!((bound[k as usize] - p(k & 7, k >> 3, false)).abs() < 1e-15);
+        }
         assert_eq!(
             nm.node_pattern_probability(&v(5.0, 5.0), 0b110, 0b111),
             p(0b110, 0b111, true)

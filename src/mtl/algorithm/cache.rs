@@ -7,7 +7,7 @@ use alloc::vec::Vec;
 
 use crate::math::{Real, Vec2};
 use crate::mtl::algorithm::candidate::{Geometry, Pair};
-use crate::mtl::geometry::{intersect, RangeEllipse};
+use crate::mtl::geometry::{intersect_with, RangeEllipse, SampleTable};
 use crate::mtl::polygon::Rect;
 
 /// Intersection points of the ellipses of two (TRP, MPC) pairs, computed on first use. The cache
@@ -20,6 +20,8 @@ pub struct IntersectionCache {
     ranges: Vec<Vec<Real>>,
     region: Option<Rect>,
     points: BTreeMap<(Pair, Pair), Vec<Vec2>>,
+    /// The §5.2 sample angles' cos/sin, built on first use.
+    table: Option<alloc::boxed::Box<SampleTable>>,
 }
 
 impl IntersectionCache {
@@ -50,12 +52,15 @@ impl IntersectionCache {
     pub fn points(&mut self, geo: &Geometry, p: Pair, q: Pair) -> &[Vec2] {
         let key = if p <= q { (p, q) } else { (q, p) };
         let region = self.region;
+        let table = self
+            .table
+            .get_or_insert_with(|| alloc::boxed::Box::new(SampleTable::new()));
         self.points.entry(key).or_insert_with(|| {
             let (tx, rx, map) = (geo.input.tx, geo.input.rx, geo.map);
             let ellipse =
                 |p: Pair| RangeEllipse::new(tx[map.tx(p.trp)], rx[map.rx(p.trp)], geo.range_of(p));
             let mut pts = match (ellipse(key.0), ellipse(key.1)) {
-                (Some(a), Some(b)) => intersect(&a, &b, region.as_ref()).to_vec(),
+                (Some(a), Some(b)) => intersect_with(&a, &b, region.as_ref(), table).to_vec(),
                 _ => Vec::new(),
             };
             // By position, so the seed (and family) order does not depend on the TRP numbering.
