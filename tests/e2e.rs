@@ -27,6 +27,10 @@ use scatterloc::{Model, Scenario, Vec2};
 #[path = "e2e/tracking.rs"]
 mod tracking;
 
+/// Multi-target mode: drag a target, the detection follows (issue 4).
+#[path = "e2e/mtl.rs"]
+mod mtl;
+
 /// `SCATTERLOC_SCREENSHOT=1`: writes docs/screenshot-tracking.png.
 #[path = "e2e/screenshot.rs"]
 mod screenshot;

@@ -18,6 +18,10 @@ wasm_bindgen_test_configure!(run_in_browser);
 #[path = "wasm/tracking.rs"]
 mod tracking;
 
+/// The multi-target view API (`mtl_view_of`).
+#[path = "wasm/mtl.rs"]
+mod mtl;
+
 fn message(e: JsError) -> String {
     let v: JsValue = e.into();
     v.dyn_into::<js_sys::Error>()

@@ -7,12 +7,13 @@ import { drawScene, makeBarCanvas } from './draw.js';
 import { Panel, showError } from './panel.js';
 import { attachPointer } from './interact.js';
 import { Tracking } from './track.js';
+import { Mtl } from './mtl.js';
 
 const $ = (id) => document.getElementById(id);
 
 /**
  * `#preset=iclgnss2019&target=6,4&seed=3&res=256` -> options; tracking: `#mode=tracking&track=II&step=45
- * &play=1&runs=200&ex=100&tseed=1&dt=0.1&speed=1&custom=x0,y0,x1,y1`.
+ * &play=1&runs=200&ex=100&tseed=1&dt=0.1&speed=1&custom=x0,y0,x1,y1`; multi-target: `#mode=mtl`.
  */
 function hashOptions() {
   const h = new URLSearchParams(location.hash.slice(1));
@@ -20,7 +21,7 @@ function hashOptions() {
   const custom = (h.get('custom') || '').split(',').map(Number);
   const int = (k) => (Number.isInteger(Number(h.get(k))) && h.get(k) ? Number(h.get(k)) : undefined);
   return {
-    mode: h.get('mode') === 'tracking' ? 'tracking' : 'snapshot',
+    mode: ['tracking', 'mtl'].includes(h.get('mode')) ? h.get('mode') : 'snapshot',
     track: h.get('track'),
     step: int('step'),
     play: h.get('play') === '1',
@@ -127,7 +128,7 @@ async function main() {
       st.overlay = tr ? (c, v) => tracking.overlay(c, v) : null;
       st.insetTitle = tr ? 'EKF zoom · true scale' : 'target zoom';
       st.insetAvoid = tr ? tracking.avoidPoints() : [];
-      drawScene(view, st, wasm);
+      if (st.mode === 'mtl') mtl.draw(); else drawScene(view, st, wasm);
     } catch (e) {
       showError(`Internal error: ${e && e.message ? e.message : e}`);
       console.error(e);
@@ -164,18 +165,21 @@ async function main() {
   ctx.panel = panel;
   const tracking = new Tracking(ctx, opts);
   ctx.tracking = tracking;
-  /** Snapshot view (click to place a target) or tracking (animated EKF track + Monte Carlo). */
+  const mtl = new Mtl(ctx);
+  /** Snapshot view (click to place a target), tracking (animated EKF track + Monte Carlo) or multi-target. */
   const setMode = (mode) => {
-    st.mode = mode === 'tracking' ? 'tracking' : 'snapshot';
+    st.mode = ['tracking', 'mtl'].includes(mode) ? mode : 'snapshot';
     document.body.classList.toggle('mode-tracking', st.mode === 'tracking');
-    $('mode-snapshot').setAttribute('aria-pressed', String(st.mode === 'snapshot'));
-    $('mode-tracking').setAttribute('aria-pressed', String(st.mode === 'tracking'));
+    document.body.classList.toggle('mode-mtl', st.mode === 'mtl');
+    for (const m of ['snapshot', 'tracking', 'mtl']) $(`mode-${m}`).setAttribute('aria-pressed', String(st.mode === m));
     tracking.setActive(st.mode === 'tracking');
+    mtl.setActive(st.mode === 'mtl');
     pointer.showHint();
     changed({ draw: true });
   };
   $('mode-snapshot').addEventListener('click', () => setMode('snapshot'));
   $('mode-tracking').addEventListener('click', () => setMode('tracking'));
+  $('mode-mtl').addEventListener('click', () => setMode('mtl'));
   $('preset').value = preset;
   const pointer = attachPointer(ctx);
 
@@ -209,6 +213,13 @@ async function main() {
     restartMc: () => tracking.startMc(),
     mcParams: () => tracking.mc.params,
     mcResult: () => (tracking.mc.result ? JSON.parse(tracking.mc.result) : null),
+  };
+  window.mtl = {
+    state: () => mtl.state(),
+    setScene: (s) => mtl.setScene(s),
+    pixelFromCentre: (x, y) => mtl.pixelFromCentre(x, y),
+    bench: (n) => mtl.bench(n),
+    setMode,
   };
   window.importScenarioText = (text, name) => panel.importText(text, name);
   /** Runs the map kernel `n` times at the current resolution: per-run kernel ms (core-timed). */

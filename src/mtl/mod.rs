@@ -17,6 +17,7 @@
 //! - [`algorithm`]: Algorithm 1 (§4), staged matching with the vector likelihood (M6) and
 //!   the final selection by `J` (M2).
 //! - [`brute`]: the brute-force reference over all matchings (small instances, tests).
+//! - [`view`]: one user-placed scene (nodes, targets, discs) turned into what the page draws.
 
 pub mod algorithm;
 pub mod blocking;
@@ -32,3 +33,4 @@ pub mod sim;
 #[cfg(all(feature = "std", not(target_arch = "wasm32")))]
 pub mod sweep;
 pub mod trp;
+pub mod view;

@@ -10,7 +10,8 @@
 //! Files: `app.rs` (the `App` class), `render.rs` (colours, ticks and labels for drawing),
 //! `json.rs` (core results as JavaScript values), `tracking.rs` (`App.simulate_track` and the
 //! `Track` it returns), `montecarlo.rs` (`MonteCarloJob`, run chunk by chunk in a Web Worker),
-//! `chart.rs` (the plotters ε_EKF / ε_PCRLB chart on a canvas).
+//! `chart.rs` (the plotters ε_EKF / ε_PCRLB chart on a canvas), `mtl.rs` (the multi-target view
+//! of a scene, [`crate::mtl::view`]).
 
 use wasm_bindgen::prelude::*;
 
@@ -21,12 +22,14 @@ mod app;
 mod chart;
 mod json;
 mod montecarlo;
+mod mtl;
 mod render;
 mod tracking;
 
 pub use app::App;
 pub use chart::draw_tracking_chart;
 pub use montecarlo::MonteCarloJob;
+pub use mtl::{mtl_check_scene, mtl_default_scene, mtl_view_of, MtlSession};
 pub use render::{
     axis_ticks, colorbar_rgba, colorbar_ticks, format_length, render_map_rgba, scale_bar,
     unbounded_rgb,

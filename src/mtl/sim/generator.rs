@@ -103,7 +103,7 @@ pub fn generate(s: &SimSettings, seed: u64, index: u64) -> Result<Realisation> {
 }
 
 /// Unsorted peaks of TRP `m`: steps (5) DPs, optional geometric IPs, (6) clutter.
-fn trp_peaks(
+pub fn trp_peaks(
     s: &SimSettings,
     map: &TrpMap,
     sc: &Scene,

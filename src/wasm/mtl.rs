@@ -1,0 +1,73 @@
+//! The multi-target ("MTL") view for the page: a scene as JSON in, its view
+//! ([`crate::mtl::view::MtlView`]) as a JavaScript object out, either one-off
+//! ([`mtl_view_of`]) or from an [`MtlSession`] that keeps the core's [`ViewCache`] between
+//! recomputes (the page's worker). Bad input throws the core's named message; no math here.
+
+use wasm_bindgen::prelude::*;
+
+use super::err;
+use super::json::to_js;
+use crate::mtl::view::{mtl_view_cached, MtlScene, ViewCache};
+
+#[wasm_bindgen]
+extern "C" {
+    /// `performance.now()`, ms (window or worker).
+    #[wasm_bindgen(js_namespace = performance, js_name = now)]
+    fn performance_now() -> f64;
+}
+
+/// The default scene (the V-B setting, [`MtlScene::vb`]) as JSON.
+#[wasm_bindgen]
+pub fn mtl_default_scene() -> String {
+    MtlScene::vb().to_json()
+}
+
+/// Parses and validates a scene; returns it re-serialised (canonical JSON). Throws the named
+/// error of [`MtlScene::from_json`].
+#[wasm_bindgen]
+pub fn mtl_check_scene(scene_json: &str) -> Result<String, JsError> {
+    Ok(MtlScene::from_json(scene_json).map_err(err)?.to_json())
+}
+
+/// The view of a scene (JSON, schema [`MtlScene`]): `{trps, seeds, hypotheses, detected,
+/// targets, segments, metrics, stages, model, mpcs, compute_ms}` (see
+/// [`crate::mtl::view::MtlView`]); `compute_ms` is the core's own time for parse, data and
+/// Algorithm 1. Throws the core's named error on bad input.
+#[wasm_bindgen]
+pub fn mtl_view_of(scene_json: &str) -> Result<JsValue, JsError> {
+    view_json(scene_json, &mut ViewCache::default())
+}
+
+/// Views of successive scenes sharing the core's [`ViewCache`] (results identical to
+/// [`mtl_view_of`]).
+#[wasm_bindgen]
+#[derive(Default)]
+pub struct MtlSession {
+    cache: ViewCache,
+}
+
+#[wasm_bindgen]
+impl MtlSession {
+    /// An empty session.
+    #[wasm_bindgen(constructor)]
+    pub fn new() -> MtlSession {
+        MtlSession::default()
+    }
+
+    /// As [`mtl_view_of`], reusing this session's cache.
+    pub fn view(&mut self, scene_json: &str) -> Result<JsValue, JsError> {
+        view_json(scene_json, &mut self.cache)
+    }
+}
+
+fn view_json(scene_json: &str, cache: &mut ViewCache) -> Result<JsValue, JsError> {
+    let t0 = performance_now();
+    let scene = MtlScene::from_json(scene_json).map_err(err)?;
+    let view = mtl_view_cached(&scene, cache).map_err(err)?;
+    let mut value =
+        serde_json::to_value(&view).map_err(|e| JsError::new(&format!("internal error: {e}")))?;
+    if let Some(obj) = value.as_object_mut() {
+        obj.insert("compute_ms".into(), (performance_now() - t0).into());
+    }
+    to_js(&value)
+}

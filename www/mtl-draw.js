@@ -1,0 +1,224 @@
+// Drawing of the multi-target mode: every number (ellipses, seeds, hypotheses, detections, LoS
+// segments, ticks) comes from the wasm core's view; this file only places it on the canvas
+// through the view transform. Markers of the scene (nodes, targets, discs) are drawn from the
+// scene itself so they follow a drag at once.
+
+import { C, LINK_COLORS, FONT, FONT_B, FULL, ellipsePath, cross, haloText } from './draw.js';
+
+const BG = '#10141c';
+const DISC = 'rgba(150,160,178,0.55)';
+const BLOCKED = '#ff4d4f';
+const LOS = 'rgba(255,255,255,0.16)';
+const SEED = 'rgba(200,210,225,0.55)';
+const HYP = 'rgba(255,209,102,0.85)';
+const HYP_REJ = 'rgba(160,170,185,0.6)';
+const DET = '#ffa94d';
+const FA = '#ff6b9a';
+
+function axes(ctx, view, w) {
+  const r = view.rect;
+  const [x0, x1, y0, y1] = view.area;
+  ctx.font = FONT;
+  ctx.fillStyle = C.text;
+  ctx.strokeStyle = C.grid;
+  ctx.lineWidth = 1;
+  const xt = w.axis_ticks(x0, x1, Math.max(2, Math.floor(r.w / 70)));
+  const yt = w.axis_ticks(y0, y1, Math.max(2, Math.floor(r.h / 50)));
+  ctx.beginPath();
+  for (const t of xt) {
+    const p = view.toPixel(t.value, y0);
+    ctx.moveTo(Math.round(p.x) + 0.5, r.y); ctx.lineTo(Math.round(p.x) + 0.5, r.y + r.h + 5);
+  }
+  for (const t of yt) {
+    const p = view.toPixel(x0, t.value);
+    ctx.moveTo(r.x - 5, Math.round(p.y) + 0.5); ctx.lineTo(r.x + r.w, Math.round(p.y) + 0.5);
+  }
+  ctx.stroke();
+  ctx.textAlign = 'center';
+  ctx.textBaseline = 'top';
+  for (const t of xt) ctx.fillText(t.label, view.toPixel(t.value, y0).x, r.y + r.h + 8);
+  ctx.textAlign = 'right';
+  ctx.textBaseline = 'middle';
+  for (const t of yt) ctx.fillText(t.label, r.x - 8, view.toPixel(x0, t.value).y);
+  ctx.fillStyle = C.muted;
+  ctx.textAlign = 'center';
+  ctx.textBaseline = 'alphabetic';
+  ctx.fillText('x (m)', r.x + r.w / 2, r.y + r.h + 36);
+  ctx.save();
+  ctx.translate(r.x - 42, r.y + r.h / 2);
+  ctx.rotate(-Math.PI / 2);
+  ctx.fillText('y (m)', 0, 0);
+  ctx.restore();
+  ctx.strokeStyle = C.frame;
+  ctx.strokeRect(Math.round(r.x) + 0.5, Math.round(r.y) + 0.5, Math.round(r.w), Math.round(r.h));
+}
+
+/** The region R (the scene's rectangle) as a lighter frame. */
+function region(ctx, view, scene) {
+  const [x0, x1, y0, y1] = scene.region;
+  const a = view.toPixel(x0, y1);
+  const b = view.toPixel(x1, y0);
+  ctx.fillStyle = '#151b26';
+  ctx.fillRect(a.x, a.y, b.x - a.x, b.y - a.y);
+  ctx.strokeStyle = 'rgba(92,200,255,0.35)';
+  ctx.setLineDash([6, 4]);
+  ctx.lineWidth = 1;
+  ctx.strokeRect(a.x, a.y, b.x - a.x, b.y - a.y);
+  ctx.setLineDash([]);
+}
+
+/** Range ellipses: DP solid, clutter dashed and faint; the ranges a detection uses bold. */
+function ellipses(ctx, view, v) {
+  for (const t of v.trps) {
+    const color = LINK_COLORS[t.trp % LINK_COLORS.length];
+    for (const r of t.ranges) {
+      if (!r.ellipse) continue;
+      const used = r.matched_by.length > 0;
+      ctx.strokeStyle = color;
+      if (r.source === 'dp') {
+        ctx.setLineDash([]);
+        ctx.globalAlpha = used ? 0.95 : 0.55;
+        ctx.lineWidth = used ? 2 : 1;
+      } else {
+        ctx.setLineDash([2, 5]);
+        ctx.globalAlpha = used ? 0.9 : 0.35;
+        ctx.lineWidth = used ? 2 : 1;
+      }
+      ellipsePath(ctx, view, r.ellipse);
+      ctx.stroke();
+    }
+  }
+  ctx.setLineDash([]);
+  ctx.globalAlpha = 1;
+}
+
+/** Node–target segments: LoS faint, blocked dashed red. */
+function segments(ctx, view, v) {
+  ctx.lineWidth = 1.25;
+  for (const s of v.segments) {
+    const a = view.toPixel(s.a[0], s.a[1]);
+    const b = view.toPixel(s.b[0], s.b[1]);
+    ctx.strokeStyle = s.blocked ? BLOCKED : LOS;
+    ctx.setLineDash(s.blocked ? [6, 4] : []);
+    ctx.beginPath(); ctx.moveTo(a.x, a.y); ctx.lineTo(b.x, b.y); ctx.stroke();
+  }
+  ctx.setLineDash([]);
+}
+
+function dot(ctx, p, r, fill) {
+  ctx.beginPath(); ctx.arc(p.x, p.y, r, 0, FULL);
+  ctx.fillStyle = fill; ctx.fill();
+}
+
+function candidates(ctx, view, v) {
+  for (const s of v.seeds) dot(ctx, view.toPixel(s.x[0], s.x[1]), 1.6, SEED);
+  ctx.lineWidth = 1.25;
+  for (const h of v.hypotheses) {
+    const p = view.toPixel(h.x[0], h.x[1]);
+    ctx.beginPath(); ctx.arc(p.x, p.y, 3.5, 0, FULL);
+    ctx.strokeStyle = h.accepted ? HYP : HYP_REJ; ctx.stroke();
+  }
+}
+
+function detections(ctx, view, v) {
+  ctx.font = FONT_B;
+  ctx.textBaseline = 'bottom';
+  v.detected.forEach((d, i) => {
+    const p = view.toPixel(d.x[0], d.x[1]);
+    const color = d.hit ? DET : FA;
+    ctx.beginPath(); ctx.arc(p.x, p.y, 10, 0, FULL);
+    ctx.lineWidth = 4; ctx.strokeStyle = 'rgba(10,12,18,0.7)'; ctx.stroke();
+    ctx.lineWidth = 2.25; ctx.strokeStyle = color; ctx.stroke();
+    dot(ctx, p, 2.5, color);
+    ctx.fillStyle = color;
+    ctx.textAlign = 'right';
+    haloText(ctx, `#${i + 1}${d.hit ? '' : ' FA'}`, p.x - 12, p.y - 8);
+  });
+}
+
+function discs(ctx, view, scene, sel) {
+  const r = view.len(scene.diameter / 2);
+  scene.discs.forEach((c, i) => {
+    const p = view.toPixel(c[0], c[1]);
+    ctx.beginPath(); ctx.arc(p.x, p.y, r, 0, FULL);
+    ctx.fillStyle = DISC; ctx.fill();
+    ctx.lineWidth = sel && sel.kind === 'disc' && sel.index === i ? 2.5 : 1;
+    ctx.strokeStyle = sel && sel.kind === 'disc' && sel.index === i ? C.sel : '#c9d2e0';
+    ctx.stroke();
+  });
+}
+
+function isSel(sel, kind, i) {
+  return sel && sel.kind === kind && sel.index === i;
+}
+
+function ring(ctx, p, r) {
+  ctx.beginPath(); ctx.arc(p.x, p.y, r, 0, FULL);
+  ctx.lineWidth = 2; ctx.strokeStyle = C.sel; ctx.stroke();
+}
+
+function nodes(ctx, view, scene, sel) {
+  ctx.font = FONT_B;
+  ctx.textAlign = 'left';
+  scene.receivers.forEach((q, i) => {
+    const p = view.toPixel(q[0], q[1]);
+    if (isSel(sel, 'rx', i)) ring(ctx, p, 11);
+    ctx.beginPath(); ctx.arc(p.x, p.y, 6, 0, FULL);
+    ctx.fillStyle = C.rx; ctx.fill();
+    ctx.lineWidth = 2; ctx.strokeStyle = '#1b1f27'; ctx.stroke();
+    ctx.fillStyle = C.rx;
+    ctx.textBaseline = 'bottom';
+    haloText(ctx, `Rx${i + 1}`, p.x + 9, p.y - 5);
+  });
+  scene.transmitters.forEach((q, i) => {
+    const p = view.toPixel(q[0], q[1]);
+    if (isSel(sel, 'tx', i)) ring(ctx, p, 12);
+    ctx.beginPath();
+    ctx.moveTo(p.x, p.y - 9); ctx.lineTo(p.x + 8, p.y + 6); ctx.lineTo(p.x - 8, p.y + 6); ctx.closePath();
+    ctx.fillStyle = C.tx; ctx.fill();
+    ctx.lineWidth = 1.5; ctx.strokeStyle = '#1b1f27'; ctx.stroke();
+    ctx.fillStyle = C.tx;
+    ctx.textBaseline = 'top';
+    haloText(ctx, `Tx${i + 1}`, p.x + 9, p.y + 5);
+  });
+}
+
+function targets(ctx, view, scene, v, sel) {
+  ctx.font = FONT_B;
+  ctx.textAlign = 'left';
+  ctx.textBaseline = 'top';
+  scene.targets.forEach((q, k) => {
+    const p = view.toPixel(q[0], q[1]);
+    if (isSel(sel, 'target', k)) ring(ctx, p, 12);
+    cross(ctx, p, 7, '#0d1017', 5);
+    cross(ctx, p, 7, '#ffffff', 2.25);
+    const t = v && v.targets[k];
+    ctx.fillStyle = '#ffffff';
+    haloText(ctx, t ? `T${k + 1} · ${t.dp_trps.length} DP` : `T${k + 1}`, p.x + 9, p.y + 6);
+  });
+}
+
+/**
+ * The whole canvas: `scene` (markers, current), `v` (the core's last view or null), `sel` (the
+ * selected object), `w` (the wasm module, for axis ticks).
+ */
+export function drawMtl(view, scene, v, sel, w) {
+  const ctx = view.context();
+  ctx.fillStyle = BG;
+  ctx.fillRect(0, 0, view.width, view.height);
+  const r = view.rect;
+  region(ctx, view, scene);
+  axes(ctx, view, w);
+  ctx.save();
+  ctx.beginPath(); ctx.rect(r.x, r.y, r.w, r.h); ctx.clip();
+  if (v) {
+    ellipses(ctx, view, v);
+    segments(ctx, view, v);
+  }
+  discs(ctx, view, scene, sel);
+  if (v) candidates(ctx, view, v);
+  ctx.restore();
+  if (v) detections(ctx, view, v);
+  targets(ctx, view, scene, v, sel);
+  nodes(ctx, view, scene, sel);
+}

@@ -1,0 +1,368 @@
+// Multi-target mode: state and events only. The scene (nodes, targets, scatterer discs, noise,
+// clutter, thresholds, blocking model) lives here as the core's JSON schema; every edit is
+// validated by the core on the main thread (mtl_check_scene: a rejected edit shows the core's
+// message and changes nothing) and the view is computed by the core in a Web Worker
+// (mtl-worker.js; the newest scene wins), then drawn by mtl-draw.js.
+
+import { View } from './view.js';
+import { drawMtl } from './mtl-draw.js';
+import { showError, clearError, fillKeyValues } from './panel.js';
+
+const $ = (id) => document.getElementById(id);
+const HIT_PX = 12; // pick radius around a marker, CSS px
+const MARGIN_M = 0.4; // shown around the region, m
+/** Where "+ target" / "+ disc" try to put a new one (first valid wins), m. */
+const SPOTS = [[5, 5], [5, 7], [3, 6], [7, 3], [6, 8.5], [8, 6], [3, 2], [1.5, 7], [8.5, 1], [4.5, 2.5]];
+
+/** Text -> number; empty text is NaN (sent as null: the core names the field). */
+function num(text) {
+  const t = String(text).trim();
+  return t === '' ? NaN : Number(t);
+}
+
+export class Mtl {
+  /** @param {object} ctx - {wasm, st, changed}. */
+  constructor(ctx) {
+    this.ctx = ctx;
+    this.wasm = ctx.wasm;
+    this.canvas = $('plot');
+    this.view = new View(this.canvas);
+    this.scene = JSON.parse(this.wasm.mtl_default_scene());
+    this.result = null; // the last view from the core
+    this.resultGen = 0;
+    this.gen = 0; // generation of the scene last posted
+    this.ms = null; // the worker's time for the last view, ms
+    this.computeMs = null; // the core's own time inside it
+    this.workerError = null;
+    this.selected = null; // {kind: 'tx' | 'rx' | 'target' | 'disc', index}
+    this.press = null;
+    this.worker = new Worker(new URL('./mtl-worker.js', import.meta.url), { type: 'module' });
+    this.worker.onmessage = (e) => this.receive(e.data);
+    this.worker.onerror = (e) => showError(`Multi-target worker: ${e.message || 'failed to start'}`);
+    this.bindPanel();
+    this.bindPointer();
+    this.syncPanel();
+  }
+
+  active() { return this.ctx.st.mode === 'mtl'; }
+
+  /** Mode switch: fit the region and recompute, or nothing (the worker idles). */
+  setActive(on) {
+    if (on) this.submit();
+  }
+
+  // ---------- scene edits ----------
+
+  /**
+   * Applies `edit` (a function changing a copy of the scene) if the core accepts the result:
+   * then posts it to the worker; else shows the core's message and keeps the scene. Returns
+   * whether it was accepted. `input` (an element) is marked invalid on rejection.
+   */
+  apply(edit, input) {
+    const next = JSON.parse(JSON.stringify(this.scene));
+    edit(next);
+    try {
+      this.wasm.mtl_check_scene(JSON.stringify(next));
+    } catch (e) {
+      showError(e.message);
+      if (input) input.classList.add('invalid');
+      this.syncPanel();
+      return false;
+    }
+    for (const el of $('mtl-section').querySelectorAll('input.invalid')) el.classList.remove('invalid');
+    this.scene = next;
+    clearError();
+    this.submit();
+    return true;
+  }
+
+  /** Posts the current scene to the worker and redraws (markers move at once). */
+  submit() {
+    this.gen += 1;
+    this.worker.postMessage({ gen: this.gen, scene: JSON.stringify(this.scene) });
+    this.showTiming();
+    this.ctx.changed({ mtl: true });
+  }
+
+  receive(m) {
+    if (m.type === 'ready') return;
+    if (m.type === 'error') {
+      // Not expected (the scene was checked before posting); the view keeps the last result.
+      this.workerError = m.message;
+      this.resultGen = Math.max(this.resultGen, m.gen);
+      showError(m.message);
+      return;
+    }
+    if (m.gen < this.resultGen) return;
+    this.result = m.view;
+    this.resultGen = m.gen;
+    this.ms = m.ms;
+    this.computeMs = m.view.compute_ms;
+    this.workerError = null;
+    this.showTiming();
+    this.showInfo();
+    if (this.active()) this.ctx.changed({ mtl: true });
+  }
+
+  showTiming() {
+    const el = $('mtl-ms');
+    if (this.ms === null) return;
+    el.dataset.ms = String(this.ms);
+    el.dataset.computeMs = String(this.computeMs);
+    el.textContent = `MTL recompute: ${this.ms.toFixed(1)} ms (worker)${this.gen > this.resultGen ? ' …' : ''}`;
+  }
+
+  // ---------- panel ----------
+
+  bindPanel() {
+    const bindNum = (id, key) => $(id).addEventListener('change', () => {
+      this.apply((s) => { s[key] = num($(id).value); }, $(id));
+    });
+    bindNum('mtl-seed', 'seed');
+    bindNum('mtl-clutter', 'clutter_mean');
+    bindNum('mtl-sigma', 'range_sigma');
+    bindNum('mtl-pd', 'p_d');
+    bindNum('mtl-lambda', 'lambda');
+    bindNum('mtl-diameter', 'diameter');
+    bindNum('mtl-resolution', 'resolution');
+    const slider = (id, key) => $(id).addEventListener('input', () => {
+      this.apply((s) => { s[key] = num($(id).value); });
+    });
+    slider('mtl-te', 't_e');
+    slider('mtl-tb', 't_b');
+    const model = () => this.apply((s) => { s.model = this.modelFromPanel(); },
+      $('mtl-model').value === 'icb-plos' ? $('mtl-plos') : $('mtl-pu'));
+    $('mtl-model').addEventListener('change', model);
+    $('mtl-pu').addEventListener('change', model);
+    $('mtl-plos').addEventListener('change', model);
+    $('mtl-reseed').addEventListener('click', () => this.apply((s) => { s.seed += 1; }));
+    $('mtl-reset').addEventListener('click', () => {
+      this.scene = JSON.parse(this.wasm.mtl_default_scene());
+      this.selected = null;
+      clearError();
+      this.submit();
+    });
+    $('mtl-add-target').addEventListener('click', () => this.add('targets'));
+    $('mtl-add-disc').addEventListener('click', () => this.add('discs'));
+    $('mtl-remove-target').addEventListener('click', () => this.remove('targets', 'target'));
+    $('mtl-remove-disc').addEventListener('click', () => this.remove('discs', 'disc'));
+  }
+
+  /** The blocking model of the panel's selector. */
+  modelFromPanel() {
+    switch ($('mtl-model').value) {
+      case 'ppp-exact': return { kind: 'ppp', exact: true };
+      case 'icb-pu': return { kind: 'icb', p_u: num($('mtl-pu').value) };
+      case 'icb-plos': return { kind: 'icb', p_los: num($('mtl-plos').value) };
+      default: return { kind: 'ppp', exact: false };
+    }
+  }
+
+  /** Adds a target or disc at the first spot the core accepts. */
+  add(list) {
+    for (const p of SPOTS) {
+      const next = JSON.parse(JSON.stringify(this.scene));
+      next[list].push(p);
+      try {
+        this.wasm.mtl_check_scene(JSON.stringify(next));
+      } catch (_) {
+        continue;
+      }
+      this.apply((s) => { s[list].push(p); });
+      this.selected = { kind: list === 'targets' ? 'target' : 'disc', index: this.scene[list].length - 1 };
+      return;
+    }
+    // None fits: let the core say why for the first spot.
+    this.apply((s) => { s[list].push(SPOTS[0]); });
+  }
+
+  /** Removes the selected target/disc, or the last one. */
+  remove(list, kind) {
+    if (this.scene[list].length === 0) return;
+    const sel = this.selected && this.selected.kind === kind ? this.selected.index : this.scene[list].length - 1;
+    if (this.apply((s) => { s[list].splice(sel, 1); })) this.selected = null;
+  }
+
+  /** Panel inputs from the scene. */
+  syncPanel() {
+    const s = this.scene;
+    for (const [id, v] of [['mtl-seed', s.seed], ['mtl-clutter', s.clutter_mean], ['mtl-sigma', s.range_sigma],
+      ['mtl-pd', s.p_d], ['mtl-lambda', s.lambda], ['mtl-diameter', s.diameter], ['mtl-resolution', s.resolution]]) {
+      if (document.activeElement !== $(id)) $(id).value = String(v);
+    }
+    $('mtl-te').value = String(s.t_e);
+    $('mtl-tb').value = String(s.t_b);
+    $('mtl-te-out').textContent = s.t_e.toFixed(1);
+    $('mtl-tb-out').textContent = `${s.t_b.toFixed(2)} nats`;
+    const m = s.model;
+    $('mtl-model').value = m.kind === 'ppp' ? (m.exact ? 'ppp-exact' : 'ppp') : (m.p_los !== undefined ? 'icb-plos' : 'icb-pu');
+    if (m.p_u !== undefined) $('mtl-pu').value = String(m.p_u);
+    if (m.p_los !== undefined) $('mtl-plos').value = String(m.p_los);
+    $('mtl-pu').disabled = $('mtl-model').value !== 'icb-pu';
+    $('mtl-plos').disabled = $('mtl-model').value !== 'icb-plos';
+    $('mtl-remove-target').disabled = s.targets.length === 0;
+    $('mtl-remove-disc').disabled = s.discs.length === 0;
+  }
+
+  /** Read-outs of the last view (numbers from the core). */
+  showInfo() {
+    const v = this.result;
+    if (!v) return;
+    const m = v.metrics;
+    const det = v.detected.map((d, i) => [`Detected #${i + 1}`,
+      `(${d.x[0].toFixed(2)}, ${d.x[1].toFixed(2)}) m · |ℳ| ${d.matching.length} · J ${d.j.toFixed(2)} · L_b ${d.l_b.toFixed(2)}`,
+      d.hit ? 'fix' : 'fa']);
+    const tgt = v.targets.map((t, k) => [`Target T${k + 1}`,
+      `(${t.x[0].toFixed(2)}, ${t.x[1].toFixed(2)}) m · ${t.dp_trps.length} DPs of ${t.los_trps.length} LoS TRPs · ${t.detected ? 'found' : 'missed'}`, '']);
+    fillKeyValues($('mtl-info'), [
+      ['Model', v.model.label, ''],
+      ['TRPs · ranges', `${v.trps.length} · ${v.mpcs} (seeds ${v.seeds.length}, live ${v.hypotheses.length})`, ''],
+      ['Detected K̂ / true K', `${m.estimates} / ${m.targets}`, ''],
+      ['N_D · N_FA', `${m.detected} · ${m.false_alarms}`, ''],
+      ['P_D · P_FA (this scene)', `${m.p_d === null ? '–' : m.p_d.toFixed(2)} · ${m.p_fa.toFixed(2)}`, ''],
+      ...tgt,
+      ...det,
+    ]);
+    const rows = v.trps.map((t) => `TRP ${t.trp + 1} (Tx${t.tx + 1}–Rx${t.rx + 1}): `
+      + t.ranges.map((r) => `${r.range_m.toFixed(2)}${r.source === 'dp' ? `ᵀ${r.target + 1}` : ''}`).join(', '));
+    $('mtl-trps').textContent = rows.join('\n');
+    if (!this.active()) return;
+    $('readout').textContent = `Multi-target · ${v.trps.length} TRPs, ${v.mpcs} ranges · detected ${m.estimates} `
+      + `(N_D ${m.detected}/${m.targets}, N_FA ${m.false_alarms}) · drag Tx, Rx, targets (×) and discs`;
+  }
+
+  // ---------- pointer (capture phase on the plot's parent, so interact.js never sees MTL events) ----------
+
+  /** The scene object under a canvas pixel: {kind, index} or null (nodes first, then targets, discs). */
+  hit(p) {
+    let best = null;
+    let bestD = HIT_PX;
+    const test = (kind, list, extra = 0) => list.forEach((q, index) => {
+      const c = this.view.toPixel(q[0], q[1]);
+      const d = Math.hypot(c.x - p.x, c.y - p.y) - extra;
+      if (d <= bestD) { best = { kind, index }; bestD = d; }
+    });
+    test('disc', this.scene.discs, this.view.len(this.scene.diameter / 2));
+    test('target', this.scene.targets);
+    test('rx', this.scene.receivers);
+    test('tx', this.scene.transmitters);
+    return best;
+  }
+
+  listOf(kind) {
+    return { tx: 'transmitters', rx: 'receivers', target: 'targets', disc: 'discs' }[kind];
+  }
+
+  bindPointer() {
+    const wrap = this.canvas.parentElement;
+    const mine = (ev) => this.active() && ev.target === this.canvas;
+    wrap.addEventListener('pointerdown', (ev) => {
+      if (!mine(ev)) return;
+      ev.stopPropagation();
+      ev.preventDefault();
+      if (ev.button !== 0) return;
+      const p = this.view.eventPixel(ev);
+      const h = this.hit(p);
+      this.selected = h;
+      this.press = h ? { ...h } : null;
+      if (h) {
+        this.canvas.setPointerCapture(ev.pointerId);
+        this.canvas.classList.add('dragging');
+      }
+      this.ctx.changed({ mtl: true });
+    }, true);
+    wrap.addEventListener('pointermove', (ev) => {
+      if (!mine(ev)) return;
+      ev.stopPropagation();
+      const p = this.view.eventPixel(ev);
+      if (!this.press) {
+        this.canvas.classList.toggle('over-node', !!this.hit(p));
+        return;
+      }
+      // Keep the dragged object inside the region (clamped in pixels).
+      const [x0, x1, y0, y1] = this.scene.region;
+      const a = this.view.toPixel(x0, y1);
+      const b = this.view.toPixel(x1, y0);
+      const m = this.view.toMetre(Math.min(Math.max(p.x, a.x), b.x), Math.min(Math.max(p.y, a.y), b.y));
+      const { kind, index } = this.press;
+      const list = this.listOf(kind);
+      const cur = this.scene[list][index];
+      if (cur[0] === m.x && cur[1] === m.y) return;
+      this.apply((s) => { s[list][index] = [m.x, m.y]; });
+    }, true);
+    const end = (ev) => {
+      if (!mine(ev)) return;
+      ev.stopPropagation();
+      this.press = null;
+      this.canvas.classList.remove('dragging');
+    };
+    wrap.addEventListener('pointerup', end, true);
+    wrap.addEventListener('pointercancel', end, true);
+    wrap.addEventListener('pointerleave', (ev) => { if (mine(ev)) ev.stopPropagation(); }, true);
+  }
+
+  // ---------- drawing ----------
+
+  /** Redraws the canvas (called by app.js's refresh in this mode). */
+  draw() {
+    const [x0, x1, y0, y1] = this.scene.region;
+    this.view.resize();
+    this.view.fit([x0 - MARGIN_M, x1 + MARGIN_M, y0 - MARGIN_M, y1 + MARGIN_M]);
+    this.syncPanel();
+    drawMtl(this.view, this.scene, this.result, this.selected, this.wasm);
+  }
+
+  /** Test and console hook: the scene, the last view's essentials and the timing. */
+  state() {
+    const v = this.result;
+    return {
+      mode: this.ctx.st.mode,
+      scene: JSON.parse(JSON.stringify(this.scene)),
+      gen: this.gen,
+      viewGen: this.resultGen,
+      pending: this.gen !== this.resultGen,
+      detected: v ? v.detected.map((d) => d.x) : [],
+      targets: v ? v.targets.map((t) => t.x) : [],
+      metrics: v ? v.metrics : null,
+      blocked: v ? v.segments.filter((s) => s.blocked).length : 0,
+      ms: this.ms,
+      computeMs: this.computeMs,
+      error: this.workerError,
+    };
+  }
+
+  /** Test hook: replaces the scene (JSON text or object); returns the core's message or null. */
+  setScene(scene) {
+    const text = typeof scene === 'string' ? scene : JSON.stringify(scene);
+    let parsed;
+    try {
+      parsed = JSON.parse(this.wasm.mtl_check_scene(text));
+    } catch (e) {
+      showError(e.message);
+      return e.message;
+    }
+    clearError();
+    this.scene = parsed;
+    this.submit();
+    return null;
+  }
+
+  /** Test and console hook: `n` cold recomputes of the current scene on this thread, ms each. */
+  bench(n = 9) {
+    const text = JSON.stringify(this.scene);
+    const out = [];
+    for (let i = 0; i < n; i++) {
+      const t0 = performance.now();
+      this.wasm.mtl_view_of(text);
+      out.push(performance.now() - t0);
+    }
+    return out;
+  }
+
+  /** Test hook: a scene point as CSS pixels relative to the canvas centre. */
+  pixelFromCentre(x, y) {
+    const p = this.view.toPixel(x, y);
+    const r = this.canvas.getBoundingClientRect();
+    return [p.x - r.width / 2, p.y - r.height / 2];
+  }
+}
