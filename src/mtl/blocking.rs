@@ -405,6 +405,52 @@ impl<N: NodePatternModel> BlockingModel for NodeBlockingModel<N> {
     }
 }
 
+/// Node tables by exact location (`x.x`, `x.y` bits), shared by a [`TableCached`] model and
+/// kept by its owner for as long as the node model does not change.
+pub type NodeTableCache = core::cell::RefCell<alloc::collections::BTreeMap<(u64, u64), NodeTable>>;
+
+/// Most tables a [`NodeTableCache`] holds through [`TableCached`]; it empties when full.
+pub const MAX_CACHED_TABLES: usize = 1 << 16;
+
+/// A [`NodeBlockingModel`] with its node table memoised per location: Algorithm 1's children that
+/// keep their parent's location (no MPC passed, `ĝ_m = 0`), repeated queries across thresholds
+/// and unchanged candidates of a previous run (a page recomputing on drag) reuse one node-table
+/// computation (for the PPP model, one set of polygon clippings). Results are bitwise those of the
+/// wrapped model. Single-threaded (the cache is a `RefCell`); give each thread its own.
+#[derive(Debug)]
+pub struct TableCached<'a, N> {
+    inner: &'a NodeBlockingModel<N>,
+    tables: &'a NodeTableCache,
+}
+
+impl<'a, N: NodePatternModel> TableCached<'a, N> {
+    /// `inner` with the tables of `tables` (which must have been filled for this same node model,
+    /// or be empty).
+    pub fn new(inner: &'a NodeBlockingModel<N>, tables: &'a NodeTableCache) -> Self {
+        Self { inner, tables }
+    }
+}
+
+impl<N: NodePatternModel> BlockingModel for TableCached<'_, N> {
+    fn trp_map(&self) -> &TrpMap {
+        self.inner.trp_map()
+    }
+
+    fn probability(&self, x: &Vec2, v: &PartialVector) -> Result<Real> {
+        check_vector(self.trp_map(), v)?;
+        let key = (x.x.to_bits(), x.y.to_bits());
+        let mut tables = self.tables.borrow_mut();
+        if tables.len() >= MAX_CACHED_TABLES {
+            tables.clear();
+        }
+        let inner = self.inner;
+        let table = tables
+            .entry(key)
+            .or_insert_with(|| inner.space().node_table(inner.node_model(), x));
+        Ok(inner.probability_with_table(table, v))
+    }
+}
+
 /// A simple node-pattern model: each TX `j` has LoS to the target with probability `p_tx[j]`,
 /// each RX `j` with `p_rx[j]`, all independent and independent of `x`. A reference and test
 /// model (with all probabilities equal to `p_LoS` its DPs are not independent, unlike i.c.b).

@@ -9,7 +9,7 @@ use crate::math::Vec2;
 use crate::mtl::algorithm::{
     locate_cached, FinalTest, IntersectionCache, Measurements, MtlConfig, Target,
 };
-use crate::mtl::blocking::{BlockingModel, NodeBlockingModel};
+use crate::mtl::blocking::{BlockingModel, NodeBlockingModel, NodeTableCache, TableCached};
 use crate::mtl::empirical::{EmpiricalNodeModel, EmpiricalTable};
 use crate::mtl::experiment::memo::Memoized;
 use crate::mtl::experiment::{genie, Experiment, ExperimentConfig, Method};
@@ -211,10 +211,12 @@ impl Runner<'_> {
             )?,
             s.p_d,
         )?;
+        // Node tables by location, shared by the PPP curve and the genie (same model).
+        let ppp_tables = NodeTableCache::default();
         let mut out = Vec::new();
         for spec in cfg.curves() {
             let curve = match spec.method {
-                Method::Ppp => self.sweep_tb(&ppp, true)?,
+                Method::Ppp => self.sweep_tb(&TableCached::new(&ppp, &ppp_tables), true)?,
                 Method::Icb => {
                     let icb = IcbModel::from_p_u(map, cfg.icb_p_u)?;
                     self.sweep_tb(&icb, false)?
@@ -238,9 +240,10 @@ impl Runner<'_> {
                     )?;
                     let model =
                         NodeBlockingModel::new(map, EmpiricalNodeModel::new(table)?, s.p_d)?;
-                    self.sweep_tb(&model, true)?
+                    let tables = NodeTableCache::default();
+                    self.sweep_tb(&TableCached::new(&model, &tables), true)?
                 }
-                Method::Genie => self.sweep_genie(r, &ppp)?,
+                Method::Genie => self.sweep_genie(r, &TableCached::new(&ppp, &ppp_tables))?,
                 Method::SizeRule => {
                     return Err(Error::OutOfRange {
                         field: "experiment".into(),

@@ -2,14 +2,12 @@
 //! `p_d` and region; the PPP node tables memoised per location in a [`ViewCache`].
 
 use alloc::boxed::Box;
-use alloc::collections::BTreeMap;
 use alloc::vec::Vec;
-use core::cell::RefCell;
 
 use crate::error::Result;
 use crate::math::{Real, Vec2};
 use crate::mtl::blocking::{
-    check_vector, BlockingModel, NodeBlockingModel, NodeTable, PartialVector,
+    BlockingModel, NodeBlockingModel, NodeTableCache, PartialVector, TableCached,
 };
 use crate::mtl::icb::IcbModel;
 use crate::mtl::ppp::{PppBlocking, PppNodeModel};
@@ -29,7 +27,7 @@ pub const MAX_CACHED_TABLES: usize = 16_384;
 #[derive(Debug, Default)]
 pub struct ViewCache {
     key: Vec<u64>,
-    tables: RefCell<BTreeMap<(u64, u64), NodeTable>>,
+    tables: NodeTableCache,
 }
 
 impl ViewCache {
@@ -75,7 +73,7 @@ pub(super) fn blocking_model<'a>(
             let ppp = PppBlocking::new(scene.lambda, scene.diameter, Some(scene.rect()?), exact)?;
             let pts = |l: &[[Real; 2]]| l.iter().map(v).collect::<Vec<Vec2>>();
             let nodes = PppNodeModel::new(ppp, pts(&scene.transmitters), pts(&scene.receivers))?;
-            let model = Memo {
+            let model = Owned {
                 inner: NodeBlockingModel::new(*map, nodes, scene.p_d)?,
                 tables: &cache.tables,
             };
@@ -121,28 +119,18 @@ pub(super) fn blocking_model<'a>(
     })
 }
 
-/// The PPP model with its node table memoised per location (bit-exact `x`, tables of a
-/// [`ViewCache`]): children that keep their parent's location (no MPC passed, `ĝ_m = 0`),
-/// repeated queries and unchanged candidates of the previous scene reuse one area computation.
-/// Results are those of the wrapped model.
-struct Memo<'a> {
+/// The scene's PPP model with the view cache's tables ([`TableCached`] over an owned model).
+struct Owned<'a> {
     inner: NodeBlockingModel<PppNodeModel>,
-    tables: &'a RefCell<BTreeMap<(u64, u64), NodeTable>>,
+    tables: &'a NodeTableCache,
 }
 
-impl BlockingModel for Memo<'_> {
+impl BlockingModel for Owned<'_> {
     fn trp_map(&self) -> &TrpMap {
         self.inner.trp_map()
     }
 
     fn probability(&self, x: &Vec2, g: &PartialVector) -> Result<Real> {
-        check_vector(self.trp_map(), g)?;
-        let key = (x.x.to_bits(), x.y.to_bits());
-        let mut tables = self.tables.borrow_mut();
-        let table = tables.entry(key).or_insert_with(|| {
-            let inner = &self.inner;
-            inner.space().node_table(inner.node_model(), x)
-        });
-        Ok(self.inner.probability_with_table(table, g))
+        TableCached::new(&self.inner, self.tables).probability(x, g)
     }
 }
