@@ -28,7 +28,8 @@ export function attachPointer(ctx) {
 
   const hover = (p) => {
     if (!view.inPlot(p.x, p.y)) {
-      readout.textContent = st.mode !== 'tracking'
+      if (st.mode === 'mtl') readout.textContent = 'Multi-target · drag Tx, Rx, targets (×) and discs';
+      else readout.textContent = st.mode !== 'tracking'
         ? 'Move over the map to read the bound · drag Tx/Rx markers · click to place a target'
         : `Move over the map to read the bound · drag Tx/Rx markers${ctx.tracking.wantsDraw() ? ' · press and drag to draw a trajectory' : ''}`;
       return;

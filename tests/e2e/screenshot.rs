@@ -1,5 +1,5 @@
-//! The docs screenshot of the tracking mode (docs/screenshot-tracking.png), taken through the
-//! same browser harness as the end-to-end tests.
+//! The docs screenshots (docs/screenshot-tracking.png by default; any mode through
+//! `SCATTERLOC_SCREENSHOT_HASH`), taken through the same browser harness as the end-to-end tests.
 
 use super::tracking::{mc_done, wait_state};
 use super::{connect, js, open_hash, runtime, settle, start_server, Driver, SERIAL};
@@ -44,6 +44,20 @@ fn tracking_screenshot() {
                     mc_done(s) && s["mcGeneration"].as_u64().unwrap_or(0) > gen
                 })
                 .await?;
+            }
+            if hash.contains("mode=mtl") {
+                // The worker's first view of the scene (ellipses, hypotheses, detections).
+                let t0 = std::time::Instant::now();
+                loop {
+                    let s = js(&c, "return window.mtl.state()").await?;
+                    if s["pending"] == false && s["viewGen"].as_u64().unwrap_or(0) > 0 {
+                        break;
+                    }
+                    if t0.elapsed() > std::time::Duration::from_secs(60) {
+                        return Err(format!("no multi-target view in 60 s; last state {s}"));
+                    }
+                    tokio::time::sleep(std::time::Duration::from_millis(25)).await;
+                }
             }
             settle(&c).await?;
             c.screenshot().await.map_err(|e| e.to_string())
