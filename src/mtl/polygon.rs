@@ -423,12 +423,12 @@ mod tests {
                 .map(|_| node_rectangle(x, v(rnd(), rnd()), 0.6, Some(&region)))
                 .collect();
             let table = subset_intersection_areas(&rects).unwrap();
-            for mask in 1..64usize {
+            for (mask, &want) in table.iter().enumerate().skip(1) {
                 let polys: Vec<&[Vec2]> = (0..6)
                     .filter(|i| mask >> i & 1 == 1)
                     .map(|i| rects[i].as_slice())
                     .collect();
-                assert_eq!(table[mask].to_bits(), intersection_area(&polys).to_bits(), "{mask:b}");
+                assert_eq!(want.to_bits(), intersection_area(&polys).to_bits(), "{mask:b}");
             }
             nested += (1..64usize)
                 .filter(|&m| m.count_ones() > 1 && table[m] == table[m & (m - 1)])
