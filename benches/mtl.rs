@@ -14,7 +14,9 @@
 //!   `generate` alone; `locate` with i.c.b (`p_u = VB_ICB_P_U`) from a cold intersection cache
 //!   (what one call costs) and with a warm one (`locate_cached` on a cache filled by an earlier
 //!   call: the algorithm without the §5.2 ellipse intersections); `locate` with the PPP model
-//!   (`λ`, `D`, `p_d` of the settings, region `R`), bound (M10) and exact (M11), cold and warm.
+//!   (`λ`, `D`, `p_d` of the settings, region `R`), bound (M10) and exact (M11), cold and warm,
+//!   and M10 with its node tables memoised per location (`TableCached`, as the experiments and
+//!   the page run it).
 //! - `mtl_growth_targets_3x3`: `K = 1..10` targets (V-B otherwise, 16 seeds each): staged
 //!   (`locate`, i.c.b) vs `brute_force` (i.c.b) where the latter finishes in reasonable time.
 //! - `mtl_growth_trps_k2`: `N_t × N_r` = 3×3 … 6×6 with `K = 2` (V-B otherwise, 16 seeds each):
@@ -36,9 +38,10 @@
 //! Where the time goes (perf, 3×3): with i.c.b ≈ 80 % of a cold `locate` is the §5.2 ellipse
 //! intersection (720 samples per ellipse pair, a `sincos` each; ≈ 390 MPC pairs per
 //! realisation), hence the warm-cache case; with the PPP model the cache hardly matters: each
-//! `L_b` query recomputes the rectangle-intersection table (`clip_convex`, allocations, `exp`)
-//! and the consistency branching evaluates more candidates (≈ 9000 vs 1700 trace entries per
-//! realisation for `IndependentNodes` vs i.c.b).
+//! `L_b` query (≈ 4600 per realisation at ≈ 2100 distinct locations) computes the
+//! rectangle-intersection table (≈ 44 convex clips, ≈ 6 µs) unless `TableCached` has it, and the
+//! consistency branching evaluates more candidates than i.c.b (`IndependentNodes`, whose table
+//! is free, takes ≈ 12 ms per realisation).
 //!
 //! Run: `cargo bench --bench mtl` (about 2 minutes here; shorter: filter by group name).
 
@@ -52,7 +55,9 @@ use scatterloc::math::Real;
 use scatterloc::mtl::algorithm::{
     locate, locate_cached, IntersectionCache, Measurements, MtlConfig,
 };
-use scatterloc::mtl::blocking::{BlockingModel, IndependentNodes, NodeBlockingModel};
+use scatterloc::mtl::blocking::{
+    BlockingModel, IndependentNodes, NodeBlockingModel, NodeTableCache, TableCached,
+};
 use scatterloc::mtl::brute::brute_force;
 use scatterloc::mtl::icb::IcbModel;
 use scatterloc::mtl::ppp::{PppBlocking, PppNodeModel};
@@ -269,6 +274,16 @@ fn vb(c: &mut Criterion) {
         n,
         staged(&s, &cs, &cfg_node, |i| &m11[i]),
     );
+    // As the experiments and the page run it: node tables memoised per exact location within
+    // the call (`TableCached` on a fresh cache; the same `x` recurs across candidates).
+    cycle(&mut g, "staged_ppp_m10_table_cache", n, |i| {
+        let tables = NodeTableCache::default();
+        let model = TableCached::new(&m10[i], &tables);
+        locate(&cs[i].input(&s), &model, black_box(&cfg_node))
+            .unwrap()
+            .targets
+            .len()
+    });
     g.measurement_time(Duration::from_secs(5));
     cycle(
         &mut g,
