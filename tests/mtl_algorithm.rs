@@ -269,6 +269,21 @@ fn trace_records_every_stage() {
     let off = run(&ranges, 0.01, &model, &MtlConfig::default());
     assert!(off.trace.is_empty());
     assert_eq!(off.targets, out.targets);
+    // The stage tallies are the trace's, and the same without it.
+    let tallies: Vec<[usize; 6]> = out
+        .trace
+        .iter()
+        .map(|stage| {
+            let mut n = [0; 6];
+            for e in stage {
+                n[e.status.index()] += 1;
+            }
+            n
+        })
+        .collect();
+    assert_eq!(out.stage_counts, tallies);
+    assert_eq!(off.stage_counts, tallies);
+    assert!(Status::ALL.iter().enumerate().all(|(i, s)| s.index() == i));
 }
 
 #[test]

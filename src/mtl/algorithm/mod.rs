@@ -180,6 +180,23 @@ pub enum Status {
     Capped,
 }
 
+impl Status {
+    /// Every status, in the order of [`Status::index`].
+    pub const ALL: [Status; 6] = [
+        Status::Kept,
+        Status::Blocking,
+        Status::Inconsistent,
+        Status::Unlocatable,
+        Status::Duplicate,
+        Status::Capped,
+    ];
+
+    /// Position in [`Status::ALL`].
+    pub fn index(self) -> usize {
+        self as usize
+    }
+}
+
 /// One candidate of the trace.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TraceEntry {
@@ -197,6 +214,9 @@ pub struct MtlOutput {
     /// Per stage (index 0 = stage 2) the candidates and their fate, if
     /// [`MtlConfig::trace`] was set.
     pub trace: Vec<Vec<TraceEntry>>,
+    /// Per stage (index 0 = stage 2) the number of candidates that ended with each [`Status`]
+    /// (by [`Status::index`]), with or without the trace.
+    pub stage_counts: Vec<[usize; 6]>,
 }
 
 /// Run Algorithm 1 (§4) on `input` with blocking model `model`.
@@ -223,8 +243,10 @@ pub fn locate_cached<B: BlockingModel + ?Sized>(
     let mut run = stages::Run::new(input, model, cfg, order, cache);
     let live = run.run()?;
     let targets = select::finalize(&live, cfg);
+    let stage_counts = run.stage_counts().to_vec();
     Ok(MtlOutput {
         targets,
         trace: run.into_trace(),
+        stage_counts,
     })
 }

@@ -20,6 +20,9 @@ pub struct Run<'a, 'c, B: ?Sized> {
     space: Option<BlockingSpace>,
     next_family: usize,
     trace: Vec<Vec<TraceEntry>>,
+    /// Per stage (2, 3, …), how many candidates ended with each [`Status`] (by
+    /// [`Status::index`]); kept whether or not the trace is.
+    counts: Vec<[usize; 6]>,
 }
 
 impl<'a, 'c, B: BlockingModel + ?Sized> Run<'a, 'c, B> {
@@ -44,6 +47,7 @@ impl<'a, 'c, B: BlockingModel + ?Sized> Run<'a, 'c, B> {
             space: cfg.consistency.then(|| BlockingSpace::new(map)),
             next_family: 0,
             trace: Vec::new(),
+            counts: Vec::new(),
         }
     }
 
@@ -55,6 +59,12 @@ impl<'a, 'c, B: BlockingModel + ?Sized> Run<'a, 'c, B> {
     /// The recorded trace (empty unless [`MtlConfig::trace`]).
     pub fn into_trace(self) -> Vec<Vec<TraceEntry>> {
         self.trace
+    }
+
+    /// Per stage (stage 2 first), the number of candidates that ended with each [`Status`]
+    /// (indexed by [`Status::index`]): the trace's tallies, also without the trace.
+    pub fn stage_counts(&self) -> &[[usize; 6]] {
+        &self.counts
     }
 
     /// All stages; returns the live candidates after the last one (all on `S` = every TRP).
@@ -243,12 +253,16 @@ impl<'a, 'c, B: BlockingModel + ?Sized> Run<'a, 'c, B> {
     }
 
     fn new_stage(&mut self) {
+        self.counts.push([0; 6]);
         if self.cfg.trace {
             self.trace.push(Vec::new());
         }
     }
 
     fn record(&mut self, c: &Candidate, status: Status) {
+        if let Some(stage) = self.counts.last_mut() {
+            stage[status.index()] += 1;
+        }
         if self.cfg.trace {
             if let Some(stage) = self.trace.last_mut() {
                 stage.push(TraceEntry {

@@ -9,7 +9,7 @@ use crate::math::{Real, Vec2};
 use crate::mtl::algorithm::candidate::Geometry;
 use crate::mtl::algorithm::{
     select, stages, validate, Candidate, IntersectionCache, Measurements, MtlConfig, Pair, Status,
-    Target, TraceEntry,
+    Target,
 };
 use crate::mtl::sim::generator::Source;
 use crate::mtl::sim::metrics::count_detections;
@@ -37,13 +37,17 @@ pub fn mtl_view_cached(scene: &MtlScene, cache: &mut ViewCache) -> Result<MtlVie
     let rect = scene.rect()?;
     let data = measure(scene, &map)?;
     cache.prepare(scene);
-    let (model, model_view) = blocking_model(scene, &map, cache)?;
+    let ViewCache {
+        tables,
+        intersections: cache,
+        ..
+    } = cache;
+    let (model, model_view) = blocking_model(scene, &map, tables)?;
     let cfg = MtlConfig {
         t_e: scene.t_e,
         t_b: scene.t_b,
         region: Some(rect),
         consistency: model_view.consistency,
-        trace: true,
         ..MtlConfig::default()
     };
     let sc = &data.scene;
@@ -54,13 +58,12 @@ pub fn mtl_view_cached(scene: &MtlScene, cache: &mut ViewCache) -> Result<MtlVie
         c_sigma_m: scene.range_sigma,
     };
     let order = validate(&input, model.as_ref(), &cfg)?;
-    let mut cache = IntersectionCache::new();
-    let mut run = stages::Run::new(&input, model.as_ref(), &cfg, order, &mut cache);
+    let mut run = stages::Run::new(&input, model.as_ref(), &cfg, order, cache);
     let live = run.run()?;
-    let trace = run.into_trace();
+    let stages = stage_counts(run.stage_counts());
     let found = select::finalize(&live, &cfg);
     let geo = Geometry { map, input };
-    let seeds = seeds(&geo, &mut cache);
+    let seeds = seeds(&geo, cache);
 
     let estimates: Vec<Vec2> = found.iter().map(|t| t.position).collect();
     let counts = count_detections(&sc.targets, &estimates, scene.detection_radius);
@@ -115,7 +118,7 @@ pub fn mtl_view_cached(scene: &MtlScene, cache: &mut ViewCache) -> Result<MtlVie
             p_d: (counts.targets > 0).then(|| counts.detected as Real / counts.targets as Real),
             p_fa: counts.false_alarms as Real / counts.estimates.max(1) as Real,
         },
-        stages: stage_counts(&trace),
+        stages,
         model: model_view,
         mpcs: data.ranges.iter().map(Vec::len).sum(),
     })
@@ -212,26 +215,21 @@ fn segments(scene: &MtlScene, sc: &Scene) -> Vec<SegmentView> {
     out
 }
 
-fn stage_counts(trace: &[Vec<TraceEntry>]) -> Vec<StageCounts> {
-    trace
+fn stage_counts(counts: &[[usize; 6]]) -> Vec<StageCounts> {
+    counts
         .iter()
         .enumerate()
-        .map(|(s, entries)| {
-            let mut c = StageCounts {
+        .map(|(s, n)| {
+            let at = |status: Status| n[status.index()];
+            StageCounts {
                 stage: s + 2,
-                ..StageCounts::default()
-            };
-            for e in entries {
-                *match e.status {
-                    Status::Kept => &mut c.kept,
-                    Status::Blocking => &mut c.blocking,
-                    Status::Inconsistent => &mut c.inconsistent,
-                    Status::Unlocatable => &mut c.unlocatable,
-                    Status::Duplicate => &mut c.duplicate,
-                    Status::Capped => &mut c.capped,
-                } += 1;
+                kept: at(Status::Kept),
+                blocking: at(Status::Blocking),
+                inconsistent: at(Status::Inconsistent),
+                unlocatable: at(Status::Unlocatable),
+                duplicate: at(Status::Duplicate),
+                capped: at(Status::Capped),
             }
-            c
         })
         .collect()
 }

@@ -9,6 +9,7 @@ use crate::math::{Real, Vec2};
 use crate::mtl::blocking::{
     BlockingModel, NodeBlockingModel, NodeTableCache, PartialVector, TableCached,
 };
+use crate::mtl::algorithm::IntersectionCache;
 use crate::mtl::icb::IcbModel;
 use crate::mtl::ppp::{PppBlocking, PppNodeModel};
 use crate::mtl::trp::TrpMap;
@@ -22,12 +23,15 @@ pub const MAX_CACHED_TABLES: usize = 16_384;
 
 /// PPP node tables `P_node(a, b | x)` by location, kept between views of scenes with the same
 /// nodes and PPP parameters (a front end recomputing on every drag): candidates built from
-/// ranges that did not change land on the same `x` and reuse their table. Results are those
-/// of [`super::mtl_view`].
+/// ranges that did not change land on the same `x` and reuse their table. Ellipse
+/// intersections are kept the same way. Results are those of [`super::mtl_view`].
 #[derive(Debug, Default)]
 pub struct ViewCache {
     key: Vec<u64>,
-    tables: NodeTableCache,
+    pub(super) tables: NodeTableCache,
+    /// Ellipse intersections by (TRP, range) pair: a drag that moves one target leaves the pairs
+    /// of every other range as they were (the cache checks its nodes and region itself).
+    pub(super) intersections: IntersectionCache,
 }
 
 impl ViewCache {
@@ -66,7 +70,7 @@ impl ViewCache {
 pub(super) fn blocking_model<'a>(
     scene: &MtlScene,
     map: &TrpMap,
-    cache: &'a ViewCache,
+    tables: &'a NodeTableCache,
 ) -> Result<(Box<dyn BlockingModel + 'a>, ModelView)> {
     Ok(match scene.model {
         BlockingChoice::Ppp { exact } => {
@@ -75,7 +79,7 @@ pub(super) fn blocking_model<'a>(
             let nodes = PppNodeModel::new(ppp, pts(&scene.transmitters), pts(&scene.receivers))?;
             let model = Owned {
                 inner: NodeBlockingModel::new(*map, nodes, scene.p_d)?,
-                tables: &cache.tables,
+                tables,
             };
             let label = alloc::format!(
                 "PPP discs (M{}), λ = {} m⁻², D = {} m, p_d = {}",

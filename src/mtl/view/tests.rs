@@ -234,7 +234,7 @@ fn empty_scene() {
     assert!(finite(&v));
 }
 
-/// A warm cache (the previous scene's node tables) changes nothing, also across a target drag
+/// A warm cache (the previous scene's node tables and ellipse intersections) changes nothing, also across a target drag
 /// and a model change; a node move empties it.
 #[test]
 fn cache_is_transparent() {
@@ -244,6 +244,12 @@ fn cache_is_transparent() {
     assert_eq!(mtl_view_cached(&s, &mut cache).unwrap(), cold);
     let n = cache.len();
     assert!(n > 0);
+    // Ellipse pairs of ranges the drag leaves alone are reused, not recomputed.
+    let pairs = cache.intersections.len();
+    s.targets[1][0] -= 0.05;
+    assert_eq!(mtl_view_cached(&s, &mut cache).unwrap(), mtl_view(&s).unwrap());
+    let grown = cache.intersections.len() - pairs;
+    assert!(grown > 0 && grown < pairs, "{pairs} pairs, {grown} new");
     for step in 1..4 {
         s.targets[1][0] -= 0.1 * step as f64;
         let warm = mtl_view_cached(&s, &mut cache).unwrap();
