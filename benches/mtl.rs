@@ -56,7 +56,7 @@ use scatterloc::mtl::algorithm::{
     locate, locate_cached, IntersectionCache, Measurements, MtlConfig,
 };
 use scatterloc::mtl::blocking::{
-    BlockingModel, IndependentNodes, NodeBlockingModel, NodeTableCache, TableCached,
+    BlockingModel, IndependentNodes, NodeBlockingModel, NodeTableCache, TableCached, TABLE_GRID_M,
 };
 use scatterloc::mtl::brute::brute_force;
 use scatterloc::mtl::icb::IcbModel;
@@ -278,7 +278,7 @@ fn vb(c: &mut Criterion) {
     // the call (`TableCached` on a fresh cache; the same `x` recurs across candidates).
     cycle(&mut g, "staged_ppp_m10_table_cache", n, |i| {
         let tables = NodeTableCache::default();
-        let model = TableCached::new(&m10[i], &tables);
+        let model = TableCached::on_grid(&m10[i], &tables, TABLE_GRID_M);
         locate(&cs[i].input(&s), &model, black_box(&cfg_node))
             .unwrap()
             .targets

@@ -132,6 +132,19 @@ pub fn atan2(y: Real, x: Real) -> Real {
     }
 }
 
+/// Nearest integer, halves away from zero.
+#[inline(always)]
+pub fn round(x: Real) -> Real {
+    #[cfg(feature = "std")]
+    {
+        x.round()
+    }
+    #[cfg(not(feature = "std"))]
+    {
+        libm::round(x)
+    }
+}
+
 /// Decibels to a linear power ratio: `10^(db/10)`.
 #[inline]
 pub fn db_to_linear(db: Real) -> Real {

@@ -33,6 +33,8 @@ export class Mtl {
     this.gen = 0; // generation of the scene last posted
     this.ms = null; // the worker's time for the last view, ms
     this.computeMs = null; // the core's own time inside it
+    this.msLog = []; // [worker ms, core ms] of the last views (at most 64), oldest first
+    this.viewCount = 0; // views received so far
     this.workerError = null;
     this.selected = null; // {kind: 'tx' | 'rx' | 'target' | 'disc', index}
     this.press = null;
@@ -98,6 +100,9 @@ export class Mtl {
     this.resultGen = m.gen;
     this.ms = m.ms;
     this.computeMs = m.view.compute_ms;
+    this.msLog.push([m.ms, m.view.compute_ms]);
+    if (this.msLog.length > 64) this.msLog.shift();
+    this.viewCount += 1;
     this.workerError = null;
     this.showTiming();
     this.showInfo();
@@ -327,6 +332,8 @@ export class Mtl {
       blocked: v ? v.segments.filter((s) => s.blocked).length : 0,
       ms: this.ms,
       computeMs: this.computeMs,
+      msLog: this.msLog.slice(),
+      viewCount: this.viewCount,
       error: this.workerError,
     };
   }

@@ -428,7 +428,11 @@ mod tests {
                     .filter(|i| mask >> i & 1 == 1)
                     .map(|i| rects[i].as_slice())
                     .collect();
-                assert_eq!(want.to_bits(), intersection_area(&polys).to_bits(), "{mask:b}");
+                assert_eq!(
+                    want.to_bits(),
+                    intersection_area(&polys).to_bits(),
+                    "{mask:b}"
+                );
             }
             nested += (1..64usize)
                 .filter(|&m| m.count_ones() > 1 && table[m] == table[m & (m - 1)])

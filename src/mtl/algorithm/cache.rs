@@ -41,8 +41,7 @@ impl IntersectionCache {
     /// if it holds [`MAX_CACHED_PAIRS`] pairs).
     pub fn prepare(&mut self, geo: &Geometry, region: Option<&Rect>) {
         let input = &geo.input;
-        let same =
-            self.tx == input.tx && self.rx == input.rx && self.region.as_ref() == region;
+        let same = self.tx == input.tx && self.rx == input.rx && self.region.as_ref() == region;
         if !same {
             self.tx = input.tx.to_vec();
             self.rx = input.rx.to_vec();

@@ -9,7 +9,9 @@ use crate::math::Vec2;
 use crate::mtl::algorithm::{
     locate_cached, FinalTest, IntersectionCache, Measurements, MtlConfig, Target,
 };
-use crate::mtl::blocking::{BlockingModel, NodeBlockingModel, NodeTableCache, TableCached};
+use crate::mtl::blocking::{
+    BlockingModel, NodeBlockingModel, NodeTableCache, TableCached, TABLE_GRID_M,
+};
 use crate::mtl::empirical::{EmpiricalNodeModel, EmpiricalTable};
 use crate::mtl::experiment::memo::Memoized;
 use crate::mtl::experiment::{genie, Experiment, ExperimentConfig, Method};
@@ -216,7 +218,9 @@ impl Runner<'_> {
         let mut out = Vec::new();
         for spec in cfg.curves() {
             let curve = match spec.method {
-                Method::Ppp => self.sweep_tb(&TableCached::new(&ppp, &ppp_tables), true)?,
+                Method::Ppp => {
+                    self.sweep_tb(&TableCached::on_grid(&ppp, &ppp_tables, TABLE_GRID_M), true)?
+                }
                 Method::Icb => {
                     let icb = IcbModel::from_p_u(map, cfg.icb_p_u)?;
                     self.sweep_tb(&icb, false)?
@@ -241,9 +245,11 @@ impl Runner<'_> {
                     let model =
                         NodeBlockingModel::new(map, EmpiricalNodeModel::new(table)?, s.p_d)?;
                     let tables = NodeTableCache::default();
-                    self.sweep_tb(&TableCached::new(&model, &tables), true)?
+                    self.sweep_tb(&TableCached::on_grid(&model, &tables, TABLE_GRID_M), true)?
                 }
-                Method::Genie => self.sweep_genie(r, &TableCached::new(&ppp, &ppp_tables))?,
+                Method::Genie => {
+                    self.sweep_genie(r, &TableCached::on_grid(&ppp, &ppp_tables, TABLE_GRID_M))?
+                }
                 Method::SizeRule => {
                     return Err(Error::OutOfRange {
                         field: "experiment".into(),

@@ -6,10 +6,10 @@ use alloc::vec::Vec;
 
 use crate::error::Result;
 use crate::math::{Real, Vec2};
-use crate::mtl::blocking::{
-    BlockingModel, NodeBlockingModel, NodeTableCache, PartialVector, TableCached,
-};
 use crate::mtl::algorithm::IntersectionCache;
+use crate::mtl::blocking::{
+    BlockingModel, NodeBlockingModel, NodeTableCache, PartialVector, TableCached, TABLE_GRID_M,
+};
 use crate::mtl::icb::IcbModel;
 use crate::mtl::ppp::{PppBlocking, PppNodeModel};
 use crate::mtl::trp::TrpMap;
@@ -135,6 +135,6 @@ impl BlockingModel for Owned<'_> {
     }
 
     fn probability(&self, x: &Vec2, g: &PartialVector) -> Result<Real> {
-        TableCached::new(&self.inner, self.tables).probability(x, g)
+        TableCached::on_grid(&self.inner, self.tables, TABLE_GRID_M).probability(x, g)
     }
 }

@@ -247,7 +247,10 @@ fn cache_is_transparent() {
     // Ellipse pairs of ranges the drag leaves alone are reused, not recomputed.
     let pairs = cache.intersections.len();
     s.targets[1][0] -= 0.05;
-    assert_eq!(mtl_view_cached(&s, &mut cache).unwrap(), mtl_view(&s).unwrap());
+    assert_eq!(
+        mtl_view_cached(&s, &mut cache).unwrap(),
+        mtl_view(&s).unwrap()
+    );
     let grown = cache.intersections.len() - pairs;
     assert!(grown > 0 && grown < pairs, "{pairs} pairs, {grown} new");
     for step in 1..4 {
