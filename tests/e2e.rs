@@ -223,6 +223,40 @@ async fn probe(c: &Client) -> Result<f64, String> {
         .ok_or_else(|| format!("probe value {v}"))
 }
 
+/// A real-mouse drag on the plot canvas: press the left button at `start` (CSS px from the
+/// canvas centre), move by each `(dx, dy, ms)` of `moves` in turn, release.
+async fn drag_on_plot(
+    c: &Client,
+    start: [f64; 2],
+    moves: &[(f64, f64, u64)],
+) -> Result<(), String> {
+    let canvas = c
+        .find(Locator::Id("plot"))
+        .await
+        .map_err(|e| e.to_string())?;
+    let mut mouse = MouseActions::new("mouse".to_string())
+        .then(PointerAction::MoveToElement {
+            element: canvas,
+            duration: None,
+            x: start[0].round(),
+            y: start[1].round(),
+        })
+        .then(PointerAction::Down {
+            button: MOUSE_BUTTON_LEFT,
+        });
+    for &(x, y, ms) in moves {
+        mouse = mouse.then(PointerAction::MoveBy {
+            duration: Some(Duration::from_millis(ms)),
+            x,
+            y,
+        });
+    }
+    let mouse = mouse.then(PointerAction::Up {
+        button: MOUSE_BUTTON_LEFT,
+    });
+    c.perform_actions(mouse).await.map_err(|e| e.to_string())
+}
+
 async fn console_errors(c: &Client) -> Result<Vec<String>, String> {
     let v = js(c, "return window.__consoleErrors || []").await?;
     Ok(serde_json::from_value(v).unwrap_or_default())
@@ -269,30 +303,8 @@ async fn drag_receiver(c: &Client, port: u16) -> Result<DragOutcome, String> {
     )
     .await?;
     let g: Vec<f64> = serde_json::from_value(geo).map_err(|e| e.to_string())?;
-    let canvas = c
-        .find(Locator::Id("plot"))
-        .await
-        .map_err(|e| e.to_string())?;
-    let (dx, dy) = ((g[0] - g[2] / 2.0).round(), (g[1] - g[3] / 2.0).round());
-    let mouse = MouseActions::new("mouse".to_string())
-        .then(PointerAction::MoveToElement {
-            element: canvas,
-            duration: None,
-            x: dx,
-            y: dy,
-        })
-        .then(PointerAction::Down {
-            button: MOUSE_BUTTON_LEFT,
-        })
-        .then(PointerAction::MoveBy {
-            duration: Some(Duration::from_millis(400)),
-            x: 70.0,
-            y: 50.0,
-        })
-        .then(PointerAction::Up {
-            button: MOUSE_BUTTON_LEFT,
-        });
-    c.perform_actions(mouse).await.map_err(|e| e.to_string())?;
+    let start = [g[0] - g[2] / 2.0, g[1] - g[3] / 2.0];
+    drag_on_plot(c, start, &[(70.0, 50.0, 400)]).await?;
     settle(c).await?;
     let hash_after = js(c, MAP_HASH).await?.as_u64().unwrap_or(0);
     let probe_after = probe(c).await?;

@@ -122,13 +122,23 @@ fn table_cache_exact_and_on_grid() {
     let map = TrpMap::new(3, 3).unwrap();
     let region = Rect::new(Vec2::new(0.0, 0.0), Vec2::new(10.0, 10.0)).unwrap();
     let ppp = PppBlocking::new(0.03, 0.6, Some(region), false).unwrap();
-    let tx = vec![Vec2::new(1.0, 1.0), Vec2::new(9.0, 2.0), Vec2::new(2.0, 8.0)];
-    let rx = vec![Vec2::new(8.0, 8.5), Vec2::new(5.0, 0.5), Vec2::new(0.5, 5.0)];
+    let tx = vec![
+        Vec2::new(1.0, 1.0),
+        Vec2::new(9.0, 2.0),
+        Vec2::new(2.0, 8.0),
+    ];
+    let rx = vec![
+        Vec2::new(8.0, 8.5),
+        Vec2::new(5.0, 0.5),
+        Vec2::new(0.5, 5.0),
+    ];
     let nodes = PppNodeModel::new(ppp, tx, rx).unwrap();
     let model = NodeBlockingModel::new(map, nodes, 0.9).unwrap();
     let mut seed = 7u64;
     let mut rnd = || {
-        seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
         (seed >> 11) as Real / (1u64 << 53) as Real
     };
     let queries: Vec<(Vec2, PartialVector)> = (0..300)
@@ -150,7 +160,10 @@ fn table_cache_exact_and_on_grid() {
     let mut largest = 0.0 as Real;
     for (x, v) in &queries {
         let want = model.blocking_likelihood(x, v).unwrap();
-        assert_eq!(exact.blocking_likelihood(x, v).unwrap().to_bits(), want.to_bits());
+        assert_eq!(
+            exact.blocking_likelihood(x, v).unwrap().to_bits(),
+            want.to_bits()
+        );
         let snapped = Vec2::new(
             (x.x / TABLE_GRID_M).round() * TABLE_GRID_M,
             (x.y / TABLE_GRID_M).round() * TABLE_GRID_M,
@@ -165,7 +178,10 @@ fn table_cache_exact_and_on_grid() {
         }
         // Another point of the same cell gives the same value.
         let near = snapped + Vec2::new(0.3 * TABLE_GRID_M, -0.3 * TABLE_GRID_M);
-        assert_eq!(grid.blocking_likelihood(&near, v).unwrap().to_bits(), on_grid.to_bits());
+        assert_eq!(
+            grid.blocking_likelihood(&near, v).unwrap().to_bits(),
+            on_grid.to_bits()
+        );
     }
     assert!(largest <= 2e-6, "{largest}");
     for (x, v) in queries.iter().rev() {

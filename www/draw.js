@@ -71,7 +71,8 @@ function drawMap(ctx, view, st) {
   ctx.restore();
 }
 
-function drawAxes(ctx, view, w) {
+/** Grid, tick labels (from the core's `axis_ticks`), axis titles and the frame of the plot rectangle. */
+export function drawAxes(ctx, view, w) {
   const r = view.rect;
   const [x0, x1, y0, y1] = view.area;
   ctx.font = FONT;

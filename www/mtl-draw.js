@@ -3,7 +3,7 @@
 // through the view transform. Markers of the scene (nodes, targets, discs) are drawn from the
 // scene itself so they follow a drag at once.
 
-import { C, LINK_COLORS, FONT, FONT_B, FULL, ellipsePath, cross, haloText } from './draw.js';
+import { C, LINK_COLORS, FONT_B, FULL, ellipsePath, cross, haloText, drawAxes } from './draw.js';
 
 const BG = '#10141c';
 const DISC = 'rgba(150,160,178,0.55)';
@@ -14,44 +14,6 @@ const HYP = 'rgba(255,209,102,0.85)';
 const HYP_REJ = 'rgba(160,170,185,0.6)';
 const DET = '#ffa94d';
 const FA = '#ff6b9a';
-
-function axes(ctx, view, w) {
-  const r = view.rect;
-  const [x0, x1, y0, y1] = view.area;
-  ctx.font = FONT;
-  ctx.fillStyle = C.text;
-  ctx.strokeStyle = C.grid;
-  ctx.lineWidth = 1;
-  const xt = w.axis_ticks(x0, x1, Math.max(2, Math.floor(r.w / 70)));
-  const yt = w.axis_ticks(y0, y1, Math.max(2, Math.floor(r.h / 50)));
-  ctx.beginPath();
-  for (const t of xt) {
-    const p = view.toPixel(t.value, y0);
-    ctx.moveTo(Math.round(p.x) + 0.5, r.y); ctx.lineTo(Math.round(p.x) + 0.5, r.y + r.h + 5);
-  }
-  for (const t of yt) {
-    const p = view.toPixel(x0, t.value);
-    ctx.moveTo(r.x - 5, Math.round(p.y) + 0.5); ctx.lineTo(r.x + r.w, Math.round(p.y) + 0.5);
-  }
-  ctx.stroke();
-  ctx.textAlign = 'center';
-  ctx.textBaseline = 'top';
-  for (const t of xt) ctx.fillText(t.label, view.toPixel(t.value, y0).x, r.y + r.h + 8);
-  ctx.textAlign = 'right';
-  ctx.textBaseline = 'middle';
-  for (const t of yt) ctx.fillText(t.label, r.x - 8, view.toPixel(x0, t.value).y);
-  ctx.fillStyle = C.muted;
-  ctx.textAlign = 'center';
-  ctx.textBaseline = 'alphabetic';
-  ctx.fillText('x (m)', r.x + r.w / 2, r.y + r.h + 36);
-  ctx.save();
-  ctx.translate(r.x - 42, r.y + r.h / 2);
-  ctx.rotate(-Math.PI / 2);
-  ctx.fillText('y (m)', 0, 0);
-  ctx.restore();
-  ctx.strokeStyle = C.frame;
-  ctx.strokeRect(Math.round(r.x) + 0.5, Math.round(r.y) + 0.5, Math.round(r.w), Math.round(r.h));
-}
 
 /** The region R (the scene's rectangle) as a lighter frame. */
 function region(ctx, view, scene) {
@@ -208,7 +170,7 @@ export function drawMtl(view, scene, v, sel, w) {
   ctx.fillRect(0, 0, view.width, view.height);
   const r = view.rect;
   region(ctx, view, scene);
-  axes(ctx, view, w);
+  drawAxes(ctx, view, w);
   ctx.save();
   ctx.beginPath(); ctx.rect(r.x, r.y, r.w, r.h); ctx.clip();
   if (v) {

@@ -5,11 +5,12 @@
 
 use std::time::{Duration, Instant};
 
-use fantoccini::actions::{InputSource, MouseActions, PointerAction, MOUSE_BUTTON_LEFT};
 use fantoccini::{Client, Locator};
 use serde_json::{json, Value};
 
-use super::{connect, console_errors, js, open, runtime, settle, start_server, Driver, SERIAL};
+use super::{
+    connect, console_errors, drag_on_plot, js, open, runtime, settle, start_server, Driver, SERIAL,
+};
 
 async fn state(c: &Client) -> Result<Value, String> {
     js(c, "return window.mtl.state()").await
@@ -90,31 +91,7 @@ async fn drag_target(c: &Client, port: u16) -> Result<Outcome, String> {
         .await?,
     )
     .map_err(|e| e.to_string())?;
-    let canvas = c
-        .find(Locator::Id("plot"))
-        .await
-        .map_err(|e| e.to_string())?;
-    let mut mouse = MouseActions::new("mouse".to_string())
-        .then(PointerAction::MoveToElement {
-            element: canvas,
-            duration: None,
-            x: px[0].round(),
-            y: px[1].round(),
-        })
-        .then(PointerAction::Down {
-            button: MOUSE_BUTTON_LEFT,
-        });
-    for _ in 0..8 {
-        mouse = mouse.then(PointerAction::MoveBy {
-            duration: Some(Duration::from_millis(50)),
-            x: -12.0,
-            y: 9.0,
-        });
-    }
-    let mouse = mouse.then(PointerAction::Up {
-        button: MOUSE_BUTTON_LEFT,
-    });
-    c.perform_actions(mouse).await.map_err(|e| e.to_string())?;
+    drag_on_plot(c, [px[0], px[1]], &[(-12.0, 9.0, 50); 8]).await?;
     let after = wait_view(c, 60).await?;
     settle(c).await?;
     // The worker's time of every view computed during the drag (a drag posts a scene per pointer

@@ -5,7 +5,6 @@
 
 use std::time::{Duration, Instant};
 
-use fantoccini::actions::{InputSource, MouseActions, PointerAction, MOUSE_BUTTON_LEFT};
 use fantoccini::{Client, Locator};
 use serde_json::Value;
 
@@ -16,7 +15,9 @@ use scatterloc::track_view::track_mean_state;
 use scatterloc::trajectory::{paper_initial_covariance, PAPER_INTENSITY};
 use scatterloc::{Model, Scenario};
 
-use super::{connect, console_errors, js, open, runtime, settle, start_server, Driver, SERIAL};
+use super::{
+    connect, console_errors, drag_on_plot, js, open, runtime, settle, start_server, Driver, SERIAL,
+};
 
 pub(super) async fn state(c: &Client) -> Result<Value, String> {
     js(c, "return window.tracking.state()").await
@@ -109,31 +110,7 @@ async fn drag_rx2(c: &Client) -> Result<(Vec<f64>, Vec<f64>), String> {
          const b = document.getElementById('plot').getBoundingClientRect(); \
          return [p.x - b.width / 2, p.y - b.height / 2, r.x, r.y];";
     let g: Vec<f64> = serde_json::from_value(js(c, rx2).await?).map_err(|e| e.to_string())?;
-    let canvas = c
-        .find(Locator::Id("plot"))
-        .await
-        .map_err(|e| e.to_string())?;
-    let mut mouse = MouseActions::new("mouse".to_string())
-        .then(PointerAction::MoveToElement {
-            element: canvas,
-            duration: None,
-            x: g[0].round(),
-            y: g[1].round(),
-        })
-        .then(PointerAction::Down {
-            button: MOUSE_BUTTON_LEFT,
-        });
-    for _ in 0..6 {
-        mouse = mouse.then(PointerAction::MoveBy {
-            duration: Some(Duration::from_millis(60)),
-            x: 10.0,
-            y: 7.0,
-        });
-    }
-    let mouse = mouse.then(PointerAction::Up {
-        button: MOUSE_BUTTON_LEFT,
-    });
-    c.perform_actions(mouse).await.map_err(|e| e.to_string())?;
+    drag_on_plot(c, [g[0], g[1]], &[(10.0, 7.0, 60); 6]).await?;
     let after: Vec<f64> = serde_json::from_value(js(c, rx2).await?).map_err(|e| e.to_string())?;
     Ok((g[2..].to_vec(), after[2..].to_vec()))
 }
@@ -214,35 +191,9 @@ async fn draw_trajectory(c: &Client) -> Result<Value, String> {
     )
     .await?;
     let p: Vec<f64> = serde_json::from_value(px).map_err(|e| e.to_string())?;
-    let canvas = c
-        .find(Locator::Id("plot"))
-        .await
-        .map_err(|e| e.to_string())?;
     let half = |v: f64| (v / 2.0).round();
-    let mouse = MouseActions::new("mouse".to_string())
-        .then(PointerAction::MoveToElement {
-            element: canvas,
-            duration: None,
-            x: p[0].round(),
-            y: p[1].round(),
-        })
-        .then(PointerAction::Down {
-            button: MOUSE_BUTTON_LEFT,
-        })
-        .then(PointerAction::MoveBy {
-            duration: Some(Duration::from_millis(60)),
-            x: half(p[2]),
-            y: half(p[3]),
-        })
-        .then(PointerAction::MoveBy {
-            duration: Some(Duration::from_millis(60)),
-            x: half(p[2]),
-            y: half(p[3]),
-        })
-        .then(PointerAction::Up {
-            button: MOUSE_BUTTON_LEFT,
-        });
-    c.perform_actions(mouse).await.map_err(|e| e.to_string())?;
+    let step = (half(p[2]), half(p[3]), 60);
+    drag_on_plot(c, [p[0], p[1]], &[step, step]).await?;
     wait_state(c, 60, |s| {
         mc_done(s) && s["mcGeneration"].as_u64().unwrap_or(0) > gen
     })
