@@ -1,7 +1,7 @@
 //! Pixel layout of the map figure: title band, an equal-scale plot (1 m in x = 1 m in y) centred
 //! in the remaining space, and the colour bar right of it. Everything scales with the image size.
 
-use plotters::coord::Shift;
+use plotters::coord::{CoordTranslate, Shift};
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
@@ -182,4 +182,38 @@ pub(crate) fn draw_titles<DB: DrawingBackend>(
             .map_err(chart_err)?;
     }
     Ok(())
+}
+
+/// The series legend of `chart`: a white box (opacity `background`) with a black border at
+/// `position`, labels at `font_px`, `margin_px` from the plot's edges.
+pub(crate) fn series_legend<'a, DB: DrawingBackend + 'a, CT: CoordTranslate>(
+    chart: &mut ChartContext<'a, DB, CT>,
+    position: SeriesLabelPosition,
+    font_px: f64,
+    margin_px: f64,
+    background: f64,
+) -> Result<(), ChartError> {
+    chart
+        .configure_series_labels()
+        .position(position)
+        .background_style(WHITE.mix(background))
+        .border_style(BLACK)
+        .label_font(("sans-serif", font_px).into_font())
+        .margin(margin_px as i32)
+        .draw()
+        .map_err(chart_err)
+}
+
+/// A one-pixel black frame around the plotting area of `chart`.
+pub(crate) fn frame_plot<DB: DrawingBackend, CT: CoordTranslate>(
+    chart: &ChartContext<'_, DB, CT>,
+) -> Result<(), ChartError> {
+    let plot = chart.plotting_area();
+    let (w, h) = plot.dim_in_pixel();
+    plot.strip_coord_spec()
+        .draw(&Rectangle::new(
+            [(0, 0), (w as i32 - 1, h as i32 - 1)],
+            BLACK.stroke_width(1),
+        ))
+        .map_err(chart_err)
 }

@@ -234,14 +234,7 @@ pub fn draw_crlb_map<DB: DrawingBackend>(
         .map_err(chart_err)?;
 
     raster::draw_nodes(&mut chart, nodes, lay.font.nodes)?;
-    let plot = chart.plotting_area();
-    let (w, h) = plot.dim_in_pixel();
-    plot.strip_coord_spec()
-        .draw(&Rectangle::new(
-            [(0, 0), (w as i32 - 1, h as i32 - 1)],
-            BLACK.stroke_width(1),
-        ))
-        .map_err(chart_err)?;
+    layout::frame_plot(&chart)?;
 
     let bar_area = root.clone().shrink(lay.bar_origin, lay.bar_size);
     raster::draw_colorbar(

@@ -7,7 +7,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
-use super::layout::Fonts;
+use super::layout::{series_legend, Fonts};
 use super::ticks::colorbar_ticks;
 use super::{chart_err, ChartError, ChartNode, MapData, NodeKind};
 use crate::colormap::{viridis, LogScale, UNBOUNDED_RGB};
@@ -161,15 +161,13 @@ fn draw_legend<'a, DB: DrawingBackend + 'a>(
             });
     }
     if has(NodeKind::Transmitter) || has(NodeKind::Receiver) {
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font(("sans-serif", font_px * 0.9).into_font())
-            .margin((8.0 * font_px / 20.0) as i32)
-            .draw()
-            .map_err(chart_err)?;
+        series_legend(
+            chart,
+            SeriesLabelPosition::UpperRight,
+            font_px * 0.9,
+            8.0 * font_px / 20.0,
+            0.85,
+        )?;
     }
     Ok(())
 }

@@ -9,7 +9,7 @@ use alloc::vec::Vec;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::layout::{draw_titles, font_scale, Fonts, TitleBand};
+use super::layout::{draw_titles, font_scale, frame_plot, series_legend, Fonts, TitleBand};
 use super::ticks::colorbar_ticks;
 use super::{axis_label, chart_err, register_fonts, ChartError};
 use crate::math::Real;
@@ -231,23 +231,14 @@ fn draw_panel<DB: DrawingBackend>(
                 });
         }
     }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
-        .background_style(WHITE.mix(0.9))
-        .border_style(BLACK)
-        .label_font(("sans-serif", font.ticks * 0.95).into_font())
-        .margin((8.0 * s) as i32)
-        .draw()
-        .map_err(chart_err)?;
-    let plot = chart.plotting_area();
-    let (pw, ph) = plot.dim_in_pixel();
-    plot.strip_coord_spec()
-        .draw(&Rectangle::new(
-            [(0, 0), (pw as i32 - 1, ph as i32 - 1)],
-            BLACK.stroke_width(1),
-        ))
-        .map_err(chart_err)
+    series_legend(
+        &mut chart,
+        SeriesLabelPosition::UpperRight,
+        font.ticks * 0.95,
+        8.0 * s,
+        0.9,
+    )?;
+    frame_plot(&chart)
 }
 
 #[cfg(test)]
