@@ -158,13 +158,7 @@ function drawNetwork(ctx, view, st) {
   ctx.textAlign = 'left';
   ctx.textBaseline = 'bottom';
   n.receivers.forEach((rx, i) => {
-    const p = view.toPixel(rx.x, rx.y);
-    if (st.selected.kind === 'rx' && st.selected.index === i) ring(ctx, p, 11);
-    ctx.beginPath(); ctx.arc(p.x, p.y, 6, 0, FULL);
-    ctx.fillStyle = C.rx; ctx.fill();
-    ctx.lineWidth = 2; ctx.strokeStyle = '#1b1f27'; ctx.stroke();
-    ctx.fillStyle = C.rx;
-    haloText(ctx, rx.name, p.x + 9, p.y - 5);
+    rxMarker(ctx, view.toPixel(rx.x, rx.y), rx.name, st.selected.kind === 'rx' && st.selected.index === i);
   });
   n.transmitters.forEach((tx, i) => {
     const p = view.toPixel(tx.x, tx.y);
@@ -173,21 +167,38 @@ function drawNetwork(ctx, view, st) {
       ctx.beginPath(); ctx.moveTo(p.x, p.y);
       ctx.lineTo(p.x + 26 * tx.boresight[0], p.y - 26 * tx.boresight[1]); ctx.stroke();
     }
-    if (st.selected.kind === 'tx' && st.selected.index === i) ring(ctx, p, 12);
-    ctx.beginPath();
-    ctx.moveTo(p.x, p.y - 9); ctx.lineTo(p.x + 8, p.y + 6); ctx.lineTo(p.x - 8, p.y + 6); ctx.closePath();
-    ctx.fillStyle = C.tx; ctx.fill();
-    ctx.lineWidth = 1.5; ctx.strokeStyle = '#1b1f27'; ctx.stroke();
-    ctx.fillStyle = C.tx;
-    ctx.textBaseline = 'top';
-    haloText(ctx, tx.name, p.x + 9, p.y + 5);
-    ctx.textBaseline = 'bottom';
+    txMarker(ctx, p, tx.name, st.selected.kind === 'tx' && st.selected.index === i);
   });
 }
 
-function ring(ctx, p, r) {
+/** A selection ring of radius `r` px around pixel `p`. */
+export function ring(ctx, p, r) {
   ctx.beginPath(); ctx.arc(p.x, p.y, r, 0, FULL);
   ctx.lineWidth = 2; ctx.strokeStyle = C.sel; ctx.stroke();
+}
+
+/** A receiver marker (disc) at pixel `p` with its label above right; ringed when `selected`. */
+export function rxMarker(ctx, p, label, selected) {
+  if (selected) ring(ctx, p, 11);
+  ctx.beginPath(); ctx.arc(p.x, p.y, 6, 0, FULL);
+  ctx.fillStyle = C.rx; ctx.fill();
+  ctx.lineWidth = 2; ctx.strokeStyle = '#1b1f27'; ctx.stroke();
+  ctx.fillStyle = C.rx;
+  ctx.textBaseline = 'bottom';
+  haloText(ctx, label, p.x + 9, p.y - 5);
+}
+
+/** A transmitter marker (triangle) at pixel `p` with its label below right; ringed when `selected`. */
+export function txMarker(ctx, p, label, selected) {
+  if (selected) ring(ctx, p, 12);
+  ctx.beginPath();
+  ctx.moveTo(p.x, p.y - 9); ctx.lineTo(p.x + 8, p.y + 6); ctx.lineTo(p.x - 8, p.y + 6); ctx.closePath();
+  ctx.fillStyle = C.tx; ctx.fill();
+  ctx.lineWidth = 1.5; ctx.strokeStyle = '#1b1f27'; ctx.stroke();
+  ctx.fillStyle = C.tx;
+  ctx.textBaseline = 'top';
+  haloText(ctx, label, p.x + 9, p.y + 5);
+  ctx.textBaseline = 'bottom';
 }
 
 /** Iso-delay ellipses and markers of the simulated snapshot in the main view. */

@@ -3,7 +3,7 @@
 // through the view transform. Markers of the scene (nodes, targets, discs) are drawn from the
 // scene itself so they follow a drag at once.
 
-import { C, LINK_COLORS, FONT_B, FULL, ellipsePath, cross, haloText, drawAxes } from './draw.js';
+import { C, LINK_COLORS, FONT_B, FULL, ellipsePath, cross, haloText, drawAxes, ring, rxMarker, txMarker } from './draw.js';
 
 const BG = '#10141c';
 const DISC = 'rgba(150,160,178,0.55)';
@@ -114,34 +114,14 @@ function isSel(sel, kind, i) {
   return sel && sel.kind === kind && sel.index === i;
 }
 
-function ring(ctx, p, r) {
-  ctx.beginPath(); ctx.arc(p.x, p.y, r, 0, FULL);
-  ctx.lineWidth = 2; ctx.strokeStyle = C.sel; ctx.stroke();
-}
-
 function nodes(ctx, view, scene, sel) {
   ctx.font = FONT_B;
   ctx.textAlign = 'left';
   scene.receivers.forEach((q, i) => {
-    const p = view.toPixel(q[0], q[1]);
-    if (isSel(sel, 'rx', i)) ring(ctx, p, 11);
-    ctx.beginPath(); ctx.arc(p.x, p.y, 6, 0, FULL);
-    ctx.fillStyle = C.rx; ctx.fill();
-    ctx.lineWidth = 2; ctx.strokeStyle = '#1b1f27'; ctx.stroke();
-    ctx.fillStyle = C.rx;
-    ctx.textBaseline = 'bottom';
-    haloText(ctx, `Rx${i + 1}`, p.x + 9, p.y - 5);
+    rxMarker(ctx, view.toPixel(q[0], q[1]), `Rx${i + 1}`, isSel(sel, 'rx', i));
   });
   scene.transmitters.forEach((q, i) => {
-    const p = view.toPixel(q[0], q[1]);
-    if (isSel(sel, 'tx', i)) ring(ctx, p, 12);
-    ctx.beginPath();
-    ctx.moveTo(p.x, p.y - 9); ctx.lineTo(p.x + 8, p.y + 6); ctx.lineTo(p.x - 8, p.y + 6); ctx.closePath();
-    ctx.fillStyle = C.tx; ctx.fill();
-    ctx.lineWidth = 1.5; ctx.strokeStyle = '#1b1f27'; ctx.stroke();
-    ctx.fillStyle = C.tx;
-    ctx.textBaseline = 'top';
-    haloText(ctx, `Tx${i + 1}`, p.x + 9, p.y + 5);
+    txMarker(ctx, view.toPixel(q[0], q[1]), `Tx${i + 1}`, isSel(sel, 'tx', i));
   });
 }
 
