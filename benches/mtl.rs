@@ -15,8 +15,8 @@
 //!   (what one call costs) and with a warm one (`locate_cached` on a cache filled by an earlier
 //!   call: the algorithm without the §5.2 ellipse intersections); `locate` with the PPP model
 //!   (`λ`, `D`, `p_d` of the settings, region `R`), bound (M10) and exact (M11), cold and warm,
-//!   and M10 with its node tables memoised per location (`TableCached`, as the experiments and
-//!   the page run it).
+//!   and M10 with its node tables memoised on the 1 µm location grid (`TableCached::on_grid`,
+//!   as the experiments and the page run it).
 //! - `mtl_growth_targets_3x3`: `K = 1..10` targets (V-B otherwise, 16 seeds each): staged
 //!   (`locate`, i.c.b) vs `brute_force` (i.c.b) where the latter finishes in reasonable time.
 //! - `mtl_growth_trps_k2`: `N_t × N_r` = 3×3 … 6×6 with `K = 2` (V-B otherwise, 16 seeds each):
@@ -274,8 +274,9 @@ fn vb(c: &mut Criterion) {
         n,
         staged(&s, &cs, &cfg_node, |i| &m11[i]),
     );
-    // As the experiments and the page run it: node tables memoised per exact location within
-    // the call (`TableCached` on a fresh cache; the same `x` recurs across candidates).
+    // As the experiments and the page run it: node tables memoised on the 1 µm location grid
+    // within the call (`TableCached::on_grid` on a fresh cache; Algorithm 1 reaches the same
+    // least-squares point along several paths).
     cycle(&mut g, "staged_ppp_m10_table_cache", n, |i| {
         let tables = NodeTableCache::default();
         let model = TableCached::on_grid(&m10[i], &tables, TABLE_GRID_M);

@@ -261,3 +261,50 @@ pub fn checked_index(field: &'static str, index: usize, len: usize) -> Result<us
         Err(Error::IndexOutOfRange { field, index, len })
     }
 }
+
+/// `v` if finite, else [`Error::NonFinite`] naming `field`.
+pub(crate) fn check_finite(field: &str, v: f64) -> Result<()> {
+    if v.is_finite() {
+        Ok(())
+    } else {
+        Err(Error::NonFinite {
+            field: field.into(),
+        })
+    }
+}
+
+/// `v > 0`: [`Error::NonFinite`] when not finite, else [`Error::NotPositive`], naming `field`.
+pub(crate) fn check_positive(field: &str, v: f64) -> Result<()> {
+    check_finite(field, v)?;
+    if v > 0.0 {
+        Ok(())
+    } else {
+        Err(Error::NotPositive {
+            field: field.into(),
+            value: v,
+        })
+    }
+}
+
+/// `v ≥ 0`: [`Error::NonFinite`] for NaN (and `±∞` unless `allow_inf`), else
+/// [`Error::OutOfRange`] with `allowed`, naming `field`.
+pub(crate) fn check_non_negative(
+    field: &str,
+    v: f64,
+    allow_inf: bool,
+    allowed: &'static str,
+) -> Result<()> {
+    if v.is_nan() || (!allow_inf && v.is_infinite()) {
+        return Err(Error::NonFinite {
+            field: field.into(),
+        });
+    }
+    if v < 0.0 {
+        return Err(Error::OutOfRange {
+            field: field.into(),
+            value: v,
+            allowed,
+        });
+    }
+    Ok(())
+}

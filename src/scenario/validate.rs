@@ -5,19 +5,19 @@ use alloc::format;
 use alloc::vec::Vec;
 
 use super::{Area, Pattern, Scenario};
-use crate::error::{Error, Result};
+use crate::error::{check_finite, check_positive, Error, Result};
 
 impl Scenario {
     /// Checks every field; the first problem found is returned as a named error.
     pub fn validate(&self) -> Result<()> {
         let r = &self.radio;
-        positive("radio.carrier_hz", r.carrier_hz)?;
-        positive("radio.bandwidth_hz", r.bandwidth_hz)?;
+        check_positive("radio.carrier_hz", r.carrier_hz)?;
+        check_positive("radio.bandwidth_hz", r.bandwidth_hz)?;
         if r.noise_figure_db.is_some() && r.noise_power_dbm.is_some() {
             return Err(Error::AmbiguousNoise);
         }
         if let Some(nf) = r.noise_figure_db {
-            finite("radio.noise_figure_db", nf)?;
+            check_finite("radio.noise_figure_db", nf)?;
             if !(0.0..=100.0).contains(&nf) {
                 return Err(Error::OutOfRange {
                     field: "radio.noise_figure_db".into(),
@@ -27,10 +27,10 @@ impl Scenario {
             }
         }
         if let Some(p) = r.noise_power_dbm {
-            finite("radio.noise_power_dbm", p)?;
+            check_finite("radio.noise_power_dbm", p)?;
         }
         if let Some(g) = r.processing_gain_db {
-            finite("radio.processing_gain_db", g)?;
+            check_finite("radio.processing_gain_db", g)?;
             if g < 0.0 {
                 return Err(Error::OutOfRange {
                     field: "radio.processing_gain_db".into(),
@@ -51,20 +51,20 @@ impl Scenario {
         for (i, t) in self.transmitters.iter().enumerate() {
             unique_name(&mut names, &t.name)?;
             position(&format!("transmitters[{i}].position_m"), t.position_m)?;
-            finite(&format!("transmitters[{i}].power_dbm"), t.power_dbm)?;
-            finite(&format!("transmitters[{i}].gain_dbi"), t.gain_dbi)?;
+            check_finite(&format!("transmitters[{i}].power_dbm"), t.power_dbm)?;
+            check_finite(&format!("transmitters[{i}].gain_dbi"), t.gain_dbi)?;
             if let Pattern::Parabolic {
                 boresight_deg,
                 beamwidth_deg,
                 floor_db,
             } = t.pattern
             {
-                finite(
+                check_finite(
                     &format!("transmitters[{i}].pattern.boresight_deg"),
                     boresight_deg,
                 )?;
                 let bw = format!("transmitters[{i}].pattern.beamwidth_deg");
-                finite(&bw, beamwidth_deg)?;
+                check_finite(&bw, beamwidth_deg)?;
                 if !(beamwidth_deg > 0.0 && beamwidth_deg <= 360.0) {
                     return Err(Error::OutOfRange {
                         field: bw,
@@ -73,7 +73,7 @@ impl Scenario {
                     });
                 }
                 let fl = format!("transmitters[{i}].pattern.floor_db");
-                finite(&fl, floor_db)?;
+                check_finite(&fl, floor_db)?;
                 if floor_db < 0.0 {
                     return Err(Error::OutOfRange {
                         field: fl,
@@ -86,9 +86,9 @@ impl Scenario {
         for (i, rx) in self.receivers.iter().enumerate() {
             unique_name(&mut names, &rx.name)?;
             position(&format!("receivers[{i}].position_m"), rx.position_m)?;
-            finite(&format!("receivers[{i}].gain_dbi"), rx.gain_dbi)?;
+            check_finite(&format!("receivers[{i}].gain_dbi"), rx.gain_dbi)?;
         }
-        positive("target.rcs_m2", self.target.rcs_m2)?;
+        check_positive("target.rcs_m2", self.target.rcs_m2)?;
         area(&self.area_m)?;
         self.link_indices().map(|_| ())
     }
@@ -98,28 +98,6 @@ impl Area {
     /// Validates the rectangle (finite, min < max on both axes).
     pub fn validate(&self) -> Result<()> {
         area(self)
-    }
-}
-
-fn finite(field: &str, v: f64) -> Result<()> {
-    if v.is_finite() {
-        Ok(())
-    } else {
-        Err(Error::NonFinite {
-            field: field.into(),
-        })
-    }
-}
-
-fn positive(field: &str, v: f64) -> Result<()> {
-    finite(field, v)?;
-    if v > 0.0 {
-        Ok(())
-    } else {
-        Err(Error::NotPositive {
-            field: field.into(),
-            value: v,
-        })
     }
 }
 

@@ -2,7 +2,7 @@
 
 use alloc::vec::Vec;
 
-use crate::error::{Error, Result};
+use crate::error::{check_non_negative, Error, Result};
 use crate::math::Real;
 use crate::mtl::algorithm::{Measurements, MtlConfig};
 use crate::mtl::blocking::BlockingModel;
@@ -64,9 +64,14 @@ pub fn validate<B: BlockingModel + ?Sized>(
             });
         }
     }
-    check_non_negative("t_e", cfg.t_e, false)?;
-    check_non_negative("t_b", cfg.t_b, true)?;
-    check_non_negative("merge_radius_m", cfg.merge_radius_m, true)?;
+    check_non_negative("t_e", cfg.t_e, false, "a threshold ≥ 0")?;
+    check_non_negative("t_b", cfg.t_b, true, "a threshold ≥ 0")?;
+    check_non_negative(
+        "merge_radius_m",
+        cfg.merge_radius_m,
+        true,
+        "a threshold ≥ 0",
+    )?;
     if !input.c_sigma_m.is_finite() {
         return Err(Error::NonFinite {
             field: "c_sigma_m".into(),
@@ -112,21 +117,4 @@ pub fn validate<B: BlockingModel + ?Sized>(
         seen |= 1 << t;
     }
     Ok(order)
-}
-
-/// `v ≥ 0` (NaN refused; `+∞` allowed only when `allow_inf`).
-fn check_non_negative(field: &str, v: Real, allow_inf: bool) -> Result<()> {
-    if v.is_nan() || (!allow_inf && v.is_infinite()) {
-        return Err(Error::NonFinite {
-            field: field.into(),
-        });
-    }
-    if v < 0.0 {
-        return Err(Error::OutOfRange {
-            field: field.into(),
-            value: v,
-            allowed: "a threshold ≥ 0",
-        });
-    }
-    Ok(())
 }

@@ -33,7 +33,7 @@ use alloc::vec::Vec;
 
 use serde::{Deserialize, Serialize};
 
-use crate::error::{Error, Result};
+use crate::error::{check_non_negative, check_positive, Error, Result};
 use crate::math::{sqrt, Real, Vec2};
 use crate::mtl::blocking::check_probability;
 use crate::mtl::polygon::Rect;
@@ -225,12 +225,12 @@ impl MtlScene {
                 check_point(&rect, &format!("{name}[{i}]"), p)?;
             }
         }
-        positive("diameter", self.diameter)?;
-        non_negative("lambda", self.lambda)?;
+        check_positive("diameter", self.diameter)?;
+        check_non_negative("lambda", self.lambda, false, "a value ≥ 0")?;
         check_probability("p_d", self.p_d)?;
-        positive("range_sigma", self.range_sigma)?;
-        non_negative("resolution", self.resolution)?;
-        non_negative("clutter_mean", self.clutter_mean)?;
+        check_positive("range_sigma", self.range_sigma)?;
+        check_non_negative("resolution", self.resolution, false, "a value ≥ 0")?;
+        check_non_negative("clutter_mean", self.clutter_mean, false, "a value ≥ 0")?;
         if self.clutter_mean > MAX_VIEW_CLUTTER {
             return Err(Error::OutOfRange {
                 field: "clutter_mean".into(),
@@ -239,11 +239,11 @@ impl MtlScene {
             });
         }
         if let Some(r) = self.r_max {
-            positive("r_max", r)?;
+            check_positive("r_max", r)?;
         }
-        positive("detection_radius", self.detection_radius)?;
-        non_negative("t_e", self.t_e)?;
-        non_negative("t_b", self.t_b)?;
+        check_positive("detection_radius", self.detection_radius)?;
+        check_non_negative("t_e", self.t_e, false, "a value ≥ 0")?;
+        check_non_negative("t_b", self.t_b, false, "a value ≥ 0")?;
         if let BlockingChoice::Icb { p_u, p_los } = self.model {
             match (p_u, p_los) {
                 (Some(p), None) => check_probability("model.p_u", p).map(|_| ())?,
@@ -309,37 +309,6 @@ fn check_point(rect: &Rect, field: &str, p: &[Real; 2]) -> Result<()> {
             field: field.into(),
             value: out,
             allowed: "a position inside the region",
-        });
-    }
-    Ok(())
-}
-
-fn non_negative(field: &str, x: Real) -> Result<()> {
-    if !x.is_finite() {
-        return Err(Error::NonFinite {
-            field: field.into(),
-        });
-    }
-    if x < 0.0 {
-        return Err(Error::OutOfRange {
-            field: field.into(),
-            value: x,
-            allowed: "a value ≥ 0",
-        });
-    }
-    Ok(())
-}
-
-fn positive(field: &str, x: Real) -> Result<()> {
-    if !x.is_finite() {
-        return Err(Error::NonFinite {
-            field: field.into(),
-        });
-    }
-    if x <= 0.0 {
-        return Err(Error::NotPositive {
-            field: field.into(),
-            value: x,
         });
     }
     Ok(())
