@@ -7,6 +7,7 @@ use alloc::vec::Vec;
 use crate::math::{sqrt, Mat2, Real, Vec2};
 use crate::mtl::algorithm::{Measurements, Refinement};
 use crate::mtl::blocking::PartialVector;
+use crate::mtl::geometry::MAX_GRADIENT_CONDITION;
 use crate::mtl::trp::TrpMap;
 
 /// One (TRP, MPC) pair `(m, i)`: range `r_{m,i}` of TRP `m` (both 0-based).
@@ -121,45 +122,95 @@ impl Geometry<'_> {
         (r - self.d(m, x)).abs() / sigma
     }
 
+    /// `Σ_ℳ (r − d_m(x))²` with the normal equations `GᵀG`, `Gᵀe` of Gauss–Newton at `x`, in one
+    /// pass (two distances per pair).
+    fn normal_equations(&self, matching: &[Pair], x: &Vec2) -> NormalEquations {
+        let mut out = NormalEquations {
+            cost: 0.0,
+            gtg: Mat2::zeros(),
+            gtr: Vec2::zeros(),
+        };
+        for &p in matching {
+            let (u, v) = (
+                self.input.tx[self.map.tx(p.trp)],
+                self.input.rx[self.map.rx(p.trp)],
+            );
+            let (du, dv) = (x - u, x - v);
+            let (nu, nv) = (du.norm(), dv.norm());
+            let unit = |d: Vec2, n: Real| if n > 0.0 { d / n } else { Vec2::zeros() };
+            let g = unit(du, nu) + unit(dv, nv);
+            let e = self.range_of(p) - (nu + nv);
+            out.cost += e * e;
+            out.gtg += g * g.transpose();
+            out.gtr += g * e;
+        }
+        out
+    }
+
     /// Gauss–Newton on `Σ_ℳ (r − d_m(x))²` from `x0` (§4, \[P\]): at most `max_iterations`
     /// steps, stopping when `‖Δx‖ < step_tol_m`. A step that would increase the sum is halved
     /// (up to [`MAX_STEP_HALVINGS`] times, then the iteration stops), so the sum never grows and
-    /// ill-conditioned ghost matchings cannot diverge. Returns `None` when the normal matrix is
-    /// singular or the iterate stops being finite.
+    /// ill-conditioned ghost matchings cannot diverge; a step already shorter than `step_tol_m`
+    /// is taken if it does not increase the sum and ends the iteration either way (halving it
+    /// could only move `x` by less than the tolerance). Returns `None` when the iterate stops
+    /// being finite or the normal matrix is singular or numerically so: `cond(G)` above
+    /// [`MAX_GRADIENT_CONDITION`], the threshold at which §5.2 drops grazing intersections (two
+    /// ellipses that do not cross near `x`: their least-squares point is where the gradients are
+    /// parallel, and the Gauss–Newton step is meaningless there).
     pub fn refine(&self, matching: &[Pair], x0: Vec2, cfg: &Refinement) -> Option<Vec2> {
         let mut x = x0;
-        let mut cost = self.sum_sq(matching, &x);
+        let mut at = self.normal_equations(matching, &x);
         for _ in 0..cfg.max_iterations {
-            let mut gtg = Mat2::zeros();
-            let mut gtr = Vec2::zeros();
-            for &p in matching {
-                let g = self.grad(p.trp, &x);
-                let e = self.range_of(p) - self.d(p.trp, &x);
-                gtg += g * g.transpose();
-                gtr += g * e;
+            if !well_conditioned(&at.gtg) {
+                return None;
             }
-            let mut dx = gtg.try_inverse()? * gtr;
+            let mut dx = at.gtg.try_inverse()? * at.gtr;
             if !(dx.x.is_finite() && dx.y.is_finite()) {
                 return None;
             }
+            let converged = dx.norm() < cfg.step_tol_m;
+            let mut trial = self.normal_equations(matching, &(x + dx));
             let mut halvings = 0;
-            let mut next = self.sum_sq(matching, &(x + dx));
-            while next > cost && halvings < MAX_STEP_HALVINGS {
+            while trial.cost > at.cost && !converged && halvings < MAX_STEP_HALVINGS {
                 dx *= 0.5;
                 halvings += 1;
-                next = self.sum_sq(matching, &(x + dx));
+                trial.cost = self.sum_sq(matching, &(x + dx));
             }
-            if next > cost {
+            if trial.cost > at.cost {
                 break;
             }
             x += dx;
-            cost = next;
-            if dx.norm() < cfg.step_tol_m {
+            if converged || dx.norm() < cfg.step_tol_m {
                 break;
             }
+            at = if halvings == 0 {
+                trial
+            } else {
+                self.normal_equations(matching, &x)
+            };
         }
         Some(x)
     }
+}
+
+/// Whether `GᵀG` (symmetric, 2×2) has `cond(G) ≤` [`MAX_GRADIENT_CONDITION`]: with `λ_max` its
+/// larger eigenvalue, `cond(G)² = λ_max/λ_min = λ_max²/det`.
+fn well_conditioned(gtg: &Mat2) -> bool {
+    let (a, b, c) = (gtg[(0, 0)], gtg[(0, 1)], gtg[(1, 1)]);
+    let det = a * c - b * b;
+    let half = 0.5 * (a + c);
+    let lmax = half + sqrt((half * half - det).max(0.0));
+    det > 0.0 && lmax * lmax <= MAX_GRADIENT_CONDITION * MAX_GRADIENT_CONDITION * det
+}
+
+/// The Gauss–Newton quantities at one point (see [`Geometry::refine`]).
+struct NormalEquations {
+    /// `Σ e²`, m².
+    cost: Real,
+    /// `GᵀG`.
+    gtg: Mat2,
+    /// `Gᵀe`, m.
+    gtr: Vec2,
 }
 
 /// Largest number of step halvings per Gauss–Newton iteration in [`Geometry::refine`].

@@ -215,18 +215,36 @@ impl<'a, 'c, B: BlockingModel + ?Sized> Run<'a, 'c, B> {
                 g: nb,
                 ..c.clone()
             };
-            match self.geo.refine(&child.matching, c.x, &self.cfg.refinement) {
-                Some(x) if child.matching.len() >= 2 => {
+            match self.relocate(&child.matching, c.x) {
+                Some(x) => {
                     child.x = x;
                     self.test(child, out)?;
                 }
-                _ => self.record(&child, Status::Unlocatable),
+                None => self.record(&child, Status::Unlocatable),
             }
         }
         if heavier {
             self.test(c, out)?;
         }
         Ok(())
+    }
+
+    /// The location of a case-2b child (a pair removed) from `x`: `None` below two pairs; for
+    /// exactly two pairs the ellipse intersection (§5.2, as the seeds: the ML locations of a
+    /// size-2 matching) nearest to `x`, `None` when the two ellipses do not meet (their
+    /// least-squares point is then where the range gradients are parallel: no location);
+    /// otherwise Gauss–Newton from `x` (§4, \[P\]).
+    fn relocate(&mut self, matching: &[Pair], x: crate::math::Vec2) -> Option<crate::math::Vec2> {
+        match *matching {
+            [] | [_] => None,
+            [p, q] => self
+                .cache
+                .points(&self.geo, p, q)
+                .iter()
+                .copied()
+                .min_by(|a, b| (a - x).norm_squared().total_cmp(&(b - x).norm_squared())),
+            _ => self.geo.refine(matching, x, &self.cfg.refinement),
+        }
     }
 
     /// Score `c` (`L_b` from the model, `J` (M2)) and keep it iff it passes the stage blocking
