@@ -546,3 +546,43 @@ fn bad_inputs_are_named_errors() {
         .to_string()
         .contains("ranges[4][0]"));
 }
+
+/// Case 2b with two pairs left (§4 step 2; the \[P\] location rule of `stages::Run`): a child
+/// whose matching drops to two pairs sits on an intersection of its two ellipses (the ML
+/// locations of a size-2 matching, as the stage-2 seeds), never at a point off either ellipse.
+/// Checked on every kept two-pair candidate of the later stages of 40 noisy, cluttered,
+/// blocked instances under a node model (where case 2b occurs).
+#[test]
+fn two_pair_case_2b_children_sit_on_ellipse_intersections() {
+    let model = node_model(0.8, 0.9);
+    let cfg = MtlConfig {
+        trace: true,
+        ..MtlConfig::default()
+    };
+    let (tx, rx) = hexagon();
+    let map = map9();
+    let mut rng = simulate::rng(77, 12);
+    let (mut two_pair, mut unlocatable) = (0, 0);
+    for _ in 0..40 {
+        let inst = instance(&mut rng, 2, (0.8, 0.9), Noise::Gaussian(0.05), 2, 0.5);
+        let out = run(&inst.ranges, 0.05, &model, &cfg);
+        for stage in out.trace.iter().skip(1) {
+            for e in stage {
+                let c = &e.candidate;
+                if e.status == Status::Unlocatable {
+                    unlocatable += 1;
+                }
+                if e.status != Status::Kept || c.matching.len() != 2 {
+                    continue;
+                }
+                two_pair += 1;
+                for p in &c.matching {
+                    let (u, v) = (tx[map.tx(p.trp)], rx[map.rx(p.trp)]);
+                    let e = range(&c.x, &u, &v) - inst.ranges[p.trp][p.mpc];
+                    assert!(e.abs() < 1e-9, "{c:?}: residual {e}");
+                }
+            }
+        }
+    }
+    assert!(two_pair > 20 && unlocatable > 0, "{two_pair} {unlocatable}");
+}

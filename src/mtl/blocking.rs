@@ -326,15 +326,20 @@ impl BlockingSpace {
     /// `Σ_{g ∈ 𝒩(ĝ), g ≥ ĝ} p_d^{|ĝ|} (1 − p_d)^{|g|−|ĝ|} P(γ_S = g)`, 0 when `𝒩(ĝ) = ∅`
     /// (only "no error" and "one DP missed" terms enter). `p_d` is not validated here.
     pub fn relaxed_probability(&self, table: &NodeTable, v: &PartialVector, p_d: Real) -> Real {
-        let base = powu(p_d, v.weight());
-        let mut sum = 0.0;
-        self.for_each_neighbour(v, |g| {
-            if g.ones & v.ones == v.ones {
-                let extra = g.weight() - v.weight();
-                sum += base * powu(1.0 - p_d, extra) * self.marginal(table, &g);
+        // One pass over the node patterns: pattern `i` contributes to `P(γ_S = g)` for
+        // `g = (b ⊗ a)|_S`, which differs from `ĝ` by `d = g ⊕ ĝ`. The terms of (M5) are `g = ĝ`
+        // (`d = 0`, weight 1) and `g = ĝ` plus one DP (`d` one bit outside `ĝ`, weight `1 − p_d`);
+        // an inconsistent `g` has no pattern, so its marginal is 0 as the definition requires.
+        let (mut exact, mut one_missed) = (0.0, 0.0);
+        for (&pattern, &q) in self.patterns.iter().zip(&table.probs) {
+            let d = (pattern & v.set) ^ v.ones;
+            if d == 0 {
+                exact += q;
+            } else if d & (d - 1) == 0 && d & v.ones == 0 {
+                one_missed += q;
             }
-        });
-        sum
+        }
+        powu(p_d, v.weight()) * (exact + (1.0 - p_d) * one_missed)
     }
 }
 
@@ -664,6 +669,51 @@ mod tests {
         let v = PartialVector::full(&map, mask(&[1, 9])).unwrap();
         assert_eq!(model.probability(&x, &v).unwrap(), 0.0);
         assert_eq!(model.blocking_likelihood(&x, &v).unwrap(), Real::INFINITY);
+    }
+
+    /// The one-pass (M5) equals its definition: the sum over the unit-Hamming neighbours
+    /// `g ≥ ĝ` of `p_d^{|ĝ|} (1 − p_d)^{|g|−|ĝ|}` times the marginal (M4), on every partial vector
+    /// of 3×3 (all `3^9` assignments of "not processed / 0 / 1" to the TRPs).
+    #[test]
+    fn relaxed_probability_equals_its_definition() {
+        let map = TrpMap::new(3, 3).unwrap();
+        let node = IndependentNodes::new(
+            &map,
+            alloc::vec![0.9, 0.3, 0.7],
+            alloc::vec![0.6, 0.95, 0.2],
+        )
+        .unwrap();
+        let model = NodeBlockingModel::new(map, node, 0.85).unwrap();
+        let space = model.space();
+        let table = space.node_table(model.node_model(), &Vec2::zeros());
+        let p_d = model.p_d();
+        for code in 0..3usize.pow(9) {
+            let (mut set, mut ones, mut c) = (0u64, 0u64, code);
+            for m in 0..9 {
+                match c % 3 {
+                    1 => set |= 1 << m,
+                    2 => {
+                        set |= 1 << m;
+                        ones |= 1 << m;
+                    }
+                    _ => {}
+                }
+                c /= 3;
+            }
+            let v = PartialVector::new(&map, set, ones).unwrap();
+            let want: Real = space
+                .neighbours(&v)
+                .iter()
+                .filter(|g| g.ones() & ones == ones)
+                .map(|g| {
+                    powu(p_d, v.weight())
+                        * powu(1.0 - p_d, g.weight() - v.weight())
+                        * space.marginal(&table, g)
+                })
+                .sum();
+            let got = space.relaxed_probability(&table, &v, p_d);
+            assert!((got - want).abs() <= 1e-15, "{set:b} {ones:b}: {got} {want}");
+        }
     }
 
     #[test]

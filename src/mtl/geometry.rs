@@ -340,16 +340,39 @@ pub fn intersect_with(
     let h = |t: Real| e2.residual(at(cos(t), sin(t)));
     let n = INTERSECTION_SAMPLES;
     let step = 2.0 * PI / n as Real;
-    let mut theta = [0.0; INTERSECTION_SAMPLES + 1];
-    let mut hv = [0.0; INTERSECTION_SAMPLES + 1];
-    for k in 0..=n {
-        theta[k] = step * k as Real;
-        hv[k] = if k == n {
-            hv[0]
-        } else {
-            e2.residual(at(table.cos[k], table.sin[k]))
-        };
+    let theta = |k: usize| step * k as Real;
+    // h at sample k (k = n is sample 0), evaluated only where the scan needs it.
+    let h_at = |k: usize| {
+        let k = if k >= n { k - n } else { k };
+        e2.residual(at(table.cos[k], table.sin[k]))
+    };
+    // The scan: the sign of h(θ_k) is the sign of the implicit quadratic of ellipse 2,
+    // q(θ) = u²/a₂² + v²/b₂² − 1 in its axes (inside ⇔ d₂ < ρ₂), affine in cos θ, sin θ: no
+    // square roots. A degenerate ellipse 2 (the focal segment, b₂ = 0) is scanned with h itself.
+    let mut qv = [0.0; INTERSECTION_SAMPLES + 1];
+    let el2 = &e2.ellipse;
+    if el2.semi_minor > 0.0 {
+        let (c2, s2) = (cos(el2.angle_rad), sin(el2.angle_rad));
+        let (ax, ay) = (ca * el.semi_major, sa * el.semi_major);
+        let (bx, by) = (-sa * el.semi_minor, ca * el.semi_minor);
+        let d = el.center - el2.center;
+        let (u0, u1, u2) = (c2 * d.x + s2 * d.y, c2 * ax + s2 * ay, c2 * bx + s2 * by);
+        let (v0, v1, v2) = (c2 * d.y - s2 * d.x, c2 * ay - s2 * ax, c2 * by - s2 * bx);
+        let (ia, ib) = (
+            1.0 / (el2.semi_major * el2.semi_major),
+            1.0 / (el2.semi_minor * el2.semi_minor),
+        );
+        for ((q, &ct), &st) in qv.iter_mut().zip(&table.cos).zip(&table.sin) {
+            let u = u0 + u1 * ct + u2 * st;
+            let v = v0 + v1 * ct + v2 * st;
+            *q = u * u * ia + v * v * ib - 1.0;
+        }
+    } else {
+        for (k, q) in qv.iter_mut().enumerate().take(n) {
+            *q = h_at(k);
+        }
     }
+    qv[n] = qv[0];
     // Candidate roots (θ), more than 4 only through numerical duplicates.
     let mut cand = [0.0; 16];
     let mut nc = 0;
@@ -359,30 +382,55 @@ pub fn intersect_with(
             *nc += 1;
         }
     };
+    // Every sign change (or zero) of the scan is bracketed with h itself, then Brent-refined.
     for k in 0..n {
-        let (h0, h1) = (hv[k], hv[k + 1]);
+        let (q0, q1) = (qv[k], qv[k + 1]);
+        if q0 != 0.0 && q1 != 0.0 && (q0 > 0.0) == (q1 > 0.0) {
+            continue;
+        }
+        let (h0, h1) = (h_at(k), h_at(k + 1));
         if h0 == 0.0 {
-            add(theta[k], &mut nc);
+            add(theta(k), &mut nc);
         } else if h1 != 0.0 && (h0 > 0.0) != (h1 > 0.0) {
-            add(brent(&h, theta[k], theta[k + 1], h0, h1), &mut nc);
+            add(brent(&h, theta(k), theta(k + 1), h0, h1), &mut nc);
         }
     }
-    // Tangencies: local minima of |h| between samples of one sign.
+    // Tangencies: local minima of |h| between samples of one sign, looked for around the
+    // same-sign local minima of |q| (the same sampled points unless |h| and |q| peak at
+    // neighbouring samples, hence the three indices tested around each).
     let tang_tol = TANGENCY_REL_TOL * e2.range_m.abs();
+    let mut tested = [usize::MAX; 16];
+    let mut nt = 0;
     for k in 0..n {
-        let prev = hv[(k + n - 1) % n];
-        let (cur, next) = (hv[k], hv[k + 1]);
+        let (prev, cur, next) = (qv[(k + n - 1) % n], qv[k], qv[k + 1]);
         if cur == 0.0 || !(cur.abs() <= prev.abs() && cur.abs() <= next.abs()) {
             continue;
         }
         if (prev > 0.0) != (cur > 0.0) || (next > 0.0) != (cur > 0.0) {
             continue;
         }
-        let s = if cur > 0.0 { 1.0 } else { -1.0 };
-        let g = |t: Real| s * h(t);
-        let t = golden_min(&g, theta[k] - step, theta[k] + step);
-        if h(t).abs() < tang_tol {
-            add(t, &mut nc);
+        for j in [k + n - 1, k, k + 1] {
+            let j = j % n;
+            if tested[..nt].contains(&j) {
+                continue;
+            }
+            if nt < tested.len() {
+                tested[nt] = j;
+                nt += 1;
+            }
+            let (prev, cur, next) = (h_at(j + n - 1), h_at(j), h_at(j + 1));
+            if cur == 0.0 || !(cur.abs() <= prev.abs() && cur.abs() <= next.abs()) {
+                continue;
+            }
+            if (prev > 0.0) != (cur > 0.0) || (next > 0.0) != (cur > 0.0) {
+                continue;
+            }
+            let s = if cur > 0.0 { 1.0 } else { -1.0 };
+            let g = |t: Real| s * h(t);
+            let t = golden_min(&g, theta(j) - step, theta(j) + step);
+            if h(t).abs() < tang_tol {
+                add(t, &mut nc);
+            }
         }
     }
     // Points, merged and filtered.

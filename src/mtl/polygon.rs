@@ -210,13 +210,16 @@ pub fn node_rectangle(x: Vec2, node: Vec2, width: Real, region: Option<&Rect>) -
     let rect = segment_rectangle(x, node, width);
     match region {
         Some(r) => clip_convex(&rect, &r.polygon()),
-        None => {
-            if area(&rect) > 0.0 {
-                rect.to_vec()
-            } else {
-                Vec::new()
-            }
-        }
+        None => full_rectangle(&rect),
+    }
+}
+
+/// `rect` as a polygon, empty when it has no area (as [`node_rectangle`] without a region).
+pub fn full_rectangle(rect: &[Vec2; 4]) -> Vec<Vec2> {
+    if area(rect) > 0.0 {
+        rect.to_vec()
+    } else {
+        Vec::new()
     }
 }
 
@@ -239,7 +242,26 @@ pub fn intersection_area(polys: &[&[Vec2]]) -> Real {
 /// `T` (entry 0, the empty set, is 0). Subsets whose intersection is already empty are not
 /// extended. At most 24 polygons ([`Error::SizeLimit`] otherwise).
 pub fn subset_intersection_areas<P: AsRef<[Vec2]>>(polys: &[P]) -> Result<Vec<Real>> {
+    subset_intersection_areas_clipped(polys, polys)
+}
+
+/// [`subset_intersection_areas`] of `polys[i] = clippers[i] ∩ C` for one convex `C` (e.g. the
+/// rectangles `A_n` clipped to the region `R`): each subset's intersection starts from its first
+/// `polys[i]` (inside `C`) and is clipped by the other members' `clippers[j]` (a rectangle has 4
+/// edges where the clipped polygon may have 8; `∩_T polys = polys[i₀] ∩ ⋂_{T∖i₀} clippers`).
+/// `clippers` must have one convex polygon per entry of `polys` ([`Error::LengthMismatch`]).
+pub fn subset_intersection_areas_clipped<P: AsRef<[Vec2]>, Q: AsRef<[Vec2]>>(
+    polys: &[P],
+    clippers: &[Q],
+) -> Result<Vec<Real>> {
     let n = polys.len();
+    if clippers.len() != n {
+        return Err(Error::LengthMismatch {
+            field: "clippers",
+            expected: n,
+            found: clippers.len(),
+        });
+    }
     if n > 24 {
         return Err(Error::SizeLimit {
             field: "polygons",
@@ -249,7 +271,7 @@ pub fn subset_intersection_areas<P: AsRef<[Vec2]>>(polys: &[P]) -> Result<Vec<Re
         });
     }
     let mut out = alloc::vec![0.0; 1usize << n];
-    let signs: Vec<Real> = polys.iter().map(|p| orientation(p.as_ref())).collect();
+    let signs: Vec<Real> = clippers.iter().map(|p| orientation(p.as_ref())).collect();
     // Depth-first over subsets in increasing index order, carrying the running intersection.
     // Polygons live in one arena: the top stack entry's polygon is always the arena's tail.
     let mut stack: Vec<(usize, usize, usize, usize)> = Vec::new();
@@ -271,7 +293,7 @@ pub fn subset_intersection_areas<P: AsRef<[Vec2]>>(polys: &[P]) -> Result<Vec<Re
         cur.clear();
         cur.extend_from_slice(&arena[start..start + len]);
         arena.truncate(start);
-        for (j, q) in polys.iter().enumerate().skip(last + 1) {
+        for (j, q) in clippers.iter().enumerate().skip(last + 1) {
             let a = clipper.clip(&cur, q.as_ref(), signs[j]);
             if a == 0.0 {
                 continue;

@@ -15,7 +15,9 @@ use alloc::vec::Vec;
 use crate::error::{Error, Result};
 use crate::math::{exp, Real, Vec2};
 use crate::mtl::blocking::NodePatternModel;
-use crate::mtl::polygon::{node_rectangle, subset_intersection_areas, Rect};
+use crate::mtl::polygon::{
+    clip_convex, full_rectangle, segment_rectangle, subset_intersection_areas_clipped, Rect,
+};
 
 /// Largest `N_t + N_r` the PPP model accepts (its area tables have `2^(N_t+N_r)` entries).
 pub const MAX_PPP_NODES: usize = 20;
@@ -120,12 +122,19 @@ impl PppBlocking {
                 max: MAX_PPP_NODES,
             });
         }
-        let rects: Vec<Vec<Vec2>> = tx
+        let full: Vec<[Vec2; 4]> = tx
             .iter()
             .chain(rx.iter())
-            .map(|node| node_rectangle(x, *node, self.diameter, self.region.as_ref()))
+            .map(|node| segment_rectangle(x, *node, self.diameter))
             .collect();
-        let intersections = subset_intersection_areas(&rects)?;
+        let rects: Vec<Vec<Vec2>> = match &self.region {
+            Some(r) => {
+                let region = r.polygon();
+                full.iter().map(|a| clip_convex(a, &region)).collect()
+            }
+            None => full.iter().map(full_rectangle).collect(),
+        };
+        let intersections = subset_intersection_areas_clipped(&rects, &full)?;
         // Union areas of every node set: zeta transform of (−1)^{|T|+1} |∩_T A_n|.
         let mut union = intersections.clone();
         for (t, u) in union.iter_mut().enumerate() {

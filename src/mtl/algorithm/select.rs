@@ -5,7 +5,7 @@ use alloc::vec::Vec;
 use core::cmp::Ordering;
 
 use crate::math::Real;
-use crate::mtl::algorithm::candidate::{Candidate, Pair};
+use crate::mtl::algorithm::candidate::Candidate;
 use crate::mtl::algorithm::{FinalTest, MtlConfig, Status, Target};
 
 /// Resolution (nats) at which scores `J` are compared: candidates whose `J` truncate to the same
@@ -33,16 +33,20 @@ pub fn prune(
     mut cands: Vec<Candidate>,
     b_max: usize,
 ) -> (Vec<Candidate>, Vec<(Candidate, Status)>) {
-    cands.sort_by(by_score);
+    // Group identical (ℳ, ĝ) with the lowest score first in each group (no key copies).
+    let same = |a: &Candidate, b: &Candidate| {
+        a.matching
+            .cmp(&b.matching)
+            .then(a.g.set().cmp(&b.g.set()))
+            .then(a.g.ones().cmp(&b.g.ones()))
+    };
+    cands.sort_by(|a, b| same(a, b).then_with(|| by_score(a, b)));
     let mut dropped = Vec::new();
-    let mut seen: BTreeMap<(Vec<Pair>, u64, u64), ()> = BTreeMap::new();
-    let mut unique = Vec::with_capacity(cands.len());
+    let mut unique: Vec<Candidate> = Vec::with_capacity(cands.len());
     for c in cands {
-        let key = (c.matching.clone(), c.g.set(), c.g.ones());
-        if seen.insert(key, ()).is_some() {
-            dropped.push((c, Status::Duplicate));
-        } else {
-            unique.push(c);
+        match unique.last() {
+            Some(u) if same(u, &c) == Ordering::Equal => dropped.push((c, Status::Duplicate)),
+            _ => unique.push(c),
         }
     }
     unique.sort_by(|a, b| a.family.cmp(&b.family).then_with(|| by_score(a, b)));
