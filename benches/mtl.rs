@@ -35,13 +35,13 @@
 //!   4×4 one realisation took ≈ 6 s (`IndependentNodes`) and ≈ 32 s (PPP M10), so both are
 //!   benched at 3×3 only; 5×5 and 6×6 (1024 and 4096 patterns) are further out of reach.
 //!
-//! Where the time goes (perf, 3×3): with i.c.b ≈ 80 % of a cold `locate` is the §5.2 ellipse
-//! intersection (720 samples per ellipse pair, a `sincos` each; ≈ 390 MPC pairs per
-//! realisation), hence the warm-cache case; with the PPP model the cache hardly matters: each
-//! `L_b` query (≈ 4600 per realisation at ≈ 2100 distinct locations) computes the
-//! rectangle-intersection table (≈ 44 convex clips, ≈ 6 µs) unless `TableCached` has it, and the
-//! consistency branching evaluates more candidates than i.c.b (`IndependentNodes`, whose table
-//! is free, takes ≈ 12 ms per realisation).
+//! Where the time goes (perf, 3×3): with i.c.b the §5.2 ellipse intersections are ≈ 60 % of a
+//! cold `locate` (≈ 390 MPC pairs per realisation, the 720-sample scan on the implicit quadratic),
+//! hence the warm-cache case; with the PPP model the cache hardly matters: ≈ 3 700 `L_b` queries
+//! per realisation each need the rectangle-intersection table at their location (≈ 44 convex
+//! clips) unless `TableCached` has it, ≈ 30 % of the memoised run, and the consistency branching
+//! scores about 2.5× the candidates of i.c.b (`IndependentNodes`, whose table is cheap, takes
+//! ≈ 3.9 ms per realisation).
 //!
 //! Run: `cargo bench --bench mtl` (about 2 minutes here; shorter: filter by group name).
 
@@ -260,7 +260,7 @@ fn vb(c: &mut Criterion) {
         n,
         staged_warm(&s, &cs, &cfg_icb, |_| &icb),
     );
-    // ≈ 0.1 s per call: 10 samples over 8 s cover the 64 realisations about once.
+    // ≈ 16 ms per call without the table memo: 10 samples over 8 s cover the 64 realisations.
     g.sample_size(10).measurement_time(Duration::from_secs(8));
     cycle(
         &mut g,

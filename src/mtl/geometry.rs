@@ -242,6 +242,16 @@ fn golden_min<F: Fn(Real) -> Real>(g: &F, mut lo: Real, mut hi: Real) -> Real {
     }
 }
 
+/// Whether `cur` (non-zero) is a local minimum of `|·|` among three neighbouring samples of one
+/// sign (a tangency candidate of §5.2).
+fn same_sign_local_min(prev: Real, cur: Real, next: Real) -> bool {
+    cur != 0.0
+        && cur.abs() <= prev.abs()
+        && cur.abs() <= next.abs()
+        && (prev > 0.0) == (cur > 0.0)
+        && (next > 0.0) == (cur > 0.0)
+}
+
 /// Intersection points of two TRP ellipses (§5.2, a \[P\] choice): ellipse 1 is parametrized, `h(θ) =
 /// d₂(p(θ)) − ρ₂` sampled at [`INTERSECTION_SAMPLES`] points, every sign change Brent-refined,
 /// tangencies (local minima of `|h|` below [`TANGENCY_REL_TOL`]`·ρ₂`) added, roots closer than
@@ -402,11 +412,7 @@ pub fn intersect_with(
     let mut tested = [usize::MAX; 16];
     let mut nt = 0;
     for k in 0..n {
-        let (prev, cur, next) = (qv[(k + n - 1) % n], qv[k], qv[k + 1]);
-        if cur == 0.0 || !(cur.abs() <= prev.abs() && cur.abs() <= next.abs()) {
-            continue;
-        }
-        if (prev > 0.0) != (cur > 0.0) || (next > 0.0) != (cur > 0.0) {
+        if !same_sign_local_min(qv[(k + n - 1) % n], qv[k], qv[k + 1]) {
             continue;
         }
         for j in [k + n - 1, k, k + 1] {
@@ -418,11 +424,8 @@ pub fn intersect_with(
                 tested[nt] = j;
                 nt += 1;
             }
-            let (prev, cur, next) = (h_at(j + n - 1), h_at(j), h_at(j + 1));
-            if cur == 0.0 || !(cur.abs() <= prev.abs() && cur.abs() <= next.abs()) {
-                continue;
-            }
-            if (prev > 0.0) != (cur > 0.0) || (next > 0.0) != (cur > 0.0) {
+            let cur = h_at(j);
+            if !same_sign_local_min(h_at(j + n - 1), cur, h_at(j + 1)) {
                 continue;
             }
             let s = if cur > 0.0 { 1.0 } else { -1.0 };
