@@ -358,8 +358,14 @@ pub fn intersect_with(
     };
     // The scan: the sign of h(θ_k) is the sign of the implicit quadratic of ellipse 2,
     // q(θ) = u²/a₂² + v²/b₂² − 1 in its axes (inside ⇔ d₂ < ρ₂), affine in cos θ, sin θ: no
-    // square roots. A degenerate ellipse 2 (the focal segment, b₂ = 0) is scanned with h itself.
+    // square roots. q is a trigonometric polynomial of degree 2, so |q'| ≤ L (its amplitudes):
+    // a stretch of COARSE samples whose end values satisfy |q_a| + |q_b| > L·Δ + 2ε holds no
+    // root and has |q| > ε throughout (no tangency either), and its inner samples are skipped.
+    // A degenerate ellipse 2 (the focal segment, b₂ = 0) is scanned with h itself, in full.
+    const COARSE: usize = 8;
+    const STRETCHES: usize = INTERSECTION_SAMPLES / COARSE;
     let mut qv = [0.0; INTERSECTION_SAMPLES + 1];
+    let mut active = [true; STRETCHES];
     let el2 = &e2.ellipse;
     if el2.semi_minor > 0.0 {
         let (c2, s2) = (cos(el2.angle_rad), sin(el2.angle_rad));
@@ -372,17 +378,55 @@ pub fn intersect_with(
             1.0 / (el2.semi_major * el2.semi_major),
             1.0 / (el2.semi_minor * el2.semi_minor),
         );
-        for ((q, &ct), &st) in qv.iter_mut().zip(&table.cos).zip(&table.sin) {
+        let q_at = |k: usize| {
+            let (ct, st) = (table.cos[k], table.sin[k]);
             let u = u0 + u1 * ct + u2 * st;
             let v = v0 + v1 * ct + v2 * st;
-            *q = u * u * ia + v * v * ib - 1.0;
+            u * u * ia + v * v * ib - 1.0
+        };
+        // q = K0 + K1 cos θ + K2 sin θ + K3 cos 2θ + K4 sin 2θ.
+        let k0 = ia * (u0 * u0 + 0.5 * (u1 * u1 + u2 * u2))
+            + ib * (v0 * v0 + 0.5 * (v1 * v1 + v2 * v2))
+            - 1.0;
+        let (k1, k2) = (
+            2.0 * (ia * u0 * u1 + ib * v0 * v1),
+            2.0 * (ia * u0 * u2 + ib * v0 * v2),
+        );
+        let (k3, k4) = (
+            0.5 * (ia * (u1 * u1 - u2 * u2) + ib * (v1 * v1 - v2 * v2)),
+            ia * u1 * u2 + ib * v1 * v2,
+        );
+        let (amp1, amp2) = (sqrt(k1 * k1 + k2 * k2), sqrt(k3 * k3 + k4 * k4));
+        let lipschitz = amp1 + 2.0 * amp2;
+        let eps = 1e-6 * (1.0 + k0.abs() + amp1 + amp2);
+        let reach = lipschitz * step * COARSE as Real + 2.0 * eps;
+        for i in 0..STRETCHES {
+            qv[i * COARSE] = q_at(i * COARSE);
+        }
+        qv[n] = qv[0];
+        for (i, live) in active.iter_mut().enumerate() {
+            let (a, b) = (i * COARSE, (i + 1) * COARSE);
+            *live = qv[a].abs() + qv[b].abs() <= reach;
+            if *live {
+                for (k, q) in qv.iter_mut().enumerate().take(b).skip(a + 1) {
+                    *q = q_at(k);
+                }
+            }
         }
     } else {
         for (k, q) in qv.iter_mut().enumerate().take(n) {
             *q = h_at(k);
         }
+        qv[n] = qv[0];
     }
-    qv[n] = qv[0];
+    // Samples k of the active stretches (k = n is sample 0 again).
+    let live_samples = || {
+        active
+            .iter()
+            .enumerate()
+            .filter(|(_, &live)| live)
+            .flat_map(|(i, _)| i * COARSE..(i + 1) * COARSE)
+    };
     // Candidate roots (θ), more than 4 only through numerical duplicates.
     let mut cand = [0.0; 16];
     let mut nc = 0;
@@ -393,7 +437,7 @@ pub fn intersect_with(
         }
     };
     // Every sign change (or zero) of the scan is bracketed with h itself, then Brent-refined.
-    for k in 0..n {
+    for k in live_samples() {
         let (q0, q1) = (qv[k], qv[k + 1]);
         if q0 != 0.0 && q1 != 0.0 && (q0 > 0.0) == (q1 > 0.0) {
             continue;
@@ -407,12 +451,15 @@ pub fn intersect_with(
     }
     // Tangencies: local minima of |h| between samples of one sign, looked for around the
     // same-sign local minima of |q| (the same sampled points unless |h| and |q| peak at
-    // neighbouring samples, hence the three indices tested around each).
+    // neighbouring samples, hence the three indices tested around each). Samples whose
+    // neighbour lies in a skipped stretch are not candidates (|q| > ε there).
     let tang_tol = TANGENCY_REL_TOL * e2.range_m.abs();
+    let live_at = |k: usize| active[(k % n) / COARSE];
     let mut tested = [usize::MAX; 16];
     let mut nt = 0;
-    for k in 0..n {
-        if !same_sign_local_min(qv[(k + n - 1) % n], qv[k], qv[k + 1]) {
+    for k in live_samples() {
+        let prev = (k + n - 1) % n;
+        if !live_at(prev) || !same_sign_local_min(qv[prev], qv[k], qv[k + 1]) {
             continue;
         }
         for j in [k + n - 1, k, k + 1] {
