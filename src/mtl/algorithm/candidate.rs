@@ -46,6 +46,14 @@ impl Candidate {
             .collect()
     }
 
+    /// A copy with an empty matching (no allocation), for building a child with its own.
+    pub fn without_matching(&self) -> Candidate {
+        Candidate {
+            matching: Vec::new(),
+            ..*self
+        }
+    }
+
     /// Number of (TRP, MPC) pairs two matchings share.
     pub fn shared_pairs(a: &[Pair], b: &[Pair]) -> usize {
         a.iter().filter(|p| b.contains(p)).count()

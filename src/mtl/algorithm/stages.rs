@@ -162,13 +162,16 @@ impl<'a, 'c, B: BlockingModel + ?Sized> Run<'a, 'c, B> {
                 continue;
             }
             any = true;
-            let mut matching = c.matching.clone();
-            matching.push(Pair { trp: m, mpc: i });
-            matching.sort_unstable();
+            let pair = Pair { trp: m, mpc: i };
+            let mut matching = Vec::with_capacity(c.matching.len() + 1);
+            let at = c.matching.partition_point(|p| *p < pair);
+            matching.extend_from_slice(&c.matching[..at]);
+            matching.push(pair);
+            matching.extend_from_slice(&c.matching[at..]);
             let mut child = Candidate {
                 matching,
                 g: c.g.with(m, true),
-                ..c.clone()
+                ..c.without_matching()
             };
             match self.geo.refine(&child.matching, c.x, &self.cfg.refinement) {
                 Some(x) => {
@@ -213,7 +216,7 @@ impl<'a, 'c, B: BlockingModel + ?Sized> Run<'a, 'c, B> {
             let mut child = Candidate {
                 matching: c.without(trp),
                 g: nb,
-                ..c.clone()
+                ..c.without_matching()
             };
             match self.relocate(&child.matching, c.x) {
                 Some(x) => {
