@@ -35,13 +35,15 @@
 //!   4×4 one realisation took ≈ 6 s (`IndependentNodes`) and ≈ 32 s (PPP M10), so both are
 //!   benched at 3×3 only; 5×5 and 6×6 (1024 and 4096 patterns) are further out of reach.
 //!
-//! Where the time goes (perf, 3×3): with i.c.b the §5.2 ellipse intersections are ≈ 60 % of a
-//! cold `locate` (≈ 390 MPC pairs per realisation, the 720-sample scan on the implicit quadratic),
+//! Where the time goes (perf, 3×3): with i.c.b the §5.2 ellipse intersections are ≈ 40 % of a
+//! cold `locate` (≈ 390 MPC pairs per realisation, the 720-sample scan on the implicit quadratic
+//! with stretches skipped by its Lipschitz bound),
 //! hence the warm-cache case; with the PPP model the cache hardly matters: ≈ 3 700 `L_b` queries
 //! per realisation each need the rectangle-intersection table at their location (≈ 44 convex
-//! clips) unless `TableCached` has it, ≈ 30 % of the memoised run, and the consistency branching
+//! clips, ≈ 3.8 µs) unless `TableCached` has it (≈ 470 cells per realisation), ≈ 40 % of the
+//! memoised run, and the consistency branching
 //! scores about 2.5× the candidates of i.c.b (`IndependentNodes`, whose table is cheap, takes
-//! ≈ 3.9 ms per realisation).
+//! ≈ 3.4 ms per realisation).
 //!
 //! Run: `cargo bench --bench mtl` (about 2 minutes here; shorter: filter by group name).
 
