@@ -367,7 +367,9 @@ pub fn intersect_with(
     let mut qv = [0.0; INTERSECTION_SAMPLES + 1];
     let mut active = [true; STRETCHES];
     let el2 = &e2.ellipse;
-    if el2.semi_minor > 0.0 {
+    // 1/b₂² overflows for a nearly degenerate ellipse: scan h itself then too.
+    let implicit = el2.semi_minor > 0.0 && (1.0 / (el2.semi_minor * el2.semi_minor)).is_finite();
+    if implicit {
         let (c2, s2) = (cos(el2.angle_rad), sin(el2.angle_rad));
         let (ax, ay) = (ca * el.semi_major, sa * el.semi_major);
         let (bx, by) = (-sa * el.semi_minor, ca * el.semi_minor);
@@ -406,7 +408,8 @@ pub fn intersect_with(
         qv[n] = qv[0];
         for (i, live) in active.iter_mut().enumerate() {
             let (a, b) = (i * COARSE, (i + 1) * COARSE);
-            *live = qv[a].abs() + qv[b].abs() <= reach;
+            // A bound that is not finite skips nothing (`!(x > reach)` is true for NaN).
+            *live = !(qv[a].abs() + qv[b].abs() > reach);
             if *live {
                 for (k, q) in qv.iter_mut().enumerate().take(b).skip(a + 1) {
                     *q = q_at(k);
