@@ -408,8 +408,9 @@ pub fn intersect_with(
         qv[n] = qv[0];
         for (i, live) in active.iter_mut().enumerate() {
             let (a, b) = (i * COARSE, (i + 1) * COARSE);
-            // A bound that is not finite skips nothing (`!(x > reach)` is true for NaN).
-            *live = !(qv[a].abs() + qv[b].abs() > reach);
+            // A bound that is not a number skips nothing.
+            let ends = qv[a].abs() + qv[b].abs();
+            *live = ends <= reach || ends.is_nan() || reach.is_nan();
             if *live {
                 for (k, q) in qv.iter_mut().enumerate().take(b).skip(a + 1) {
                     *q = q_at(k);
