@@ -32,8 +32,9 @@
 //! - PPP model (both variants) and `IndependentNodes` vs TRPs: every blocking query evaluates all
 //!   `2^(N_t+N_r)` node patterns (PPP: plus the convex clipping of all `2^(N_t+N_r)` rectangle
 //!   intersections, from scratch at every location), and the candidates multiply with `M`; at
-//!   4×4 one realisation took ≈ 6 s (`IndependentNodes`) and ≈ 32 s (PPP M10), so both are
-//!   benched at 3×3 only; 5×5 and 6×6 (1024 and 4096 patterns) are further out of reach.
+//!   4×4 one realisation took ≈ 6 s (`IndependentNodes`) and ≈ 32 s (PPP M10) before the
+//!   case-2b two-pair rule, 0.10–0.37 s (`IndependentNodes`) after it, while 5×5 still takes
+//!   9–223 s; both are benched at 3×3 only (4×4 would dominate the bench's run time).
 //!
 //! Where the time goes (perf, 3×3): with i.c.b the §5.2 ellipse intersections are ≈ 40 % of a
 //! cold `locate` (≈ 390 MPC pairs per realisation, the 720-sample scan on the implicit quadratic
