@@ -305,7 +305,10 @@ fn intersection_scan_finds_every_sampled_sign_change_of_h() {
     let mut total = 0;
     for _ in 0..2000 {
         let mut ell = || loop {
-            let (u, w) = (v(rnd(0.0, 10.0), rnd(0.0, 10.0)), v(rnd(0.0, 10.0), rnd(0.0, 10.0)));
+            let (u, w) = (
+                v(rnd(0.0, 10.0), rnd(0.0, 10.0)),
+                v(rnd(0.0, 10.0), rnd(0.0, 10.0)),
+            );
             if let Some(e) = RangeEllipse::new(u, w, rnd(6.0, 30.0)) {
                 break e;
             }

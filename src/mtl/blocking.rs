@@ -279,27 +279,16 @@ impl BlockingSpace {
     /// The unit-Hamming neighbour set `𝒩(ĝ) = {g ∈ 𝒞_S : d_H(g, ĝ) ≤ 1}` (M5), all on the same
     /// `S`: `ĝ` itself first if consistent, then the single-bit flips in ascending TRP order.
     pub fn neighbours(&self, v: &PartialVector) -> Vec<PartialVector> {
-        let mut out = Vec::new();
-        self.for_each_neighbour(v, |g| out.push(g));
-        out
-    }
-
-    fn for_each_neighbour(&self, v: &PartialVector, mut f: impl FnMut(PartialVector)) {
-        if self.is_consistent(v) {
-            f(*v);
-        }
-        let mut rest = v.set;
-        while rest != 0 {
-            let bit = rest & rest.wrapping_neg();
-            rest &= rest - 1;
-            let g = PartialVector {
+        let flips = (0..64)
+            .filter(|m| v.set >> m & 1 == 1)
+            .map(|m| PartialVector {
                 set: v.set,
-                ones: v.ones ^ bit,
-            };
-            if self.is_consistent(&g) {
-                f(g);
-            }
-        }
+                ones: v.ones ^ 1 << m,
+            });
+        core::iter::once(*v)
+            .chain(flips)
+            .filter(|g| self.is_consistent(g))
+            .collect()
     }
 
     /// `P_node` of every node pattern at `x`, indexed like [`BlockingSpace::pattern`]; evaluate
@@ -713,7 +702,10 @@ mod tests {
                 })
                 .sum();
             let got = space.relaxed_probability(&table, &v, p_d);
-            assert!((got - want).abs() <= 1e-15, "{set:b} {ones:b}: {got} {want}");
+            assert!(
+                (got - want).abs() <= 1e-15,
+                "{set:b} {ones:b}: {got} {want}"
+            );
         }
     }
 

@@ -207,19 +207,15 @@ pub fn segment_rectangle(x: Vec2, node: Vec2, width: Real) -> [Vec2; 4] {
 
 /// The rectangle `A_n` of §6.2, clipped to `region` when one is given.
 pub fn node_rectangle(x: Vec2, node: Vec2, width: Real, region: Option<&Rect>) -> Vec<Vec2> {
-    let rect = segment_rectangle(x, node, width);
-    match region {
-        Some(r) => clip_convex(&rect, &r.polygon()),
-        None => full_rectangle(&rect),
-    }
+    rectangle_in_region(&segment_rectangle(x, node, width), region)
 }
 
-/// `rect` as a polygon, empty when it has no area (as [`node_rectangle`] without a region).
-pub fn full_rectangle(rect: &[Vec2; 4]) -> Vec<Vec2> {
-    if area(rect) > 0.0 {
-        rect.to_vec()
-    } else {
-        Vec::new()
+/// `rect` clipped to `region` when one is given, else as it is; empty when it has no area.
+pub fn rectangle_in_region(rect: &[Vec2; 4], region: Option<&Rect>) -> Vec<Vec2> {
+    match region {
+        Some(r) => clip_convex(rect, &r.polygon()),
+        None if area(rect) > 0.0 => rect.to_vec(),
+        None => Vec::new(),
     }
 }
 

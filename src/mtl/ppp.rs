@@ -16,7 +16,7 @@ use crate::error::{Error, Result};
 use crate::math::{exp, Real, Vec2};
 use crate::mtl::blocking::NodePatternModel;
 use crate::mtl::polygon::{
-    clip_convex, full_rectangle, segment_rectangle, subset_intersection_areas_clipped, Rect,
+    rectangle_in_region, segment_rectangle, subset_intersection_areas_clipped, Rect,
 };
 
 /// Largest `N_t + N_r` the PPP model accepts (its area tables have `2^(N_t+N_r)` entries).
@@ -127,13 +127,10 @@ impl PppBlocking {
             .chain(rx.iter())
             .map(|node| segment_rectangle(x, *node, self.diameter))
             .collect();
-        let rects: Vec<Vec<Vec2>> = match &self.region {
-            Some(r) => {
-                let region = r.polygon();
-                full.iter().map(|a| clip_convex(a, &region)).collect()
-            }
-            None => full.iter().map(full_rectangle).collect(),
-        };
+        let rects: Vec<Vec<Vec2>> = full
+            .iter()
+            .map(|a| rectangle_in_region(a, self.region.as_ref()))
+            .collect();
         let intersections = subset_intersection_areas_clipped(&rects, &full)?;
         // Union areas of every node set: zeta transform of (−1)^{|T|+1} |∩_T A_n|.
         let mut union = intersections.clone();

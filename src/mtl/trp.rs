@@ -114,6 +114,12 @@ impl TrpMap {
     pub fn range_gradient(&self, m: usize, x: &Vec2, tx: &[Vec2], rx: &[Vec2]) -> Vec2 {
         range_gradient(x, &tx[self.tx(m)], &rx[self.rx(m)])
     }
+
+    /// [`TrpMap::range`] and [`TrpMap::range_gradient`] in one pass (see
+    /// [`range_and_gradient`]). Same panics.
+    pub fn range_and_gradient(&self, m: usize, x: &Vec2, tx: &[Vec2], rx: &[Vec2]) -> (Real, Vec2) {
+        range_and_gradient(x, &tx[self.tx(m)], &rx[self.rx(m)])
+    }
 }
 
 /// The mask of bits `0..n` (`n ≤ 64`).
@@ -136,12 +142,23 @@ pub fn range_gradient(x: &Vec2, u: &Vec2, v: &Vec2) -> Vec2 {
     unit(&(x - u)) + unit(&(x - v))
 }
 
+/// [`range`] and [`range_gradient`] together, from the two distances computed once (the same
+/// values, bitwise).
+pub fn range_and_gradient(x: &Vec2, u: &Vec2, v: &Vec2) -> (Real, Vec2) {
+    let (du, dv) = (x - u, x - v);
+    let (nu, nv) = (norm(&du), norm(&dv));
+    (nu + nv, unit_with_norm(&du, nu) + unit_with_norm(&dv, nv))
+}
+
 fn norm(d: &Vec2) -> Real {
     sqrt(d.x * d.x + d.y * d.y)
 }
 
 fn unit(d: &Vec2) -> Vec2 {
-    let n = norm(d);
+    unit_with_norm(d, norm(d))
+}
+
+fn unit_with_norm(d: &Vec2, n: Real) -> Vec2 {
     if n > 0.0 {
         d / n
     } else {

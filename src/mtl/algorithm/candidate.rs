@@ -139,15 +139,10 @@ impl Geometry<'_> {
             gtr: Vec2::zeros(),
         };
         for &p in matching {
-            let (u, v) = (
-                self.input.tx[self.map.tx(p.trp)],
-                self.input.rx[self.map.rx(p.trp)],
-            );
-            let (du, dv) = (x - u, x - v);
-            let (nu, nv) = (du.norm(), dv.norm());
-            let unit = |d: Vec2, n: Real| if n > 0.0 { d / n } else { Vec2::zeros() };
-            let g = unit(du, nu) + unit(dv, nv);
-            let e = self.range_of(p) - (nu + nv);
+            let (d, g) = self
+                .map
+                .range_and_gradient(p.trp, x, self.input.tx, self.input.rx);
+            let e = self.range_of(p) - d;
             out.cost += e * e;
             out.gtg += g * g.transpose();
             out.gtr += g * e;

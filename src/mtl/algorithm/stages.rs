@@ -5,6 +5,7 @@
 use alloc::vec::Vec;
 
 use crate::error::Result;
+use crate::math::Vec2;
 use crate::mtl::algorithm::cache::IntersectionCache;
 use crate::mtl::algorithm::candidate::{Candidate, Geometry, Pair};
 use crate::mtl::algorithm::{select, Measurements, MtlConfig, Status, TraceEntry};
@@ -237,7 +238,7 @@ impl<'a, 'c, B: BlockingModel + ?Sized> Run<'a, 'c, B> {
     /// size-2 matching) nearest to `x`, `None` when the two ellipses do not meet (their
     /// least-squares point is then where the range gradients are parallel: no location);
     /// otherwise Gauss–Newton from `x` (§4, \[P\]).
-    fn relocate(&mut self, matching: &[Pair], x: crate::math::Vec2) -> Option<crate::math::Vec2> {
+    fn relocate(&mut self, matching: &[Pair], x: Vec2) -> Option<Vec2> {
         match *matching {
             [] | [_] => None,
             [p, q] => self
