@@ -128,6 +128,16 @@ struct Clipper {
 }
 
 impl Clipper {
+    /// A clipper whose buffers hold `n` vertices before they grow.
+    fn with_capacity(n: usize) -> Self {
+        Clipper {
+            out: Vec::with_capacity(n),
+            tmp: Vec::with_capacity(n),
+            sides: Vec::with_capacity(n),
+            unchanged: false,
+        }
+    }
+
     /// Clips `subject` by the convex `clip` of orientation `sign` ([`orientation`]) into
     /// `self.out`; returns the area of the result (0 when it has none).
     ///
@@ -213,9 +223,10 @@ pub fn node_rectangle(x: Vec2, node: Vec2, width: Real, region: Option<&Rect>) -
 /// `rect` clipped to `region` when one is given, else as it is; empty when it has no area.
 pub fn rectangle_in_region(rect: &[Vec2; 4], region: Option<&Rect>) -> Vec<Vec2> {
     match region {
-        Some(r) => clip_convex(rect, &r.polygon()),
-        None if area(rect) > 0.0 => rect.to_vec(),
-        None => Vec::new(),
+        // Inside the region: what the clip would return (the rectangle as it is).
+        Some(r) if !rect.iter().all(|p| r.contains(*p)) => clip_convex(rect, &r.polygon()),
+        _ if area(rect) > 0.0 => rect.to_vec(),
+        _ => Vec::new(),
     }
 }
 
@@ -270,8 +281,8 @@ pub fn subset_intersection_areas_clipped<P: AsRef<[Vec2]>, Q: AsRef<[Vec2]>>(
     let signs: Vec<Real> = clippers.iter().map(|p| orientation(p.as_ref())).collect();
     // Depth-first over subsets in increasing index order, carrying the running intersection.
     // Polygons live in one arena: the top stack entry's polygon is always the arena's tail.
-    let mut stack: Vec<(usize, usize, usize, usize)> = Vec::new();
-    let mut arena: Vec<Vec2> = Vec::new();
+    let mut stack: Vec<(usize, usize, usize, usize)> = Vec::with_capacity(n * (n + 1) / 2 + 1);
+    let mut arena: Vec<Vec2> = Vec::with_capacity(16 * (n * (n + 1) / 2 + 1));
     for (i, p) in polys.iter().enumerate() {
         let p = p.as_ref();
         let a = area(p);
@@ -283,8 +294,8 @@ pub fn subset_intersection_areas_clipped<P: AsRef<[Vec2]>, Q: AsRef<[Vec2]>>(
     }
     // `same_as[m] = m'` (≠ 0): `∩_m` is `∩_{m'}`, filled in after the search.
     let mut same_as = alloc::vec![0usize; 1usize << n];
-    let mut cur = Vec::new();
-    let mut clipper = Clipper::default();
+    let mut cur = Vec::with_capacity(32);
+    let mut clipper = Clipper::with_capacity(32);
     while let Some((mask, last, start, len)) = stack.pop() {
         cur.clear();
         cur.extend_from_slice(&arena[start..start + len]);
