@@ -40,9 +40,10 @@
 //! cold `locate` (≈ 390 MPC pairs per realisation, the 720-sample scan on the implicit quadratic
 //! with stretches skipped by its Lipschitz bound),
 //! hence the warm-cache case; with the PPP model the cache hardly matters: ≈ 3 700 `L_b` queries
-//! per realisation each need the rectangle-intersection table at their location (≈ 44 convex
-//! clips, ≈ 3.8 µs) unless `TableCached` has it (≈ 470 cells per realisation), ≈ 40 % of the
-//! memoised run, and the consistency branching
+//! per realisation each need the rectangle-intersection table at their location (≈ 45 convex
+//! clips, one per rectangle subset whose intersection has area) unless `TableCached` has it
+//! (≈ 470 cells per realisation), about half of the memoised run; the late seeds with their
+//! catch-up take ≈ 70 % of it; and the consistency branching
 //! scores about 2.5× the candidates of i.c.b (`IndependentNodes`, whose table is cheap, takes
 //! ≈ 3.4 ms per realisation).
 //!
