@@ -38,14 +38,13 @@
 //!
 //! Where the time goes (perf, 3×3): with i.c.b the §5.2 ellipse intersections are ≈ 40 % of a
 //! cold `locate` (≈ 390 MPC pairs per realisation, the 720-sample scan on the implicit quadratic
-//! with stretches skipped by its Lipschitz bound),
-//! hence the warm-cache case; with the PPP model the cache hardly matters: ≈ 3 700 `L_b` queries
-//! per realisation each need the rectangle-intersection table at their location (≈ 45 convex
-//! clips, one per rectangle subset whose intersection has area) unless `TableCached` has it
-//! (≈ 470 cells per realisation), about half of the memoised run; the late seeds with their
-//! catch-up take ≈ 70 % of it; and the consistency branching
-//! scores about 2.5× the candidates of i.c.b (`IndependentNodes`, whose table is cheap, takes
-//! ≈ 3.4 ms per realisation).
+//! with stretches skipped by its Lipschitz bound), hence the warm-cache case. With the PPP model
+//! the cache hardly matters: ≈ 3 700 `L_b` queries per realisation each need the
+//! rectangle-intersection table at their location (≈ 45 convex clips, one per rectangle subset
+//! whose intersection has area) unless `TableCached` has it (≈ 470 cells per realisation), about
+//! half of the memoised run; the late seeds with their catch-up take ≈ 70 % of it, and the
+//! consistency branching scores about 2.5× the candidates of i.c.b (`IndependentNodes`, whose
+//! table is cheap, takes ≈ 3.4 ms per realisation).
 //!
 //! Run: `cargo bench --bench mtl` (about 2 minutes here; shorter: filter by group name).
 

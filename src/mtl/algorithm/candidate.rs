@@ -46,6 +46,17 @@ impl Candidate {
             .collect()
     }
 
+    /// The matching with `pair` inserted at its place (kept sorted by TRP; `pair`'s TRP must not
+    /// be matched yet).
+    pub fn with_pair(&self, pair: Pair) -> Vec<Pair> {
+        let at = self.matching.partition_point(|p| *p < pair);
+        let mut out = Vec::with_capacity(self.matching.len() + 1);
+        out.extend_from_slice(&self.matching[..at]);
+        out.push(pair);
+        out.extend_from_slice(&self.matching[at..]);
+        out
+    }
+
     /// A copy with an empty matching (no allocation), for building a child with its own.
     pub fn without_matching(&self) -> Candidate {
         Candidate {

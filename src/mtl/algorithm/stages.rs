@@ -163,14 +163,8 @@ impl<'a, 'c, B: BlockingModel + ?Sized> Run<'a, 'c, B> {
                 continue;
             }
             any = true;
-            let pair = Pair { trp: m, mpc: i };
-            let mut matching = Vec::with_capacity(c.matching.len() + 1);
-            let at = c.matching.partition_point(|p| *p < pair);
-            matching.extend_from_slice(&c.matching[..at]);
-            matching.push(pair);
-            matching.extend_from_slice(&c.matching[at..]);
             let mut child = Candidate {
-                matching,
+                matching: c.with_pair(Pair { trp: m, mpc: i }),
                 g: c.g.with(m, true),
                 ..c.without_matching()
             };
