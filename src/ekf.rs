@@ -45,6 +45,34 @@ pub enum MeasurementNoise<'a> {
     At(Vec2),
 }
 
+impl MeasurementNoise<'_> {
+    /// `σ_p` of link `link`, s, for a filter whose predicted position is `r_pred`.
+    pub fn sigma(&self, model: &Model, link: usize, r_pred: Vec2) -> Real {
+        match *self {
+            MeasurementNoise::Fixed(s) => s[link],
+            MeasurementNoise::AtPrediction => model.sigma_delay(link, r_pred),
+            MeasurementNoise::At(r) => model.sigma_delay(link, r),
+        }
+    }
+}
+
+/// The filter's predicted measurement of one link: `h_p(r̂⁻)` (E1) and the innovation standard
+/// deviation `√S_pp`, `S_pp = J_p P_rr J_pᵀ + σ_p²` (E3, spec §6), both in seconds.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PredictedDelay {
+    /// `h_p(r̂⁻)`, s.
+    pub delay_s: Real,
+    /// `√S_pp`, s.
+    pub innovation_sigma_s: Real,
+}
+
+impl PredictedDelay {
+    /// `|τ − h_p(r̂⁻)| / √S_pp`: the normalised innovation of a candidate delay.
+    pub fn normalized_innovation(&self, delay_s: Real) -> Real {
+        (delay_s - self.delay_s).abs() / self.innovation_sigma_s
+    }
+}
+
 /// Outcome of one update.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct UpdateSummary {
@@ -214,6 +242,43 @@ impl Ekf {
         self.predict(motion);
         self.update(model, z, noise, None)
             .inspect_err(|_| *self = before)
+    }
+
+    /// The predicted measurement of every link at the current state (call after
+    /// [`Ekf::predict`]): `h_p(r̂⁻)` and `√S_pp` with `σ_p` from `noise`. A `σ_p` that is not
+    /// finite and `> 0` is [`Error::InvalidSigma`]; `Fixed` noise of the wrong length is
+    /// [`Error::LengthMismatch`].
+    pub fn predicted_delays(
+        &self,
+        model: &Model,
+        noise: MeasurementNoise,
+    ) -> Result<alloc::vec::Vec<PredictedDelay>> {
+        let n = model.link_count();
+        if let MeasurementNoise::Fixed(s) = noise {
+            if s.len() != n {
+                return Err(Error::LengthMismatch {
+                    field: "sigma_s",
+                    expected: n,
+                    found: s.len(),
+                });
+            }
+        }
+        let r = self.position();
+        let p_rr = self.covariance.fixed_view::<2, 2>(0, 0).into_owned();
+        (0..n)
+            .map(|link| {
+                let sigma = noise.sigma(model, link, r);
+                if !positive_finite(sigma) {
+                    return Err(Error::InvalidSigma { link, value: sigma });
+                }
+                let j = model.network.jacobian_row(link, r);
+                let s = (j.transpose() * p_rr * j)[0] + sigma * sigma;
+                Ok(PredictedDelay {
+                    delay_s: model.network.delay(link, r),
+                    innovation_sigma_s: sqrt(s),
+                })
+            })
+            .collect()
     }
 
     /// Normalised estimation error squared `(x̂ − x)ᵀ P⁻¹ (x̂ − x)` against a true state;

@@ -12,6 +12,9 @@
 //! - [`crlb`]: Fisher matrix, CRLB and the fast map kernel (E8, S18–S24).
 //! - [`lm`]: weighted Levenberg–Marquardt snapshot fix (E5–E6).
 //! - [`simulate`]: seeded noisy delays.
+//! - [`calibration`], [`association`]: the calibration stage, 3σ gating (E4) and the association
+//!   of the remaining delays to the scatterer (spec §4); [`raw_snapshot`] simulates the
+//!   estimator's per-snapshot lists; [`gated_track`] runs the EKF on them.
 //! - [`snapshot`]: one simulated snapshot with its ellipses, fix and CRLB (what the page draws).
 //! - [`track_view`]: a simulated track's steps as the page draws them (snapshot-shaped frames).
 //! - [`edit`], [`session`]: validated, rolled-back scenario edits for interactive front ends.
@@ -21,6 +24,8 @@
 
 extern crate alloc;
 
+pub mod association;
+pub mod calibration;
 #[cfg(feature = "std")]
 pub mod chart;
 pub mod colormap;
@@ -29,6 +34,7 @@ pub mod edit;
 pub mod ekf;
 pub mod ellipse;
 pub mod error;
+pub mod gated_track;
 pub mod geometry;
 pub mod lm;
 pub mod math;
@@ -41,6 +47,7 @@ pub mod parallel;
 pub mod pattern;
 pub mod pcrlb;
 pub mod presets;
+pub mod raw_snapshot;
 pub mod scenario;
 pub mod session;
 pub mod simulate;

@@ -242,11 +242,7 @@ fn first_input_error(
         if !zi.is_finite() {
             return Some(Error::NonFiniteDelay { link });
         }
-        let sigma = match noise {
-            MeasurementNoise::Fixed(s) => s[link],
-            MeasurementNoise::AtPrediction => model.sigma_delay(link, r_pred),
-            MeasurementNoise::At(r) => model.sigma_delay(link, r),
-        };
+        let sigma = noise.sigma(model, link, r_pred);
         if !(positive_finite(sigma) && information_from_sigma(sigma).is_finite()) {
             return Some(Error::InvalidSigma { link, value: sigma });
         }

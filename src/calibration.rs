@@ -1,0 +1,364 @@
+//! Calibration stage and 3σ gating (spec §4, [S] §3.1–3.2, [I] §III-A/B).
+//!
+//! With no mobile object in the area (`Q = 0`) every link records `⌊T_cal/T_g⌋` snapshots, each a
+//! list of estimated delays `τ̂` (from a parameter estimator such as KEST, which is outside this
+//! crate). The delays of one link are clustered into its static paths `r = 0 … R_kl` (the LoS is
+//! the earliest, index 0), each stored as a mean `τ̄_kl,r` and a standard deviation `σ̄_kl,r`.
+//! In the estimation stage a delay is *static* and discarded when it lies within `3σ̄` of a
+//! cluster mean (E4); the rest are the candidates of the mobile scatterer.
+//!
+//! The default clusterer is the spec's **[choice]** (delay only): sort all calibration delays of
+//! the link, split where consecutive values differ by more than the gap `g = 1/B`, drop clusters
+//! holding fewer than 50 % of the snapshots (counted as the snapshots with a delay in the
+//! cluster, so one snapshot's repeated estimates count once), and floor `σ̄` at `σ_min = 0.01/B`.
+//! Estimator false alarms recorded during calibration are a known weakness of this delay-only
+//! rule: when they are denser than one per `g` they chain into one wide cluster that holds
+//! most snapshots and then gates the echo as well; calibrate with a detection threshold that
+//! keeps them sparse (X-means on amplitude, as the papers, separates them). X-means on
+//! (amplitude, delay), which the papers use, would sit behind the same [`LinkCalibration`].
+
+use alloc::format;
+use alloc::vec::Vec;
+
+use crate::error::{Error, Result};
+use crate::math::{sqrt, Real};
+
+/// The gate's half-width in cluster standard deviations (E4).
+pub const GATE_SIGMAS: Real = 3.0;
+
+/// Largest number of calibration snapshots accepted per link.
+pub const MAX_CALIBRATION_SNAPSHOTS: usize = 1_000_000;
+
+/// Largest number of delays accepted in one link's calibration (all snapshots together).
+pub const MAX_CALIBRATION_DELAYS: usize = 10_000_000;
+
+/// Settings of the default delay-only clusterer (spec §4 **[choice]**).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ClusterConfig {
+    /// Split between sorted consecutive delays further apart than this, s (`g`, default `1/B`).
+    pub gap_s: Real,
+    /// Keep a cluster only if it holds at least this fraction of the snapshots (default 0.5).
+    pub min_fraction: Real,
+    /// Floor of a cluster's standard deviation, s (`σ_min`, default `0.01/B`).
+    pub sigma_floor_s: Real,
+}
+
+impl ClusterConfig {
+    /// The spec's defaults for a receiver bandwidth `B` (Hz): `g = 1/B`, 50 %, `σ_min = 0.01/B`.
+    pub fn for_bandwidth(bandwidth_hz: Real) -> Result<ClusterConfig> {
+        if !(bandwidth_hz.is_finite() && bandwidth_hz > 0.0) {
+            return Err(Error::NotPositive {
+                field: "radio.bandwidth_hz".into(),
+                value: bandwidth_hz,
+            });
+        }
+        Ok(ClusterConfig {
+            gap_s: 1.0 / bandwidth_hz,
+            min_fraction: 0.5,
+            sigma_floor_s: 0.01 / bandwidth_hz,
+        })
+    }
+
+    /// Checks the settings: a finite gap and floor `> 0`, a fraction in `[0, 1]`.
+    pub fn validate(&self) -> Result<()> {
+        for (field, v) in [
+            ("calibration.gap_s", self.gap_s),
+            ("calibration.sigma_floor_s", self.sigma_floor_s),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(Error::NotPositive {
+                    field: field.into(),
+                    value: v,
+                });
+            }
+        }
+        if !(0.0..=1.0).contains(&self.min_fraction) {
+            return Err(Error::OutOfRange {
+                field: "calibration.min_fraction".into(),
+                value: self.min_fraction,
+                allowed: "0 … 1",
+            });
+        }
+        Ok(())
+    }
+}
+
+/// One static path of a link: `τ̄_kl,r` and `σ̄_kl,r`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StaticCluster {
+    /// Cluster mean `τ̄`, s.
+    pub mean_s: Real,
+    /// Cluster standard deviation `σ̄` (sample, floored at `σ_min`), s.
+    pub sigma_s: Real,
+    /// Calibration delays in the cluster.
+    pub count: usize,
+    /// Calibration snapshots with at least one delay in the cluster (the 50 % rule counts these).
+    pub snapshots: usize,
+}
+
+impl StaticCluster {
+    /// `|τ − τ̄| ≤ 3σ̄` (E4).
+    #[inline]
+    pub fn contains(&self, delay_s: Real) -> bool {
+        (delay_s - self.mean_s).abs() <= GATE_SIGMAS * self.sigma_s
+    }
+}
+
+/// The static paths of one link, ascending in delay (index 0 is the LoS when it was seen).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct LinkCalibration {
+    /// The kept clusters, ascending in mean delay.
+    pub clusters: Vec<StaticCluster>,
+}
+
+impl LinkCalibration {
+    /// Clusters the calibration snapshots of link `link` (each a list of delay estimates, s)
+    /// with the default clusterer. Errors: no snapshots or too many (`SizeLimit`), a non-finite
+    /// delay (`NonFinite`, naming the snapshot), invalid settings.
+    pub fn from_snapshots(
+        link: usize,
+        snapshots: &[Vec<Real>],
+        cfg: &ClusterConfig,
+    ) -> Result<LinkCalibration> {
+        cfg.validate()?;
+        if snapshots.is_empty() || snapshots.len() > MAX_CALIBRATION_SNAPSHOTS {
+            return Err(Error::SizeLimit {
+                field: "calibration snapshots per link",
+                value: snapshots.len(),
+                min: 1,
+                max: MAX_CALIBRATION_SNAPSHOTS,
+            });
+        }
+        let total: usize = snapshots.iter().map(Vec::len).sum();
+        if total > MAX_CALIBRATION_DELAYS {
+            return Err(Error::SizeLimit {
+                field: "calibration delays per link",
+                value: total,
+                min: 0,
+                max: MAX_CALIBRATION_DELAYS,
+            });
+        }
+        // (delay, snapshot index), sorted by delay.
+        let mut delays = Vec::with_capacity(total);
+        for (k, snapshot) in snapshots.iter().enumerate() {
+            for (i, &d) in snapshot.iter().enumerate() {
+                if !d.is_finite() {
+                    return Err(Error::NonFinite {
+                        field: format!("calibration[{link}][{k}][{i}]"),
+                    });
+                }
+                delays.push((d, k));
+            }
+        }
+        delays.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        let needed = cfg.min_fraction * snapshots.len() as Real;
+        let mut clusters = Vec::new();
+        let mut seen = Vec::new();
+        let mut start = 0;
+        for end in 1..=delays.len() {
+            if end == delays.len() || delays[end].0 - delays[end - 1].0 > cfg.gap_s {
+                let members = &delays[start..end];
+                seen.clear();
+                seen.extend(members.iter().map(|m| m.1));
+                seen.sort_unstable();
+                seen.dedup();
+                if seen.len() as Real >= needed {
+                    clusters.push(cluster_of(members, seen.len(), cfg.sigma_floor_s));
+                }
+                start = end;
+            }
+        }
+        Ok(LinkCalibration { clusters })
+    }
+
+    /// A link calibration from given clusters (e.g. read back from JSON): every mean finite and
+    /// every `σ̄` finite and `> 0`; sorted by mean.
+    pub fn from_clusters(link: usize, mut clusters: Vec<StaticCluster>) -> Result<LinkCalibration> {
+        for (r, c) in clusters.iter().enumerate() {
+            if !c.mean_s.is_finite() {
+                return Err(Error::NonFinite {
+                    field: format!("calibration.links[{link}].clusters[{r}].mean_s"),
+                });
+            }
+            if !(c.sigma_s.is_finite() && c.sigma_s > 0.0) {
+                return Err(Error::NotPositive {
+                    field: format!("calibration.links[{link}].clusters[{r}].sigma_s"),
+                    value: c.sigma_s,
+                });
+            }
+        }
+        clusters.sort_by(|a, b| a.mean_s.total_cmp(&b.mean_s));
+        Ok(LinkCalibration { clusters })
+    }
+
+    /// E4: `τ̂` is static iff some cluster has `|τ̂ − τ̄_r| ≤ 3σ̄_r`.
+    pub fn is_static(&self, delay_s: Real) -> bool {
+        self.clusters.iter().any(|c| c.contains(delay_s))
+    }
+}
+
+/// Mean and sample standard deviation (`n − 1`; 0 for one member) floored at `floor` of
+/// `(delay, snapshot)` members seen in `snapshots` distinct snapshots.
+fn cluster_of(members: &[(Real, usize)], snapshots: usize, floor: Real) -> StaticCluster {
+    let n = members.len() as Real;
+    let mean = members.iter().map(|m| m.0).sum::<Real>() / n;
+    let ss: Real = members.iter().map(|m| (m.0 - mean) * (m.0 - mean)).sum();
+    let sigma = if members.len() > 1 {
+        sqrt(ss / (n - 1.0))
+    } else {
+        0.0
+    };
+    StaticCluster {
+        mean_s: mean,
+        sigma_s: sigma.max(floor),
+        count: members.len(),
+        snapshots,
+    }
+}
+
+/// The calibration of every link of a scenario, in scenario link order.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Calibration {
+    /// Per link, its static clusters.
+    pub links: Vec<LinkCalibration>,
+}
+
+impl Calibration {
+    /// Clusters every link's calibration snapshots (`per_link[p]` = link `p`'s snapshots).
+    pub fn from_snapshots(per_link: &[Vec<Vec<Real>>], cfg: &ClusterConfig) -> Result<Calibration> {
+        let links = per_link
+            .iter()
+            .enumerate()
+            .map(|(p, s)| LinkCalibration::from_snapshots(p, s, cfg))
+            .collect::<Result<Vec<_>>>()?;
+        Ok(Calibration { links })
+    }
+
+    /// Number of links calibrated.
+    pub fn link_count(&self) -> usize {
+        self.links.len()
+    }
+
+    /// Checks that there is one entry per link of a model with `links` links.
+    pub fn check_links(&self, links: usize) -> Result<()> {
+        if self.links.len() != links {
+            return Err(Error::LengthMismatch {
+                field: "calibration.links",
+                expected: links,
+                found: self.links.len(),
+            });
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use alloc::vec;
+
+    const B: Real = 120e6;
+
+    #[test]
+    fn clusters_split_at_the_gap_and_drop_sparse_ones() {
+        let cfg = ClusterConfig::for_bandwidth(B).unwrap();
+        // Four snapshots: a path at 40 ns (every snapshot), one at 60 ns (every snapshot), a
+        // spurious 80 ns once (25 % < 50 %: dropped).
+        let s = vec![
+            vec![40.0e-9, 60.0e-9],
+            vec![40.2e-9, 60.2e-9, 80.0e-9],
+            vec![39.8e-9, 59.8e-9],
+            vec![40.0e-9, 60.0e-9],
+        ];
+        let c = LinkCalibration::from_snapshots(0, &s, &cfg).unwrap();
+        assert_eq!(c.clusters.len(), 2);
+        assert!((c.clusters[0].mean_s - 40.0e-9).abs() < 1e-15);
+        assert!((c.clusters[1].mean_s - 60.0e-9).abs() < 1e-15);
+        assert_eq!((c.clusters[0].count, c.clusters[1].count), (4, 4));
+        assert_eq!(c.clusters[0].snapshots, 4);
+        // Sample std of {39.8, 40, 40, 40.2} ns = √(0.08/3) ns (above the floor 0.01/B = 0.083 ns).
+        assert!((c.clusters[0].sigma_s - sqrt(0.08 / 3.0) * 1e-9).abs() < 1e-18);
+        assert!(c.is_static(40.2e-9) && !c.is_static(41.0e-9) && !c.is_static(80.0e-9));
+    }
+
+    #[test]
+    fn identical_delays_get_the_sigma_floor() {
+        let cfg = ClusterConfig::for_bandwidth(B).unwrap();
+        let c = LinkCalibration::from_snapshots(0, &[vec![50e-9], vec![50e-9]], &cfg).unwrap();
+        assert_eq!(c.clusters[0].sigma_s, 0.01 / B);
+        assert!(c.is_static(50e-9 + 2.9 * 0.01 / B));
+        assert!(!c.is_static(50e-9 + 3.1 * 0.01 / B));
+    }
+
+    #[test]
+    fn delays_closer_than_the_gap_chain_into_one_cluster() {
+        // 5 ns steps < g = 8.33 ns chain; a 9 ns step splits.
+        let cfg = ClusterConfig::for_bandwidth(B).unwrap();
+        let s = vec![vec![10e-9, 15e-9, 20e-9, 29e-9]];
+        let c = LinkCalibration::from_snapshots(0, &s, &cfg).unwrap();
+        let counts: Vec<usize> = c.clusters.iter().map(|c| c.count).collect();
+        assert_eq!(counts, vec![3, 1]);
+    }
+
+    #[test]
+    fn bad_calibrations_are_named_errors() {
+        let cfg = ClusterConfig::for_bandwidth(B).unwrap();
+        let e = LinkCalibration::from_snapshots(2, &[], &cfg).unwrap_err();
+        assert!(matches!(e, Error::SizeLimit { value: 0, .. }), "{e}");
+        let e =
+            LinkCalibration::from_snapshots(2, &[vec![1e-8], vec![Real::NAN]], &cfg).unwrap_err();
+        assert_eq!(e.to_string(), "calibration[2][1][0]: not a finite number");
+        let bad = ClusterConfig {
+            min_fraction: 1.5,
+            ..cfg
+        };
+        assert!(LinkCalibration::from_snapshots(0, &[vec![]], &bad).is_err());
+        assert!(ClusterConfig::for_bandwidth(0.0).is_err());
+        let e = LinkCalibration::from_clusters(
+            1,
+            vec![StaticCluster {
+                mean_s: 1e-8,
+                sigma_s: 0.0,
+                count: 1,
+                snapshots: 1,
+            }],
+        )
+        .unwrap_err();
+        assert!(
+            e.to_string()
+                .starts_with("calibration.links[1].clusters[0].sigma_s"),
+            "{e}"
+        );
+        let cal = Calibration::default();
+        assert!(matches!(
+            cal.check_links(4),
+            Err(Error::LengthMismatch {
+                expected: 4,
+                found: 0,
+                ..
+            })
+        ));
+    }
+
+    #[test]
+    fn the_fifty_percent_rule_counts_snapshots_not_delays() {
+        // One snapshot of four with three estimates near 70 ns: 4 delays but 1 snapshot of 4.
+        let cfg = ClusterConfig::for_bandwidth(B).unwrap();
+        let s = vec![
+            vec![40e-9, 70e-9, 70.5e-9, 71e-9],
+            vec![40e-9],
+            vec![40e-9],
+            vec![40e-9],
+        ];
+        let c = LinkCalibration::from_snapshots(0, &s, &cfg).unwrap();
+        assert_eq!(c.clusters.len(), 1);
+        assert_eq!((c.clusters[0].count, c.clusters[0].snapshots), (4, 4));
+    }
+
+    #[test]
+    fn an_empty_snapshot_list_gates_nothing() {
+        let cfg = ClusterConfig::for_bandwidth(B).unwrap();
+        let c = LinkCalibration::from_snapshots(0, &[vec![], vec![]], &cfg).unwrap();
+        assert!(c.clusters.is_empty() && !c.is_static(1e-8));
+    }
+}

@@ -1,0 +1,253 @@
+//! The calibration stage, 3σ gating and association (spec §4): spec check 12, the calibration
+//! of a simulated static channel, and the EKF fed through gating and association on the
+//! synthetic stand-in of the measurement case (spec §9.6: a 60 s loop through L4 with blind-zone
+//! dropouts and delay noise from E8).
+//!
+//! Every tolerance is derived next to its assertion (binomial Monte Carlo error, the sampling
+//! error of a calibrated σ̄); the runs are seeded, so each test is deterministic.
+
+use scatterloc::association::{select, AssociationRule, Choice};
+use scatterloc::calibration::{Calibration, ClusterConfig, LinkCalibration, StaticCluster};
+use scatterloc::ekf::{Ekf, MeasurementNoise};
+use scatterloc::gated_track::GatedTracker;
+use scatterloc::math::{erfc, sqrt, Real, Vec2, Vec4};
+use scatterloc::motion::ConstantVelocity;
+use scatterloc::raw_snapshot::StaticChannel;
+use scatterloc::trajectory::paper_initial_covariance;
+use scatterloc::{presets, simulate, Model};
+
+/// Spec check 12: the probability that a Gaussian static estimate falls within 3σ, 0.9973.
+const P_GATE: Real = 0.9973;
+
+fn bandwidth() -> Real {
+    presets::sensors2019().radio.bandwidth_hz
+}
+
+/// L4 with one static reflector (a wall corner), static paths jittering by 0.3 ns and, unless
+/// zeroed, 0.5 false alarms per link and snapshot over 200 ns.
+fn channel(false_alarms: Real) -> StaticChannel {
+    StaticChannel {
+        reflectors_m: vec![Vec2::new(6.0, 18.0)],
+        static_sigma_s: 0.3e-9,
+        static_amplitude: 30.0,
+        resolution_s: 1.0 / bandwidth(),
+        false_alarms,
+        false_alarm_span_s: 200e-9,
+    }
+}
+
+fn model() -> Model {
+    Model::new(&presets::sensors2019()).unwrap()
+}
+
+/// Check 12 in closed form and by Monte Carlo on a known cluster: `P(|τ − τ̄| ≤ 3σ̄) =
+/// 1 − erfc(3/√2) = 0.99730020`. With n = 10⁶ draws the removed fraction's standard error is
+/// √(p(1 − p)/n) = 5.2·10⁻⁵; the tolerance is 4 of them.
+#[test]
+fn check12_gating_removes_a_gaussian_static_estimate_with_probability_0_9973() {
+    let exact = 1.0 - erfc(3.0 / sqrt(2.0));
+    assert!((exact - P_GATE).abs() < 5e-5, "{exact}");
+    let cluster = StaticCluster {
+        mean_s: 50e-9,
+        sigma_s: 0.3e-9,
+        count: 1,
+        snapshots: 1,
+    };
+    let link = LinkCalibration::from_clusters(0, vec![cluster]).unwrap();
+    let n = 1_000_000;
+    let mut rng = simulate::rng(12, 0);
+    let removed = (0..n)
+        .filter(|_| {
+            link.is_static(cluster.mean_s + cluster.sigma_s * simulate::standard_normal(&mut rng))
+        })
+        .count();
+    let p = removed as Real / n as Real;
+    let tol = 4.0 * sqrt(exact * (1.0 - exact) / n as Real);
+    assert!(
+        (p - exact).abs() <= tol,
+        "removed {p}, expected {exact} ± {tol}"
+    );
+}
+
+/// Check 12 end to end: cluster 2000 calibration snapshots of the empty area (4 links × 2 static
+/// paths), then gate 50 000 further empty snapshots. The clusters are found with their means
+/// and σ̄ to the sampling error (σ̄: relative SE 1/√(2·2000) = 1.6 %, 5 SE allowed), and the
+/// removed fraction of the 4·10⁵ static estimates is 0.9973 within 1·10⁻³: binomial SE 8·10⁻⁵,
+/// plus the effect of the σ̄ errors, 2·3·φ(3)·1.6 % = 4·10⁻⁴ per cluster, averaged over 8.
+#[test]
+fn check12_calibrated_clusters_gate_the_static_paths() {
+    let model = model();
+    let ch = channel(0.0);
+    let cfg = ClusterConfig::for_bandwidth(bandwidth()).unwrap();
+    let mut rng = simulate::rng(12, 1);
+    let cal = Calibration::from_snapshots(&ch.calibration_snapshots(&model, 2000, &mut rng), &cfg)
+        .unwrap();
+    for p in 0..model.link_count() {
+        let statics = ch.static_delays(&model, p);
+        let c = &cal.links[p].clusters;
+        assert_eq!(c.len(), statics.len(), "link {p}: {c:?}");
+        for (c, s) in c.iter().zip(&statics) {
+            assert_eq!((c.count, c.snapshots), (2000, 2000));
+            assert!(
+                (c.mean_s - s).abs() < 5.0 * ch.static_sigma_s / sqrt(2000.0),
+                "{c:?} vs {s}"
+            );
+            assert!(
+                (c.sigma_s / ch.static_sigma_s - 1.0).abs() < 5.0 / sqrt(4000.0),
+                "{c:?}"
+            );
+        }
+    }
+    let (mut total, mut removed) = (0usize, 0usize);
+    for _ in 0..50_000 {
+        let snap = ch.snapshot(&model, None, &mut rng);
+        let s = select(&cal, &snap, None, AssociationRule::Spec).unwrap();
+        total += snap.iter().map(Vec::len).sum::<usize>();
+        removed += s.static_removed.iter().sum::<usize>();
+    }
+    let p = removed as Real / total as Real;
+    assert_eq!(total, 400_000);
+    assert!((p - P_GATE).abs() < 1e-3, "removed fraction {p}");
+}
+
+/// The circle of spec §9.6: centre (12, 6) m, radius 8 m, 1.4 m/s, counter-clockwise from
+/// angle 0; position and velocity at `t`.
+fn circle(t: Real) -> Vec4 {
+    let (r, v) = (8.0, 1.4);
+    let w = v / r;
+    let a = w * t;
+    Vec4::new(
+        12.0 + r * a.cos(),
+        6.0 + r * a.sin(),
+        -v * a.sin(),
+        v * a.cos(),
+    )
+}
+
+/// What [`run_loop`] counted.
+#[derive(Debug)]
+struct LoopStats {
+    /// (step, link) pairs whose echo is resolved from every static path.
+    resolved: usize,
+    /// Of those, the pairs where association took the echo (within 6 σ_p of the true delay).
+    echo_taken: usize,
+    /// (step, link) pairs whose echo lies in a blind zone (not resolved).
+    unresolved: usize,
+    /// Of those, the pairs left without a measurement.
+    dropped: usize,
+    /// Steps whose position error is inside the filter's 99.9 % χ²(2) ellipse (13.8).
+    consistent: usize,
+    /// Largest position error after the first second, m.
+    worst_after_1s_m: Real,
+}
+
+const LOOP_STEPS: usize = 600;
+
+/// Spec §9.6 synthetic stand-in: 60 s on the loop at T = 0.1 s (600 snapshots) with the static
+/// paths of [`channel`] and `false_alarms` per link and snapshot, after a calibration of 500
+/// snapshots of the empty area (without false alarms: see the calibration module on why). The
+/// EKF (CV, q̃ = 0.1 m²/s³: the loop's 0.245 m/s² centripetal acceleration is a manoeuvre the
+/// spec's q̃ = 0.01 for a near-straight walk does not cover) starts at the truth with P(t₀) of
+/// §9.5, σ_p from the link budget at the prediction.
+fn run_loop(false_alarms: Real, rule: AssociationRule, seed: u64) -> LoopStats {
+    let model = model();
+    let cfg = ClusterConfig::for_bandwidth(bandwidth()).unwrap();
+    let mut rng = simulate::rng(seed, 0);
+    let snaps = channel(0.0).calibration_snapshots(&model, 500, &mut rng);
+    let cal = Calibration::from_snapshots(&snaps, &cfg).unwrap();
+    let ch = channel(false_alarms);
+    let dt = 0.1;
+    let motion = ConstantVelocity::validated(dt, 0.1).unwrap();
+    let ekf = Ekf::new(circle(0.0), paper_initial_covariance()).unwrap();
+    let noise = MeasurementNoise::AtPrediction;
+    let mut tracker = GatedTracker::new(ekf, &model, &cal, motion, noise, rule).unwrap();
+    let mut st = LoopStats {
+        resolved: 0,
+        echo_taken: 0,
+        unresolved: 0,
+        dropped: 0,
+        consistent: 0,
+        worst_after_1s_m: 0.0,
+    };
+    for k in 1..=LOOP_STEPS {
+        let truth = circle(k as Real * dt);
+        let r = Vec2::new(truth[0], truth[1]);
+        let snap = ch.snapshot(&model, Some(r), &mut rng);
+        let step = tracker.step(&snap).unwrap();
+        for p in 0..model.link_count() {
+            let tau = model.network.delay(p, r);
+            let sigma = model.sigma_delay(p, r);
+            if ch.resolved(&model, p, tau) {
+                st.resolved += 1;
+                if step.selection.delays[p].is_some_and(|d| (d - tau).abs() <= 6.0 * sigma) {
+                    st.echo_taken += 1;
+                }
+            } else {
+                st.unresolved += 1;
+                if step.selection.choices[p] == Choice::Absent {
+                    st.dropped += 1;
+                }
+            }
+        }
+        let e = tracker.ekf.position() - r;
+        let p_rr = tracker.ekf.covariance.fixed_view::<2, 2>(0, 0).into_owned();
+        if (e.transpose() * p_rr.try_inverse().unwrap() * e)[0] <= 13.8 {
+            st.consistent += 1;
+        }
+        if k as Real * dt > 1.0 {
+            st.worst_after_1s_m = st.worst_after_1s_m.max(e.norm());
+        }
+    }
+    println!("{rule:?}, {false_alarms} false alarms per link and snapshot: {st:?}");
+    st
+}
+
+/// The loop under the gated rule without false alarms (seeds 96, 97): the echo is taken wherever
+/// it is resolved (all but at most 0.5 % of the pairs); blind-zone pairs drop out (≥ 99 %:
+/// only a static estimate that leaked through the 3σ gate, 0.27 % each by check 12, and fell
+/// inside the innovation gate could stand in); the loop does cross blind zones (the Tx–Rx2
+/// baseline's among them); the error stays inside the filter's 99.9 % ellipse at ≥ 98 % of the
+/// steps, and below 20 cm after the first second (a divergence guard: the CRLB along the loop
+/// is a few mm to cm, more where links drop out).
+#[test]
+fn gated_ekf_tracks_the_loop_through_blind_zones() {
+    for seed in [96, 97] {
+        let st = run_loop(0.0, AssociationRule::Gated, seed);
+        assert!(st.unresolved > 0, "{st:?}");
+        assert!(st.dropped as Real >= 0.99 * st.unresolved as Real, "{st:?}");
+        assert!(
+            st.echo_taken as Real >= 0.995 * st.resolved as Real,
+            "{st:?}"
+        );
+        assert!(st.consistent as Real >= 0.98 * LOOP_STEPS as Real, "{st:?}");
+        assert!(st.worst_after_1s_m < 0.20, "{st:?}");
+    }
+}
+
+/// With 0.5 false alarms per link and snapshot the gated rule keeps the track (bounds as above;
+/// blind-zone pairs drop out unless a false alarm falls inside the innovation gate), while the
+/// spec's rule, which takes a lone candidate however far from the prediction, loses it (an error
+/// of metres). The spec's rule fails the same way without false alarms whenever a static
+/// estimate leaks through the gate (0.27 %) on a link whose echo is in a blind zone — on this
+/// loop with seed 96 that happens twice and the track is lost.
+#[test]
+fn gated_association_survives_false_alarms_and_leaks_where_the_spec_rule_does_not() {
+    let st = run_loop(0.5, AssociationRule::Gated, 96);
+    assert!(
+        st.unresolved > 0 && st.dropped as Real >= 0.9 * st.unresolved as Real,
+        "{st:?}"
+    );
+    assert!(
+        st.echo_taken as Real >= 0.995 * st.resolved as Real,
+        "{st:?}"
+    );
+    assert!(st.consistent as Real >= 0.98 * LOOP_STEPS as Real, "{st:?}");
+    assert!(st.worst_after_1s_m < 0.20, "{st:?}");
+    let spec = run_loop(0.5, AssociationRule::Spec, 96);
+    assert!(spec.worst_after_1s_m > 1.0, "{spec:?}");
+    let leak = run_loop(0.0, AssociationRule::Spec, 96);
+    assert!(
+        leak.dropped < leak.unresolved && leak.worst_after_1s_m > 1.0,
+        "{leak:?}"
+    );
+}
