@@ -14,7 +14,8 @@
 //! - [`simulate`]: seeded noisy delays.
 //! - [`calibration`], [`association`]: the calibration stage, 3σ gating (E4) and the association
 //!   of the remaining delays to the scatterer (spec §4); [`raw_snapshot`] simulates the
-//!   estimator's per-snapshot lists; [`gated_track`] runs the EKF on them.
+//!   estimator's per-snapshot lists; [`gated_track`] runs the EKF on them;
+//!   [`measurement_case`] is the synthetic stand-in of the measurement case (spec §9.6).
 //! - [`snapshot`]: one simulated snapshot with its ellipses, fix and CRLB (what the page draws).
 //! - [`track_view`]: a simulated track's steps as the page draws them (snapshot-shaped frames).
 //! - [`edit`], [`session`]: validated, rolled-back scenario edits for interactive front ends.
@@ -38,6 +39,7 @@ pub mod gated_track;
 pub mod geometry;
 pub mod lm;
 pub mod math;
+pub mod measurement_case;
 pub mod model;
 pub mod montecarlo;
 pub mod motion;

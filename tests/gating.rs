@@ -11,6 +11,7 @@ use scatterloc::calibration::{Calibration, ClusterConfig, LinkCalibration, Stati
 use scatterloc::ekf::{Ekf, MeasurementNoise};
 use scatterloc::gated_track::GatedTracker;
 use scatterloc::math::{erfc, sqrt, Real, Vec2, Vec4};
+use scatterloc::measurement_case::{default_channel, LoopPath};
 use scatterloc::motion::ConstantVelocity;
 use scatterloc::raw_snapshot::StaticChannel;
 use scatterloc::trajectory::paper_initial_covariance;
@@ -23,17 +24,10 @@ fn bandwidth() -> Real {
     presets::sensors2019().radio.bandwidth_hz
 }
 
-/// L4 with one static reflector (a wall corner), static paths jittering by 0.3 ns and, unless
-/// zeroed, 0.5 false alarms per link and snapshot over 200 ns.
+/// The stand-in's static channel ([`default_channel`]: one reflector, 0.3 ns jitter) with
+/// `false_alarms` per link and snapshot.
 fn channel(false_alarms: Real) -> StaticChannel {
-    StaticChannel {
-        reflectors_m: vec![Vec2::new(6.0, 18.0)],
-        static_sigma_s: 0.3e-9,
-        static_amplitude: 30.0,
-        resolution_s: 1.0 / bandwidth(),
-        false_alarms,
-        false_alarm_span_s: 200e-9,
-    }
+    default_channel(bandwidth(), false_alarms)
 }
 
 fn model() -> Model {
@@ -110,18 +104,8 @@ fn check12_calibrated_clusters_gate_the_static_paths() {
     assert!((p - P_GATE).abs() < 1e-3, "removed fraction {p}");
 }
 
-/// The circle of spec §9.6: centre (12, 6) m, radius 8 m, 1.4 m/s, counter-clockwise from
-/// angle 0; position and velocity at `t`.
 fn circle(t: Real) -> Vec4 {
-    let (r, v) = (8.0, 1.4);
-    let w = v / r;
-    let a = w * t;
-    Vec4::new(
-        12.0 + r * a.cos(),
-        6.0 + r * a.sin(),
-        -v * a.sin(),
-        v * a.cos(),
-    )
+    LoopPath::default().state_at(t)
 }
 
 /// What [`run_loop`] counted.
@@ -249,5 +233,47 @@ fn gated_association_survives_false_alarms_and_leaks_where_the_spec_rule_does_no
     assert!(
         leak.dropped < leak.unresolved && leak.worst_after_1s_m > 1.0,
         "{leak:?}"
+    );
+}
+
+/// The prediction the association gates on is the filter's own: for every link, an update with
+/// that link alone has NIS `νᵀS⁻¹ν = (ν/√S_pp)²` (the batch update's S for one row, spec §6),
+/// to 1e-9 relative, at several states along the loop with P(t₀) of §9.5.
+#[test]
+fn predicted_delay_and_innovation_sigma_match_a_single_link_update() {
+    let model = model();
+    for t in [0.0, 7.0, 21.0, 33.0] {
+        let ekf = Ekf::new(circle(t), paper_initial_covariance()).unwrap();
+        let pred = ekf
+            .predicted_delays(&model, MeasurementNoise::AtPrediction)
+            .unwrap();
+        for (p, pr) in pred.iter().enumerate() {
+            assert_eq!(pr.delay_s, model.network.delay(p, ekf.position()));
+            let z_val = pr.delay_s + 2.5 * pr.innovation_sigma_s;
+            let mut z = vec![None; model.link_count()];
+            z[p] = Some(z_val);
+            let mut f = ekf;
+            let s = f
+                .update(&model, &z, MeasurementNoise::AtPrediction, None)
+                .unwrap();
+            let want = pr.normalized_innovation(z_val).powi(2);
+            assert!(
+                (s.nis / want - 1.0).abs() < 1e-9,
+                "t {t} link {p}: {} vs {want}",
+                s.nis
+            );
+        }
+    }
+    // A bad σ is named.
+    let ekf = Ekf::new(circle(0.0), paper_initial_covariance()).unwrap();
+    let e = ekf
+        .predicted_delays(&model, MeasurementNoise::Fixed(&[1e-10, 0.0, 1e-10, 1e-10]))
+        .unwrap_err();
+    assert_eq!(
+        e,
+        scatterloc::Error::InvalidSigma {
+            link: 1,
+            value: 0.0
+        }
     );
 }

@@ -1,18 +1,24 @@
 //! `scatterloc track`: the EKF of spec §6 (S16, S17) over a measurement file — step `n` predicts
 //! by `dt_s` with the CV model (E7), then updates with `steps[n−1]` (missing links skipped, none =
 //! predict only), `R` fixed from `sigma_s` or from the link budget (E8) at the predicted position.
+//! With `raw_steps` (every link's full list of `[delay, amplitude]` estimates) each step is first
+//! gated against `--calibration` (E4) and associated (spec §4) before the update.
 
 use std::ffi::OsString;
 
 use serde::{Deserialize, Serialize};
 
+use scatterloc::association::{AssociationRule, DelayEstimate};
+use scatterloc::calibration::Calibration;
 use scatterloc::ekf::{Ekf, MeasurementNoise};
+use scatterloc::gated_track::GatedTracker;
 use scatterloc::math::{Mat4, Vec4};
 use scatterloc::montecarlo::MAX_STEPS;
 use scatterloc::motion::ConstantVelocity;
 use scatterloc::Error;
 
 use crate::commands::{emit, model_of, parse_args, read_json_file, read_scenario, Sigma};
+use crate::gating_cmd::{read_calibration, RawStep};
 use crate::CliError;
 
 /// The `--measurements` file.
@@ -31,7 +37,11 @@ struct MeasurementsFile {
     #[serde(default)]
     sigma_s: Option<Sigma>,
     /// Per step, one delay per link in scenario link order (`null` = missing), s.
-    steps: Vec<Vec<Option<f64>>>,
+    #[serde(default)]
+    steps: Option<Vec<Vec<Option<f64>>>>,
+    /// Per step, per link, every `[delay_s, amplitude]` estimate (gated and associated).
+    #[serde(default)]
+    raw_steps: Option<Vec<RawStep>>,
 }
 
 /// Output of `track`: one entry per step (after its update).
@@ -43,11 +53,21 @@ struct TrackOut {
     /// NIS `νᵀS⁻¹ν` of the step; `null` when no link was used.
     nis: Vec<Option<f64>>,
     links_used: Vec<usize>,
+    /// `raw_steps` only: per step the delay taken per link (`null` = absent), s.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    delays_used_s: Option<Vec<Vec<Option<f64>>>>,
+    /// `raw_steps` only: per step how each link was chosen (absent/single/nearest/strongest).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    choices: Option<Vec<Vec<&'static str>>>,
+    /// `raw_steps` only: per step per link the estimates discarded as static (E4).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    static_removed: Option<Vec<Vec<usize>>>,
 }
 
-/// `scatterloc track --scenario S --measurements M`.
+/// `scatterloc track --scenario S --measurements M [--calibration C] [--association R]`.
 pub fn track(argv: &[OsString]) -> Result<(), CliError> {
-    let Some(args) = parse_args(argv, "track", &["scenario", "measurements"], &[])? else {
+    let flags = ["scenario", "measurements", "calibration", "association"];
+    let Some(args) = parse_args(argv, "track", &flags, &[])? else {
         return Ok(());
     };
     args.expect_positional("track", 0, "")?;
@@ -59,7 +79,7 @@ pub fn track(argv: &[OsString]) -> Result<(), CliError> {
     let n = model.link_count();
     let motion = ConstantVelocity::validated(m.dt_s, m.process_noise).map_err(|e| bad(&e))?;
     let p0 = Mat4::from_fn(|i, j| m.initial_covariance[i][j]);
-    let mut ekf = Ekf::new(Vec4::from(m.initial_state), p0).map_err(|e| bad(&e))?;
+    let ekf = Ekf::new(Vec4::from(m.initial_state), p0).map_err(|e| bad(&e))?;
     let sigmas = match m.sigma_s {
         Some(s) => Some(s.per_link(n).map_err(|e| bad(&e))?),
         None => None,
@@ -68,20 +88,113 @@ pub fn track(argv: &[OsString]) -> Result<(), CliError> {
         Some(s) => MeasurementNoise::Fixed(s),
         None => MeasurementNoise::AtPrediction,
     };
-    if m.steps.len() > MAX_STEPS {
+    let rule = match args.get("association") {
+        None | Some("spec") => AssociationRule::Spec,
+        Some("gated") => AssociationRule::Gated,
+        Some(other) => {
+            return Err(CliError::usage(format!(
+                "--association: '{other}' is not spec or gated"
+            )))
+        }
+    };
+    let calibration = match args.get("calibration") {
+        Some(path) => Some(read_calibration(path, &model)?),
+        None => None,
+    };
+    let len = match (&m.steps, &m.raw_steps) {
+        (Some(s), None) => s.len(),
+        (None, Some(r)) => r.len(),
+        _ => return Err(bad(&"give exactly one of steps and raw_steps")),
+    };
+    if len > MAX_STEPS {
         return Err(bad(&format!(
-            "steps: {} steps, at most {MAX_STEPS} are allowed",
-            m.steps.len()
+            "steps: {len} steps, at most {MAX_STEPS} are allowed"
         )));
     }
+    if m.raw_steps.is_none() && (calibration.is_some() || args.get("association").is_some()) {
+        return Err(CliError::usage(
+            "--calibration/--association: apply to raw_steps only (this file has steps)",
+        ));
+    }
     let mut out = TrackOut {
-        t_s: Vec::with_capacity(m.steps.len()),
-        states: Vec::with_capacity(m.steps.len()),
-        covariances: Vec::with_capacity(m.steps.len()),
-        nis: Vec::with_capacity(m.steps.len()),
-        links_used: Vec::with_capacity(m.steps.len()),
+        t_s: Vec::with_capacity(len),
+        states: Vec::with_capacity(len),
+        covariances: Vec::with_capacity(len),
+        nis: Vec::with_capacity(len),
+        links_used: Vec::with_capacity(len),
+        delays_used_s: None,
+        choices: None,
+        static_removed: None,
     };
-    for (k, z) in m.steps.iter().enumerate() {
+    match (m.steps, m.raw_steps) {
+        (Some(steps), _) => plain(&model, ekf, &motion, noise, &steps, m.dt_s, &mut out, &bad)?,
+        (_, Some(raw)) => {
+            // No calibration: nothing is static (every estimate is a candidate).
+            let cal = calibration.unwrap_or_else(|| Calibration {
+                links: vec![Default::default(); n],
+            });
+            let mut tracker =
+                GatedTracker::new(ekf, &model, &cal, motion, noise, rule).map_err(|e| bad(&e))?;
+            let (mut used, mut choices, mut removed) = (vec![], vec![], vec![]);
+            for (k, step) in raw.iter().enumerate() {
+                let field = format!("raw_steps[{k}]");
+                if step.len() != n {
+                    return Err(bad(&format!(
+                        "{field}: expected {n} lists (one per link), found {}",
+                        step.len()
+                    )));
+                }
+                let snapshot: Vec<Vec<DelayEstimate>> = step
+                    .iter()
+                    .map(|l| {
+                        l.iter()
+                            .map(|&[delay_s, amplitude]| DelayEstimate { delay_s, amplitude })
+                            .collect()
+                    })
+                    .collect();
+                let s = tracker.step(&snapshot).map_err(|e| match e {
+                    Error::NonFiniteDelay { link } => {
+                        bad(&format!("{field}[{link}]: a delay is not a finite number"))
+                    }
+                    other => bad(&format!("{field}: {other}")),
+                })?;
+                record(
+                    &mut out,
+                    &tracker.ekf,
+                    k,
+                    m.dt_s,
+                    s.summary.nis,
+                    s.summary.links_used,
+                );
+                used.push(s.selection.delays);
+                choices.push(s.selection.choices.iter().map(|c| c.name()).collect());
+                removed.push(s.selection.static_removed);
+            }
+            out.delays_used_s = Some(used);
+            out.choices = Some(choices);
+            out.static_removed = Some(removed);
+        }
+        (None, None) => unreachable!("checked above"),
+    }
+    let text =
+        serde_json::to_string(&out).map_err(|e| CliError::output(format!("encoding JSON: {e}")))?;
+    emit(&text)
+}
+
+/// The plain form: one delay (or null) per link and step.
+#[allow(clippy::too_many_arguments)]
+fn plain(
+    model: &scatterloc::Model,
+    mut ekf: Ekf,
+    motion: &ConstantVelocity,
+    noise: MeasurementNoise,
+    steps: &[Vec<Option<f64>>],
+    dt_s: f64,
+    out: &mut TrackOut,
+    bad: &dyn Fn(&dyn std::fmt::Display) -> CliError,
+) -> Result<(), CliError> {
+    let n = model.link_count();
+    for (k, z) in steps.iter().enumerate() {
         let field = format!("steps[{k}]");
         if z.len() != n {
             return Err(bad(&format!(
@@ -89,21 +202,23 @@ pub fn track(argv: &[OsString]) -> Result<(), CliError> {
                 z.len()
             )));
         }
-        ekf.predict(&motion);
-        let summary = ekf.update(&model, z, noise, None).map_err(|e| match e {
+        ekf.predict(motion);
+        let summary = ekf.update(model, z, noise, None).map_err(|e| match e {
             Error::NonFiniteDelay { link } => bad(&format!("{field}[{link}]: not a finite number")),
             other => bad(&format!("{field}: {other}")),
         })?;
-        let p = &ekf.covariance;
-        out.t_s.push((k + 1) as f64 * m.dt_s);
-        out.states.push(ekf.state.into());
-        out.covariances
-            .push(std::array::from_fn(|i| std::array::from_fn(|j| p[(i, j)])));
-        out.nis
-            .push((summary.links_used > 0).then_some(summary.nis));
-        out.links_used.push(summary.links_used);
+        record(out, &ekf, k, dt_s, summary.nis, summary.links_used);
     }
-    let text =
-        serde_json::to_string(&out).map_err(|e| CliError::output(format!("encoding JSON: {e}")))?;
-    emit(&text)
+    Ok(())
+}
+
+/// Appends step `k`'s filter state to the output.
+fn record(out: &mut TrackOut, ekf: &Ekf, k: usize, dt_s: f64, nis: f64, links_used: usize) {
+    let p = &ekf.covariance;
+    out.t_s.push((k + 1) as f64 * dt_s);
+    out.states.push(ekf.state.into());
+    out.covariances
+        .push(std::array::from_fn(|i| std::array::from_fn(|j| p[(i, j)])));
+    out.nis.push((links_used > 0).then_some(nis));
+    out.links_used.push(links_used);
 }

@@ -1,0 +1,337 @@
+//! `scatterloc calibrate` (spec §4: cluster calibration snapshots into static paths) and
+//! `scatterloc simulate-walk` (spec §9.6: the synthetic measurement case's input files), plus
+//! the calibration file read by `track --calibration`.
+
+use std::ffi::OsString;
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+
+use scatterloc::calibration::{
+    Calibration, ClusterConfig, LinkCalibration, StaticCluster, MAX_CALIBRATION_SNAPSHOTS,
+};
+use scatterloc::math::Real;
+use scatterloc::measurement_case::{default_channel, LoopPath, LOOP_DURATION_S};
+use scatterloc::montecarlo::MAX_STEPS;
+use scatterloc::trajectory::{paper_initial_covariance, step_count};
+use scatterloc::{simulate, Model};
+
+use crate::commands::{emit_json, model_of, parse_args, read_json_file, read_scenario};
+use crate::output::write_json_file;
+use crate::CliError;
+
+/// The `--snapshots` file of `calibrate`: per snapshot, per link, the delay estimates, s.
+#[derive(Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct SnapshotsFile {
+    /// `snapshots[k][p]` = link `p`'s delays in snapshot `k`.
+    pub snapshots: Vec<Vec<Vec<f64>>>,
+}
+
+/// One cluster as JSON.
+#[derive(Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct ClusterJson {
+    /// `τ̄`, s.
+    pub mean_s: f64,
+    /// `σ̄`, s.
+    pub sigma_s: f64,
+    /// Calibration delays in the cluster.
+    #[serde(default)]
+    pub count: usize,
+    /// Calibration snapshots represented in it.
+    #[serde(default)]
+    pub snapshots: usize,
+}
+
+/// One link's clusters as JSON.
+#[derive(Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct LinkJson {
+    /// Ascending in delay.
+    pub clusters: Vec<ClusterJson>,
+}
+
+/// The calibration file (`calibrate`'s output, `track --calibration`'s input).
+#[derive(Debug, Deserialize, Serialize)]
+pub struct CalibrationFile {
+    /// Clusterer gap `g`, s (informative on input).
+    #[serde(default)]
+    pub gap_s: Option<f64>,
+    /// The 50 % rule's fraction (informative on input).
+    #[serde(default)]
+    pub min_fraction: Option<f64>,
+    /// `σ_min`, s (informative on input).
+    #[serde(default)]
+    pub sigma_floor_s: Option<f64>,
+    /// Calibration snapshots used (informative on input).
+    #[serde(default)]
+    pub snapshot_count: Option<usize>,
+    /// Per link in scenario link order.
+    pub links: Vec<LinkJson>,
+}
+
+impl CalibrationFile {
+    fn of(cal: &Calibration, cfg: &ClusterConfig, snapshots: usize) -> CalibrationFile {
+        CalibrationFile {
+            gap_s: Some(cfg.gap_s),
+            min_fraction: Some(cfg.min_fraction),
+            sigma_floor_s: Some(cfg.sigma_floor_s),
+            snapshot_count: Some(snapshots),
+            links: cal
+                .links
+                .iter()
+                .map(|l| LinkJson {
+                    clusters: l
+                        .clusters
+                        .iter()
+                        .map(|c| ClusterJson {
+                            mean_s: c.mean_s,
+                            sigma_s: c.sigma_s,
+                            count: c.count,
+                            snapshots: c.snapshots,
+                        })
+                        .collect(),
+                })
+                .collect(),
+        }
+    }
+
+    /// The validated calibration for a model with `links` links.
+    pub fn into_calibration(self, links: usize) -> Result<Calibration, scatterloc::Error> {
+        let cal = Calibration {
+            links: self
+                .links
+                .into_iter()
+                .enumerate()
+                .map(|(p, l)| {
+                    let clusters = l
+                        .clusters
+                        .into_iter()
+                        .map(|c| StaticCluster {
+                            mean_s: c.mean_s,
+                            sigma_s: c.sigma_s,
+                            count: c.count,
+                            snapshots: c.snapshots,
+                        })
+                        .collect();
+                    LinkCalibration::from_clusters(p, clusters)
+                })
+                .collect::<Result<Vec<_>, _>>()?,
+        };
+        cal.check_links(links)?;
+        Ok(cal)
+    }
+}
+
+/// Reads `--calibration` for a model.
+pub fn read_calibration(path: &str, model: &Model) -> Result<Calibration, CliError> {
+    let f: CalibrationFile = read_json_file("calibration", path)?;
+    f.into_calibration(model.link_count())
+        .map_err(|e| CliError::usage(format!("--calibration {path}: {e}")))
+}
+
+/// `scatterloc calibrate --scenario S --snapshots C [--gap-s G] [--min-fraction F]
+/// [--sigma-floor-s S] [--out OUT.json]`.
+pub fn calibrate(argv: &[OsString]) -> Result<(), CliError> {
+    let flags = [
+        "scenario",
+        "snapshots",
+        "gap-s",
+        "min-fraction",
+        "sigma-floor-s",
+        "out",
+    ];
+    let Some(args) = parse_args(argv, "calibrate", &flags, &[])? else {
+        return Ok(());
+    };
+    args.expect_positional("calibrate", 0, "")?;
+    let scenario = read_scenario(&args)?;
+    let model = model_of(&scenario)?;
+    let n = model.link_count();
+    let mut cfg = ClusterConfig::for_bandwidth(scenario.radio.bandwidth_hz)
+        .map_err(|e| CliError::usage(format!("--scenario: {e}")))?;
+    if let Some(g) = args.number("gap-s")? {
+        cfg.gap_s = g;
+    }
+    if let Some(f) = args.number("min-fraction")? {
+        cfg.min_fraction = f;
+    }
+    if let Some(s) = args.number("sigma-floor-s")? {
+        cfg.sigma_floor_s = s;
+    }
+    cfg.validate().map_err(|e| {
+        let text = e.to_string();
+        let flag = if text.contains("gap_s") {
+            "--gap-s"
+        } else if text.contains("min_fraction") {
+            "--min-fraction"
+        } else {
+            "--sigma-floor-s"
+        };
+        CliError::usage(format!("{flag}: {e}"))
+    })?;
+    let path = args.required("snapshots")?;
+    let f: SnapshotsFile = read_json_file("snapshots", path)?;
+    let bad = |e: &dyn std::fmt::Display| CliError::usage(format!("--snapshots {path}: {e}"));
+    if f.snapshots.is_empty() || f.snapshots.len() > MAX_CALIBRATION_SNAPSHOTS {
+        return Err(bad(&format!(
+            "snapshots: {} given, 1 … {MAX_CALIBRATION_SNAPSHOTS} are allowed",
+            f.snapshots.len()
+        )));
+    }
+    let mut per_link = vec![Vec::with_capacity(f.snapshots.len()); n];
+    for (k, snap) in f.snapshots.into_iter().enumerate() {
+        if snap.len() != n {
+            return Err(bad(&format!(
+                "snapshots[{k}]: expected {n} lists (one per link), found {}",
+                snap.len()
+            )));
+        }
+        for (p, d) in snap.into_iter().enumerate() {
+            per_link[p].push(d);
+        }
+    }
+    let count = per_link[0].len();
+    let cal = Calibration::from_snapshots(&per_link, &cfg).map_err(|e| bad(&e))?;
+    let out = CalibrationFile::of(&cal, &cfg, count);
+    match args.get("out") {
+        Some(p) => write_json_file("out", p, &out),
+        None => emit_json(&out),
+    }
+}
+
+/// One raw step of a measurements file: per link, `[delay_s, amplitude]` estimates.
+pub type RawStep = Vec<Vec<[f64; 2]>>;
+
+/// The measurements file `simulate-walk` writes (the `raw_steps` form of `track`).
+#[derive(Serialize)]
+struct WalkMeasurements {
+    dt_s: f64,
+    process_noise: f64,
+    initial_state: [f64; 4],
+    initial_covariance: [[f64; 4]; 4],
+    raw_steps: Vec<RawStep>,
+}
+
+/// The truth file of `simulate-walk`.
+#[derive(Serialize)]
+struct WalkTruth {
+    t_s: Vec<f64>,
+    states: Vec<[f64; 4]>,
+    /// Per step, per link: whether the echo was resolved from every static path.
+    resolved: Vec<Vec<bool>>,
+}
+
+/// `scatterloc simulate-walk --scenario S --out-dir DIR [--duration S] [--dt T]
+/// [--calibration-snapshots N] [--false-alarms F] [--process-noise Q] [--seed N]`.
+pub fn simulate_walk(argv: &[OsString]) -> Result<(), CliError> {
+    let flags = [
+        "scenario",
+        "out-dir",
+        "duration",
+        "dt",
+        "calibration-snapshots",
+        "false-alarms",
+        "process-noise",
+        "seed",
+    ];
+    let Some(args) = parse_args(argv, "simulate-walk", &flags, &[])? else {
+        return Ok(());
+    };
+    args.expect_positional("simulate-walk", 0, "")?;
+    let scenario = read_scenario(&args)?;
+    let model = model_of(&scenario)?;
+    let dir = args.required("out-dir")?;
+    let positive = |name: &str, v: f64| {
+        if v.is_finite() && v > 0.0 {
+            Ok(v)
+        } else {
+            Err(CliError::usage(format!("--{name}: must be > 0 (got {v})")))
+        }
+    };
+    let duration = positive(
+        "duration",
+        args.number("duration")?.unwrap_or(LOOP_DURATION_S),
+    )?;
+    let dt = positive("dt", args.number("dt")?.unwrap_or(0.1))?;
+    let q = positive(
+        "process-noise",
+        args.number("process-noise")?.unwrap_or(0.1),
+    )?;
+    let steps = step_count(duration, dt);
+    if steps == 0 || steps > MAX_STEPS {
+        return Err(CliError::usage(format!(
+            "--duration/--dt: {steps} steps, 1 … {MAX_STEPS} are allowed"
+        )));
+    }
+    let ncal = args.integer("calibration-snapshots")?.unwrap_or(500);
+    if ncal == 0 || ncal > 100_000 {
+        return Err(CliError::usage(format!(
+            "--calibration-snapshots: {ncal}, 1 … 100000 are allowed"
+        )));
+    }
+    let fa = args.number("false-alarms")?.unwrap_or(0.5);
+    let seed = args.integer("seed")?.unwrap_or(1) as u64;
+    let channel = default_channel(scenario.radio.bandwidth_hz, fa);
+    channel
+        .validate()
+        .map_err(|e| CliError::usage(format!("--false-alarms: {e}")))?;
+    let path = LoopPath::default();
+    // Calibration of the empty area without false alarms (see the calibration module).
+    let clean = default_channel(scenario.radio.bandwidth_hz, 0.0);
+    let mut rng = simulate::rng(seed, 0);
+    let per_link = clean.calibration_snapshots(&model, ncal, &mut rng);
+    let cal_snaps: Vec<Vec<Vec<Real>>> = (0..ncal)
+        .map(|k| per_link.iter().map(|l| l[k].clone()).collect())
+        .collect();
+    let states = path.states(dt, steps);
+    let mut raw_steps = Vec::with_capacity(steps);
+    let mut resolved = Vec::with_capacity(steps);
+    for s in &states {
+        let r = scatterloc::Vec2::new(s[0], s[1]);
+        let snap = channel.snapshot(&model, Some(r), &mut rng);
+        raw_steps.push(
+            snap.iter()
+                .map(|l| l.iter().map(|e| [e.delay_s, e.amplitude]).collect())
+                .collect(),
+        );
+        resolved.push(
+            (0..model.link_count())
+                .map(|p| channel.resolved(&model, p, model.network.delay(p, r)))
+                .collect(),
+        );
+    }
+    let p0 = paper_initial_covariance();
+    let measurements = WalkMeasurements {
+        dt_s: dt,
+        process_noise: q,
+        initial_state: path.state_at(0.0).into(),
+        initial_covariance: std::array::from_fn(|i| std::array::from_fn(|j| p0[(i, j)])),
+        raw_steps,
+    };
+    let truth = WalkTruth {
+        t_s: (1..=steps).map(|k| k as f64 * dt).collect(),
+        states: states.iter().map(|s| (*s).into()).collect(),
+        resolved,
+    };
+    std::fs::create_dir_all(dir)
+        .map_err(|e| CliError::output(format!("--out-dir: cannot create '{dir}': {e}")))?;
+    let file = |name: &str| Path::new(dir).join(name).to_string_lossy().into_owned();
+    write_json_file(
+        "out-dir",
+        &file("calibration_snapshots.json"),
+        &SnapshotsFile {
+            snapshots: cal_snaps,
+        },
+    )?;
+    write_json_file("out-dir", &file("measurements.json"), &measurements)?;
+    write_json_file("out-dir", &file("truth.json"), &truth)?;
+    emit_json(&serde_json::json!({
+        "steps": steps,
+        "calibration_snapshots": ncal,
+        "false_alarms": fa,
+        "blind_zone_pairs": truth.resolved.iter().flatten().filter(|r| !**r).count(),
+        "files": ["calibration_snapshots.json", "measurements.json", "truth.json"],
+    }))
+}

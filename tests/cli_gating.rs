@@ -1,0 +1,354 @@
+//! End-to-end tests of `simulate-walk`, `calibrate` and `track` with `raw_steps` (spec §4,
+//! §9.6): the three commands chained as the README shows, and named errors for bad input.
+#![cfg(not(target_arch = "wasm32"))]
+
+mod cli_support;
+
+use scatterloc::math::SPEED_OF_LIGHT;
+use scatterloc::{presets, Model, Vec2};
+use serde_json::{json, Value};
+
+use cli_support::{fails, floats, ok_json, read_json, TempDir};
+
+/// Runs the pipeline in `dir` with `--seed 3`; returns (walk summary, calibration, track).
+fn pipeline(dir: &TempDir, association: &str) -> (Value, Value, Value) {
+    let scenario = dir.write(
+        "l4.json",
+        &serde_json::to_value(presets::sensors2019()).unwrap(),
+    );
+    let out = dir.path("walk");
+    let walk = ok_json(&[
+        "simulate-walk",
+        "--scenario",
+        &scenario,
+        "--out-dir",
+        &out,
+        "--seed",
+        "3",
+    ]);
+    let snaps = format!("{out}/calibration_snapshots.json");
+    let cal_path = dir.path("cal.json");
+    let cal = ok_json(&["calibrate", "--scenario", &scenario, "--snapshots", &snaps]);
+    std::fs::write(&cal_path, cal.to_string()).unwrap();
+    let track = ok_json(&[
+        "track",
+        "--scenario",
+        &scenario,
+        "--measurements",
+        &format!("{out}/measurements.json"),
+        "--calibration",
+        &cal_path,
+        "--association",
+        association,
+    ]);
+    (walk, cal, track)
+}
+
+/// The chain recovers the static paths (the LoS `‖Rx − Tx‖/c` and the reflector at (6, 18) on
+/// each link, to 5 standard errors of a 500-snapshot mean of 0.3 ns jitter), and the gated
+/// track follows the truth file: every blind-zone pair is absent or a gated false alarm (≥ 90 %
+/// absent), the RMSE after the first second is below 5 cm and the largest error below 20 cm
+/// (the §9.6 loop test in `gating.rs` derives these bounds).
+#[test]
+fn simulate_calibrate_track_chain() {
+    let dir = TempDir::new();
+    let (walk, cal, track) = pipeline(&dir, "gated");
+    assert_eq!(walk["steps"], 600);
+    let model = Model::new(&presets::sensors2019()).unwrap();
+    let links = cal["links"].as_array().unwrap();
+    assert_eq!(links.len(), model.link_count());
+    for (p, l) in links.iter().enumerate() {
+        let (tx, rx) = model.network.link_nodes(p);
+        let want = [
+            (rx - tx).norm() / SPEED_OF_LIGHT,
+            model.network.delay(p, Vec2::new(6.0, 18.0)),
+        ];
+        let c = l["clusters"].as_array().unwrap();
+        assert_eq!(c.len(), 2, "link {p}: {l}");
+        for (c, w) in c.iter().zip(want) {
+            let m = c["mean_s"].as_f64().unwrap();
+            assert!(
+                (m - w).abs() < 5.0 * 0.3e-9 / 500f64.sqrt(),
+                "link {p}: {m} vs {w}"
+            );
+            assert_eq!(c["snapshots"], 500);
+        }
+    }
+    let truth = read_json(&dir.path("walk/truth.json"));
+    let states = track["states"].as_array().unwrap();
+    assert_eq!(states.len(), 600);
+    let mut sq = 0.0;
+    let mut worst: f64 = 0.0;
+    for (k, (s, t)) in states
+        .iter()
+        .zip(truth["states"].as_array().unwrap())
+        .enumerate()
+    {
+        let (s, t) = (floats(s), floats(t));
+        let e = (s[0] - t[0]).hypot(s[1] - t[1]);
+        if k >= 10 {
+            sq += e * e;
+            worst = worst.max(e);
+        }
+    }
+    let rmse = (sq / 590.0).sqrt();
+    assert!(rmse < 0.05 && worst < 0.20, "rmse {rmse} worst {worst}");
+    let (mut blind, mut absent) = (0, 0);
+    for (r, c) in truth["resolved"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .zip(track["choices"].as_array().unwrap())
+    {
+        for (r, c) in r.as_array().unwrap().iter().zip(c.as_array().unwrap()) {
+            if r == false {
+                blind += 1;
+                absent += usize::from(c == "absent");
+            }
+        }
+    }
+    assert_eq!(blind, walk["blind_zone_pairs"].as_u64().unwrap() as usize);
+    assert!(
+        blind > 0 && absent as f64 >= 0.9 * blind as f64,
+        "{absent}/{blind}"
+    );
+    let removed: usize = track["static_removed"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .flat_map(floats)
+        .map(|x| x as usize)
+        .sum();
+    // 600 steps × 4 links × 2 static paths, 0.27 % of which leak (check 12): ≥ 99 % removed;
+    // plus the false alarms that fall into a static gate: 1200 alarms × 2 gates × 1.8 ns /
+    // 200 ns ≈ 22 expected, ≤ 60 allowed.
+    assert!(
+        removed as f64 >= 0.99 * 4800.0 && removed <= 4860,
+        "{removed}"
+    );
+}
+
+#[test]
+fn gating_commands_name_their_bad_input() {
+    let dir = TempDir::new();
+    let scenario = dir.write(
+        "l4.json",
+        &serde_json::to_value(presets::sensors2019()).unwrap(),
+    );
+    let s = scenario.as_str();
+    // calibrate: wrong number of links, no snapshots, bad settings.
+    let three = dir.write(
+        "three.json",
+        &json!({"snapshots": [[[1e-8], [1e-8], [1e-8]]]}),
+    );
+    fails(
+        &["calibrate", "--scenario", s, "--snapshots", &three],
+        &["snapshots[0]", "expected 4 lists"],
+    );
+    let none = dir.write("none.json", &json!({"snapshots": []}));
+    fails(
+        &["calibrate", "--scenario", s, "--snapshots", &none],
+        &["snapshots: 0 given"],
+    );
+    let one = dir.write("one.json", &json!({"snapshots": [[[1e-8], [], [], []]]}));
+    fails(
+        &[
+            "calibrate",
+            "--scenario",
+            s,
+            "--snapshots",
+            &one,
+            "--min-fraction",
+            "2",
+        ],
+        &["--min-fraction", "out of range"],
+    );
+    fails(
+        &[
+            "calibrate",
+            "--scenario",
+            s,
+            "--snapshots",
+            &one,
+            "--gap-s",
+            "-1",
+        ],
+        &["--gap-s", "must be > 0"],
+    );
+    // track: both forms, unknown rule, calibration of the wrong size or with a bad sigma.
+    let base = json!({
+        "dt_s": 0.1, "process_noise": 0.1, "initial_state": [12.0, 6.0, 0.0, 1.4],
+        "initial_covariance": [[0.1,0,0,0],[0,0.1,0,0],[0,0,0.01,0],[0,0,0,0.01]],
+    });
+    let with = |extra: Value| {
+        let mut m = base.clone();
+        m.as_object_mut()
+            .unwrap()
+            .extend(extra.as_object().unwrap().clone());
+        m
+    };
+    let both = dir.write(
+        "both.json",
+        &with(json!({"steps": [[null, null, null, null]], "raw_steps": [[[], [], [], []]]})),
+    );
+    fails(
+        &["track", "--scenario", s, "--measurements", &both],
+        &["exactly one of steps and raw_steps"],
+    );
+    let raw = dir.write(
+        "raw.json",
+        &with(json!({"raw_steps": [[[[1.1e-7, 2.0]], [], [], []]]})),
+    );
+    fails(
+        &[
+            "track",
+            "--scenario",
+            s,
+            "--measurements",
+            &raw,
+            "--association",
+            "best",
+        ],
+        &["--association", "'best'"],
+    );
+    let small = dir.write("small.json", &json!({"links": [{"clusters": []}]}));
+    fails(
+        &[
+            "track",
+            "--scenario",
+            s,
+            "--measurements",
+            &raw,
+            "--calibration",
+            &small,
+        ],
+        &["--calibration", "calibration.links", "expected 4"],
+    );
+    let zero = dir.write(
+        "zero.json",
+        &json!({"links": [{"clusters": [{"mean_s": 1e-8, "sigma_s": 0.0}]},
+                          {"clusters": []}, {"clusters": []}, {"clusters": []}]}),
+    );
+    fails(
+        &[
+            "track",
+            "--scenario",
+            s,
+            "--measurements",
+            &raw,
+            "--calibration",
+            &zero,
+        ],
+        &["calibration.links[0].clusters[0].sigma_s", "must be > 0"],
+    );
+    let short = dir.write("short.json", &with(json!({"raw_steps": [[[], []]]})));
+    fails(
+        &["track", "--scenario", s, "--measurements", &short],
+        &["raw_steps[0]", "expected 4 lists"],
+    );
+    let plain = dir.write(
+        "plain.json",
+        &with(json!({"steps": [[null, null, null, null]]})),
+    );
+    fails(
+        &[
+            "track",
+            "--scenario",
+            s,
+            "--measurements",
+            &plain,
+            "--association",
+            "gated",
+        ],
+        &["raw_steps only"],
+    );
+    // simulate-walk: bad counts and rates.
+    let out = dir.path("w");
+    fails(
+        &[
+            "simulate-walk",
+            "--scenario",
+            s,
+            "--out-dir",
+            &out,
+            "--false-alarms",
+            "1000",
+        ],
+        &["--false-alarms", "out of range"],
+    );
+    fails(
+        &[
+            "simulate-walk",
+            "--scenario",
+            s,
+            "--out-dir",
+            &out,
+            "--calibration-snapshots",
+            "0",
+        ],
+        &["--calibration-snapshots"],
+    );
+    fails(
+        &[
+            "simulate-walk",
+            "--scenario",
+            s,
+            "--out-dir",
+            &out,
+            "--dt",
+            "0",
+        ],
+        &["--dt", "must be > 0"],
+    );
+    assert!(
+        !std::path::Path::new(&out).exists(),
+        "nothing written on bad input"
+    );
+}
+
+/// Without a calibration nothing is static, and the spec rule with no track yet is not reached
+/// (the file's initial state is the track): a raw step with one estimate per link is the plain
+/// step with those delays, to the bit.
+#[test]
+fn raw_steps_without_calibration_equal_plain_steps() {
+    let dir = TempDir::new();
+    let scenario = dir.write(
+        "l4.json",
+        &serde_json::to_value(presets::sensors2019()).unwrap(),
+    );
+    let model = Model::new(&presets::sensors2019()).unwrap();
+    let d: Vec<Vec<f64>> = (1..=20)
+        .map(|k| model.network.delays(Vec2::new(12.0, 6.0 + 0.14 * k as f64)))
+        .collect();
+    let base = json!({
+        "dt_s": 0.1, "process_noise": 0.1, "initial_state": [12.0, 6.0, 0.0, 1.4],
+        "initial_covariance": [[0.1,0,0,0],[0,0.1,0,0],[0,0,0.01,0],[0,0,0,0.01]],
+    });
+    let mut plain = base.clone();
+    plain["steps"] = json!(d);
+    let mut raw = base;
+    raw["raw_steps"] = json!(d
+        .iter()
+        .map(|row| row.iter().map(|x| vec![[*x, 1.0]]).collect::<Vec<_>>())
+        .collect::<Vec<_>>());
+    let a = ok_json(&[
+        "track",
+        "--scenario",
+        &scenario,
+        "--measurements",
+        &dir.write("p.json", &plain),
+    ]);
+    let b = ok_json(&[
+        "track",
+        "--scenario",
+        &scenario,
+        "--measurements",
+        &dir.write("r.json", &raw),
+    ]);
+    assert_eq!(a["states"], b["states"]);
+    assert_eq!(a["covariances"], b["covariances"]);
+    assert_eq!(
+        b["choices"][0],
+        json!(["single", "single", "single", "single"])
+    );
+}
