@@ -186,6 +186,8 @@ fn benches(c: &mut Criterion) {
     });
     g.finish();
 
+    gated_step(c);
+
     let fast = study(0.1, 10.0, 10);
     let paper = study(PAPER_STEP_S, 1.0, 50);
     let mut g = c.benchmark_group("montecarlo_chunk");
@@ -211,6 +213,56 @@ fn benches(c: &mut Criterion) {
         ns_per_step(&s.model, &fast, 5),
         ns_per_step(&s.model, &paper, 5)
     );
+}
+
+/// One step of the spec §9.6 stand-in (`GatedTracker::step`: predict, the predicted delays and
+/// innovation σ, 3σ gating against 2 static clusters per link, association, update) over the
+/// first 256 snapshots of the 60 s loop at T = 0.1 s with 0.5 false alarms per link and
+/// snapshot (about 3.5 estimates per link); and the gating + association alone.
+fn gated_step(c: &mut Criterion) {
+    use scatterloc::association::{select, AssociationRule};
+    use scatterloc::calibration::{Calibration, ClusterConfig};
+    use scatterloc::gated_track::GatedTracker;
+    use scatterloc::measurement_case::{default_channel, LoopPath};
+    let model = Model::new(&presets::sensors2019()).unwrap();
+    let b = presets::sensors2019().radio.bandwidth_hz;
+    let mut rng = simulate::rng(SEED, 7);
+    let cfg = ClusterConfig::for_bandwidth(b).unwrap();
+    let clean = default_channel(b, 0.0);
+    let cal =
+        Calibration::from_snapshots(&clean.calibration_snapshots(&model, 500, &mut rng), &cfg)
+            .unwrap();
+    let ch = default_channel(b, 0.5);
+    let path = LoopPath::default();
+    let snaps: Vec<_> = path
+        .states(0.1, BENCH_STEPS)
+        .iter()
+        .map(|x| ch.snapshot(&model, Some(Vec2::new(x[0], x[1])), &mut rng))
+        .collect();
+    let motion = ConstantVelocity::new(0.1, 0.1);
+    let ekf = Ekf::new(path.state_at(0.0), paper_initial_covariance()).unwrap();
+    let noise = MeasurementNoise::AtPrediction;
+    let rule = AssociationRule::Gated;
+    let mut g = c.benchmark_group("gated_step_4_links");
+    g.throughput(Throughput::Elements(BENCH_STEPS as u64));
+    g.bench_function("predict+gate+associate+update", |bch| {
+        bch.iter(|| {
+            let mut t = GatedTracker::new(ekf, &model, &cal, motion, noise, rule).unwrap();
+            for s in &snaps {
+                black_box(t.step(black_box(s)).unwrap());
+            }
+            t.ekf
+        })
+    });
+    let preds = ekf.predicted_delays(&model, noise).unwrap();
+    g.bench_function("gate+associate", |bch| {
+        bch.iter(|| {
+            for s in &snaps {
+                black_box(select(&cal, black_box(s), Some(&preds), rule).unwrap());
+            }
+        })
+    });
+    g.finish();
 }
 
 criterion_group!(tracking, benches);

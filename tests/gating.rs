@@ -1,3 +1,4 @@
+#![cfg(not(target_arch = "wasm32"))]
 //! The calibration stage, 3σ gating and association (spec §4): spec check 12, the calibration
 //! of a simulated static channel, and the EKF fed through gating and association on the
 //! synthetic stand-in of the measurement case (spec §9.6: a 60 s loop through L4 with blind-zone

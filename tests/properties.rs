@@ -375,3 +375,38 @@ fn lm_spurious_local_minimum_near_a_receiver() {
         "{rep:?}"
     );
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 64, ..ProptestConfig::default() })]
+
+    /// The calibration stage (spec §4) does not depend on the order of the snapshots nor of the
+    /// estimates within one (bitwise: delays are sorted before any sum), every kept cluster's
+    /// σ̄ is at least the floor, and every calibration delay inside a kept cluster's span is
+    /// static (E4: the mean lies within 3σ̄ of itself).
+    #[test]
+    fn calibration_is_order_free_and_gates_its_own_means(
+        snaps in proptest::collection::vec(
+            proptest::collection::vec(0.0..300e-9f64, 0..6), 1..40),
+        seed in any::<u64>(),
+    ) {
+        use scatterloc::calibration::{ClusterConfig, LinkCalibration};
+        let cfg = ClusterConfig::for_bandwidth(120e6).unwrap();
+        let a = LinkCalibration::from_snapshots(0, &snaps, &cfg).unwrap();
+        // A deterministic shuffle of the snapshots and of each snapshot's estimates.
+        let mut shuffled = snaps.clone();
+        let mut s = seed | 1;
+        let mut next = |n: usize| { s ^= s << 13; s ^= s >> 7; s ^= s << 17; (s % n as u64) as usize };
+        for i in (1..shuffled.len()).rev() { let j = next(i + 1); shuffled.swap(i, j); }
+        for v in &mut shuffled { for i in (1..v.len()).rev() { let j = next(i + 1); v.swap(i, j); } }
+        let b = LinkCalibration::from_snapshots(0, &shuffled, &cfg).unwrap();
+        prop_assert_eq!(&a, &b);
+        for c in &a.clusters {
+            prop_assert!(c.sigma_s >= cfg.sigma_floor_s);
+            prop_assert!(2 * c.snapshots >= snaps.len());
+            prop_assert!(a.is_static(c.mean_s));
+        }
+        for w in a.clusters.windows(2) {
+            prop_assert!(w[1].mean_s - w[0].mean_s > cfg.gap_s);
+        }
+    }
+}

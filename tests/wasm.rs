@@ -298,3 +298,29 @@ fn labels_and_ticks() {
     let bar = ok(wasm::scale_bar(0.03));
     assert_eq!(num(&bar, "length_m"), 0.02);
 }
+
+/// Spec check 12 and the calibration stage in wasm: 1 − erfc(3/√2) = 0.9973, and a calibrated
+/// link gates its static paths and keeps the echo (spec §4).
+#[wasm_bindgen_test]
+fn gating_in_wasm() {
+    use scatterloc::association::{select, AssociationRule, Choice};
+    use scatterloc::calibration::{Calibration, ClusterConfig};
+    use scatterloc::measurement_case::default_channel;
+    let p = 1.0 - scatterloc::math::erfc(3.0 / 2f64.sqrt());
+    assert!((p - 0.9973).abs() < 5e-5, "{p}");
+    let model = Model::new(&presets::sensors2019()).unwrap();
+    let ch = default_channel(120e6, 0.0);
+    let mut rng = scatterloc::simulate::rng(5, 0);
+    let cfg = ClusterConfig::for_bandwidth(120e6).unwrap();
+    let cal = Calibration::from_snapshots(&ch.calibration_snapshots(&model, 200, &mut rng), &cfg)
+        .unwrap();
+    assert!(cal.links.iter().all(|l| l.clusters.len() == 2));
+    let r = Vec2::new(20.0, 6.0);
+    let snap = ch.snapshot(&model, Some(r), &mut rng);
+    let s = select(&cal, &snap, None, AssociationRule::Spec).unwrap();
+    for p in 0..model.link_count() {
+        let tau = model.network.delay(p, r);
+        assert_eq!(s.choices[p], Choice::Single, "link {p}");
+        assert!((s.delays[p].unwrap() - tau).abs() < 6.0 * model.sigma_delay(p, r));
+    }
+}
