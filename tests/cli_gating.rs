@@ -74,6 +74,12 @@ fn simulate_calibrate_track_chain() {
             assert_eq!(c["snapshots"], 500);
         }
     }
+    // No track yet: the filter started from the LM fix of the t₀ snapshot (all 4 links, the
+    // echo taken as the strongest estimate), within 10 cm of the start of the loop (12 + 8, 6).
+    let start = &track["start"];
+    assert_eq!(start["links_used"], 4, "{start}");
+    let p0 = floats(&start["position_m"]);
+    assert!((p0[0] - 20.0).hypot(p0[1] - 6.0) < 0.1, "{start}");
     let truth = read_json(&dir.path("walk/truth.json"));
     let states = track["states"].as_array().unwrap();
     assert_eq!(states.len(), 600);
@@ -261,6 +267,27 @@ fn gating_commands_name_their_bad_input() {
             "gated",
         ],
         &["raw_steps only"],
+    );
+    let nostart = dir.write(
+        "nostart.json",
+        &json!({"dt_s": 0.1, "process_noise": 0.1,
+        "raw_steps": [[[], [], [], []]]}),
+    );
+    fails(
+        &["track", "--scenario", s, "--measurements", &nostart],
+        &[
+            "initial_state and initial_covariance, or",
+            "initial_snapshot",
+        ],
+    );
+    let empty_start = dir.write(
+        "es.json",
+        &json!({"dt_s": 0.1, "process_noise": 0.1,
+        "initial_snapshot": [[], [], [], []], "raw_steps": [[[], [], [], []]]}),
+    );
+    fails(
+        &["track", "--scenario", s, "--measurements", &empty_start],
+        &["initial_snapshot", "at least 3"],
     );
     // simulate-walk: bad counts and rates.
     let out = dir.path("w");

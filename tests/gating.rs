@@ -10,7 +10,7 @@
 use scatterloc::association::{select, AssociationRule, Choice};
 use scatterloc::calibration::{Calibration, ClusterConfig, LinkCalibration, StaticCluster};
 use scatterloc::ekf::{Ekf, MeasurementNoise};
-use scatterloc::gated_track::GatedTracker;
+use scatterloc::gated_track::{start_from_snapshot, GatedTracker, START_SPEED_SIGMA_MPS};
 use scatterloc::math::{erfc, sqrt, Real, Vec2, Vec4};
 use scatterloc::measurement_case::{default_channel, LoopPath};
 use scatterloc::motion::ConstantVelocity;
@@ -135,6 +135,17 @@ const LOOP_STEPS: usize = 600;
 /// spec's q̃ = 0.01 for a near-straight walk does not cover) starts at the truth with P(t₀) of
 /// §9.5, σ_p from the link budget at the prediction.
 fn run_loop(false_alarms: Real, rule: AssociationRule, seed: u64) -> LoopStats {
+    run_loop_from(false_alarms, rule, seed, false)
+}
+
+/// [`run_loop`]; with `lm_start` the filter starts from an LM fix of the snapshot at t₀ (spec
+/// §9.6, "LM at t₀ = 0"; no track yet: the largest amplitude per link) instead of the truth.
+fn run_loop_from(
+    false_alarms: Real,
+    rule: AssociationRule,
+    seed: u64,
+    lm_start: bool,
+) -> LoopStats {
     let model = model();
     let cfg = ClusterConfig::for_bandwidth(bandwidth()).unwrap();
     let mut rng = simulate::rng(seed, 0);
@@ -143,7 +154,27 @@ fn run_loop(false_alarms: Real, rule: AssociationRule, seed: u64) -> LoopStats {
     let ch = channel(false_alarms);
     let dt = 0.1;
     let motion = ConstantVelocity::validated(dt, 0.1).unwrap();
-    let ekf = Ekf::new(circle(0.0), paper_initial_covariance()).unwrap();
+    let ekf = if lm_start {
+        let r0 = Vec2::new(circle(0.0)[0], circle(0.0)[1]);
+        let snap = ch.snapshot(&model, Some(r0), &mut rng);
+        let area = presets::sensors2019().area_m;
+        let start = start_from_snapshot(&model, &cal, &snap, &area, START_SPEED_SIGMA_MPS).unwrap();
+        // The fix is consistent with its covariance (inside the 99.9 % χ²(2) ellipse).
+        let e = start.report.position - r0;
+        let c = start.report.covariance_m2.unwrap();
+        assert!(
+            (e.transpose() * c.try_inverse().unwrap() * e)[0] <= 13.8,
+            "{e:?} vs {c:?}"
+        );
+        assert!(start
+            .selection
+            .choices
+            .iter()
+            .all(|c| *c == Choice::Strongest || *c == Choice::Single));
+        start.ekf
+    } else {
+        Ekf::new(circle(0.0), paper_initial_covariance()).unwrap()
+    };
     let noise = MeasurementNoise::AtPrediction;
     let mut tracker = GatedTracker::new(ekf, &model, &cal, motion, noise, rule).unwrap();
     let mut st = LoopStats {
@@ -183,7 +214,9 @@ fn run_loop(false_alarms: Real, rule: AssociationRule, seed: u64) -> LoopStats {
             st.worst_after_1s_m = st.worst_after_1s_m.max(e.norm());
         }
     }
-    println!("{rule:?}, {false_alarms} false alarms per link and snapshot: {st:?}");
+    println!(
+        "{rule:?}, {false_alarms} false alarms per link and snapshot, LM start {lm_start}: {st:?}"
+    );
     st
 }
 
@@ -235,6 +268,24 @@ fn gated_association_survives_false_alarms_and_leaks_where_the_spec_rule_does_no
         leak.dropped < leak.unresolved && leak.worst_after_1s_m > 1.0,
         "{leak:?}"
     );
+}
+
+/// The measurement case as spec §9.6 runs it: no track yet, so the snapshot at t₀ is gated,
+/// each link takes its strongest remaining estimate (the echo, √SNR ≫ the false alarms' 1), LM
+/// fixes the start (consistent with its covariance, checked in `run_loop_from`) and the gated
+/// EKF, started at rest with σ_v = 2 m/s per component, locks on within the first second and
+/// then meets the bounds of the truth-started runs, with false alarms.
+#[test]
+fn lm_started_gated_track_meets_the_same_bounds() {
+    for seed in [96, 98] {
+        let st = run_loop_from(0.5, AssociationRule::Gated, seed, true);
+        assert!(
+            st.echo_taken as Real >= 0.995 * st.resolved as Real,
+            "{st:?}"
+        );
+        assert!(st.consistent as Real >= 0.98 * LOOP_STEPS as Real, "{st:?}");
+        assert!(st.worst_after_1s_m < 0.20, "{st:?}");
+    }
 }
 
 /// The prediction the association gates on is the filter's own: for every link, an update with

@@ -209,8 +209,12 @@ pub type RawStep = Vec<Vec<[f64; 2]>>;
 struct WalkMeasurements {
     dt_s: f64,
     process_noise: f64,
-    initial_state: [f64; 4],
-    initial_covariance: [[f64; 4]; 4],
+    #[serde(skip_serializing_if = "Option::is_none")]
+    initial_state: Option<[f64; 4]>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    initial_covariance: Option<[[f64; 4]; 4]>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    initial_snapshot: Option<RawStep>,
     raw_steps: Vec<RawStep>,
 }
 
@@ -235,6 +239,7 @@ pub fn simulate_walk(argv: &[OsString]) -> Result<(), CliError> {
         "false-alarms",
         "process-noise",
         "seed",
+        "start",
     ];
     let Some(args) = parse_args(argv, "simulate-walk", &flags, &[])? else {
         return Ok(());
@@ -273,6 +278,15 @@ pub fn simulate_walk(argv: &[OsString]) -> Result<(), CliError> {
     }
     let fa = args.number("false-alarms")?.unwrap_or(0.5);
     let seed = args.integer("seed")?.unwrap_or(1) as u64;
+    let from_truth = match args.get("start") {
+        None | Some("snapshot") => false,
+        Some("truth") => true,
+        Some(other) => {
+            return Err(CliError::usage(format!(
+                "--start: '{other}' is not snapshot or truth"
+            )))
+        }
+    };
     let channel = default_channel(scenario.radio.bandwidth_hz, fa);
     channel
         .validate()
@@ -286,16 +300,19 @@ pub fn simulate_walk(argv: &[OsString]) -> Result<(), CliError> {
         .map(|k| per_link.iter().map(|l| l[k].clone()).collect())
         .collect();
     let states = path.states(dt, steps);
+    let raw = |snap: Vec<Vec<scatterloc::association::DelayEstimate>>| -> RawStep {
+        snap.iter()
+            .map(|l| l.iter().map(|e| [e.delay_s, e.amplitude]).collect())
+            .collect()
+    };
+    // The snapshot at t₀ (drawn either way, so the later ones do not depend on --start).
+    let s0 = path.state_at(0.0);
+    let first = raw(channel.snapshot(&model, Some(scatterloc::Vec2::new(s0[0], s0[1])), &mut rng));
     let mut raw_steps = Vec::with_capacity(steps);
     let mut resolved = Vec::with_capacity(steps);
     for s in &states {
         let r = scatterloc::Vec2::new(s[0], s[1]);
-        let snap = channel.snapshot(&model, Some(r), &mut rng);
-        raw_steps.push(
-            snap.iter()
-                .map(|l| l.iter().map(|e| [e.delay_s, e.amplitude]).collect())
-                .collect(),
-        );
+        raw_steps.push(raw(channel.snapshot(&model, Some(r), &mut rng)));
         resolved.push(
             (0..model.link_count())
                 .map(|p| channel.resolved(&model, p, model.network.delay(p, r)))
@@ -306,8 +323,10 @@ pub fn simulate_walk(argv: &[OsString]) -> Result<(), CliError> {
     let measurements = WalkMeasurements {
         dt_s: dt,
         process_noise: q,
-        initial_state: path.state_at(0.0).into(),
-        initial_covariance: std::array::from_fn(|i| std::array::from_fn(|j| p0[(i, j)])),
+        initial_state: from_truth.then(|| s0.into()),
+        initial_covariance: from_truth
+            .then(|| std::array::from_fn(|i| std::array::from_fn(|j| p0[(i, j)]))),
+        initial_snapshot: (!from_truth).then_some(first),
         raw_steps,
     };
     let truth = WalkTruth {

@@ -65,7 +65,10 @@ USAGE:
       (spec 4) with --association spec (default: one candidate is taken; of several the
       nearest to the prediction within 3 sigma, else the strongest) or gated (with a track only
       candidates within 3 sigma of the prediction; robust to false alarms and gate leaks).
-      Adds {delays_used_s, choices, static_removed} per step and link.
+      Adds {delays_used_s, choices, static_removed} per step and link. No track yet:
+      \"initial_snapshot\" (one raw step at t0) instead of initial_state/initial_covariance:
+      gated, strongest estimate per link, LM fix; the filter starts there at rest with
+      sigma_v = 2 m/s per component ({start: {position_m, covariance_m2, termination, ..}}).
   scatterloc calibrate --scenario FILE --snapshots FILE [--gap-s G] [--min-fraction F]
                        [--sigma-floor-s S] [--out OUT.json]
       Calibration stage (spec 4) of the empty area: {\"snapshots\": [[[delay_s, ..] per link]
@@ -75,12 +78,14 @@ USAGE:
       [{clusters: [{mean_s, sigma_s, count, snapshots}]}]} (the --calibration file of track).
   scatterloc simulate-walk --scenario FILE --out-dir DIR [--duration S] [--dt T] [--seed N]
                            [--calibration-snapshots N] [--false-alarms F] [--process-noise Q]
+                           [--start snapshot|truth]
       The synthetic measurement case (spec 9.6): a 1.4 m/s walk on a circle of 8 m about
       (12, 6) through the scenario, a static reflector at (6, 18), static paths jittering by
       0.3 ns, echoes lost within 1/B of a static path (blind zone), F (0.5) false alarms per
       link and snapshot. Writes DIR/calibration_snapshots.json (N = 500, for calibrate),
-      DIR/measurements.json (raw_steps for track; defaults 60 s, T = 0.1 s, q = 0.1) and
-      DIR/truth.json {t_s, states, resolved[step][link]}.
+      DIR/measurements.json (raw_steps for track; defaults 60 s, T = 0.1 s, q = 0.1; the
+      start: the snapshot at t0 as initial_snapshot, or with --start truth the true state
+      and P(t0) of spec 9.5) and DIR/truth.json {t_s, states, resolved[step][link]}.
   scatterloc montecarlo [--preset NAME | --scenario FILE] [--trajectory I|II|III|all]
                         [--runs N] [--noise-runs N] [--dt T] [--duration S] [--process-noise Q]
                         [--seed N] [--threads N] [--oracle-noise] [--out FIG.{svg,png}]

@@ -11,8 +11,8 @@ use serde::{Deserialize, Serialize};
 use scatterloc::association::{AssociationRule, DelayEstimate};
 use scatterloc::calibration::Calibration;
 use scatterloc::ekf::{Ekf, MeasurementNoise};
-use scatterloc::gated_track::GatedTracker;
-use scatterloc::math::{Mat4, Vec4};
+use scatterloc::gated_track::{start_from_snapshot, GatedTracker, START_SPEED_SIGMA_MPS};
+use scatterloc::math::{Mat2, Mat4, Vec4};
 use scatterloc::montecarlo::MAX_STEPS;
 use scatterloc::motion::ConstantVelocity;
 use scatterloc::Error;
@@ -30,9 +30,15 @@ struct MeasurementsFile {
     /// Process-noise intensity `q̃`, m²/s³.
     process_noise: f64,
     /// `x̂(t₀) = [x, y, vx, vy]`, m and m/s.
-    initial_state: [f64; 4],
+    #[serde(default)]
+    initial_state: Option<[f64; 4]>,
     /// `P(t₀)`, row-major.
-    initial_covariance: [[f64; 4]; 4],
+    #[serde(default)]
+    initial_covariance: Option<[[f64; 4]; 4]>,
+    /// No track yet (raw form only): the snapshot at t₀, `[[delay_s, amplitude], ..]` per link;
+    /// the filter starts from its LM fix.
+    #[serde(default)]
+    initial_snapshot: Option<Vec<Vec<[f64; 2]>>>,
     /// Fixed delay σ (one or per link), s; absent: the link budget at the prediction.
     #[serde(default)]
     sigma_s: Option<Sigma>,
@@ -62,6 +68,31 @@ struct TrackOut {
     /// `raw_steps` only: per step per link the estimates discarded as static (E4).
     #[serde(skip_serializing_if = "Option::is_none")]
     static_removed: Option<Vec<Vec<usize>>>,
+    /// `initial_snapshot` only: the LM fix that started the filter.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    start: Option<StartOut>,
+}
+
+/// The start of a track from `initial_snapshot`.
+#[derive(Serialize)]
+struct StartOut {
+    position_m: [f64; 2],
+    covariance_m2: [[f64; 2]; 2],
+    termination: &'static str,
+    links_used: usize,
+    delays_used_s: Vec<Option<f64>>,
+    choices: Vec<&'static str>,
+}
+
+/// One raw step as the core's estimates.
+fn estimates(step: &[Vec<[f64; 2]>]) -> Vec<Vec<DelayEstimate>> {
+    step.iter()
+        .map(|l| {
+            l.iter()
+                .map(|&[delay_s, amplitude]| DelayEstimate { delay_s, amplitude })
+                .collect()
+        })
+        .collect()
 }
 
 /// `scatterloc track --scenario S --measurements M [--calibration C] [--association R]`.
@@ -78,8 +109,6 @@ pub fn track(argv: &[OsString]) -> Result<(), CliError> {
     let model = model_of(&scenario)?;
     let n = model.link_count();
     let motion = ConstantVelocity::validated(m.dt_s, m.process_noise).map_err(|e| bad(&e))?;
-    let p0 = Mat4::from_fn(|i, j| m.initial_covariance[i][j]);
-    let ekf = Ekf::new(Vec4::from(m.initial_state), p0).map_err(|e| bad(&e))?;
     let sigmas = match m.sigma_s {
         Some(s) => Some(s.per_link(n).map_err(|e| bad(&e))?),
         None => None,
@@ -101,6 +130,46 @@ pub fn track(argv: &[OsString]) -> Result<(), CliError> {
         Some(path) => Some(read_calibration(path, &model)?),
         None => None,
     };
+    let cal = calibration.unwrap_or_else(|| Calibration {
+        // No calibration: nothing is static (every estimate is a candidate).
+        links: vec![Default::default(); n],
+    });
+    let (ekf, start) =
+        match (m.initial_state, m.initial_covariance, &m.initial_snapshot) {
+            (Some(x0), Some(p0), None) => {
+                let p0 = Mat4::from_fn(|i, j| p0[i][j]);
+                (Ekf::new(Vec4::from(x0), p0).map_err(|e| bad(&e))?, None)
+            }
+            (None, None, Some(snap)) if m.raw_steps.is_some() => {
+                if snap.len() != n {
+                    return Err(bad(&format!(
+                        "initial_snapshot: expected {n} lists (one per link), found {}",
+                        snap.len()
+                    )));
+                }
+                let f = start_from_snapshot(
+                    &model,
+                    &cal,
+                    &estimates(snap),
+                    &scenario.area_m,
+                    START_SPEED_SIGMA_MPS,
+                )
+                .map_err(|e| bad(&format!("initial_snapshot: {e}")))?;
+                let c = f.report.covariance_m2.unwrap_or_else(Mat2::zeros);
+                let start = StartOut {
+                    position_m: [f.report.position.x, f.report.position.y],
+                    covariance_m2: [[c[(0, 0)], c[(0, 1)]], [c[(1, 0)], c[(1, 1)]]],
+                    termination: f.report.termination.as_str(),
+                    links_used: f.report.links_used,
+                    delays_used_s: f.selection.delays.clone(),
+                    choices: f.selection.choices.iter().map(|c| c.name()).collect(),
+                };
+                (f.ekf, Some(start))
+            }
+            _ => return Err(bad(
+                &"give initial_state and initial_covariance, or (with raw_steps) initial_snapshot",
+            )),
+        };
     let len = match (&m.steps, &m.raw_steps) {
         (Some(s), None) => s.len(),
         (None, Some(r)) => r.len(),
@@ -111,7 +180,9 @@ pub fn track(argv: &[OsString]) -> Result<(), CliError> {
             "steps: {len} steps, at most {MAX_STEPS} are allowed"
         )));
     }
-    if m.raw_steps.is_none() && (calibration.is_some() || args.get("association").is_some()) {
+    if m.raw_steps.is_none()
+        && (args.get("calibration").is_some() || args.get("association").is_some())
+    {
         return Err(CliError::usage(
             "--calibration/--association: apply to raw_steps only (this file has steps)",
         ));
@@ -125,14 +196,11 @@ pub fn track(argv: &[OsString]) -> Result<(), CliError> {
         delays_used_s: None,
         choices: None,
         static_removed: None,
+        start,
     };
     match (m.steps, m.raw_steps) {
         (Some(steps), _) => plain(&model, ekf, &motion, noise, &steps, m.dt_s, &mut out, &bad)?,
         (_, Some(raw)) => {
-            // No calibration: nothing is static (every estimate is a candidate).
-            let cal = calibration.unwrap_or_else(|| Calibration {
-                links: vec![Default::default(); n],
-            });
             let mut tracker =
                 GatedTracker::new(ekf, &model, &cal, motion, noise, rule).map_err(|e| bad(&e))?;
             let (mut used, mut choices, mut removed) = (vec![], vec![], vec![]);
@@ -144,15 +212,7 @@ pub fn track(argv: &[OsString]) -> Result<(), CliError> {
                         step.len()
                     )));
                 }
-                let snapshot: Vec<Vec<DelayEstimate>> = step
-                    .iter()
-                    .map(|l| {
-                        l.iter()
-                            .map(|&[delay_s, amplitude]| DelayEstimate { delay_s, amplitude })
-                            .collect()
-                    })
-                    .collect();
-                let s = tracker.step(&snapshot).map_err(|e| match e {
+                let s = tracker.step(&estimates(step)).map_err(|e| match e {
                     Error::NonFiniteDelay { link } => {
                         bad(&format!("{field}[{link}]: a delay is not a finite number"))
                     }
