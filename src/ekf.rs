@@ -46,6 +46,18 @@ pub enum MeasurementNoise<'a> {
 }
 
 impl MeasurementNoise<'_> {
+    /// `Fixed` noise must give one σ per link (`LengthMismatch` of `sigma_s` otherwise).
+    pub fn check_links(&self, n: usize) -> Result<()> {
+        match self {
+            MeasurementNoise::Fixed(s) if s.len() != n => Err(Error::LengthMismatch {
+                field: "sigma_s",
+                expected: n,
+                found: s.len(),
+            }),
+            _ => Ok(()),
+        }
+    }
+
     /// `σ_p` of link `link`, s, for a filter whose predicted position is `r_pred`.
     pub fn sigma(&self, model: &Model, link: usize, r_pred: Vec2) -> Real {
         match *self {
@@ -195,15 +207,7 @@ impl Ekf {
                 found: z.len(),
             });
         }
-        if let MeasurementNoise::Fixed(s) = noise {
-            if s.len() != n {
-                return Err(Error::LengthMismatch {
-                    field: "sigma_s",
-                    expected: n,
-                    found: s.len(),
-                });
-            }
-        }
+        noise.check_links(n)?;
         if let Some(out) = innovations.as_deref_mut() {
             if out.len() != n {
                 return Err(Error::LengthMismatch {
@@ -254,15 +258,7 @@ impl Ekf {
         noise: MeasurementNoise,
     ) -> Result<alloc::vec::Vec<PredictedDelay>> {
         let n = model.link_count();
-        if let MeasurementNoise::Fixed(s) = noise {
-            if s.len() != n {
-                return Err(Error::LengthMismatch {
-                    field: "sigma_s",
-                    expected: n,
-                    found: s.len(),
-                });
-            }
-        }
+        noise.check_links(n)?;
         let r = self.position();
         let p_rr = self.covariance.fixed_view::<2, 2>(0, 0).into_owned();
         (0..n)

@@ -10,12 +10,17 @@ use serde_json::{json, Value};
 
 use cli_support::{fails, floats, ok_json, read_json, TempDir};
 
-/// Runs the pipeline in `dir` with `--seed 3`; returns (walk summary, calibration, track).
-fn pipeline(dir: &TempDir, association: &str) -> (Value, Value, Value) {
-    let scenario = dir.write(
+/// Writes the sensors2019 scenario into `dir`; returns its path.
+fn scenario_file(dir: &TempDir) -> String {
+    dir.write(
         "l4.json",
         &serde_json::to_value(presets::sensors2019()).unwrap(),
-    );
+    )
+}
+
+/// Runs the pipeline in `dir` with `--seed 3`; returns (walk summary, calibration, track).
+fn pipeline(dir: &TempDir, association: &str) -> (Value, Value, Value) {
+    let scenario = scenario_file(dir);
     let out = dir.path("walk");
     let walk = ok_json(&[
         "simulate-walk",
@@ -137,10 +142,7 @@ fn simulate_calibrate_track_chain() {
 #[test]
 fn gating_commands_name_their_bad_input() {
     let dir = TempDir::new();
-    let scenario = dir.write(
-        "l4.json",
-        &serde_json::to_value(presets::sensors2019()).unwrap(),
-    );
+    let scenario = scenario_file(&dir);
     let s = scenario.as_str();
     // calibrate: wrong number of links, no snapshots, bad settings.
     let three = dir.write(
@@ -339,10 +341,7 @@ fn gating_commands_name_their_bad_input() {
 #[test]
 fn raw_steps_without_calibration_equal_plain_steps() {
     let dir = TempDir::new();
-    let scenario = dir.write(
-        "l4.json",
-        &serde_json::to_value(presets::sensors2019()).unwrap(),
-    );
+    let scenario = scenario_file(&dir);
     let model = Model::new(&presets::sensors2019()).unwrap();
     let d: Vec<Vec<f64>> = (1..=20)
         .map(|k| model.network.delays(Vec2::new(12.0, 6.0 + 0.14 * k as f64)))

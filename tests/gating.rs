@@ -128,6 +128,22 @@ struct LoopStats {
 
 const LOOP_STEPS: usize = 600;
 
+impl LoopStats {
+    /// The tracking bounds shared by the loop tests: the echo taken at ≥ 99.5 % of the resolved
+    /// pairs, the error inside the filter's 99.9 % ellipse at ≥ 98 % of the steps and below
+    /// 20 cm after the first second (a divergence guard: the CRLB along the loop is a few mm to
+    /// cm, more where links drop out).
+    fn assert_tracked(&self) {
+        let st = self;
+        assert!(
+            st.echo_taken as Real >= 0.995 * st.resolved as Real,
+            "{st:?}"
+        );
+        assert!(st.consistent as Real >= 0.98 * LOOP_STEPS as Real, "{st:?}");
+        assert!(st.worst_after_1s_m < 0.20, "{st:?}");
+    }
+}
+
 /// Spec §9.6 synthetic stand-in: 60 s on the loop at T = 0.1 s (600 snapshots) with the static
 /// paths of [`channel`] and `false_alarms` per link and snapshot, after a calibration of 500
 /// snapshots of the empty area (without false alarms: see the calibration module on why). The
@@ -220,25 +236,17 @@ fn run_loop_from(
     st
 }
 
-/// The loop under the gated rule without false alarms (seeds 96, 97): the echo is taken wherever
-/// it is resolved (all but at most 0.5 % of the pairs); blind-zone pairs drop out (≥ 99 %:
-/// only a static estimate that leaked through the 3σ gate, 0.27 % each by check 12, and fell
-/// inside the innovation gate could stand in); the loop does cross blind zones (the Tx–Rx2
-/// baseline's among them); the error stays inside the filter's 99.9 % ellipse at ≥ 98 % of the
-/// steps, and below 20 cm after the first second (a divergence guard: the CRLB along the loop
-/// is a few mm to cm, more where links drop out).
+/// The loop under the gated rule without false alarms (seeds 96, 97): blind-zone pairs drop out
+/// (≥ 99 %: only a static estimate that leaked through the 3σ gate, 0.27 % each by check 12,
+/// and fell inside the innovation gate could stand in); the loop does cross blind zones (the
+/// Tx–Rx2 baseline's among them); and the bounds of [`LoopStats::assert_tracked`] hold.
 #[test]
 fn gated_ekf_tracks_the_loop_through_blind_zones() {
     for seed in [96, 97] {
         let st = run_loop(0.0, AssociationRule::Gated, seed);
         assert!(st.unresolved > 0, "{st:?}");
         assert!(st.dropped as Real >= 0.99 * st.unresolved as Real, "{st:?}");
-        assert!(
-            st.echo_taken as Real >= 0.995 * st.resolved as Real,
-            "{st:?}"
-        );
-        assert!(st.consistent as Real >= 0.98 * LOOP_STEPS as Real, "{st:?}");
-        assert!(st.worst_after_1s_m < 0.20, "{st:?}");
+        st.assert_tracked();
     }
 }
 
@@ -255,12 +263,7 @@ fn gated_association_survives_false_alarms_and_leaks_where_the_spec_rule_does_no
         st.unresolved > 0 && st.dropped as Real >= 0.9 * st.unresolved as Real,
         "{st:?}"
     );
-    assert!(
-        st.echo_taken as Real >= 0.995 * st.resolved as Real,
-        "{st:?}"
-    );
-    assert!(st.consistent as Real >= 0.98 * LOOP_STEPS as Real, "{st:?}");
-    assert!(st.worst_after_1s_m < 0.20, "{st:?}");
+    st.assert_tracked();
     let spec = run_loop(0.5, AssociationRule::Spec, 96);
     assert!(spec.worst_after_1s_m > 1.0, "{spec:?}");
     let leak = run_loop(0.0, AssociationRule::Spec, 96);
@@ -278,13 +281,7 @@ fn gated_association_survives_false_alarms_and_leaks_where_the_spec_rule_does_no
 #[test]
 fn lm_started_gated_track_meets_the_same_bounds() {
     for seed in [96, 98] {
-        let st = run_loop_from(0.5, AssociationRule::Gated, seed, true);
-        assert!(
-            st.echo_taken as Real >= 0.995 * st.resolved as Real,
-            "{st:?}"
-        );
-        assert!(st.consistent as Real >= 0.98 * LOOP_STEPS as Real, "{st:?}");
-        assert!(st.worst_after_1s_m < 0.20, "{st:?}");
+        run_loop_from(0.5, AssociationRule::Gated, seed, true).assert_tracked();
     }
 }
 

@@ -182,12 +182,7 @@ pub fn calibrate(argv: &[OsString]) -> Result<(), CliError> {
     }
     let mut per_link = vec![Vec::with_capacity(f.snapshots.len()); n];
     for (k, snap) in f.snapshots.into_iter().enumerate() {
-        if snap.len() != n {
-            return Err(bad(&format!(
-                "snapshots[{k}]: expected {n} lists (one per link), found {}",
-                snap.len()
-            )));
-        }
+        one_list_per_link(&format!("snapshots[{k}]"), snap.len(), n).map_err(|e| bad(&e))?;
         for (p, d) in snap.into_iter().enumerate() {
             per_link[p].push(d);
         }
@@ -198,6 +193,17 @@ pub fn calibrate(argv: &[OsString]) -> Result<(), CliError> {
     match args.get("out") {
         Some(p) => write_json_file("out", p, &out),
         None => emit_json(&out),
+    }
+}
+
+/// `Err` naming `field` unless it holds one list per link (`len == n`).
+pub fn one_list_per_link(field: &str, len: usize, n: usize) -> Result<(), String> {
+    if len == n {
+        Ok(())
+    } else {
+        Err(format!(
+            "{field}: expected {n} lists (one per link), found {len}"
+        ))
     }
 }
 

@@ -18,7 +18,7 @@ use scatterloc::motion::ConstantVelocity;
 use scatterloc::Error;
 
 use crate::commands::{emit, model_of, parse_args, read_json_file, read_scenario, Sigma};
-use crate::gating_cmd::{read_calibration, RawStep};
+use crate::gating_cmd::{one_list_per_link, read_calibration, RawStep};
 use crate::CliError;
 
 /// The `--measurements` file.
@@ -141,12 +141,7 @@ pub fn track(argv: &[OsString]) -> Result<(), CliError> {
                 (Ekf::new(Vec4::from(x0), p0).map_err(|e| bad(&e))?, None)
             }
             (None, None, Some(snap)) if m.raw_steps.is_some() => {
-                if snap.len() != n {
-                    return Err(bad(&format!(
-                        "initial_snapshot: expected {n} lists (one per link), found {}",
-                        snap.len()
-                    )));
-                }
+                one_list_per_link("initial_snapshot", snap.len(), n).map_err(|e| bad(&e))?;
                 let f = start_from_snapshot(
                     &model,
                     &cal,
@@ -206,12 +201,7 @@ pub fn track(argv: &[OsString]) -> Result<(), CliError> {
             let (mut used, mut choices, mut removed) = (vec![], vec![], vec![]);
             for (k, step) in raw.iter().enumerate() {
                 let field = format!("raw_steps[{k}]");
-                if step.len() != n {
-                    return Err(bad(&format!(
-                        "{field}: expected {n} lists (one per link), found {}",
-                        step.len()
-                    )));
-                }
+                one_list_per_link(&field, step.len(), n).map_err(|e| bad(&e))?;
                 let s = tracker.step(&estimates(step)).map_err(|e| match e {
                     Error::NonFiniteDelay { link } => {
                         bad(&format!("{field}[{link}]: a delay is not a finite number"))
