@@ -45,6 +45,10 @@ fn pipeline(dir: &TempDir, association: &str) -> (Value, Value, Value) {
         &cal_path,
         "--association",
         association,
+        "--out",
+        &dir.path("walk.svg"),
+        "--truth",
+        &format!("{out}/truth.json"),
     ]);
     (walk, cal, track)
 }
@@ -85,6 +89,15 @@ fn simulate_calibrate_track_chain() {
     assert_eq!(start["links_used"], 4, "{start}");
     let p0 = floats(&start["position_m"]);
     assert!((p0[0] - 20.0).hypot(p0[1] - 6.0) < 0.1, "{start}");
+    let svg = std::fs::read_to_string(dir.path("walk.svg")).unwrap();
+    for label in [
+        "EKF track",
+        "filter 1σ",
+        "position error",
+        "links used (top = all 4)",
+    ] {
+        assert!(svg.contains(label), "figure lacks {label:?}");
+    }
     let truth = read_json(&dir.path("walk/truth.json"));
     let states = track["states"].as_array().unwrap();
     assert_eq!(states.len(), 600);
@@ -290,6 +303,57 @@ fn gating_commands_name_their_bad_input() {
     fails(
         &["track", "--scenario", s, "--measurements", &empty_start],
         &["initial_snapshot", "at least 3"],
+    );
+    let ok_raw = dir.write(
+        "okraw.json",
+        &with(json!({"raw_steps": [[[], [], [], []]]})),
+    );
+    fails(
+        &[
+            "track",
+            "--scenario",
+            s,
+            "--measurements",
+            &ok_raw,
+            "--truth",
+            &ok_raw,
+        ],
+        &["--truth", "only used with --out"],
+    );
+    let truth = dir.write(
+        "truth.json",
+        &json!({"t_s": [0.1, 0.2], "states": [[0,0,0,0],[0,0,0,0]]}),
+    );
+    let fig = dir.path("f.png");
+    fails(
+        &[
+            "track",
+            "--scenario",
+            s,
+            "--measurements",
+            &ok_raw,
+            "--out",
+            &fig,
+            "--truth",
+            &truth,
+        ],
+        &["--truth", "2 times and 2 states, the track has 1 steps"],
+    );
+    assert!(
+        !std::path::Path::new(&fig).exists(),
+        "no figure on bad input"
+    );
+    fails(
+        &[
+            "track",
+            "--scenario",
+            s,
+            "--measurements",
+            &ok_raw,
+            "--out",
+            &dir.path("f.gif"),
+        ],
+        &["--out"],
     );
     // simulate-walk: bad counts and rates.
     let out = dir.path("w");

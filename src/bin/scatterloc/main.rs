@@ -29,6 +29,8 @@ mod report;
 mod study;
 #[cfg(not(target_arch = "wasm32"))]
 mod track_cmd;
+#[cfg(not(target_arch = "wasm32"))]
+mod track_fig;
 
 /// Usage text (`scatterloc help`).
 #[cfg(not(target_arch = "wasm32"))]
@@ -53,7 +55,8 @@ USAGE:
       Levenberg-Marquardt fix. Delays file: {\"delays_s\": [one per link in scenario link
       order, null = no measurement], \"sigma_s\": number | [per link], \"initial_m\": [x, y]
       (optional; default: best node of a 0.5 m grid over area_m)}.
-  scatterloc track --scenario FILE --measurements FILE
+  scatterloc track --scenario FILE --measurements FILE [--calibration FILE]
+                   [--association spec|gated] [--out FIG.{svg,png} [--truth FILE]]
       EKF (spec 6): step n predicts by dt_s, then updates with steps[n-1]. Measurements file:
       {\"dt_s\": T, \"process_noise\": q (m^2/s^3), \"initial_state\": [x, y, vx, vy],
       \"initial_covariance\": [[4x4]], \"sigma_s\": number | [per link] (optional; default: link
@@ -69,6 +72,8 @@ USAGE:
       \"initial_snapshot\" (one raw step at t0) instead of initial_state/initial_covariance:
       gated, strongest estimate per link, LM fix; the filter starts there at rest with
       sigma_v = 2 m/s per component ({start: {position_m, covariance_m2, termination, ..}}).
+      --out: a figure of the filter's 1 sigma position sqrt(Pxx + Pyy) and the links used over
+      time; --truth FILE ({t_s, states}, e.g. simulate-walk's truth.json) adds the error.
   scatterloc calibrate --scenario FILE --snapshots FILE [--gap-s G] [--min-fraction F]
                        [--sigma-floor-s S] [--out OUT.json]
       Calibration stage (spec 4) of the empty area: {\"snapshots\": [[[delay_s, ..] per link]

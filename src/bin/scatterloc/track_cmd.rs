@@ -19,6 +19,8 @@ use scatterloc::Error;
 
 use crate::commands::{emit, model_of, parse_args, read_json_file, read_scenario, Sigma};
 use crate::gating_cmd::{one_list_per_link, read_calibration, RawStep};
+use crate::output::{check_writable, Format};
+use crate::track_fig::{read_truth, write_track_figure, TrackSeries};
 use crate::CliError;
 
 /// The `--measurements` file.
@@ -97,12 +99,32 @@ fn estimates(step: &[Vec<[f64; 2]>]) -> Vec<Vec<DelayEstimate>> {
 
 /// `scatterloc track --scenario S --measurements M [--calibration C] [--association R]`.
 pub fn track(argv: &[OsString]) -> Result<(), CliError> {
-    let flags = ["scenario", "measurements", "calibration", "association"];
+    let flags = [
+        "scenario",
+        "measurements",
+        "calibration",
+        "association",
+        "out",
+        "truth",
+    ];
     let Some(args) = parse_args(argv, "track", &flags, &[])? else {
         return Ok(());
     };
     args.expect_positional("track", 0, "")?;
     let mpath = args.required("measurements")?;
+    let figure = match args.get("out") {
+        Some(p) => {
+            let f = Format::of("out", p, &[Format::Svg, Format::Png])?;
+            check_writable("out", p)?;
+            Some((p, f))
+        }
+        None if args.get("truth").is_some() => {
+            return Err(CliError::usage(
+                "--truth: only used with --out (the figure)",
+            ))
+        }
+        None => None,
+    };
     let scenario = read_scenario(&args)?;
     let m: MeasurementsFile = read_json_file("measurements", mpath)?;
     let bad = |e: &dyn std::fmt::Display| CliError::usage(format!("--measurements {mpath}: {e}"));
@@ -225,6 +247,34 @@ pub fn track(argv: &[OsString]) -> Result<(), CliError> {
             out.static_removed = Some(removed);
         }
         (None, None) => unreachable!("checked above"),
+    }
+    if let Some((path, format)) = figure {
+        let truth = match args.get("truth") {
+            Some(t) => Some(read_truth(t, &out.t_s)?),
+            None => None,
+        };
+        let series = TrackSeries {
+            t_s: &out.t_s,
+            states: &out.states,
+            covariances: &out.covariances,
+            links_used: &out.links_used,
+            link_count: n,
+        };
+        let how = if out.choices.is_some() {
+            format!(
+                "raw estimates gated (E4), association {}",
+                args.get("association").unwrap_or("spec")
+            )
+        } else {
+            "delays as given".to_string()
+        };
+        let subtitle = format!(
+            "{} · {} steps of {} s · {how}",
+            scenario.name,
+            out.t_s.len(),
+            m.dt_s
+        );
+        write_track_figure(path, format, &series, truth.as_ref(), subtitle)?;
     }
     let text =
         serde_json::to_string(&out).map_err(|e| CliError::output(format!("encoding JSON: {e}")))?;
