@@ -393,6 +393,20 @@ fn gating_commands_name_their_bad_input() {
         ],
         &["--dt", "must be > 0"],
     );
+    fails(
+        &[
+            "simulate-walk",
+            "--scenario",
+            s,
+            "--out-dir",
+            &out,
+            "--dt",
+            "1e-4",
+            "--false-alarms",
+            "100",
+        ],
+        &["estimates would be written"],
+    );
     assert!(
         !std::path::Path::new(&out).exists(),
         "nothing written on bad input"

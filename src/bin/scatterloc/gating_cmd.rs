@@ -207,6 +207,9 @@ pub fn one_list_per_link(field: &str, len: usize, n: usize) -> Result<(), String
     }
 }
 
+/// Largest expected number of estimates `simulate-walk` writes (≈ 0.5 GB of JSON).
+const MAX_WALK_ESTIMATES: f64 = 2e7;
+
 /// One raw step of a measurements file: per link, `[delay_s, amplitude]` estimates.
 pub type RawStep = Vec<Vec<[f64; 2]>>;
 
@@ -297,6 +300,15 @@ pub fn simulate_walk(argv: &[OsString]) -> Result<(), CliError> {
     channel
         .validate()
         .map_err(|e| CliError::usage(format!("--false-alarms: {e}")))?;
+    // The files' size: about (static paths + echo + false alarms) estimates per link and step.
+    let per_step = model.link_count() as f64 * (2.0 + channel.reflectors_m.len() as f64 + fa);
+    let estimates = per_step * (steps + 1) as f64 + per_step * ncal as f64;
+    if estimates > MAX_WALK_ESTIMATES {
+        return Err(CliError::usage(format!(
+            "--duration/--dt/--false-alarms/--calibration-snapshots: about {estimates:.0} \
+             estimates would be written, at most {MAX_WALK_ESTIMATES:.0} are allowed"
+        )));
+    }
     let path = LoopPath::default();
     // Calibration of the empty area without false alarms (see the calibration module).
     let clean = default_channel(scenario.radio.bandwidth_hz, 0.0);
