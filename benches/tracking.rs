@@ -229,9 +229,12 @@ fn gated_step(c: &mut Criterion) {
     let mut rng = simulate::rng(SEED, 7);
     let cfg = ClusterConfig::for_bandwidth(b).unwrap();
     let clean = default_channel(b, 0.0);
-    let cal =
-        Calibration::from_snapshots(&clean.calibration_snapshots(&model, 500, &mut rng), &cfg)
-            .unwrap();
+    let cal = Calibration::from_snapshots(
+        &clean.calibration_snapshots(&model, 500, &mut rng),
+        model.link_count(),
+        &cfg,
+    )
+    .unwrap();
     let ch = default_channel(b, 0.5);
     let path = LoopPath::default();
     let snaps: Vec<_> = path

@@ -82,32 +82,25 @@ pub fn associate(
     if candidates.is_empty() {
         return (None, Choice::Absent);
     }
-    if let (Some(pred), AssociationRule::Gated) = (prediction, rule) {
-        let nearest = argmin(candidates, |c| pred.normalized_innovation(c.delay_s));
-        return if pred.normalized_innovation(candidates[nearest].delay_s) <= INNOVATION_GATE {
-            let how = if candidates.len() == 1 {
-                Choice::Single
-            } else {
-                Choice::Nearest
-            };
-            (Some(nearest), how)
-        } else {
-            (None, Choice::Absent)
-        };
+    let single = candidates.len() == 1;
+    // The candidate nearest the prediction and whether it passes the innovation gate.
+    let nearest = prediction.map(|pred| {
+        let i = argmin(candidates, |c| pred.normalized_innovation(c.delay_s));
+        (
+            i,
+            pred.normalized_innovation(candidates[i].delay_s) <= INNOVATION_GATE,
+        )
+    });
+    match (rule, nearest) {
+        (AssociationRule::Gated, Some((i, true))) if single => (Some(i), Choice::Single),
+        (AssociationRule::Gated, Some((_, false))) => (None, Choice::Absent),
+        _ if single => (Some(0), Choice::Single),
+        (_, Some((i, true))) => (Some(i), Choice::Nearest),
+        _ => (
+            Some(argmin(candidates, |c| -c.amplitude)),
+            Choice::Strongest,
+        ),
     }
-    if candidates.len() == 1 {
-        return (Some(0), Choice::Single);
-    }
-    if let Some(pred) = prediction {
-        let nearest = argmin(candidates, |c| pred.normalized_innovation(c.delay_s));
-        if pred.normalized_innovation(candidates[nearest].delay_s) <= INNOVATION_GATE {
-            return (Some(nearest), Choice::Nearest);
-        }
-    }
-    (
-        Some(argmin(candidates, |c| -c.amplitude)),
-        Choice::Strongest,
-    )
 }
 
 /// Index of the smallest key, the first one on ties.

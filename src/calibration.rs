@@ -20,6 +20,8 @@
 use alloc::format;
 use alloc::vec::Vec;
 
+use serde::{Deserialize, Serialize};
+
 use crate::error::{Error, Result};
 use crate::math::{sqrt, Real};
 
@@ -83,16 +85,20 @@ impl ClusterConfig {
     }
 }
 
-/// One static path of a link: `τ̄_kl,r` and `σ̄_kl,r`.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// One static path of a link: `τ̄_kl,r` and `σ̄_kl,r` (JSON: `{"mean_s", "sigma_s", "count",
+/// "snapshots"}`, the counts optional).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct StaticCluster {
     /// Cluster mean `τ̄`, s.
     pub mean_s: Real,
     /// Cluster standard deviation `σ̄` (sample, floored at `σ_min`), s.
     pub sigma_s: Real,
     /// Calibration delays in the cluster.
+    #[serde(default)]
     pub count: usize,
     /// Calibration snapshots with at least one delay in the cluster (the 50 % rule counts these).
+    #[serde(default)]
     pub snapshots: usize,
 }
 
@@ -105,7 +111,9 @@ impl StaticCluster {
 }
 
 /// The static paths of one link, ascending in delay (index 0 is the LoS when it was seen).
-#[derive(Debug, Clone, PartialEq, Default)]
+/// Deserialised values are unchecked: pass them through [`LinkCalibration::from_clusters`].
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct LinkCalibration {
     /// The kept clusters, ascending in mean delay.
     pub clusters: Vec<StaticCluster>,
@@ -120,16 +128,26 @@ impl LinkCalibration {
         snapshots: &[Vec<Real>],
         cfg: &ClusterConfig,
     ) -> Result<LinkCalibration> {
+        Self::from_lists(link, snapshots.iter().map(Vec::as_slice), cfg)
+    }
+
+    /// [`LinkCalibration::from_snapshots`] over link `link`'s list of each snapshot.
+    fn from_lists<'s>(
+        link: usize,
+        lists: impl ExactSizeIterator<Item = &'s [Real]> + Clone,
+        cfg: &ClusterConfig,
+    ) -> Result<LinkCalibration> {
         cfg.validate()?;
-        if snapshots.is_empty() || snapshots.len() > MAX_CALIBRATION_SNAPSHOTS {
+        let count = lists.len();
+        if count == 0 || count > MAX_CALIBRATION_SNAPSHOTS {
             return Err(Error::SizeLimit {
                 field: "calibration snapshots per link",
-                value: snapshots.len(),
+                value: count,
                 min: 1,
                 max: MAX_CALIBRATION_SNAPSHOTS,
             });
         }
-        let total: usize = snapshots.iter().map(Vec::len).sum();
+        let total: usize = lists.clone().map(<[Real]>::len).sum();
         if total > MAX_CALIBRATION_DELAYS {
             return Err(Error::SizeLimit {
                 field: "calibration delays per link",
@@ -140,18 +158,18 @@ impl LinkCalibration {
         }
         // (delay, snapshot index), sorted by delay.
         let mut delays = Vec::with_capacity(total);
-        for (k, snapshot) in snapshots.iter().enumerate() {
+        for (k, snapshot) in lists.enumerate() {
             for (i, &d) in snapshot.iter().enumerate() {
                 if !d.is_finite() {
                     return Err(Error::NonFinite {
-                        field: format!("calibration[{link}][{k}][{i}]"),
+                        field: format!("calibration[{k}][{link}][{i}]"),
                     });
                 }
                 delays.push((d, k));
             }
         }
         delays.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-        let needed = cfg.min_fraction * snapshots.len() as Real;
+        let needed = cfg.min_fraction * count as Real;
         let mut clusters = Vec::new();
         let mut seen = Vec::new();
         let mut start = 0;
@@ -224,12 +242,23 @@ pub struct Calibration {
 }
 
 impl Calibration {
-    /// Clusters every link's calibration snapshots (`per_link[p]` = link `p`'s snapshots).
-    pub fn from_snapshots(per_link: &[Vec<Vec<Real>>], cfg: &ClusterConfig) -> Result<Calibration> {
-        let links = per_link
-            .iter()
-            .enumerate()
-            .map(|(p, s)| LinkCalibration::from_snapshots(p, s, cfg))
+    /// Clusters the calibration snapshots of a network of `links` links (`snapshots[k][p]` =
+    /// link `p`'s delays in snapshot `k`, as recorded). Errors: a snapshot without one list per
+    /// link (`LengthMismatch`), and those of [`LinkCalibration::from_snapshots`].
+    pub fn from_snapshots(
+        snapshots: &[Vec<Vec<Real>>],
+        links: usize,
+        cfg: &ClusterConfig,
+    ) -> Result<Calibration> {
+        if let Some(s) = snapshots.iter().find(|s| s.len() != links) {
+            return Err(Error::LengthMismatch {
+                field: "calibration snapshot",
+                expected: links,
+                found: s.len(),
+            });
+        }
+        let links = (0..links)
+            .map(|p| LinkCalibration::from_lists(p, snapshots.iter().map(|s| s[p].as_slice()), cfg))
             .collect::<Result<Vec<_>>>()?;
         Ok(Calibration { links })
     }
@@ -307,7 +336,7 @@ mod tests {
         assert!(matches!(e, Error::SizeLimit { value: 0, .. }), "{e}");
         let e =
             LinkCalibration::from_snapshots(2, &[vec![1e-8], vec![Real::NAN]], &cfg).unwrap_err();
-        assert_eq!(e.to_string(), "calibration[2][1][0]: not a finite number");
+        assert_eq!(e.to_string(), "calibration[1][2][0]: not a finite number");
         let bad = ClusterConfig {
             min_fraction: 1.5,
             ..cfg

@@ -83,9 +83,12 @@ impl StaticChannel {
 
     /// Whether an echo at delay `tau` on link `p` is resolved from every static path.
     pub fn resolved(&self, model: &Model, p: usize, tau: Real) -> bool {
-        self.static_delays(model, p)
-            .iter()
-            .all(|s| (tau - s).abs() >= self.resolution_s)
+        self.resolved_from(&self.static_delays(model, p), tau)
+    }
+
+    /// Whether `tau` is at least the resolution away from every delay of `statics`.
+    fn resolved_from(&self, statics: &[Real], tau: Real) -> bool {
+        statics.iter().all(|s| (tau - s).abs() >= self.resolution_s)
     }
 
     /// One snapshot's estimates for every link with the scatterer at `target` (`None`: the
@@ -110,7 +113,7 @@ impl StaticChannel {
                 if let Some(r) = target {
                     let tau = model.network.delay(p, r);
                     let noisy = tau + model.sigma_delay(p, r) * standard_normal(rng);
-                    if statics.iter().all(|s| (tau - s).abs() >= self.resolution_s) {
+                    if self.resolved_from(&statics, tau) {
                         list.push(DelayEstimate {
                             delay_s: noisy,
                             amplitude: sqrt(model.snr(p, r)),
@@ -131,7 +134,7 @@ impl StaticChannel {
             .collect()
     }
 
-    /// `count` calibration snapshots of the empty area, arranged per link (`[p][k]` = link `p`'s
+    /// `count` calibration snapshots of the empty area as delays only (`[k][p]` = link `p`'s
     /// delays in snapshot `k`), as [`crate::calibration::Calibration::from_snapshots`] takes them.
     pub fn calibration_snapshots(
         &self,
@@ -139,12 +142,13 @@ impl StaticChannel {
         count: usize,
         rng: &mut Rng,
     ) -> Vec<Vec<Vec<Real>>> {
-        let mut per_link = alloc::vec![Vec::with_capacity(count); model.link_count()];
-        for _ in 0..count {
-            for (p, list) in self.snapshot(model, None, rng).into_iter().enumerate() {
-                per_link[p].push(list.iter().map(|e| e.delay_s).collect());
-            }
-        }
-        per_link
+        (0..count)
+            .map(|_| {
+                self.snapshot(model, None, rng)
+                    .iter()
+                    .map(|l| l.iter().map(|e| e.delay_s).collect())
+                    .collect()
+            })
+            .collect()
     }
 }

@@ -84,7 +84,8 @@ fn simulate_calibrate_track_chain() {
         }
     }
     // No track yet: the filter started from the LM fix of the t₀ snapshot (all 4 links, the
-    // echo taken as the strongest estimate), within 10 cm of the start of the loop (12 + 8, 6).
+    // echo taken as the strongest estimate), within 10 cm of the start of the loop (12 + 8, 6):
+    // about 3σ of the fix there (σx ≈ 1 cm, σy ≈ 3 cm, its reported covariance).
     let start = &track["start"];
     assert_eq!(start["links_used"], 4, "{start}");
     let p0 = floats(&start["position_m"]);

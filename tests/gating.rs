@@ -75,8 +75,12 @@ fn check12_calibrated_clusters_gate_the_static_paths() {
     let ch = channel(0.0);
     let cfg = ClusterConfig::for_bandwidth(bandwidth()).unwrap();
     let mut rng = simulate::rng(12, 1);
-    let cal = Calibration::from_snapshots(&ch.calibration_snapshots(&model, 2000, &mut rng), &cfg)
-        .unwrap();
+    let cal = Calibration::from_snapshots(
+        &ch.calibration_snapshots(&model, 2000, &mut rng),
+        model.link_count(),
+        &cfg,
+    )
+    .unwrap();
     for p in 0..model.link_count() {
         let statics = ch.static_delays(&model, p);
         let c = &cal.links[p].clusters;
@@ -166,7 +170,7 @@ fn run_loop_from(
     let cfg = ClusterConfig::for_bandwidth(bandwidth()).unwrap();
     let mut rng = simulate::rng(seed, 0);
     let snaps = channel(0.0).calibration_snapshots(&model, 500, &mut rng);
-    let cal = Calibration::from_snapshots(&snaps, &cfg).unwrap();
+    let cal = Calibration::from_snapshots(&snaps, model.link_count(), &cfg).unwrap();
     let ch = channel(false_alarms);
     let dt = 0.1;
     let motion = ConstantVelocity::validated(dt, 0.1).unwrap();

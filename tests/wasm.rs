@@ -312,8 +312,12 @@ fn gating_in_wasm() {
     let ch = default_channel(120e6, 0.0);
     let mut rng = scatterloc::simulate::rng(5, 0);
     let cfg = ClusterConfig::for_bandwidth(120e6).unwrap();
-    let cal = Calibration::from_snapshots(&ch.calibration_snapshots(&model, 200, &mut rng), &cfg)
-        .unwrap();
+    let cal = Calibration::from_snapshots(
+        &ch.calibration_snapshots(&model, 200, &mut rng),
+        model.link_count(),
+        &cfg,
+    )
+    .unwrap();
     assert!(cal.links.iter().all(|l| l.clusters.len() == 2));
     let r = Vec2::new(20.0, 6.0);
     let snap = ch.snapshot(&model, Some(r), &mut rng);

@@ -8,16 +8,16 @@ use std::path::Path;
 use serde::{Deserialize, Serialize};
 
 use scatterloc::calibration::{
-    Calibration, ClusterConfig, LinkCalibration, StaticCluster, MAX_CALIBRATION_SNAPSHOTS,
+    Calibration, ClusterConfig, LinkCalibration, MAX_CALIBRATION_SNAPSHOTS,
 };
-use scatterloc::math::Real;
 use scatterloc::measurement_case::{default_channel, LoopPath, LOOP_DURATION_S};
-use scatterloc::montecarlo::MAX_STEPS;
-use scatterloc::trajectory::{paper_initial_covariance, step_count};
+use scatterloc::motion::ConstantVelocity;
+use scatterloc::trajectory::paper_initial_covariance;
 use scatterloc::{simulate, Model};
 
 use crate::commands::{emit_json, model_of, parse_args, read_json_file, read_scenario};
 use crate::output::write_json_file;
+use crate::study::{checked_steps, flag_error, seed};
 use crate::CliError;
 
 /// The `--snapshots` file of `calibrate`: per snapshot, per link, the delay estimates, s.
@@ -26,30 +26,6 @@ use crate::CliError;
 pub struct SnapshotsFile {
     /// `snapshots[k][p]` = link `p`'s delays in snapshot `k`.
     pub snapshots: Vec<Vec<Vec<f64>>>,
-}
-
-/// One cluster as JSON.
-#[derive(Debug, Deserialize, Serialize)]
-#[serde(deny_unknown_fields)]
-pub struct ClusterJson {
-    /// `τ̄`, s.
-    pub mean_s: f64,
-    /// `σ̄`, s.
-    pub sigma_s: f64,
-    /// Calibration delays in the cluster.
-    #[serde(default)]
-    pub count: usize,
-    /// Calibration snapshots represented in it.
-    #[serde(default)]
-    pub snapshots: usize,
-}
-
-/// One link's clusters as JSON.
-#[derive(Debug, Deserialize, Serialize)]
-#[serde(deny_unknown_fields)]
-pub struct LinkJson {
-    /// Ascending in delay.
-    pub clusters: Vec<ClusterJson>,
 }
 
 /// The calibration file (`calibrate`'s output, `track --calibration`'s input).
@@ -67,36 +43,11 @@ pub struct CalibrationFile {
     /// Calibration snapshots used (informative on input).
     #[serde(default)]
     pub snapshot_count: Option<usize>,
-    /// Per link in scenario link order.
-    pub links: Vec<LinkJson>,
+    /// Per link in scenario link order: `{"clusters": [{"mean_s", "sigma_s", ..}]}`.
+    pub links: Vec<LinkCalibration>,
 }
 
 impl CalibrationFile {
-    fn of(cal: &Calibration, cfg: &ClusterConfig, snapshots: usize) -> CalibrationFile {
-        CalibrationFile {
-            gap_s: Some(cfg.gap_s),
-            min_fraction: Some(cfg.min_fraction),
-            sigma_floor_s: Some(cfg.sigma_floor_s),
-            snapshot_count: Some(snapshots),
-            links: cal
-                .links
-                .iter()
-                .map(|l| LinkJson {
-                    clusters: l
-                        .clusters
-                        .iter()
-                        .map(|c| ClusterJson {
-                            mean_s: c.mean_s,
-                            sigma_s: c.sigma_s,
-                            count: c.count,
-                            snapshots: c.snapshots,
-                        })
-                        .collect(),
-                })
-                .collect(),
-        }
-    }
-
     /// The validated calibration for a model with `links` links.
     pub fn into_calibration(self, links: usize) -> Result<Calibration, scatterloc::Error> {
         let cal = Calibration {
@@ -104,19 +55,7 @@ impl CalibrationFile {
                 .links
                 .into_iter()
                 .enumerate()
-                .map(|(p, l)| {
-                    let clusters = l
-                        .clusters
-                        .into_iter()
-                        .map(|c| StaticCluster {
-                            mean_s: c.mean_s,
-                            sigma_s: c.sigma_s,
-                            count: c.count,
-                            snapshots: c.snapshots,
-                        })
-                        .collect();
-                    LinkCalibration::from_clusters(p, clusters)
-                })
+                .map(|(p, l)| LinkCalibration::from_clusters(p, l.clusters))
                 .collect::<Result<Vec<_>, _>>()?,
         };
         cal.check_links(links)?;
@@ -180,16 +119,17 @@ pub fn calibrate(argv: &[OsString]) -> Result<(), CliError> {
             f.snapshots.len()
         )));
     }
-    let mut per_link = vec![Vec::with_capacity(f.snapshots.len()); n];
-    for (k, snap) in f.snapshots.into_iter().enumerate() {
+    for (k, snap) in f.snapshots.iter().enumerate() {
         one_list_per_link(&format!("snapshots[{k}]"), snap.len(), n).map_err(|e| bad(&e))?;
-        for (p, d) in snap.into_iter().enumerate() {
-            per_link[p].push(d);
-        }
     }
-    let count = per_link[0].len();
-    let cal = Calibration::from_snapshots(&per_link, &cfg).map_err(|e| bad(&e))?;
-    let out = CalibrationFile::of(&cal, &cfg, count);
+    let cal = Calibration::from_snapshots(&f.snapshots, n, &cfg).map_err(|e| bad(&e))?;
+    let out = CalibrationFile {
+        gap_s: Some(cfg.gap_s),
+        min_fraction: Some(cfg.min_fraction),
+        sigma_floor_s: Some(cfg.sigma_floor_s),
+        snapshot_count: Some(f.snapshots.len()),
+        links: cal.links,
+    };
     match args.get("out") {
         Some(p) => write_json_file("out", p, &out),
         None => emit_json(&out),
@@ -257,28 +197,11 @@ pub fn simulate_walk(argv: &[OsString]) -> Result<(), CliError> {
     let scenario = read_scenario(&args)?;
     let model = model_of(&scenario)?;
     let dir = args.required("out-dir")?;
-    let positive = |name: &str, v: f64| {
-        if v.is_finite() && v > 0.0 {
-            Ok(v)
-        } else {
-            Err(CliError::usage(format!("--{name}: must be > 0 (got {v})")))
-        }
-    };
-    let duration = positive(
-        "duration",
-        args.number("duration")?.unwrap_or(LOOP_DURATION_S),
-    )?;
-    let dt = positive("dt", args.number("dt")?.unwrap_or(0.1))?;
-    let q = positive(
-        "process-noise",
-        args.number("process-noise")?.unwrap_or(0.1),
-    )?;
-    let steps = step_count(duration, dt);
-    if steps == 0 || steps > MAX_STEPS {
-        return Err(CliError::usage(format!(
-            "--duration/--dt: {steps} steps, 1 … {MAX_STEPS} are allowed"
-        )));
-    }
+    let dt = args.number("dt")?.unwrap_or(0.1);
+    let q = args.number("process-noise")?.unwrap_or(0.1);
+    ConstantVelocity::validated(dt, q).map_err(flag_error)?;
+    let duration = args.number("duration")?.unwrap_or(LOOP_DURATION_S);
+    let steps = checked_steps(duration, dt)?;
     let ncal = args.integer("calibration-snapshots")?.unwrap_or(500);
     if ncal == 0 || ncal > 100_000 {
         return Err(CliError::usage(format!(
@@ -286,7 +209,7 @@ pub fn simulate_walk(argv: &[OsString]) -> Result<(), CliError> {
         )));
     }
     let fa = args.number("false-alarms")?.unwrap_or(0.5);
-    let seed = args.integer("seed")?.unwrap_or(1) as u64;
+    let seed = seed(&args)?;
     let from_truth = match args.get("start") {
         None | Some("snapshot") => false,
         Some("truth") => true,
@@ -313,10 +236,7 @@ pub fn simulate_walk(argv: &[OsString]) -> Result<(), CliError> {
     // Calibration of the empty area without false alarms (see the calibration module).
     let clean = default_channel(scenario.radio.bandwidth_hz, 0.0);
     let mut rng = simulate::rng(seed, 0);
-    let per_link = clean.calibration_snapshots(&model, ncal, &mut rng);
-    let cal_snaps: Vec<Vec<Vec<Real>>> = (0..ncal)
-        .map(|k| per_link.iter().map(|l| l[k].clone()).collect())
-        .collect();
+    let cal_snaps = clean.calibration_snapshots(&model, ncal, &mut rng);
     let states = path.states(dt, steps);
     let raw = |snap: Vec<Vec<scatterloc::association::DelayEstimate>>| -> RawStep {
         snap.iter()

@@ -119,17 +119,7 @@ pub fn parse_study(args: &Args) -> Result<Study, CliError> {
     let q = args.number("process-noise")?.unwrap_or(PAPER_INTENSITY);
     let motion = ConstantVelocity::validated(dt, q).map_err(flag_error)?;
     let duration = args.number("duration")?.unwrap_or(PAPER_DURATION_S);
-    if duration <= 0.0 {
-        return Err(CliError::usage(format!(
-            "--duration: must be > 0 s (got {duration})"
-        )));
-    }
-    let steps = step_count(duration, dt);
-    if steps == 0 || steps > MAX_STEPS {
-        return Err(CliError::usage(format!(
-            "--duration / --dt: {duration} s at {dt} s is {steps} steps, outside 1..={MAX_STEPS}"
-        )));
-    }
+    let steps = checked_steps(duration, dt)?;
     Ok(Study {
         layout,
         model: model_of(&scenario)?,
@@ -194,6 +184,23 @@ pub fn threads(args: &Args) -> Result<(usize, usize), CliError> {
         n
     };
     Ok((n, used))
+}
+
+/// The steps after `t₀` of `--duration` at `--dt` (validated `dt`): `--duration` must be `> 0`
+/// and give 1 … [`MAX_STEPS`] steps.
+pub fn checked_steps(duration: f64, dt: f64) -> Result<usize, CliError> {
+    if duration <= 0.0 {
+        return Err(CliError::usage(format!(
+            "--duration: must be > 0 s (got {duration})"
+        )));
+    }
+    let steps = step_count(duration, dt);
+    if steps == 0 || steps > MAX_STEPS {
+        return Err(CliError::usage(format!(
+            "--duration / --dt: {duration} s at {dt} s is {steps} steps, outside 1..={MAX_STEPS}"
+        )));
+    }
+    Ok(steps)
 }
 
 /// `--seed` (default 1).

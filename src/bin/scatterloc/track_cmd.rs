@@ -8,14 +8,15 @@ use std::ffi::OsString;
 
 use serde::{Deserialize, Serialize};
 
-use scatterloc::association::{AssociationRule, DelayEstimate};
+use scatterloc::association::{AssociationRule, Choice, DelayEstimate};
 use scatterloc::calibration::Calibration;
-use scatterloc::ekf::{Ekf, MeasurementNoise};
+use scatterloc::ekf::{Ekf, MeasurementNoise, UpdateSummary};
 use scatterloc::gated_track::{start_from_snapshot, GatedTracker, START_SPEED_SIGMA_MPS};
-use scatterloc::math::{Mat2, Mat4, Vec4};
+use scatterloc::math::{Mat4, Vec4};
 use scatterloc::montecarlo::MAX_STEPS;
 use scatterloc::motion::ConstantVelocity;
-use scatterloc::Error;
+use scatterloc::scenario::Area;
+use scatterloc::{Error, Model};
 
 use crate::commands::{emit, model_of, parse_args, read_json_file, read_scenario, Sigma};
 use crate::gating_cmd::{one_list_per_link, read_calibration, RawStep};
@@ -40,7 +41,7 @@ struct MeasurementsFile {
     /// No track yet (raw form only): the snapshot at t₀, `[[delay_s, amplitude], ..]` per link;
     /// the filter starts from its LM fix.
     #[serde(default)]
-    initial_snapshot: Option<Vec<Vec<[f64; 2]>>>,
+    initial_snapshot: Option<RawStep>,
     /// Fixed delay σ (one or per link), s; absent: the link budget at the prediction.
     #[serde(default)]
     sigma_s: Option<Sigma>,
@@ -126,12 +127,12 @@ pub fn track(argv: &[OsString]) -> Result<(), CliError> {
         None => None,
     };
     let scenario = read_scenario(&args)?;
-    let m: MeasurementsFile = read_json_file("measurements", mpath)?;
+    let mut m: MeasurementsFile = read_json_file("measurements", mpath)?;
     let bad = |e: &dyn std::fmt::Display| CliError::usage(format!("--measurements {mpath}: {e}"));
     let model = model_of(&scenario)?;
     let n = model.link_count();
     let motion = ConstantVelocity::validated(m.dt_s, m.process_noise).map_err(|e| bad(&e))?;
-    let sigmas = match m.sigma_s {
+    let sigmas = match m.sigma_s.take() {
         Some(s) => Some(s.per_link(n).map_err(|e| bad(&e))?),
         None => None,
     };
@@ -156,37 +157,7 @@ pub fn track(argv: &[OsString]) -> Result<(), CliError> {
         // No calibration: nothing is static (every estimate is a candidate).
         links: vec![Default::default(); n],
     });
-    let (ekf, start) =
-        match (m.initial_state, m.initial_covariance, &m.initial_snapshot) {
-            (Some(x0), Some(p0), None) => {
-                let p0 = Mat4::from_fn(|i, j| p0[i][j]);
-                (Ekf::new(Vec4::from(x0), p0).map_err(|e| bad(&e))?, None)
-            }
-            (None, None, Some(snap)) if m.raw_steps.is_some() => {
-                one_list_per_link("initial_snapshot", snap.len(), n).map_err(|e| bad(&e))?;
-                let f = start_from_snapshot(
-                    &model,
-                    &cal,
-                    &estimates(snap),
-                    &scenario.area_m,
-                    START_SPEED_SIGMA_MPS,
-                )
-                .map_err(|e| bad(&format!("initial_snapshot: {e}")))?;
-                let c = f.report.covariance_m2.unwrap_or_else(Mat2::zeros);
-                let start = StartOut {
-                    position_m: [f.report.position.x, f.report.position.y],
-                    covariance_m2: [[c[(0, 0)], c[(0, 1)]], [c[(1, 0)], c[(1, 1)]]],
-                    termination: f.report.termination.as_str(),
-                    links_used: f.report.links_used,
-                    delays_used_s: f.selection.delays.clone(),
-                    choices: f.selection.choices.iter().map(|c| c.name()).collect(),
-                };
-                (f.ekf, Some(start))
-            }
-            _ => return Err(bad(
-                &"give initial_state and initial_covariance, or (with raw_steps) initial_snapshot",
-            )),
-        };
+    let (ekf, start) = initial_filter(&m, &model, &cal, &scenario.area_m, &bad)?;
     let len = match (&m.steps, &m.raw_steps) {
         (Some(s), None) => s.len(),
         (None, Some(r)) => r.len(),
@@ -218,33 +189,9 @@ pub fn track(argv: &[OsString]) -> Result<(), CliError> {
     match (m.steps, m.raw_steps) {
         (Some(steps), _) => plain(&model, ekf, &motion, noise, &steps, m.dt_s, &mut out, &bad)?,
         (_, Some(raw)) => {
-            let mut tracker =
+            let tracker =
                 GatedTracker::new(ekf, &model, &cal, motion, noise, rule).map_err(|e| bad(&e))?;
-            let (mut used, mut choices, mut removed) = (vec![], vec![], vec![]);
-            for (k, step) in raw.iter().enumerate() {
-                let field = format!("raw_steps[{k}]");
-                one_list_per_link(&field, step.len(), n).map_err(|e| bad(&e))?;
-                let s = tracker.step(&estimates(step)).map_err(|e| match e {
-                    Error::NonFiniteDelay { link } => {
-                        bad(&format!("{field}[{link}]: a delay is not a finite number"))
-                    }
-                    other => bad(&format!("{field}: {other}")),
-                })?;
-                record(
-                    &mut out,
-                    &tracker.ekf,
-                    k,
-                    m.dt_s,
-                    s.summary.nis,
-                    s.summary.links_used,
-                );
-                used.push(s.selection.delays);
-                choices.push(s.selection.choices.iter().map(|c| c.name()).collect());
-                removed.push(s.selection.static_removed);
-            }
-            out.delays_used_s = Some(used);
-            out.choices = Some(choices);
-            out.static_removed = Some(removed);
+            gated(tracker, n, &raw, m.dt_s, &mut out, &bad)?
         }
         (None, None) => unreachable!("checked above"),
     }
@@ -281,10 +228,59 @@ pub fn track(argv: &[OsString]) -> Result<(), CliError> {
     emit(&text)
 }
 
+/// The filter at `t₀`: from `initial_state` and `initial_covariance`, or (raw steps only) from
+/// the LM fix of `initial_snapshot`, reported as `start`.
+fn initial_filter(
+    m: &MeasurementsFile,
+    model: &Model,
+    cal: &Calibration,
+    area: &Area,
+    bad: &dyn Fn(&dyn std::fmt::Display) -> CliError,
+) -> Result<(Ekf, Option<StartOut>), CliError> {
+    match (m.initial_state, m.initial_covariance, &m.initial_snapshot) {
+        (Some(x0), Some(p0), None) => {
+            let p0 = Mat4::from_fn(|i, j| p0[i][j]);
+            Ok((Ekf::new(Vec4::from(x0), p0).map_err(|e| bad(&e))?, None))
+        }
+        (None, None, Some(snap)) if m.raw_steps.is_some() => {
+            one_list_per_link("initial_snapshot", snap.len(), model.link_count())
+                .map_err(|e| bad(&e))?;
+            let f = start_from_snapshot(model, cal, &estimates(snap), area, START_SPEED_SIGMA_MPS)
+                .map_err(|e| bad(&format!("initial_snapshot: {e}")))?;
+            let c = &f.ekf.covariance;
+            let start = StartOut {
+                position_m: [f.report.position.x, f.report.position.y],
+                covariance_m2: [[c[(0, 0)], c[(0, 1)]], [c[(1, 0)], c[(1, 1)]]],
+                termination: f.report.termination.as_str(),
+                links_used: f.report.links_used,
+                choices: names(&f.selection.choices),
+                delays_used_s: f.selection.delays,
+            };
+            Ok((f.ekf, Some(start)))
+        }
+        _ => Err(bad(
+            &"give initial_state and initial_covariance, or (with raw_steps) initial_snapshot",
+        )),
+    }
+}
+
+/// The names of `choices`.
+fn names(choices: &[Choice]) -> Vec<&'static str> {
+    choices.iter().map(|c| c.name()).collect()
+}
+
+/// A core error of step `field` as the CLI reports it.
+fn step_error(field: &str, e: Error, bad: &dyn Fn(&dyn std::fmt::Display) -> CliError) -> CliError {
+    match e {
+        Error::NonFiniteDelay { link } => bad(&format!("{field}[{link}]: not a finite number")),
+        other => bad(&format!("{field}: {other}")),
+    }
+}
+
 /// The plain form: one delay (or null) per link and step.
 #[allow(clippy::too_many_arguments)]
 fn plain(
-    model: &scatterloc::Model,
+    model: &Model,
     mut ekf: Ekf,
     motion: &ConstantVelocity,
     noise: MeasurementNoise,
@@ -303,22 +299,50 @@ fn plain(
             )));
         }
         ekf.predict(motion);
-        let summary = ekf.update(model, z, noise, None).map_err(|e| match e {
-            Error::NonFiniteDelay { link } => bad(&format!("{field}[{link}]: not a finite number")),
-            other => bad(&format!("{field}: {other}")),
-        })?;
-        record(out, &ekf, k, dt_s, summary.nis, summary.links_used);
+        let summary = ekf
+            .update(model, z, noise, None)
+            .map_err(|e| step_error(&field, e, bad))?;
+        record(out, &ekf, k, dt_s, &summary);
     }
     Ok(())
 }
 
+/// The raw form: every step (one list per each of `links` links) gated and associated by
+/// `tracker`, with what it chose.
+fn gated(
+    mut tracker: GatedTracker,
+    links: usize,
+    raw: &[RawStep],
+    dt_s: f64,
+    out: &mut TrackOut,
+    bad: &dyn Fn(&dyn std::fmt::Display) -> CliError,
+) -> Result<(), CliError> {
+    let (mut used, mut choices, mut removed) = (vec![], vec![], vec![]);
+    for (k, step) in raw.iter().enumerate() {
+        let field = format!("raw_steps[{k}]");
+        one_list_per_link(&field, step.len(), links).map_err(|e| bad(&e))?;
+        let s = tracker
+            .step(&estimates(step))
+            .map_err(|e| step_error(&field, e, bad))?;
+        record(out, &tracker.ekf, k, dt_s, &s.summary);
+        choices.push(names(&s.selection.choices));
+        used.push(s.selection.delays);
+        removed.push(s.selection.static_removed);
+    }
+    out.delays_used_s = Some(used);
+    out.choices = Some(choices);
+    out.static_removed = Some(removed);
+    Ok(())
+}
+
 /// Appends step `k`'s filter state to the output.
-fn record(out: &mut TrackOut, ekf: &Ekf, k: usize, dt_s: f64, nis: f64, links_used: usize) {
+fn record(out: &mut TrackOut, ekf: &Ekf, k: usize, dt_s: f64, summary: &UpdateSummary) {
     let p = &ekf.covariance;
     out.t_s.push((k + 1) as f64 * dt_s);
     out.states.push(ekf.state.into());
     out.covariances
         .push(std::array::from_fn(|i| std::array::from_fn(|j| p[(i, j)])));
-    out.nis.push((links_used > 0).then_some(nis));
-    out.links_used.push(links_used);
+    out.nis
+        .push((summary.links_used > 0).then_some(summary.nis));
+    out.links_used.push(summary.links_used);
 }
