@@ -13,12 +13,12 @@ use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
 use nalgebra::storage::Owned;
 use nalgebra::{DVector, Dyn, OMatrix, Vector2, U2};
 
-use scatterloc::crlb::{crlb_at, crlb_map, Grid};
-use scatterloc::geometry::unit_from;
-use scatterloc::lm::{self, DelayMeasurements, LmConfig};
+use scatterloc::localize::{self, DelayMeasurements, LmConfig};
+use scatterloc::localize::{crlb_at, crlb_map, Grid};
 use scatterloc::math::{Real, Vec2, SPEED_OF_LIGHT};
+use scatterloc::measure::unit_from;
 use scatterloc::scenario::Scenario;
-use scatterloc::{presets, simulate, Model};
+use scatterloc::{measure, scenario::presets, Model};
 
 const TRUTH: [Real; 2] = [4.0, 1.0];
 const START_OFFSET: [Real; 2] = [2.0, 2.0];
@@ -37,7 +37,7 @@ fn setup() -> Setup {
     let scenario = presets::sensors2019();
     let model = Model::new(&scenario).unwrap();
     let truth = Vec2::new(TRUTH[0], TRUTH[1]);
-    let delays = simulate::noisy_delays(&model, truth, &mut simulate::rng(SEED, 0))
+    let delays = measure::noisy_delays(&model, truth, &mut measure::rng(SEED, 0))
         .into_iter()
         .map(Some)
         .collect();
@@ -52,12 +52,12 @@ fn setup() -> Setup {
 }
 
 impl Setup {
-    fn ours(&self, initial: Option<Vec2>) -> lm::LmReport {
+    fn ours(&self, initial: Option<Vec2>) -> localize::LmReport {
         let m = DelayMeasurements {
             delays_s: &self.delays,
             sigmas_s: &self.sigmas,
         };
-        lm::locate(
+        localize::locate(
             &self.model.network,
             &m,
             &LmConfig::default(),

@@ -15,15 +15,15 @@ use std::time::Instant;
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 
-use scatterloc::ekf::{Ekf, MeasurementNoise};
 use scatterloc::math::{Real, Vec2, Vec4};
-use scatterloc::montecarlo::{run_chunk, run_truth_chunk, MonteCarloConfig, CHUNK_TRAJECTORIES};
-use scatterloc::motion::ConstantVelocity;
-use scatterloc::trajectory::{
+use scatterloc::track::ConstantVelocity;
+use scatterloc::track::{
     paper_initial_covariance, step_count, TrackScenario, TruthSampler, PAPER_INTENSITY,
     PAPER_STEP_S,
 };
-use scatterloc::{presets, simulate, Model};
+use scatterloc::track::{run_chunk, run_truth_chunk, MonteCarloConfig, CHUNK_TRAJECTORIES};
+use scatterloc::track::{Ekf, MeasurementNoise};
+use scatterloc::{measure, scenario::presets, Model};
 
 const SEED: u64 = 2019;
 /// Steps run before the benchmarked ones, so `P` has its steady-state size (0.5 s at 2.048 ms).
@@ -50,14 +50,14 @@ fn step_setup() -> StepSetup {
     let mut truth = Vec::new();
     sampler.sample(
         WARM_STEPS + BENCH_STEPS,
-        &mut simulate::rng(SEED, 0),
+        &mut measure::rng(SEED, 0),
         &mut truth,
     );
-    let mut noise = simulate::rng(SEED, 1);
+    let mut noise = measure::rng(SEED, 1);
     let z: Vec<Vec<Option<Real>>> = truth
         .iter()
         .map(|x| {
-            simulate::noisy_delays(&model, Vec2::new(x[0], x[1]), &mut noise)
+            measure::noisy_delays(&model, Vec2::new(x[0], x[1]), &mut noise)
                 .into_iter()
                 .map(Some)
                 .collect()
@@ -220,13 +220,13 @@ fn benches(c: &mut Criterion) {
 /// first 256 snapshots of the 60 s loop at T = 0.1 s with 0.5 false alarms per link and
 /// snapshot (about 3.5 estimates per link); and the gating + association alone.
 fn gated_step(c: &mut Criterion) {
-    use scatterloc::association::{select, AssociationRule};
-    use scatterloc::calibration::{Calibration, ClusterConfig};
-    use scatterloc::gated_track::GatedTracker;
-    use scatterloc::measurement_case::{default_channel, LoopPath};
+    use scatterloc::gating::GatedTracker;
+    use scatterloc::gating::{default_channel, LoopPath};
+    use scatterloc::gating::{select, AssociationRule};
+    use scatterloc::gating::{Calibration, ClusterConfig};
     let model = Model::new(&presets::sensors2019()).unwrap();
     let b = presets::sensors2019().radio.bandwidth_hz;
-    let mut rng = simulate::rng(SEED, 7);
+    let mut rng = measure::rng(SEED, 7);
     let cfg = ClusterConfig::for_bandwidth(b).unwrap();
     let clean = default_channel(b, 0.0);
     let cal = Calibration::from_snapshots(

@@ -224,7 +224,7 @@ impl fmt::Display for Error {
             Error::UnknownPreset { name } => write!(
                 f,
                 "unknown preset \"{name}\" (known: {})",
-                crate::presets::PRESET_NAMES.join(", ")
+                crate::scenario::presets::PRESET_NAMES.join(", ")
             ),
             Error::IndexOutOfRange { field, index, len } => {
                 write!(f, "{field}[{index}]: no such entry (there are {len})")

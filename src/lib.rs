@@ -4,67 +4,58 @@
 //! propagation delays measured on a network of transmitters and receivers.
 //!
 //! The core is `no_std` + `alloc` (with `libm` math) and follows the project spec
-//! (`shared/spec/delay-localization.md`); equation tags such as (E3) refer to it.
+//! (`shared/spec/*.md`); equation tags such as (E3) or (M6) in doc comments refer to it.
+//! `ARCHITECTURE.md` at the repository root draws the layers and the data flow.
 //!
-//! - [`scenario`]: scenario JSON (schema v1) and validation.
-//! - [`geometry`]: bistatic delays (E1), Jacobian (E3), iso-delay ellipses.
-//! - [`model`]: link budget, SNR and delay standard deviations (E8).
-//! - [`crlb`]: Fisher matrix, CRLB and the fast map kernel (E8, S18–S24).
-//! - [`lm`]: weighted Levenberg–Marquardt snapshot fix (E5–E6).
-//! - [`simulate`]: seeded noisy delays.
-//! - [`calibration`], [`association`]: the calibration stage, 3σ gating (E4) and the association
-//!   of the remaining delays to the scatterer (spec §4); [`raw_snapshot`] simulates the
-//!   estimator's per-snapshot lists; [`gated_track`] runs the EKF on them;
-//!   [`measurement_case`] is the synthetic stand-in of the measurement case (spec §9.6).
-//! - [`snapshot`]: one simulated snapshot with its ellipses, fix and CRLB (what the page draws).
-//! - [`track_view`]: a simulated track's steps as the page draws them (snapshot-shaped frames).
-//! - [`edit`], [`session`]: validated, rolled-back scenario edits for interactive front ends.
-//! - [`presets`]: the `sensors2019` and `iclgnss2019` case studies.
-//! - [`ticks`]: axis ticks and length labels shared by the front ends.
+//! ## Module map
+//! The core (`no_std` + `alloc`, builds for every target):
+//! - [`math`]: scalar and small-matrix aliases, constants, elementary functions.
+//! - [`error`]: the one error type; every bad input has a named variant.
+//! - [`scenario`]: scenario JSON (schema v1), validation, presets, validated editing.
+//! - [`measure`]: bistatic geometry (E1, E3), the Tx pattern, the link budget and `σ_τ` (E8),
+//!   ellipses and seeded noise draws (E2).
+//! - [`localize`]: the snapshot CRLB and its map kernel (E8, S18–S24) and the weighted
+//!   Levenberg–Marquardt fix (E5–E6).
+//! - [`track`]: the motion model (E7), the EKF (§6), the posterior CRLB (E9), trajectories and
+//!   the Monte Carlo study (§8, §9.5).
+//! - [`gating`]: calibration, 3σ gating (E4), association (§4), the gated tracker and the §9.6
+//!   stand-in.
+//! - [`mtl`]: multi-target localization under correlated blocking (`multi-target.md`).
+//! - [`present`]: view models shared by the page and the figures: ticks, colour map, snapshot and
+//!   track views, the interactive session.
+//!
+//! Platform edges (`std`):
+//! - `native` (native `std` only): the one ordered parallel driver (rayon) of Monte Carlo studies
+//!   and multi-target sweeps.
+//! - `chart` (`std`): plotters figures on any drawing backend (SVG/PNG natively, a canvas in the
+//!   page).
+//! - `wasm` (`std` on wasm32 only): the page's bindings; they only wrap the core.
+//!
+//! The CLI lives in `src/bin/scatterloc` and uses only the public API.
 #![cfg_attr(not(feature = "std"), no_std)]
 
 extern crate alloc;
 
-pub mod association;
-pub mod calibration;
+pub mod error;
+pub mod gating;
+pub mod localize;
+pub mod math;
+pub mod measure;
+pub mod mtl;
+pub mod present;
+pub mod scenario;
+pub mod track;
+
 #[cfg(feature = "std")]
 pub mod chart;
-pub mod colormap;
-pub mod crlb;
-pub mod edit;
-pub mod ekf;
-pub mod ellipse;
-pub mod error;
-pub mod gated_track;
-pub mod geometry;
-pub mod lm;
-pub mod math;
-pub mod measurement_case;
-pub mod model;
-pub mod montecarlo;
-pub mod motion;
-pub mod mtl;
 #[cfg(all(feature = "std", not(target_arch = "wasm32")))]
-pub mod parallel;
-pub mod pattern;
-pub mod pcrlb;
-pub mod presets;
-pub mod raw_snapshot;
-pub mod scenario;
-pub mod session;
-pub mod simulate;
-pub mod snapshot;
-pub mod ticks;
-pub mod track_sim;
-pub mod track_view;
-pub mod trajectory;
-
+pub mod native;
 #[cfg(all(feature = "std", target_arch = "wasm32"))]
 pub mod wasm;
 
 pub use error::{Error, Result};
 pub use math::{Mat2, Real, Vec2};
-pub use model::Model;
+pub use measure::Model;
 pub use scenario::Scenario;
 
 #[cfg(all(not(feature = "std"), target_family = "wasm"))]

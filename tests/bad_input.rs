@@ -3,10 +3,10 @@
 //! panic) and its `Display` names the offending field. Degenerate-but-valid geometry (a receiver
 //! on a transmitter) gives finite or unbounded outputs, never NaN.
 
-use scatterloc::crlb::{crlb_at, crlb_map, Grid, MAX_GRID_CELLS, MAX_GRID_SIDE};
-use scatterloc::lm::{self, DelayMeasurements, LmConfig};
+use scatterloc::localize::{self, DelayMeasurements, LmConfig};
+use scatterloc::localize::{crlb_at, crlb_map, Grid, MAX_GRID_CELLS, MAX_GRID_SIDE};
 use scatterloc::math::{Real, Vec2};
-use scatterloc::presets::{self, preset};
+use scatterloc::scenario::presets::{self, preset};
 use scatterloc::scenario::{Area, LinkSpec, Pattern, Scenario};
 use scatterloc::{Error, Model};
 
@@ -444,12 +444,12 @@ fn lm_fixture() -> Fixture {
 }
 
 impl Fixture {
-    fn locate(&self, initial: Option<Vec2>) -> Result<lm::LmReport, Error> {
+    fn locate(&self, initial: Option<Vec2>) -> Result<localize::LmReport, Error> {
         let m = DelayMeasurements {
             delays_s: &self.delays,
             sigmas_s: &self.sigmas,
         };
-        lm::locate(
+        localize::locate(
             &self.model.network,
             &m,
             &LmConfig::default(),
@@ -701,7 +701,8 @@ fn receiver_on_transmitter_gives_no_nan() {
         sigmas_s: &sigmas,
     };
     for start in [Some(truth + Vec2::new(1.0, -1.0)), Some(on_node), None] {
-        let rep = lm::locate(&m.network, &meas, &LmConfig::default(), start, &s.area_m).unwrap();
+        let rep =
+            localize::locate(&m.network, &meas, &LmConfig::default(), start, &s.area_m).unwrap();
         assert!(rep.position.x.is_finite() && rep.position.y.is_finite());
         assert!(rep.cost.is_finite());
         if start != Some(on_node) {

@@ -5,9 +5,9 @@
 use std::path::Path;
 use std::process::Command;
 
-use scatterloc::crlb::{crlb_at, Grid};
+use scatterloc::localize::{crlb_at, Grid};
 use scatterloc::scenario::Area;
-use scatterloc::{presets, Model, Scenario, Vec2};
+use scatterloc::{scenario::presets, Model, Scenario, Vec2};
 use serde_json::{json, Value};
 
 mod cli_support;

@@ -5,7 +5,7 @@
 mod cli_support;
 
 use scatterloc::math::SPEED_OF_LIGHT;
-use scatterloc::{presets, Model, Vec2};
+use scatterloc::{scenario::presets, Model, Vec2};
 use serde_json::{json, Value};
 
 use cli_support::{fails, floats, ok_json, read_json, TempDir};

@@ -20,7 +20,7 @@ use fantoccini::actions::{InputSource, MouseActions, PointerAction, MOUSE_BUTTON
 use fantoccini::{Client, ClientBuilder, Locator};
 use serde_json::{json, Value};
 
-use scatterloc::crlb::crlb_at;
+use scatterloc::localize::crlb_at;
 use scatterloc::{Model, Scenario, Vec2};
 
 /// Tracking mode: scenario II, the Web Worker Monte Carlo and its chart (issue 3).
@@ -498,7 +498,7 @@ async fn import_broken(c: &Client, port: u16, file: &Path) -> Result<ImportOutco
 #[ignore = "needs chromium + chromedriver and www/pkg (wasm-pack build); run with --ignored"]
 fn broken_import_shows_error_banner() {
     let _serial = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
-    let good = scatterloc::presets::sensors2019().to_json();
+    let good = scatterloc::scenario::presets::sensors2019().to_json();
     let broken = good.replace("\"bandwidth_hz\": 120000000.0", "\"bandwidth_hz\": -5.0");
     assert_ne!(good, broken);
     let file =

@@ -7,16 +7,16 @@
 //! Every tolerance is derived next to its assertion (binomial Monte Carlo error, the sampling
 //! error of a calibrated σ̄); the runs are seeded, so each test is deterministic.
 
-use scatterloc::association::{select, AssociationRule, Choice};
-use scatterloc::calibration::{Calibration, ClusterConfig, LinkCalibration, StaticCluster};
-use scatterloc::ekf::{Ekf, MeasurementNoise};
-use scatterloc::gated_track::{start_from_snapshot, GatedTracker, START_SPEED_SIGMA_MPS};
+use scatterloc::gating::StaticChannel;
+use scatterloc::gating::{default_channel, LoopPath};
+use scatterloc::gating::{select, AssociationRule, Choice};
+use scatterloc::gating::{start_from_snapshot, GatedTracker, START_SPEED_SIGMA_MPS};
+use scatterloc::gating::{Calibration, ClusterConfig, LinkCalibration, StaticCluster};
 use scatterloc::math::{erfc, sqrt, Real, Vec2, Vec4};
-use scatterloc::measurement_case::{default_channel, LoopPath};
-use scatterloc::motion::ConstantVelocity;
-use scatterloc::raw_snapshot::StaticChannel;
-use scatterloc::trajectory::paper_initial_covariance;
-use scatterloc::{presets, simulate, Model};
+use scatterloc::track::paper_initial_covariance;
+use scatterloc::track::ConstantVelocity;
+use scatterloc::track::{Ekf, MeasurementNoise};
+use scatterloc::{measure, scenario::presets, Model};
 
 /// Spec check 12: the probability that a Gaussian static estimate falls within 3σ, 0.9973.
 const P_GATE: Real = 0.9973;
@@ -50,10 +50,10 @@ fn check12_gating_removes_a_gaussian_static_estimate_with_probability_0_9973() {
     };
     let link = LinkCalibration::from_clusters(0, vec![cluster]).unwrap();
     let n = 1_000_000;
-    let mut rng = simulate::rng(12, 0);
+    let mut rng = measure::rng(12, 0);
     let removed = (0..n)
         .filter(|_| {
-            link.is_static(cluster.mean_s + cluster.sigma_s * simulate::standard_normal(&mut rng))
+            link.is_static(cluster.mean_s + cluster.sigma_s * measure::standard_normal(&mut rng))
         })
         .count();
     let p = removed as Real / n as Real;
@@ -74,7 +74,7 @@ fn check12_calibrated_clusters_gate_the_static_paths() {
     let model = model();
     let ch = channel(0.0);
     let cfg = ClusterConfig::for_bandwidth(bandwidth()).unwrap();
-    let mut rng = simulate::rng(12, 1);
+    let mut rng = measure::rng(12, 1);
     let cal = Calibration::from_snapshots(
         &ch.calibration_snapshots(&model, 2000, &mut rng),
         model.link_count(),
@@ -168,7 +168,7 @@ fn run_loop_from(
 ) -> LoopStats {
     let model = model();
     let cfg = ClusterConfig::for_bandwidth(bandwidth()).unwrap();
-    let mut rng = simulate::rng(seed, 0);
+    let mut rng = measure::rng(seed, 0);
     let snaps = channel(0.0).calibration_snapshots(&model, 500, &mut rng);
     let cal = Calibration::from_snapshots(&snaps, model.link_count(), &cfg).unwrap();
     let ch = channel(false_alarms);

@@ -8,6 +8,7 @@
 
 use rand::Rng as _;
 use scatterloc::math::{Real, Vec2};
+use scatterloc::measure::{self, Rng};
 use scatterloc::mtl::algorithm::{
     locate, locate_cached, FinalTest, IntersectionCache, Measurements, MtlConfig, MtlOutput, Pair,
     Status, Target,
@@ -16,7 +17,6 @@ use scatterloc::mtl::blocking::{kron, BlockingModel, IndependentNodes, NodeBlock
 use scatterloc::mtl::brute::brute_force;
 use scatterloc::mtl::icb::IcbModel;
 use scatterloc::mtl::trp::{range, TrpMap};
-use scatterloc::simulate::{self, Rng};
 use scatterloc::Error;
 
 /// The V-A network (§7): TX at 90°, 210°, 330°, RX at 30°, 150°, 270° on the 5 m circle
@@ -88,7 +88,7 @@ fn instance(
             if g >> m & 1 == 1 && rng.random::<Real>() < p_d {
                 let n = match noise {
                     Noise::Uniform(s) => rng.random_range(-s..=s),
-                    Noise::Gaussian(s) => s * simulate::standard_normal(rng),
+                    Noise::Gaussian(s) => s * measure::standard_normal(rng),
                 };
                 r.push(map.range(m, &x, &tx, &rx) + n);
             }
@@ -299,7 +299,7 @@ fn staged_equals_brute_force_on_random_small_instances() {
     let (tx, rx) = hexagon();
     let mut detected = 0;
     for seed in 0..200 {
-        let mut rng = simulate::rng(seed, 4);
+        let mut rng = measure::rng(seed, 4);
         let inst = instance(&mut rng, 2, (0.9, 0.9), Noise::Uniform(cs), 0, 0.3);
         let mut cache = IntersectionCache::new();
         let staged = run_cached(&inst.ranges, cs, &icb, &cfg, &mut cache);
@@ -327,7 +327,7 @@ fn check_6_icb_threshold_equals_size_rule() {
     assert!(icb.p_u() < 0.5);
     let mut detected = [0usize; 3];
     for seed in 0..100 {
-        let mut rng = simulate::rng(seed, 6);
+        let mut rng = measure::rng(seed, 6);
         let inst = instance(&mut rng, 2, (0.9, 0.9), Noise::Gaussian(0.05), 1, 0.0);
         let mut cache = IntersectionCache::new();
         for (k, n_u) in [2usize, 4, 6].into_iter().enumerate() {
@@ -369,7 +369,7 @@ fn invariant_to_node_relabelling() {
     let (pt, pr) = ([2usize, 0, 1], [1usize, 2, 0]);
     let relabel = |m: usize| pt[map.tx(m)] + 3 * pr[map.rx(m)];
     for seed in 0..20 {
-        let mut rng = simulate::rng(seed, 8);
+        let mut rng = measure::rng(seed, 8);
         let inst = instance(&mut rng, 2, (0.85, 0.9), Noise::Gaussian(0.02), 1, 0.0);
         let cfg = MtlConfig::default();
         let a = run(&inst.ranges, 0.02, &model, &cfg).targets;
@@ -561,7 +561,7 @@ fn two_pair_case_2b_children_sit_on_ellipse_intersections() {
     };
     let (tx, rx) = hexagon();
     let map = map9();
-    let mut rng = simulate::rng(77, 12);
+    let mut rng = measure::rng(77, 12);
     let (mut two_pair, mut unlocatable) = (0, 0);
     for _ in 0..40 {
         let inst = instance(&mut rng, 2, (0.8, 0.9), Noise::Gaussian(0.05), 2, 0.5);

@@ -7,8 +7,8 @@ use scatterloc::mtl::empirical::{EmpiricalNodeModel, EmpiricalTable};
 use scatterloc::mtl::polygon::Rect;
 use scatterloc::Error;
 
+use scatterloc::measure::rng;
 use scatterloc::mtl::ppp::{PppBlocking, PppNodeModel};
-use scatterloc::simulate::rng;
 
 fn v(x: Real, y: Real) -> Vec2 {
     Vec2::new(x, y)

@@ -11,11 +11,11 @@ use scatterloc::mtl::experiment::{
     grid, run_sequential, Curve, EmpiricalTraining, Experiment, ExperimentConfig, Method,
 };
 use scatterloc::mtl::sim::LosModel;
-use scatterloc::mtl::sweep::run_parallel;
+use scatterloc::native::run_experiment_parallel;
 use scatterloc::Error;
 
 fn run(cfg: &ExperimentConfig, threads: usize) -> scatterloc::mtl::experiment::ExperimentResult {
-    run_parallel(cfg, threads, &AtomicBool::new(false), |_, _| {}).unwrap()
+    run_experiment_parallel(cfg, threads, &AtomicBool::new(false), |_, _| {}).unwrap()
 }
 
 fn curve(r: &[Curve], m: Method) -> &Curve {
@@ -166,7 +166,7 @@ fn bad_configurations_are_named_errors() {
             ..
         }
     ));
-    let cancelled = run_parallel(&ok, 1, &AtomicBool::new(true), |_, _| {});
+    let cancelled = run_experiment_parallel(&ok, 1, &AtomicBool::new(true), |_, _| {});
     assert_eq!(cancelled.unwrap_err(), Error::Cancelled);
     assert_eq!(
         run_sequential(&ok, |_, _| {}, || true).unwrap_err(),

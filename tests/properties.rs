@@ -5,11 +5,11 @@
 
 use proptest::prelude::*;
 
-use scatterloc::crlb::{crlb_at, crlb_map, fisher, Grid};
-use scatterloc::geometry::Network;
-use scatterloc::lm::{self, DelayMeasurements, LmConfig};
+use scatterloc::localize::{self, DelayMeasurements, LmConfig};
+use scatterloc::localize::{crlb_at, crlb_map, fisher, Grid};
 use scatterloc::math::{Real, Vec2};
-use scatterloc::presets;
+use scatterloc::measure::Network;
+use scatterloc::scenario::presets;
 use scatterloc::scenario::{
     Area, LinkIndex, LinkSpec, Pattern, Radio, Receiver, Scenario, Target, Transmitter,
 };
@@ -293,7 +293,7 @@ proptest! {
         let sigmas = m.sigma_delays(truth);
         let meas = DelayMeasurements { delays_s: &delays, sigmas_s: &sigmas };
         let start = truth + radius * Vec2::new(angle.cos(), angle.sin());
-        let rep = lm::locate(&m.network, &meas, &LmConfig::default(), Some(start), &s.area_m)
+        let rep = localize::locate(&m.network, &meas, &LmConfig::default(), Some(start), &s.area_m)
             .unwrap();
         let err = (rep.position - truth).norm();
         prop_assert!(
@@ -331,7 +331,7 @@ fn lm_spurious_local_minimum_near_a_receiver() {
         restart_tail_probability: None,
         ..LmConfig::default()
     };
-    let rep = lm::locate(&m.network, &meas, &no_restart, Some(start), &s.area_m).unwrap();
+    let rep = localize::locate(&m.network, &meas, &no_restart, Some(start), &s.area_m).unwrap();
     let cost = |r: Vec2| -> Real {
         (0..m.link_count())
             .map(|p| ((m.network.delay(p, r) - m.network.delay(p, truth)) / sigmas[p]).powi(2))
@@ -349,7 +349,7 @@ fn lm_spurious_local_minimum_near_a_receiver() {
     }
     // With the default restart the implausible cost (χ²₁ tail ≪ 1e-3) triggers the grid-search
     // start, which converges to the truth (§5, check 8).
-    let rep = lm::locate(
+    let rep = localize::locate(
         &m.network,
         &meas,
         &LmConfig::default(),
@@ -362,7 +362,7 @@ fn lm_spurious_local_minimum_near_a_receiver() {
         "{rep:?}"
     );
     // From a start on the truth's side the same problem converges without a restart.
-    let rep = lm::locate(
+    let rep = localize::locate(
         &m.network,
         &meas,
         &LmConfig::default(),
@@ -389,7 +389,7 @@ proptest! {
             proptest::collection::vec(0.0..300e-9f64, 0..6), 1..40),
         seed in any::<u64>(),
     ) {
-        use scatterloc::calibration::{ClusterConfig, LinkCalibration};
+        use scatterloc::gating::{ClusterConfig, LinkCalibration};
         let cfg = ClusterConfig::for_bandwidth(120e6).unwrap();
         let a = LinkCalibration::from_snapshots(0, &snaps, &cfg).unwrap();
         // A deterministic shuffle of the snapshots and of each snapshot's estimates.

@@ -5,15 +5,15 @@
 //! number is cited next to it) or derived from a closed form / finite difference stated in a comment.
 //! Tolerances for printed values are half a unit of the last printed digit.
 
-use scatterloc::crlb::{self, crlb_at, crlb_map, Grid};
-use scatterloc::ellipse::Ellipse;
-use scatterloc::lm::{self, DelayMeasurements, LmConfig};
+use scatterloc::localize::{self, crlb_at, crlb_map, Grid};
+use scatterloc::localize::{DelayMeasurements, LmConfig};
 use scatterloc::math::{linear_to_db, watt_to_dbm, Mat2, Real, Vec2, SPEED_OF_LIGHT};
-use scatterloc::model::{noise_power_w, Model};
-use scatterloc::pattern::TxPattern;
-use scatterloc::presets;
+use scatterloc::measure;
+use scatterloc::measure::Ellipse;
+use scatterloc::measure::TxPattern;
+use scatterloc::measure::{noise_power_w, Model};
+use scatterloc::scenario::presets;
 use scatterloc::scenario::{Area, LinkSpec, Pattern, Receiver, Scenario, Transmitter};
-use scatterloc::simulate;
 
 const C: Real = SPEED_OF_LIGHT;
 
@@ -517,7 +517,7 @@ fn check7_l4_crlb_rmse() {
         );
         // S24: RMSE = √(σx² + σy²) and the covariance is F⁻¹.
         rel_close("S24", b.rmse_m, b.sigma_x_m.hypot(b.sigma_y_m), 1e-12);
-        let f = crlb::fisher(&m, Vec2::new(x, y));
+        let f = localize::fisher(&m, Vec2::new(x, y));
         let id = f * b.covariance_m2;
         assert!((id - Mat2::identity()).norm() < 1e-9, "F·F⁻¹ = {id}");
     }
@@ -736,7 +736,8 @@ fn check8_lm_noise_free_converges_to_truth() {
             for o in offsets {
                 let start = truth + Vec2::new(o[0], o[1]);
                 assert!((start - truth).norm() <= 3.0 + 1e-12);
-                let rep = lm::locate(&m.network, &meas, &cfg, Some(start), &s.area_m).unwrap();
+                let rep =
+                    localize::locate(&m.network, &meas, &cfg, Some(start), &s.area_m).unwrap();
                 let err = (rep.position - truth).norm();
                 assert!(
                     err <= 1e-6 && rep.termination.converged(),
@@ -767,7 +768,7 @@ fn check8_lm_default_grid_start_converges() {
             delays_s: &delays,
             sigmas_s: &sigmas,
         };
-        let rep = lm::locate(&m.network, &meas, &cfg, None, &s.area_m).unwrap();
+        let rep = localize::locate(&m.network, &meas, &cfg, None, &s.area_m).unwrap();
         assert!(rep.termination.converged());
         assert!((rep.position - truth).norm() <= 1e-6, "{rep:?}");
         // The kept start is a node of the 0.5 m grid anchored at the area's corner (§5); with the
@@ -781,13 +782,13 @@ fn check8_lm_default_grid_start_converges() {
             );
         }
         // Noisy: the same minimum as the fix started at the truth.
-        let noisy = some(&simulate::noisy_delays(&m, truth, &mut simulate::rng(7, 0)));
+        let noisy = some(&measure::noisy_delays(&m, truth, &mut measure::rng(7, 0)));
         let meas = DelayMeasurements {
             delays_s: &noisy,
             sigmas_s: &sigmas,
         };
-        let a = lm::locate(&m.network, &meas, &cfg, None, &s.area_m).unwrap();
-        let b = lm::locate(&m.network, &meas, &cfg, Some(truth), &s.area_m).unwrap();
+        let a = localize::locate(&m.network, &meas, &cfg, None, &s.area_m).unwrap();
+        let b = localize::locate(&m.network, &meas, &cfg, Some(truth), &s.area_m).unwrap();
         assert!(a.termination.converged() && b.termination.converged());
         assert!((a.position - b.position).norm() <= 1e-6);
     }
@@ -800,16 +801,16 @@ fn monte_carlo_fixes(s: &Scenario, truth: Vec2, n: u64, seed: u64) -> Vec<Vec2> 
     let sigmas = m.sigma_delays(truth);
     (0..n)
         .map(|i| {
-            let d = some(&simulate::noisy_delays(
+            let d = some(&measure::noisy_delays(
                 &m,
                 truth,
-                &mut simulate::rng(seed, i),
+                &mut measure::rng(seed, i),
             ));
             let meas = DelayMeasurements {
                 delays_s: &d,
                 sigmas_s: &sigmas,
             };
-            let rep = lm::locate(&m.network, &meas, &cfg, Some(truth), &s.area_m).unwrap();
+            let rep = localize::locate(&m.network, &meas, &cfg, Some(truth), &s.area_m).unwrap();
             assert!(rep.termination.converged(), "fix {i}: {rep:?}");
             rep.position
         })
@@ -867,7 +868,7 @@ fn lm_reports_covariance_equal_to_crlb_at_fix() {
         delays_s: &delays,
         sigmas_s: &sigmas,
     };
-    let rep = lm::locate(
+    let rep = localize::locate(
         &m.network,
         &meas,
         &LmConfig::default(),

@@ -14,19 +14,19 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 use nalgebra::{DMatrix, DVector};
 
-use scatterloc::ekf::{Ekf, MeasurementNoise, UpdateSummary};
 use scatterloc::math::{Mat4, Real, Vec2, Vec4};
-use scatterloc::montecarlo::{
-    run_pcrlb_sequential, run_sequential, MonteCarloConfig, MonteCarloResult, MAX_RUNS, MAX_STEPS,
-};
-use scatterloc::motion::ConstantVelocity;
-use scatterloc::parallel::run_parallel;
-use scatterloc::pcrlb::{nominal_pcrlb_rmse, pcrlb_rmse};
-use scatterloc::trajectory::{
+use scatterloc::native::run_parallel;
+use scatterloc::track::ConstantVelocity;
+use scatterloc::track::{nominal_pcrlb_rmse, pcrlb_rmse};
+use scatterloc::track::{
     paper_initial_covariance, step_count, TrackScenario, TruthSampler, PAPER_INTENSITY,
     PAPER_STEP_S,
 };
-use scatterloc::{crlb, presets, simulate, Error, Mat2, Model};
+use scatterloc::track::{
+    run_pcrlb_sequential, run_sequential, MonteCarloConfig, MonteCarloResult, MAX_RUNS, MAX_STEPS,
+};
+use scatterloc::track::{Ekf, MeasurementNoise, UpdateSummary};
+use scatterloc::{localize, measure, scenario::presets, Error, Mat2, Model};
 
 /// The spec's fast profile step (§9.5), s.
 const FAST_STEP_S: Real = 0.1;
@@ -247,15 +247,14 @@ fn tracked(
     let model = model();
     let sampler = TruthSampler::new(*motion, s.mean_state(), &paper_initial_covariance()).unwrap();
     let mut truth = Vec::new();
-    sampler.sample(steps + 5, &mut simulate::rng(seed, 0), &mut truth);
-    let mut noise = simulate::rng(seed, 1);
+    sampler.sample(steps + 5, &mut measure::rng(seed, 0), &mut truth);
+    let mut noise = measure::rng(seed, 1);
     let mut f = Ekf::new(s.mean_state(), paper_initial_covariance()).unwrap();
     for x in &truth[1..=steps] {
-        let z: Vec<Option<Real>> =
-            simulate::noisy_delays(&model, Vec2::new(x[0], x[1]), &mut noise)
-                .into_iter()
-                .map(Some)
-                .collect();
+        let z: Vec<Option<Real>> = measure::noisy_delays(&model, Vec2::new(x[0], x[1]), &mut noise)
+            .into_iter()
+            .map(Some)
+            .collect();
         f.step(motion, &model, &z, MeasurementNoise::AtPrediction)
             .unwrap();
     }
@@ -281,9 +280,9 @@ fn ekf_update_equals_batch_kalman_filter() {
             let (mut f, truth) = tracked(s, &motion, steps, 7);
             f.predict(&motion);
             let x = truth[steps + 1];
-            let mut rng = simulate::rng(7, 99);
+            let mut rng = measure::rng(7, 99);
             let z: Vec<Option<Real>> =
-                simulate::noisy_delays(&model, Vec2::new(x[0], x[1]), &mut rng)
+                measure::noisy_delays(&model, Vec2::new(x[0], x[1]), &mut rng)
                     .into_iter()
                     .map(Some)
                     .collect();
@@ -333,15 +332,15 @@ fn missing_link_mid_run_and_predict_only_steps() {
     let s = TrackScenario::II;
     let sampler = TruthSampler::new(motion, s.mean_state(), &paper_initial_covariance()).unwrap();
     let mut truth = Vec::new();
-    sampler.sample(30, &mut simulate::rng(11, 0), &mut truth);
-    let mut rng = simulate::rng(11, 1);
+    sampler.sample(30, &mut measure::rng(11, 0), &mut truth);
+    let mut rng = measure::rng(11, 1);
     let mut f = Ekf::new(s.mean_state(), paper_initial_covariance()).unwrap();
     let (mut x_ref, mut p_ref) = (f.state, f.covariance);
     let a = motion.transition();
     for (n, x) in truth.iter().enumerate().skip(1) {
         let r = Vec2::new(x[0], x[1]);
         let sigmas = model.sigma_delays(r);
-        let mut z: Vec<Option<Real>> = simulate::noisy_delays(&model, r, &mut rng)
+        let mut z: Vec<Option<Real>> = measure::noisy_delays(&model, r, &mut rng)
             .into_iter()
             .map(Some)
             .collect();
@@ -770,7 +769,7 @@ fn identical_results_for_one_and_two_threads_and_sequential() {
 /// The harness computes what its documentation says: trajectory `i` from stream
 /// `rng(seed, 2i)`, noise run `j` from `rng(seed, 2(i·N_noise + j) + 1)` with one standard normal
 /// per link in link order, `z_p = τ_p(r) + σ_p(r) w`, an `Ekf::update` with R at the prediction,
-/// ε_EKF = √(mean ‖r̂ − r‖²), mean NEES, and E9 with the mean `F(r_true)` (`crlb::fisher`). Rebuilt
+/// ε_EKF = √(mean ‖r̂ − r‖²), mean NEES, and E9 with the mean `F(r_true)` (`localize::fisher`). Rebuilt
 /// here from the public API for 2 trajectories × 5 noise runs; equal to 1e-12 relative (the harness
 /// evaluates delays, σ and F from shared per-node geometry, equal up to rounding).
 #[test]
@@ -786,12 +785,12 @@ fn monte_carlo_reproduces_independent_filter_runs() {
     let mut fisher = vec![Mat2::zeros(); 30];
     let mut truth = Vec::new();
     for i in 0..2u64 {
-        sampler.sample(30, &mut simulate::rng(SEED, 2 * i), &mut truth);
+        sampler.sample(30, &mut measure::rng(SEED, 2 * i), &mut truth);
         for (n, x) in truth.iter().enumerate().skip(1) {
-            fisher[n - 1] += crlb::fisher(&model, Vec2::new(x[0], x[1])) / 2.0;
+            fisher[n - 1] += localize::fisher(&model, Vec2::new(x[0], x[1])) / 2.0;
         }
         for j in 0..5u64 {
-            let mut rng = simulate::rng(SEED, 2 * (i * 5 + j) + 1);
+            let mut rng = measure::rng(SEED, 2 * (i * 5 + j) + 1);
             let mut f = Ekf::new(cfg.mean_state, cfg.initial_covariance).unwrap();
             for (n, x) in truth.iter().enumerate() {
                 if n > 0 {
@@ -800,7 +799,7 @@ fn monte_carlo_reproduces_independent_filter_runs() {
                         .map(|p| {
                             Some(
                                 model.network.delay(p, r)
-                                    + model.sigma_delay(p, r) * simulate::standard_normal(&mut rng),
+                                    + model.sigma_delay(p, r) * measure::standard_normal(&mut rng),
                             )
                         })
                         .collect();

@@ -7,10 +7,10 @@ use js_sys::{Float64Array, Reflect, Uint8ClampedArray};
 use wasm_bindgen::{JsCast, JsError, JsValue};
 use wasm_bindgen_test::*;
 
-use scatterloc::crlb::{crlb_at, Grid};
-use scatterloc::lm::{locate, DelayMeasurements, LmConfig};
+use scatterloc::localize::{crlb_at, Grid};
+use scatterloc::localize::{locate, DelayMeasurements, LmConfig};
 use scatterloc::wasm::{self, App};
-use scatterloc::{presets, Model, Vec2};
+use scatterloc::{scenario::presets, Model, Vec2};
 
 wasm_bindgen_test_configure!(run_in_browser);
 
@@ -303,14 +303,14 @@ fn labels_and_ticks() {
 /// link gates its static paths and keeps the echo (spec §4).
 #[wasm_bindgen_test]
 fn gating_in_wasm() {
-    use scatterloc::association::{select, AssociationRule, Choice};
-    use scatterloc::calibration::{Calibration, ClusterConfig};
-    use scatterloc::measurement_case::default_channel;
+    use scatterloc::gating::default_channel;
+    use scatterloc::gating::{select, AssociationRule, Choice};
+    use scatterloc::gating::{Calibration, ClusterConfig};
     let p = 1.0 - scatterloc::math::erfc(3.0 / 2f64.sqrt());
     assert!((p - 0.9973).abs() < 5e-5, "{p}");
     let model = Model::new(&presets::sensors2019()).unwrap();
     let ch = default_channel(120e6, 0.0);
-    let mut rng = scatterloc::simulate::rng(5, 0);
+    let mut rng = scatterloc::measure::rng(5, 0);
     let cfg = ClusterConfig::for_bandwidth(120e6).unwrap();
     let cal = Calibration::from_snapshots(
         &ch.calibration_snapshots(&model, 200, &mut rng),

@@ -2,7 +2,7 @@
 //! PNG natively (the CLI), a `<canvas>` in the browser.
 //!
 //! The figure shows the RMSE bound `√(σx² + σy²)` (spec §7, S24) on the log colour scale of
-//! [`crate::colormap`] (the same colours as the page), unbounded cells in grey, a colour bar
+//! [`crate::present`] (the same colours as the page), unbounded cells in grey, a colour bar
 //! labelled in metres, the transmitters (triangles) and receivers (circles) with their names,
 //! metre axes at equal scale and a title.
 //!
@@ -22,9 +22,9 @@ use core::fmt;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use crate::colormap::LogScale;
-use crate::crlb::Grid;
+use crate::localize::Grid;
 use crate::math::Real;
+use crate::present::LogScale;
 use crate::scenario::{Area, Scenario};
 
 pub use layout::suggested_size;
@@ -34,7 +34,7 @@ pub use roc::{
 pub use tracking::{draw_tracking_rmse, tracking_size, TrackingChartOptions, TrackingPanel};
 
 /// A computed map: the grid and its values, row-major with row `j` at `y_j` (ascending y), m;
-/// `+∞` (or any non-finite value) marks an unbounded cell. This is what [`crate::crlb::crlb_map`]
+/// `+∞` (or any non-finite value) marks an unbounded cell. This is what [`crate::localize::crlb_map`]
 /// writes.
 #[derive(Debug, Clone, Copy)]
 pub struct MapData<'a> {

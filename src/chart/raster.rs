@@ -10,8 +10,8 @@ use plotters::style::text_anchor::{HPos, Pos, VPos};
 use super::layout::{series_legend, Fonts};
 use super::ticks::colorbar_ticks;
 use super::{chart_err, ChartError, ChartNode, MapData, NodeKind};
-use crate::colormap::{viridis, LogScale, UNBOUNDED_RGB};
 use crate::math::Real;
+use crate::present::{viridis, LogScale, UNBOUNDED_RGB};
 
 type Chart<'a, DB> = ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
 

@@ -1,4 +1,4 @@
-//! Colour-bar ticks: the labelled ticks of the shared [`crate::ticks::log_length_ticks`] (so the
+//! Colour-bar ticks: the labelled ticks of the shared [`crate::present::log_length_ticks`] (so the
 //! figures and the page print the same labels), thinned to fit the bar, plus unlabelled minor
 //! ticks at the other integer multiples of each decade.
 
@@ -6,7 +6,7 @@ use alloc::string::String;
 use alloc::vec::Vec;
 
 use crate::math::Real;
-use crate::ticks::log_length_ticks;
+use crate::present::log_length_ticks;
 
 /// A colour-bar tick: value in metres and its label (empty for a minor tick).
 #[derive(Debug, Clone, PartialEq)]
@@ -65,41 +65,4 @@ pub fn colorbar_ticks(min: Real, max: Real, max_labels: usize) -> Vec<BarTick> {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn labels(t: &[BarTick]) -> Vec<&str> {
-        t.iter()
-            .filter(|t| !t.label.is_empty())
-            .map(|t| t.label.as_str())
-            .collect()
-    }
-
-    #[test]
-    fn decades_with_minor_ticks() {
-        let t = colorbar_ticks(0.00105, 1.13, 4);
-        assert_eq!(labels(&t), ["1 cm", "10 cm", "1 m"]);
-        assert!(t.iter().filter(|t| t.label.is_empty()).count() >= 20);
-        assert!(t.iter().all(|t| t.value_m >= 0.00105 && t.value_m <= 1.13));
-        let t = colorbar_ticks(0.00105, 1.13, 12);
-        let l = labels(&t);
-        assert!((3..=12).contains(&l.len()), "{l:?}");
-        assert!(
-            ["1 cm", "10 cm", "1 m"].iter().all(|x| l.contains(x)),
-            "{l:?}"
-        );
-    }
-
-    #[test]
-    fn thinned_to_fit() {
-        let t = colorbar_ticks(1e-6, 1e3, 3);
-        let n = labels(&t).len();
-        assert!((2..=3).contains(&n), "{n}");
-    }
-
-    #[test]
-    fn flat_map_keeps_two_labels() {
-        let t = colorbar_ticks(0.0079, 0.0081, 8);
-        assert!(labels(&t).len() >= 2, "{t:?}");
-    }
-}
+mod tests;

@@ -13,7 +13,7 @@ use super::layout::{draw_titles, font_scale, frame_plot, series_legend, Fonts, T
 use super::ticks::colorbar_ticks;
 use super::{axis_label, chart_err, register_fonts, ChartError};
 use crate::math::Real;
-use crate::ticks::nice_below;
+use crate::present::nice_below;
 
 /// Colour of the EKF curve (solid).
 const EKF_RGB: RGBColor = RGBColor(0, 94, 184);
@@ -68,12 +68,12 @@ fn y_range(panels: &[TrackingPanel]) -> (Real, Real) {
     }
     // A little room so that no curve runs along the frame.
     let (min, max) = (min / 1.15, max * 1.05);
-    let lo = nice_below(min).map_or(min, |(m, k)| crate::ticks::decimal(m, k));
+    let lo = nice_below(min).map_or(min, |(m, k)| crate::present::decimal(m, k));
     let hi = match nice_below(max) {
-        Some((m, k)) if crate::ticks::decimal(m, k) >= max => max,
-        Some((1, k)) => crate::ticks::decimal(2, k),
-        Some((2, k)) => crate::ticks::decimal(5, k),
-        Some((_, k)) => crate::ticks::decimal(1, k + 1),
+        Some((m, k)) if crate::present::decimal(m, k) >= max => max,
+        Some((1, k)) => crate::present::decimal(2, k),
+        Some((2, k)) => crate::present::decimal(5, k),
+        Some((_, k)) => crate::present::decimal(1, k + 1),
         None => max,
     };
     if hi > lo {
@@ -242,27 +242,4 @@ fn draw_panel<DB: DrawingBackend>(
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn range_and_gaps() {
-        let t = [0.0, 1.0, 2.0, 3.0];
-        let ekf = [0.447, 0.02, Real::NAN, 0.004];
-        let pcrlb = [Some(0.447), None, Some(0.01), Some(0.0022)];
-        let p = TrackingPanel {
-            title: "I",
-            t_s: &t,
-            rmse_ekf_m: &ekf,
-            rmse_pcrlb_m: &pcrlb,
-        };
-        let (lo, hi) = y_range(&[p]);
-        // 2.2 mm is within 15 % of 2 mm: one more 1-2-5 step below; 0.447 m fits under 0.5 m.
-        assert_eq!((lo, hi), (0.001, 0.5));
-        let parts = segments(&t, ekf.iter().map(|v| Some(*v)));
-        assert_eq!(parts.len(), 2);
-        assert_eq!(parts[1], [(3.0, 0.004)]);
-        assert_eq!(segments(&t, pcrlb.iter().copied()).len(), 2);
-        assert_eq!(y_range(&[]), (1e-3, 1.0));
-    }
-}
+mod tests;

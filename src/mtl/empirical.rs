@@ -22,11 +22,11 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
 use crate::math::{Real, Vec2};
+use crate::measure::Rng;
 use crate::mtl::blocking::NodePatternModel;
 use crate::mtl::polygon::Rect;
 use crate::mtl::sim::scene::{is_free, poisson, segment_is_los, uniform};
 use crate::mtl::trp::MAX_NODES;
-use crate::simulate::Rng;
 
 /// Largest `nx · ny · 2^{N_t+N_r}` table accepted (16 Mi counts = 64 MiB).
 pub const MAX_TABLE_ENTRIES: usize = 1 << 24;

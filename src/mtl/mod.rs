@@ -12,7 +12,7 @@
 //! - [`ppp`]: the PPP-disc blocking model (M9–M11).
 //! - [`empirical`]: node-pattern probabilities tabulated per grid cell (§6.3).
 //! - [`experiment`]: the §8 experiments as ROC sweeps (Figs. 3–5), one realisation at a time.
-//! - `sweep` (native `std` only): the parallel, thread-count-independent experiment driver.
+//!   (The parallel experiment driver is native-only: `crate::native::run_experiment_parallel`.)
 //! - [`sim`]: the §7 data generator, metrics (M12) and Table II helpers.
 //! - [`algorithm`]: Algorithm 1 (§4), staged matching with the vector likelihood (M6) and
 //!   the final selection by `J` (M2).
@@ -30,7 +30,5 @@ pub mod input;
 pub mod polygon;
 pub mod ppp;
 pub mod sim;
-#[cfg(all(feature = "std", not(target_arch = "wasm32")))]
-pub mod sweep;
 pub mod trp;
 pub mod view;

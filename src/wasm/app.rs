@@ -6,11 +6,11 @@ use wasm_bindgen::prelude::*;
 
 use super::json::{crlb_json, nodes_json, snapshot_json, to_js};
 use super::{err, point};
-use crate::crlb::{crlb_at, crlb_map, Grid};
+use crate::localize::{crlb_at, crlb_map, Grid};
+use crate::present::simulate_snapshot;
+use crate::present::Session;
 use crate::scenario::Area;
-use crate::session::Session;
-use crate::snapshot::simulate_snapshot;
-use crate::{presets, Scenario};
+use crate::{scenario::presets, Scenario};
 
 #[wasm_bindgen]
 extern "C" {

@@ -4,12 +4,12 @@
 use serde_json::{json, Value};
 use wasm_bindgen::prelude::*;
 
-use crate::crlb::CrlbPoint;
-use crate::ellipse::Ellipse;
-use crate::session::Session;
-use crate::snapshot::{LinkSim, SnapshotFix, SnapshotSimulation};
-use crate::ticks::format_length_m;
-use crate::track_view::{TrackEstimate, TrackFrame};
+use crate::localize::CrlbPoint;
+use crate::measure::Ellipse;
+use crate::present::format_length_m;
+use crate::present::Session;
+use crate::present::{LinkSim, SnapshotFix, SnapshotSimulation};
+use crate::present::{TrackEstimate, TrackFrame};
 use crate::{Scenario, Vec2};
 
 /// Parsed JSON for JavaScript (numbers that are not finite are already `null` in `Value`).

@@ -1,6 +1,6 @@
 //! WebAssembly bindings for the page: a thin edge over the core, no math here.
 //!
-//! [`App`] wraps a core [`Session`](crate::session::Session) (a validated scenario and its
+//! [`App`] wraps a core [`Session`](crate::present::Session) (a validated scenario and its
 //! compiled model; rejected edits change nothing). This layer only checks the numbers JavaScript
 //! hands over, calls the core and converts the results: objects as parsed JSON (serde_json, whose
 //! non-finite numbers become `null`, so no NaN reaches JavaScript), maps as typed arrays
@@ -16,7 +16,7 @@
 use wasm_bindgen::prelude::*;
 
 use crate::error::Error;
-use crate::{presets, Vec2};
+use crate::{scenario::presets, Vec2};
 
 mod app;
 mod chart;

@@ -1,6 +1,6 @@
-//! The worker-facing Monte Carlo job: the core's chunked study ([`crate::montecarlo`]) run a few
+//! The worker-facing Monte Carlo job: the core's chunked study ([`crate::track`]) run a few
 //! chunks per call, so a Web Worker can report progress and drop a job between calls. Chunks are
-//! merged in order, so the result equals [`run_sequential`](crate::montecarlo::run_sequential)
+//! merged in order, so the result equals [`run_sequential`](crate::track::run_sequential)
 //! (and the native CLI) for the same inputs.
 
 use serde_json::json;
@@ -8,8 +8,8 @@ use wasm_bindgen::prelude::*;
 
 use super::err;
 use super::tracking::{checked_steps, prior_and_motion};
-use crate::montecarlo::{finish, run_chunk, MonteCarloConfig, PartialSums};
-use crate::trajectory::paper_initial_covariance;
+use crate::track::paper_initial_covariance;
+use crate::track::{finish, run_chunk, MonteCarloConfig, PartialSums};
 use crate::{Model, Scenario};
 
 /// A Monte Carlo study of ε_EKF(t) and ε_PCRLB(t) in progress.

@@ -1,5 +1,5 @@
 //! Drawing helpers: map colouring into the caller's buffers, the colour bar, axis ticks and
-//! length labels, all computed by the core ([`crate::colormap`], [`crate::ticks`]).
+//! length labels, all computed by the core ([`crate::present`], [`crate::present`]).
 
 use js_sys::{Float64Array, Uint8ClampedArray};
 use serde_json::{json, Value};
@@ -7,8 +7,8 @@ use wasm_bindgen::prelude::*;
 
 use super::err;
 use super::json::to_js;
-use crate::colormap::{self, LogScale, UNBOUNDED_RGB};
-use crate::ticks::{self, format_length_m, linear_ticks};
+use crate::present::{self, LogScale, UNBOUNDED_RGB};
+use crate::present::{format_length_m, linear_ticks};
 
 /// Colours a map (`values`, m) into `rgba` (4 bytes per value, e.g. an `ImageData.data`) on the
 /// log scale spanning its finite values. Returns `[min, max]` of the scale, m; `[Infinity,
@@ -19,7 +19,7 @@ pub fn render_map_rgba(
     rgba: &Uint8ClampedArray,
 ) -> Result<Vec<f64>, JsError> {
     let mut px = vec![0u8; rgba.length() as usize];
-    let scale = colormap::render_rgba(&values.to_vec(), &mut px).map_err(err)?;
+    let scale = present::render_rgba(&values.to_vec(), &mut px).map_err(err)?;
     rgba.copy_from(&px);
     Ok(match scale {
         Some(s) => vec![s.min, s.max],
@@ -30,7 +30,7 @@ pub fn render_map_rgba(
 /// `n` RGBA pixels of the colour bar, dark (small error) first.
 #[wasm_bindgen]
 pub fn colorbar_rgba(n: usize) -> Vec<u8> {
-    colormap::colorbar_rgba(n)
+    present::colorbar_rgba(n)
 }
 
 /// The colour of unbounded cells, `[r, g, b]`.
@@ -71,7 +71,7 @@ pub fn format_length(m: f64, significant: usize) -> String {
 /// A scale bar no longer than `max_len_m`: `{length_m, label}`, or null.
 #[wasm_bindgen]
 pub fn scale_bar(max_len_m: f64) -> Result<JsValue, JsError> {
-    to_js(&match ticks::scale_bar(max_len_m) {
+    to_js(&match present::scale_bar(max_len_m) {
         Some(t) => json!({"length_m": t.value, "label": t.label}),
         None => Value::Null,
     })

@@ -1,6 +1,6 @@
 //! Tracking for the page's animation: `App::simulate_track` runs the core's
 //! [`simulate_track`] (truth, noisy delays, EKF) and hands back a [`Track`], whose `data()` is
-//! the whole run and `frame(n)` one step shaped like a snapshot ([`crate::track_view`]).
+//! the whole run and `frame(n)` one step shaped like a snapshot ([`crate::present`]).
 
 use serde_json::{json, Value};
 use wasm_bindgen::prelude::*;
@@ -9,10 +9,10 @@ use super::json::{ellipse_json, estimate_json, frame_json, to_js};
 use super::{err, App};
 use crate::error::Error;
 use crate::math::{Real, Vec2, Vec4};
-use crate::motion::ConstantVelocity;
-use crate::track_sim::{simulate_track, TrackRun};
-use crate::track_view::{track_estimate, track_frame, track_mean_state, velocity_through};
-use crate::trajectory::{paper_initial_covariance, step_count, PAPER_INTENSITY};
+use crate::present::{track_estimate, track_frame, track_mean_state, velocity_through};
+use crate::track::ConstantVelocity;
+use crate::track::{paper_initial_covariance, step_count, PAPER_INTENSITY};
+use crate::track::{simulate_track, TrackRun};
 use crate::{Model, Scenario};
 
 /// Most steps of one simulated track or browser Monte Carlo study (keeps the JSON and the

@@ -9,10 +9,10 @@ use fantoccini::{Client, Locator};
 use serde_json::Value;
 
 use scatterloc::math::Vec2;
-use scatterloc::montecarlo::{run_sequential, MonteCarloConfig};
-use scatterloc::motion::ConstantVelocity;
-use scatterloc::track_view::track_mean_state;
-use scatterloc::trajectory::{paper_initial_covariance, PAPER_INTENSITY};
+use scatterloc::present::track_mean_state;
+use scatterloc::track::ConstantVelocity;
+use scatterloc::track::{paper_initial_covariance, PAPER_INTENSITY};
+use scatterloc::track::{run_sequential, MonteCarloConfig};
 use scatterloc::{Model, Scenario};
 
 use super::{

@@ -7,11 +7,11 @@ use serde_json::Value;
 use wasm_bindgen::{JsCast, JsValue};
 use wasm_bindgen_test::*;
 
-use scatterloc::montecarlo::{run_sequential, MonteCarloConfig};
-use scatterloc::motion::ConstantVelocity;
-use scatterloc::trajectory::{paper_initial_covariance, TrackScenario, PAPER_INTENSITY};
+use scatterloc::track::ConstantVelocity;
+use scatterloc::track::{paper_initial_covariance, TrackScenario, PAPER_INTENSITY};
+use scatterloc::track::{run_sequential, MonteCarloConfig};
 use scatterloc::wasm::{self, MonteCarloJob};
-use scatterloc::{presets, Model};
+use scatterloc::{scenario::presets, Model};
 
 use super::{err, get, num, ok, sensors};
 

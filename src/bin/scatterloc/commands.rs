@@ -6,10 +6,10 @@ use std::io::{Read, Write};
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 
-use scatterloc::crlb::crlb_at;
-use scatterloc::lm::{locate as lm_locate, DelayMeasurements, LmConfig};
+use scatterloc::localize::crlb_at;
+use scatterloc::localize::{locate as lm_locate, DelayMeasurements, LmConfig};
 use scatterloc::scenario::parse_json;
-use scatterloc::{presets, Error, Mat2, Model, Scenario, Vec2};
+use scatterloc::{scenario::presets, Error, Mat2, Model, Scenario, Vec2};
 
 use crate::args::{parse_xy, Args};
 use crate::{CliError, USAGE};

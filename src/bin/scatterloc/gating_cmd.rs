@@ -7,13 +7,11 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use scatterloc::calibration::{
-    Calibration, ClusterConfig, LinkCalibration, MAX_CALIBRATION_SNAPSHOTS,
-};
-use scatterloc::measurement_case::{default_channel, LoopPath, LOOP_DURATION_S};
-use scatterloc::motion::ConstantVelocity;
-use scatterloc::trajectory::paper_initial_covariance;
-use scatterloc::{simulate, Model};
+use scatterloc::gating::{default_channel, LoopPath, LOOP_DURATION_S};
+use scatterloc::gating::{Calibration, ClusterConfig, LinkCalibration, MAX_CALIBRATION_SNAPSHOTS};
+use scatterloc::track::paper_initial_covariance;
+use scatterloc::track::ConstantVelocity;
+use scatterloc::{measure, Model};
 
 use crate::commands::{emit_json, model_of, parse_args, read_json_file, read_scenario};
 use crate::output::write_json_file;
@@ -235,10 +233,10 @@ pub fn simulate_walk(argv: &[OsString]) -> Result<(), CliError> {
     let path = LoopPath::default();
     // Calibration of the empty area without false alarms (see the calibration module).
     let clean = default_channel(scenario.radio.bandwidth_hz, 0.0);
-    let mut rng = simulate::rng(seed, 0);
+    let mut rng = measure::rng(seed, 0);
     let cal_snaps = clean.calibration_snapshots(&model, ncal, &mut rng);
     let states = path.states(dt, steps);
-    let raw = |snap: Vec<Vec<scatterloc::association::DelayEstimate>>| -> RawStep {
+    let raw = |snap: Vec<Vec<scatterloc::gating::DelayEstimate>>| -> RawStep {
         snap.iter()
             .map(|l| l.iter().map(|e| [e.delay_s, e.amplitude]).collect())
             .collect()

@@ -12,7 +12,7 @@ use scatterloc::chart::{
     check_area, default_titles, draw_crlb_map, scenario_nodes, suggested_size,
 };
 use scatterloc::chart::{ChartError, ChartNode, ChartOptions, MapData};
-use scatterloc::crlb::{crlb_map as map_kernel, Grid};
+use scatterloc::localize::{crlb_map as map_kernel, Grid};
 use scatterloc::scenario::Area;
 use scatterloc::{Error, Model, Scenario};
 

@@ -7,8 +7,8 @@ use std::ffi::OsString;
 use serde::Serialize;
 
 use scatterloc::chart::TrackingChartOptions;
-use scatterloc::pcrlb::nominal_pcrlb_rmse;
-use scatterloc::trajectory::paper_initial_covariance;
+use scatterloc::track::nominal_pcrlb_rmse;
+use scatterloc::track::paper_initial_covariance;
 
 use crate::commands::parse_args;
 use crate::report::{which, CurveDoc, Outputs};

@@ -9,14 +9,14 @@ use std::time::{Duration, Instant};
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
 
-use scatterloc::montecarlo::{MonteCarloConfig, MonteCarloResult, MAX_STEPS};
-use scatterloc::motion::ConstantVelocity;
-use scatterloc::parallel::{run_parallel, run_pcrlb_parallel};
-use scatterloc::trajectory::{
+use scatterloc::native::{run_parallel, run_pcrlb_parallel};
+use scatterloc::track::ConstantVelocity;
+use scatterloc::track::{
     paper_initial_covariance, step_count, TrackScenario, PAPER_DURATION_S, PAPER_INTENSITY,
     PAPER_STEP_S,
 };
-use scatterloc::{presets, Error, Model, Scenario};
+use scatterloc::track::{MonteCarloConfig, MonteCarloResult, MAX_STEPS};
+use scatterloc::{scenario::presets, Error, Model, Scenario};
 
 use crate::args::Args;
 use crate::commands::{model_of, read_scenario};

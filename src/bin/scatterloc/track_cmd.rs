@@ -8,14 +8,14 @@ use std::ffi::OsString;
 
 use serde::{Deserialize, Serialize};
 
-use scatterloc::association::{AssociationRule, Choice, DelayEstimate};
-use scatterloc::calibration::Calibration;
-use scatterloc::ekf::{Ekf, MeasurementNoise, UpdateSummary};
-use scatterloc::gated_track::{start_from_snapshot, GatedTracker, START_SPEED_SIGMA_MPS};
+use scatterloc::gating::Calibration;
+use scatterloc::gating::{start_from_snapshot, GatedTracker, START_SPEED_SIGMA_MPS};
+use scatterloc::gating::{AssociationRule, Choice, DelayEstimate};
 use scatterloc::math::{Mat4, Vec4};
-use scatterloc::montecarlo::MAX_STEPS;
-use scatterloc::motion::ConstantVelocity;
 use scatterloc::scenario::Area;
+use scatterloc::track::ConstantVelocity;
+use scatterloc::track::MAX_STEPS;
+use scatterloc::track::{Ekf, MeasurementNoise, UpdateSummary};
 use scatterloc::{Error, Model};
 
 use crate::commands::{emit, model_of, parse_args, read_json_file, read_scenario, Sigma};

@@ -6,6 +6,7 @@ use alloc::vec::Vec;
 
 use crate::error::{Error, Result};
 use crate::math::Vec2;
+use crate::measure::rng;
 use crate::mtl::algorithm::{
     locate_cached, FinalTest, IntersectionCache, Measurements, MtlConfig, Target,
 };
@@ -18,7 +19,6 @@ use crate::mtl::experiment::{genie, Experiment, ExperimentConfig, Method};
 use crate::mtl::icb::IcbModel;
 use crate::mtl::ppp::{PppBlocking, PppNodeModel};
 use crate::mtl::sim::{count_detections, generate, DetectionCounts, LosModel, Realisation};
-use crate::simulate::rng;
 
 /// Stream offset of the empirical model's training draws: realisation `i` trains on the stream
 /// `rng(seed, TRAINING_STREAM + i)`, disjoint from the generator's `rng(seed, i)`.

@@ -26,6 +26,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
 use crate::math::{Real, Vec2};
+use crate::measure::rng;
 use crate::mtl::algorithm::{Measurements, MtlConfig, Target};
 use crate::mtl::blocking::{check_probability, BlockingModel, NodeBlockingModel};
 use crate::mtl::empirical::{EmpiricalNodeModel, EmpiricalTable};
@@ -33,7 +34,6 @@ use crate::mtl::icb::IcbModel;
 use crate::mtl::polygon::Rect;
 use crate::mtl::ppp::{PppBlocking, PppNodeModel};
 use crate::mtl::trp::TrpMap;
-use crate::simulate::rng;
 
 /// Default range standard deviation `cσ`, m (§7 table, \[P\] 0.1).
 pub const DEFAULT_C_SIGMA_M: Real = 0.1;

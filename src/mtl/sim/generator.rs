@@ -5,10 +5,10 @@ use alloc::vec::Vec;
 
 use crate::error::Result;
 use crate::math::{Real, Vec2};
+use crate::measure::{rng, standard_normal, Rng};
 use crate::mtl::sim::scene::{draw_scene_with, poisson, segment_is_los, uniform, Scene};
 use crate::mtl::sim::settings::SimSettings;
 use crate::mtl::trp::{range, TrpMap};
-use crate::simulate::{rng, standard_normal, Rng};
 
 /// What produced a range (the ground truth of §1's decision variables).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -10,10 +10,10 @@ use rand_distr::{Distribution, Poisson};
 
 use crate::error::{Error, Result};
 use crate::math::{Real, Vec2};
+use crate::measure::Rng;
 use crate::mtl::blocking::kron;
 use crate::mtl::polygon::Rect;
 use crate::mtl::sim::settings::{LosModel, NodeLayout, SimSettings};
-use crate::simulate::Rng;
 
 /// Rejection sampling in `R \ S` gives up after this many draws for one point.
 pub const MAX_REJECTIONS: usize = 100_000;
@@ -190,5 +190,5 @@ pub(crate) fn draw_scene_with(s: &SimSettings, rng: &mut Rng) -> Result<Scene> {
 /// free point in [`MAX_REJECTIONS`] draws.
 pub fn draw_scene(s: &SimSettings, seed: u64, index: u64) -> Result<Scene> {
     s.validate()?;
-    draw_scene_with(s, &mut crate::simulate::rng(seed, index))
+    draw_scene_with(s, &mut crate::measure::rng(seed, index))
 }

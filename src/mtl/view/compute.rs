@@ -4,8 +4,8 @@
 use alloc::vec::Vec;
 
 use crate::error::Result;
-use crate::geometry::iso_range_ellipse;
 use crate::math::{Real, Vec2};
+use crate::measure::iso_range_ellipse;
 use crate::mtl::algorithm::candidate::Geometry;
 use crate::mtl::algorithm::{
     select, stages, validate, Candidate, IntersectionCache, Measurements, MtlConfig, Pair, Status,

@@ -7,12 +7,12 @@ use alloc::vec::Vec;
 
 use crate::error::Result;
 use crate::math::{Real, Vec2};
+use crate::measure::rng;
 use crate::mtl::blocking::kron;
 use crate::mtl::sim::generator::{resolution_merge, trp_peaks, Source};
 use crate::mtl::sim::scene::{segment_distance_sq, Scene, TargetBlocking};
 use crate::mtl::sim::settings::{GeometricIps, LosModel, NodeLayout, SimSettings};
 use crate::mtl::trp::TrpMap;
-use crate::simulate::rng;
 
 use super::{v, MtlScene};
 

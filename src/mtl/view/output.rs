@@ -7,8 +7,8 @@ use alloc::vec::Vec;
 
 use serde::Serialize;
 
-use crate::ellipse::Ellipse;
 use crate::math::Real;
+use crate::measure::Ellipse;
 
 /// An ellipse: centre `(cx, cy)` m, semi-axes `a ≥ b` m, major-axis angle rad from +x.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]

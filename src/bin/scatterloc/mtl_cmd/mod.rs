@@ -23,7 +23,7 @@ use scatterloc::mtl::input::{
 };
 use scatterloc::mtl::sim::table2::{icb_row, table2_buckets, true_row};
 use scatterloc::mtl::sim::{LosModel, NodeLayout, SimSettings, VB_ICB_P_U};
-use scatterloc::mtl::sweep::run_parallel;
+use scatterloc::native::run_experiment_parallel;
 use scatterloc::Error;
 
 use crate::commands::{emit, parse_args, read_input};

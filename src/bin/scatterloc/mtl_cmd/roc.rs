@@ -14,7 +14,7 @@ fn run_with_progress(
         cfg.realisations,
         "realisations",
         &label,
-        |cancel, progress| run_parallel(cfg, threads, cancel, progress),
+        |cancel, progress| run_experiment_parallel(cfg, threads, cancel, progress),
     )?;
     Ok((res.map_err(|e| core_error(&e, "mtl roc"))?, wall))
 }

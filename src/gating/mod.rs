@@ -1,0 +1,24 @@
+//! The raw-estimate front end of the tracker (spec §4): the calibration stage (static clusters
+//! per link), 3σ gating of static estimates (E4), association of the remaining estimates to the
+//! scatterer, the gated tracker that feeds the EKF, the simulated output of the per-snapshot
+//! estimator, and the synthetic stand-in of the measurement case (spec §9.6).
+
+mod association;
+mod calibration;
+mod gated_track;
+mod measurement_case;
+mod raw_snapshot;
+
+pub use association::{
+    associate, select, AssociationRule, Choice, DelayEstimate, Selection, INNOVATION_GATE,
+    MAX_ESTIMATES_PER_LINK,
+};
+pub use calibration::{
+    Calibration, ClusterConfig, LinkCalibration, StaticCluster, GATE_SIGMAS,
+    MAX_CALIBRATION_DELAYS, MAX_CALIBRATION_SNAPSHOTS,
+};
+pub use gated_track::{
+    start_from_snapshot, GatedStep, GatedTracker, StartFix, START_SPEED_SIGMA_MPS,
+};
+pub use measurement_case::{default_channel, LoopPath, LOOP_DURATION_S};
+pub use raw_snapshot::{StaticChannel, MAX_FALSE_ALARMS};

@@ -1,0 +1,254 @@
+//! The CRLB map: a validated [`Grid`] of cell centres and the kernel [`crlb_map`] that writes
+//! the RMSE bound of every cell row by row in structure-of-arrays form (spec §7, S24).
+
+use alloc::vec;
+use alloc::vec::Vec;
+
+use super::{is_regular, link_weights};
+use crate::error::{checked_index, Error, Result};
+use crate::math::{sqrt, Real, Vec2};
+use crate::measure::TxPattern;
+use crate::measure::UNIT_VECTOR_MIN_DISTANCE_M;
+use crate::measure::{Model, SNR_DISTANCE_FLOOR_M};
+use crate::scenario::Area;
+
+/// Largest grid side accepted by the map kernel.
+pub const MAX_GRID_SIDE: usize = 4096;
+/// Largest number of grid cells accepted by the map kernel (2048²).
+pub const MAX_GRID_CELLS: usize = 2048 * 2048;
+
+/// A regular grid of cell centres over a rectangle: `x_i = x_min + (i + ½)·(x_max − x_min)/nx`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Grid {
+    /// Extent, m.
+    pub area: Area,
+    /// Number of columns (x).
+    pub nx: usize,
+    /// Number of rows (y).
+    pub ny: usize,
+}
+
+impl Grid {
+    /// A validated grid: finite, non-inverted area; `2 ≤ nx, ny ≤ 4096`; at most 2048² cells.
+    pub fn new(area: Area, nx: usize, ny: usize) -> Result<Grid> {
+        area.validate()?;
+        for (field, v) in [("nx", nx), ("ny", ny)] {
+            if !(2..=MAX_GRID_SIDE).contains(&v) {
+                return Err(Error::SizeLimit {
+                    field,
+                    value: v,
+                    min: 2,
+                    max: MAX_GRID_SIDE,
+                });
+            }
+        }
+        if nx * ny > MAX_GRID_CELLS {
+            return Err(Error::SizeLimit {
+                field: "nx*ny",
+                value: nx * ny,
+                min: 4,
+                max: MAX_GRID_CELLS,
+            });
+        }
+        Ok(Grid { area, nx, ny })
+    }
+
+    /// x of column `i` (cell centre), m.
+    #[inline]
+    pub fn x(&self, i: usize) -> Real {
+        self.area.x[0] + (i as Real + 0.5) * (self.area.x[1] - self.area.x[0]) / self.nx as Real
+    }
+
+    /// y of row `j` (cell centre), m.
+    #[inline]
+    pub fn y(&self, j: usize) -> Real {
+        self.area.y[0] + (j as Real + 0.5) * (self.area.y[1] - self.area.y[0]) / self.ny as Real
+    }
+
+    /// Centre of cell `(i, j)`, m; [`Error::IndexOutOfRange`] outside the grid.
+    pub fn cell_center(&self, i: usize, j: usize) -> Result<Vec2> {
+        let i = checked_index("grid columns", i, self.nx)?;
+        let j = checked_index("grid rows", j, self.ny)?;
+        Ok(Vec2::new(self.x(i), self.y(j)))
+    }
+
+    /// Number of cells.
+    pub fn len(&self) -> usize {
+        self.nx * self.ny
+    }
+
+    /// Always false for a validated grid.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+}
+
+/// Writes the RMSE bound of every grid cell into `out` (row-major, row `j` = `y_j`, ascending y),
+/// m; unbounded cells get `+∞`. `out.len()` must equal `grid.len()`.
+///
+/// The same quantity as [`crlb_at`](super::crlb_at) per cell, computed row by row in
+/// structure-of-arrays form so the square roots and divisions vectorize; the Tx pattern goes
+/// through [`GainPolynomial`]
+/// ([`crate::measure::GainPolynomial`], ≤ 1e-12 relative from the exact §9.3 formula) when it can be fitted, else the exact formula.
+pub fn crlb_map(model: &Model, grid: &Grid, out: &mut [Real]) -> Result<()> {
+    if out.len() != grid.len() {
+        return Err(Error::LengthMismatch {
+            field: "map buffer",
+            expected: grid.len(),
+            found: out.len(),
+        });
+    }
+    let net = &model.network;
+    let nx = grid.nx;
+    let weights: Vec<Real> = link_weights(model).collect();
+    let xs: Vec<Real> = (0..nx).map(|i| grid.x(i)).collect();
+    // Per node and row: unit vector (ux, uy) and gain/d² (Tx) or 1/d² (Rx).
+    let mut tx_rows = vec![NodeRow::new(nx); net.transmitters.len()];
+    let mut rx_rows = vec![NodeRow::new(nx); net.receivers.len()];
+    let mut fisher = FisherRow::new(nx);
+    for (j, out_row) in out.chunks_exact_mut(nx).enumerate() {
+        let y = grid.y(j);
+        for (k, row) in tx_rows.iter_mut().enumerate() {
+            row.fill(net.transmitters[k], y, &xs);
+            row.apply_pattern(&model.patterns[k]);
+        }
+        for (l, row) in rx_rows.iter_mut().enumerate() {
+            row.fill(net.receivers[l], y, &xs);
+        }
+        fisher.clear();
+        for (link, &w) in net.links.iter().zip(&weights) {
+            fisher.accumulate(&tx_rows[link.tx], &rx_rows[link.rx], w);
+        }
+        fisher.rmse_into(out_row);
+    }
+    Ok(())
+}
+
+/// One grid row seen from one node.
+#[derive(Clone)]
+struct NodeRow {
+    ux: Vec<Real>,
+    uy: Vec<Real>,
+    /// `1/max(d², 1 m²)`, times the Tx gain for transmitters.
+    weight: Vec<Real>,
+}
+
+impl NodeRow {
+    fn new(n: usize) -> NodeRow {
+        NodeRow {
+            ux: vec![0.0; n],
+            uy: vec![0.0; n],
+            weight: vec![0.0; n],
+        }
+    }
+
+    /// Unit vectors node → cell (zero on the node, spec §3) and `1/max(d², 1)`.
+    fn fill(&mut self, node: Vec2, y: Real, xs: &[Real]) {
+        let dy = y - node.y;
+        let floor2 = SNR_DISTANCE_FLOOR_M * SNR_DISTANCE_FLOOR_M;
+        let n = xs.len();
+        let (ux, uy, w) = (&mut self.ux[..n], &mut self.uy[..n], &mut self.weight[..n]);
+        for i in 0..n {
+            let dx = xs[i] - node.x;
+            let d2 = dx * dx + dy * dy;
+            let d = sqrt(d2);
+            let inv = if d < UNIT_VECTOR_MIN_DISTANCE_M {
+                0.0
+            } else {
+                1.0 / d
+            };
+            ux[i] = dx * inv;
+            uy[i] = dy * inv;
+            // 1/max(d², 1 m²) without a second division.
+            w[i] = if d2 < floor2 { 1.0 / floor2 } else { inv * inv };
+        }
+    }
+
+    /// Multiplies the weights by the Tx gain toward each cell.
+    fn apply_pattern(&mut self, pattern: &TxPattern) {
+        let n = self.weight.len();
+        match (pattern.beam, pattern.polynomial.as_ref()) {
+            (None, _) => self.weight.iter_mut().for_each(|w| *w *= pattern.peak_gain),
+            (Some(_), Some(p)) => {
+                // LANES cells at a time, so the Clenshaw recurrence lives in vector registers.
+                const LANES: usize = 4;
+                let mut i0 = 0;
+                while i0 < n {
+                    let m = LANES.min(n - i0);
+                    let mut c = [1.0; LANES];
+                    for (l, c) in c.iter_mut().enumerate().take(m) {
+                        *c = self.ux[i0 + l] * p.boresight.x + self.uy[i0 + l] * p.boresight.y;
+                    }
+                    let gains = p.gains_at_cos(c);
+                    for (l, g) in gains.iter().enumerate().take(m) {
+                        let i = i0 + l;
+                        // A cell on the Tx gets the peak gain, as in `TxPattern::gain_toward`.
+                        let on_node = self.ux[i] == 0.0 && self.uy[i] == 0.0;
+                        self.weight[i] *= if on_node { pattern.peak_gain } else { *g };
+                    }
+                    i0 += m;
+                }
+            }
+            (Some(_), None) => {
+                for i in 0..n {
+                    self.weight[i] *= pattern.gain_toward(Vec2::new(self.ux[i], self.uy[i]));
+                }
+            }
+        }
+    }
+}
+
+/// Fisher entries `[[a, b], [b, c]]` of one grid row.
+struct FisherRow {
+    a: Vec<Real>,
+    b: Vec<Real>,
+    c: Vec<Real>,
+}
+
+impl FisherRow {
+    fn new(n: usize) -> FisherRow {
+        FisherRow {
+            a: vec![0.0; n],
+            b: vec![0.0; n],
+            c: vec![0.0; n],
+        }
+    }
+
+    fn clear(&mut self) {
+        self.a.fill(0.0);
+        self.b.fill(0.0);
+        self.c.fill(0.0);
+    }
+
+    /// Adds one link's `w·(gTx/d²)(1/d²)·(u^Tx+u^Rx)(u^Tx+u^Rx)ᵀ`.
+    fn accumulate(&mut self, tx: &NodeRow, rx: &NodeRow, w: Real) {
+        let n = self.a.len();
+        let (a, b, c) = (&mut self.a[..n], &mut self.b[..n], &mut self.c[..n]);
+        let (tux, tuy, tw) = (&tx.ux[..n], &tx.uy[..n], &tx.weight[..n]);
+        let (rux, ruy, rw) = (&rx.ux[..n], &rx.uy[..n], &rx.weight[..n]);
+        for i in 0..n {
+            let gx = tux[i] + rux[i];
+            let gy = tuy[i] + ruy[i];
+            let wp = w * tw[i] * rw[i];
+            a[i] += wp * gx * gx;
+            b[i] += wp * gx * gy;
+            c[i] += wp * gy * gy;
+        }
+    }
+
+    /// `√(σx² + σy²)` per cell, `+∞` where singular (same rule as
+    /// [`bound_from_fisher`](super::bound_from_fisher)).
+    fn rmse_into(&self, out: &mut [Real]) {
+        let n = out.len();
+        let (a, b, c) = (&self.a[..n], &self.b[..n], &self.c[..n]);
+        for i in 0..n {
+            let det = a[i] * c[i] - b[i] * b[i];
+            let tr = a[i] + c[i];
+            out[i] = if is_regular(det, tr) {
+                sqrt(tr / det)
+            } else {
+                Real::INFINITY
+            };
+        }
+    }
+}

@@ -1,0 +1,96 @@
+//! The fix as a weighted least-squares problem in range units: the used links with their
+//! weights, the cost 𝓛(r) (E5) and its linearisation.
+
+use alloc::vec::Vec;
+
+use super::{DelayMeasurements, MIN_LINKS};
+use crate::error::{Error, Result};
+use crate::math::{Mat2, Real, Vec2, SPEED_OF_LIGHT};
+use crate::measure::{unit_from, Network};
+
+/// One used link in range units: foci, measured range `cτ̂` and weight `1/(cσ)²`.
+#[derive(Clone, Copy)]
+pub(super) struct Row {
+    tx: Vec2,
+    rx: Vec2,
+    range: Real,
+    weight: Real,
+}
+
+/// Validated problem in range units.
+pub(super) struct Problem {
+    pub(super) rows: Vec<Row>,
+}
+
+impl Problem {
+    pub(super) fn new(net: &Network, m: &DelayMeasurements) -> Result<Problem> {
+        let n = net.link_count();
+        if m.delays_s.len() != n {
+            return Err(Error::LengthMismatch {
+                field: "delays_s",
+                expected: n,
+                found: m.delays_s.len(),
+            });
+        }
+        if m.sigmas_s.len() != n {
+            return Err(Error::LengthMismatch {
+                field: "sigma_s",
+                expected: n,
+                found: m.sigmas_s.len(),
+            });
+        }
+        let mut rows = Vec::with_capacity(n);
+        for (p, (d, s)) in m.delays_s.iter().zip(m.sigmas_s).enumerate() {
+            let Some(d) = *d else { continue };
+            if !d.is_finite() {
+                return Err(Error::NonFiniteDelay { link: p });
+            }
+            if !(s.is_finite() && *s > 0.0) {
+                return Err(Error::InvalidSigma { link: p, value: *s });
+            }
+            let (tx, rx) = net.link_nodes(p);
+            let sr = SPEED_OF_LIGHT * s;
+            rows.push(Row {
+                tx,
+                rx,
+                range: SPEED_OF_LIGHT * d,
+                weight: 1.0 / (sr * sr),
+            });
+        }
+        if rows.len() < MIN_LINKS {
+            return Err(Error::TooFewLinks {
+                available: rows.len(),
+                required: MIN_LINKS,
+            });
+        }
+        Ok(Problem { rows })
+    }
+
+    /// 𝓛(r) (E5).
+    #[inline]
+    pub(super) fn cost(&self, r: Vec2) -> Real {
+        self.rows
+            .iter()
+            .map(|row| {
+                let e = row.range - ((r - row.tx).norm() + (r - row.rx).norm());
+                row.weight * e * e
+            })
+            .sum()
+    }
+
+    /// Cost, normal matrix `JᵀWJ` and gradient term `JᵀW(ρ̂ − h)` at `r` (range units).
+    #[inline]
+    pub(super) fn linearize(&self, r: Vec2) -> (Real, Mat2, Vec2) {
+        let (mut cost, mut n, mut g) = (0.0, Mat2::zeros(), Vec2::zeros());
+        for row in &self.rows {
+            let (ut, dt) = unit_from(row.tx, r);
+            let (ur, dr) = unit_from(row.rx, r);
+            let j = ut + ur;
+            let e = row.range - (dt + dr);
+            cost += row.weight * e * e;
+            n += row.weight * j * j.transpose();
+            g += (row.weight * e) * j;
+        }
+        (cost, n, g)
+    }
+}

@@ -1,0 +1,21 @@
+//! The measurement model of one scatterer: bistatic geometry, the one home of range, delay and
+//! their gradients (E1, E3, and the range function (M1) of the multi-target layer), iso-delay and
+//! covariance ellipses (spec §2), the Tx antenna pattern (§9.3), the link budget that sets each
+//! link's SNR and delay standard deviation `σ_τ` (E8) in [`Model`], and seeded noise draws (E2).
+
+mod ellipse;
+mod geometry;
+mod model;
+mod pattern;
+mod simulate;
+
+pub use ellipse::Ellipse;
+pub use geometry::{
+    bistatic_delay, delay_gradient, iso_delay_ellipse, iso_range_ellipse, unit_from, Network,
+    UNIT_VECTOR_MIN_DISTANCE_M,
+};
+pub use model::{
+    noise_power_w, sigma_delay_from_snr, Model, DEFAULT_NOISE_FIGURE_DB, SNR_DISTANCE_FLOOR_M,
+};
+pub use pattern::{Beam, GainPolynomial, TxPattern, GAIN_POLYNOMIAL_TOLERANCE};
+pub use simulate::{noisy_delays, rng, standard_normal, Rng};

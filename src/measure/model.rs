@@ -1,0 +1,148 @@
+//! The measurement model of a validated scenario: geometry `h(r)` plus the link budget that sets
+//! each link's SNR and delay standard deviation `σ_p` (E8).
+
+use alloc::vec::Vec;
+
+use crate::error::Result;
+use crate::math::{
+    db_to_linear, dbm_to_watt, sqrt, Real, Vec2, BOLTZMANN, PI, REFERENCE_TEMPERATURE_K,
+    SPEED_OF_LIGHT,
+};
+use crate::measure::TxPattern;
+use crate::measure::{unit_from, Network};
+use crate::scenario::{Radio, Scenario};
+
+/// Default receiver noise figure `F`, dB (spec §7).
+pub const DEFAULT_NOISE_FIGURE_DB: Real = 10.0;
+/// Distance floor inside the SNR only, m (spec §7: `max(d, 1 m)`).
+pub const SNR_DISTANCE_FLOOR_M: Real = 1.0;
+
+/// A scenario compiled for computation: node positions, link set and per-link budget constants.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Model {
+    /// Geometry.
+    pub network: Network,
+    /// Tx patterns, one per transmitter.
+    pub patterns: Vec<TxPattern>,
+    /// Per link: `P_Tx G_Rx σ_RCS c² G_p / ((4π)³ f_c² P_n)` — the SNR at unit distances and unit
+    /// Tx gain (E8 without `G_Tx(r)` and the distances).
+    pub snr_scale: Vec<Real>,
+    /// Effective RMS bandwidth squared `β² = B²/12`, Hz².
+    pub beta2: Real,
+    /// Receiver noise power `P_n`, W.
+    pub noise_power_w: Real,
+}
+
+/// Noise power `P_n`, W: `k_B T₀ B F` or the explicit `noise_power_dbm` (spec §7).
+pub fn noise_power_w(radio: &Radio) -> Real {
+    match radio.noise_power_dbm {
+        Some(p) => dbm_to_watt(p),
+        None => {
+            BOLTZMANN
+                * REFERENCE_TEMPERATURE_K
+                * radio.bandwidth_hz
+                * db_to_linear(radio.noise_figure_db.unwrap_or(DEFAULT_NOISE_FIGURE_DB))
+        }
+    }
+}
+
+/// `1/√(8π²β²·SNR)`: delay standard deviation for a given SNR (E8), s.
+#[inline]
+pub fn sigma_delay_from_snr(beta2: Real, snr: Real) -> Real {
+    1.0 / sqrt(8.0 * PI * PI * beta2 * snr)
+}
+
+impl Model {
+    /// Validates and compiles a scenario.
+    pub fn new(s: &Scenario) -> Result<Model> {
+        s.validate()?;
+        let links = s.link_indices()?;
+        let pn = noise_power_w(&s.radio);
+        let fc = s.radio.carrier_hz;
+        let pg = db_to_linear(s.radio.processing_gain_db.unwrap_or(0.0));
+        let four_pi3 = (4.0 * PI) * (4.0 * PI) * (4.0 * PI);
+        let snr_scale = links
+            .iter()
+            .map(|l| {
+                let tx = &s.transmitters[l.tx];
+                let rx = &s.receivers[l.rx];
+                dbm_to_watt(tx.power_dbm)
+                    * db_to_linear(rx.gain_dbi)
+                    * s.target.rcs_m2
+                    * SPEED_OF_LIGHT
+                    * SPEED_OF_LIGHT
+                    * pg
+                    / (four_pi3 * fc * fc * pn)
+            })
+            .collect();
+        Ok(Model {
+            network: Network {
+                transmitters: s
+                    .transmitters
+                    .iter()
+                    .map(|t| Vec2::new(t.position_m[0], t.position_m[1]))
+                    .collect(),
+                receivers: s
+                    .receivers
+                    .iter()
+                    .map(|r| Vec2::new(r.position_m[0], r.position_m[1]))
+                    .collect(),
+                links,
+            },
+            patterns: s
+                .transmitters
+                .iter()
+                .map(|t| TxPattern::new(t.gain_dbi, &t.pattern))
+                .collect(),
+            snr_scale,
+            beta2: s.radio.bandwidth_hz * s.radio.bandwidth_hz / 12.0,
+            noise_power_w: pn,
+        })
+    }
+
+    /// Number of links.
+    pub fn link_count(&self) -> usize {
+        self.network.links.len()
+    }
+
+    /// `SNR_p(r)` of link `p` for a scatterer at `r`, linear (E8, with the 1 m distance floor).
+    pub fn snr(&self, p: usize, r: Vec2) -> Real {
+        let l = self.network.links[p];
+        let (u_tx, d_tx) = unit_from(self.network.transmitters[l.tx], r);
+        let (_, d_rx) = unit_from(self.network.receivers[l.rx], r);
+        self.snr_from_geometry(p, self.patterns[l.tx].gain_toward(u_tx), d_tx, d_rx)
+    }
+
+    /// `SNR_p` from already computed geometry: the Tx gain toward the scatterer (linear) and
+    /// the distances `d_Tx`, `d_Rx` (m; floored at 1 m here, E8). For hot loops that already
+    /// hold the unit vectors (EKF update, Monte Carlo).
+    #[inline]
+    pub fn snr_from_geometry(&self, p: usize, tx_gain: Real, d_tx: Real, d_rx: Real) -> Real {
+        let d_tx = d_tx.max(SNR_DISTANCE_FLOOR_M);
+        let d_rx = d_rx.max(SNR_DISTANCE_FLOOR_M);
+        self.snr_scale[p] * tx_gain / (d_tx * d_tx * d_rx * d_rx)
+    }
+
+    /// Received scatter power `P_r` of link `p` at `r`, W (`SNR·P_n`, without processing gain
+    /// only when none is configured).
+    pub fn received_power_w(&self, p: usize, r: Vec2) -> Real {
+        self.snr(p, r) * self.noise_power_w
+    }
+
+    /// Delay-domain Fisher information `[F_τ]_pp = 8π²β²·SNR_p(r)`, 1/s² (E8).
+    pub fn delay_information(&self, p: usize, r: Vec2) -> Real {
+        8.0 * PI * PI * self.beta2 * self.snr(p, r)
+    }
+
+    /// Delay standard deviation `σ_p(r) = [F_τ]_pp^(−1/2)`, s (E8).
+    pub fn sigma_delay(&self, p: usize, r: Vec2) -> Real {
+        sigma_delay_from_snr(self.beta2, self.snr(p, r))
+    }
+
+    /// `σ_p(r)` of every link in link order, s.
+    pub fn sigma_delays(&self, r: Vec2) -> Vec<Real> {
+        (0..self.link_count())
+            .map(|p| self.sigma_delay(p, r))
+            .collect()
+    }
+}

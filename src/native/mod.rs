@@ -1,0 +1,13 @@
+//! Native (`std`, not wasm32) drivers: [`run_ordered`], the one ordered parallel driver (rayon
+//! waves, results merged in job order, progress and cancel between waves), and the two studies
+//! that run on it: the tracker's Monte Carlo ([`run_parallel`], [`run_pcrlb_parallel`]) and
+//! the multi-target experiment sweeps ([`run_experiment_parallel`]). Results never depend on
+//! the thread count.
+
+mod driver;
+mod parallel;
+mod sweep;
+
+pub use driver::{run_ordered, thread_pool};
+pub use parallel::{run_parallel, run_pcrlb_parallel};
+pub use sweep::run_experiment_parallel;

@@ -1,0 +1,26 @@
+//! View models shared by every front end (the page through `wasm`, the figures through `chart`):
+//! axis ticks and length labels, the log colour scale of CRLB maps, one simulated snapshot as the
+//! page draws it, a simulated track's frames, and the interactive [`Session`] (a validated
+//! scenario and its compiled model, kept in step). Pure `no_std` functions of the core's results:
+//! no maths of their own beyond layout.
+
+mod colormap;
+mod session;
+mod snapshot;
+mod ticks;
+mod track_view;
+
+pub use colormap::{colorbar_rgba, fill_rgba, render_rgba, viridis, LogScale, UNBOUNDED_RGB};
+pub use session::Session;
+pub(crate) use snapshot::{link_sim, view_radius};
+pub use snapshot::{
+    simulate_snapshot, LinkSim, SnapshotFix, SnapshotSimulation, ARC_POINTS, FALLBACK_EXTENT_M,
+    OUTLINE_POINTS, VIEW_MARGIN,
+};
+pub use ticks::{
+    decimal, format_length_m, linear_ticks, log_length_ticks, nice_below, scale_bar, Tick,
+};
+pub use track_view::{
+    position_ellipse, track_estimate, track_frame, track_mean_state, velocity_through,
+    TrackEstimate, TrackFrame, TRAJECTORY_KINDS,
+};

@@ -1,0 +1,216 @@
+//! Presentation helpers shared by every front end (the page, figures): 1-2-5 "nice" numbers,
+//! linear and logarithmic axis ticks with clean labels, and length labels in µm/mm/cm/m/km.
+//! Pure functions, so the page's JavaScript only places text where these say.
+
+use alloc::format;
+use alloc::string::{String, ToString};
+use alloc::vec::Vec;
+
+use crate::math::{log10, Real};
+
+/// A tick: its value and its label.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Tick {
+    /// Value, in the axis unit (m for lengths).
+    pub value: Real,
+    /// Text to print.
+    pub label: String,
+}
+
+/// The double nearest to `mantissa · 10^exp10` (decimal parse, so `3 · 10^-1` is exactly `0.3`).
+pub fn decimal(mantissa: i64, exp10: i32) -> Real {
+    format!("{mantissa}e{exp10}").parse().unwrap_or(Real::NAN)
+}
+
+/// `⌊log10 x⌋` for finite `x > 0`, robust to rounding at exact powers of ten.
+fn decade(x: Real) -> i32 {
+    let mut k = libm::floor(log10(x)) as i32;
+    if decimal(1, k + 1) <= x {
+        k += 1;
+    } else if decimal(1, k) > x {
+        k -= 1;
+    }
+    k
+}
+
+/// The largest `m · 10^k` with `m ∈ {1, 2, 5}` that is `≤ x`, as `(m, k)`; `None` unless
+/// `x` is finite and > 0.
+pub fn nice_below(x: Real) -> Option<(i64, i32)> {
+    if !(x.is_finite() && x > 0.0) {
+        return None;
+    }
+    let k = decade(x);
+    let m = [5, 2, 1]
+        .into_iter()
+        .find(|&m| decimal(m, k) <= x)
+        .unwrap_or(1);
+    Some((m, k))
+}
+
+/// The smallest `m · 10^k` with `m ∈ {1, 2, 5}` that is `≥ x`, as `(m, k)`.
+fn nice_above(x: Real) -> Option<(i64, i32)> {
+    let (m, k) = nice_below(x)?;
+    if decimal(m, k) >= x {
+        return Some((m, k));
+    }
+    Some(match m {
+        1 => (2, k),
+        2 => (5, k),
+        _ => (1, k + 1),
+    })
+}
+
+/// Formats `mantissa · 10^exp10` exactly, without exponent (`-25, -1` → `"−2.5"`).
+fn decimal_label(mantissa: i64, exp10: i32) -> String {
+    let neg = mantissa < 0;
+    let digits = mantissa.unsigned_abs().to_string();
+    let body = if exp10 >= 0 {
+        let mut s = digits;
+        if s != "0" {
+            s.extend(core::iter::repeat_n('0', exp10 as usize));
+        }
+        s
+    } else {
+        let frac = (-exp10) as usize;
+        let padded = if digits.len() <= frac {
+            let mut p: String = core::iter::repeat_n('0', frac + 1 - digits.len()).collect();
+            p.push_str(&digits);
+            p
+        } else {
+            digits
+        };
+        let (int, fr) = padded.split_at(padded.len() - frac);
+        let fr = fr.trim_end_matches('0');
+        if fr.is_empty() {
+            int.to_string()
+        } else {
+            format!("{int}.{fr}")
+        }
+    };
+    if neg && body != "0" {
+        format!("\u{2212}{body}")
+    } else {
+        body
+    }
+}
+
+/// Ticks at multiples of a 1-2-5 step over `[lo, hi]`, at most about `max_count` of them, with
+/// exact decimal labels (`"−2.5"`, `"10"`). Empty when the range is not finite or not increasing.
+pub fn linear_ticks(lo: Real, hi: Real, max_count: usize) -> Vec<Tick> {
+    if !(lo.is_finite() && hi.is_finite() && hi > lo) {
+        return Vec::new();
+    }
+    let Some((m, k)) = nice_above((hi - lo) / max_count.max(1) as Real) else {
+        return Vec::new();
+    };
+    let step = decimal(m, k);
+    let first = libm::ceil(lo / step) as i64;
+    let last = libm::floor(hi / step) as i64;
+    (first..=last)
+        .take(1000)
+        .map(|i| Tick {
+            value: decimal(i * m, k),
+            label: decimal_label(i * m, k),
+        })
+        .collect()
+}
+
+/// Ticks of a logarithmic axis over `[min, max]` (both > 0): 1-2-5 per decade while that gives
+/// at most ten, else every decade (every other one beyond eight); never fewer than the two ends. Labels are lengths
+/// ([`format_length_m`]).
+pub fn log_length_ticks(min: Real, max: Real) -> Vec<Tick> {
+    if !(min.is_finite() && max.is_finite() && min > 0.0 && max >= min) {
+        return Vec::new();
+    }
+    let (lo, hi) = (min * (1.0 - 1e-9), max * (1.0 + 1e-9));
+    let (k0, k1) = (decade(min), decade(max) + 1);
+    let pick = |mantissas: &[i64]| -> Vec<Real> {
+        let mut v = Vec::new();
+        for k in k0..=k1 {
+            for &m in mantissas {
+                let x = decimal(m, k);
+                if x >= lo && x <= hi {
+                    v.push(x);
+                }
+            }
+        }
+        v
+    };
+    let mut values = pick(&[1, 2, 5]);
+    if values.len() > 10 {
+        values = pick(&[1]);
+        if values.len() > 8 {
+            values = values.into_iter().step_by(2).collect();
+        }
+    }
+    if values.len() < 2 {
+        values = alloc::vec![min, max];
+    }
+    values
+        .into_iter()
+        .map(|value| Tick {
+            value,
+            label: format_length_m(value, 3),
+        })
+        .collect()
+}
+
+/// A length in metres as text with a readable unit (µm, mm, cm, m, km) and `significant`
+/// significant digits, trailing zeros dropped: `0.00426 → "4.26 mm"`, `0.0792 → "7.92 cm"`.
+/// Infinite → `"∞"` (unbounded), NaN → `"–"`.
+pub fn format_length_m(v: Real, significant: usize) -> String {
+    if v.is_nan() {
+        return "\u{2013}".into();
+    }
+    if v.is_infinite() {
+        return if v > 0.0 {
+            "\u{221e}"
+        } else {
+            "\u{2212}\u{221e}"
+        }
+        .into();
+    }
+    let a = v.abs();
+    let (scale, unit) = if a == 0.0 {
+        (1.0, "m")
+    } else if a < 1e-3 {
+        (1e-6, "\u{b5}m")
+    } else if a < 1e-2 {
+        (1e-3, "mm")
+    } else if a < 1.0 {
+        (1e-2, "cm")
+    } else if a < 1e3 {
+        (1.0, "m")
+    } else {
+        (1e3, "km")
+    };
+    let u = v / scale;
+    let sig = significant.clamp(1, 17) as i32;
+    let decimals = if u == 0.0 {
+        0
+    } else {
+        (sig - 1 - decade(u.abs())).max(0) as usize
+    };
+    let mut s = format!("{u:.decimals$}");
+    if s.contains('.') {
+        s = s.trim_end_matches('0').trim_end_matches('.').to_string();
+    }
+    if let Some(rest) = s.strip_prefix('-') {
+        s = format!("\u{2212}{rest}");
+    }
+    format!("{s} {unit}")
+}
+
+/// A scale bar: the longest 1-2-5 length `≤ max_len_m`, with its label; `None` unless
+/// `max_len_m` is finite and > 0.
+pub fn scale_bar(max_len_m: Real) -> Option<Tick> {
+    let (m, k) = nice_below(max_len_m)?;
+    let value = decimal(m, k);
+    Some(Tick {
+        value,
+        label: format_length_m(value, 3),
+    })
+}
+
+#[cfg(test)]
+mod tests;

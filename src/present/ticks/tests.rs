@@ -1,0 +1,47 @@
+use super::*;
+
+#[test]
+fn lengths() {
+    assert_eq!(format_length_m(0.00426, 3), "4.26 mm");
+    assert_eq!(format_length_m(0.0792, 3), "7.92 cm");
+    assert_eq!(format_length_m(0.01, 3), "1 cm");
+    assert_eq!(format_length_m(2.0, 3), "2 m");
+    assert_eq!(format_length_m(5e-7, 3), "0.5 \u{b5}m");
+    assert_eq!(format_length_m(Real::INFINITY, 3), "\u{221e}");
+    assert_eq!(format_length_m(0.1769, 4), "17.69 cm");
+}
+
+#[test]
+fn linear() {
+    let t = linear_ticks(-7.5, 30.0, 8);
+    let labels: Vec<_> = t.iter().map(|t| t.label.as_str()).collect();
+    assert_eq!(
+        labels,
+        ["\u{2212}5", "0", "5", "10", "15", "20", "25", "30"]
+    );
+    let t = linear_ticks(0.0, 1.0, 4);
+    assert_eq!(t[1].value, 0.5); // step 0.5: 0, 0.5, 1
+    assert_eq!(t[1].label, "0.5");
+    assert!(linear_ticks(1.0, 1.0, 5).is_empty());
+}
+
+#[test]
+fn logs() {
+    let t = log_length_ticks(0.003, 0.5);
+    let labels: Vec<_> = t.iter().map(|t| t.label.as_str()).collect();
+    assert_eq!(
+        labels,
+        ["5 mm", "1 cm", "2 cm", "5 cm", "10 cm", "20 cm", "50 cm"]
+    );
+    let t = log_length_ticks(1e-4, 10.0);
+    assert_eq!(t.len(), 6);
+    assert_eq!(log_length_ticks(1e-9, 1e3).len(), 7);
+    assert_eq!(log_length_ticks(0.0042, 0.0043).len(), 2);
+}
+
+#[test]
+fn bars() {
+    assert_eq!(scale_bar(0.0073).unwrap().label, "5 mm");
+    assert_eq!(scale_bar(0.02).unwrap().value, 0.02);
+    assert!(scale_bar(0.0).is_none());
+}

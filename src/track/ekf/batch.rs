@@ -1,0 +1,251 @@
+//! Pass 1 and pass 2 of the EKF update for `L` filters at once: the links' position
+//! information `M`, `b`, `νᵀR⁻¹ν` and the batch Joseph-form update in the position space
+//! (derivation in the [`ekf`](super) module docs), with the folded input checks.
+
+use super::{
+    finite_probe, positive_finite, range_information_per_snr, Ekf, MeasurementNoise, NodeView,
+    UpdateSummary,
+};
+use crate::error::{Error, Result};
+use crate::math::{Mat4, Real, Vec2, Vec4, SPEED_OF_LIGHT};
+use crate::measure::Model;
+
+/// Running sums of pass 1 of an update for one filter (module docs): `M`, `b`, `νᵀR⁻¹ν`, the
+/// number of links used and the folded input checks.
+#[derive(Debug, Clone, Copy)]
+struct Information {
+    m00: Real,
+    m01: Real,
+    m11: Real,
+    b0: Real,
+    b1: Real,
+    nu_info_nu: Real,
+    links_used: usize,
+    /// Every `σ_p` and `w` positive.
+    positive: bool,
+    /// `Σ (z_p − z_p) + w`: finite iff every used `z_p` and `w` is finite (`is_finite` becomes
+    /// an integer classification sequence in the hot loop; this is two float operations).
+    finite_sum: Real,
+}
+
+const NO_INFORMATION: Information = Information {
+    m00: 0.0,
+    m01: 0.0,
+    m11: 0.0,
+    b0: 0.0,
+    b1: 0.0,
+    nu_info_nu: 0.0,
+    links_used: 0,
+    positive: true,
+    finite_sum: 0.0,
+};
+
+const NO_VIEW: NodeView = NodeView {
+    unit: Vec2::new(0.0, 0.0),
+    distance: 0.0,
+    inv_floored_sq: 0.0,
+};
+
+/// The EKF update of `L` independent filters against the same model and noise option, each
+/// with its own delays `z[j]` (lengths checked by the caller); `active[j] = false` skips filter
+/// `j` (its result is a zero summary). `L = 1` is [`Ekf::update`]; the Monte Carlo harness
+/// advances a few noise runs together so that the processor overlaps their dependency chains
+/// (the arithmetic of each filter is the same as with `L = 1`, so results are bitwise equal).
+/// `innovation(j, p, ν_p)` receives each used link's range innovation, m.
+#[inline(always)]
+pub(crate) fn update_lanes<const L: usize>(
+    filters: &mut [Ekf; L],
+    model: &Model,
+    z: [&[Option<Real>]; L],
+    active: [bool; L],
+    noise: MeasurementNoise,
+    mut innovation: impl FnMut(usize, usize, Real),
+) -> [Result<UpdateSummary>; L] {
+    let r_pred: [Vec2; L] =
+        core::array::from_fn(|j| Vec2::new(filters[j].state[0], filters[j].state[1]));
+    let info_per_snr = range_information_per_snr(model);
+    // Pass 1: M = Σ w g gᵀ, b = Σ w ν g, νᵀR⁻¹ν over the available links, with g = cJ_p(r̂⁻),
+    // ν = cz_p − (d_Tx + d_Rx), w = 1/(cσ_p)². The links are independent (no chain through P).
+    let mut acc = [NO_INFORMATION; L];
+    // Geometry and gain toward r̂⁻ of the current transmitter (links of one Tx share it).
+    let (mut tx_seen, mut tx_view, mut tx_gain) = (usize::MAX, [NO_VIEW; L], [0.0; L]);
+    let links = model.network.links.iter().zip(&model.snr_scale);
+    for (link, (l, snr_scale)) in links.enumerate() {
+        if l.tx != tx_seen {
+            tx_seen = l.tx;
+            let tx = model.network.transmitters[l.tx];
+            for j in 0..L {
+                tx_view[j] = NodeView::new(tx, r_pred[j]);
+                if matches!(noise, MeasurementNoise::AtPrediction) {
+                    tx_gain[j] = model.patterns[l.tx].gain_toward(tx_view[j].unit);
+                }
+            }
+        }
+        let rx = model.network.receivers[l.rx];
+        for j in 0..L {
+            let (Some(zi), true) = (z[j][link], active[j]) else {
+                continue;
+            };
+            let (tv, gain, a) = (tx_view[j], tx_gain[j], &mut acc[j]);
+            let rv = NodeView::new(rx, r_pred[j]);
+            let (w, sigma_positive) = match noise {
+                MeasurementNoise::Fixed(s) => (information_from_sigma(s[link]), s[link] > 0.0),
+                MeasurementNoise::AtPrediction => (
+                    info_per_snr * (snr_scale * gain * tv.inv_floored_sq * rv.inv_floored_sq),
+                    true,
+                ),
+                MeasurementNoise::At(r) => {
+                    let sigma = model.sigma_delay(link, r);
+                    (information_from_sigma(sigma), sigma > 0.0)
+                }
+            };
+            a.positive &= sigma_positive & (w > 0.0);
+            a.finite_sum += finite_probe(zi) + w;
+            let nu = SPEED_OF_LIGHT * zi - (tv.distance + rv.distance);
+            innovation(j, link, nu);
+            let (gx, gy) = (tv.unit.x + rv.unit.x, tv.unit.y + rv.unit.y);
+            let (wgx, wgy) = (w * gx, w * gy);
+            a.m00 += wgx * gx;
+            a.m01 += wgx * gy;
+            a.m11 += wgy * gy;
+            a.b0 += wgx * nu;
+            a.b1 += wgy * nu;
+            a.nu_info_nu += w * nu * nu;
+            a.links_used += 1;
+        }
+    }
+    // Pass 2, per filter.
+    let mut out = [NO_UPDATE; L];
+    for (j, out) in out.iter_mut().enumerate() {
+        let a = &acc[j];
+        if !(a.positive && a.finite_sum < Real::INFINITY) {
+            // On failure the inputs are re-scanned in link order for the named error.
+            if let Some(e) = first_input_error(model, z[j], noise, r_pred[j]) {
+                *out = Err(e);
+                continue;
+            }
+        }
+        if active[j] && a.links_used > 0 {
+            *out = filters[j].apply_information(a);
+        }
+    }
+    out
+}
+
+/// The summary of an update without links.
+const NO_UPDATE: Result<UpdateSummary> = Ok(UpdateSummary {
+    nis: 0.0,
+    links_used: 0,
+});
+
+impl Ekf {
+    /// Pass 2 of an update: the batch update in the position space (module docs) from the
+    /// accumulated information; the filter changes only on success.
+    #[inline(always)]
+    fn apply_information(&mut self, a: &Information) -> Result<UpdateSummary> {
+        let (m00, m01, m11, b0, b1) = (a.m00, a.m01, a.m11, a.b0, a.b1);
+        let p = &self.covariance;
+        let (p00, p01, p02, p03) = (p[(0, 0)], p[(0, 1)], p[(0, 2)], p[(0, 3)]);
+        let (p11, p12, p13) = (p[(1, 1)], p[(1, 2)], p[(1, 3)]);
+        let (p22, p23, p33) = (p[(2, 2)], p[(2, 3)], p[(3, 3)]);
+        // T = I + M P_rr, N = T⁻¹.
+        let t00 = 1.0 + m00 * p00 + m01 * p01;
+        let t01 = m00 * p01 + m01 * p11;
+        let t10 = m01 * p00 + m11 * p01;
+        let t11 = 1.0 + m01 * p01 + m11 * p11;
+        let det = t00 * t11 - t01 * t10;
+        if !positive_finite(det) {
+            return Err(Error::NotPositiveDefinite {
+                field: "ekf.innovation_covariance".into(),
+            });
+        }
+        let inv_det = 1.0 / det;
+        let (n00, n01, n10, n11) = (t11 * inv_det, -t01 * inv_det, -t10 * inv_det, t00 * inv_det);
+        // N M.
+        let nm00 = n00 * m00 + n01 * m01;
+        let nm01 = n00 * m01 + n01 * m11;
+        let nm10 = n10 * m00 + n11 * m01;
+        let nm11 = n10 * m01 + n11 * m11;
+        // X = M + M P_rr M (symmetric): Y = P_rr M, X = M + M Y.
+        let y00 = p00 * m00 + p01 * m01;
+        let y01 = p00 * m01 + p01 * m11;
+        let y11 = p01 * m01 + p11 * m11;
+        let x00 = m00 + (m00 * y00 + m01 * (p01 * m00 + p11 * m01));
+        let x01 = m01 + (m00 * y01 + m01 * y11);
+        let x11 = m11 + (m01 * y01 + m11 * y11);
+        // U = N X, then N X Nᵀ.
+        let u00 = n00 * x00 + n01 * x01;
+        let u01 = n00 * x01 + n01 * x11;
+        let u10 = n10 * x00 + n11 * x01;
+        let u11 = n10 * x01 + n11 * x11;
+        let z00 = 2.0 * nm00 - (u00 * n00 + u01 * n01);
+        let z01 = (nm01 + nm10) - (u00 * n10 + u01 * n11);
+        let z11 = 2.0 * nm11 - (u10 * n10 + u11 * n11);
+        // Rows of C = P⁻Πᵀ: c_i = (P_i0, P_i1).
+        let c = [(p00, p01), (p01, p11), (p02, p12), (p03, p13)];
+        // Z c_j.
+        let zc = c.map(|(a, b)| (z00 * a + z01 * b, z01 * a + z11 * b));
+        let q = |i: usize, j: usize| c[i].0 * zc[j].0 + c[i].1 * zc[j].1;
+        let (e00, e01, e02, e03) = (p00 - q(0, 0), p01 - q(0, 1), p02 - q(0, 2), p03 - q(0, 3));
+        let (e11, e12, e13) = (p11 - q(1, 1), p12 - q(1, 2), p13 - q(1, 3));
+        let (e22, e23, e33) = (p22 - q(2, 2), p23 - q(2, 3), p33 - q(3, 3));
+        // K ν = C N b.
+        let (v0, v1) = (n00 * b0 + n01 * b1, n10 * b0 + n11 * b1);
+        let dx = c.map(|(a, b)| a * v0 + b * v1);
+        let state = self.state + Vec4::new(dx[0], dx[1], dx[2], dx[3]);
+        // NIS = νᵀR⁻¹ν − bᵀ P_rr N b; P_rr N b is the position correction (dx0, dx1).
+        let nis = (a.nu_info_nu - (b0 * dx[0] + b1 * dx[1])).max(0.0);
+        let covariance = Mat4::new(
+            e00, e01, e02, e03, //
+            e01, e11, e12, e13, //
+            e02, e12, e22, e23, //
+            e03, e13, e23, e33,
+        );
+        let state_finite = finite_probe(state[0])
+            + finite_probe(state[1])
+            + finite_probe(state[2])
+            + finite_probe(state[3]);
+        let diagonal_positive = e00 > 0.0 && e11 > 0.0 && e22 > 0.0 && e33 > 0.0;
+        if !(diagonal_positive && state_finite == 0.0 && (e00 + e11 + e22 + e33) < Real::INFINITY) {
+            return Err(Error::NotPositiveDefinite {
+                field: "ekf.covariance".into(),
+            });
+        }
+        self.state = state;
+        self.covariance = covariance;
+        Ok(UpdateSummary {
+            nis,
+            links_used: a.links_used,
+        })
+    }
+}
+
+/// `1/(cσ)²` for a delay standard deviation `σ`, 1/m² (checked by the caller).
+#[inline(always)]
+fn information_from_sigma(sigma: Real) -> Real {
+    let r = SPEED_OF_LIGHT * sigma;
+    1.0 / (r * r)
+}
+
+/// The first bad input of an update in link order (slow path, after the accumulated checks
+/// failed): a non-finite delay, or a `σ_p` that is not finite and positive (or so small that
+/// `1/(cσ_p)²` overflows). `None` if all are fine.
+#[cold]
+fn first_input_error(
+    model: &Model,
+    z: &[Option<Real>],
+    noise: MeasurementNoise,
+    r_pred: Vec2,
+) -> Option<Error> {
+    for (link, zi) in z.iter().enumerate() {
+        let Some(zi) = *zi else { continue };
+        if !zi.is_finite() {
+            return Some(Error::NonFiniteDelay { link });
+        }
+        let sigma = noise.sigma(model, link, r_pred);
+        if !(positive_finite(sigma) && information_from_sigma(sigma).is_finite()) {
+            return Some(Error::InvalidSigma { link, value: sigma });
+        }
+    }
+    None
+}

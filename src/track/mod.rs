@@ -1,0 +1,26 @@
+//! Tracking a moving scatterer: the white-noise-acceleration motion model (E7), the EKF with the
+//! Joseph-form update (spec §6, S16–S17), the posterior CRLB recursion (E9, §8), the trajectories
+//! of [S] Fig. 2b and the Monte Carlo prior (§9.4–9.5), one simulated run for display, and the
+//! Monte Carlo study of the tracker against its bound, chunked so that any driver (sequential,
+//! [`crate::native`], the page's worker) gives the same result.
+
+mod ekf;
+mod montecarlo;
+mod motion;
+mod pcrlb;
+mod track_sim;
+mod trajectory;
+
+pub use ekf::{check_covariance, Ekf, MeasurementNoise, PredictedDelay, UpdateSummary};
+pub(crate) use ekf::{range_information_per_snr, spd_quadratic_form, update_lanes, NodeView};
+pub use montecarlo::{
+    finish, pcrlb_from_sums, run_chunk, run_pcrlb_sequential, run_sequential, run_truth_chunk,
+    MonteCarloConfig, MonteCarloResult, PartialSums, CHUNK_TRAJECTORIES, MAX_RUNS, MAX_STEPS,
+};
+pub use motion::ConstantVelocity;
+pub use pcrlb::{nominal_pcrlb_rmse, pcrlb_rmse, PosteriorInformation};
+pub use track_sim::{simulate_track, TrackRun};
+pub use trajectory::{
+    paper_initial_covariance, step_count, TrackScenario, TruthSampler, PAPER_DURATION_S,
+    PAPER_INTENSITY, PAPER_STEP_S,
+};
