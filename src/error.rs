@@ -136,12 +136,15 @@ pub enum Error {
         /// `transmitters` or `receivers`.
         field: &'static str,
     },
-    /// A tracking scenario name that is not I, II or III (spec §9.4).
+    /// A trajectory name that is not known: not I, II or III (spec §9.4), or for front ends that
+    /// also draw one, not `custom` either.
     UnknownTrajectory {
         /// Path of the field, e.g. `trajectory`.
         field: String,
         /// The name given.
         name: String,
+        /// The names accepted there, e.g. `I, II, III`.
+        known: &'static str,
     },
     /// An antenna pattern kind that is not known (spec §9.3: `omni`, `parabolic`).
     UnknownPattern {
@@ -233,11 +236,8 @@ impl fmt::Display for Error {
                 f,
                 "{field}: the last one cannot be removed (at least one is required)"
             ),
-            Error::UnknownTrajectory { field, name } => {
-                write!(
-                    f,
-                    "{field}: unknown trajectory \"{name}\" (known: I, II, III)"
-                )
+            Error::UnknownTrajectory { field, name, known } => {
+                write!(f, "{field}: unknown trajectory \"{name}\" (known: {known})")
             }
             Error::UnknownPattern { field, kind } => write!(
                 f,

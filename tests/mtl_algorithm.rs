@@ -16,7 +16,8 @@ use scatterloc::mtl::algorithm::{
 use scatterloc::mtl::blocking::{kron, BlockingModel, IndependentNodes, NodeBlockingModel};
 use scatterloc::mtl::brute::brute_force;
 use scatterloc::mtl::icb::IcbModel;
-use scatterloc::mtl::trp::{range, TrpMap};
+use scatterloc::measure::bistatic_range;
+use scatterloc::mtl::trp::TrpMap;
 use scatterloc::Error;
 
 /// The V-A network (§7): TX at 90°, 210°, 330°, RX at 30°, 150°, 270° on the 5 m circle
@@ -156,7 +157,7 @@ fn exact_ranges(targets: &[Vec2], dps: &[u64]) -> Vec<Vec<Real>> {
                 .iter()
                 .zip(dps)
                 .filter(|(_, g)| *g >> m & 1 == 1)
-                .map(|(x, _)| range(x, &tx[map.tx(m)], &rx[map.rx(m)]))
+                .map(|(x, _)| bistatic_range(tx[map.tx(m)], rx[map.rx(m)], *x))
                 .collect();
             r.sort_by(Real::total_cmp);
             r
@@ -578,7 +579,7 @@ fn two_pair_case_2b_children_sit_on_ellipse_intersections() {
                 two_pair += 1;
                 for p in &c.matching {
                     let (u, v) = (tx[map.tx(p.trp)], rx[map.rx(p.trp)]);
-                    let e = range(&c.x, &u, &v) - inst.ranges[p.trp][p.mpc];
+                    let e = bistatic_range(u, v, c.x) - inst.ranges[p.trp][p.mpc];
                     assert!(e.abs() < 1e-9, "{c:?}: residual {e}");
                 }
             }

@@ -2,7 +2,8 @@
 #![cfg(not(target_arch = "wasm32"))]
 
 use scatterloc::mtl::sim::*;
-use scatterloc::mtl::trp::{range, TrpMap};
+use scatterloc::measure::bistatic_range;
+use scatterloc::mtl::trp::TrpMap;
 use scatterloc::{Error, Vec2};
 
 fn close(a: f64, b: f64, tol: f64) -> bool {
@@ -147,7 +148,7 @@ fn ground_truth_matches_the_ranges() {
                     };
                     assert_eq!(t.sources[i], Source::Dp { target: k });
                     assert_eq!(sc.blocking[k].gamma >> m & 1, 1);
-                    let d = range(&sc.targets[k], &u, &v);
+                    let d = bistatic_range(u, v, sc.targets[k]);
                     assert!((t.ranges[i] - d).abs() <= 5.0 * s.range_sigma);
                 }
             }

@@ -1,11 +1,17 @@
-//! Pixel layout of the map figure: title band, an equal-scale plot (1 m in x = 1 m in y) centred
-//! in the remaining space, and the colour bar right of it. Everything scales with the image size.
+//! Layout shared by every figure: the pixel layout of the map figure (title band, an equal-scale
+//! plot with 1 m in x = 1 m in y centred in the remaining space, the colour bar right of it), the
+//! font scale, titles, legends, the plot frame and the curve segments. Everything scales with the
+//! image size.
 
 use plotters::coord::{CoordTranslate, Shift};
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
-use super::{chart_err, ChartError};
+use alloc::string::{String, ToString};
+use alloc::vec::Vec;
+use core::fmt;
+
+use crate::math::Real;
 use crate::scenario::Area;
 
 /// Font sizes in pixels.
@@ -217,3 +223,72 @@ pub(crate) fn frame_plot<DB: DrawingBackend, CT: CoordTranslate>(
         ))
         .map_err(chart_err)
 }
+
+/// The runs of consecutive points that `keep` accepts (a curve is drawn as one line per run, so
+/// a gap shows where values are missing or unbounded).
+pub(crate) fn segments(
+    points: impl IntoIterator<Item = (Real, Real)>,
+    keep: impl Fn(Real, Real) -> bool,
+) -> Vec<Vec<(Real, Real)>> {
+    let mut out = Vec::new();
+    let mut run = Vec::new();
+    for (x, y) in points {
+        if keep(x, y) {
+            run.push((x, y));
+        } else if !run.is_empty() {
+            out.push(core::mem::take(&mut run));
+        }
+    }
+    if !run.is_empty() {
+        out.push(run);
+    }
+    out
+}
+
+/// A drawing failure (backend I/O, font problems) or inconsistent input, as text.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ChartError(pub String);
+
+impl fmt::Display for ChartError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "chart: {}", self.0)
+    }
+}
+
+impl std::error::Error for ChartError {}
+
+pub(crate) fn chart_err<E: fmt::Display>(e: E) -> ChartError {
+    ChartError(e.to_string())
+}
+
+/// Registers the bundled DejaVu Sans as plotters' `sans-serif` font (native only; in the browser
+/// the page's fonts are used). Idempotent; [`draw_crlb_map`] calls it.
+#[cfg(not(target_arch = "wasm32"))]
+pub fn register_fonts() {
+    static ONCE: std::sync::Once = std::sync::Once::new();
+    ONCE.call_once(|| {
+        // The bundled file is a valid TrueType font; a failure would only lose the text.
+        let _ = plotters::style::register_font(
+            "sans-serif",
+            FontStyle::Normal,
+            include_bytes!("../../assets/DejaVuSans.ttf"),
+        );
+    });
+}
+
+/// No-op in the browser (the canvas uses the page's fonts).
+#[cfg(target_arch = "wasm32")]
+pub fn register_fonts() {}
+
+/// Axis tick label: integers without decimals, otherwise up to two decimals; a typographic
+/// minus sign (as the page's labels).
+pub(crate) fn axis_label(v: Real) -> String {
+    let s = if (v - v.round()).abs() < 1e-9 {
+        alloc::format!("{}", v.round() as i64)
+    } else {
+        let s = alloc::format!("{v:.2}");
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    };
+    s.replace('-', "\u{2212}")
+}
+

@@ -8,7 +8,7 @@ use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use super::layout::{series_legend, Fonts};
-use super::ticks::colorbar_ticks;
+use crate::present::colorbar_ticks;
 use super::{chart_err, ChartError, ChartNode, MapData, NodeKind};
 use crate::math::Real;
 use crate::present::{viridis, LogScale, UNBOUNDED_RGB};
@@ -218,7 +218,7 @@ pub(crate) fn draw_colorbar<DB: DrawingBackend>(
         ))?;
         let max_labels = (bar_h as Real / (2.0 * font.ticks)) as usize;
         for t in colorbar_ticks(scale.min, scale.max, max_labels) {
-            let y = ((1.0 - scale.fraction(t.value_m)) * bar_h as Real).round() as i32;
+            let y = ((1.0 - scale.fraction(t.value)) * bar_h as Real).round() as i32;
             let major = !t.label.is_empty();
             let len = ((if major { 7.0 } else { 4.0 }) * s).round() as i32;
             area.draw(&PathElement::new(

@@ -7,12 +7,14 @@
 //! coincide stay visible: draw one as a line and the other as open markers over it.
 
 use alloc::string::String;
-use alloc::vec::Vec;
+
 
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::layout::{draw_titles, font_scale, frame_plot, series_legend, Fonts, TitleBand};
+use super::layout::{
+    draw_titles, font_scale, frame_plot, segments, series_legend, Fonts, TitleBand,
+};
 use super::{axis_label, chart_err, register_fonts, ChartError};
 use crate::math::Real;
 
@@ -108,23 +110,6 @@ pub fn curve_chart_size() -> (u32, u32) {
     (1000, 800)
 }
 
-/// The runs of consecutive finite points.
-fn segments(points: &[(Real, Real)]) -> Vec<Vec<(Real, Real)>> {
-    let mut out = Vec::new();
-    let mut run = Vec::new();
-    for &(x, y) in points {
-        if x.is_finite() && y.is_finite() {
-            run.push((x, y));
-        } else if !run.is_empty() {
-            out.push(core::mem::take(&mut run));
-        }
-    }
-    if !run.is_empty() {
-        out.push(run);
-    }
-    out
-}
-
 /// Draws the figure onto `root` (filled white first): title band, axes with grid, every curve of
 /// `series` in order (later ones on top) and the legend. Does not call `present()`.
 ///
@@ -187,7 +172,7 @@ pub fn draw_curves<DB: DrawingBackend>(
     for c in series {
         let colour = CURVE_PALETTE[c.colour % CURVE_PALETTE.len()];
         let stroke = colour.stroke_width(width);
-        for part in segments(c.points) {
+        for part in segments(c.points.iter().copied(), |x, y| x.is_finite() && y.is_finite()) {
             match c.line {
                 LineKind::None => {}
                 LineKind::Solid => {

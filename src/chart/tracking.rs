@@ -9,8 +9,10 @@ use alloc::vec::Vec;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::layout::{draw_titles, font_scale, frame_plot, series_legend, Fonts, TitleBand};
-use super::ticks::colorbar_ticks;
+use super::layout::{
+    draw_titles, font_scale, frame_plot, segments, series_legend, Fonts, TitleBand,
+};
+use crate::present::colorbar_ticks;
 use super::{axis_label, chart_err, register_fonts, ChartError};
 use crate::math::Real;
 use crate::present::nice_below;
@@ -83,23 +85,6 @@ fn y_range(panels: &[TrackingPanel]) -> (Real, Real) {
     }
 }
 
-/// The runs of consecutive drawable points `(t, v)` (finite, `v > 0` for the log axis).
-fn segments(t_s: &[Real], values: impl Iterator<Item = Option<Real>>) -> Vec<Vec<(Real, Real)>> {
-    let mut out = Vec::new();
-    let mut run = Vec::new();
-    for (&t, v) in t_s.iter().zip(values) {
-        match v {
-            Some(v) if v.is_finite() && v > 0.0 && t.is_finite() => run.push((t, v)),
-            _ if !run.is_empty() => out.push(core::mem::take(&mut run)),
-            _ => {}
-        }
-    }
-    if !run.is_empty() {
-        out.push(run);
-    }
-    out
-}
-
 /// Draws the figure onto `root` (filled white first): the title band, then one panel per entry
 /// of `panels` side by side with a shared y range. Returns that range `(lo, hi)`, m. Does not call
 /// `present()`.
@@ -165,11 +150,11 @@ fn draw_panel<DB: DrawingBackend>(
     let max_labels = ((h as f64 - 3.0 * font.ticks) / (1.6 * font.ticks)).max(2.0) as usize;
     let ticks = colorbar_ticks(lo, hi, max_labels);
     let (major, minor): (Vec<_>, Vec<_>) = ticks.into_iter().partition(|t| !t.label.is_empty());
-    let labels: Vec<(Real, String)> = major.iter().map(|t| (t.value_m, t.label.clone())).collect();
+    let labels: Vec<(Real, String)> = major.iter().map(|t| (t.value, t.label.clone())).collect();
     let y_axis = (lo..hi)
         .log_scale()
-        .with_key_points(major.iter().map(|t| t.value_m).collect())
-        .with_light_points(minor.iter().map(|t| t.value_m));
+        .with_key_points(major.iter().map(|t| t.value).collect())
+        .with_light_points(minor.iter().map(|t| t.value));
     let mut chart = ChartBuilder::on(area)
         .caption(p.title, ("sans-serif", font.axis * 1.1).into_font())
         .margin_top((6.0 * s) as u32)
@@ -205,8 +190,11 @@ fn draw_panel<DB: DrawingBackend>(
     let ekf = EKF_RGB.stroke_width(width);
     let pcrlb = PCRLB_RGB.stroke_width(width);
     let (dash, gap) = ((9.0 * s) as u32, (5.0 * s) as u32);
-    let ekf_parts = segments(p.t_s, p.rmse_ekf_m.iter().map(|v| Some(*v)));
-    let pcrlb_parts = segments(p.t_s, p.rmse_pcrlb_m.iter().copied());
+    // Drawable on the log axis: finite, `v > 0`.
+    let drawable = |t: Real, v: Real| t.is_finite() && v.is_finite() && v > 0.0;
+    let ekf_parts = segments(p.t_s.iter().copied().zip(p.rmse_ekf_m.iter().copied()), drawable);
+    let bound = p.rmse_pcrlb_m.iter().map(|v| v.unwrap_or(Real::NAN));
+    let pcrlb_parts = segments(p.t_s.iter().copied().zip(bound), drawable);
     for (k, part) in ekf_parts.into_iter().enumerate() {
         let series = chart
             .draw_series(LineSeries::new(part, ekf))

@@ -33,17 +33,41 @@ pub fn unit_from(node: Vec2, r: Vec2) -> (Vec2, Real) {
     }
 }
 
+/// Bistatic range `d(r) = ‖r − r^Tx‖ + ‖r − r^Rx‖`, m: `c·τ` of (E1) and the range function
+/// (M1) of the multi-target layer. The one home of the range; every layer calls it.
+#[inline]
+pub fn bistatic_range(tx: Vec2, rx: Vec2, r: Vec2) -> Real {
+    (r - tx).norm() + (r - rx).norm()
+}
+
+/// Gradient of [`bistatic_range`] with respect to `r`: `u^Tx + u^Rx` (E3 times `c`), unitless.
+/// A term whose node (nearly) coincides with `r` contributes the zero vector
+/// ([`UNIT_VECTOR_MIN_DISTANCE_M`]); zero on the Tx–Rx baseline segment.
+#[inline]
+pub fn range_gradient(tx: Vec2, rx: Vec2, r: Vec2) -> Vec2 {
+    unit_from(tx, r).0 + unit_from(rx, r).0
+}
+
+/// [`bistatic_range`] and [`range_gradient`] from the two distances computed once (the same
+/// values, bitwise).
+#[inline]
+pub fn range_and_gradient(tx: Vec2, rx: Vec2, r: Vec2) -> (Real, Vec2) {
+    let (ut, nt) = unit_from(tx, r);
+    let (ur, nr) = unit_from(rx, r);
+    (nt + nr, ut + ur)
+}
+
 /// Bistatic delay `τ = (‖r − r^Tx‖ + ‖r − r^Rx‖)/c`, s (E1).
 #[inline]
 pub fn bistatic_delay(tx: Vec2, rx: Vec2, r: Vec2) -> Real {
-    ((r - tx).norm() + (r - rx).norm()) / SPEED_OF_LIGHT
+    bistatic_range(tx, rx, r) / SPEED_OF_LIGHT
 }
 
 /// Gradient of the bistatic delay with respect to `r`, s/m: `(u^Tx + u^Rx)/c` (E3).
 /// Zero on the Tx–Rx baseline segment.
 #[inline]
 pub fn delay_gradient(tx: Vec2, rx: Vec2, r: Vec2) -> Vec2 {
-    (unit_from(tx, r).0 + unit_from(rx, r).0) / SPEED_OF_LIGHT
+    range_gradient(tx, rx, r) / SPEED_OF_LIGHT
 }
 
 impl Network {

@@ -11,7 +11,7 @@ mod simulate;
 
 pub use ellipse::Ellipse;
 pub use geometry::{
-    bistatic_delay, delay_gradient, iso_delay_ellipse, iso_range_ellipse, unit_from, Network,
+    bistatic_delay, bistatic_range, delay_gradient, iso_delay_ellipse, iso_range_ellipse, range_and_gradient, range_gradient, unit_from, Network,
     UNIT_VECTOR_MIN_DISTANCE_M,
 };
 pub use model::{

@@ -5,8 +5,7 @@
 use core::ops::Deref;
 
 use crate::math::{cos, sin, sqrt, Real, Vec2, PI};
-use crate::measure::Ellipse;
-use crate::measure::{iso_range_ellipse, unit_from};
+use crate::measure::{bistatic_range, iso_range_ellipse, range_gradient, Ellipse};
 use crate::mtl::polygon::Rect;
 
 /// Samples of `h(θ)` around ellipse 1 (§5.2).
@@ -60,7 +59,7 @@ impl RangeEllipse {
     /// The TRP range `d(x) = ‖x − tx‖ + ‖x − rx‖` (M1), m.
     #[inline]
     pub fn range_at(&self, x: Vec2) -> Real {
-        (x - self.tx).norm() + (x - self.rx).norm()
+        bistatic_range(self.tx, self.rx, x)
     }
 
     /// Residual `d(x) − ρ`, m.
@@ -72,7 +71,7 @@ impl RangeEllipse {
     /// Gradient of `d` at `x`: the sum of the unit vectors from the foci (zero at a focus).
     #[inline]
     pub fn gradient(&self, x: Vec2) -> Vec2 {
-        unit_from(self.tx, x).0 + unit_from(self.rx, x).0
+        range_gradient(self.tx, self.rx, x)
     }
 
     /// Point at parameter `θ`: `c + a cos θ ê + b sin θ ê^⊥` (§5.2).

@@ -1,12 +1,14 @@
 //! Transmitter–receiver pairs (TRPs) of the multi-target method: the TRP index map of Table I and
-//! the range function (M1) of `shared/spec/multi-target.md`.
+//! the range function (M1) of `shared/spec/multi-target.md` per TRP (the range itself lives in
+//! [`crate::measure`]).
 //!
 //! The spec numbers TRPs, TXs and RXs from 1; this module numbers them from 0. TRP `m` (0-based)
 //! uses TX `m mod N_t` and RX `m div N_t` — the TX index runs fastest (spec check 1), so spec TRP
 //! `m + 1` is TX `(m mod N_t) + 1`, RX `(m div N_t) + 1`.
 
 use crate::error::{Error, Result};
-use crate::math::{sqrt, Real, Vec2};
+use crate::math::{Real, Vec2};
+use crate::measure::{bistatic_range, range_and_gradient, range_gradient};
 
 /// Largest number of TRPs `M = N_t N_r`: blocking vectors are bit masks in a `u64`.
 pub const MAX_TRPS: usize = 64;
@@ -107,18 +109,17 @@ impl TrpMap {
     ///
     /// Panics if `m ≥ M` or a position slice is shorter than its node count.
     pub fn range(&self, m: usize, x: &Vec2, tx: &[Vec2], rx: &[Vec2]) -> Real {
-        range(x, &tx[self.tx(m)], &rx[self.rx(m)])
+        bistatic_range(tx[self.tx(m)], rx[self.rx(m)], *x)
     }
 
-    /// Gradient `∇d_m(x)` of [`TrpMap::range`] (see [`range_gradient`]). Same panics.
+    /// Gradient `∇d_m(x)` of [`TrpMap::range`] ([`crate::measure::range_gradient`]). Same panics.
     pub fn range_gradient(&self, m: usize, x: &Vec2, tx: &[Vec2], rx: &[Vec2]) -> Vec2 {
-        range_gradient(x, &tx[self.tx(m)], &rx[self.rx(m)])
+        range_gradient(tx[self.tx(m)], rx[self.rx(m)], *x)
     }
 
-    /// [`TrpMap::range`] and [`TrpMap::range_gradient`] in one pass (see
-    /// [`range_and_gradient`]). Same panics.
+    /// [`TrpMap::range`] and [`TrpMap::range_gradient`] in one pass ([`crate::measure::range_and_gradient`]). Same panics.
     pub fn range_and_gradient(&self, m: usize, x: &Vec2, tx: &[Vec2], rx: &[Vec2]) -> (Real, Vec2) {
-        range_and_gradient(x, &tx[self.tx(m)], &rx[self.rx(m)])
+        range_and_gradient(tx[self.tx(m)], rx[self.rx(m)], *x)
     }
 }
 
@@ -128,41 +129,6 @@ pub(crate) fn low_bits(n: usize) -> u64 {
         u64::MAX
     } else {
         (1u64 << n) - 1
-    }
-}
-
-/// Bistatic range `d(x) = ‖x − u‖ + ‖x − v‖` (M1) for TX at `u`, RX at `v`, in metres.
-pub fn range(x: &Vec2, u: &Vec2, v: &Vec2) -> Real {
-    norm(&(x - u)) + norm(&(x - v))
-}
-
-/// Gradient of (M1): `(x − u)/‖x − u‖ + (x − v)/‖x − v‖`. A term whose distance is 0 (`x` on a
-/// node, where (M1) is not differentiable) contributes the zero vector.
-pub fn range_gradient(x: &Vec2, u: &Vec2, v: &Vec2) -> Vec2 {
-    unit(&(x - u)) + unit(&(x - v))
-}
-
-/// [`range`] and [`range_gradient`] together, from the two distances computed once (the same
-/// values, bitwise).
-pub fn range_and_gradient(x: &Vec2, u: &Vec2, v: &Vec2) -> (Real, Vec2) {
-    let (du, dv) = (x - u, x - v);
-    let (nu, nv) = (norm(&du), norm(&dv));
-    (nu + nv, unit_with_norm(&du, nu) + unit_with_norm(&dv, nv))
-}
-
-fn norm(d: &Vec2) -> Real {
-    sqrt(d.x * d.x + d.y * d.y)
-}
-
-fn unit(d: &Vec2) -> Vec2 {
-    unit_with_norm(d, norm(d))
-}
-
-fn unit_with_norm(d: &Vec2, n: Real) -> Vec2 {
-    if n > 0.0 {
-        d / n
-    } else {
-        Vec2::zeros()
     }
 }
 

@@ -5,7 +5,7 @@ use alloc::vec::Vec;
 
 use crate::error::{Error, Result};
 use crate::math::{log10, Real};
-use crate::present::{log_length_ticks, Tick};
+use crate::present::{colorbar_ticks, Tick};
 
 /// Colour of unbounded (∞) or missing cells: neutral grey.
 pub const UNBOUNDED_RGB: [u8; 3] = [72, 72, 80];
@@ -85,10 +85,11 @@ impl LogScale {
         viridis(self.fraction(v))
     }
 
-    /// The labelled length ticks of a colour bar on this scale ([`log_length_ticks`]), each with
-    /// its [`fraction`](LogScale::fraction) from the dark end.
-    pub fn ticks(&self) -> Vec<(Real, Tick)> {
-        log_length_ticks(self.min, self.max)
+    /// The ticks of a colour bar on this scale ([`colorbar_ticks`], at most `max_labels`
+    /// labels; minor ticks have an empty label), each with its
+    /// [`fraction`](LogScale::fraction) from the dark end.
+    pub fn ticks(&self, max_labels: usize) -> Vec<(Real, Tick)> {
+        colorbar_ticks(self.min, self.max, max_labels)
             .into_iter()
             .map(|t| (self.fraction(t.value), t))
             .collect()

@@ -6,7 +6,7 @@ use alloc::format;
 use alloc::string::{String, ToString};
 use alloc::vec::Vec;
 
-use crate::math::{log10, Real};
+use crate::math::{log10, round, Real};
 
 /// A tick: its value and its label.
 #[derive(Debug, Clone, PartialEq)]
@@ -153,6 +153,50 @@ pub fn log_length_ticks(min: Real, max: Real) -> Vec<Tick> {
             label: format_length_m(value, 3),
         })
         .collect()
+}
+
+/// Ticks of a logarithmic colour bar over `[min, max]` m — the one algorithm of the page's bar
+/// and the figures' bars: the labelled [`log_length_ticks`], thinned to at most `max_labels`
+/// (≥ 2; powers of ten first, then every other one), plus unlabelled minor ticks (empty label)
+/// at the other integer multiples of each decade when the labels are at most a decade apart.
+pub fn colorbar_ticks(min: Real, max: Real, max_labels: usize) -> Vec<Tick> {
+    let max_labels = max_labels.max(2);
+    let mut major = log_length_ticks(min, max);
+    if major.len() > max_labels {
+        // Too many for the bar: keep the powers of ten, then every other one.
+        let decades: Vec<_> = major
+            .iter()
+            .filter(|t| (log10(t.value) - round(log10(t.value))).abs() < 1e-9)
+            .cloned()
+            .collect();
+        if decades.len() >= 2 {
+            major = decades;
+        }
+    }
+    while major.len() > max_labels {
+        major = major.into_iter().step_by(2).collect();
+    }
+    let mut out = major.clone();
+    // Minor ticks only when the labels are at most a decade apart (not for thinned decades or the
+    // bare end points of a flat map).
+    let dense = major.len() >= 2 && major.windows(2).all(|w| w[1].value <= 10.0001 * w[0].value);
+    if dense && min > 0.0 && max > min {
+        let (k0, k1) = (decade(min), decade(max) + 1);
+        for k in k0..=k1 {
+            for m in 1..=9 {
+                let v = decimal(m, k);
+                let inside = v >= min * (1.0 - 1e-9) && v <= max * (1.0 + 1e-9);
+                let taken = major.iter().any(|t| (t.value - v).abs() <= 1e-9 * v);
+                if inside && !taken {
+                    out.push(Tick {
+                        value: v,
+                        label: String::new(),
+                    });
+                }
+            }
+        }
+    }
+    out
 }
 
 /// A length in metres as text with a readable unit (µm, mm, cm, m, km) and `significant`

@@ -5,10 +5,9 @@
 //! truth), the snapshot CRLB at the truth (§7) and a zoom radius holding them — so the page draws
 //! a track step with the same code as a snapshot.
 
-use alloc::string::ToString;
 use alloc::vec::Vec;
 
-use crate::error::{checked_index, Error, Result};
+use crate::error::{check_finite, check_positive, checked_index, Error, Result};
 use crate::localize::{crlb_at, CrlbPoint};
 use crate::math::{sqrt, Mat2, Mat4, Real, Vec2, Vec4};
 use crate::measure::Ellipse;
@@ -27,27 +26,17 @@ pub fn track_mean_state(kind: &str, start: Vec2, velocity: Vec2) -> Result<Vec4>
         return TrackScenario::parse(kind).map(TrackScenario::mean_state);
     }
     if kind != "custom" {
-        return Err(Error::OutOfRange {
-            field: alloc::format!("trajectory \"{kind}\""),
-            value: Real::NAN,
-            allowed: "I, II, III or custom",
+        return Err(Error::UnknownTrajectory {
+            field: "trajectory".into(),
+            name: kind.into(),
+            known: "I, II, III, custom",
         });
     }
-    finite("x0", start.x)?;
-    finite("y0", start.y)?;
-    finite("vx", velocity.x)?;
-    finite("vy", velocity.y)?;
+    check_finite("x0", start.x)?;
+    check_finite("y0", start.y)?;
+    check_finite("vx", velocity.x)?;
+    check_finite("vy", velocity.y)?;
     Ok(Vec4::new(start.x, start.y, velocity.x, velocity.y))
-}
-
-fn finite(field: &str, v: Real) -> Result<Real> {
-    if v.is_finite() {
-        Ok(v)
-    } else {
-        Err(Error::NonFinite {
-            field: field.to_string(),
-        })
-    }
 }
 
 /// The constant velocity that carries `start` to `end` in `duration_s` (a trajectory drawn as
@@ -59,14 +48,9 @@ pub fn velocity_through(start: Vec2, end: Vec2, duration_s: Real) -> Result<Vec2
         ("x1", end.x),
         ("y1", end.y),
     ] {
-        finite(field, v)?;
+        check_finite(field, v)?;
     }
-    if finite("duration_s", duration_s)? <= 0.0 {
-        return Err(Error::NotPositive {
-            field: "duration_s".to_string(),
-            value: duration_s,
-        });
-    }
+    check_positive("duration_s", duration_s)?;
     Ok((end - start) / duration_s)
 }
 

@@ -1,5 +1,6 @@
 //! White-noise-acceleration (constant-velocity) motion model (spec §6, E7 = S13, S14).
 
+use crate::error::check_positive;
 use crate::math::{sqrt, Mat4, Real, Vec4};
 
 /// The CV model for a step `T` and intensity `q̃`.
@@ -20,19 +21,8 @@ impl ConstantVelocity {
 
     /// The model after checking `dt_s > 0` and `intensity > 0`, both finite.
     pub fn validated(dt_s: Real, intensity: Real) -> crate::Result<ConstantVelocity> {
-        for (field, v) in [("dt_s", dt_s), ("process_noise", intensity)] {
-            if !v.is_finite() {
-                return Err(crate::Error::NonFinite {
-                    field: field.into(),
-                });
-            }
-            if v <= 0.0 {
-                return Err(crate::Error::NotPositive {
-                    field: field.into(),
-                    value: v,
-                });
-            }
-        }
+        check_positive("dt_s", dt_s)?;
+        check_positive("process_noise", intensity)?;
         Ok(ConstantVelocity { dt_s, intensity })
     }
 

@@ -39,6 +39,7 @@ impl TrackScenario {
             _ => Err(Error::UnknownTrajectory {
                 field: "trajectory".into(),
                 name: s.into(),
+                known: "I, II, III",
             }),
         }
     }

@@ -40,11 +40,13 @@ pub fn unbounded_rgb() -> Vec<u8> {
 }
 
 /// Ticks of the log colour bar for a scale `[min, max]`, m: `[{frac, value_m, label}]` with
-/// `frac ∈ [0, 1]` from the dark end. Empty for an invalid scale.
+/// `frac ∈ [0, 1]` from the dark end; minor ticks have an empty label. The same algorithm as
+/// the figures' bars ([`crate::present::colorbar_ticks`]), with at most `max_labels` labels
+/// (none given: no thinning). Empty for an invalid scale.
 #[wasm_bindgen]
-pub fn colorbar_ticks(min: f64, max: f64) -> Result<JsValue, JsError> {
+pub fn colorbar_ticks(min: f64, max: f64, max_labels: Option<usize>) -> Result<JsValue, JsError> {
     let ticks: Vec<Value> = LogScale::new(min, max)
-        .map(|s| s.ticks())
+        .map(|s| s.ticks(max_labels.unwrap_or(usize::MAX)))
         .unwrap_or_default()
         .into_iter()
         .map(|(frac, t)| json!({"frac": frac, "value_m": t.value, "label": t.label}))

@@ -3,7 +3,7 @@ use super::*;
 #[test]
 fn segments_skip_non_finite_points() {
     let p = [(0.0, 0.1), (0.2, Real::NAN), (0.3, 0.4), (0.5, 0.6)];
-    let parts = segments(&p);
+    let parts = segments(p.iter().copied(), |x, y| x.is_finite() && y.is_finite());
     assert_eq!(
         parts,
         [alloc::vec![(0.0, 0.1)], alloc::vec![(0.3, 0.4), (0.5, 0.6)]]

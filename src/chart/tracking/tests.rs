@@ -14,9 +14,11 @@ fn range_and_gaps() {
     let (lo, hi) = y_range(&[p]);
     // 2.2 mm is within 15 % of 2 mm: one more 1-2-5 step below; 0.447 m fits under 0.5 m.
     assert_eq!((lo, hi), (0.001, 0.5));
-    let parts = segments(&t, ekf.iter().map(|v| Some(*v)));
+    let drawable = |t: Real, v: Real| t.is_finite() && v.is_finite() && v > 0.0;
+    let parts = segments(t.iter().copied().zip(ekf.iter().copied()), drawable);
     assert_eq!(parts.len(), 2);
     assert_eq!(parts[1], [(3.0, 0.004)]);
-    assert_eq!(segments(&t, pcrlb.iter().copied()).len(), 2);
+    let bound = pcrlb.iter().map(|v| v.unwrap_or(Real::NAN));
+    assert_eq!(segments(t.iter().copied().zip(bound), drawable).len(), 2);
     assert_eq!(y_range(&[]), (1e-3, 1.0));
 }

@@ -6,7 +6,7 @@ use alloc::vec::Vec;
 use super::{DelayMeasurements, MIN_LINKS};
 use crate::error::{Error, Result};
 use crate::math::{Mat2, Real, Vec2, SPEED_OF_LIGHT};
-use crate::measure::{unit_from, Network};
+use crate::measure::{bistatic_range, unit_from, Network};
 
 /// One used link in range units: foci, measured range `cτ̂` and weight `1/(cσ)²`.
 #[derive(Clone, Copy)]
@@ -72,7 +72,7 @@ impl Problem {
         self.rows
             .iter()
             .map(|row| {
-                let e = row.range - ((r - row.tx).norm() + (r - row.rx).norm());
+                let e = row.range - bistatic_range(row.tx, row.rx, r);
                 row.weight * e * e
             })
             .sum()

@@ -4,7 +4,7 @@
 
 use alloc::vec::Vec;
 
-use crate::error::{Error, Result};
+use crate::error::{check_positive, Error, Result};
 use crate::math::{cos, sin, sqrt, Real, Vec2, PI};
 use crate::mtl::blocking::check_probability;
 use crate::mtl::polygon::Rect;
@@ -178,7 +178,7 @@ impl SimSettings {
     /// [`Error::NonFinite`] / [`Error::OutOfRange`] (`lambda`), [`Error::NotPositive`]
     /// (`diameter`) (via [`PppBlocking::new`]); [`Error::OutOfRange`] (`p_d`, `p_los`) outside
     /// `[0, 1]`; [`Error::OutOfRange`] (`range_sigma`, `resolution`, `clutter_mean`) when
-    /// negative or not finite; [`Error::NotPositive`] (`detection_radius`, `r_max`);
+    /// negative or not finite; [`Error::NonFinite`] / [`Error::NotPositive`] (`detection_radius`, `r_max`);
     /// [`Error::SizeLimit`] (`targets`) unless `1 ≤ K ≤` [`MAX_TARGETS`]; [`Error::OutOfRange`]
     /// (`lambda`, `clutter_mean`) when a Poisson mean exceeds [`MAX_POISSON_MEAN`].
     pub fn validate(&self) -> Result<()> {
@@ -228,17 +228,6 @@ fn check_non_negative(field: &str, v: Real) -> Result<()> {
             field: field.into(),
             value: v,
             allowed: "a finite value ≥ 0",
-        })
-    }
-}
-
-fn check_positive(field: &str, v: Real) -> Result<()> {
-    if v.is_finite() && v > 0.0 {
-        Ok(())
-    } else {
-        Err(Error::NotPositive {
-            field: field.into(),
-            value: v,
         })
     }
 }

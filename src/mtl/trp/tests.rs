@@ -60,6 +60,6 @@ fn range_and_gradient() {
         / (2.0 * h);
     assert!((g.x - gx).abs() < 1e-7 && (g.y - gy).abs() < 1e-7);
     // On a node the singular term is dropped, never NaN.
-    let g0 = range_gradient(&tx[0], &tx[0], &rx[0]);
+    let g0 = range_gradient(tx[0], rx[0], tx[0]);
     assert!(g0.x.is_finite() && g0.y.is_finite());
 }
