@@ -8,6 +8,7 @@
 
 use rand::Rng as _;
 use scatterloc::math::{Real, Vec2};
+use scatterloc::measure::bistatic_range;
 use scatterloc::measure::{self, Rng};
 use scatterloc::mtl::algorithm::{
     locate, locate_cached, FinalTest, IntersectionCache, Measurements, MtlConfig, MtlOutput, Pair,
@@ -16,7 +17,6 @@ use scatterloc::mtl::algorithm::{
 use scatterloc::mtl::blocking::{kron, BlockingModel, IndependentNodes, NodeBlockingModel};
 use scatterloc::mtl::brute::brute_force;
 use scatterloc::mtl::icb::IcbModel;
-use scatterloc::measure::bistatic_range;
 use scatterloc::mtl::trp::TrpMap;
 use scatterloc::Error;
 

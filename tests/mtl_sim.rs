@@ -1,8 +1,8 @@
 //! The §7 generator, metrics (M12) and Table II helpers of spec `multi-target.md` (checks 4, 11).
 #![cfg(not(target_arch = "wasm32"))]
 
-use scatterloc::mtl::sim::*;
 use scatterloc::measure::bistatic_range;
+use scatterloc::mtl::sim::*;
 use scatterloc::mtl::trp::TrpMap;
 use scatterloc::{Error, Vec2};
 

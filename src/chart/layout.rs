@@ -291,4 +291,3 @@ pub(crate) fn axis_label(v: Real) -> String {
     };
     s.replace('-', "\u{2212}")
 }
-

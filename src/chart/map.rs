@@ -8,9 +8,9 @@ use alloc::vec::Vec;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
+use super::axis_label;
 use super::layout::{self, chart_err, register_fonts, ChartError};
 use super::raster;
-use super::axis_label;
 
 use crate::localize::Grid;
 use crate::math::Real;

@@ -11,8 +11,8 @@ mod raster;
 mod roc;
 mod tracking;
 
-pub use layout::{register_fonts, suggested_size, ChartError};
 pub(crate) use layout::{axis_label, chart_err};
+pub use layout::{register_fonts, suggested_size, ChartError};
 pub use map::{
     check_area, default_titles, draw_crlb_map, scenario_nodes, ChartNode, ChartOptions,
     ChartSummary, MapData, NodeKind,

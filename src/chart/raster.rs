@@ -8,9 +8,9 @@ use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use super::layout::{series_legend, Fonts};
-use crate::present::colorbar_ticks;
 use super::{chart_err, ChartError, ChartNode, MapData, NodeKind};
 use crate::math::Real;
+use crate::present::colorbar_ticks;
 use crate::present::{viridis, LogScale, UNBOUNDED_RGB};
 
 type Chart<'a, DB> = ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>;

@@ -8,7 +8,6 @@
 
 use alloc::string::String;
 
-
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
@@ -172,7 +171,9 @@ pub fn draw_curves<DB: DrawingBackend>(
     for c in series {
         let colour = CURVE_PALETTE[c.colour % CURVE_PALETTE.len()];
         let stroke = colour.stroke_width(width);
-        for part in segments(c.points.iter().copied(), |x, y| x.is_finite() && y.is_finite()) {
+        for part in segments(c.points.iter().copied(), |x, y| {
+            x.is_finite() && y.is_finite()
+        }) {
             match c.line {
                 LineKind::None => {}
                 LineKind::Solid => {

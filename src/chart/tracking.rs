@@ -12,9 +12,9 @@ use plotters::prelude::*;
 use super::layout::{
     draw_titles, font_scale, frame_plot, segments, series_legend, Fonts, TitleBand,
 };
-use crate::present::colorbar_ticks;
 use super::{axis_label, chart_err, register_fonts, ChartError};
 use crate::math::Real;
+use crate::present::colorbar_ticks;
 use crate::present::nice_below;
 
 /// Colour of the EKF curve (solid).
@@ -192,7 +192,10 @@ fn draw_panel<DB: DrawingBackend>(
     let (dash, gap) = ((9.0 * s) as u32, (5.0 * s) as u32);
     // Drawable on the log axis: finite, `v > 0`.
     let drawable = |t: Real, v: Real| t.is_finite() && v.is_finite() && v > 0.0;
-    let ekf_parts = segments(p.t_s.iter().copied().zip(p.rmse_ekf_m.iter().copied()), drawable);
+    let ekf_parts = segments(
+        p.t_s.iter().copied().zip(p.rmse_ekf_m.iter().copied()),
+        drawable,
+    );
     let bound = p.rmse_pcrlb_m.iter().map(|v| v.unwrap_or(Real::NAN));
     let pcrlb_parts = segments(p.t_s.iter().copied().zip(bound), drawable);
     for (k, part) in ekf_parts.into_iter().enumerate() {

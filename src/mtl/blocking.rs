@@ -410,13 +410,11 @@ pub const MAX_CACHED_TABLES: usize = 1 << 16;
 ///
 /// Algorithm 1 reaches the same least-squares location along several paths (a matching grown in
 /// another order, a late seed's catch-up) and Gauss–Newton lands within ≈ 1e-10 m of it each
-/// time: per V-B realisation ≈ 2 100 distinct locations fell into ≈ 1 070 cells of 1 µm (before
-/// the case-2b two-pair rule of `stages`, which cut the candidates by a third). Moving
-/// `x` by ≤ 0.71 µm changes a PPP rectangle area by ≤ 0.71 µm × `D`; `L_b` changes by the
-/// relative change of its probabilities, largest where an NLoS polygon `A'_n` is small: ≤ 1.1e-6
-/// nats over 300 random V-B queries (`tests/mtl_blocking.rs`), against `T_b` steps of 0.25 nats.
-/// Outcomes are not bitwise those at exact locations: near-ties in `J` between candidates that
-/// reach the same matching along different paths can resolve the other way.
+/// time, so tables memoised on this grid are reused. Moving `x` by ≤ 0.71 µm changes `L_b` by
+/// ≤ 1.1e-6 nats on random V-B queries (tested in `tests/mtl_blocking.rs`), far below the
+/// `T_b` steps of 0.25 nats. Outcomes are not bitwise those at exact locations: near-ties in `J`
+/// between candidates that reach the same matching along different paths can resolve the other
+/// way. The measurements behind this choice are in `docs/benchmarks.md` (table grid).
 pub const TABLE_GRID_M: Real = 1e-6;
 
 /// A [`NodeBlockingModel`] with its node table memoised per location: Algorithm 1's children that

@@ -18,7 +18,8 @@ pub use snapshot::{
     OUTLINE_POINTS, VIEW_MARGIN,
 };
 pub use ticks::{
-    colorbar_ticks, decimal, format_length_m, linear_ticks, log_length_ticks, nice_below, scale_bar, Tick,
+    colorbar_ticks, decimal, format_length_m, linear_ticks, log_length_ticks, nice_below,
+    scale_bar, Tick,
 };
 pub use track_view::{
     position_ellipse, track_estimate, track_frame, track_mean_state, velocity_through,

@@ -2,7 +2,7 @@
 //! Joseph-form update (spec §6, S16–S17), the posterior CRLB recursion (E9, §8), the trajectories
 //! of [S] Fig. 2b and the Monte Carlo prior (§9.4–9.5), one simulated run for display, and the
 //! Monte Carlo study of the tracker against its bound, chunked so that any driver (sequential,
-//! [`crate::native`], the page's worker) gives the same result.
+//! `native`, the page's worker) gives the same result.
 
 mod ekf;
 mod montecarlo;

@@ -6,7 +6,7 @@
 //! Every realisation `i` is drawn by the §7 generator from the stream `rng(seed, i)` and
 //! evaluated on its own ([`realisation::evaluate`]); the sums over realisations are merged in
 //! realisation order ([`Tally`]), so results depend on the configuration and seed only — the
-//! native parallel driver ([`crate::native`]) gives bitwise the same numbers as
+//! native parallel driver (`native`) gives bitwise the same numbers as
 //! [`run_sequential`].
 //!
 //! - [`config`]: the configuration and its curves; [`result`]: ROC points and the sums.

@@ -5,10 +5,10 @@ use alloc::vec::Vec;
 
 use crate::error::Result;
 use crate::math::{Real, Vec2};
+use crate::measure::bistatic_range;
 use crate::measure::{rng, standard_normal, Rng};
 use crate::mtl::sim::scene::{draw_scene_with, poisson, segment_is_los, uniform, Scene};
 use crate::mtl::sim::settings::SimSettings;
-use crate::measure::bistatic_range;
 use crate::mtl::trp::TrpMap;
 
 /// What produced a range (the ground truth of §1's decision variables).
@@ -116,7 +116,10 @@ pub fn trp_peaks(
     let noisy = |rng: &mut Rng, d: Real| d + s.range_sigma * standard_normal(rng);
     for (k, x) in sc.targets.iter().enumerate() {
         if sc.blocking[k].gamma >> m & 1 == 1 && uniform(rng) < s.p_d {
-            peaks.push((noisy(rng, bistatic_range(u, v, *x)), Source::Dp { target: k }));
+            peaks.push((
+                noisy(rng, bistatic_range(u, v, *x)),
+                Source::Dp { target: k },
+            ));
         }
         let ips = s.geometric_ips;
         for (l, y) in sc.discs.iter().enumerate() {

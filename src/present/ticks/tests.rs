@@ -46,7 +46,6 @@ fn bars() {
     assert!(scale_bar(0.0).is_none());
 }
 
-
 fn labels(t: &[Tick]) -> Vec<&str> {
     t.iter()
         .filter(|t| !t.label.is_empty())
