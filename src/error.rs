@@ -262,6 +262,19 @@ pub fn checked_index(field: &'static str, index: usize, len: usize) -> Result<us
     }
 }
 
+/// `Ok` when `found == expected`, else [`Error::LengthMismatch`] naming `field`.
+pub(crate) fn check_len(field: &'static str, expected: usize, found: usize) -> Result<()> {
+    if found == expected {
+        Ok(())
+    } else {
+        Err(Error::LengthMismatch {
+            field,
+            expected,
+            found,
+        })
+    }
+}
+
 /// `v` if finite, else [`Error::NonFinite`] naming `field`.
 pub(crate) fn check_finite(field: &str, v: f64) -> Result<()> {
     if v.is_finite() {

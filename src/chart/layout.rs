@@ -166,6 +166,29 @@ pub fn suggested_size(area: &Area, width: u32) -> (u32, u32) {
     (width, height)
 }
 
+/// Fills `root` white, draws the title band (scaled by `s`) and returns the fonts and the area
+/// below the band, with side margins: the frame shared by the curve figures.
+pub(crate) fn titled_body<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    s: f64,
+    title: &str,
+    subtitle: Option<&str>,
+) -> Result<(Fonts, DrawingArea<DB, Shift>), ChartError> {
+    let (w, h) = root.dim_in_pixel();
+    let font = Fonts::scaled(s);
+    let band = TitleBand::new(s, &font, subtitle.is_some());
+    root.fill(&WHITE).map_err(chart_err)?;
+    draw_titles(root, &font, &band, title, subtitle)?;
+    let body = root.clone().shrink(
+        (band.pad as i32, band.height as i32),
+        (
+            w.saturating_sub(2 * band.pad as u32),
+            h.saturating_sub(band.height as u32 + band.pad as u32 / 2),
+        ),
+    );
+    Ok((font, body))
+}
+
 /// Title and subtitle, centred in the band.
 pub(crate) fn draw_titles<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,

@@ -11,9 +11,7 @@ use alloc::string::String;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::layout::{
-    draw_titles, font_scale, frame_plot, segments, series_legend, Fonts, TitleBand,
-};
+use super::layout::{font_scale, frame_plot, segments, series_legend, titled_body, Fonts};
 use super::{axis_label, chart_err, register_fonts, ChartError};
 use crate::math::Real;
 
@@ -128,17 +126,7 @@ pub fn draw_curves<DB: DrawingBackend>(
     }
     let (w, h) = root.dim_in_pixel();
     let s = font_scale(w, h);
-    let font = Fonts::scaled(s);
-    let band = TitleBand::new(s, &font, opts.subtitle.is_some());
-    root.fill(&WHITE).map_err(chart_err)?;
-    draw_titles(root, &font, &band, &opts.title, opts.subtitle.as_deref())?;
-    let body = root.clone().shrink(
-        (band.pad as i32, band.height as i32),
-        (
-            w.saturating_sub(2 * band.pad as u32),
-            h.saturating_sub(band.height as u32 + band.pad as u32 / 2),
-        ),
-    );
+    let (font, body) = titled_body(root, s, &opts.title, opts.subtitle.as_deref())?;
     let (x0, x1) = opts.x_range;
     let (y0, y1) = opts.y_range;
     let mut chart = ChartBuilder::on(&body)

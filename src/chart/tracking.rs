@@ -9,9 +9,7 @@ use alloc::vec::Vec;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::layout::{
-    draw_titles, font_scale, frame_plot, segments, series_legend, Fonts, TitleBand,
-};
+use super::layout::{font_scale, frame_plot, segments, series_legend, titled_body, Fonts};
 use super::{axis_label, chart_err, register_fonts, ChartError};
 use crate::math::Real;
 use crate::present::colorbar_ticks;
@@ -116,17 +114,7 @@ pub fn draw_tracking_rmse<DB: DrawingBackend>(
     } else {
         font_scale(w, h)
     };
-    let font = Fonts::scaled(s);
-    let band = TitleBand::new(s, &font, opts.subtitle.is_some());
-    root.fill(&WHITE).map_err(chart_err)?;
-    draw_titles(root, &font, &band, &opts.title, opts.subtitle.as_deref())?;
-    let body = root.clone().shrink(
-        (band.pad as i32, band.height as i32),
-        (
-            w.saturating_sub(2 * band.pad as u32),
-            h.saturating_sub(band.height as u32 + band.pad as u32 / 2),
-        ),
-    );
+    let (font, body) = titled_body(root, s, &opts.title, opts.subtitle.as_deref())?;
     let range = y_range(panels);
     for (k, (area, panel)) in body.split_evenly((1, n)).iter().zip(panels).enumerate() {
         // The y range is shared: its title only on the first panel.

@@ -13,7 +13,7 @@
 use alloc::format;
 use alloc::vec::Vec;
 
-use crate::error::{Error, Result};
+use crate::error::{check_len, Error, Result};
 use crate::gating::Calibration;
 use crate::math::Real;
 use crate::track::PredictedDelay;
@@ -136,21 +136,9 @@ pub fn select(
     rule: AssociationRule,
 ) -> Result<Selection> {
     let n = calibration.link_count();
-    if estimates.len() != n {
-        return Err(Error::LengthMismatch {
-            field: "estimates",
-            expected: n,
-            found: estimates.len(),
-        });
-    }
+    check_len("estimates", n, estimates.len())?;
     if let Some(p) = predictions {
-        if p.len() != n {
-            return Err(Error::LengthMismatch {
-                field: "predictions",
-                expected: n,
-                found: p.len(),
-            });
-        }
+        check_len("predictions", n, p.len())?;
     }
     let mut out = Selection {
         delays: Vec::with_capacity(n),

@@ -22,7 +22,7 @@ use alloc::vec::Vec;
 
 use serde::{Deserialize, Serialize};
 
-use crate::error::{Error, Result};
+use crate::error::{check_len, Error, Result};
 use crate::math::{sqrt, Real};
 
 /// The gate's half-width in cluster standard deviations (E4).
@@ -270,13 +270,7 @@ impl Calibration {
 
     /// Checks that there is one entry per link of a model with `links` links.
     pub fn check_links(&self, links: usize) -> Result<()> {
-        if self.links.len() != links {
-            return Err(Error::LengthMismatch {
-                field: "calibration.links",
-                expected: links,
-                found: self.links.len(),
-            });
-        }
+        check_len("calibration.links", links, self.links.len())?;
         Ok(())
     }
 }

@@ -20,7 +20,7 @@ use alloc::vec;
 use alloc::vec::Vec;
 use serde::{Deserialize, Serialize};
 
-use crate::error::{Error, Result};
+use crate::error::{check_len, Error, Result};
 use crate::math::{Real, Vec2};
 use crate::measure::Rng;
 use crate::mtl::blocking::NodePatternModel;
@@ -144,21 +144,9 @@ impl EmpiricalTable {
     /// when a cell has no observation and `α = 0` (its probabilities would be 0/0).
     pub fn validate(&self) -> Result<()> {
         self.check_shape()?;
-        if self.counts.len() != self.nx * self.ny {
-            return Err(Error::LengthMismatch {
-                field: "counts",
-                expected: self.nx * self.ny,
-                found: self.counts.len(),
-            });
-        }
+        check_len("counts", self.nx * self.ny, self.counts.len())?;
         for row in &self.counts {
-            if row.len() != self.n_patterns() {
-                return Err(Error::LengthMismatch {
-                    field: "counts[cell]",
-                    expected: self.n_patterns(),
-                    found: row.len(),
-                });
-            }
+            check_len("counts[cell]", self.n_patterns(), row.len())?;
             if self.pseudo_count == 0.0 && row.iter().all(|&c| c == 0) {
                 return Err(Error::OutOfRange {
                     field: "counts".into(),

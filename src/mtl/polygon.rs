@@ -8,7 +8,7 @@
 
 use alloc::vec::Vec;
 
-use crate::error::{Error, Result};
+use crate::error::{check_len, Error, Result};
 use crate::math::{Real, Vec2};
 
 /// An axis-aligned rectangle `[min.x, max.x] × [min.y, max.y]` (the region `R` of §6.2/§7).
@@ -262,13 +262,7 @@ pub fn subset_intersection_areas_clipped<P: AsRef<[Vec2]>, Q: AsRef<[Vec2]>>(
     clippers: &[Q],
 ) -> Result<Vec<Real>> {
     let n = polys.len();
-    if clippers.len() != n {
-        return Err(Error::LengthMismatch {
-            field: "clippers",
-            expected: n,
-            found: clippers.len(),
-        });
-    }
+    check_len("clippers", n, clippers.len())?;
     if n > 24 {
         return Err(Error::SizeLimit {
             field: "polygons",

@@ -3,7 +3,7 @@
 
 use alloc::vec::Vec;
 
-use crate::error::{Error, Result};
+use crate::error::{check_len, Error, Result};
 use crate::math::{log10, Real};
 use crate::present::{colorbar_ticks, Tick};
 
@@ -112,13 +112,11 @@ pub fn fill_rgba(values: &[Real], scale: &LogScale, rgba: &mut [u8]) -> bool {
 /// Colours a map (`values`, m) into `rgba` (4 bytes per value) on the log scale spanning its
 /// finite values and returns that scale; `None` (and all grey) when no value is bounded.
 pub fn render_rgba(values: &[Real], rgba: &mut [u8]) -> Result<Option<LogScale>> {
-    if rgba.len() != 4 * values.len() {
-        return Err(Error::LengthMismatch {
-            field: "rgba buffer (4 bytes per map value)",
-            expected: 4 * values.len(),
-            found: rgba.len(),
-        });
-    }
+    check_len(
+        "rgba buffer (4 bytes per map value)",
+        4 * values.len(),
+        rgba.len(),
+    )?;
     let scale = LogScale::spanning(values);
     match &scale {
         Some(s) => {

@@ -22,7 +22,7 @@
 
 use nalgebra::Cholesky;
 
-use crate::error::{Error, Result};
+use crate::error::{check_len, Error, Result};
 use crate::math::{sqrt, Mat4, Real, Vec2, Vec4, PI, SPEED_OF_LIGHT};
 use crate::measure::UNIT_VECTOR_MIN_DISTANCE_M;
 use crate::measure::{Model, SNR_DISTANCE_FLOOR_M};
@@ -200,22 +200,10 @@ impl Ekf {
         mut innovations: Option<&mut [Option<Real>]>,
     ) -> Result<UpdateSummary> {
         let n = model.link_count();
-        if z.len() != n {
-            return Err(Error::LengthMismatch {
-                field: "measurement",
-                expected: n,
-                found: z.len(),
-            });
-        }
+        check_len("measurement", n, z.len())?;
         noise.check_links(n)?;
         if let Some(out) = innovations.as_deref_mut() {
-            if out.len() != n {
-                return Err(Error::LengthMismatch {
-                    field: "innovations",
-                    expected: n,
-                    found: out.len(),
-                });
-            }
+            check_len("innovations", n, out.len())?;
             out.fill(None);
         }
         let innovation = |_lane: usize, link: usize, nu: Real| {

@@ -5,7 +5,7 @@ use alloc::vec;
 use alloc::vec::Vec;
 
 use super::{is_regular, link_weights};
-use crate::error::{checked_index, Error, Result};
+use crate::error::{check_len, checked_index, Error, Result};
 use crate::math::{sqrt, Real, Vec2};
 use crate::measure::TxPattern;
 use crate::measure::UNIT_VECTOR_MIN_DISTANCE_M;
@@ -91,13 +91,7 @@ impl Grid {
 /// through [`GainPolynomial`]
 /// ([`crate::measure::GainPolynomial`], ≤ 1e-12 relative from the exact §9.3 formula) when it can be fitted, else the exact formula.
 pub fn crlb_map(model: &Model, grid: &Grid, out: &mut [Real]) -> Result<()> {
-    if out.len() != grid.len() {
-        return Err(Error::LengthMismatch {
-            field: "map buffer",
-            expected: grid.len(),
-            found: out.len(),
-        });
-    }
+    check_len("map buffer", grid.len(), out.len())?;
     let net = &model.network;
     let nx = grid.nx;
     let weights: Vec<Real> = link_weights(model).collect();

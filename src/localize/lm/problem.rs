@@ -4,7 +4,7 @@
 use alloc::vec::Vec;
 
 use super::{DelayMeasurements, MIN_LINKS};
-use crate::error::{Error, Result};
+use crate::error::{check_len, Error, Result};
 use crate::math::{Mat2, Real, Vec2, SPEED_OF_LIGHT};
 use crate::measure::{bistatic_range, unit_from, Network};
 
@@ -25,20 +25,8 @@ pub(super) struct Problem {
 impl Problem {
     pub(super) fn new(net: &Network, m: &DelayMeasurements) -> Result<Problem> {
         let n = net.link_count();
-        if m.delays_s.len() != n {
-            return Err(Error::LengthMismatch {
-                field: "delays_s",
-                expected: n,
-                found: m.delays_s.len(),
-            });
-        }
-        if m.sigmas_s.len() != n {
-            return Err(Error::LengthMismatch {
-                field: "sigma_s",
-                expected: n,
-                found: m.sigmas_s.len(),
-            });
-        }
+        check_len("delays_s", n, m.delays_s.len())?;
+        check_len("sigma_s", n, m.sigmas_s.len())?;
         let mut rows = Vec::with_capacity(n);
         for (p, (d, s)) in m.delays_s.iter().zip(m.sigmas_s).enumerate() {
             let Some(d) = *d else { continue };

@@ -2,7 +2,7 @@
 
 use alloc::vec::Vec;
 
-use crate::error::{check_non_negative, Error, Result};
+use crate::error::{check_len, check_non_negative, Error, Result};
 use crate::math::Real;
 use crate::mtl::algorithm::{Measurements, MtlConfig};
 use crate::mtl::blocking::BlockingModel;
@@ -98,13 +98,7 @@ pub fn validate<B: BlockingModel + ?Sized>(
     }
     let m = map.n_trps();
     let order: Vec<usize> = cfg.order.clone().unwrap_or_else(|| (0..m).collect());
-    if order.len() != m {
-        return Err(Error::LengthMismatch {
-            field: "order",
-            expected: m,
-            found: order.len(),
-        });
-    }
+    check_len("order", m, order.len())?;
     let mut seen = 0u64;
     for &t in &order {
         if t >= m || seen >> t & 1 == 1 {

@@ -24,7 +24,7 @@ pub use model::{BuiltModel, ModelSpec, TrainingSpec};
 
 use serde::{Deserialize, Serialize};
 
-use crate::error::{Error, Result};
+use crate::error::{check_len, Error, Result};
 use crate::math::{Real, Vec2};
 use crate::measure::rng;
 use crate::mtl::algorithm::{Measurements, MtlConfig, Target};
@@ -250,13 +250,7 @@ impl RangesInput {
     /// (`ranges_m[m][i]`) for a negative range.
     pub fn validate(&self, network: &Network) -> Result<()> {
         let m = network.map.n_trps();
-        if self.ranges_m.len() != m {
-            return Err(Error::LengthMismatch {
-                field: "ranges_m",
-                expected: m,
-                found: self.ranges_m.len(),
-            });
-        }
+        check_len("ranges_m", m, self.ranges_m.len())?;
         for (t, rs) in self.ranges_m.iter().enumerate() {
             if rs.len() > MAX_RANGES_PER_TRP {
                 return Err(Error::SizeLimit {
