@@ -2,38 +2,8 @@
 // goes to a validating wasm setter; a rejected value shows its message in the error banner and
 // leaves the scenario unchanged.
 
-import { LINK_COLORS } from './draw.js';
-
-/** Replaces the children of a <dl> with [label, value, cssClass] rows. */
-export function fillKeyValues(dl, rows) {
-  dl.replaceChildren();
-  for (const [k, v, cls] of rows) {
-    const dt = document.createElement('dt');
-    dt.textContent = k;
-    const dd = document.createElement('dd');
-    dd.textContent = v;
-    if (cls) dd.className = cls;
-    dl.append(dt, dd);
-  }
-}
-
-const $ = (id) => document.getElementById(id);
-
-/** Text -> number; empty text is NaN, so the core names the field instead of taking 0. */
-function num(text) {
-  const t = String(text).trim();
-  return t === '' ? NaN : Number(t);
-}
-
-/** Shows or clears the error banner. */
-export function showError(message) {
-  $('error-text').textContent = message;
-  $('error').hidden = false;
-}
-export function clearError() {
-  $('error').hidden = true;
-  $('error-text').textContent = '';
-}
+import { $, num, errorText, fillKeyValues, showError, clearError } from './dom.js';
+import { linkColor } from './draw.js';
 
 export class Panel {
   /**
@@ -128,7 +98,7 @@ export class Panel {
       return true;
     } catch (e) {
       if (input) input.classList.add('invalid');
-      showError(e && e.message ? e.message : String(e));
+      showError(errorText(e));
       return false;
     }
   }
@@ -249,7 +219,7 @@ export class Panel {
     fix.links.forEach((l, i) => {
       const row = document.createElement('div');
       const sw = document.createElement('i');
-      sw.style.background = LINK_COLORS[i % LINK_COLORS.length];
+      sw.style.background = linkColor(i);
       const name = document.createElement('span');
       name.textContent = l.name;
       const note = document.createElement('span');

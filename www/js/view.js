@@ -1,6 +1,8 @@
 // Pixel <-> metre transform of the plot: DPR-aware canvas, equal scale on both axes (metres stay
 // square), y up. The only arithmetic in the page's JavaScript lives here.
 
+import { fitCanvas } from './dom.js';
+
 export const MARGIN = { left: 58, right: 112, top: 16, bottom: 44 };
 
 export class View {
@@ -16,16 +18,7 @@ export class View {
 
   /** Matches the backing store to the element size and device pixel ratio. */
   resize() {
-    const r = this.canvas.getBoundingClientRect();
-    this.dpr = window.devicePixelRatio || 1;
-    this.width = Math.max(1, r.width);
-    this.height = Math.max(1, r.height);
-    const w = Math.round(this.width * this.dpr);
-    const h = Math.round(this.height * this.dpr);
-    if (this.canvas.width !== w || this.canvas.height !== h) {
-      this.canvas.width = w;
-      this.canvas.height = h;
-    }
+    ({ width: this.width, height: this.height, dpr: this.dpr } = fitCanvas(this.canvas));
     this.fit(this.area);
   }
 
@@ -49,6 +42,11 @@ export class View {
   /** CSS pixels (canvas-relative) -> metres. */
   toMetre(px, py) {
     return { x: this.area[0] + (px - this.rect.x) / this.scale, y: this.area[3] - (py - this.rect.y) / this.scale };
+  }
+
+  /** CSS pixels -> metres, the pixel first clamped into the box from corner `a` (top left) to `b`. */
+  toMetreWithin(p, a, b) {
+    return this.toMetre(Math.min(Math.max(p.x, a.x), b.x), Math.min(Math.max(p.y, a.y), b.y));
   }
 
   /** A length in metres as CSS pixels. */

@@ -1,8 +1,8 @@
-// The page side of the browser Monte Carlo: one module Web Worker (worker.js) runs the study; a
+// The page side of the browser Monte Carlo: one module Web Worker (mc-worker.js) runs the study; a
 // generation number cancels a run when a newer one starts (every drag restarts it). Shows the
 // progress bar, the status line and the plotters chart (drawn by the wasm core on #track-chart).
 
-const $ = (id) => document.getElementById(id);
+import { $, errorText, fitCanvas } from './dom.js';
 
 export class MonteCarlo {
   /** @param {object} wasm - the wasm module; @param {function} onError - shows a message. */
@@ -22,7 +22,7 @@ export class MonteCarlo {
     this.coldStart = false;
     this.series = 0;
     this.caption = '';
-    this.worker = new Worker(new URL('./worker.js', import.meta.url), { type: 'module' });
+    this.worker = new Worker(new URL('./mc-worker.js', import.meta.url), { type: 'module' });
     this.worker.onmessage = (e) => this.receive(e.data);
     this.worker.onerror = (e) => this.fail(`Monte Carlo worker: ${e.message || 'failed to start'}`);
     new ResizeObserver(() => this.drawChart()).observe($('track-chart').parentElement);
@@ -87,18 +87,17 @@ export class MonteCarlo {
     const canvas = $('track-chart');
     const r = canvas.getBoundingClientRect();
     if (r.width < 10 || r.height < 10) return;
-    const dpr = window.devicePixelRatio || 1;
-    canvas.width = Math.round(r.width * dpr);
-    canvas.height = Math.round(r.height * dpr);
+    fitCanvas(canvas); // the chart fills its background itself
     const p = this.params;
     let sub = p ? `${p.trajectories * p.noise_runs} runs × ${p.steps} steps, T = ${p.dt_s} s` : '';
+    if (this.result) sub += ` · ${failedRuns(JSON.parse(this.result))}`;
     if (this.state === 'running') sub += ` · running, ${this.done}/${this.total} chunks`;
     try {
       this.series = this.wasm.draw_tracking_chart(canvas, this.result || '',
         'Position RMSE: EKF vs posterior CRLB', sub, this.caption);
     } catch (e) {
       this.series = 0;
-      this.onError(`Chart: ${e.message}`);
+      this.onError(`Chart: ${errorText(e)}`);
       console.error(e);
     }
     canvas.dataset.series = String(this.series);
@@ -124,8 +123,7 @@ export class MonteCarlo {
       const fmt = (v) => (v === null ? '–' : this.wasm.format_length(v, 3));
       const cold = this.coldStart ? ' (incl. worker start-up)' : '';
       text = `${size} in ${this.ms.toFixed(0)} ms${cold} · at t = ${r.t_s[n]} s: ε_EKF ${fmt(r.rmse_ekf_m[n])}, `
-        + `ε_PCRLB ${fmt(r.rmse_pcrlb_m[n])}, NEES ${r.nees[n].toFixed(2)} (4 = consistent)`;
-      if (r.failed_runs) text += ` · ${r.failed_runs} failed runs excluded`;
+        + `ε_PCRLB ${fmt(r.rmse_pcrlb_m[n])}, NEES ${r.nees[n].toFixed(2)} (4 = consistent) · ${failedRuns(r)}`;
     }
     if (this.state === 'error') text = `${size} · failed`;
     el.textContent = text;
@@ -133,4 +131,13 @@ export class MonteCarlo {
     ms.textContent = this.ms === null ? 'MC –' : `MC ${size}: ${this.ms.toFixed(0)} ms`;
     ms.dataset.ms = this.ms === null ? '' : String(this.ms);
   }
+}
+
+/**
+ * The failed-run count of a result, shown wherever ε_EKF is (even when 0): "0 failed runs",
+ * "3 failed runs (excluded from ε_EKF)".
+ */
+function failedRuns(r) {
+  const n = r.failed_runs;
+  return `${n} failed run${n === 1 ? '' : 's'}${n ? ' (excluded from ε_EKF)' : ''}`;
 }

@@ -3,7 +3,7 @@
 // through the view transform. Markers of the scene (nodes, targets, discs) are drawn from the
 // scene itself so they follow a drag at once.
 
-import { C, LINK_COLORS, FONT_B, FULL, ellipsePath, cross, haloText, drawAxes, ring, rxMarker, txMarker } from './draw.js';
+import { C, FONT_B, FULL, clipTo, cross, drawAxes, drawNodes, ellipsePath, haloText, isSelected, linkColor, ring } from './draw.js';
 
 const BG = '#10141c';
 const DISC = 'rgba(150,160,178,0.55)';
@@ -32,7 +32,7 @@ function region(ctx, view, scene) {
 /** Range ellipses: DP solid, clutter dashed and faint; the ranges a detection uses bold. */
 function ellipses(ctx, view, v) {
   for (const t of v.trps) {
-    const color = LINK_COLORS[t.trp % LINK_COLORS.length];
+    const color = linkColor(t.trp);
     for (const r of t.ranges) {
       if (!r.ellipse) continue;
       const used = r.matched_by.length > 0;
@@ -104,24 +104,10 @@ function discs(ctx, view, scene, sel) {
     const p = view.toPixel(c[0], c[1]);
     ctx.beginPath(); ctx.arc(p.x, p.y, r, 0, FULL);
     ctx.fillStyle = DISC; ctx.fill();
-    ctx.lineWidth = sel && sel.kind === 'disc' && sel.index === i ? 2.5 : 1;
-    ctx.strokeStyle = sel && sel.kind === 'disc' && sel.index === i ? C.sel : '#c9d2e0';
+    const on = isSelected(sel, 'disc', i);
+    ctx.lineWidth = on ? 2.5 : 1;
+    ctx.strokeStyle = on ? C.sel : '#c9d2e0';
     ctx.stroke();
-  });
-}
-
-function isSel(sel, kind, i) {
-  return sel && sel.kind === kind && sel.index === i;
-}
-
-function nodes(ctx, view, scene, sel) {
-  ctx.font = FONT_B;
-  ctx.textAlign = 'left';
-  scene.receivers.forEach((q, i) => {
-    rxMarker(ctx, view.toPixel(q[0], q[1]), `Rx${i + 1}`, isSel(sel, 'rx', i));
-  });
-  scene.transmitters.forEach((q, i) => {
-    txMarker(ctx, view.toPixel(q[0], q[1]), `Tx${i + 1}`, isSel(sel, 'tx', i));
   });
 }
 
@@ -131,7 +117,7 @@ function targets(ctx, view, scene, v, sel) {
   ctx.textBaseline = 'top';
   scene.targets.forEach((q, k) => {
     const p = view.toPixel(q[0], q[1]);
-    if (isSel(sel, 'target', k)) ring(ctx, p, 12);
+    if (isSelected(sel, 'target', k)) ring(ctx, p, 12);
     cross(ctx, p, 7, '#0d1017', 5);
     cross(ctx, p, 7, '#ffffff', 2.25);
     const t = v && v.targets[k];
@@ -151,8 +137,7 @@ export function drawMtl(view, scene, v, sel, w) {
   const r = view.rect;
   region(ctx, view, scene);
   drawAxes(ctx, view, w);
-  ctx.save();
-  ctx.beginPath(); ctx.rect(r.x, r.y, r.w, r.h); ctx.clip();
+  clipTo(ctx, r);
   if (v) {
     ellipses(ctx, view, v);
     segments(ctx, view, v);
@@ -162,5 +147,6 @@ export function drawMtl(view, scene, v, sel, w) {
   ctx.restore();
   if (v) detections(ctx, view, v);
   targets(ctx, view, scene, v, sel);
-  nodes(ctx, view, scene, sel);
+  const named = (prefix) => (q, i) => ({ x: q[0], y: q[1], name: `${prefix}${i + 1}` });
+  drawNodes(ctx, view, scene.receivers.map(named('Rx')), scene.transmitters.map(named('Tx')), sel);
 }

@@ -3,7 +3,7 @@
 // the arrow of a drawn trajectory. The current step's markers, iso-delay ellipses and the zoom
 // inset are drawn by draw.js from the snapshot-shaped frame.
 
-import { C, FONT_B, FULL, ellipsePath, haloText, polyline } from './draw.js';
+import { C, FONT_B, FULL, clipTo, ellipsePath, haloText, polyline } from './draw.js';
 
 const TRUTH = 'rgba(255,255,255,0.9)';
 const EKF = C.fix;
@@ -53,9 +53,7 @@ function drawArrow(ctx, view, d) {
  * Ellipses every `stride` steps up to the current one are drawn faintly, the current one bold.
  */
 export function drawTrack(ctx, view, tr) {
-  const r = view.rect;
-  ctx.save();
-  ctx.beginPath(); ctx.rect(r.x, r.y, r.w, r.h); ctx.clip();
+  clipTo(ctx, view.rect);
   const d = tr.data;
   if (d) {
     const step = Math.min(tr.step, d.truth.length - 1);

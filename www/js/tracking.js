@@ -1,13 +1,12 @@
-// Tracking mode: simulates a track with the wasm core (App.simulate_track), animates it over the
+// The tracking view: simulates a track with the wasm core (App.simulate_track), animates it over the
 // CRLB map (play/pause, scrub, speed), lets the user draw a trajectory (press = start, drag = where
 // it is after the run's duration) and keeps the Monte Carlo chart (montecarlo.js) in step: every
 // change of scenario, nodes or trajectory re-simulates the track and restarts the Monte Carlo.
 
+import { $, num, errorText, fillKeyValues, showError, clearError } from './dom.js';
 import { MonteCarlo } from './montecarlo.js';
 import { drawTrack } from './track-draw.js';
-import { showError, clearError, fillKeyValues } from './panel.js';
 
-const $ = (id) => document.getElementById(id);
 const DURATION_S = 10; // the scenarios of spec §9.4 last 10 s
 
 export class Tracking {
@@ -51,7 +50,7 @@ export class Tracking {
     let v = [0, 0];
     const d = this.drawn;
     if (this.kind === 'custom') v = w.drag_velocity(d.x0, d.y0, d.x1, d.y1, DURATION_S);
-    const seed = Number($('track-seed').value.trim() === '' ? NaN : $('track-seed').value);
+    const seed = num($('track-seed').value);
     return { kind: this.kind, x0: d.x0, y0: d.y0, vx: v[0], vy: v[1], dt_s: dt, steps, seed };
   }
 
@@ -74,8 +73,8 @@ export class Tracking {
       this.seek(Math.min(this.step, track.entries() - 1), false);
       this.startMc();
     } catch (e) {
-      $('track-seed').classList.toggle('invalid', /seed/.test(e.message));
-      showError(e.message);
+      $('track-seed').classList.toggle('invalid', /seed/.test(errorText(e)));
+      showError(errorText(e));
       this.failed = true;
     }
     $('track-hint').hidden = this.kind !== 'custom';

@@ -5,7 +5,8 @@
 // result (MonteCarloJob.result_json text), ms}, {type: 'error', gen, message} and, once the wasm
 // module is compiled, {type: 'ready'}.
 
-import init, { MonteCarloJob } from './pkg/scatterloc.js';
+import init, { MonteCarloJob } from '../pkg/scatterloc.js';
+import { errorText } from './dom.js';
 
 const SLICE_MS = 40; // work between progress reports and cancellation checks
 const ready = init().then(() => self.postMessage({ type: 'ready' }));
@@ -15,7 +16,7 @@ self.onmessage = (e) => {
   const m = e.data;
   current = m.gen;
   if (m.type === 'run') {
-    run(m).catch((err) => self.postMessage({ type: 'error', gen: m.gen, message: String(err && err.message || err) }));
+    run(m).catch((err) => self.postMessage({ type: 'error', gen: m.gen, message: errorText(err) }));
   }
 };
 

@@ -1,24 +1,17 @@
-// Multi-target mode: state and events only. The scene (nodes, targets, scatterer discs, noise,
+// The multi-target view: state and events only. The scene (nodes, targets, scatterer discs, noise,
 // clutter, thresholds, blocking model) lives here as the core's JSON schema; every edit is
 // validated by the core on the main thread (mtl_check_scene: a rejected edit shows the core's
 // message and changes nothing) and the view is computed by the core in a Web Worker
 // (mtl-worker.js; the newest scene wins), then drawn by mtl-draw.js.
 
+import { $, num, errorText, fillKeyValues, showError, clearError } from './dom.js';
 import { View } from './view.js';
+import { pickNearest } from './interact.js';
 import { drawMtl } from './mtl-draw.js';
-import { showError, clearError, fillKeyValues } from './panel.js';
 
-const $ = (id) => document.getElementById(id);
-const HIT_PX = 12; // pick radius around a marker, CSS px
 const MARGIN_M = 0.4; // shown around the region, m
 /** Where "+ target" / "+ disc" try to put a new one (first valid wins), m. */
 const SPOTS = [[5, 5], [5, 7], [3, 6], [7, 3], [6, 8.5], [8, 6], [3, 2], [1.5, 7], [8.5, 1], [4.5, 2.5]];
-
-/** Text -> number; empty text is NaN (sent as null: the core names the field). */
-function num(text) {
-  const t = String(text).trim();
-  return t === '' ? NaN : Number(t);
-}
 
 export class Mtl {
   /** @param {object} ctx - {wasm, st, changed}. */
@@ -61,12 +54,12 @@ export class Mtl {
    * whether it was accepted. `input` (an element) is marked invalid on rejection.
    */
   apply(edit, input) {
-    const next = JSON.parse(JSON.stringify(this.scene));
+    const next = structuredClone(this.scene);
     edit(next);
     try {
       this.wasm.mtl_check_scene(JSON.stringify(next));
     } catch (e) {
-      showError(e.message);
+      showError(errorText(e));
       if (input) input.classList.add('invalid');
       this.syncPanel();
       return false;
@@ -166,7 +159,7 @@ export class Mtl {
   /** Adds a target or disc at the first spot the core accepts. */
   add(list) {
     for (const p of SPOTS) {
-      const next = JSON.parse(JSON.stringify(this.scene));
+      const next = structuredClone(this.scene);
       next[list].push(p);
       try {
         this.wasm.mtl_check_scene(JSON.stringify(next));
@@ -240,18 +233,9 @@ export class Mtl {
 
   /** The scene object under a canvas pixel: {kind, index} or null (nodes first, then targets, discs). */
   hit(p) {
-    let best = null;
-    let bestD = HIT_PX;
-    const test = (kind, list, extra = 0) => list.forEach((q, index) => {
-      const c = this.view.toPixel(q[0], q[1]);
-      const d = Math.hypot(c.x - p.x, c.y - p.y) - extra;
-      if (d <= bestD) { best = { kind, index }; bestD = d; }
-    });
-    test('disc', this.scene.discs, this.view.len(this.scene.diameter / 2));
-    test('target', this.scene.targets);
-    test('rx', this.scene.receivers);
-    test('tx', this.scene.transmitters);
-    return best;
+    const s = this.scene;
+    return pickNearest(this.view, [['disc', s.discs, this.view.len(s.diameter / 2)], ['target', s.targets],
+      ['rx', s.receivers], ['tx', s.transmitters]], p);
   }
 
   listOf(kind) {
@@ -286,9 +270,7 @@ export class Mtl {
       }
       // Keep the dragged object inside the region (clamped in pixels).
       const [x0, x1, y0, y1] = this.scene.region;
-      const a = this.view.toPixel(x0, y1);
-      const b = this.view.toPixel(x1, y0);
-      const m = this.view.toMetre(Math.min(Math.max(p.x, a.x), b.x), Math.min(Math.max(p.y, a.y), b.y));
+      const m = this.view.toMetreWithin(p, this.view.toPixel(x0, y1), this.view.toPixel(x1, y0));
       const { kind, index } = this.press;
       const list = this.listOf(kind);
       const cur = this.scene[list][index];
@@ -322,7 +304,7 @@ export class Mtl {
     const v = this.result;
     return {
       mode: this.ctx.st.mode,
-      scene: JSON.parse(JSON.stringify(this.scene)),
+      scene: structuredClone(this.scene),
       gen: this.gen,
       viewGen: this.resultGen,
       pending: this.gen !== this.resultGen,
@@ -345,8 +327,8 @@ export class Mtl {
     try {
       parsed = JSON.parse(this.wasm.mtl_check_scene(text));
     } catch (e) {
-      showError(e.message);
-      return e.message;
+      showError(errorText(e));
+      return errorText(e);
     }
     clearError();
     this.scene = parsed;

@@ -1,125 +1,115 @@
-// Drawing only: every number drawn here (map colours, ticks, labels, ellipses) comes from the
-// wasm core; this file places it on the canvas through the view transform.
+// The snapshot (CRLB map) view: the core's RMSE-bound map over the area (computed on the main
+// thread at the chosen resolution), the probe read-out, the placed target's simulated snapshot
+// (LM fix vs CRLB) and the drawing of the whole scene: heatmap, colour bar, links, nodes, the
+// target's iso-delay ellipses and its zoom inset. The tracking view draws through the same scene
+// (its frame is snapshot-shaped, plus an overlay). Every number comes from the wasm core.
 
+import { $ } from './dom.js';
 import { Zoom } from './view.js';
+import { C, FONT, FONT_B, FULL, clipTo, cross, drawAxes, drawNodes, ellipsePath, haloText, linkColor, polyline } from './draw.js';
 
-export const C = {
-  bg: '#141922',
-  frame: '#3a4456',
-  text: '#c9d2e0',
-  muted: '#8a94a6',
-  grid: 'rgba(255,255,255,0.10)',
-  tx: '#ff6b6b',
-  rx: '#f4f4f0',
-  fix: '#ffa94d',
-  crlb: '#5cc8ff',
-  sel: '#5cc8ff',
-  iso: 'rgba(255,255,255,0.62)',
-  baseline: 'rgba(255,255,255,0.28)',
-};
-export const LINK_COLORS = ['#f4f4f0', '#ffd166', '#9be564', '#ff8fab', '#b8c0ff', '#7ee8fa', '#ffb86b', '#d0a2f7'];
-export const FONT = '11.5px system-ui, -apple-system, "Segoe UI", Roboto, sans-serif';
-export const FONT_B = '600 11.5px system-ui, -apple-system, "Segoe UI", Roboto, sans-serif';
-export const FULL = 2 * Math.PI;
+export class MapView {
+  /** @param {object} ctx - {app, wasm, st, view, changed}. */
+  constructor(ctx) {
+    this.ctx = ctx;
+    const { wasm } = ctx;
+    const rgb = wasm.unbounded_rgb();
+    Object.assign(ctx.st, {
+      mapCanvas: document.createElement('canvas'), // one pixel per cell, row 0 = lowest y
+      barCanvas: makeBarCanvas(wasm.colorbar_rgba(256)),
+      unboundedColor: `rgb(${rgb[0]},${rgb[1]},${rgb[2]})`,
+      values: null,
+      image: null,
+      range: null,
+      res: 256,
+    });
+  }
 
-/**
- * Ellipse {cx, cy, a, b, angle} through a transform (View or Zoom); y flips the angle's sign.
- * `magnify` enlarges it on screen only (a labelled exaggeration).
- */
-export function ellipsePath(ctx, tr, e, magnify = 1) {
-  const c = tr.toPixel(e.cx, e.cy);
-  ctx.beginPath();
-  ctx.ellipse(c.x, c.y, tr.len(e.a) * magnify, tr.len(e.b) * magnify, -e.angle, 0, FULL);
+  /** Recomputes the map at the resolution of #resolution and shows the kernel time in #map-ms. */
+  compute() {
+    const { app, wasm, st } = this.ctx;
+    const n = Number($('resolution').value) || 256;
+    if (!st.values || st.res !== n) {
+      st.values = new Float64Array(n * n);
+      st.image = new ImageData(n, n);
+      st.mapCanvas.width = n;
+      st.mapCanvas.height = n;
+      st.res = n;
+    }
+    const ms = app.compute_map(n, n, st.values);
+    st.range = Array.from(wasm.render_map_rgba(st.values, st.image.data));
+    st.mapCanvas.getContext('2d').putImageData(st.image, 0, 0);
+    const el = $('map-ms');
+    el.dataset.ms = String(ms);
+    el.dataset.res = `${n}x${n}`;
+    el.textContent = `map ${n}×${n}: ${ms.toFixed(1)} ms`;
+  }
+
+  /** The bound at #probe's data-x, data-y (m) into its data-rmse-m and text. */
+  probe() {
+    const { app, wasm } = this.ctx;
+    const el = $('probe');
+    const x = Number(el.dataset.x);
+    const y = Number(el.dataset.y);
+    const rmse = app.rmse_at(x, y);
+    el.dataset.rmseM = String(rmse);
+    el.textContent = `probe (${x}, ${y}) m: ${wasm.format_length(rmse, 4)}`;
+  }
+
+  /** Places the target at (x, y) m with the next noise seed. */
+  placeTarget(x, y) {
+    const { st } = this.ctx;
+    st.target = { x, y, seed: st.nextSeed++ };
+    this.ctx.changed({ target: true });
+  }
+
+  /** A new noise realisation for the placed target. */
+  resample() {
+    const { st } = this.ctx;
+    if (st.target) st.target.seed = st.nextSeed++;
+    this.ctx.changed({ target: true });
+  }
+
+  clearTarget() {
+    this.ctx.st.target = null;
+    this.ctx.changed({ target: true });
+  }
+
+  /** Re-simulates the placed target's snapshot (st.snap; null without a target). */
+  simulateTarget() {
+    const { app, st } = this.ctx;
+    st.snap = st.target ? app.simulate_fix(st.target.x, st.target.y, st.target.seed) : null;
+    return st.snap;
+  }
+
+  /** Redraws the canvas (see drawScene). */
+  draw() {
+    drawScene(this.ctx.view, this.ctx.st, this.ctx.wasm);
+  }
 }
 
-/** A path through points [[x, y], …] (m) via a transform. */
-export function polyline(ctx, tr, points, closed) {
-  ctx.beginPath();
-  points.forEach(([x, y], k) => {
-    const q = tr.toPixel(x, y);
-    if (k === 0) ctx.moveTo(q.x, q.y); else ctx.lineTo(q.x, q.y);
-  });
-  if (closed) ctx.closePath();
-}
-
-export function cross(ctx, p, r, color, width) {
-  ctx.strokeStyle = color;
-  ctx.lineWidth = width;
-  ctx.beginPath();
-  ctx.moveTo(p.x - r, p.y - r); ctx.lineTo(p.x + r, p.y + r);
-  ctx.moveTo(p.x - r, p.y + r); ctx.lineTo(p.x + r, p.y - r);
-  ctx.stroke();
-}
-
-export function haloText(ctx, text, x, y) {
-  ctx.lineWidth = 3;
-  ctx.strokeStyle = 'rgba(10,12,18,0.85)';
-  ctx.strokeText(text, x, y);
-  ctx.fillText(text, x, y);
+/** An image flipped to y-up into the box (x, y, w, h) CSS px (its row 0 at the bottom). */
+function drawFlipped(ctx, image, x, y, w, h, quality) {
+  ctx.save();
+  ctx.imageSmoothingEnabled = true;
+  if (quality) ctx.imageSmoothingQuality = quality;
+  ctx.translate(x, y + h);
+  ctx.scale(1, -1);
+  ctx.drawImage(image, 0, 0, w, h);
+  ctx.restore();
 }
 
 /** The heatmap: the wasm-coloured RGBA image (row 0 = lowest y), flipped to y-up. */
 function drawMap(ctx, view, st) {
   const r = view.rect;
-  if (!st.mapCanvas) return;
-  ctx.save();
-  ctx.imageSmoothingEnabled = true;
-  ctx.imageSmoothingQuality = 'high';
-  ctx.translate(r.x, r.y + r.h);
-  ctx.scale(1, -1);
-  ctx.drawImage(st.mapCanvas, 0, 0, r.w, r.h);
-  ctx.restore();
-}
-
-/** Grid, tick labels (from the core's `axis_ticks`), axis titles and the frame of the plot rectangle. */
-export function drawAxes(ctx, view, w) {
-  const r = view.rect;
-  const [x0, x1, y0, y1] = view.area;
-  ctx.font = FONT;
-  ctx.fillStyle = C.text;
-  ctx.strokeStyle = C.grid;
-  ctx.lineWidth = 1;
-  const xt = w.axis_ticks(x0, x1, Math.max(2, Math.floor(r.w / 70)));
-  const yt = w.axis_ticks(y0, y1, Math.max(2, Math.floor(r.h / 50)));
-  ctx.beginPath();
-  for (const t of xt) {
-    const p = view.toPixel(t.value, y0);
-    ctx.moveTo(Math.round(p.x) + 0.5, r.y); ctx.lineTo(Math.round(p.x) + 0.5, r.y + r.h + 5);
-  }
-  for (const t of yt) {
-    const p = view.toPixel(x0, t.value);
-    ctx.moveTo(r.x - 5, Math.round(p.y) + 0.5); ctx.lineTo(r.x + r.w, Math.round(p.y) + 0.5);
-  }
-  ctx.stroke();
-  ctx.textAlign = 'center';
-  ctx.textBaseline = 'top';
-  for (const t of xt) ctx.fillText(t.label, view.toPixel(t.value, y0).x, r.y + r.h + 8);
-  ctx.textAlign = 'right';
-  ctx.textBaseline = 'middle';
-  for (const t of yt) ctx.fillText(t.label, r.x - 8, view.toPixel(x0, t.value).y);
-  ctx.fillStyle = C.muted;
-  ctx.textAlign = 'center';
-  ctx.textBaseline = 'alphabetic';
-  ctx.fillText('x (m)', r.x + r.w / 2, r.y + r.h + 36);
-  ctx.save();
-  ctx.translate(r.x - 42, r.y + r.h / 2);
-  ctx.rotate(-Math.PI / 2);
-  ctx.fillText('y (m)', 0, 0);
-  ctx.restore();
-  ctx.strokeStyle = C.frame;
-  ctx.strokeRect(Math.round(r.x) + 0.5, Math.round(r.y) + 0.5, Math.round(r.w), Math.round(r.h));
+  if (st.mapCanvas) drawFlipped(ctx, st.mapCanvas, r.x, r.y, r.w, r.h, 'high');
 }
 
 function drawColorbar(ctx, view, st, w) {
   const r = view.rect;
   const bx = r.x + r.w + 18;
   const bw = 14;
-  ctx.save();
-  ctx.imageSmoothingEnabled = true;
-  ctx.translate(bx, r.y + r.h);
-  ctx.scale(1, -1);
-  ctx.drawImage(st.barCanvas, 0, 0, bw, r.h);
-  ctx.restore();
+  drawFlipped(ctx, st.barCanvas, bx, r.y, bw, r.h);
   ctx.strokeStyle = C.frame;
   ctx.lineWidth = 1;
   ctx.strokeRect(bx + 0.5, r.y + 0.5, bw, r.h);
@@ -141,8 +131,8 @@ function drawColorbar(ctx, view, st, w) {
   ctx.fillText('unbounded', bx + bw + 8, r.y + r.h + 15);
 }
 
-function drawNetwork(ctx, view, st) {
-  const n = st.nodes;
+/** Tx–Rx baselines (dashed), then the node markers (`n` = App.nodes()). */
+function drawNetwork(ctx, view, n, selected) {
   ctx.setLineDash([4, 4]);
   ctx.strokeStyle = C.baseline;
   ctx.lineWidth = 1;
@@ -154,67 +144,27 @@ function drawNetwork(ctx, view, st) {
   }
   ctx.stroke();
   ctx.setLineDash([]);
-  ctx.font = FONT_B;
-  ctx.textAlign = 'left';
-  ctx.textBaseline = 'bottom';
-  n.receivers.forEach((rx, i) => {
-    rxMarker(ctx, view.toPixel(rx.x, rx.y), rx.name, st.selected.kind === 'rx' && st.selected.index === i);
+  drawNodes(ctx, view, n.receivers, n.transmitters, selected);
+}
+
+/** Each link's curve `key` ('outline': closed, 'arc': open) in its plot colour at `alpha`. */
+function linkCurves(ctx, tr, links, key, alpha) {
+  const closed = key === 'outline';
+  links.forEach((l, i) => {
+    if (l[key].length < (closed ? 3 : 2)) return;
+    ctx.strokeStyle = linkColor(i);
+    ctx.globalAlpha = alpha;
+    polyline(ctx, tr, l[key], closed);
+    ctx.stroke();
   });
-  n.transmitters.forEach((tx, i) => {
-    const p = view.toPixel(tx.x, tx.y);
-    if (tx.boresight) {
-      ctx.strokeStyle = C.tx; ctx.lineWidth = 2;
-      ctx.beginPath(); ctx.moveTo(p.x, p.y);
-      ctx.lineTo(p.x + 26 * tx.boresight[0], p.y - 26 * tx.boresight[1]); ctx.stroke();
-    }
-    txMarker(ctx, p, tx.name, st.selected.kind === 'tx' && st.selected.index === i);
-  });
-}
-
-/** A selection ring of radius `r` px around pixel `p`. */
-export function ring(ctx, p, r) {
-  ctx.beginPath(); ctx.arc(p.x, p.y, r, 0, FULL);
-  ctx.lineWidth = 2; ctx.strokeStyle = C.sel; ctx.stroke();
-}
-
-/** A receiver marker (disc) at pixel `p` with its label above right; ringed when `selected`. */
-export function rxMarker(ctx, p, label, selected) {
-  if (selected) ring(ctx, p, 11);
-  ctx.beginPath(); ctx.arc(p.x, p.y, 6, 0, FULL);
-  ctx.fillStyle = C.rx; ctx.fill();
-  ctx.lineWidth = 2; ctx.strokeStyle = '#1b1f27'; ctx.stroke();
-  ctx.fillStyle = C.rx;
-  ctx.textBaseline = 'bottom';
-  haloText(ctx, label, p.x + 9, p.y - 5);
-}
-
-/** A transmitter marker (triangle) at pixel `p` with its label below right; ringed when `selected`. */
-export function txMarker(ctx, p, label, selected) {
-  if (selected) ring(ctx, p, 12);
-  ctx.beginPath();
-  ctx.moveTo(p.x, p.y - 9); ctx.lineTo(p.x + 8, p.y + 6); ctx.lineTo(p.x - 8, p.y + 6); ctx.closePath();
-  ctx.fillStyle = C.tx; ctx.fill();
-  ctx.lineWidth = 1.5; ctx.strokeStyle = '#1b1f27'; ctx.stroke();
-  ctx.fillStyle = C.tx;
-  ctx.textBaseline = 'top';
-  haloText(ctx, label, p.x + 9, p.y + 5);
-  ctx.textBaseline = 'bottom';
+  ctx.globalAlpha = 1;
 }
 
 /** Iso-delay ellipses and markers of the simulated snapshot in the main view. */
 function drawTargetMain(ctx, view, fix) {
-  const r = view.rect;
-  ctx.save();
-  ctx.beginPath(); ctx.rect(r.x, r.y, r.w, r.h); ctx.clip();
+  clipTo(ctx, view.rect);
   ctx.lineWidth = 1;
-  fix.links.forEach((l, i) => {
-    if (l.outline.length < 3) return;
-    ctx.strokeStyle = LINK_COLORS[i % LINK_COLORS.length];
-    ctx.globalAlpha = 0.7;
-    polyline(ctx, view, l.outline, true);
-    ctx.stroke();
-  });
-  ctx.globalAlpha = 1;
+  linkCurves(ctx, view, fix.links, 'outline', 0.7);
   ctx.restore();
   const t = view.toPixel(fix.truth.x, fix.truth.y);
   cross(ctx, t, 6, '#0d1017', 4);
@@ -274,18 +224,10 @@ function drawInset(ctx, view, fix, w, title, avoid) {
   ctx.fillStyle = 'rgba(13,16,23,0.94)';
   ctx.fillRect(box.x, box.y, size, size);
   ctx.restore();
-  ctx.save();
-  ctx.beginPath(); ctx.rect(box.x, box.y, size, size); ctx.clip();
+  clipTo(ctx, { x: box.x, y: box.y, w: size, h: size });
   ctx.lineWidth = 1.25;
   // The core hands over only the arc near the target, so no path is millions of pixels wide.
-  fix.links.forEach((l, i) => {
-    if (l.arc.length < 2) return;
-    ctx.strokeStyle = LINK_COLORS[i % LINK_COLORS.length];
-    ctx.globalAlpha = 0.85;
-    polyline(ctx, z, l.arc, false);
-    ctx.stroke();
-  });
-  ctx.globalAlpha = 1;
+  linkCurves(ctx, z, fix.links, 'arc', 0.85);
   const c = z.toPixel(fix.truth.x, fix.truth.y);
   if (fix.crlb.ellipse) {
     ctx.setLineDash([5, 4]); ctx.lineWidth = 2; ctx.strokeStyle = C.crlb;
@@ -326,7 +268,7 @@ function drawInset(ctx, view, fix, w, title, avoid) {
  * frame), `st.overlay(ctx, view)` draws extra layers under the markers, `st.insetTitle` names
  * the zoom inset and `st.insetAvoid` lists points it should not cover.
  */
-export function drawScene(view, st, w) {
+function drawScene(view, st, w) {
   const ctx = view.context();
   ctx.fillStyle = C.bg;
   ctx.fillRect(0, 0, view.width, view.height);
@@ -335,12 +277,12 @@ export function drawScene(view, st, w) {
   drawColorbar(ctx, view, st, w);
   if (st.overlay) st.overlay(ctx, view);
   if (st.fix) drawTargetMain(ctx, view, st.fix);
-  drawNetwork(ctx, view, st);
+  drawNetwork(ctx, view, st.nodes, st.selected);
   if (st.fix) drawInset(ctx, view, st.fix, w, st.insetTitle || 'target zoom', st.insetAvoid || []);
 }
 
 /** A 1-pixel-wide canvas holding the colour bar gradient (dark first = bottom). */
-export function makeBarCanvas(rgba) {
+function makeBarCanvas(rgba) {
   const n = rgba.length / 4;
   const c = document.createElement('canvas');
   c.width = 1;

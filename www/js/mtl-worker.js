@@ -4,7 +4,8 @@
 // view, ms} (ms = this worker's time for the call), {type: 'error', gen, message} and, once the
 // wasm module is compiled, {type: 'ready'}.
 
-import init, { MtlSession } from './pkg/scatterloc.js';
+import init, { MtlSession } from '../pkg/scatterloc.js';
+import { errorText } from './dom.js';
 
 let session = null;
 const ready = init().then(() => {
@@ -34,7 +35,7 @@ async function loop() {
         const view = session.view(m.scene);
         self.postMessage({ type: 'view', gen: m.gen, view, ms: performance.now() - t0 });
       } catch (err) {
-        self.postMessage({ type: 'error', gen: m.gen, message: String((err && err.message) || err) });
+        self.postMessage({ type: 'error', gen: m.gen, message: errorText(err) });
       }
       await pause();
     }

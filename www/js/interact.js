@@ -1,29 +1,37 @@
-// Mouse/pointer handling on the plot: drag Tx/Rx markers, click to place a target (snapshot mode) or
-// press-and-drag a trajectory (tracking mode, "draw"), hover read-out.
+// Mouse/pointer handling on the plot for the snapshot and tracking views: drag Tx/Rx markers,
+// click to place a target (snapshot mode) or press-and-drag a trajectory (tracking mode, "draw"),
+// hover read-out. pickNearest is the hit test of every view (mtl.js uses it too).
 
-import { showError, clearError } from './panel.js';
+import { $, errorText, showError, clearError } from './dom.js';
 
 const HIT_PX = 12; // pick radius around a marker, CSS px
 const CLICK_PX = 4; // a press that moves less than this is a click
 
-/** The node under a canvas pixel, or null. */
-export function hitNode(view, nodes, p) {
+/**
+ * The object nearest to canvas pixel `p` within HIT_PX, or null: `groups` = [[kind, points,
+ * extraPx = 0], …] with points [x, y] or {x, y} (m) and `extraPx` their radius on screen; on a
+ * tie the later group wins. Returns {kind, index}.
+ */
+export function pickNearest(view, groups, p) {
   let best = null;
   let bestD = HIT_PX;
-  const test = (kind, list) => list.forEach((n, index) => {
-    const q = view.toPixel(n.x, n.y);
-    const d = Math.hypot(q.x - p.x, q.y - p.y);
-    if (d <= bestD) { best = { kind, index }; bestD = d; }
-  });
-  test('rx', nodes.receivers);
-  test('tx', nodes.transmitters);
+  for (const [kind, list, extra = 0] of groups) {
+    list.forEach((q, index) => {
+      const c = Array.isArray(q) ? view.toPixel(q[0], q[1]) : view.toPixel(q.x, q.y);
+      const d = Math.hypot(c.x - p.x, c.y - p.y) - extra;
+      if (d <= bestD) { best = { kind, index }; bestD = d; }
+    });
+  }
   return best;
 }
+
+/** The Tx/Rx node under a canvas pixel ({kind, index}), or null. */
+const hitNode = (view, nodes, p) => pickNearest(view, [['rx', nodes.receivers], ['tx', nodes.transmitters]], p);
 
 export function attachPointer(ctx) {
   const { view, st, app } = ctx;
   const canvas = view.canvas;
-  const readout = document.getElementById('readout');
+  const readout = $('readout');
   let press = null; // { start: {x, y}, node: {kind, index} | null, moved }
 
   const hover = (p) => {
@@ -66,14 +74,14 @@ export function attachPointer(ctx) {
       press.moved = true;
       // Keep the node inside the plotted area (clamped in pixels).
       const r = view.rect;
-      const m = view.toMetre(Math.min(Math.max(p.x, r.x), r.x + r.w), Math.min(Math.max(p.y, r.y), r.y + r.h));
+      const m = view.toMetreWithin(p, r, { x: r.x + r.w, y: r.y + r.h });
       try {
         if (press.node.kind === 'tx') app.move_transmitter(press.node.index, m.x, m.y);
         else app.move_receiver(press.node.index, m.x, m.y);
         clearError();
         ctx.changed({ all: true, dragging: true });
       } catch (e) {
-        showError(e.message);
+        showError(errorText(e));
       }
     } else if (press && press.draw) {
       ctx.tracking.drawMove(view.toMetre(p.x, p.y));

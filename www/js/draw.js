@@ -1,0 +1,159 @@
+// Canvas drawing shared by the views (map, tracking, multi-target): colours, fonts, paths
+// through a transform (View or Zoom), markers, axes. Every number drawn comes from the wasm core;
+// this file only places it on the canvas.
+
+export const C = {
+  bg: '#141922',
+  frame: '#3a4456',
+  text: '#c9d2e0',
+  muted: '#8a94a6',
+  grid: 'rgba(255,255,255,0.10)',
+  tx: '#ff6b6b',
+  rx: '#f4f4f0',
+  fix: '#ffa94d',
+  crlb: '#5cc8ff',
+  sel: '#5cc8ff',
+  iso: 'rgba(255,255,255,0.62)',
+  baseline: 'rgba(255,255,255,0.28)',
+};
+const LINK_COLORS = ['#f4f4f0', '#ffd166', '#9be564', '#ff8fab', '#b8c0ff', '#7ee8fa', '#ffb86b', '#d0a2f7'];
+/** The plot colour of link (or TRP) `i`. */
+export const linkColor = (i) => LINK_COLORS[i % LINK_COLORS.length];
+export const FONT = '11.5px system-ui, -apple-system, "Segoe UI", Roboto, sans-serif';
+export const FONT_B = '600 11.5px system-ui, -apple-system, "Segoe UI", Roboto, sans-serif';
+export const FULL = 2 * Math.PI;
+
+/**
+ * Ellipse {cx, cy, a, b, angle} through a transform (View or Zoom); y flips the angle's sign.
+ * `magnify` enlarges it on screen only (a labelled exaggeration).
+ */
+export function ellipsePath(ctx, tr, e, magnify = 1) {
+  const c = tr.toPixel(e.cx, e.cy);
+  ctx.beginPath();
+  ctx.ellipse(c.x, c.y, tr.len(e.a) * magnify, tr.len(e.b) * magnify, -e.angle, 0, FULL);
+}
+
+/** A path through points [[x, y], …] (m) via a transform. */
+export function polyline(ctx, tr, points, closed) {
+  ctx.beginPath();
+  points.forEach(([x, y], k) => {
+    const q = tr.toPixel(x, y);
+    if (k === 0) ctx.moveTo(q.x, q.y); else ctx.lineTo(q.x, q.y);
+  });
+  if (closed) ctx.closePath();
+}
+
+/** Saves the context and clips it to the rectangle `r` {x, y, w, h} (CSS px); undo with ctx.restore(). */
+export function clipTo(ctx, r) {
+  ctx.save();
+  ctx.beginPath(); ctx.rect(r.x, r.y, r.w, r.h); ctx.clip();
+}
+
+export function cross(ctx, p, r, color, width) {
+  ctx.strokeStyle = color;
+  ctx.lineWidth = width;
+  ctx.beginPath();
+  ctx.moveTo(p.x - r, p.y - r); ctx.lineTo(p.x + r, p.y + r);
+  ctx.moveTo(p.x - r, p.y + r); ctx.lineTo(p.x + r, p.y - r);
+  ctx.stroke();
+}
+
+export function haloText(ctx, text, x, y) {
+  ctx.lineWidth = 3;
+  ctx.strokeStyle = 'rgba(10,12,18,0.85)';
+  ctx.strokeText(text, x, y);
+  ctx.fillText(text, x, y);
+}
+
+/** Grid, tick labels (from the core's `axis_ticks`), axis titles and the frame of the plot rectangle. */
+export function drawAxes(ctx, view, w) {
+  const r = view.rect;
+  const [x0, x1, y0, y1] = view.area;
+  ctx.font = FONT;
+  ctx.fillStyle = C.text;
+  ctx.strokeStyle = C.grid;
+  ctx.lineWidth = 1;
+  const xt = w.axis_ticks(x0, x1, Math.max(2, Math.floor(r.w / 70)));
+  const yt = w.axis_ticks(y0, y1, Math.max(2, Math.floor(r.h / 50)));
+  ctx.beginPath();
+  for (const t of xt) {
+    const p = view.toPixel(t.value, y0);
+    ctx.moveTo(Math.round(p.x) + 0.5, r.y); ctx.lineTo(Math.round(p.x) + 0.5, r.y + r.h + 5);
+  }
+  for (const t of yt) {
+    const p = view.toPixel(x0, t.value);
+    ctx.moveTo(r.x - 5, Math.round(p.y) + 0.5); ctx.lineTo(r.x + r.w, Math.round(p.y) + 0.5);
+  }
+  ctx.stroke();
+  ctx.textAlign = 'center';
+  ctx.textBaseline = 'top';
+  for (const t of xt) ctx.fillText(t.label, view.toPixel(t.value, y0).x, r.y + r.h + 8);
+  ctx.textAlign = 'right';
+  ctx.textBaseline = 'middle';
+  for (const t of yt) ctx.fillText(t.label, r.x - 8, view.toPixel(x0, t.value).y);
+  ctx.fillStyle = C.muted;
+  ctx.textAlign = 'center';
+  ctx.textBaseline = 'alphabetic';
+  ctx.fillText('x (m)', r.x + r.w / 2, r.y + r.h + 36);
+  ctx.save();
+  ctx.translate(r.x - 42, r.y + r.h / 2);
+  ctx.rotate(-Math.PI / 2);
+  ctx.fillText('y (m)', 0, 0);
+  ctx.restore();
+  ctx.strokeStyle = C.frame;
+  ctx.strokeRect(Math.round(r.x) + 0.5, Math.round(r.y) + 0.5, Math.round(r.w), Math.round(r.h));
+}
+
+/** A selection ring of radius `r` px around pixel `p`. */
+export function ring(ctx, p, r) {
+  ctx.beginPath(); ctx.arc(p.x, p.y, r, 0, FULL);
+  ctx.lineWidth = 2; ctx.strokeStyle = C.sel; ctx.stroke();
+}
+
+/** A receiver marker (disc) at pixel `p` with its label above right; ringed when `selected`. */
+function rxMarker(ctx, p, label, selected) {
+  if (selected) ring(ctx, p, 11);
+  ctx.beginPath(); ctx.arc(p.x, p.y, 6, 0, FULL);
+  ctx.fillStyle = C.rx; ctx.fill();
+  ctx.lineWidth = 2; ctx.strokeStyle = '#1b1f27'; ctx.stroke();
+  ctx.fillStyle = C.rx;
+  ctx.textBaseline = 'bottom';
+  haloText(ctx, label, p.x + 9, p.y - 5);
+}
+
+/** A transmitter marker (triangle) at pixel `p` with its label below right; ringed when `selected`. */
+function txMarker(ctx, p, label, selected) {
+  if (selected) ring(ctx, p, 12);
+  ctx.beginPath();
+  ctx.moveTo(p.x, p.y - 9); ctx.lineTo(p.x + 8, p.y + 6); ctx.lineTo(p.x - 8, p.y + 6); ctx.closePath();
+  ctx.fillStyle = C.tx; ctx.fill();
+  ctx.lineWidth = 1.5; ctx.strokeStyle = '#1b1f27'; ctx.stroke();
+  ctx.fillStyle = C.tx;
+  ctx.textBaseline = 'top';
+  haloText(ctx, label, p.x + 9, p.y + 5);
+  ctx.textBaseline = 'bottom';
+}
+
+/** True if `sel` ({kind, index} or null) is object `index` of `kind`. */
+export function isSelected(sel, kind, index) {
+  return !!sel && sel.kind === kind && sel.index === index;
+}
+
+/**
+ * Receiver discs, then transmitter triangles (with a boresight tick where a node has one), each
+ * labelled; nodes are {x, y, name, boresight?} (m); `sel` {kind: 'rx' | 'tx', index} is ringed.
+ */
+export function drawNodes(ctx, view, receivers, transmitters, sel) {
+  ctx.font = FONT_B;
+  ctx.textAlign = 'left';
+  receivers.forEach((n, i) => rxMarker(ctx, view.toPixel(n.x, n.y), n.name, isSelected(sel, 'rx', i)));
+  transmitters.forEach((n, i) => {
+    const p = view.toPixel(n.x, n.y);
+    if (n.boresight) {
+      ctx.strokeStyle = C.tx; ctx.lineWidth = 2;
+      ctx.beginPath(); ctx.moveTo(p.x, p.y);
+      ctx.lineTo(p.x + 26 * n.boresight[0], p.y - 26 * n.boresight[1]); ctx.stroke();
+    }
+    txMarker(ctx, p, n.name, isSelected(sel, 'tx', i));
+  });
+}

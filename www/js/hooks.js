@@ -1,0 +1,86 @@
+// Every hook the end-to-end tests (tests/e2e.rs, tests/e2e/*.rs) and the console use, in one
+// place: the `window` names below, and the body's data-ready / data-error attributes. The names
+// are read by the tests; keep them.
+//
+//   window.__consoleErrors   every console.error, page error and unhandled rejection (text)
+//   window.app               the core's App (scenario, nodes, map kernel)
+//   window.view              the map view's pixel <-> metre transform (View)
+//   window.wasm              the wasm module
+//   window.pageState         the page state (mode, nodes, target, …)
+//   window.mapCanvas         the CRLB map image (one pixel per cell)
+//   window.pageIdle()        true when no redraw is pending
+//   window.placeTarget(x, y) places the snapshot target (m)
+//   window.tracking          {state, setMode, play, pause, seek, restartMc, mcParams, mcResult}
+//   window.mtl               {state, setScene, pixelFromCentre, bench, setMode}
+//   window.importScenarioText(text, name)  loads scenario JSON as an imported file would
+//   window.benchMap(n)       n runs of the map kernel at the current resolution: core-timed ms
+//   body[data-ready='1']     the page is up;  body[data-error]  it failed (the message)
+
+/**
+ * Records every error from now on in `window.__consoleErrors` and marks the body with the first
+ * uncaught one, so the tests fail fast with the message. main.js calls it before loading the page.
+ */
+export function captureErrors() {
+  window.__consoleErrors = [];
+  const orig = console.error.bind(console);
+  console.error = (...args) => {
+    window.__consoleErrors.push(args.map(String).join(' '));
+    orig(...args);
+  };
+  const fail = (msg) => {
+    window.__consoleErrors.push(msg);
+    markFailed(msg);
+  };
+  addEventListener('error', (e) => fail(e.message ? `error: ${e.message}`
+    : `failed to load ${(e.target && (e.target.src || e.target.href)) || 'a resource'}`), true);
+  addEventListener('unhandledrejection', (e) => fail(`unhandledrejection: ${(e.reason && e.reason.message) || e.reason}`));
+}
+
+/** body[data-error] = the message (the tests stop waiting on it). */
+export function markFailed(msg) {
+  if (document.body) document.body.dataset.error = msg;
+  else addEventListener('DOMContentLoaded', () => { document.body.dataset.error = msg; });
+}
+
+/**
+ * Registers the window hooks once the page is up, then sets body[data-ready].
+ * @param {object} p - {app, wasm, view, st, isIdle, setMode, panel, tracking, mtl, placeTarget}
+ */
+export function registerHooks(p) {
+  const { app, st, tracking, mtl } = p;
+  Object.assign(window, {
+    app,
+    view: p.view,
+    wasm: p.wasm,
+    pageState: st,
+    mapCanvas: st.mapCanvas,
+    pageIdle: p.isIdle,
+    placeTarget: p.placeTarget,
+    tracking: {
+      state: () => tracking.state(),
+      setMode: p.setMode,
+      play: () => tracking.play(),
+      pause: () => tracking.pause(),
+      seek: (n) => tracking.seek(n),
+      restartMc: () => tracking.startMc(),
+      mcParams: () => tracking.mc.params,
+      mcResult: () => (tracking.mc.result ? JSON.parse(tracking.mc.result) : null),
+    },
+    mtl: {
+      state: () => mtl.state(),
+      setScene: (s) => mtl.setScene(s),
+      pixelFromCentre: (x, y) => mtl.pixelFromCentre(x, y),
+      bench: (n) => mtl.bench(n),
+      setMode: p.setMode,
+    },
+    importScenarioText: (text, name) => p.panel.importText(text, name),
+    benchMap: (n = 9) => {
+      const r = st.res;
+      const buf = new Float64Array(r * r);
+      const kernel = [];
+      for (let i = 0; i < n; i++) kernel.push(app.compute_map(r, r, buf));
+      return { res: r, kernel_ms: kernel };
+    },
+  });
+  document.body.dataset.ready = '1';
+}
