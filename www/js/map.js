@@ -118,10 +118,14 @@ function drawColorbar(ctx, view, st, w) {
   ctx.textAlign = 'left';
   ctx.textBaseline = 'middle';
   const [min, max] = st.range || [Infinity, Infinity];
-  for (const t of w.colorbar_ticks(min, max)) {
+  // The figures' algorithm (core colorbar_ticks): labels thinned to the bar's height, minor
+  // ticks (empty label) drawn shorter.
+  const maxLabels = Math.max(2, Math.floor(r.h / 24));
+  for (const t of w.colorbar_ticks(min, max, maxLabels)) {
     const y = r.y + r.h - t.frac * r.h;
-    ctx.beginPath(); ctx.moveTo(bx + bw, y); ctx.lineTo(bx + bw + 5, y); ctx.stroke();
-    ctx.fillText(t.label, bx + bw + 8, y);
+    const len = t.label ? 5 : 3;
+    ctx.beginPath(); ctx.moveTo(bx + bw, y); ctx.lineTo(bx + bw + len, y); ctx.stroke();
+    if (t.label) ctx.fillText(t.label, bx + bw + 8, y);
   }
   // Unbounded swatch under the bar.
   ctx.fillStyle = st.unboundedColor;
