@@ -2,7 +2,8 @@
 //! Tracking, the posterior CRLB (spec §8, E9): spec checks 5, 9 (against the Monte Carlo bound)
 //! and 10. Monte Carlo tolerances are derived from the Monte Carlo standard error and stated
 //! where used. Runs too slow for a debug build are `#[ignore]` (run them with
-//! `cargo test --release --test tracking_pcrlb -- --ignored`); a smaller variant of each always runs.
+//! `cargo test --release --test tracking_pcrlb -- --ignored`); a smaller variant of each always
+//! runs.
 //! (Split from the former `tracking.rs`.)
 
 mod common;
@@ -192,9 +193,9 @@ fn pcrlb_and_jackknife_se(cfg: &MonteCarloConfig, sums: &[Mat2]) -> ([Real; 4], 
 ///
 /// The claim. The spec's "within 5 %" is a statement about the quantity a 5000-trajectory run
 /// estimates; a single run scatters around it by its Monte Carlo error. That error is small
-/// (jackknife SE ≤ 0.2 % at 1 and 2 s, ≤ 0.6 % in I and II at 5 s, 0.4 % in I at 10 s) except
-/// where trajectories can pass near a node, where F(r) is large (SNR floored at 1 m) and E[F]
-/// heavy-tailed: II at 10 s has SE ≈ 2.6 % and III at 5 s 1.5–4 %. Seeds 1–5 give II at 10 s
+/// (jackknife SE ≤ 0.2 % at 1 and 2 s, ≤ 0.6 % in I and II at 5 s, ≤ 0.4 % in I and ≤ 1 % in
+/// III at 10 s) except where trajectories can pass near a node, where F(r) is large (SNR
+/// floored at 1 m) and E[F] heavy-tailed: II at 10 s has SE ≈ 2.6 % and III at 5 s 1.4–4 %. Seeds 1–5 give II at 10 s
 /// = 1.327, 1.339, 1.363, 1.266, 1.275 cm against the table's 1.29 (seed 3: +5.7 %) and III at
 /// 5 s = 1.410, 1.434, 1.329, 1.397, 1.393 cm against 1.39, so "every 5000-trajectory run is
 /// within 5 %" is false for this implementation (the old one-seed test passed because seed 1
