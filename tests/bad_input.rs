@@ -10,6 +10,10 @@ use scatterloc::scenario::presets::{self, preset};
 use scatterloc::scenario::{Area, LinkSpec, Pattern, Scenario};
 use scatterloc::{Error, Model};
 
+mod common;
+
+use common::noise_free;
+
 const NAN: Real = Real::NAN;
 const INF: Real = Real::INFINITY;
 
@@ -433,8 +437,7 @@ fn lm_fixture() -> Fixture {
     let s = l4();
     let model = Model::new(&s).unwrap();
     let truth = Vec2::new(4.0, 1.0);
-    let delays = model.network.delays(truth).into_iter().map(Some).collect();
-    let sigmas = model.sigma_delays(truth);
+    let (delays, sigmas) = noise_free(&model, truth);
     Fixture {
         model,
         area: s.area_m,
@@ -694,8 +697,7 @@ fn receiver_on_transmitter_gives_no_nan() {
     assert!(out.iter().all(|v| !v.is_nan() && *v > 0.0));
     // LM: noise-free fix still works, and starting exactly on the node does not panic.
     let truth = Vec2::new(4.0, 1.0);
-    let delays: Vec<Option<Real>> = m.network.delays(truth).into_iter().map(Some).collect();
-    let sigmas = m.sigma_delays(truth);
+    let (delays, sigmas) = noise_free(&m, truth);
     let meas = DelayMeasurements {
         delays_s: &delays,
         sigmas_s: &sigmas,

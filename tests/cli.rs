@@ -10,9 +10,10 @@ use scatterloc::scenario::Area;
 use scatterloc::{scenario::presets, Model, Scenario, Vec2};
 use serde_json::{json, Value};
 
-mod cli_support;
+mod common;
 
-use cli_support::{fails, ok_json, run, TempDir, BIN};
+use common::cli::{fails, ok_json, run, TempDir, BIN};
+use common::within_rel;
 
 fn preset_file(dir: &TempDir, name: &str) -> String {
     let out = run(&["preset", name]);
@@ -25,10 +26,6 @@ fn preset_file(dir: &TempDir, name: &str) -> String {
 
 fn sensors_value() -> Value {
     serde_json::from_str(&presets::sensors2019().to_json()).unwrap()
-}
-
-fn close(a: f64, b: f64, rel: f64) -> bool {
-    (a - b).abs() <= rel * b.abs()
 }
 
 #[test]
@@ -51,12 +48,12 @@ fn crlb_matches_spec_check_7() {
     assert_eq!(v["bounded"], json!(true));
     assert_eq!(v["position_m"], json!([10.0, 0.0]));
     let rmse = v["rmse_bound_m"].as_f64().unwrap();
-    assert!(close(rmse, 0.00792, 1e-3), "{rmse}");
+    assert!(within_rel(rmse, 0.00792, 1e-3), "{rmse}");
     let (sx, sy) = (
         v["sigma_x_m"].as_f64().unwrap(),
         v["sigma_y_m"].as_f64().unwrap(),
     );
-    assert!(close((sx * sx + sy * sy).sqrt(), rmse, 1e-12));
+    assert!(within_rel((sx * sx + sy * sy).sqrt(), rmse, 1e-12));
     let f = &v["fim_per_m2"];
     assert_eq!(f[0][1], f[1][0]);
     let links = v["links"].as_array().unwrap();
@@ -79,7 +76,7 @@ fn crlb_matches_spec_check_7() {
     for (at, cm) in [("4,1", 0.426), ("20,10", 4.864), ("0,20", 17.69)] {
         let v = ok_json(&["crlb", "--scenario", &s, "--at", at]);
         let got = v["rmse_bound_m"].as_f64().unwrap() * 100.0;
-        assert!(close(got, cm, 1e-3), "{at}: {got} cm");
+        assert!(within_rel(got, cm, 1e-3), "{at}: {got} cm");
     }
 }
 
@@ -153,7 +150,7 @@ fn crlb_map_json_matches_core() {
             assert_eq!(ys[j].as_f64().unwrap(), y);
             let want = crlb_at(&model, Vec2::new(x, y)).bound.unwrap().rmse_m;
             let got = cell.as_f64().unwrap();
-            assert!(close(got, want, 1e-12), "({i},{j}): {got} vs {want}");
+            assert!(within_rel(got, want, 1e-12), "({i},{j}): {got} vs {want}");
         }
     }
     let min = summary["min_m"].as_f64().unwrap();
@@ -592,5 +589,9 @@ fn scenario_from_stdin() {
     let out = child.wait_with_output().unwrap();
     assert!(out.status.success());
     let v: Value = serde_json::from_slice(&out.stdout).unwrap();
-    assert!(close(v["rmse_bound_m"].as_f64().unwrap(), 0.00792, 1e-3));
+    assert!(within_rel(
+        v["rmse_bound_m"].as_f64().unwrap(),
+        0.00792,
+        1e-3
+    ));
 }

@@ -2,13 +2,13 @@
 //! §9.6): the three commands chained as the README shows, and named errors for bad input.
 #![cfg(not(target_arch = "wasm32"))]
 
-mod cli_support;
+mod common;
 
 use scatterloc::math::SPEED_OF_LIGHT;
 use scatterloc::{scenario::presets, Model, Vec2};
 use serde_json::{json, Value};
 
-use cli_support::{fails, floats, ok_json, read_json, TempDir};
+use common::cli::{fails, floats, ok_json, read_json, TempDir};
 
 /// Writes the sensors2019 scenario into `dir`; returns its path.
 fn scenario_file(dir: &TempDir) -> String {

@@ -3,14 +3,14 @@
 //! trajectories, and Ctrl-C leaving no files behind.
 #![cfg(not(target_arch = "wasm32"))]
 
-mod cli_support;
+mod common;
 
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 use serde_json::json;
 
-use cli_support::{floats, ok_json_line, read_json, TempDir, BIN, FAST};
+use common::cli::{floats, ok_json_line, read_json, TempDir, BIN, FAST};
 
 #[test]
 fn montecarlo_fast_profile_writes_curves_and_figure() {

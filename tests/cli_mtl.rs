@@ -3,11 +3,11 @@
 //! (check 4) and small `roc` runs writing JSON and figures. Few realisations: fast in debug.
 #![cfg(not(target_arch = "wasm32"))]
 
-mod cli_support;
+mod common;
 
 use serde_json::{json, Value};
 
-use cli_support::{fails, ok_json_line, read_json, run, TempDir};
+use common::cli::{fails, ok_json_line, read_json, run, TempDir};
 
 /// The V-A hexagon of §7: TX at 90°, 210°, 330°, RX at 30°, 150°, 270° on radius 5 m about (5, 5).
 fn hexagon() -> (Vec<[f64; 2]>, Vec<[f64; 2]>) {

@@ -3,12 +3,12 @@
 //! (§8, check 9) and the Monte Carlo bound, and bad study flags. `montecarlo`: cli_montecarlo.rs.
 #![cfg(not(target_arch = "wasm32"))]
 
-mod cli_support;
+mod common;
 
 use scatterloc::{scenario::presets, Model, Vec2};
 use serde_json::{json, Value};
 
-use cli_support::{fails, floats, ok_json_line, read_json, run, TempDir};
+use common::cli::{fails, floats, ok_json_line, read_json, run, TempDir};
 
 /// A straight path from (4, 1) at (1.4, 0.25) m/s sampled every 0.1 s.
 fn truth(n: usize) -> Vec2 {

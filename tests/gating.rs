@@ -16,7 +16,11 @@ use scatterloc::math::{erfc, sqrt, Real, Vec2, Vec4};
 use scatterloc::track::paper_initial_covariance;
 use scatterloc::track::ConstantVelocity;
 use scatterloc::track::{Ekf, MeasurementNoise};
-use scatterloc::{measure, scenario::presets, Model};
+use scatterloc::{measure, scenario::presets};
+
+mod common;
+
+use common::sensors_model as model;
 
 /// Spec check 12: the probability that a Gaussian static estimate falls within 3σ, 0.9973.
 const P_GATE: Real = 0.9973;
@@ -29,10 +33,6 @@ fn bandwidth() -> Real {
 /// `false_alarms` per link and snapshot.
 fn channel(false_alarms: Real) -> StaticChannel {
     default_channel(bandwidth(), false_alarms)
-}
-
-fn model() -> Model {
-    Model::new(&presets::sensors2019()).unwrap()
 }
 
 /// Check 12 in closed form and by Monte Carlo on a known cluster: `P(|τ − τ̄| ≤ 3σ̄) =
@@ -124,6 +124,8 @@ struct LoopStats {
     unresolved: usize,
     /// Of those, the pairs left without a measurement.
     dropped: usize,
+    /// Static paths of the links over those pairs (the estimates that could leak in).
+    unresolved_static_paths: usize,
     /// Steps whose position error is inside the filter's 99.9 % χ²(2) ellipse (13.8).
     consistent: usize,
     /// Largest position error after the first second, m.
@@ -133,20 +135,32 @@ struct LoopStats {
 const LOOP_STEPS: usize = 600;
 
 impl LoopStats {
-    /// The tracking bounds shared by the loop tests: the echo taken at ≥ 99.5 % of the resolved
-    /// pairs, the error inside the filter's 99.9 % ellipse at ≥ 98 % of the steps and below
-    /// 20 cm after the first second (a divergence guard: the CRLB along the loop is a few mm to
-    /// cm, more where links drop out).
+    /// The tracking bounds shared by the loop tests, each a claim about every seed:
+    /// - the echo taken at ≥ 99.2 % of the resolved pairs. A resolved echo is missed when noise
+    ///   or a false alarm inside the innovation gate wins the association; pooled over seeds
+    ///   1–8 the three gated loop tests miss 52 of 44 712 resolved pairs (p̂ = 0.12 %; the worst
+    ///   run, seed 7 with false alarms, 11 of 1863). With p = 0.12 % a run's 1863 pairs give 2.2
+    ///   misses, binomial SE 1.5; 99.2 % allows 14, 8 SE above the mean, leaving room for the
+    ///   clustering of misses in time (one perturbed step misses several links) that makes the
+    ///   count over-dispersed;
+    /// - the error inside the filter's 99.9 % ellipse at ≥ 98 % of the steps (a consistent filter
+    ///   leaves 0.1 %, 0.6 of 600 steps; 12 allowed; seeds 1–8: 0 to 6 outside);
+    /// - a divergence guard: the error stays below 0.5 m after the first second. The CRLB along
+    ///   the loop is a few mm to cm, more where links drop out; tracked runs reach 0.09–0.26 m
+    ///   (seeds 1–8, the maximum over 590 steps including the blind zones), lost ones ≥ 1 m.
     fn assert_tracked(&self) {
         let st = self;
         assert!(
-            st.echo_taken as Real >= 0.995 * st.resolved as Real,
+            st.echo_taken as Real >= 0.992 * st.resolved as Real,
             "{st:?}"
         );
         assert!(st.consistent as Real >= 0.98 * LOOP_STEPS as Real, "{st:?}");
-        assert!(st.worst_after_1s_m < 0.20, "{st:?}");
+        assert!(st.worst_after_1s_m < 0.5, "{st:?}");
     }
 }
+
+/// Seeds of the loop tests (fixed in advance, not picked from results; the old tests used 96–98).
+const LOOP_SEEDS: std::ops::RangeInclusive<u64> = 1..=8;
 
 /// Spec §9.6 synthetic stand-in: 60 s on the loop at T = 0.1 s (600 snapshots) with the static
 /// paths of [`channel`] and `false_alarms` per link and snapshot, after a calibration of 500
@@ -202,6 +216,7 @@ fn run_loop_from(
         echo_taken: 0,
         unresolved: 0,
         dropped: 0,
+        unresolved_static_paths: 0,
         consistent: 0,
         worst_after_1s_m: 0.0,
     };
@@ -220,6 +235,7 @@ fn run_loop_from(
                 }
             } else {
                 st.unresolved += 1;
+                st.unresolved_static_paths += ch.static_delays(&model, p).len();
                 if step.selection.choices[p] == Choice::Absent {
                     st.dropped += 1;
                 }
@@ -240,13 +256,14 @@ fn run_loop_from(
     st
 }
 
-/// The loop under the gated rule without false alarms (seeds 96, 97): blind-zone pairs drop out
+/// The loop under the gated rule without false alarms, seeds 1–8: blind-zone pairs drop out
 /// (≥ 99 %: only a static estimate that leaked through the 3σ gate, 0.27 % each by check 12,
-/// and fell inside the innovation gate could stand in); the loop does cross blind zones (the
-/// Tx–Rx2 baseline's among them); and the bounds of [`LoopStats::assert_tracked`] hold.
+/// and fell inside the innovation gate could stand in; seeds 1–8 keep 0 or 1 of 537); the loop
+/// does cross blind zones (the Tx–Rx2 baseline's among them); and the bounds of
+/// [`LoopStats::assert_tracked`] hold.
 #[test]
 fn gated_ekf_tracks_the_loop_through_blind_zones() {
-    for seed in [96, 97] {
+    for seed in LOOP_SEEDS {
         let st = run_loop(0.0, AssociationRule::Gated, seed);
         assert!(st.unresolved > 0, "{st:?}");
         assert!(st.dropped as Real >= 0.99 * st.unresolved as Real, "{st:?}");
@@ -255,36 +272,56 @@ fn gated_ekf_tracks_the_loop_through_blind_zones() {
 }
 
 /// With 0.5 false alarms per link and snapshot the gated rule keeps the track (bounds as above;
-/// blind-zone pairs drop out unless a false alarm falls inside the innovation gate), while the
-/// spec's rule, which takes a lone candidate however far from the prediction, loses it (an error
-/// of metres). The spec's rule fails the same way without false alarms whenever a static
-/// estimate leaks through the gate (0.27 %) on a link whose echo is in a blind zone — on this
-/// loop with seed 96 that happens twice and the track is lost.
+/// blind-zone pairs drop out unless a false alarm falls inside the innovation gate: ≥ 90 %,
+/// seeds 1–8 drop ≥ 534 of 537), while the spec's rule, which takes a lone candidate however
+/// far from the prediction, loses it (an error of metres) for every seed: a blind-zone pair has
+/// a false alarm as its lone candidate with probability 1 − e^(−0.5) = 39 %, ≈ 200 wild updates
+/// per run (seeds 1–8: worst errors 44 m to 7.9 km).
+///
+/// Without false alarms the spec's rule takes a static estimate that leaked through the 3σ
+/// gate (0.27 % each, check 12) whenever its link's echo is in a blind zone. The number of such
+/// leaks is a count of rare independent events: Poisson with mean `λ = 0.0027 · Σ (static paths
+/// of the link)` over the blind-zone pairs (≈ 2.9 per run, 23 over the 8 seeds); pooled over the
+/// seeds it must lie within λ ± 4.5 √λ (seeds 1–8: 4, 4, 4, 3, 2, 6, 4, 4, total 31). Whether a
+/// leak loses the track depends on how far the static path is from the echo (up to the
+/// resolution, 2.5 m of range), so the claim per seed is not "the track is lost" (a seed with no
+/// leak, probability e^(−2.9) ≈ 5 %, keeps it); asserted is that the spec rule's track is lost
+/// (> 1 m) in most seeds (≥ 5 of 8; seeds 1–8: all 8, worst errors 1.05 m to 164 m).
 #[test]
 fn gated_association_survives_false_alarms_and_leaks_where_the_spec_rule_does_not() {
-    let st = run_loop(0.5, AssociationRule::Gated, 96);
+    let (mut leaks, mut expected, mut lost) = (0usize, 0.0, 0usize);
+    for seed in LOOP_SEEDS {
+        let st = run_loop(0.5, AssociationRule::Gated, seed);
+        assert!(
+            st.unresolved > 0 && st.dropped as Real >= 0.9 * st.unresolved as Real,
+            "{st:?}"
+        );
+        st.assert_tracked();
+        let spec = run_loop(0.5, AssociationRule::Spec, seed);
+        assert!(spec.worst_after_1s_m > 1.0, "seed {seed}: {spec:?}");
+        let leak = run_loop(0.0, AssociationRule::Spec, seed);
+        leaks += leak.unresolved - leak.dropped;
+        expected += (1.0 - P_GATE) * leak.unresolved_static_paths as Real;
+        if leak.worst_after_1s_m > 1.0 {
+            lost += 1;
+        }
+    }
+    let tol = 4.5 * expected.sqrt();
     assert!(
-        st.unresolved > 0 && st.dropped as Real >= 0.9 * st.unresolved as Real,
-        "{st:?}"
+        (leaks as Real - expected).abs() <= tol,
+        "{leaks} leaks, expected {expected:.1} ± {tol:.1}"
     );
-    st.assert_tracked();
-    let spec = run_loop(0.5, AssociationRule::Spec, 96);
-    assert!(spec.worst_after_1s_m > 1.0, "{spec:?}");
-    let leak = run_loop(0.0, AssociationRule::Spec, 96);
-    assert!(
-        leak.dropped < leak.unresolved && leak.worst_after_1s_m > 1.0,
-        "{leak:?}"
-    );
+    assert!(lost >= 5, "spec rule lost the track in {lost} of 8 seeds");
 }
 
 /// The measurement case as spec §9.6 runs it: no track yet, so the snapshot at t₀ is gated,
 /// each link takes its strongest remaining estimate (the echo, √SNR ≫ the false alarms' 1), LM
 /// fixes the start (consistent with its covariance, checked in `run_loop_from`) and the gated
 /// EKF, started at rest with σ_v = 2 m/s per component, locks on within the first second and
-/// then meets the bounds of the truth-started runs, with false alarms.
+/// then meets the bounds of the truth-started runs, with false alarms, for seeds 1–8.
 #[test]
 fn lm_started_gated_track_meets_the_same_bounds() {
-    for seed in [96, 98] {
+    for seed in LOOP_SEEDS {
         run_loop_from(0.5, AssociationRule::Gated, seed, true).assert_tracked();
     }
 }

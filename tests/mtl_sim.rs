@@ -6,35 +6,81 @@ use scatterloc::mtl::sim::*;
 use scatterloc::mtl::trp::TrpMap;
 use scatterloc::{Error, Vec2};
 
-fn close(a: f64, b: f64, tol: f64) -> bool {
-    (a - b).abs() <= tol
-}
+mod common;
 
-/// Table II "True" columns (≤2, 3, …, 9) of `realisations · 2` V-B target draws, checked
-/// against spec check 11 (±0.005) and the exact zeros of weights 5, 7, 8.
-fn check_11(seed: u64, realisations: u64) {
+use common::within_abs;
+
+/// Spec check 11's columns (≤2, 3, …, 9) and its tolerance.
+const CHECK_11: [f64; 8] = [0.034, 0.029, 0.045, 0.0, 0.224, 0.0, 0.0, 0.669];
+const CHECK_11_TOL: f64 = 0.005;
+
+/// Table II "True" columns (≤2, 3, …, 9) of `realisations · 2` V-B target draws, and the exact
+/// zeros of weights 5, 7, 8.
+fn check_11_columns(seed: u64, realisations: u64) -> Vec<f64> {
     let row = true_row(&SimSettings::vb(), seed, realisations).unwrap();
     let b = table2_buckets(&row);
     println!(
-        "check 11, {} draws (≤2, 3, …, 9): {b:.4?}",
+        "check 11, seed {seed}, {} draws (≤2, 3, …, 9): {b:.4?}",
         2 * realisations
     );
-    let expect = [0.034, 0.029, 0.045, 0.0, 0.224, 0.0, 0.0, 0.669];
-    for (i, (&got, &want)) in b.iter().zip(&expect).enumerate() {
-        assert!(close(got, want, 0.005), "column {i}: {got} vs {want}");
-    }
     // Weights 5, 7, 8 never occur (γ = γ^R ⊗ γ^T, check 2): exactly 0.
     assert_eq!((row[5], row[7], row[8]), (0.0, 0.0, 0.0));
-    assert!(close(row.iter().sum::<f64>(), 1.0, 1e-12));
+    assert!(within_abs(row.iter().sum::<f64>(), 1.0, 1e-12));
+    b
 }
 
+/// Check 11 (±0.005 of the spec's columns) on one run.
+fn check_11(seed: u64, realisations: u64) {
+    let b = check_11_columns(seed, realisations);
+    for (i, (&got, &want)) in b.iter().zip(&CHECK_11).enumerate() {
+        assert!(
+            within_abs(got, want, CHECK_11_TOL),
+            "column {i}: {got} vs {want}"
+        );
+    }
+}
+
+/// Spec check 11 at its size, 10⁵ target draws (5·10⁴ realisations × K = 2), over seeds 1–5.
+///
+/// What is true. The binomial standard error of P(9) ≈ 0.67 at 10⁵ draws is
+/// √(p(1−p)/10⁵) ≈ 0.0015 (the two targets of a realisation share its scene, so up to
+/// √2 · 0.0015 = 0.0021 with n = 5·10⁴ realisations as the independent units; seeds 1–8 spread
+/// with sd 0.0017). This generator's P(9) converges to ≈ 0.667 (seeds 1–8 at 10⁵ draws:
+/// 0.6657, 0.6669, 0.6697, 0.6671, 0.6650, 0.6673, 0.6697, 0.6672; 10⁶ draws: 0.6664, 0.6659),
+/// 0.002–0.003 below the spec's 0.669, so the ±0.005 band is only ≈ 1.5–2 SE from the limit at
+/// 10⁵ draws: "every 10⁵-draw run is within ±0.005" holds for most seeds but not all (≈ 5 % of
+/// seeds fail) and is not asserted per seed. Asserted instead:
+/// - pooled over the seeds (5·10⁵ draws, SE ≤ 0.0021/√5 = 0.00095 for P(9)), every column is
+///   within the spec's ±0.005 (P(9): the limit's 0.0028 margin is ≥ 3 SE; the other columns
+///   have SE ≤ 0.0009 and margins ≥ 0.002);
+/// - each seed agrees with the pooled value to 4.5 binomial SE of a seed,
+///   `4.5 · √(p(1−p)/5·10⁴)` (realisations as the units, the conservative count), so a seed
+///   fails with probability < 1e-5 per column.
 #[test]
 fn check_11_true_row_of_table_two() {
-    // 10⁵ target draws (5·10⁴ realisations × K = 2), as the spec states. The binomial standard
-    // error of P(9) ≈ 0.67 is √(p(1−p)/10⁵) ≈ 0.0015. Note: with 10⁶ draws this generator
-    // converges to P(9) ≈ 0.666 (0.6664 and 0.6659 for two seeds), 0.003 below the spec's
-    // 0.669, so at 10⁵ draws the ±0.005 band holds for most seeds but not all (≈ 1.3 SE margin).
-    check_11(1, 50_000);
+    let realisations = 50_000u64;
+    let runs: Vec<Vec<f64>> = (1..=5)
+        .map(|seed| check_11_columns(seed, realisations))
+        .collect();
+    let pooled: Vec<f64> = (0..CHECK_11.len())
+        .map(|i| runs.iter().map(|r| r[i]).sum::<f64>() / runs.len() as f64)
+        .collect();
+    println!("check 11, pooled over seeds 1–5: {pooled:.4?}");
+    for (i, (&got, &want)) in pooled.iter().zip(&CHECK_11).enumerate() {
+        assert!(
+            within_abs(got, want, CHECK_11_TOL),
+            "pooled column {i}: {got} vs {want} ± {CHECK_11_TOL}"
+        );
+    }
+    for (seed, run) in (1..=5).zip(&runs) {
+        for (i, (&got, &p)) in run.iter().zip(&pooled).enumerate() {
+            let tol = 4.5 * (p * (1.0 - p) / realisations as f64).sqrt();
+            assert!(
+                within_abs(got, p, tol),
+                "seed {seed}, column {i}: {got} vs pooled {p} ± {tol}"
+            );
+        }
+    }
 }
 
 #[test]
@@ -52,7 +98,7 @@ fn check_4_icb_row_of_table_two() {
         0.1267, 0.1961, 0.2578, 0.2259, 0.1320, 0.0496, 0.0109, 0.0011,
     ];
     for (&got, &want) in b.iter().zip(&printed) {
-        assert!(close(got, want, 5e-5), "{got} vs {want}");
+        assert!(within_abs(got, want, 5e-5), "{got} vs {want}");
     }
     assert!(icb_row(TrpMap::new(3, 3).unwrap(), 1.5).is_err());
 }
@@ -76,7 +122,7 @@ fn va_hexagon_positions() {
     let rx = [(5.0 + h, 7.5), (5.0 - h, 7.5), (5.0, 0.0)];
     for (p, &(x, y)) in r.scene.tx.iter().zip(&tx).chain(r.scene.rx.iter().zip(&rx)) {
         assert!(
-            close(p.x, x, 1e-12) && close(p.y, y, 1e-12),
+            within_abs(p.x, x, 1e-12) && within_abs(p.y, y, 1e-12),
             "{p:?} vs ({x}, {y})"
         );
     }
@@ -95,7 +141,7 @@ fn va_node_segments_are_blocked_independently() {
             n += 9;
         }
     }
-    assert!(close(ones as f64 / n as f64, 0.81, 0.006));
+    assert!(within_abs(ones as f64 / n as f64, 0.81, 0.006));
 }
 
 #[test]
@@ -128,7 +174,7 @@ fn clutter_mean_is_two_per_trp() {
         }
     }
     let mean = total as f64 / n as f64;
-    assert!(close(mean, 2.0, 0.04), "clutter mean {mean}");
+    assert!(within_abs(mean, 2.0, 0.04), "clutter mean {mean}");
 }
 
 #[test]

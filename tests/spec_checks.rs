@@ -1,6 +1,6 @@
 #![cfg(not(target_arch = "wasm32"))]
 //! Spec §0 checks 1, 2, 3, 6, 7 and 8 (`shared/spec/delay-localization.md`), plus the §2 ellipse
-//! geometry and the CRLB map kernel (checks 4, 5, 9–11: `tracking.rs` and the unit tests; check
+//! geometry and the CRLB map kernel (checks 4, 5, 9–11: `tracking_*.rs` and the unit tests; check
 //! 12: `gating.rs`). Every expected number is quoted from the spec (its check
 //! number is cited next to it) or derived from a closed form / finite difference stated in a comment.
 //! Tolerances for printed values are half a unit of the last printed digit.
@@ -14,6 +14,10 @@ use scatterloc::measure::TxPattern;
 use scatterloc::measure::{noise_power_w, Model};
 use scatterloc::scenario::presets;
 use scatterloc::scenario::{Area, LinkSpec, Pattern, Receiver, Scenario, Transmitter};
+
+mod common;
+
+use common::{abs_close, rel_close};
 
 const C: Real = SPEED_OF_LIGHT;
 
@@ -29,25 +33,6 @@ fn model(s: &Scenario) -> Model {
     Model::new(s).expect("valid scenario")
 }
 
-/// `|got − want| ≤ tol`, with a readable message.
-#[track_caller]
-fn close(what: &str, got: Real, want: Real, tol: Real) {
-    assert!(
-        (got - want).abs() <= tol,
-        "{what}: got {got}, want {want} ± {tol} (off by {})",
-        got - want
-    );
-}
-
-#[track_caller]
-fn rel_close(what: &str, got: Real, want: Real, rel: Real) {
-    assert!(
-        (got - want).abs() <= rel * want.abs(),
-        "{what}: got {got}, want {want} (relative error {} > {rel})",
-        ((got - want) / want).abs()
-    );
-}
-
 // ---------------------------------------------------------------------------------------------
 // Check 1: P_n = k_B T0 B F = 4.8047e-12 W = −83.18 dBm for B = 120 MHz, F = 10 dB.
 // ---------------------------------------------------------------------------------------------
@@ -57,8 +42,8 @@ fn check1_noise_power() {
     let radio = l4().radio; // B = 120 MHz, F = 10 dB (spec §9.1, §7)
     assert_eq!(radio.bandwidth_hz, 120e6);
     let pn = noise_power_w(&radio);
-    close("P_n [W] (check 1)", pn, 4.8047e-12, 0.00005e-12);
-    close("P_n [dBm] (check 1)", watt_to_dbm(pn), -83.18, 0.005);
+    abs_close("P_n [W] (check 1)", pn, 4.8047e-12, 0.00005e-12);
+    abs_close("P_n [dBm] (check 1)", watt_to_dbm(pn), -83.18, 0.005);
     // Closed form k_B·T0·B·F with the §0 constants.
     rel_close(
         "P_n closed form",
@@ -122,26 +107,26 @@ fn check2_link_budget() {
         let (tx, rx) = m.network.link_nodes(0);
         assert_eq!((r - tx).norm(), 10.0);
         assert_eq!((r - rx).norm(), 10.0);
-        close(
+        abs_close(
             "G_Tx toward boresight [dBi]",
             linear_to_db(m.patterns[0].gain_toward(Vec2::new(1.0, 0.0))),
             9.0,
             1e-12,
         );
         // Check 2 numbers.
-        close(
+        abs_close(
             "P_r [dBm] (check 2)",
             watt_to_dbm(m.received_power_w(0, r)),
             -43.76,
             0.005,
         );
         let snr = m.snr(0, r);
-        close("SNR (check 2)", snr, 8756.7, 0.05);
-        close("SNR [dB] (check 2)", linear_to_db(snr), 39.42, 0.005);
-        close("beta [MHz] (check 2)", m.beta2.sqrt() / 1e6, 34.641, 0.0005);
+        abs_close("SNR (check 2)", snr, 8756.7, 0.05);
+        abs_close("SNR [dB] (check 2)", linear_to_db(snr), 39.42, 0.005);
+        abs_close("beta [MHz] (check 2)", m.beta2.sqrt() / 1e6, 34.641, 0.0005);
         let sigma = m.sigma_delay(0, r);
-        close("sigma_tau [ps] (check 2)", sigma * 1e12, 34.72, 0.005);
-        close(
+        abs_close("sigma_tau [ps] (check 2)", sigma * 1e12, 34.72, 0.005);
+        abs_close(
             "c sigma_tau [cm] (check 2)",
             C * sigma * 100.0,
             1.041,
@@ -164,7 +149,7 @@ fn check2_link_budget() {
     // Noise figures 0 / 5 / 15 dB: c σ_τ = 3.29 / 5.85 / 18.5 mm (check 2).
     for (nf, want_mm, tol) in [(0.0, 3.29, 0.005), (5.0, 5.85, 0.005), (15.0, 18.5, 0.05)] {
         let m = model(&check2_scenario(Pattern::Omni, nf));
-        close(
+        abs_close(
             &format!("c sigma_tau [mm] at NF {nf} dB (check 2)"),
             C * m.sigma_delay(0, r) * 1e3,
             want_mm,
@@ -249,7 +234,7 @@ fn check3_jacobian_units_and_norm() {
                 let (a, b) = ((tx - r).normalize(), (rx - r).normalize());
                 let beta = a.dot(&b).clamp(-1.0, 1.0).acos();
                 let want = 2.0 * (beta / 2.0).cos() / C;
-                close("|J row| = 2cos(beta/2)/c", j.norm(), want, 1e-9 / C);
+                abs_close("|J row| = 2cos(beta/2)/c", j.norm(), want, 1e-9 / C);
                 assert!(j.norm() <= 2.0 / C * (1.0 + 1e-15), "check 3: |J| > 2/c");
                 // Direction: gradient of τ is the sum of unit vectors from the nodes (E3).
                 let g = ((r - tx).normalize() + (r - rx).normalize()) / C;
@@ -277,7 +262,7 @@ fn check3_row_zero_on_baseline() {
     }
     // Beyond the segment on the same line the row is the full 2/c along the line.
     let r = Vec2::new(12.0, 12.0);
-    close(
+    abs_close(
         "|J| beyond Rx2",
         net.jacobian_row(1, r).norm(),
         2.0 / C,
@@ -322,7 +307,7 @@ fn iso_delay_ellipse_exists_iff_delay_at_least_los() {
         let e = net
             .iso_delay_ellipse(p, los)
             .expect("degenerate ellipse at LoS delay");
-        close("b at LoS delay", e.semi_minor, 0.0, 1e-7);
+        abs_close("b at LoS delay", e.semi_minor, 0.0, 1e-7);
         assert!(net.iso_delay_ellipse(p, los * (1.0 + 1e-9)).is_some());
     }
 }
@@ -382,7 +367,7 @@ fn covariance_ellipse_axes_are_sqrt_eigenvalues() {
             };
             let (l1, l2) = (eig.eigenvalues[imax], eig.eigenvalues[imin]);
             rel_close("semi-major", e.semi_major, k * l1.sqrt(), 1e-12);
-            close(
+            abs_close(
                 "semi-minor",
                 e.semi_minor,
                 k * l2.max(0.0).sqrt(),
@@ -391,7 +376,7 @@ fn covariance_ellipse_axes_are_sqrt_eigenvalues() {
             // Major axis direction ∥ eigenvector of λ_max (skip the isotropic case: none).
             let v = eig.eigenvectors.column(imax);
             let dir = Vec2::new(e.angle_rad.cos(), e.angle_rad.sin());
-            close("axis alignment", dir.dot(&v).abs(), 1.0, 1e-12);
+            abs_close("axis alignment", dir.dot(&v).abs(), 1.0, 1e-12);
             // Points satisfy (q−c)ᵀΣ⁻¹(q−c) = k² when Σ is invertible.
             if let Some(inv) = cov.try_inverse().filter(|_| l2 > 0.0) {
                 for i in 0..8 {
@@ -427,13 +412,13 @@ fn check6_iclgnss_ratio() {
     // So σx, σy are held to 0.1 % (σy at exactly −21.35 is 6.4203 mm, printed 6.421).
     rel_close("sigma_x [mm] (check 6)", b.sigma_x_m * 1e3, 1.211, 1e-3);
     rel_close("sigma_y [mm] (check 6)", b.sigma_y_m * 1e3, 6.421, 1e-3);
-    close(
+    abs_close(
         "sigma_y/sigma_x at -21.35 (check 6)",
         ratio(-21.35),
         5.30,
         0.005,
     );
-    close(
+    abs_close(
         "sigma_y/sigma_x at 9.06 (check 6)",
         ratio(9.06),
         5.30,
@@ -509,7 +494,7 @@ fn check7_l4_crlb_rmse() {
         (0.0, 20.0, 17.69, 0.005),
     ] {
         let b = crlb_at(&m, Vec2::new(x, y)).bound.expect("bounded");
-        close(
+        abs_close(
             &format!("CRLB RMSE at ({x},{y}) [cm] (check 7)"),
             b.rmse_m * 100.0,
             want_cm,
@@ -528,7 +513,7 @@ fn check7_l4_link_snr() {
     let m = model(&l4());
     let r = Vec2::new(10.0, 0.0);
     for (p, want_db) in [33.51, 39.18, 34.13, 43.16].into_iter().enumerate() {
-        close(
+        abs_close(
             &format!("SNR Rx{} at (10,0) [dB] (check 7)", p + 1),
             linear_to_db(m.snr(p, r)),
             want_db,
@@ -550,7 +535,7 @@ fn section93_tx_gains_toward_receivers() {
             .zip([(-11.0, 0.005), (6.0, 0.05), (-11.0, 0.005), (5.73, 0.005)])
     {
         let u = (Vec2::new(rx.position_m[0], rx.position_m[1]) - tx).normalize();
-        close(
+        abs_close(
             &format!("G_Tx toward {} [dBi] (spec 9.3)", rx.name),
             linear_to_db(pat.gain_toward(u)),
             want,
@@ -559,7 +544,7 @@ fn section93_tx_gains_toward_receivers() {
     }
     // Closed form inside the beam: G0 − 12(ψ/ψ3dB)² at ψ = 30°.
     let u = Vec2::new(40f64.to_radians().cos(), 40f64.to_radians().sin());
-    close(
+    abs_close(
         "G(30 deg off boresight)",
         linear_to_db(pat.gain_toward(u)),
         9.0 - 12.0 * (30.0f64 / 70.0).powi(2),

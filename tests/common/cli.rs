@@ -1,7 +1,6 @@
-//! Helpers shared by the CLI tests (`cli`, `cli_tracking`, `cli_montecarlo`): a temporary
+//! Helpers of the CLI tests (`cli*.rs`): a temporary
 //! directory, running the binary, and the "exit 2 + one stderr line naming the field" contract
 //! for bad input.
-#![allow(dead_code)]
 
 use std::path::PathBuf;
 use std::process::{Command, Output};
