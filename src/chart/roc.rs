@@ -11,7 +11,7 @@ use alloc::string::String;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::layout::{font_scale, frame_plot, segments, series_legend, titled_body, Fonts};
+use super::layout::{font_scale, frame_plot, segments, series_legend, titled_body};
 use super::{axis_label, chart_err, register_fonts, ChartError};
 use crate::math::Real;
 

@@ -3,7 +3,7 @@
 
 use alloc::vec::Vec;
 
-use crate::error::{check_len, Error, Result};
+use crate::error::{check_len, Result};
 use crate::math::{log10, Real};
 use crate::present::{colorbar_ticks, Tick};
 
