@@ -226,7 +226,9 @@ pub fn command() -> clap::Command {
     hyphen_values(Cli::command())
 }
 
-/// The outcome of parsing that is not a command to run.
+/// What parsing the command line gave.
+// Built once and matched once: the size of the largest variant does not matter.
+#[allow(clippy::large_enum_variant)]
 pub enum Parsed {
     /// Run this command.
     Run(Cli),

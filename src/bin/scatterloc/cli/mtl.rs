@@ -8,6 +8,8 @@ use super::values::{
 };
 
 /// `scatterloc mtl SUBCOMMAND`.
+// Parsed once and moved once: the size of the largest variant does not matter.
+#[allow(clippy::large_enum_variant)]
 #[derive(Debug, Subcommand)]
 pub enum MtlCommand {
     /// Locate several targets from per-TRP range lists (spec multi-target.md §4, Algorithm 1).

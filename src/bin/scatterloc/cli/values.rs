@@ -128,13 +128,13 @@ pub enum WalkStart {
 pub enum Trajectory {
     /// Trajectory I.
     #[value(name = "I", alias = "1")]
-    I,
+    One,
     /// Trajectory II.
     #[value(name = "II", alias = "2")]
-    II,
+    Two,
     /// Trajectory III.
     #[value(name = "III", alias = "3")]
-    III,
+    Three,
     /// I, II and III in turn.
     #[value(name = "all")]
     All,

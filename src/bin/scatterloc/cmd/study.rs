@@ -99,9 +99,9 @@ pub fn parse_study(args: &StudyArgs) -> Result<Study, CliError> {
     };
     let trajectories = match args.trajectory {
         None | Some(Trajectory::All) => TrackScenario::ALL.to_vec(),
-        Some(Trajectory::I) => vec![TrackScenario::I],
-        Some(Trajectory::II) => vec![TrackScenario::II],
-        Some(Trajectory::III) => vec![TrackScenario::III],
+        Some(Trajectory::One) => vec![TrackScenario::I],
+        Some(Trajectory::Two) => vec![TrackScenario::II],
+        Some(Trajectory::Three) => vec![TrackScenario::III],
     };
     let dt = args.dt.unwrap_or(PAPER_STEP_S);
     let q = args.process_noise.unwrap_or(PAPER_INTENSITY);
