@@ -641,6 +641,10 @@ fn typos_get_a_suggestion_on_one_line() {
         &["mtl", "'locat'", "did you mean 'locate'?"],
     );
     fails(
+        &["mtl"],
+        &["mtl: missing subcommand", "locate, table2 or roc"],
+    );
+    fails(
         &["montecarlo", "--runz", "3"],
         &["unexpected argument '--runz'", "did you mean '--runs'?"],
     );

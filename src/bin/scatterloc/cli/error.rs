@@ -2,20 +2,23 @@
 //! clap's did-you-mean suggestion kept in the line (`unexpected argument '--runz' (did you mean
 //! '--runs'?)`). Help and version requests are printed to stdout (exit status 0).
 
+use std::ffi::OsString;
+
 use clap::error::{ContextKind, ContextValue, ErrorKind};
 
 use super::Parsed;
 use crate::CliError;
 
 /// Prints help or the version (status 0), or turns any other error into a usage error.
-pub fn handle(e: clap::Error, cmd: &clap::Command) -> Result<Parsed, CliError> {
+/// `argv` (without the program name) tells which subcommand the error belongs to.
+pub fn handle(e: clap::Error, cmd: &clap::Command, argv: &[OsString]) -> Result<Parsed, CliError> {
     match e.kind() {
         ErrorKind::DisplayHelp | ErrorKind::DisplayVersion => {
             e.print()
                 .map_err(|io| CliError::output(format!("stdout: {io}")))?;
             Ok(Parsed::Printed)
         }
-        _ => Err(CliError::usage(one_line(&e, cmd))),
+        _ => Err(CliError::usage(one_line(&e, cmd, argv))),
     }
 }
 
@@ -69,16 +72,21 @@ fn suggestion(e: &clap::Error) -> String {
     }
 }
 
-/// The command path of the error (`["mtl"]`, empty for the top level), from its usage line.
-fn command_path(e: &clap::Error) -> Vec<String> {
-    let usage = string(e, ContextKind::Usage).unwrap_or_default();
-    let usage = usage.trim_start().trim_start_matches("Usage:").trim();
-    usage
-        .split_whitespace()
-        .skip(1)
-        .take_while(|w| !w.starts_with(['<', '[', '-']))
-        .map(str::to_string)
-        .collect()
+/// The subcommand path of the command line (`["mtl", "roc"]`, empty for the top level): its
+/// leading words that name a subcommand of the one before.
+fn command_path(cmd: &clap::Command, argv: &[OsString]) -> Vec<String> {
+    let mut path = Vec::new();
+    let mut c = cmd;
+    for word in argv {
+        match word.to_str().and_then(|w| c.find_subcommand(w)) {
+            Some(sub) if sub.get_name() != "help" => {
+                path.push(sub.get_name().to_string());
+                c = sub;
+            }
+            _ => break,
+        }
+    }
+    path
 }
 
 /// The subcommand names of the command at `path` (without `help`, which the top level lists
@@ -112,14 +120,14 @@ fn prefix(path: &[String]) -> String {
 }
 
 /// One line for a clap error (without the `error: ` the caller adds).
-pub fn one_line(e: &clap::Error, cmd: &clap::Command) -> String {
+pub fn one_line(e: &clap::Error, cmd: &clap::Command, argv: &[OsString]) -> String {
+    let path = command_path(cmd, argv);
     let arg = string(e, ContextKind::InvalidArg).unwrap_or_default();
     let value = string(e, ContextKind::InvalidValue).unwrap_or_default();
     let name = flag(&arg).to_string();
     let line = match e.kind() {
         ErrorKind::UnknownArgument => format!("unexpected argument '{arg}'{}", suggestion(e)),
         ErrorKind::InvalidSubcommand => {
-            let path = command_path(e);
             let sub = string(e, ContextKind::InvalidSubcommand).unwrap_or_default();
             let hint = match suggestion(e) {
                 s if s.starts_with(" (did you mean") => s,
@@ -128,13 +136,6 @@ pub fn one_line(e: &clap::Error, cmd: &clap::Command) -> String {
             format!("{}unknown subcommand '{sub}'{hint}", prefix(&path))
         }
         ErrorKind::MissingSubcommand | ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => {
-            // The command lacking a subcommand (`scatterloc mtl`, or `mtl` alone).
-            let parent = string(e, ContextKind::InvalidSubcommand).unwrap_or_default();
-            let path: Vec<String> = parent
-                .split_whitespace()
-                .filter(|w| *w != "scatterloc")
-                .map(str::to_string)
-                .collect();
             format!(
                 "{}missing subcommand ({})",
                 prefix(&path),
@@ -142,7 +143,6 @@ pub fn one_line(e: &clap::Error, cmd: &clap::Command) -> String {
             )
         }
         ErrorKind::MissingRequiredArgument => {
-            let path = command_path(e);
             let missing: Vec<String> = strings(e, ContextKind::InvalidArg)
                 .iter()
                 .map(|a| match a.starts_with('-') {
@@ -161,7 +161,6 @@ pub fn one_line(e: &clap::Error, cmd: &clap::Command) -> String {
         ErrorKind::InvalidValue if value.is_empty() => format!("{name}: missing value"),
         ErrorKind::InvalidValue if !arg.starts_with('-') => {
             let valid = either(&strings(e, ContextKind::ValidValue));
-            let path = command_path(e);
             format!("{}'{value}' is not {valid}{}", prefix(&path), suggestion(e))
         }
         ErrorKind::InvalidValue => {

@@ -240,14 +240,14 @@ pub enum Parsed {
 /// other clap error is one line naming the flag (exit status 2).
 pub fn parse(argv: Vec<OsString>) -> Result<Parsed, CliError> {
     let mut cmd = command();
-    let args = std::iter::once(OsString::from("scatterloc")).chain(argv);
+    let args = std::iter::once(OsString::from("scatterloc")).chain(argv.iter().cloned());
     let matches = match cmd.try_get_matches_from_mut(args) {
         Ok(m) => m,
-        Err(e) => return error::handle(e, &cmd),
+        Err(e) => return error::handle(e, &cmd, &argv),
     };
     Cli::from_arg_matches(&matches)
         .map(Parsed::Run)
-        .map_err(|e| CliError::usage(error::one_line(&e, &cmd)))
+        .map_err(|e| CliError::usage(error::one_line(&e, &cmd, &argv)))
 }
 
 /// Writes the completion script for `shell` to stdout.
