@@ -595,3 +595,132 @@ fn scenario_from_stdin() {
         1e-3
     ));
 }
+
+#[test]
+fn version_flag() {
+    for flag in ["--version", "-V"] {
+        let out = run(&[flag]);
+        assert_eq!(out.status.code(), Some(0));
+        let text = String::from_utf8(out.stdout).unwrap();
+        assert_eq!(text, format!("scatterloc {}\n", env!("CARGO_PKG_VERSION")));
+    }
+}
+
+#[test]
+fn completions_for_bash_zsh_fish() {
+    for shell in ["bash", "zsh", "fish"] {
+        let out = run(&["completions", shell]);
+        assert_eq!(out.status.code(), Some(0), "{shell}");
+        let script = String::from_utf8(out.stdout).unwrap();
+        assert!(script.len() > 500, "{shell}: {script}");
+        for word in [
+            "scatterloc",
+            "crlb-map",
+            "simulate-walk",
+            "montecarlo",
+            "mtl",
+            "scenario",
+        ] {
+            assert!(script.contains(word), "{shell} script lacks {word}");
+        }
+    }
+    fails(&["completions", "tcsh"], &["tcsh", "bash, zsh or fish"]);
+    fails(&["completions"], &["completions"]);
+}
+
+#[test]
+fn typos_get_a_suggestion_on_one_line() {
+    fails(
+        &["montecarol"],
+        &[
+            "unknown subcommand 'montecarol'",
+            "did you mean 'montecarlo'?",
+        ],
+    );
+    fails(
+        &["mtl", "locat"],
+        &["mtl", "'locat'", "did you mean 'locate'?"],
+    );
+    fails(
+        &["mtl"],
+        &["mtl: missing subcommand", "locate, table2 or roc"],
+    );
+    fails(
+        &["montecarlo", "--runz", "3"],
+        &["unexpected argument '--runz'", "did you mean '--runs'?"],
+    );
+    fails(
+        &["track", "--scenari", "s.json"],
+        &["'--scenari'", "did you mean '--scenario'?"],
+    );
+    fails(
+        &[
+            "track",
+            "--scenario",
+            "s.json",
+            "--measurements",
+            "m.json",
+            "--association",
+            "gatd",
+        ],
+        &["--association", "'gatd'", "did you mean 'gated'?"],
+    );
+}
+
+#[test]
+fn every_command_has_help_citing_the_spec() {
+    let commands: [&[&str]; 13] = [
+        &["preset"],
+        &["crlb"],
+        &["crlb-map"],
+        &["locate"],
+        &["track"],
+        &["calibrate"],
+        &["simulate-walk"],
+        &["montecarlo"],
+        &["pcrlb"],
+        &["mtl"],
+        &["mtl", "locate"],
+        &["mtl", "table2"],
+        &["mtl", "roc"],
+    ];
+    for cmd in commands {
+        for how in ["--help", "-h"] {
+            let mut args = cmd.to_vec();
+            args.push(how);
+            let out = run(&args);
+            assert_eq!(out.status.code(), Some(0), "{args:?}");
+            assert!(out.stderr.is_empty(), "{args:?}");
+            let text = String::from_utf8(out.stdout).unwrap();
+            assert!(
+                text.contains("spec") && text.contains('§'),
+                "{args:?}: {text}"
+            );
+            assert!(
+                text.contains(&format!("scatterloc {}", cmd.join(" "))),
+                "{args:?}"
+            );
+        }
+        // `help COMMAND` is the long help, as `COMMAND --help`.
+        let mut args = vec!["help"];
+        args.extend(cmd);
+        let out = run(&args);
+        assert_eq!(out.status.code(), Some(0), "{args:?}");
+        let mut long = cmd.to_vec();
+        long.push("--help");
+        assert_eq!(out.stdout, run(&long).stdout, "{args:?}");
+    }
+    // Flags name their unit and default.
+    let text = String::from_utf8(run(&["montecarlo", "--help"]).stdout).unwrap();
+    for want in [
+        "--runs <N>",
+        "[default: 5000]",
+        "--dt <T>",
+        "s [default: 2.048e-3",
+    ] {
+        assert!(
+            text.contains(want),
+            "montecarlo --help lacks {want}: {text}"
+        );
+    }
+}

@@ -2,19 +2,15 @@
 //! §10), and `scatterloc pcrlb`: the bound alone, at the nominal path (check 9) or with `E[F̃]`
 //! over truth trajectories (check 10).
 
-use std::ffi::OsString;
-
 use serde::Serialize;
 
 use scatterloc::chart::TrackingChartOptions;
 use scatterloc::track::nominal_pcrlb_rmse;
 use scatterloc::track::paper_initial_covariance;
 
-use crate::commands::parse_args;
-use crate::report::{which, CurveDoc, Outputs};
-use crate::study::{
-    flag_error, parse_study, run_pcrlb_with_progress, run_with_progress, seed, threads, STUDY_FLAGS,
-};
+use super::report::{which, CurveDoc, Outputs};
+use super::study::{flag_error, parse_study, run_pcrlb_with_progress, run_with_progress, threads};
+use crate::cli::{MontecarloArgs, PcrlbArgs};
 use crate::CliError;
 
 /// Scalars of one Monte Carlo study, after the curves in the JSON file and in the summary.
@@ -41,24 +37,18 @@ struct McMeta {
 }
 
 /// `scatterloc montecarlo`.
-pub fn montecarlo(argv: &[OsString]) -> Result<(), CliError> {
-    let own = ["runs", "noise-runs", "seed", "threads", "out", "json"];
-    let flags = [STUDY_FLAGS, &own].concat();
-    let Some(args) = parse_args(argv, "montecarlo", &flags, &["oracle-noise"])? else {
-        return Ok(());
-    };
-    args.expect_positional("montecarlo", 0, "")?;
-    let study = parse_study(&args)?;
-    let runs = args.integer("runs")?.unwrap_or(5000);
-    let noise_runs = args.integer("noise-runs")?.unwrap_or(50);
-    let (seed, (threads, used)) = (seed(&args)?, threads(&args)?);
-    let oracle = args.switch("oracle-noise");
+pub fn montecarlo(args: &MontecarloArgs) -> Result<(), CliError> {
+    let study = parse_study(&args.study)?;
+    let runs = args.runs.unwrap_or(5000);
+    let noise_runs = args.noise_runs.unwrap_or(50);
+    let (seed, (threads, used)) = (args.seed.unwrap_or(1), threads(args.threads)?);
+    let oracle = args.oracle_noise;
     let configs = study
         .trajectories
         .iter()
         .map(|t| study.config(*t, runs, noise_runs, seed, oracle))
         .collect::<Result<Vec<_>, _>>()?;
-    let outputs = Outputs::parse(&args)?;
+    let outputs = Outputs::parse(args.out.as_deref(), args.json.as_deref())?;
 
     let mut docs = Vec::new();
     for (t, cfg) in study.trajectories.iter().zip(&configs) {
@@ -119,28 +109,27 @@ struct PcrlbMeta {
 }
 
 /// `scatterloc pcrlb`.
-pub fn pcrlb(argv: &[OsString]) -> Result<(), CliError> {
-    let flags = [STUDY_FLAGS, &["runs", "seed", "threads", "out", "json"]].concat();
-    let Some(args) = parse_args(argv, "pcrlb", &flags, &["nominal"])? else {
-        return Ok(());
-    };
-    args.expect_positional("pcrlb", 0, "")?;
-    let study = parse_study(&args)?;
-    let nominal = args.switch("nominal");
-    let mc_only = ["runs", "seed", "threads"];
-    if let Some(f) = mc_only.iter().find(|f| nominal && args.get(f).is_some()) {
+pub fn pcrlb(args: &PcrlbArgs) -> Result<(), CliError> {
+    let study = parse_study(&args.study)?;
+    let nominal = args.nominal;
+    let mc_only = [
+        ("runs", args.runs.is_some()),
+        ("seed", args.seed.is_some()),
+        ("threads", args.threads.is_some()),
+    ];
+    if let Some((f, _)) = mc_only.iter().find(|(_, given)| nominal && *given) {
         return Err(CliError::usage(format!(
             "--{f}: only for the Monte Carlo bound (drop --nominal)"
         )));
     }
-    let runs = args.integer("runs")?.unwrap_or(5000);
-    let (seed, (threads, _)) = (seed(&args)?, threads(&args)?);
+    let runs = args.runs.unwrap_or(5000);
+    let (seed, (threads, _)) = (args.seed.unwrap_or(1), threads(args.threads)?);
     let configs = study
         .trajectories
         .iter()
         .map(|t| study.config(*t, runs, 1, seed, false))
         .collect::<Result<Vec<_>, _>>()?;
-    let outputs = Outputs::parse(&args)?;
+    let outputs = Outputs::parse(args.out.as_deref(), args.json.as_deref())?;
 
     let mut docs = Vec::new();
     for (t, cfg) in study.trajectories.iter().zip(&configs) {

@@ -1,6 +1,5 @@
 //! `scatterloc crlb-map`: the RMSE bound over a grid, written as JSON, SVG or PNG.
 
-use std::ffi::OsString;
 use std::time::Instant;
 
 use plotters::coord::Shift;
@@ -16,24 +15,19 @@ use scatterloc::localize::{crlb_map as map_kernel, Grid};
 use scatterloc::scenario::Area;
 use scatterloc::{Error, Model, Scenario};
 
-use crate::args::Args;
-use crate::commands::{emit, parse_args, read_scenario};
-use crate::output::{write_figure, write_json_file, Figure, Format};
+use super::io::{emit, read_scenario};
+use super::output::{write_figure, write_json_file, Figure, Format};
+use crate::cli::CrlbMapArgs;
 use crate::CliError;
 
-const FLAGS: &[&str] = &[
-    "scenario", "out", "nx", "ny", "x-min", "x-max", "y-min", "y-max", "width", "height", "title",
-];
 /// Default grid side.
 const DEFAULT_N: usize = 256;
 
 /// The scenario's area with the `--x-min` … `--y-max` overrides applied.
-fn area_of(args: &Args, s: &Scenario) -> Result<Area, CliError> {
+fn area_of(args: &CrlbMapArgs, s: &Scenario) -> Result<Area, CliError> {
     let mut a = s.area_m;
-    let pick =
-        |name: &str, v: f64| -> Result<f64, CliError> { Ok(args.number(name)?.unwrap_or(v)) };
-    a.x = [pick("x-min", a.x[0])?, pick("x-max", a.x[1])?];
-    a.y = [pick("y-min", a.y[0])?, pick("y-max", a.y[1])?];
+    a.x = [args.x_min.unwrap_or(a.x[0]), args.x_max.unwrap_or(a.x[1])];
+    a.y = [args.y_min.unwrap_or(a.y[0]), args.y_max.unwrap_or(a.y[1])];
     for (axis, [lo, hi]) in [("x", a.x), ("y", a.y)] {
         if lo >= hi {
             return Err(CliError::usage(format!(
@@ -50,9 +44,9 @@ fn area_of(args: &Args, s: &Scenario) -> Result<Area, CliError> {
     Ok(a)
 }
 
-fn grid_of(args: &Args, area: Area) -> Result<Grid, CliError> {
-    let nx = args.integer("nx")?.unwrap_or(DEFAULT_N);
-    let ny = args.integer("ny")?.unwrap_or(DEFAULT_N);
+fn grid_of(args: &CrlbMapArgs, area: Area) -> Result<Grid, CliError> {
+    let nx = args.nx.unwrap_or(DEFAULT_N);
+    let ny = args.ny.unwrap_or(DEFAULT_N);
     Grid::new(area, nx, ny).map_err(|e| match e {
         Error::SizeLimit { field, .. } if field == "nx" || field == "ny" => {
             CliError::usage(format!("--{e}"))
@@ -67,20 +61,16 @@ fn grid_of(args: &Args, area: Area) -> Result<Grid, CliError> {
 }
 
 /// `scatterloc crlb-map`.
-pub fn crlb_map(argv: &[OsString]) -> Result<(), CliError> {
-    let Some(args) = parse_args(argv, "crlb-map", FLAGS, &[])? else {
-        return Ok(());
-    };
-    args.expect_positional("crlb-map", 0, "")?;
-    let out = args.required("out")?;
+pub fn crlb_map(args: &CrlbMapArgs) -> Result<(), CliError> {
+    let out = args.out.as_str();
     let format = Format::of("out", out, &[Format::Json, Format::Svg, Format::Png])?;
-    let s = read_scenario(&args)?;
-    let area = area_of(&args, &s)?;
-    let grid = grid_of(&args, area)?;
+    let s = read_scenario(&args.scenario)?;
+    let area = area_of(args, &s)?;
+    let grid = grid_of(args, area)?;
     if format != Format::Json {
         check_area(&area).map_err(|e| CliError::usage(format!("--x-min .. --y-max: {e}")))?;
     }
-    let size = figure_size(&args, &area)?;
+    let size = figure_size(args, &area)?;
     let model = Model::new(&s).map_err(|e| CliError::usage(format!("--scenario: {e}")))?;
 
     let t0 = Instant::now();
@@ -94,7 +84,7 @@ pub fn crlb_map(argv: &[OsString]) -> Result<(), CliError> {
         Format::Svg | Format::Png => {
             let (title, subtitle) = default_titles(&s, &grid);
             let opts = ChartOptions {
-                title: args.get("title").map_or(title, str::to_string),
+                title: args.title.clone().unwrap_or(title),
                 subtitle: Some(subtitle),
                 ..ChartOptions::default()
             };
@@ -134,18 +124,19 @@ fn round3(v: f64) -> f64 {
     (v * 1e3).round() / 1e3
 }
 
-fn figure_size(args: &Args, area: &Area) -> Result<(u32, u32), CliError> {
-    let dim = |name: &str, lo: usize, hi: usize| -> Result<Option<u32>, CliError> {
-        match args.integer(name)? {
-            Some(v) if (lo..=hi).contains(&v) => Ok(Some(v as u32)),
-            Some(v) => Err(CliError::usage(format!(
-                "--{name}: {v} is outside the allowed range {lo}..={hi} pixels"
-            ))),
-            None => Ok(None),
-        }
-    };
-    let w = dim("width", 200, 8000)?;
-    let h = dim("height", 150, 8000)?;
+fn figure_size(args: &CrlbMapArgs, area: &Area) -> Result<(u32, u32), CliError> {
+    let dim =
+        |name: &str, v: Option<usize>, lo: usize, hi: usize| -> Result<Option<u32>, CliError> {
+            match v {
+                Some(v) if (lo..=hi).contains(&v) => Ok(Some(v as u32)),
+                Some(v) => Err(CliError::usage(format!(
+                    "--{name}: {v} is outside the allowed range {lo}..={hi} pixels"
+                ))),
+                None => Ok(None),
+            }
+        };
+    let w = dim("width", args.width, 200, 8000)?;
+    let h = dim("height", args.height, 150, 8000)?;
     let (sw, sh) = suggested_size(area, w.unwrap_or(1000));
     Ok((sw, h.unwrap_or(sh)))
 }

@@ -39,19 +39,15 @@ struct Table2Doc {
 }
 
 /// `scatterloc mtl table2`.
-pub(super) fn mtl_table2(argv: &[OsString]) -> Result<(), CliError> {
-    let Some(args) = parse_args(argv, "mtl table2", &["draws", "seed", "json"], &[])? else {
-        return Ok(());
-    };
-    args.expect_positional("mtl table2", 0, "")?;
-    let draws = args.integer("draws")?.unwrap_or(100_000);
+pub fn mtl_table2(args: &Table2Args) -> Result<(), CliError> {
+    let draws = args.draws.unwrap_or(100_000);
     if !(1..=MAX_DRAWS).contains(&draws) {
         return Err(CliError::usage(format!(
             "--draws: {draws} is outside the allowed range 1..={MAX_DRAWS}"
         )));
     }
-    let seed = seed(&args)?;
-    let json = match args.get("json") {
+    let seed = args.seed.unwrap_or(1);
+    let json = match args.json.as_deref() {
         Some(p) => {
             Format::of("json", p, &[Format::Json])?;
             check_writable("json", p)?;

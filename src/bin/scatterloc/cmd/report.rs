@@ -11,10 +11,9 @@ use scatterloc::chart::{
     draw_tracking_rmse, tracking_size, ChartError, TrackingChartOptions, TrackingPanel,
 };
 
-use crate::args::Args;
-use crate::commands::emit;
-use crate::output::{check_writable, write_figure, write_json_file, Figure, Format};
-use crate::study::{at_report_times, AtTime, Study};
+use super::io::emit;
+use super::output::{check_writable, write_figure, write_json_file, Figure, Format};
+use super::study::{at_report_times, AtTime, Study};
 use crate::CliError;
 
 /// The curves of one trajectory and its scalars `M` (flattened after the curves).
@@ -105,16 +104,17 @@ pub struct Outputs {
 }
 
 impl Outputs {
-    /// Parses `--out` and `--json` and checks now, before any long run, that both can be written.
-    pub fn parse(args: &Args) -> Result<Outputs, CliError> {
-        let figure = match args.get("out") {
+    /// Checks `--out` and `--json` now, before any long run: formats, and that both can be
+    /// written.
+    pub fn parse(out: Option<&str>, json: Option<&str>) -> Result<Outputs, CliError> {
+        let figure = match out {
             Some(p) => Some((
                 p.to_string(),
                 Format::of("out", p, &[Format::Svg, Format::Png])?,
             )),
             None => None,
         };
-        let json = match args.get("json") {
+        let json = match json {
             Some(p) => Format::of("json", p, &[Format::Json]).map(|_| Some(p.to_string()))?,
             None => None,
         };

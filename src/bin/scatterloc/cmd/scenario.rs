@@ -1,72 +1,14 @@
-//! `preset`, `crlb` and `locate`, plus the shared input readers and stdout writer.
+//! `preset`, `crlb` and `locate`: one scenario, one point or one snapshot of delays.
 
-use std::ffi::OsString;
-use std::io::{Read, Write};
-
-use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 
 use scatterloc::localize::crlb_at;
 use scatterloc::localize::{locate as lm_locate, DelayMeasurements, LmConfig};
-use scatterloc::scenario::parse_json;
-use scatterloc::{scenario::presets, Error, Mat2, Model, Scenario, Vec2};
+use scatterloc::{scenario::presets, Error, Mat2, Vec2};
 
-use crate::args::{parse_xy, Args};
-use crate::{CliError, USAGE};
-
-/// Writes `text` and a newline to stdout.
-pub fn emit(text: &str) -> Result<(), CliError> {
-    let mut out = std::io::stdout().lock();
-    writeln!(out, "{text}")
-        .and_then(|_| out.flush())
-        .map_err(|e| CliError::output(format!("stdout: {e}")))
-}
-
-/// Pretty JSON on stdout (serde_json writes non-finite numbers as `null`).
-pub fn emit_json<T: Serialize>(v: &T) -> Result<(), CliError> {
-    let text = serde_json::to_string_pretty(v)
-        .map_err(|e| CliError::output(format!("encoding JSON: {e}")))?;
-    emit(&text)
-}
-
-/// Parses the subcommand's flags (`allowed` take a value, `switches` do not); `Ok(None)` when
-/// `--help` was asked (usage already printed).
-pub fn parse_args(
-    argv: &[OsString],
-    cmd: &str,
-    allowed: &[&str],
-    switches: &[&str],
-) -> Result<Option<Args>, CliError> {
-    let args = Args::parse(argv, cmd, allowed, switches)?;
-    if args.help {
-        emit(USAGE.trim_end())?;
-        return Ok(None);
-    }
-    Ok(Some(args))
-}
-
-/// Reads a file (or stdin for `-`) named by `--flag`.
-pub fn read_input(flag: &str, path: &str) -> Result<String, CliError> {
-    let res = if path == "-" {
-        let mut s = String::new();
-        std::io::stdin().read_to_string(&mut s).map(|_| s)
-    } else {
-        std::fs::read_to_string(path)
-    };
-    res.map_err(|e| CliError::usage(format!("--{flag}: cannot read '{path}': {e}")))
-}
-
-/// Reads and validates the scenario of `--scenario`.
-pub fn read_scenario(args: &Args) -> Result<Scenario, CliError> {
-    let path = args.required("scenario")?;
-    let text = read_input("scenario", path)?;
-    Scenario::from_json(&text).map_err(|e| CliError::usage(format!("--scenario {path}: {e}")))
-}
-
-/// The model of a validated scenario.
-pub fn model_of(s: &Scenario) -> Result<Model, CliError> {
-    Model::new(s).map_err(|e| CliError::usage(format!("--scenario: {e}")))
-}
+use super::io::{emit, emit_json, model_of, read_json_file, read_scenario};
+use crate::cli::{CrlbArgs, LocateArgs, PresetArgs};
+use crate::CliError;
 
 /// A symmetric 2×2 matrix as `[[a, b], [b, c]]` (upper triangle).
 fn sym(m: &Mat2) -> [[f64; 2]; 2] {
@@ -74,23 +16,15 @@ fn sym(m: &Mat2) -> [[f64; 2]; 2] {
 }
 
 /// `scatterloc preset NAME`.
-pub fn preset(argv: &[OsString]) -> Result<(), CliError> {
-    let Some(args) = parse_args(argv, "preset", &[], &[])? else {
-        return Ok(());
-    };
-    args.expect_positional("preset", 1, "preset name (sensors2019 or iclgnss2019)")?;
-    let s = presets::preset(&args.positional[0]).map_err(|e| CliError::usage(e.to_string()))?;
+pub fn preset(args: &PresetArgs) -> Result<(), CliError> {
+    let s = presets::preset(&args.name).map_err(|e| CliError::usage(e.to_string()))?;
     emit(&s.to_json())
 }
 
 /// `scatterloc crlb --scenario S --at X,Y`.
-pub fn crlb(argv: &[OsString]) -> Result<(), CliError> {
-    let Some(args) = parse_args(argv, "crlb", &["scenario", "at"], &[])? else {
-        return Ok(());
-    };
-    args.expect_positional("crlb", 0, "")?;
-    let at = parse_xy("at", args.required("at")?)?;
-    let s = read_scenario(&args)?;
+pub fn crlb(args: &CrlbArgs) -> Result<(), CliError> {
+    let at = args.at;
+    let s = read_scenario(&args.scenario)?;
     let model = model_of(&s)?;
     let r = Vec2::new(at[0], at[1]);
     let pt = crlb_at(&model, r);
@@ -212,28 +146,10 @@ impl Sigma {
     }
 }
 
-/// Reads and parses the JSON file named by `--flag` (errors: `--flag PATH: field: problem`).
-pub fn read_json_file<T: DeserializeOwned>(flag: &str, path: &str) -> Result<T, CliError> {
-    let text = read_input(flag, path)?;
-    parse_json(&text).map_err(|e| {
-        CliError::usage(format!(
-            "--{flag} {path}: {}",
-            e.to_string().replace(
-                "data did not match any variant of untagged enum Sigma",
-                "expected a number or a list of numbers (one per link)",
-            )
-        ))
-    })
-}
-
 /// `scatterloc locate --scenario S --delays D`.
-pub fn locate(argv: &[OsString]) -> Result<(), CliError> {
-    let Some(args) = parse_args(argv, "locate", &["scenario", "delays"], &[])? else {
-        return Ok(());
-    };
-    args.expect_positional("locate", 0, "")?;
-    let dpath = args.required("delays")?;
-    let s = read_scenario(&args)?;
+pub fn locate(args: &LocateArgs) -> Result<(), CliError> {
+    let dpath = args.delays.as_str();
+    let s = read_scenario(&args.scenario)?;
     let bad = |m: String| CliError::usage(format!("--delays {dpath}: {m}"));
     let d: DelaysFile = read_json_file("delays", dpath)?;
     let model = model_of(&s)?;

@@ -35,20 +35,12 @@ struct ModelSummary {
 }
 
 /// `scatterloc mtl locate`.
-pub(super) fn mtl_locate(argv: &[OsString]) -> Result<(), CliError> {
-    let flags = [
-        "network", "ranges", "model", "te", "tb", "p-u", "p-d", "p-los", "lambda", "diameter",
-        "table", "seed", "scenes", "cells", "b-max", "n-min", "order", "out",
-    ];
-    let Some(args) = parse_args(argv, "mtl locate", &flags, &["exact"])? else {
-        return Ok(());
-    };
-    args.expect_positional("mtl locate", 0, "")?;
-    let net_path = args.required("network")?;
-    let ranges_path = args.required("ranges")?;
-    let spec = model_spec(&args)?;
-    let cfg = mtl_config(&args)?;
-    let out_path = match args.get("out") {
+pub fn mtl_locate(args: &MtlLocateArgs) -> Result<(), CliError> {
+    let net_path = args.network.as_str();
+    let ranges_path = args.ranges.as_str();
+    let spec = model_spec(args)?;
+    let cfg = mtl_config(args);
+    let out_path = match args.out.as_deref() {
         Some(p) => {
             Format::of("out", p, &[Format::Json])?;
             check_writable("out", p)?;

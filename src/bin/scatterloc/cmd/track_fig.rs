@@ -11,8 +11,8 @@ use scatterloc::chart::{
     draw_curves, ChartError, CurveChartOptions, CurveSeries, LineKind, Marker,
 };
 
-use crate::commands::read_json_file;
-use crate::output::{write_figure, Figure, Format};
+use super::io::read_json_file;
+use super::output::{write_figure, Figure, Format};
 use crate::CliError;
 
 /// The `--truth` file: the true states at the track's times.

@@ -2,7 +2,6 @@
 //! `scatterloc simulate-walk` (spec §9.6: the synthetic measurement case's input files), plus
 //! the calibration file read by `track --calibration`.
 
-use std::ffi::OsString;
 use std::path::Path;
 
 use serde::{Deserialize, Serialize};
@@ -13,9 +12,10 @@ use scatterloc::track::paper_initial_covariance;
 use scatterloc::track::ConstantVelocity;
 use scatterloc::{measure, Model};
 
-use crate::commands::{emit_json, model_of, parse_args, read_json_file, read_scenario};
-use crate::output::write_json_file;
-use crate::study::{checked_steps, flag_error, seed};
+use super::io::{emit_json, model_of, read_json_file, read_scenario};
+use super::output::write_json_file;
+use super::study::{checked_steps, flag_error};
+use crate::cli::{CalibrateArgs, SimulateWalkArgs, WalkStart};
 use crate::CliError;
 
 /// The `--snapshots` file of `calibrate`: per snapshot, per link, the delay estimates, s.
@@ -70,31 +70,19 @@ pub fn read_calibration(path: &str, model: &Model) -> Result<Calibration, CliErr
 
 /// `scatterloc calibrate --scenario S --snapshots C [--gap-s G] [--min-fraction F]
 /// [--sigma-floor-s S] [--out OUT.json]`.
-pub fn calibrate(argv: &[OsString]) -> Result<(), CliError> {
-    let flags = [
-        "scenario",
-        "snapshots",
-        "gap-s",
-        "min-fraction",
-        "sigma-floor-s",
-        "out",
-    ];
-    let Some(args) = parse_args(argv, "calibrate", &flags, &[])? else {
-        return Ok(());
-    };
-    args.expect_positional("calibrate", 0, "")?;
-    let scenario = read_scenario(&args)?;
+pub fn calibrate(args: &CalibrateArgs) -> Result<(), CliError> {
+    let scenario = read_scenario(&args.scenario)?;
     let model = model_of(&scenario)?;
     let n = model.link_count();
     let mut cfg = ClusterConfig::for_bandwidth(scenario.radio.bandwidth_hz)
         .map_err(|e| CliError::usage(format!("--scenario: {e}")))?;
-    if let Some(g) = args.number("gap-s")? {
+    if let Some(g) = args.gap_s {
         cfg.gap_s = g;
     }
-    if let Some(f) = args.number("min-fraction")? {
+    if let Some(f) = args.min_fraction {
         cfg.min_fraction = f;
     }
-    if let Some(s) = args.number("sigma-floor-s")? {
+    if let Some(s) = args.sigma_floor_s {
         cfg.sigma_floor_s = s;
     }
     cfg.validate().map_err(|e| {
@@ -108,7 +96,7 @@ pub fn calibrate(argv: &[OsString]) -> Result<(), CliError> {
         };
         CliError::usage(format!("{flag}: {e}"))
     })?;
-    let path = args.required("snapshots")?;
+    let path = args.snapshots.as_str();
     let f: SnapshotsFile = read_json_file("snapshots", path)?;
     let bad = |e: &dyn std::fmt::Display| CliError::usage(format!("--snapshots {path}: {e}"));
     if f.snapshots.is_empty() || f.snapshots.len() > MAX_CALIBRATION_SNAPSHOTS {
@@ -128,7 +116,7 @@ pub fn calibrate(argv: &[OsString]) -> Result<(), CliError> {
         snapshot_count: Some(f.snapshots.len()),
         links: cal.links,
     };
-    match args.get("out") {
+    match args.out.as_deref() {
         Some(p) => write_json_file("out", p, &out),
         None => emit_json(&out),
     }
@@ -176,47 +164,24 @@ struct WalkTruth {
 
 /// `scatterloc simulate-walk --scenario S --out-dir DIR [--duration S] [--dt T]
 /// [--calibration-snapshots N] [--false-alarms F] [--process-noise Q] [--seed N]`.
-pub fn simulate_walk(argv: &[OsString]) -> Result<(), CliError> {
-    let flags = [
-        "scenario",
-        "out-dir",
-        "duration",
-        "dt",
-        "calibration-snapshots",
-        "false-alarms",
-        "process-noise",
-        "seed",
-        "start",
-    ];
-    let Some(args) = parse_args(argv, "simulate-walk", &flags, &[])? else {
-        return Ok(());
-    };
-    args.expect_positional("simulate-walk", 0, "")?;
-    let scenario = read_scenario(&args)?;
+pub fn simulate_walk(args: &SimulateWalkArgs) -> Result<(), CliError> {
+    let scenario = read_scenario(&args.scenario)?;
     let model = model_of(&scenario)?;
-    let dir = args.required("out-dir")?;
-    let dt = args.number("dt")?.unwrap_or(0.1);
-    let q = args.number("process-noise")?.unwrap_or(0.1);
+    let dir = args.out_dir.as_str();
+    let dt = args.dt.unwrap_or(0.1);
+    let q = args.process_noise.unwrap_or(0.1);
     ConstantVelocity::validated(dt, q).map_err(flag_error)?;
-    let duration = args.number("duration")?.unwrap_or(LOOP_DURATION_S);
+    let duration = args.duration.unwrap_or(LOOP_DURATION_S);
     let steps = checked_steps(duration, dt)?;
-    let ncal = args.integer("calibration-snapshots")?.unwrap_or(500);
+    let ncal = args.calibration_snapshots.unwrap_or(500);
     if ncal == 0 || ncal > 100_000 {
         return Err(CliError::usage(format!(
             "--calibration-snapshots: {ncal}, 1 … 100000 are allowed"
         )));
     }
-    let fa = args.number("false-alarms")?.unwrap_or(0.5);
-    let seed = seed(&args)?;
-    let from_truth = match args.get("start") {
-        None | Some("snapshot") => false,
-        Some("truth") => true,
-        Some(other) => {
-            return Err(CliError::usage(format!(
-                "--start: '{other}' is not snapshot or truth"
-            )))
-        }
-    };
+    let fa = args.false_alarms.unwrap_or(0.5);
+    let seed = args.seed.unwrap_or(1);
+    let from_truth = args.start == Some(WalkStart::Truth);
     let channel = default_channel(scenario.radio.bandwidth_hz, fa);
     channel
         .validate()

@@ -316,52 +316,40 @@ fn summary_table(r: &ExperimentResult, cfg: &ExperimentConfig, wall: f64, used: 
 }
 
 /// `scatterloc mtl roc`.
-pub(super) fn mtl_roc(argv: &[OsString]) -> Result<(), CliError> {
-    let flags = [
-        "experiment",
-        "realizations",
-        "seed",
-        "threads",
-        "out",
-        "json",
-    ];
-    let Some(args) = parse_args(argv, "mtl roc", &flags, &["empirical", "exact"])? else {
-        return Ok(());
+pub fn mtl_roc(args: &RocArgs) -> Result<(), CliError> {
+    let experiment = match args.experiment {
+        RocExperiment::Va => Experiment::Va,
+        RocExperiment::Vb => Experiment::Vb,
+        RocExperiment::Vc => Experiment::Vc,
     };
-    args.expect_positional("mtl roc", 0, "")?;
-    let name = args.required("experiment")?;
-    let experiment = Experiment::parse(name).ok_or_else(|| {
-        CliError::usage(format!(
-            "--experiment: unknown experiment '{name}' (expected va, vb or vc)"
-        ))
-    })?;
     let mut cfg = ExperimentConfig::new(experiment);
-    let n = args.integer("realizations")?.unwrap_or(cfg.realisations);
+    let n = args.realizations.unwrap_or(cfg.realisations);
     if !(1..=MAX_REALISATIONS).contains(&n) {
         return Err(CliError::usage(format!(
             "--realizations: {n} is outside the allowed range 1..={MAX_REALISATIONS}"
         )));
     }
     cfg.realisations = n;
-    cfg.seed = seed(&args)?;
+    cfg.seed = args.seed.unwrap_or(1);
     if experiment == Experiment::Va {
-        refuse(
-            &args,
-            &["empirical", "exact"],
-            "with --experiment va (i.c.b only)",
-        )?;
+        let only = [("empirical", args.empirical), ("exact", args.exact)];
+        if let Some((f, _)) = only.iter().find(|(_, given)| *given) {
+            return Err(CliError::usage(format!(
+                "--{f}: not used with --experiment va (i.c.b only)"
+            )));
+        }
     }
-    cfg.ppp_exact = args.switch("exact");
-    if args.switch("empirical") {
+    cfg.ppp_exact = args.exact;
+    if args.empirical {
         cfg.empirical = Some(EmpiricalTraining::default());
     }
     cfg.validate().map_err(|e| core_error(&e, "mtl roc"))?;
-    let (threads, used) = threads(&args)?;
-    let figure = match args.get("out") {
+    let (threads, used) = threads(args.threads)?;
+    let figure = match args.out.as_deref() {
         Some(p) => Some((p, Format::of("out", p, &[Format::Svg, Format::Png])?)),
         None => None,
     };
-    let json = match args.get("json") {
+    let json = match args.json.as_deref() {
         Some(p) => Format::of("json", p, &[Format::Json]).map(|_| Some(p))?,
         None => None,
     };

@@ -4,8 +4,6 @@
 //! With `raw_steps` (every link's full list of `[delay, amplitude]` estimates) each step is first
 //! gated against `--calibration` (E4) and associated (spec §4) before the update.
 
-use std::ffi::OsString;
-
 use serde::{Deserialize, Serialize};
 
 use scatterloc::gating::Calibration;
@@ -18,10 +16,12 @@ use scatterloc::track::MAX_STEPS;
 use scatterloc::track::{Ekf, MeasurementNoise, UpdateSummary};
 use scatterloc::{Error, Model};
 
-use crate::commands::{emit, model_of, parse_args, read_json_file, read_scenario, Sigma};
-use crate::gating_cmd::{one_list_per_link, read_calibration, RawStep};
-use crate::output::{check_writable, Format};
-use crate::track_fig::{read_truth, write_track_figure, TrackSeries};
+use super::gating::{one_list_per_link, read_calibration, RawStep};
+use super::io::{emit, model_of, read_json_file, read_scenario};
+use super::output::{check_writable, Format};
+use super::scenario::Sigma;
+use super::track_fig::{read_truth, write_track_figure, TrackSeries};
+use crate::cli::{Association, TrackArgs};
 use crate::CliError;
 
 /// The `--measurements` file.
@@ -99,34 +99,22 @@ fn estimates(step: &[Vec<[f64; 2]>]) -> Vec<Vec<DelayEstimate>> {
 }
 
 /// `scatterloc track --scenario S --measurements M [--calibration C] [--association R]`.
-pub fn track(argv: &[OsString]) -> Result<(), CliError> {
-    let flags = [
-        "scenario",
-        "measurements",
-        "calibration",
-        "association",
-        "out",
-        "truth",
-    ];
-    let Some(args) = parse_args(argv, "track", &flags, &[])? else {
-        return Ok(());
-    };
-    args.expect_positional("track", 0, "")?;
-    let mpath = args.required("measurements")?;
-    let figure = match args.get("out") {
+pub fn track(args: &TrackArgs) -> Result<(), CliError> {
+    let mpath = args.measurements.as_str();
+    let figure = match args.out.as_deref() {
         Some(p) => {
             let f = Format::of("out", p, &[Format::Svg, Format::Png])?;
             check_writable("out", p)?;
             Some((p, f))
         }
-        None if args.get("truth").is_some() => {
+        None if args.truth.is_some() => {
             return Err(CliError::usage(
                 "--truth: only used with --out (the figure)",
             ))
         }
         None => None,
     };
-    let scenario = read_scenario(&args)?;
+    let scenario = read_scenario(&args.scenario)?;
     let mut m: MeasurementsFile = read_json_file("measurements", mpath)?;
     let bad = |e: &dyn std::fmt::Display| CliError::usage(format!("--measurements {mpath}: {e}"));
     let model = model_of(&scenario)?;
@@ -140,16 +128,11 @@ pub fn track(argv: &[OsString]) -> Result<(), CliError> {
         Some(s) => MeasurementNoise::Fixed(s),
         None => MeasurementNoise::AtPrediction,
     };
-    let rule = match args.get("association") {
-        None | Some("spec") => AssociationRule::Spec,
-        Some("gated") => AssociationRule::Gated,
-        Some(other) => {
-            return Err(CliError::usage(format!(
-                "--association: '{other}' is not spec or gated"
-            )))
-        }
+    let rule = match args.association {
+        None | Some(Association::Spec) => AssociationRule::Spec,
+        Some(Association::Gated) => AssociationRule::Gated,
     };
-    let calibration = match args.get("calibration") {
+    let calibration = match args.calibration.as_deref() {
         Some(path) => Some(read_calibration(path, &model)?),
         None => None,
     };
@@ -168,9 +151,7 @@ pub fn track(argv: &[OsString]) -> Result<(), CliError> {
             "steps: {len} steps, at most {MAX_STEPS} are allowed"
         )));
     }
-    if m.raw_steps.is_none()
-        && (args.get("calibration").is_some() || args.get("association").is_some())
-    {
+    if m.raw_steps.is_none() && (args.calibration.is_some() || args.association.is_some()) {
         return Err(CliError::usage(
             "--calibration/--association: apply to raw_steps only (this file has steps)",
         ));
@@ -196,7 +177,7 @@ pub fn track(argv: &[OsString]) -> Result<(), CliError> {
         (None, None) => unreachable!("checked above"),
     }
     if let Some((path, format)) = figure {
-        let truth = match args.get("truth") {
+        let truth = match args.truth.as_deref() {
             Some(t) => Some(read_truth(t, &out.t_s)?),
             None => None,
         };
@@ -210,7 +191,7 @@ pub fn track(argv: &[OsString]) -> Result<(), CliError> {
         let how = if out.choices.is_some() {
             format!(
                 "raw estimates gated (E4), association {}",
-                args.get("association").unwrap_or("spec")
+                args.association.unwrap_or(Association::Spec).name()
             )
         } else {
             "delays as given".to_string()

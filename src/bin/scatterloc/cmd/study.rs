@@ -18,19 +18,10 @@ use scatterloc::track::{
 use scatterloc::track::{MonteCarloConfig, MonteCarloResult, MAX_STEPS};
 use scatterloc::{scenario::presets, Error, Model, Scenario};
 
-use crate::args::Args;
-use crate::commands::{model_of, read_scenario};
+use super::io::{model_of, read_scenario};
+use crate::cli::{StudyArgs, Trajectory};
 use crate::CliError;
 
-/// Flags every study takes.
-pub const STUDY_FLAGS: &[&str] = &[
-    "preset",
-    "scenario",
-    "trajectory",
-    "dt",
-    "duration",
-    "process-noise",
-];
 /// Times at which the summaries report the curves, s (check 9, 10).
 pub const REPORT_TIMES_S: [f64; 4] = [1.0, 2.0, 5.0, 10.0];
 /// Most worker threads accepted by `--threads`.
@@ -89,36 +80,33 @@ pub fn cancelled() -> CliError {
 
 /// Parses the study flags: `--preset` (default `sensors2019`) or `--scenario`, `--trajectory`
 /// (`I`, `II`, `III` or `all`, the default), `--dt`, `--duration`, `--process-noise`.
-pub fn parse_study(args: &Args) -> Result<Study, CliError> {
-    let (layout, scenario): (String, Scenario) = match (args.get("preset"), args.get("scenario")) {
+pub fn parse_study(args: &StudyArgs) -> Result<Study, CliError> {
+    let (layout, scenario): (String, Scenario) = match (&args.preset, &args.scenario) {
         (Some(_), Some(_)) => {
             return Err(CliError::usage(
                 "--preset / --scenario: give one of them, not both",
             ))
         }
-        (_, Some(_)) => {
-            let s = read_scenario(args)?;
+        (_, Some(path)) => {
+            let s = read_scenario(path)?;
             (s.name.clone(), s)
         }
         (p, None) => {
-            let name = p.unwrap_or("sensors2019");
+            let name = p.as_deref().unwrap_or("sensors2019");
             let s = presets::preset(name).map_err(|e| CliError::usage(format!("--preset: {e}")))?;
             (name.to_string(), s)
         }
     };
-    let trajectories = match args.get("trajectory") {
-        None => TrackScenario::ALL.to_vec(),
-        Some(t) if t.eq_ignore_ascii_case("all") => TrackScenario::ALL.to_vec(),
-        Some(t) => vec![TrackScenario::parse(t).map_err(|_| {
-            CliError::usage(format!(
-                "--trajectory: '{t}' is not one of I, II, III or all"
-            ))
-        })?],
+    let trajectories = match args.trajectory {
+        None | Some(Trajectory::All) => TrackScenario::ALL.to_vec(),
+        Some(Trajectory::One) => vec![TrackScenario::I],
+        Some(Trajectory::Two) => vec![TrackScenario::II],
+        Some(Trajectory::Three) => vec![TrackScenario::III],
     };
-    let dt = args.number("dt")?.unwrap_or(PAPER_STEP_S);
-    let q = args.number("process-noise")?.unwrap_or(PAPER_INTENSITY);
+    let dt = args.dt.unwrap_or(PAPER_STEP_S);
+    let q = args.process_noise.unwrap_or(PAPER_INTENSITY);
     let motion = ConstantVelocity::validated(dt, q).map_err(flag_error)?;
-    let duration = args.number("duration")?.unwrap_or(PAPER_DURATION_S);
+    let duration = args.duration.unwrap_or(PAPER_DURATION_S);
     let steps = checked_steps(duration, dt)?;
     Ok(Study {
         layout,
@@ -171,8 +159,8 @@ impl Study {
 }
 
 /// `--threads` (default 0 = all cores) and the number of threads that means.
-pub fn threads(args: &Args) -> Result<(usize, usize), CliError> {
-    let n = args.integer("threads")?.unwrap_or(0);
+pub fn threads(threads: Option<usize>) -> Result<(usize, usize), CliError> {
+    let n = threads.unwrap_or(0);
     if n > MAX_THREADS {
         return Err(CliError::usage(format!(
             "--threads: {n} is outside the allowed range 0..={MAX_THREADS} (0 = all cores)"
@@ -201,11 +189,6 @@ pub fn checked_steps(duration: f64, dt: f64) -> Result<usize, CliError> {
         )));
     }
     Ok(steps)
-}
-
-/// `--seed` (default 1).
-pub fn seed(args: &Args) -> Result<u64, CliError> {
-    Ok(args.integer("seed")?.unwrap_or(1) as u64)
 }
 
 /// Runs `cfg` on `threads` threads with a progress bar labelled `label` (drawn only when stderr

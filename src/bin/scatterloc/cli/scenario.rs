@@ -1,0 +1,73 @@
+//! Flags of the single-snapshot commands: `preset`, `crlb`, `crlb-map`, `locate`.
+
+use clap::Args;
+
+use super::values::{finite, whole, xy};
+
+/// `scatterloc preset NAME`.
+#[derive(Debug, Args)]
+pub struct PresetArgs {
+    /// The preset: sensors2019 (the [S] layout L4: one Tx, four Rx, 5.8 GHz) or iclgnss2019.
+    #[arg(value_name = "NAME")]
+    pub name: String,
+}
+
+/// `scatterloc crlb`.
+#[derive(Debug, Args)]
+pub struct CrlbArgs {
+    /// Scenario JSON file ('-' = standard input), e.g. the output of `scatterloc preset`.
+    #[arg(long, value_name = "FILE")]
+    pub scenario: String,
+    /// The point, metres: X,Y (e.g. 10,0).
+    #[arg(long, value_name = "X,Y", value_parser = xy)]
+    pub at: [f64; 2],
+}
+
+/// `scatterloc crlb-map`.
+#[derive(Debug, Args)]
+pub struct CrlbMapArgs {
+    /// Scenario JSON file ('-' = standard input).
+    #[arg(long, value_name = "FILE")]
+    pub scenario: String,
+    /// Output file; the extension picks the format: .json (the values), .svg or .png (figure).
+    #[arg(long, value_name = "OUT.{json,svg,png}")]
+    pub out: String,
+    /// Grid cells along x, 2..=4096 [default: 256].
+    #[arg(long, value_name = "N", value_parser = whole)]
+    pub nx: Option<usize>,
+    /// Grid cells along y, 2..=4096 [default: 256]; nx * ny at most 4194304.
+    #[arg(long, value_name = "N", value_parser = whole)]
+    pub ny: Option<usize>,
+    /// Left edge of the grid, m [default: area_m.x[0] of the scenario].
+    #[arg(long, value_name = "A", value_parser = finite)]
+    pub x_min: Option<f64>,
+    /// Right edge of the grid, m [default: area_m.x[1] of the scenario].
+    #[arg(long, value_name = "B", value_parser = finite)]
+    pub x_max: Option<f64>,
+    /// Bottom edge of the grid, m [default: area_m.y[0] of the scenario].
+    #[arg(long, value_name = "C", value_parser = finite)]
+    pub y_min: Option<f64>,
+    /// Top edge of the grid, m [default: area_m.y[1] of the scenario].
+    #[arg(long, value_name = "D", value_parser = finite)]
+    pub y_max: Option<f64>,
+    /// Figure width, pixels, 200..=8000 [default: 1000] (.svg/.png only).
+    #[arg(long, value_name = "PX", value_parser = whole)]
+    pub width: Option<usize>,
+    /// Figure height, pixels, 150..=8000 [default: from the width and the area's aspect ratio].
+    #[arg(long, value_name = "PX", value_parser = whole)]
+    pub height: Option<usize>,
+    /// Figure title [default: the scenario's name and the bound plotted].
+    #[arg(long, value_name = "TEXT")]
+    pub title: Option<String>,
+}
+
+/// `scatterloc locate`.
+#[derive(Debug, Args)]
+pub struct LocateArgs {
+    /// Scenario JSON file ('-' = standard input).
+    #[arg(long, value_name = "FILE")]
+    pub scenario: String,
+    /// Delays JSON file ('-' = standard input): {"delays_s": [..], "sigma_s": .., "initial_m": [x, y]}.
+    #[arg(long, value_name = "FILE")]
+    pub delays: String,
+}

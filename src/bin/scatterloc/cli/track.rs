@@ -1,0 +1,90 @@
+//! Flags of the tracking commands: `track`, `calibrate`, `simulate-walk`.
+
+use clap::Args;
+
+use super::values::{finite, seed, whole, Association, WalkStart};
+
+/// `scatterloc track`.
+#[derive(Debug, Args)]
+pub struct TrackArgs {
+    /// Scenario JSON file ('-' = standard input).
+    #[arg(long, value_name = "FILE")]
+    pub scenario: String,
+    /// Measurements JSON file ('-' = standard input): dt_s, process_noise, the start, and steps
+    /// or raw_steps (see above).
+    #[arg(long, value_name = "FILE")]
+    pub measurements: String,
+    /// Static paths from `scatterloc calibrate` (raw_steps only); estimates within 3 sigma of a
+    /// static cluster are discarded (E4) [default: none, nothing is static].
+    #[arg(long, value_name = "FILE")]
+    pub calibration: Option<String>,
+    /// Association rule of raw_steps (spec §4) [default: spec].
+    #[arg(long, value_name = "RULE")]
+    pub association: Option<Association>,
+    /// Figure of the 1 sigma position uncertainty and the links used over time (.svg or .png).
+    #[arg(long, value_name = "FIG.{svg,png}")]
+    pub out: Option<String>,
+    /// Truth file {t_s, states} (e.g. simulate-walk's truth.json): adds the position error to
+    /// the --out figure.
+    #[arg(long, value_name = "FILE")]
+    pub truth: Option<String>,
+}
+
+/// `scatterloc calibrate`.
+#[derive(Debug, Args)]
+pub struct CalibrateArgs {
+    /// Scenario JSON file ('-' = standard input).
+    #[arg(long, value_name = "FILE")]
+    pub scenario: String,
+    /// Snapshots JSON file ('-' = standard input): {"snapshots": [[[delay_s, ..] per link] per
+    /// snapshot]}.
+    #[arg(long, value_name = "FILE")]
+    pub snapshots: String,
+    /// Clusterer gap G, s: sorted delays further apart than G start a new cluster
+    /// [default: 1/B of the scenario's bandwidth].
+    #[arg(long, value_name = "G", value_parser = finite)]
+    pub gap_s: Option<f64>,
+    /// Least fraction F of the snapshots a cluster must be seen in to count as static
+    /// [default: 0.5].
+    #[arg(long, value_name = "F", value_parser = finite)]
+    pub min_fraction: Option<f64>,
+    /// Floor of a cluster's sigma, s [default: 0.01/B].
+    #[arg(long, value_name = "S", value_parser = finite)]
+    pub sigma_floor_s: Option<f64>,
+    /// Write the calibration to this .json file instead of standard output.
+    #[arg(long, value_name = "OUT.json")]
+    pub out: Option<String>,
+}
+
+/// `scatterloc simulate-walk`.
+#[derive(Debug, Args)]
+pub struct SimulateWalkArgs {
+    /// Scenario JSON file ('-' = standard input).
+    #[arg(long, value_name = "FILE")]
+    pub scenario: String,
+    /// Directory for calibration_snapshots.json, measurements.json and truth.json (created if
+    /// missing).
+    #[arg(long, value_name = "DIR")]
+    pub out_dir: String,
+    /// Length of the walk, s [default: 60, one loop].
+    #[arg(long, value_name = "S", value_parser = finite)]
+    pub duration: Option<f64>,
+    /// Step T between snapshots, s [default: 0.1].
+    #[arg(long, value_name = "T", value_parser = finite)]
+    pub dt: Option<f64>,
+    /// Random seed [default: 1].
+    #[arg(long, value_name = "N", value_parser = seed)]
+    pub seed: Option<u64>,
+    /// Calibration snapshots of the empty area, 1..=100000 [default: 500].
+    #[arg(long, value_name = "N", value_parser = whole)]
+    pub calibration_snapshots: Option<usize>,
+    /// Mean number of false alarms per link and snapshot [default: 0.5].
+    #[arg(long, value_name = "F", value_parser = finite)]
+    pub false_alarms: Option<f64>,
+    /// Process-noise intensity q written to measurements.json, m^2/s^3 [default: 0.1].
+    #[arg(long, value_name = "Q", value_parser = finite)]
+    pub process_noise: Option<f64>,
+    /// How measurements.json starts the filter [default: snapshot].
+    #[arg(long, value_name = "HOW")]
+    pub start: Option<WalkStart>,
+}
