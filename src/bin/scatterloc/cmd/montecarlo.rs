@@ -77,6 +77,7 @@ pub fn montecarlo(args: &MontecarloArgs) -> Result<(), CliError> {
             rmse_ekf_m: Some(r.rmse_ekf_m),
             rmse_pcrlb_m: r.rmse_pcrlb_m,
             nees: Some(r.nees),
+            caption_note: Some(failed_note(r.failed_runs, r.runs + r.failed_runs)),
             meta,
         });
     }
@@ -89,6 +90,12 @@ pub fn montecarlo(args: &MontecarloArgs) -> Result<(), CliError> {
         )),
     };
     outputs.finish(&study, &docs, &opts)
+}
+
+/// The figure's note on the EKF runs that failed numerically (left out of `ε_EKF`), shown
+/// even when there are none.
+fn failed_note(failed: usize, total: usize) -> String {
+    format!("{failed} of {total} runs failed")
 }
 
 /// Scalars of one bound curve (`pcrlb`).
@@ -163,6 +170,7 @@ pub fn pcrlb(args: &PcrlbArgs) -> Result<(), CliError> {
             rmse_ekf_m: None,
             rmse_pcrlb_m: rmse,
             nees: None,
+            caption_note: None,
             meta,
         });
     }

@@ -32,6 +32,10 @@ pub struct CurveDoc<M: Serialize> {
     /// Everything else.
     #[serde(flatten)]
     pub meta: M,
+    /// Added to the panel caption of the figure (EKF studies: the failed runs, which
+    /// `ε_EKF` leaves out); not part of the JSON.
+    #[serde(skip)]
+    pub caption_note: Option<String>,
 }
 
 /// The scalars and the values at the reporting times.
@@ -145,7 +149,11 @@ impl Outputs {
             let captions: Vec<String> = study
                 .trajectories
                 .iter()
-                .map(|t| format!("Scenario {}", t.name()))
+                .zip(docs)
+                .map(|(t, d)| match &d.caption_note {
+                    Some(note) => format!("Scenario {} · {note}", t.name()),
+                    None => format!("Scenario {}", t.name()),
+                })
                 .collect();
             let panels = docs
                 .iter()
