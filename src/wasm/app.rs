@@ -233,10 +233,7 @@ impl App {
     /// CRLB at `(x, y)`: `{x, y, bounded, sigma_x_m, sigma_y_m, rmse_m, *_label, ellipse:
     /// {cx, cy, a, b, angle} }`; unbounded: `bounded: false` and nulls.
     pub fn crlb_at(&self, x: f64, y: f64) -> Result<JsValue, JsError> {
-        to_js(&CrlbJs::new(&crlb_at(
-            self.session.model(),
-            point(x, y)?,
-        )))
+        to_js(&CrlbJs::new(&crlb_at(self.session.model(), point(x, y)?)))
     }
 
     /// CRLB RMSE bound at `(x, y)`, m (`Infinity` when unbounded).

@@ -12,8 +12,8 @@ use crate::math::{Real, Vec4};
 use crate::measure::Ellipse;
 use crate::mtl::view::output::EllipseView;
 use crate::mtl::view::MtlView;
-use crate::present::{format_length_m, Tick};
 use crate::present::Session;
+use crate::present::{format_length_m, Tick};
 use crate::present::{LinkSim, SnapshotFix, SnapshotSimulation};
 use crate::present::{TrackEstimate, TrackFrame};
 use crate::track::{MonteCarloConfig, MonteCarloResult, TrackRun};
@@ -195,7 +195,10 @@ impl<'a> LinkJs<'a> {
         LinkJs {
             tx,
             rx,
-            name: format!("{}\u{2013}{}", s.transmitters[tx].name, s.receivers[rx].name),
+            name: format!(
+                "{}\u{2013}{}",
+                s.transmitters[tx].name, s.receivers[rx].name
+            ),
             delay_s: l.delay_s,
             sigma_s: l.sigma_s,
             range_sigma_label: label(l.range_sigma_m),
@@ -488,7 +491,5 @@ pub(super) struct MtlViewJs<'a> {
     pub(super) compute_ms: f64,
 }
 
-#[cfg(test)]
-mod legacy;
 #[cfg(test)]
 mod tests;
