@@ -9,7 +9,7 @@ use alloc::vec::Vec;
 use crate::math::{log10, round, Real};
 
 /// A tick: its value and its label.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct Tick {
     /// Value, in the axis unit (m for lengths).
     pub value: Real,

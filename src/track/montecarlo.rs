@@ -148,7 +148,7 @@ impl PartialSums {
 }
 
 /// The curves of a study.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct MonteCarloResult {
     /// `t_n = n T`, s, `n = 0 … steps`.
     pub t_s: Vec<Real>,

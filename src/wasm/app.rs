@@ -4,7 +4,7 @@
 use js_sys::Float64Array;
 use wasm_bindgen::prelude::*;
 
-use super::json::{crlb_json, nodes_json, snapshot_json, to_js};
+use super::json::{to_js, CrlbJs, NodesJs, SnapshotJs};
 use super::{err, point};
 use crate::localize::{crlb_at, crlb_map, Grid};
 use crate::present::simulate_snapshot;
@@ -67,9 +67,7 @@ impl App {
 
     /// The scenario as a plain JavaScript object (parsed JSON).
     pub fn scenario(&self) -> Result<JsValue, JsError> {
-        let v = serde_json::to_value(self.session.scenario())
-            .map_err(|e| JsError::new(&e.to_string()))?;
-        to_js(&v)
+        to_js(self.session.scenario())
     }
 
     /// Replaces the scenario with parsed, validated JSON; unchanged on error.
@@ -102,7 +100,7 @@ impl App {
     /// Nodes for drawing: `{transmitters: [{name, x, y, boresight: [ux, uy] | null}],
     /// receivers: [{name, x, y}], links: [[tx, rx], …]}` (indices).
     pub fn nodes(&self) -> Result<JsValue, JsError> {
-        to_js(&nodes_json(&self.session))
+        to_js(&NodesJs::new(&self.session))
     }
 
     /// Area of interest `[x_min, x_max, y_min, y_max]`, m.
@@ -235,7 +233,7 @@ impl App {
     /// CRLB at `(x, y)`: `{x, y, bounded, sigma_x_m, sigma_y_m, rmse_m, *_label, ellipse:
     /// {cx, cy, a, b, angle} }`; unbounded: `bounded: false` and nulls.
     pub fn crlb_at(&self, x: f64, y: f64) -> Result<JsValue, JsError> {
-        to_js(&crlb_json(&crlb_at(self.session.model(), point(x, y)?)))
+        to_js(&CrlbJs::new(&crlb_at(self.session.model(), point(x, y)?)))
     }
 
     /// CRLB RMSE bound at `(x, y)`, m (`Infinity` when unbounded).
@@ -252,6 +250,6 @@ impl App {
     pub fn simulate_fix(&self, x: f64, y: f64, seed: u32) -> Result<JsValue, JsError> {
         let s = self.session.scenario();
         let sim = simulate_snapshot(self.session.model(), &s.area_m, point(x, y)?, seed.into());
-        to_js(&snapshot_json(&sim, s))
+        to_js(&SnapshotJs::new(&sim, s))
     }
 }

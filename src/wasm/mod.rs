@@ -2,13 +2,14 @@
 //!
 //! [`App`] wraps a core [`Session`](crate::present::Session) (a validated scenario and its
 //! compiled model; rejected edits change nothing). This layer only checks the numbers JavaScript
-//! hands over, calls the core and converts the results: objects as parsed JSON (serde_json, whose
-//! non-finite numbers become `null`, so no NaN reaches JavaScript), maps as typed arrays
-//! (unbounded cells are `Infinity`), and errors as exceptions (`JsError`) carrying the core
-//! [`Error`]'s one-line message, which names the offending field; nothing panics on input.
+//! hands over, calls the core and converts the results: objects as serde structs, serialised by
+//! one helper to parsed JSON (serde_json, whose non-finite numbers become `null`, so no NaN
+//! reaches JavaScript), maps as typed arrays (unbounded cells are `Infinity`), and errors as
+//! exceptions (`JsError`) carrying the core [`Error`]'s one-line message, which names the
+//! offending field; nothing panics on input.
 //!
 //! Files: `app.rs` (the `App` class), `render.rs` (colours, ticks and labels for drawing),
-//! `json.rs` (core results as JavaScript values), `tracking.rs` (`App.simulate_track` and the
+//! `json.rs` (the page's object shapes and `to_js`), `tracking.rs` (`App.simulate_track` and the
 //! `Track` it returns), `montecarlo.rs` (`MonteCarloJob`, run chunk by chunk in a Web Worker),
 //! `chart.rs` (the plotters ε_EKF / ε_PCRLB chart on a canvas), `mtl.rs` (the multi-target view
 //! of a scene, [`crate::mtl::view`]).

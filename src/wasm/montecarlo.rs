@@ -3,10 +3,10 @@
 //! merged in order, so the result equals [`run_sequential`](crate::track::run_sequential)
 //! (and the native CLI) for the same inputs.
 
-use serde_json::json;
 use wasm_bindgen::prelude::*;
 
 use super::err;
+use super::json::{to_json, MonteCarloJs};
 use super::tracking::{checked_steps, prior_and_motion};
 use crate::track::paper_initial_covariance;
 use crate::track::{finish, run_chunk, MonteCarloConfig, PartialSums};
@@ -103,15 +103,11 @@ impl MonteCarloJob {
     /// chunk_count, done}`. Throws before the first chunk has run (no run counted yet).
     pub fn result_json(&self) -> Result<String, JsError> {
         let r = finish(&self.cfg, &self.sums).map_err(err)?;
-        Ok(json!({
-            "t_s": r.t_s, "rmse_ekf_m": r.rmse_ekf_m, "rmse_pcrlb_m": r.rmse_pcrlb_m,
-            "nees": r.nees, "runs": r.runs, "failed_runs": r.failed_runs, "seed": r.seed,
-            "trajectories": self.cfg.trajectories, "noise_runs": self.cfg.noise_runs,
-            "trajectories_done": self.sums.trajectories,
-            "steps": self.cfg.steps, "dt_s": self.cfg.motion.dt_s,
-            "chunks_done": self.chunks_done, "chunk_count": self.cfg.chunk_count(),
-            "done": self.is_done(),
-        })
-        .to_string())
+        to_json(&MonteCarloJs::new(
+            &r,
+            &self.cfg,
+            self.sums.trajectories,
+            self.chunks_done,
+        ))
     }
 }

@@ -6,7 +6,7 @@
 use wasm_bindgen::prelude::*;
 
 use super::err;
-use super::json::to_js;
+use super::json::{to_js, MtlViewJs};
 use crate::mtl::view::{mtl_view_cached, MtlScene, ViewCache};
 
 #[wasm_bindgen]
@@ -64,10 +64,8 @@ fn view_json(scene_json: &str, cache: &mut ViewCache) -> Result<JsValue, JsError
     let t0 = performance_now();
     let scene = MtlScene::from_json(scene_json).map_err(err)?;
     let view = mtl_view_cached(&scene, cache).map_err(err)?;
-    let mut value =
-        serde_json::to_value(&view).map_err(|e| JsError::new(&format!("internal error: {e}")))?;
-    if let Some(obj) = value.as_object_mut() {
-        obj.insert("compute_ms".into(), (performance_now() - t0).into());
-    }
-    to_js(&value)
+    to_js(&MtlViewJs {
+        view: &view,
+        compute_ms: performance_now() - t0,
+    })
 }

@@ -2,11 +2,10 @@
 //! length labels, all computed by the core ([`crate::present`], [`crate::present`]).
 
 use js_sys::{Float64Array, Uint8ClampedArray};
-use serde_json::{json, Value};
 use wasm_bindgen::prelude::*;
 
 use super::err;
-use super::json::to_js;
+use super::json::{to_js, ColorbarTickJs, ScaleBarJs};
 use crate::present::{self, LogScale, UNBOUNDED_RGB};
 use crate::present::{format_length_m, linear_ticks};
 
@@ -45,23 +44,16 @@ pub fn unbounded_rgb() -> Vec<u8> {
 /// (none given: no thinning). Empty for an invalid scale.
 #[wasm_bindgen]
 pub fn colorbar_ticks(min: f64, max: f64, max_labels: Option<usize>) -> Result<JsValue, JsError> {
-    let ticks: Vec<Value> = LogScale::new(min, max)
+    let ticks = LogScale::new(min, max)
         .map(|s| s.ticks(max_labels.unwrap_or(usize::MAX)))
-        .unwrap_or_default()
-        .into_iter()
-        .map(|(frac, t)| json!({"frac": frac, "value_m": t.value, "label": t.label}))
-        .collect();
-    to_js(&Value::Array(ticks))
+        .unwrap_or_default();
+    to_js(&ColorbarTickJs::all(&ticks))
 }
 
 /// Linear axis ticks over `[lo, hi]` (about `max_count`): `[{value, label}]`.
 #[wasm_bindgen]
 pub fn axis_ticks(lo: f64, hi: f64, max_count: usize) -> Result<JsValue, JsError> {
-    let t: Vec<Value> = linear_ticks(lo, hi, max_count)
-        .into_iter()
-        .map(|t| json!({"value": t.value, "label": t.label}))
-        .collect();
-    to_js(&Value::Array(t))
+    to_js(&linear_ticks(lo, hi, max_count))
 }
 
 /// A length as text with a readable unit (`"4.26 mm"`, `"17.7 cm"`, `"∞"`).
@@ -73,8 +65,6 @@ pub fn format_length(m: f64, significant: usize) -> String {
 /// A scale bar no longer than `max_len_m`: `{length_m, label}`, or null.
 #[wasm_bindgen]
 pub fn scale_bar(max_len_m: f64) -> Result<JsValue, JsError> {
-    to_js(&match present::scale_bar(max_len_m) {
-        Some(t) => json!({"length_m": t.value, "label": t.label}),
-        None => Value::Null,
-    })
+    let bar = present::scale_bar(max_len_m);
+    to_js(&bar.as_ref().map(ScaleBarJs::new))
 }

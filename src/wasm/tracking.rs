@@ -2,10 +2,9 @@
 //! [`simulate_track`] (truth, noisy delays, EKF) and hands back a [`Track`], whose `data()` is
 //! the whole run and `frame(n)` one step shaped like a snapshot ([`crate::present`]).
 
-use serde_json::{json, Value};
 use wasm_bindgen::prelude::*;
 
-use super::json::{ellipse_json, estimate_json, frame_json, to_js};
+use super::json::{to_js, EstimateJs, FrameJs, TrackDataJs};
 use super::{err, App};
 use crate::error::Error;
 use crate::math::{Real, Vec2, Vec4};
@@ -107,32 +106,14 @@ impl Track {
             .map(|n| track_estimate(run, n))
             .collect::<crate::Result<_>>()
             .map_err(err)?;
-        let net = &self.model.network;
-        let measurements: Vec<Value> = run
-            .delays_s
-            .iter()
-            .map(|d| {
-                let per_link = d.iter().enumerate();
-                Value::Array(
-                    per_link
-                        .map(|(p, t)| ellipse_json(net.iso_delay_ellipse(p, *t)))
-                        .collect(),
-                )
-            })
-            .collect();
-        to_js(&json!({
-            "kind": self.kind, "seed": self.seed, "steps": self.steps,
-            "dt_s": run.t_s.get(1).copied(),
-            "failed_at": run.failed_at,
-            "t_s": run.t_s,
-            "truth": run.truth.iter().map(|x| [x[0], x[1]]).collect::<Vec<_>>(),
-            "estimates": run.estimates.iter().map(|x| [x[0], x[1], x[2], x[3]]).collect::<Vec<_>>(),
-            "ellipses": est.iter().map(|e| ellipse_json(e.ellipse)).collect::<Vec<_>>(),
-            "sigma_m": est.iter().map(|e| e.sigma_m).collect::<Vec<_>>(),
-            "error_m": est.iter().map(|e| e.error_m).collect::<Vec<_>>(),
-            "nis": run.nis,
-            "measurements": measurements,
-        }))
+        to_js(&TrackDataJs::new(
+            &self.kind,
+            self.seed,
+            self.steps,
+            run,
+            &est,
+            &self.model,
+        ))
     }
 
     /// Step `n` shaped like `App.simulate_fix`'s snapshot (`fix` is the EKF estimate: `{x, y,
@@ -140,12 +121,14 @@ impl Track {
     /// and the truth's velocity. Throws for a step past the end.
     pub fn frame(&self, n: usize) -> Result<JsValue, JsError> {
         let f = track_frame(&self.model, &self.run, n).map_err(err)?;
-        to_js(&frame_json(&f, &self.scenario))
+        to_js(&FrameJs::new(&f, &self.scenario))
     }
 
     /// One estimate: as `frame(n).fix`, without the measurement geometry.
     pub fn estimate(&self, n: usize) -> Result<JsValue, JsError> {
-        to_js(&estimate_json(&track_estimate(&self.run, n).map_err(err)?))
+        to_js(&EstimateJs::new(
+            &track_estimate(&self.run, n).map_err(err)?,
+        ))
     }
 }
 
