@@ -288,12 +288,23 @@ fn simulated_fix_has_ellipses_and_lands_near_truth() {
 fn labels_and_ticks() {
     assert_eq!(wasm::format_length(0.004258, 3), "4.26 mm");
     assert_eq!(wasm::format_length(f64::INFINITY, 3), "\u{221e}");
-    let t = js_sys::Array::from(&ok(wasm::colorbar_ticks(0.003, 0.5)));
+    let t = js_sys::Array::from(&ok(wasm::colorbar_ticks(0.003, 0.5, None)));
     assert_eq!(get(&t.get(1), "label").as_string().unwrap(), "1 cm");
     assert_eq!(
-        js_sys::Array::from(&ok(wasm::colorbar_ticks(f64::NAN, 1.0))).length(),
+        js_sys::Array::from(&ok(wasm::colorbar_ticks(f64::NAN, 1.0, None))).length(),
         0
     );
+    // The page's colour bar uses the figures' algorithm: same values and labels, thinned alike.
+    for max_labels in [2, 3, 8] {
+        let page = js_sys::Array::from(&ok(wasm::colorbar_ticks(1e-4, 3.0, Some(max_labels))));
+        let figure = scatterloc::present::colorbar_ticks(1e-4, 3.0, max_labels);
+        assert_eq!(page.length() as usize, figure.len());
+        for (i, t) in figure.iter().enumerate() {
+            let p = page.get(i as u32);
+            assert_eq!(get(&p, "label").as_string().unwrap(), t.label);
+            assert_eq!(num(&p, "value_m"), t.value);
+        }
+    }
     assert_eq!(wasm::colorbar_rgba(16).len(), 64);
     let bar = ok(wasm::scale_bar(0.03));
     assert_eq!(num(&bar, "length_m"), 0.02);
