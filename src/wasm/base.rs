@@ -1,0 +1,49 @@
+//! What every binding shares: the module start (panics routed to the console), the presets,
+//! and the two conversions at the JavaScript edge (a core error to an exception, two numbers
+//! to a checked point).
+
+use alloc::string::{String, ToString};
+use alloc::vec::Vec;
+
+use wasm_bindgen::prelude::*;
+
+use crate::error::Error;
+use crate::{scenario::presets, Vec2};
+
+/// Module start: route Rust panics to `console.error` with their message.
+#[wasm_bindgen(start)]
+pub fn start() {
+    console_error_panic_hook::set_once();
+}
+
+/// Names of the presets.
+#[wasm_bindgen]
+pub fn preset_names() -> Vec<String> {
+    presets::PRESET_NAMES
+        .iter()
+        .map(|s| s.to_string())
+        .collect()
+}
+
+/// A preset's scenario JSON.
+#[wasm_bindgen]
+pub fn preset_json(name: &str) -> Result<String, JsError> {
+    Ok(presets::preset(name).map_err(err)?.to_json())
+}
+
+/// A core error as a JavaScript exception with its message.
+pub(super) fn err(e: Error) -> JsError {
+    JsError::new(&e.to_string())
+}
+
+/// A point from JavaScript numbers, which must be finite (named `x`, `y`).
+pub(super) fn point(x: f64, y: f64) -> Result<Vec2, JsError> {
+    for (field, v) in [("x", x), ("y", y)] {
+        if !v.is_finite() {
+            return Err(err(Error::NonFinite {
+                field: field.to_string(),
+            }));
+        }
+    }
+    Ok(Vec2::new(x, y))
+}
