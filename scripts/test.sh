@@ -22,6 +22,9 @@ wasm-pack build --release --target web --out-dir www/pkg --mode no-install
 step "native cargo test (unit, spec checks, properties, CLI)"
 cargo test 2>&1 | tee -a "$log"
 
+step "full-size spec checks: check 10 at the paper step, check 11 at full size (the cheap part of scripts/reproduce.sh)"
+cargo test --test tracking_pcrlb --test tracking_check11 --test mtl_sim -- --ignored 2>&1 | tee -a "$log"
+
 step "browser end-to-end (Debian chromium + chromedriver; prints the page's own map timing)"
 cargo test --test e2e -- --ignored --nocapture --test-threads=1 2>&1 | tee -a "$log"
 
