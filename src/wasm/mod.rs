@@ -25,8 +25,8 @@ mod render;
 mod tracking;
 
 pub use app::App;
-pub use base::{preset_json, preset_names, start};
 use base::{err, point};
+pub use base::{preset_json, preset_names, start};
 pub use chart::draw_tracking_chart;
 pub use montecarlo::MonteCarloJob;
 pub use mtl::{mtl_check_scene, mtl_default_scene, mtl_view_of, MtlSession};
@@ -35,4 +35,3 @@ pub use render::{
     unbounded_rgb,
 };
 pub use tracking::{drag_velocity, track_steps, Track, MAX_TRACK_STEPS};
-

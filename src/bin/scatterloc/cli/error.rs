@@ -126,7 +126,13 @@ pub fn one_line(e: &clap::Error, cmd: &clap::Command, argv: &[OsString]) -> Stri
     let value = string(e, ContextKind::InvalidValue).unwrap_or_default();
     let name = flag(&arg).to_string();
     let line = match e.kind() {
-        ErrorKind::UnknownArgument => format!("unexpected argument '{arg}'{}", suggestion(e)),
+        ErrorKind::UnknownArgument => {
+            format!(
+                "{}unexpected argument '{arg}'{}",
+                prefix(&path),
+                suggestion(e)
+            )
+        }
         ErrorKind::InvalidSubcommand => {
             let sub = string(e, ContextKind::InvalidSubcommand).unwrap_or_default();
             let hint = match suggestion(e) {
