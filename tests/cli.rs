@@ -724,3 +724,117 @@ fn every_command_has_help_citing_the_spec() {
         );
     }
 }
+
+/// Issue 12 item 4: output paths. A symbolic link, a FIFO or a device at an output path is
+/// refused with a named error and left as it was (an atomic rename would replace it and never
+/// write its target); an empty path and an `--out-dir` naming a file exit 2; a regular file is
+/// still replaced.
+#[cfg(unix)]
+#[test]
+fn output_paths_that_are_not_regular_files_are_refused_and_kept() {
+    let dir = TempDir::new();
+    let scenario = dir.write_text("s.json", &presets::sensors2019().to_json());
+    let target = dir.write_text("target.json", "keep me");
+    let link = dir.path("link.json");
+    std::os::unix::fs::symlink(&target, &link).unwrap();
+    let map = |out: &str| {
+        [
+            "crlb-map",
+            "--scenario",
+            &scenario,
+            "--out",
+            out,
+            "--nx",
+            "4",
+            "--ny",
+            "4",
+        ]
+        .map(String::from)
+    };
+    let args = map(&link);
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    fails(&args, &["--out", "link.json", "symbolic link", "refusing"]);
+    assert!(std::fs::symlink_metadata(&link)
+        .unwrap()
+        .file_type()
+        .is_symlink());
+    assert_eq!(std::fs::read_to_string(&target).unwrap(), "keep me");
+
+    let fifo = dir.path("fifo.json");
+    let made = Command::new("mkfifo").arg(&fifo).status();
+    if made.is_ok_and(|s| s.success()) {
+        let args = map(&fifo);
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        fails(&args, &["--out", "fifo.json", "not a regular file"]);
+        assert!(!std::fs::symlink_metadata(&fifo).unwrap().is_file());
+    }
+    // A device (the issue's case: run as root, `calibrate --out /dev/full` replaced the node).
+    let walk = dir.path("walk");
+    let w = [
+        "simulate-walk",
+        "--scenario",
+        &scenario,
+        "--out-dir",
+        &walk,
+        "--duration",
+        "1",
+    ];
+    assert!(run(&[&w[..], &["--calibration-snapshots", "5"]].concat())
+        .status
+        .success());
+    let snaps = format!("{walk}/calibration_snapshots.json");
+    fails(
+        &[
+            "calibrate",
+            "--scenario",
+            &scenario,
+            "--snapshots",
+            &snaps,
+            "--out",
+            "/dev/null",
+        ],
+        &["--out", "/dev/null", "not a regular file"],
+    );
+    assert!(!std::fs::metadata("/dev/null").unwrap().is_file());
+
+    let args = map("");
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    fails(&args, &["--out"]);
+    let file = dir.write_text("afile", "x");
+    for (out_dir, needle) in [(file.as_str(), "not a directory"), ("", "empty")] {
+        fails(
+            &[
+                "simulate-walk",
+                "--scenario",
+                &scenario,
+                "--out-dir",
+                out_dir,
+                "--duration",
+                "1",
+            ],
+            &["--out-dir", needle],
+        );
+    }
+    assert_eq!(std::fs::read_to_string(&file).unwrap(), "x");
+    // A regular file is replaced, atomically, as before.
+    let regular = dir.write_text("map.json", "old");
+    let args = map(&regular);
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    assert!(run(&args).status.success());
+    assert!(std::fs::read_to_string(&regular)
+        .unwrap()
+        .contains("rmse_bound_m"));
+}
+
+/// Issue 12 item 11: a scenario with a UTF-8 byte-order mark (as some editors write it) is read
+/// like the same file without one.
+#[test]
+fn a_utf8_bom_scenario_is_accepted() {
+    let dir = TempDir::new();
+    let text = presets::sensors2019().to_json();
+    let plain = dir.write_text("plain.json", &text);
+    let bom = dir.write_text("bom.json", &format!("\u{feff}{text}"));
+    let a = ok_json(&["crlb", "--scenario", &plain, "--at", "3,4"]);
+    let b = ok_json(&["crlb", "--scenario", &bom, "--at", "3,4"]);
+    assert_eq!(a, b);
+}

@@ -162,12 +162,26 @@ struct WalkTruth {
     resolved: Vec<Vec<bool>>,
 }
 
+/// `--out-dir` must name a directory or a new path: not empty, not an existing file.
+fn check_out_dir(dir: &str) -> Result<(), CliError> {
+    if dir.is_empty() {
+        return Err(CliError::usage("--out-dir: the path is empty".to_string()));
+    }
+    match std::fs::metadata(dir) {
+        Ok(meta) if !meta.is_dir() => Err(CliError::usage(format!(
+            "--out-dir: '{dir}' exists and is not a directory"
+        ))),
+        _ => Ok(()),
+    }
+}
+
 /// `scatterloc simulate-walk --scenario S --out-dir DIR [--duration S] [--dt T]
 /// [--calibration-snapshots N] [--false-alarms F] [--process-noise Q] [--seed N]`.
 pub fn simulate_walk(args: &SimulateWalkArgs) -> Result<(), CliError> {
     let scenario = read_scenario(&args.scenario)?;
     let model = model_of(&scenario)?;
     let dir = args.out_dir.as_str();
+    check_out_dir(dir)?;
     let dt = args.dt.unwrap_or(0.1);
     let q = args.process_noise.unwrap_or(0.1);
     ConstantVelocity::validated(dt, q).map_err(flag_error)?;

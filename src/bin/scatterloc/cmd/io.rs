@@ -26,7 +26,8 @@ pub fn emit_json<T: Serialize>(v: &T) -> Result<(), CliError> {
     emit(&text)
 }
 
-/// Reads a file (or stdin for `-`) named by `--flag`.
+/// Reads a file (or stdin for `-`) named by `--flag`. A leading UTF-8 byte-order mark is
+/// dropped (editors on some systems write one; the page accepts it too).
 pub fn read_input(flag: &str, path: &str) -> Result<String, CliError> {
     let res = if path == "-" {
         let mut s = String::new();
@@ -34,7 +35,11 @@ pub fn read_input(flag: &str, path: &str) -> Result<String, CliError> {
     } else {
         std::fs::read_to_string(path)
     };
-    res.map_err(|e| CliError::usage(format!("--{flag}: cannot read '{path}': {e}")))
+    res.map(|s| match s.strip_prefix('\u{feff}') {
+        Some(rest) => rest.to_string(),
+        None => s,
+    })
+    .map_err(|e| CliError::usage(format!("--{flag}: cannot read '{path}': {e}")))
 }
 
 /// Reads and validates the scenario file `path` of `--scenario`.

@@ -85,9 +85,39 @@ fn temporary_path(path: &Path) -> PathBuf {
     path.with_file_name(name)
 }
 
-/// Fails now, naming `--flag`, if `path` could not be written later (missing directory, no
-/// permission): creates and removes its temporary file. For long runs, before they start.
+/// Refuses, naming `--flag`, an empty path and anything at `path` that an atomic write would
+/// destroy instead of writing: a symbolic link (its target would never be written), a device,
+/// a FIFO, a socket or a directory. A regular file (replaced) or a new path is fine.
+pub fn check_target(flag: &str, path: &str) -> Result<(), CliError> {
+    if path.is_empty() {
+        return Err(CliError::usage(format!("--{flag}: the path is empty")));
+    }
+    let meta = match std::fs::symlink_metadata(path) {
+        Ok(meta) => meta,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(()),
+        Err(e) => return Err(cannot_write(flag, path, e)),
+    };
+    let kind = meta.file_type();
+    if kind.is_file() {
+        return Ok(());
+    }
+    let what = if kind.is_symlink() {
+        "a symbolic link"
+    } else if kind.is_dir() {
+        "a directory"
+    } else {
+        "a device, FIFO or socket"
+    };
+    Err(CliError::usage(format!(
+        "--{flag}: '{path}' is {what}, not a regular file; refusing to replace it (write to a new path or a regular file)"
+    )))
+}
+
+/// Fails now, naming `--flag`, if `path` could not be written later (see [`check_target`];
+/// missing directory, no permission): creates and removes its temporary file. For long runs,
+/// before they start.
 pub fn check_writable(flag: &str, path: &str) -> Result<(), CliError> {
+    check_target(flag, path)?;
     let tmp = temporary_path(Path::new(path));
     std::fs::File::create(&tmp).map_err(|e| cannot_write(flag, path, e))?;
     let _ = std::fs::remove_file(&tmp);
@@ -101,6 +131,7 @@ pub fn write_atomic(
     path: &str,
     write: impl FnOnce(&Path) -> Result<(), CliError>,
 ) -> Result<(), CliError> {
+    check_target(flag, path)?;
     let tmp = temporary_path(Path::new(path));
     // Fail early, with the target's name, when the directory is missing or not writable.
     std::fs::File::create(&tmp).map_err(|e| cannot_write(flag, path, e))?;
