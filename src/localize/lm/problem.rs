@@ -6,7 +6,7 @@ use alloc::vec::Vec;
 use super::{DelayMeasurements, MIN_LINKS};
 use crate::error::{check_len, Error, Result};
 use crate::math::{Mat2, Real, Vec2, SPEED_OF_LIGHT};
-use crate::measure::{bistatic_range, unit_from, Network};
+use crate::measure::{bistatic_range, range_and_gradient, Network};
 
 /// One used link in range units: foci, measured range `cτ̂` and weight `1/(cσ)²`.
 #[derive(Clone, Copy)]
@@ -71,10 +71,8 @@ impl Problem {
     pub(super) fn linearize(&self, r: Vec2) -> (Real, Mat2, Vec2) {
         let (mut cost, mut n, mut g) = (0.0, Mat2::zeros(), Vec2::zeros());
         for row in &self.rows {
-            let (ut, dt) = unit_from(row.tx, r);
-            let (ur, dr) = unit_from(row.rx, r);
-            let j = ut + ur;
-            let e = row.range - (dt + dr);
+            let (d, j) = range_and_gradient(row.tx, row.rx, r);
+            let e = row.range - d;
             cost += row.weight * e * e;
             n += row.weight * j * j.transpose();
             g += (row.weight * e) * j;

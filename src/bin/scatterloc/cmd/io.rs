@@ -35,9 +35,11 @@ pub fn read_input(flag: &str, path: &str) -> Result<String, CliError> {
     } else {
         std::fs::read_to_string(path)
     };
-    res.map(|s| match s.strip_prefix('\u{feff}') {
-        Some(rest) => rest.to_string(),
-        None => s,
+    res.map(|mut s| {
+        if s.starts_with('\u{feff}') {
+            s.drain(..'\u{feff}'.len_utf8());
+        }
+        s
     })
     .map_err(|e| CliError::usage(format!("--{flag}: cannot read '{path}': {e}")))
 }
