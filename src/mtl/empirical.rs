@@ -86,7 +86,8 @@ impl EmpiricalTable {
 
     /// The region `R`.
     pub fn region(&self) -> Result<Rect> {
-        Rect::new(
+        Rect::named(
+            ["min_m/max_m", "min_m[0]/max_m[0]", "min_m[1]/max_m[1]"],
             Vec2::new(self.min_m[0], self.min_m[1]),
             Vec2::new(self.max_m[0], self.max_m[1]),
         )

@@ -8,7 +8,7 @@
 
 use alloc::vec::Vec;
 
-use crate::error::{check_len, Error, Result};
+use crate::error::{check_len, limits, Error, Result};
 use crate::math::{Real, Vec2};
 
 /// An axis-aligned rectangle `[min.x, max.x] × [min.y, max.y]` (the region `R` of §6.2/§7).
@@ -21,24 +21,29 @@ pub struct Rect {
 }
 
 impl Rect {
-    /// A rectangle from its corners; [`Error::NonFinite`] for a non-finite coordinate and
-    /// [`Error::InvertedArea`] when a minimum is not below its maximum.
+    /// A rectangle from its corners, named `region` in errors (see [`Rect::named`]).
     pub fn new(min: Vec2, max: Vec2) -> Result<Rect> {
-        if !(min.x.is_finite() && min.y.is_finite() && max.x.is_finite() && max.y.is_finite()) {
-            return Err(Error::NonFinite {
-                field: "region".into(),
-            });
+        Rect::named(["region", "region.x", "region.y"], min, max)
+    }
+
+    /// A rectangle from its corners; errors name `fields` = `[whole, x side, y side]`:
+    /// [`Error::NonFinite`] (whole) for a non-finite coordinate, [`Error::OutOfRange`] (whole)
+    /// for one outside [`limits::COORDINATE_M`], and [`Error::InvertedArea`] (side) when a
+    /// minimum is not below its maximum.
+    pub fn named(fields: [&'static str; 3], min: Vec2, max: Vec2) -> Result<Rect> {
+        for v in [min.x, min.y, max.x, max.y] {
+            limits::COORDINATE_M.check(fields[0], v)?;
         }
         if min.x >= max.x {
             return Err(Error::InvertedArea {
-                field: "region.x",
+                field: fields[1],
                 min: min.x,
                 max: max.x,
             });
         }
         if min.y >= max.y {
             return Err(Error::InvertedArea {
-                field: "region.y",
+                field: fields[2],
                 min: min.y,
                 max: max.y,
             });

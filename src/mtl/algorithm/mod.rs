@@ -108,7 +108,20 @@ pub struct MtlConfig {
     pub late_seed_catch_up: bool,
     /// Record the candidate trace per stage (for visualisation).
     pub trace: bool,
+    /// The work budget: the largest number of candidates one run may evaluate (every candidate
+    /// that ends a stage with a [`Status`] counts once). Past it the run stops with
+    /// [`crate::Error::WorkLimit`]; time and memory grow with this count (default
+    /// [`DEFAULT_MAX_CANDIDATES`], at most [`MAX_CANDIDATES`]).
+    pub max_candidates: usize,
 }
+
+/// The default work budget of one run of Algorithm 1, candidates: about 4 s and 50 MB on the
+/// reference machine (3.6 µs per candidate measured; docs/cli.md, "Limits"). The paper's
+/// experiments need at most 23 577 (V-B/V-C, 300 realisations) and 6 266 (V-A): a margin of 40.
+pub const DEFAULT_MAX_CANDIDATES: usize = 1_000_000;
+
+/// The largest work budget a caller may set, candidates.
+pub const MAX_CANDIDATES: usize = 100_000_000;
 
 impl Default for MtlConfig {
     fn default() -> Self {
@@ -129,6 +142,7 @@ impl Default for MtlConfig {
             late_seeds: true,
             late_seed_catch_up: true,
             trace: false,
+            max_candidates: DEFAULT_MAX_CANDIDATES,
         }
     }
 }
@@ -217,6 +231,14 @@ pub struct MtlOutput {
     /// Per stage (index 0 = stage 2) the number of candidates that ended with each [`Status`]
     /// (by [`Status::index`]), with or without the trace.
     pub stage_counts: Vec<[usize; 6]>,
+}
+
+impl MtlOutput {
+    /// The number of candidates evaluated (the work counted against
+    /// [`MtlConfig::max_candidates`]).
+    pub fn evaluated(&self) -> usize {
+        self.stage_counts.iter().flatten().sum()
+    }
 }
 
 /// Run Algorithm 1 (§4) on `input` with blocking model `model`.

@@ -4,7 +4,7 @@
 
 use alloc::vec::Vec;
 
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::math::Vec2;
 use crate::mtl::algorithm::cache::IntersectionCache;
 use crate::mtl::algorithm::candidate::{Candidate, Geometry, Pair};
@@ -24,6 +24,8 @@ pub struct Run<'a, 'c, B: ?Sized> {
     /// Per stage (2, 3, …), how many candidates ended with each [`Status`] (by
     /// [`Status::index`]); kept whether or not the trace is.
     counts: Vec<[usize; 6]>,
+    /// Candidates evaluated so far (every [`Run::record`]), against [`MtlConfig::max_candidates`].
+    evaluated: usize,
 }
 
 impl<'a, 'c, B: BlockingModel + ?Sized> Run<'a, 'c, B> {
@@ -49,6 +51,7 @@ impl<'a, 'c, B: BlockingModel + ?Sized> Run<'a, 'c, B> {
             next_family: 0,
             trace: Vec::new(),
             counts: Vec::new(),
+            evaluated: 0,
         }
     }
 
@@ -69,6 +72,9 @@ impl<'a, 'c, B: BlockingModel + ?Sized> Run<'a, 'c, B> {
     }
 
     /// All stages; returns the live candidates after the last one (all on `S` = every TRP).
+    ///
+    /// [`Error::WorkLimit`] (`ranges`) once more than [`MtlConfig::max_candidates`] candidates
+    /// have been evaluated.
     pub fn run(&mut self) -> Result<Vec<Candidate>> {
         let m_total = self.order.len();
         if m_total < 2 {
@@ -153,6 +159,7 @@ impl<'a, 'c, B: BlockingModel + ?Sized> Run<'a, 'c, B> {
     /// Step 2 for one candidate and TRP `m`: the MPCs passing the ellipse test each give a child
     /// (pair added, `ĝ_m = 1`, `x̂` refined); none passing gives the child with `ĝ_m = 0`.
     fn extend(&mut self, c: &Candidate, m: usize, out: &mut Vec<Candidate>) -> Result<()> {
+        self.check_budget()?;
         let mut any = false;
         let inv = self.geo.information_inverse(&c.matching, &c.x);
         for (i, &r) in self.geo.input.ranges[m].iter().enumerate() {
@@ -248,6 +255,7 @@ impl<'a, 'c, B: BlockingModel + ?Sized> Run<'a, 'c, B> {
     /// Score `c` (`L_b` from the model, `J` (M2)) and keep it iff it passes the stage blocking
     /// test.
     fn test(&mut self, mut c: Candidate, out: &mut Vec<Candidate>) -> Result<()> {
+        self.check_budget()?;
         c.l_b = self.model.blocking_likelihood(&c.x, &c.g)?;
         c.j = self.geo.range_term(&c.matching, &c.x) + c.l_b;
         if !self.cfg.stage_blocking_test || c.l_b <= self.cfg.t_b {
@@ -275,7 +283,19 @@ impl<'a, 'c, B: BlockingModel + ?Sized> Run<'a, 'c, B> {
         }
     }
 
+    /// [`Error::WorkLimit`] once the run has evaluated more than its budget.
+    fn check_budget(&self) -> Result<()> {
+        if self.evaluated > self.cfg.max_candidates {
+            return Err(Error::WorkLimit {
+                field: "ranges".into(),
+                limit: self.cfg.max_candidates,
+            });
+        }
+        Ok(())
+    }
+
     fn record(&mut self, c: &Candidate, status: Status) {
+        self.evaluated += 1;
         if let Some(stage) = self.counts.last_mut() {
             stage[status.index()] += 1;
         }

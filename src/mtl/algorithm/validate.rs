@@ -2,9 +2,9 @@
 
 use alloc::vec::Vec;
 
-use crate::error::{check_len, check_non_negative, Error, Result};
+use crate::error::{check_len, check_non_negative, limits, Error, Result};
 use crate::math::Real;
-use crate::mtl::algorithm::{Measurements, MtlConfig};
+use crate::mtl::algorithm::{Measurements, MtlConfig, MAX_CANDIDATES};
 use crate::mtl::blocking::BlockingModel;
 
 /// Check `input`, `model` and `cfg`; returns the TRP order `π`.
@@ -12,8 +12,9 @@ use crate::mtl::blocking::BlockingModel;
 /// Errors: [`Error::EmptyNodeList`] (`transmitters` / `receivers`); [`Error::LengthMismatch`]
 /// (`transmitters`, `receivers`, `ranges`, `order`) against the model's TRP map;
 /// [`Error::NonFinite`] (`transmitters[j]`, `receivers[j]`, `ranges[m][i]`, `t_e`, `t_b`,
-/// `c_sigma_m`); [`Error::NotPositive`] (`c_sigma_m`); [`Error::OutOfRange`] (`t_e`, `t_b` when
-/// negative; `order` when not a permutation); [`Error::SizeLimit`] (`b_max`, `merge_shared_pairs`
+/// `c_sigma_m`); [`Error::OutOfRange`] (`c_sigma_m` outside [`limits::C_SIGMA_M`]); [`Error::OutOfRange`] (`t_e`, `t_b` when
+/// negative; `order` when not a permutation); [`Error::SizeLimit`] (`max_candidates` outside
+/// 1..=[`MAX_CANDIDATES`]; `b_max`, `merge_shared_pairs`
 /// when 0).
 pub fn validate<B: BlockingModel + ?Sized>(
     input: &Measurements,
@@ -72,17 +73,7 @@ pub fn validate<B: BlockingModel + ?Sized>(
         true,
         "a threshold ≥ 0",
     )?;
-    if !input.c_sigma_m.is_finite() {
-        return Err(Error::NonFinite {
-            field: "c_sigma_m".into(),
-        });
-    }
-    if input.c_sigma_m <= 0.0 {
-        return Err(Error::NotPositive {
-            field: "c_sigma_m".into(),
-            value: input.c_sigma_m,
-        });
-    }
+    limits::C_SIGMA_M.check("c_sigma_m", input.c_sigma_m)?;
     for (field, v) in [
         ("b_max", cfg.b_max),
         ("merge_shared_pairs", cfg.merge_shared_pairs),
@@ -95,6 +86,14 @@ pub fn validate<B: BlockingModel + ?Sized>(
                 max: usize::MAX,
             });
         }
+    }
+    if !(1..=MAX_CANDIDATES).contains(&cfg.max_candidates) {
+        return Err(Error::SizeLimit {
+            field: "max_candidates",
+            value: cfg.max_candidates,
+            min: 1,
+            max: MAX_CANDIDATES,
+        });
     }
     let m = map.n_trps();
     let order: Vec<usize> = cfg.order.clone().unwrap_or_else(|| (0..m).collect());

@@ -42,8 +42,20 @@ fn positions(targets: &[Target]) -> Vec<Vec2> {
 
 /// Realisation `index` of `cfg` (not validated here; see [`ExperimentConfig::validate`]).
 ///
-/// Errors: those of the generator ([`generate`]) and of the models' constructors.
+/// Errors: those of the generator ([`generate`]) and of the models' constructors;
+/// [`crate::Error::WorkLimit`] (`realisation {index}: ranges`) when Algorithm 1 exceeds its
+/// budget on this realisation.
 pub fn evaluate(cfg: &ExperimentConfig, index: u64) -> Result<RealisationCounts> {
+    evaluate_unnamed(cfg, index).map_err(|e| match e {
+        crate::Error::WorkLimit { field, limit } => crate::Error::WorkLimit {
+            field: alloc::format!("realisation {index}: {field}"),
+            limit,
+        },
+        e => e,
+    })
+}
+
+fn evaluate_unnamed(cfg: &ExperimentConfig, index: u64) -> Result<RealisationCounts> {
     let s = &cfg.settings;
     let r = generate(s, cfg.seed, index)?;
     let ranges = r.ranges();

@@ -24,7 +24,7 @@ pub use model::{BuiltModel, ModelSpec, TrainingSpec};
 
 use serde::{Deserialize, Serialize};
 
-use crate::error::{check_len, Error, Result};
+use crate::error::{check_finite, check_len, limits, Error, Result};
 use crate::math::{Real, Vec2};
 use crate::measure::rng;
 use crate::mtl::algorithm::{Measurements, MtlConfig, Target};
@@ -149,13 +149,12 @@ fn points(field: &str, list: &[[Real; 2]]) -> Result<Vec<Vec2>> {
     list.iter()
         .enumerate()
         .map(|(j, p)| {
-            if p[0].is_finite() && p[1].is_finite() {
-                Ok(Vec2::new(p[0], p[1]))
-            } else {
-                Err(Error::NonFinite {
-                    field: format!("{field}[{j}]"),
-                })
-            }
+            let name = format!("{field}[{j}]");
+            check_finite(&name, p[0])?;
+            check_finite(&name, p[1])?;
+            limits::COORDINATE_M.check(&name, p[0])?;
+            limits::COORDINATE_M.check(&name, p[1])?;
+            Ok(Vec2::new(p[0], p[1]))
         })
         .collect()
 }
@@ -164,7 +163,8 @@ impl NetworkInput {
     /// Checks the network. Errors: [`Error::EmptyNodeList`] (`tx` / `rx`); [`Error::SizeLimit`]
     /// (`trps`, `nodes`) past [`crate::mtl::trp::MAX_TRPS`] / [`crate::mtl::trp::MAX_NODES`];
     /// [`Error::NonFinite`] (`tx[j]`, `rx[j]`, `region`, `c_sigma_m`); [`Error::InvertedArea`]
-    /// (`region.x`, `region.y`); [`Error::NotPositive`] (`c_sigma_m`).
+    /// (`region.x`, `region.y`); [`Error::OutOfRange`] (`tx[j]`, `rx[j]`, `region` outside
+    /// [`limits::COORDINATE_M`], `c_sigma_m` outside [`limits::C_SIGMA_M`]).
     pub fn validate(&self) -> Result<Network> {
         if self.tx.is_empty() {
             return Err(Error::EmptyNodeList { field: "tx" });
@@ -176,17 +176,7 @@ impl NetworkInput {
         let tx = points("tx", &self.tx)?;
         let rx = points("rx", &self.rx)?;
         let region = self.region.as_ref().map(RegionInput::rect).transpose()?;
-        if !self.c_sigma_m.is_finite() {
-            return Err(Error::NonFinite {
-                field: "c_sigma_m".into(),
-            });
-        }
-        if self.c_sigma_m <= 0.0 {
-            return Err(Error::NotPositive {
-                field: "c_sigma_m".into(),
-                value: self.c_sigma_m,
-            });
-        }
+        limits::C_SIGMA_M.check("c_sigma_m", self.c_sigma_m)?;
         Ok(Network {
             map,
             tx,

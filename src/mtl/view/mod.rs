@@ -33,7 +33,7 @@ use alloc::vec::Vec;
 
 use serde::{Deserialize, Serialize};
 
-use crate::error::{check_non_negative, check_positive, Error, Result};
+use crate::error::{check_non_negative, check_positive, limits, Error, Result};
 use crate::math::{sqrt, Real, Vec2};
 use crate::mtl::blocking::check_probability;
 use crate::mtl::polygon::Rect;
@@ -197,7 +197,8 @@ impl MtlScene {
     ///   … outside the region);
     /// - [`Error::OutOfRange`] (`discs[j]`) when a disc covers a node or a target (centre within
     ///   `D/2`; value = the distance, m);
-    /// - [`Error::NotPositive`] (`diameter`, `range_sigma`, `detection_radius`, `r_max`);
+    /// - [`Error::NotPositive`] (`diameter`, `detection_radius`, `r_max`); [`Error::OutOfRange`]
+    ///   (`range_sigma` outside [`limits::C_SIGMA_M`]);
     ///   [`Error::OutOfRange`] / [`Error::NonFinite`] (`lambda`, `resolution`, `clutter_mean`,
     ///   `t_e`, `t_b` negative or not finite; `clutter_mean` above [`MAX_VIEW_CLUTTER`]);
     ///   [`Error::OutOfRange`] (`p_d`, `model.p_u`, `model.p_los` outside `[0, 1]`);
@@ -228,7 +229,7 @@ impl MtlScene {
         check_positive("diameter", self.diameter)?;
         check_non_negative("lambda", self.lambda, false, "a value ≥ 0")?;
         check_probability("p_d", self.p_d)?;
-        check_positive("range_sigma", self.range_sigma)?;
+        limits::C_SIGMA_M.check("range_sigma", self.range_sigma)?;
         check_non_negative("resolution", self.resolution, false, "a value ≥ 0")?;
         check_non_negative("clutter_mean", self.clutter_mean, false, "a value ≥ 0")?;
         if self.clutter_mean > MAX_VIEW_CLUTTER {

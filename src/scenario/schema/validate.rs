@@ -1,65 +1,47 @@
 //! Validation of a parsed [`Scenario`]: every field checked, the first problem returned as a
 //! named [`Error`] with the path of its field.
 
+use alloc::collections::BTreeSet;
 use alloc::format;
-use alloc::vec::Vec;
 
 use super::{Area, Pattern, Scenario};
-use crate::error::{check_finite, check_positive, Error, Result};
+use crate::error::{check_finite, limits, Error, Result};
 
 impl Scenario {
-    /// Checks every field; the first problem found is returned as a named error.
+    /// Checks every field against its documented range ([`crate::error::limits`]) and the size
+    /// caps ([`limits::MAX_NODES`], [`limits::MAX_LINKS`]); the first problem found is returned
+    /// as a named error.
     pub fn validate(&self) -> Result<()> {
         let r = &self.radio;
-        check_positive("radio.carrier_hz", r.carrier_hz)?;
-        check_positive("radio.bandwidth_hz", r.bandwidth_hz)?;
+        limits::CARRIER_HZ.check("radio.carrier_hz", r.carrier_hz)?;
+        limits::BANDWIDTH_HZ.check("radio.bandwidth_hz", r.bandwidth_hz)?;
         if r.noise_figure_db.is_some() && r.noise_power_dbm.is_some() {
             return Err(Error::AmbiguousNoise);
         }
         if let Some(nf) = r.noise_figure_db {
-            check_finite("radio.noise_figure_db", nf)?;
-            if !(0.0..=100.0).contains(&nf) {
-                return Err(Error::OutOfRange {
-                    field: "radio.noise_figure_db".into(),
-                    value: nf,
-                    allowed: "0 to 100 dB",
-                });
-            }
+            limits::NOISE_FIGURE_DB.check("radio.noise_figure_db", nf)?;
         }
         if let Some(p) = r.noise_power_dbm {
-            check_finite("radio.noise_power_dbm", p)?;
+            limits::NOISE_POWER_DBM.check("radio.noise_power_dbm", p)?;
         }
         if let Some(g) = r.processing_gain_db {
-            check_finite("radio.processing_gain_db", g)?;
-            if g < 0.0 {
-                return Err(Error::OutOfRange {
-                    field: "radio.processing_gain_db".into(),
-                    value: g,
-                    allowed: ">= 0 dB",
-                });
-            }
+            limits::PROCESSING_GAIN_DB.check("radio.processing_gain_db", g)?;
         }
-        if self.transmitters.is_empty() {
-            return Err(Error::EmptyNodeList {
-                field: "transmitters",
-            });
-        }
-        if self.receivers.is_empty() {
-            return Err(Error::EmptyNodeList { field: "receivers" });
-        }
-        let mut names: Vec<&str> = Vec::new();
+        node_count("transmitters", self.transmitters.len())?;
+        node_count("receivers", self.receivers.len())?;
+        let mut names: BTreeSet<&str> = BTreeSet::new();
         for (i, t) in self.transmitters.iter().enumerate() {
             unique_name(&mut names, &t.name)?;
             position(&format!("transmitters[{i}].position_m"), t.position_m)?;
-            check_finite(&format!("transmitters[{i}].power_dbm"), t.power_dbm)?;
-            check_finite(&format!("transmitters[{i}].gain_dbi"), t.gain_dbi)?;
+            limits::POWER_DBM.check(&format!("transmitters[{i}].power_dbm"), t.power_dbm)?;
+            limits::GAIN_DBI.check(&format!("transmitters[{i}].gain_dbi"), t.gain_dbi)?;
             if let Pattern::Parabolic {
                 boresight_deg,
                 beamwidth_deg,
                 floor_db,
             } = t.pattern
             {
-                check_finite(
+                limits::BORESIGHT_DEG.check(
                     &format!("transmitters[{i}].pattern.boresight_deg"),
                     boresight_deg,
                 )?;
@@ -72,50 +54,68 @@ impl Scenario {
                         allowed: "0 < beamwidth <= 360 degrees",
                     });
                 }
-                let fl = format!("transmitters[{i}].pattern.floor_db");
-                check_finite(&fl, floor_db)?;
-                if floor_db < 0.0 {
-                    return Err(Error::OutOfRange {
-                        field: fl,
-                        value: floor_db,
-                        allowed: ">= 0 dB",
-                    });
-                }
+                limits::PATTERN_FLOOR_DB
+                    .check(&format!("transmitters[{i}].pattern.floor_db"), floor_db)?;
             }
         }
         for (i, rx) in self.receivers.iter().enumerate() {
             unique_name(&mut names, &rx.name)?;
             position(&format!("receivers[{i}].position_m"), rx.position_m)?;
-            check_finite(&format!("receivers[{i}].gain_dbi"), rx.gain_dbi)?;
+            limits::GAIN_DBI.check(&format!("receivers[{i}].gain_dbi"), rx.gain_dbi)?;
         }
-        check_positive("target.rcs_m2", self.target.rcs_m2)?;
+        limits::RCS_M2.check("target.rcs_m2", self.target.rcs_m2)?;
         area(&self.area_m)?;
-        self.link_indices().map(|_| ())
+        let links = self.link_indices()?.len();
+        if links > limits::MAX_LINKS {
+            return Err(Error::SizeLimit {
+                field: "links",
+                value: links,
+                min: 1,
+                max: limits::MAX_LINKS,
+            });
+        }
+        Ok(())
     }
 }
 
 impl Area {
-    /// Validates the rectangle (finite, min < max on both axes).
+    /// Validates the rectangle: finite, within [`limits::COORDINATE_M`], min < max and a span of at
+    /// least [`limits::MIN_AREA_SPAN_M`] on both axes.
     pub fn validate(&self) -> Result<()> {
         area(self)
     }
 }
 
+/// A position: both coordinates finite and within [`limits::COORDINATE_M`].
 fn position(field: &str, p: [f64; 2]) -> Result<()> {
-    if p.iter().all(|v| v.is_finite()) {
-        Ok(())
-    } else {
-        Err(Error::NonFinite {
-            field: field.into(),
-        })
+    for v in p {
+        check_finite(field, v)?;
     }
+    for v in p {
+        limits::COORDINATE_M.check(field, v)?;
+    }
+    Ok(())
 }
 
-fn unique_name<'a>(names: &mut Vec<&'a str>, name: &'a str) -> Result<()> {
-    if names.contains(&name) {
+fn node_count(field: &'static str, n: usize) -> Result<()> {
+    if n == 0 {
+        return Err(Error::EmptyNodeList { field });
+    }
+    if n > limits::MAX_NODES {
+        return Err(Error::SizeLimit {
+            field,
+            value: n,
+            min: 1,
+            max: limits::MAX_NODES,
+        });
+    }
+    Ok(())
+}
+
+fn unique_name<'a>(names: &mut BTreeSet<&'a str>, name: &'a str) -> Result<()> {
+    if !names.insert(name) {
         return Err(Error::DuplicateName { name: name.into() });
     }
-    names.push(name);
     Ok(())
 }
 
@@ -135,6 +135,15 @@ fn area(a: &Area) -> Result<()> {
             min: a.y[0],
             max: a.y[1],
         });
+    }
+    for (field, [lo, hi]) in [("area_m.x", a.x), ("area_m.y", a.y)] {
+        if hi - lo < limits::MIN_AREA_SPAN_M {
+            return Err(Error::OutOfRange {
+                field: field.into(),
+                value: hi - lo,
+                allowed: "a span of at least 1e-3 m",
+            });
+        }
     }
     Ok(())
 }

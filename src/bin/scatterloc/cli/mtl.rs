@@ -68,6 +68,10 @@ pub struct MtlLocateArgs {
     /// Largest number of candidates per family B_max, >= 1 or inf [default: 16].
     #[arg(long, value_name = "N|inf", value_parser = count_or_inf)]
     pub b_max: Option<usize>,
+    /// Work budget: the most candidates Algorithm 1 may evaluate, 1 ..= 100000000 (about 2 us
+    /// and 200 bytes each) [default: 1000000].
+    #[arg(long, value_name = "N", value_parser = whole)]
+    pub max_candidates: Option<usize>,
     /// Smallest matching size n_min of a target (TRPs that see it) [default: 3].
     #[arg(long, value_name = "N", value_parser = whole)]
     pub n_min: Option<usize>,

@@ -10,6 +10,8 @@ struct LocateOut<'a> {
     /// `null` = ∞.
     t_b: Option<f64>,
     count: usize,
+    /// Candidates evaluated (the work counted against `--max-candidates`).
+    candidates: usize,
     targets: Vec<TargetReport>,
 }
 
@@ -61,7 +63,7 @@ pub fn mtl_locate(args: &MtlLocateArgs) -> Result<(), CliError> {
         .map_err(|e| core_error(&e, "--model"))?;
     let cfg = network.config(&cfg, &built);
     let out = locate(&network.measurements(&ranges.ranges_m), &*built.model, &cfg)
-        .map_err(|e| core_error(&e, "mtl locate"))?;
+        .map_err(|e| core_error(&e, &format!("--ranges {ranges_path}")))?;
     let summary = match &spec {
         ModelSpec::Icb { p_d, .. } => ModelSummary {
             kind: "icb",
@@ -112,6 +114,7 @@ pub fn mtl_locate(args: &MtlLocateArgs) -> Result<(), CliError> {
         t_e: cfg.t_e,
         t_b: cfg.t_b.is_finite().then_some(cfg.t_b),
         count: targets.len(),
+        candidates: out.evaluated(),
         targets,
     };
     match out_path {

@@ -46,6 +46,7 @@ fn flag_of(field: &str) -> Option<&'static str> {
         "t_b" => "--tb",
         "b_max" => "--b-max",
         "n_min" => "--n-min",
+        "max_candidates" => "--max-candidates",
         "order" => "--order",
         "p_u" => "--p-u",
         "p_d" => "--p-d",
@@ -151,6 +152,10 @@ fn model_spec(args: &MtlLocateArgs) -> Result<ModelSpec, CliError> {
             if let Some(path) = args.table.as_deref() {
                 refuse(args, &training_flags, "with --table (the table is given)")?;
                 let table: EmpiricalTable = read_file("table", path)?;
+                // Checked here, so a bad field is named as the table's (not as a flag's).
+                table
+                    .validate()
+                    .map_err(|e| CliError::usage(format!("--table {path}: {e}")))?;
                 return Ok(ModelSpec::Empirical {
                     p_d,
                     table: Some(table),
@@ -181,6 +186,7 @@ fn mtl_config(args: &MtlLocateArgs) -> MtlConfig {
         t_b: args.tb.unwrap_or(d.t_b),
         b_max: args.b_max.unwrap_or(d.b_max),
         n_min: args.n_min.unwrap_or(d.n_min),
+        max_candidates: args.max_candidates.unwrap_or(d.max_candidates),
         order: args.order.clone().map(|o| o.0),
         ..d
     }

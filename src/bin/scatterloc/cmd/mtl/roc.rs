@@ -94,6 +94,7 @@ struct AlgorithmDoc {
     refinement_step_tol_m: f64,
     late_seeds: bool,
     late_seed_catch_up: bool,
+    max_candidates: usize,
 }
 
 fn config_doc(cfg: &ExperimentConfig) -> ConfigDoc {
@@ -158,6 +159,7 @@ fn config_doc(cfg: &ExperimentConfig) -> ConfigDoc {
             refinement_step_tol_m: m.refinement.step_tol_m,
             late_seeds: m.late_seeds,
             late_seed_catch_up: m.late_seed_catch_up,
+            max_candidates: m.max_candidates,
         },
     }
 }

@@ -4,6 +4,11 @@
 use alloc::string::String;
 use core::fmt;
 
+pub mod limits;
+mod show;
+
+pub use show::{Clip, Num};
+
 /// A named error. `Display` gives one line that names the offending field.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Error {
@@ -115,6 +120,15 @@ pub enum Error {
         /// Which matrix, e.g. `initial_covariance` or `ekf.covariance`.
         field: String,
     },
+    /// Multi-target localization (Algorithm 1) would evaluate more candidates than its work
+    /// budget: the measurements are too ambiguous (too many ranges per TRP for the gate `T_e`
+    /// and noise `cσ`) to be solved in bounded time and memory.
+    WorkLimit {
+        /// The input that drives the work, e.g. `ranges`.
+        field: String,
+        /// The budget, candidates.
+        limit: usize,
+    },
     /// A long computation was cancelled by its caller (Ctrl-C, a new drag in the page).
     Cancelled,
     /// A name that is not one of the known presets.
@@ -158,27 +172,38 @@ pub enum Error {
 impl fmt::Display for Error {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            Error::Parse { message } => write!(f, "invalid JSON: {message}"),
+            Error::Parse { message } => write!(f, "invalid JSON: {}", Clip(message)),
             Error::NonFinite { field } => write!(f, "{field}: not a finite number"),
-            Error::NotPositive { field, value } => write!(f, "{field}: must be > 0 (got {value})"),
+            Error::NotPositive { field, value } => {
+                write!(f, "{field}: must be > 0 (got {})", Num(*value))
+            },
             Error::OutOfRange {
                 field,
                 value,
                 allowed,
             } => {
-                write!(f, "{field}: {value} is out of range ({allowed})")
+                write!(f, "{field}: {} is out of range ({allowed})", Num(*value))
             }
             Error::EmptyNodeList { field } => write!(f, "{field}: at least one node is required"),
             Error::EmptyLinkList => write!(f, "links: the link list is empty"),
-            Error::DuplicateName { name } => write!(f, "duplicate node name \"{name}\""),
-            Error::UnknownNode { field, name } => write!(f, "{field}: unknown node \"{name}\""),
+            Error::DuplicateName { name } => write!(f, "duplicate node name \"{}\"", Clip(name)),
+            Error::UnknownNode { field, name } => {
+                write!(f, "{field}: unknown node \"{}\"", Clip(name))
+            },
             Error::DuplicateLink { tx, rx } => {
-                write!(f, "links: the link [\"{tx}\", \"{rx}\"] appears twice")
+                write!(
+                    f,
+                    "links: the link [\"{}\", \"{}\"] appears twice",
+                    Clip(tx),
+                    Clip(rx)
+                )
             }
             Error::InvertedArea { field, min, max } => {
                 write!(
                     f,
-                    "{field}: the minimum {min} must be below the maximum {max}"
+                    "{field}: the minimum {} must be below the maximum {}",
+                    Num(*min),
+                    Num(*max)
                 )
             }
             Error::AmbiguousNoise => write!(
@@ -206,7 +231,8 @@ impl fmt::Display for Error {
             Error::InvalidSigma { link, value } => {
                 write!(
                     f,
-                    "sigma_s[{link}]: must be a finite number > 0 (got {value})"
+                    "sigma_s[{link}]: must be a finite number > 0 (got {})",
+                    Num(*value)
                 )
             }
             Error::SizeLimit {
@@ -223,10 +249,16 @@ impl fmt::Display for Error {
             Error::NotPositiveDefinite { field } => {
                 write!(f, "{field}: not a symmetric positive-definite matrix")
             }
+            Error::WorkLimit { field, limit } => write!(
+                f,
+                "{field}: more than {limit} candidates to evaluate (the work budget of \
+                 multi-target localization); give fewer ranges per TRP, or lower T_e or c_sigma_m"
+            ),
             Error::Cancelled => write!(f, "cancelled"),
             Error::UnknownPreset { name } => write!(
                 f,
-                "unknown preset \"{name}\" (known: {})",
+                "unknown preset \"{}\" (known: {})",
+                Clip(name),
                 crate::scenario::presets::PRESET_NAMES.join(", ")
             ),
             Error::IndexOutOfRange { field, index, len } => {
@@ -237,11 +269,16 @@ impl fmt::Display for Error {
                 "{field}: the last one cannot be removed (at least one is required)"
             ),
             Error::UnknownTrajectory { field, name, known } => {
-                write!(f, "{field}: unknown trajectory \"{name}\" (known: {known})")
+                write!(
+                    f,
+                    "{field}: unknown trajectory \"{}\" (known: {known})",
+                    Clip(name)
+                )
             }
             Error::UnknownPattern { field, kind } => write!(
                 f,
-                "{field}: unknown pattern \"{kind}\" (known: omni, parabolic)"
+                "{field}: unknown pattern \"{}\" (known: omni, parabolic)",
+                Clip(kind)
             ),
         }
     }

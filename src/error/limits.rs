@@ -1,0 +1,159 @@
+//! The documented range of every physical parameter and the size caps that are not local to one
+//! module, each with its reason (docs/cli.md, "Limits"). A value outside its range is a named
+//! [`Error::OutOfRange`]; a size past its cap a named [`Error::SizeLimit`].
+
+use crate::error::{check_finite, Error, Result};
+
+/// A closed interval of allowed values, with the words an error shows.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Range {
+    /// Smallest allowed value.
+    pub min: f64,
+    /// Largest allowed value.
+    pub max: f64,
+    /// The interval in words, with its unit (shown in errors and in docs/cli.md).
+    pub allowed: &'static str,
+}
+
+impl Range {
+    /// `Ok` when `v` is finite and in `[min, max]`; else [`Error::NonFinite`] or
+    /// [`Error::OutOfRange`] naming `field`.
+    pub fn check(&self, field: &str, v: f64) -> Result<()> {
+        check_finite(field, v)?;
+        if (self.min..=self.max).contains(&v) {
+            Ok(())
+        } else {
+            Err(Error::OutOfRange {
+                field: field.into(),
+                value: v,
+                allowed: self.allowed,
+            })
+        }
+    }
+
+    /// Whether `v` lies in the range (false for NaN).
+    pub fn contains(&self, v: f64) -> bool {
+        (self.min..=self.max).contains(&v)
+    }
+}
+
+/// Any coordinate (node positions, area and region bounds): `|x| ≤ 10⁷ m`. The model is planar
+/// free-space propagation; 10 000 km is past any ground network, and every derived length
+/// (spans, bistatic ranges up to 4·√2·10⁷ m) stays far from overflow.
+pub const COORDINATE_M: Range = Range {
+    min: -1e7,
+    max: 1e7,
+    allowed: "-1e7 to 1e7 m",
+};
+
+/// The smallest span of an area side, m: a grid cell of a 4096-cell side is then ≥ 0.24 µm, far
+/// above the spacing of doubles at 10⁷ m (1.9 nm).
+pub const MIN_AREA_SPAN_M: f64 = 1e-3;
+
+/// Carrier frequency `f_c`: 1 kHz (VLF) to 1 THz (sub-millimetre radio). Only the wavelength of
+/// the free-space budget depends on it.
+pub const CARRIER_HZ: Range = Range {
+    min: 1e3,
+    max: 1e12,
+    allowed: "1e3 to 1e12 Hz",
+};
+
+/// Bandwidth `B`: 1 kHz to 1 THz. It sets `β = B/√12`, the noise power and the resolution 1/B.
+pub const BANDWIDTH_HZ: Range = Range {
+    min: 1e3,
+    max: 1e12,
+    allowed: "1e3 to 1e12 Hz",
+};
+
+/// Transmit power: −100 dBm (0.1 pW) to 100 dBm (10 MW, beyond the peak power of any radar).
+pub const POWER_DBM: Range = Range {
+    min: -100.0,
+    max: 100.0,
+    allowed: "-100 to 100 dBm",
+};
+
+/// Antenna gain: −60 dBi (a deep null) to 80 dBi (beyond the largest radio-telescope dishes).
+pub const GAIN_DBI: Range = Range {
+    min: -60.0,
+    max: 80.0,
+    allowed: "-60 to 80 dBi",
+};
+
+/// Radar cross section: 10⁻⁸ m² (below an insect) to 10⁸ m² (beyond a ship or a mountain face).
+pub const RCS_M2: Range = Range {
+    min: 1e-8,
+    max: 1e8,
+    allowed: "1e-8 to 1e8 m²",
+};
+
+/// Receiver noise figure `F`: 0 to 100 dB.
+pub const NOISE_FIGURE_DB: Range = Range {
+    min: 0.0,
+    max: 100.0,
+    allowed: "0 to 100 dB",
+};
+
+/// Explicit noise power: −250 dBm to 50 dBm (k_B·T₀·1 kHz is −144 dBm).
+pub const NOISE_POWER_DBM: Range = Range {
+    min: -250.0,
+    max: 50.0,
+    allowed: "-250 to 50 dBm",
+};
+
+/// Processing gain `B·T_p`: 0 to 200 dB (1 THz × 10⁸ s).
+pub const PROCESSING_GAIN_DB: Range = Range {
+    min: 0.0,
+    max: 200.0,
+    allowed: "0 to 200 dB",
+};
+
+/// Antenna boresight azimuth: one turn either way.
+pub const BORESIGHT_DEG: Range = Range {
+    min: -360.0,
+    max: 360.0,
+    allowed: "-360 to 360 degrees",
+};
+
+/// Maximum attenuation `A_m` of a parabolic pattern: 0 to 200 dB.
+pub const PATTERN_FLOOR_DB: Range = Range {
+    min: 0.0,
+    max: 200.0,
+    allowed: "0 to 200 dB",
+};
+
+/// A measured bistatic delay: > 0 and at most 1 s. Coordinates within [`COORDINATE_M`] give
+/// delays below 0.19 s; a delay ≤ 0 is not a propagation delay.
+pub const DELAY_S: Range = Range {
+    min: f64::MIN_POSITIVE,
+    max: 1.0,
+    allowed: "0 < delay <= 1 s",
+};
+
+/// A delay standard deviation: 10⁻¹⁵ s (0.3 µm) to 10⁻³ s (300 km). Larger σ make every squared
+/// normalised residual underflow, so the fit could not tell positions apart.
+pub const DELAY_SIGMA_S: Range = Range {
+    min: 1e-15,
+    max: 1e-3,
+    allowed: "1e-15 to 1e-3 s",
+};
+
+/// Range noise `cσ` of multi-target localization: 1 mm to 1 km.
+pub const C_SIGMA_M: Range = Range {
+    min: 1e-3,
+    max: 1e3,
+    allowed: "1e-3 to 1e3 m",
+};
+
+/// Largest number of links of a scenario. The CRLB map costs links × cells: at 4096 links a
+/// 256² map takes about 2.5 s on one core of the reference machine (docs/benchmarks.md), a grid
+/// search start of `locate` a fraction of a second; 1000 × 1000 nodes took minutes.
+pub const MAX_LINKS: usize = 4096;
+
+/// Largest number of transmitters, and of receivers, in a scenario (a node without a link adds
+/// nothing but cost; a full mesh already reaches [`MAX_LINKS`] at 64 × 64).
+pub const MAX_NODES: usize = 4096;
+
+/// Largest input file the CLI reads, bytes (`--scenario`, `--delays`, `--measurements`, …):
+/// 256 MiB. The largest legitimate input, a `simulate-walk` raw-steps file, is capped at the
+/// same size when written.
+pub const MAX_INPUT_BYTES: u64 = 256 << 20;
