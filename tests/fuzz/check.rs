@@ -336,12 +336,18 @@ pub struct CliRun {
 
 /// Runs `scatterloc args…` under the memory limit, killed after the time limit.
 pub fn run_cli(args: &[String]) -> CliRun {
+    run_limited(BIN, args, &[])
+}
+
+/// Runs `program args…` (with `envs`) under the memory limit, killed after the time limit.
+pub fn run_limited(program: &str, args: &[String], envs: &[(&str, &str)]) -> CliRun {
     use std::os::unix::process::ExitStatusExt;
     let mut child = Command::new("prlimit")
         .arg(format!("--as={}", cli_memory_bytes()))
         .arg("--")
-        .arg(BIN)
+        .arg(program)
         .args(args)
+        .envs(envs.iter().copied())
         .stdin(Stdio::null())
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
@@ -501,5 +507,99 @@ impl CaseDir {
 impl Drop for CaseDir {
     fn drop(&mut self) {
         let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+// ------------------------------------------------------------------------------- child cases
+
+/// Marker of the verdict line a child case prints.
+const VERDICT: &str = "@@fuzz-verdict@@";
+
+/// In a child process (`SCATTERLOC_FUZZ_CHILD` = kind, `SCATTERLOC_FUZZ_CHILD_FILE` = case):
+/// runs `run` on the case text if `kind` is the one asked for and prints the verdict line.
+pub fn child_main(kind: &str, run: impl FnOnce(&str) -> Verdict) {
+    if std::env::var("SCATTERLOC_FUZZ_CHILD").ok().as_deref() != Some(kind) {
+        return;
+    }
+    let path = std::env::var("SCATTERLOC_FUZZ_CHILD_FILE").expect("case file");
+    let text = std::fs::read_to_string(path).expect("read case");
+    let line = match guarded(&text, || run(&text)) {
+        Ok(Pass::Ok) => "ok".to_string(),
+        Ok(Pass::Err) => "err".to_string(),
+        Err(f) => format!("fail {:?} {}", f.class, f.detail.replace('\n', " ")),
+    };
+    println!("{VERDICT} {line}");
+}
+
+/// Runs an in-process case in a child process of this test binary (its test `test_name`), so
+/// that a run-away case is killed at the CLI time limit and bounded by the CLI memory limit.
+pub fn run_child(kind: &str, test_name: &str, dir: &CaseDir, text: &str) -> Verdict {
+    let file = dir.write("case.json", text);
+    let exe = std::env::current_exe().expect("test binary");
+    let args: Vec<String> = [test_name, "--exact", "--nocapture", "--test-threads=1", "-q"]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+    let run = run_limited(
+        &exe.to_string_lossy(),
+        &args,
+        &[
+            ("SCATTERLOC_FUZZ_CHILD", kind),
+            ("SCATTERLOC_FUZZ_CHILD_FILE", &file),
+            ("RUST_BACKTRACE", "0"),
+        ],
+    );
+    if run.timed_out {
+        return Err(fail(
+            Class::OverTime,
+            format!(
+                "killed after {:.1} s (limit {:.0} s)",
+                run.elapsed.as_secs_f64(),
+                cli_time_limit().as_secs_f64()
+            ),
+        ));
+    }
+    if run.stderr.contains("memory allocation of") {
+        return Err(fail(
+            Class::OverMemory,
+            format!("allocation failure under {} MB", cli_memory_bytes() >> 20),
+        ));
+    }
+    let Some(line) = run.stdout.lines().find_map(|l| l.strip_prefix(VERDICT)) else {
+        return Err(fail(
+            Class::Abort,
+            format!(
+                "child case ended without a verdict (exit {:?}, signal {:?}): {}",
+                run.code,
+                run.signal,
+                clip(run.stderr.trim(), 300)
+            ),
+        ));
+    };
+    let line = line.trim();
+    match line {
+        "ok" => Ok(Pass::Ok),
+        "err" => Ok(Pass::Err),
+        _ => {
+            let rest = line.strip_prefix("fail ").unwrap_or(line);
+            let (class, detail) = rest.split_once(' ').unwrap_or((rest, ""));
+            let class = [
+                Class::Panic,
+                Class::Abort,
+                Class::Signal,
+                Class::BadExit,
+                Class::NonFinite,
+                Class::UnnamedError,
+                Class::InternalError,
+                Class::LongMessage,
+                Class::BadOutput,
+                Class::OverTime,
+                Class::OverMemory,
+            ]
+            .into_iter()
+            .find(|c| format!("{c:?}") == class)
+            .unwrap_or(Class::BadOutput);
+            Err(fail(class, detail))
+        }
     }
 }

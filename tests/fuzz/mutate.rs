@@ -187,11 +187,12 @@ pub enum Op {
     SwapType,
 }
 
-fn op() -> impl Strategy<Value = Op> {
+fn op(grow_cap: usize) -> impl Strategy<Value = Op> {
     let grow = prop_oneof![
         4 => prop::sample::select(&[2usize, 3, 5, 9, 17, 50, 65, 257][..]),
         1 => prop::sample::select(&[1000usize, MAX_GROW][..]),
-    ];
+    ]
+    .prop_map(move |n| n.min(grow_cap));
     prop_oneof![
         3 => Just(Op::Delete),
         2 => key_mut().prop_map(Op::Rename),
@@ -216,10 +217,11 @@ pub struct Mutation {
     pub op: Op,
 }
 
-/// Up to `max` mutations (0 = the valid document itself, kept as a baseline case).
-pub fn mutations(max: usize) -> impl Strategy<Value = Vec<Mutation>> {
+/// Up to `max` mutations (0 = the valid document itself, kept as a baseline case); arrays grow
+/// to at most `grow_cap` elements.
+pub fn mutations(max: usize, grow_cap: usize) -> impl Strategy<Value = Vec<Mutation>> {
     prop::collection::vec(
-        (any::<Index>(), op()).prop_map(|(target, op)| Mutation { target, op }),
+        (any::<Index>(), op(grow_cap)).prop_map(|(target, op)| Mutation { target, op }),
         0..=max,
     )
 }

@@ -21,6 +21,8 @@ pub struct Known {
     pub class: Class,
     /// Substrings, all of which must occur in "detail ‖ mutations" (empty: any).
     pub needles: &'static [&'static str],
+    /// Substrings, one of which must occur too (empty: any).
+    pub any_of: &'static [&'static str],
     /// The issue 12 item, in words.
     pub issue: &'static str,
 }
@@ -59,6 +61,31 @@ struct Stats {
     ok: u64,
     err: u64,
     known: BTreeMap<&'static str, u64>,
+    /// Collect mode: per failure signature, the count and the shortest case seen.
+    seen: BTreeMap<String, (u64, String)>,
+}
+
+/// `SCATTERLOC_FUZZ_COLLECT=1`: no case fails; every distinct failure (class and detail with
+/// digits masked) is printed at the end with its count and shortest case, known or not.
+fn collect() -> bool {
+    std::env::var("SCATTERLOC_FUZZ_COLLECT").is_ok_and(|v| v == "1")
+}
+
+fn signature(f: &Failure) -> String {
+    let masked: String = f
+        .detail
+        .chars()
+        .map(|c| if c.is_ascii_digit() { '#' } else { c })
+        .collect();
+    let mut sig = format!("{:?}: {masked}", f.class);
+    if sig.len() > 110 {
+        let mut end = 110;
+        while !sig.is_char_boundary(end) {
+            end -= 1;
+        }
+        sig.truncate(end);
+    }
+    sig
 }
 
 /// Runs `run` on `cases(default_cases)` values of `strategy`, deterministic, and panics with the
@@ -94,10 +121,34 @@ pub fn fuzz<S: Strategy>(
         match case.verdict {
             Ok(Pass::Ok) => s.ok += 1,
             Ok(Pass::Err) => s.err += 1,
+            Err(f) if collect() => {
+                let hay = format!("{} ‖ {}", f.detail, case.what);
+                let tag = match known.iter().find(|k| {
+                    (k.kind == "*" || k.kind == kind)
+                        && k.class == f.class
+                        && k.needles.iter().all(|n| hay.contains(n))
+                        && (k.any_of.is_empty() || k.any_of.iter().any(|n| hay.contains(n)))
+                }) {
+                    Some(k) => format!("known ({})", k.issue),
+                    None => "UNKNOWN".to_string(),
+                };
+                let e = s
+                    .seen
+                    .entry(format!("{tag} {}", signature(&f)))
+                    .or_insert((0, String::new()));
+                e.0 += 1;
+                let this = report(&f, &case.what);
+                if e.1.is_empty() || this.len() < e.1.len() {
+                    e.1 = this;
+                }
+            }
             Err(f) => {
                 let hay = format!("{} ‖ {}", f.detail, case.what);
                 let k = known.iter().find(|k| {
-                    (k.kind == "*" || k.kind == kind) && k.class == f.class && k.needles.iter().all(|n| hay.contains(n))
+                    (k.kind == "*" || k.kind == kind)
+                        && k.class == f.class
+                        && k.needles.iter().all(|n| hay.contains(n))
+                        && (k.any_of.is_empty() || k.any_of.iter().any(|n| hay.contains(n)))
                 });
                 match k {
                     Some(k) if !strict() => *s.known.entry(k.issue).or_default() += 1,
@@ -110,7 +161,7 @@ pub fn fuzz<S: Strategy>(
     let s = stats.into_inner();
     let secs = t0.elapsed().as_secs_f64();
     let mut line = format!(
-        "fuzz {kind:<16} {n:>6} cases {:>7.1} s ({:.2} ms/case): {} ok, {} named errors",
+        "fuzz {kind:<20} {n:>6} cases {:>7.1} s ({:.2} ms/case): {} ok, {} named errors",
         secs,
         1e3 * secs / (s.ok + s.err + s.known.values().sum::<u64>()).max(1) as f64,
         s.ok,
@@ -118,6 +169,9 @@ pub fn fuzz<S: Strategy>(
     );
     for (issue, c) in &s.known {
         line.push_str(&format!("; known failure ×{c}: {issue}"));
+    }
+    for (sig, (c, example)) in &s.seen {
+        line.push_str(&format!("\n  [{kind}] ×{c} {sig}\n{example}"));
     }
     eprintln!("{line}");
     match result {
