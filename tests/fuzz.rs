@@ -205,7 +205,10 @@ const LINK_BUDGET_NEEDLES: &[&str] = &[
 /// A document kind's strategy: one of `bases`, mutated up to `max` times (arrays grow up to
 /// [`mutate::MAX_GROW`] elements).
 fn docs(bases: Vec<Value>, max: usize) -> impl Strategy<Value = (Value, Vec<Mutation>)> {
-    (prop::sample::select(bases), mutations(max, mutate::MAX_GROW))
+    (
+        prop::sample::select(bases),
+        mutations(max, mutate::MAX_GROW),
+    )
 }
 
 /// Longest list of the `network_ranges` kind (a child process killed at the time limit, as each
@@ -214,7 +217,10 @@ const MTL_IN_PROCESS_GROW: usize = 9;
 
 /// [`docs`] for the in-process multi-target kinds (lists grow to [`MTL_IN_PROCESS_GROW`]).
 fn mtl_docs(bases: Vec<Value>, max: usize) -> impl Strategy<Value = (Value, Vec<Mutation>)> {
-    (prop::sample::select(bases), mutations(max, MTL_IN_PROCESS_GROW))
+    (
+        prop::sample::select(bases),
+        mutations(max, MTL_IN_PROCESS_GROW),
+    )
 }
 
 fn mutated(case: &(Value, Vec<Mutation>)) -> mutate::Mutated {
@@ -590,12 +596,7 @@ fn fuzz_network_ranges() {
         mtl_docs(docs::mtl_requests(), 4),
         |c| {
             let m = mutated(c);
-            let v = run_child(
-                "network_ranges",
-                "fuzz_network_ranges_child",
-                &dir,
-                &m.text,
-            );
+            let v = run_child("network_ranges", "fuzz_network_ranges_child", &dir, &m.text);
             case(&m, v)
         },
     );
@@ -844,7 +845,13 @@ fn fuzz_cli_measurements() {
             let m = mutated(c);
             let v = cli_case(
                 "measurements",
-                &["track", "--scenario", "{s.json}", "--measurements", "{m.json}"],
+                &[
+                    "track",
+                    "--scenario",
+                    "{s.json}",
+                    "--measurements",
+                    "{m.json}",
+                ],
                 &[("s.json", &scen), ("m.json", &m.text)],
                 &track_nulls,
             );
@@ -867,29 +874,39 @@ fn fuzz_cli_raw_steps() {
     let w = docs::walk();
     let cal = w.calibration.to_string();
     let strategy = (
-        docs(vec![w.raw_snapshot_start.clone(), w.raw_truth_start.clone()], 4),
+        docs(
+            vec![w.raw_snapshot_start.clone(), w.raw_truth_start.clone()],
+            4,
+        ),
         prop::sample::select(RAW_FLAGS),
     );
-    fuzz(file!(), "cli_raw_steps", 48, KNOWN, strategy, |(c, flags)| {
-        let m = mutated(c);
-        let mut args = vec![
-            "track",
-            "--scenario",
-            "{s.json}",
-            "--measurements",
-            "{m.json}",
-        ];
-        args.extend_from_slice(flags);
-        let v = cli_case(
-            "raw",
-            &args,
-            &[("s.json", &scen), ("m.json", &m.text), ("c.json", &cal)],
-            &track_nulls,
-        );
-        let mut k = case(&m, v);
-        k.what = format!("flags {flags:?}: {}", k.what);
-        k
-    });
+    fuzz(
+        file!(),
+        "cli_raw_steps",
+        48,
+        KNOWN,
+        strategy,
+        |(c, flags)| {
+            let m = mutated(c);
+            let mut args = vec![
+                "track",
+                "--scenario",
+                "{s.json}",
+                "--measurements",
+                "{m.json}",
+            ];
+            args.extend_from_slice(flags);
+            let v = cli_case(
+                "raw",
+                &args,
+                &[("s.json", &scen), ("m.json", &m.text), ("c.json", &cal)],
+                &track_nulls,
+            );
+            let mut k = case(&m, v);
+            k.what = format!("flags {flags:?}: {}", k.what);
+            k
+        },
+    );
 }
 
 #[test]
@@ -943,7 +960,13 @@ fn fuzz_cli_snapshots() {
             let m = mutated(c);
             let v = cli_case(
                 "snapshots",
-                &["calibrate", "--scenario", "{s.json}", "--snapshots", "{f.json}"],
+                &[
+                    "calibrate",
+                    "--scenario",
+                    "{s.json}",
+                    "--snapshots",
+                    "{f.json}",
+                ],
                 &[("s.json", &scen), ("f.json", &m.text)],
                 &|_, _| false,
             );
@@ -971,10 +994,10 @@ fn fuzz_cli_mtl() {
     fuzz(file!(), "cli_mtl", 24, KNOWN, strategy, |(c, flags)| {
         let m = mutated(c);
         // The two files of the case: each top-level part (absent = the text `null`).
-        let doc: Value = serde_json::from_str(&m.text).unwrap_or(Value::Null);
+        let doc = serde_json::from_str::<Value>(&m.text);
         let part = |k: &str| -> String {
-            match serde_json::from_str::<Value>(&m.text) {
-                Ok(_) => doc.get(k).map_or("null".into(), Value::to_string),
+            match &doc {
+                Ok(doc) => doc.get(k).map_or("null".into(), Value::to_string),
                 // Raw tokens made the document invalid JSON: cut it by hand.
                 Err(_) => cut(&m.text, k),
             }
@@ -1016,6 +1039,6 @@ fn cut(text: &str, k: &str) -> String {
     };
     let end = rest
         .find(other)
-        .unwrap_or(rest.len().saturating_sub(1).max(0));
+        .unwrap_or(rest.len().saturating_sub(1));
     rest[..end].to_string()
 }

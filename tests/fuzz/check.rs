@@ -145,7 +145,11 @@ pub fn check_message(msg: &str) -> Verdict {
     if line.contains('\n') {
         return Err(fail(
             Class::UnnamedError,
-            format!("error of {} lines: {}", line.lines().count(), clip(line, 300)),
+            format!(
+                "error of {} lines: {}",
+                line.lines().count(),
+                clip(line, 300)
+            ),
         ));
     }
     if line.len() > MAX_MESSAGE_BYTES {
@@ -183,11 +187,7 @@ pub fn nonfinite_in_debug(what: &str, dbg: &str) -> Result<(), Failure> {
             let before_ok = i == 0 || !word(b[i - 1]);
             let after_ok = j >= b.len() || !word(b[j]);
             if before_ok && after_ok {
-                let lo = dbg[..i]
-                    .char_indices()
-                    .rev()
-                    .nth(80)
-                    .map_or(0, |(p, _)| p);
+                let lo = dbg[..i].char_indices().rev().nth(80).map_or(0, |(p, _)| p);
                 return Err(fail(
                     Class::NonFinite,
                     format!("{what}: {tok} in …{}", clip(&dbg[lo..], 160)),
@@ -466,7 +466,10 @@ pub fn check_cli(run: &CliRun, allow_null: &dyn Fn(&str, &Value) -> bool) -> Ver
             }
             Ok(Pass::Err)
         }
-        (Some(101), _) => Err(fail(Class::Panic, format!("exit 101: {}", first(&run.stderr)))),
+        (Some(101), _) => Err(fail(
+            Class::Panic,
+            format!("exit 101: {}", first(&run.stderr)),
+        )),
         (Some(134), _) | (None, Some(6)) => {
             Err(fail(Class::Abort, format!("abort: {}", first(&run.stderr))))
         }
@@ -536,10 +539,16 @@ pub fn child_main(kind: &str, run: impl FnOnce(&str) -> Verdict) {
 pub fn run_child(kind: &str, test_name: &str, dir: &CaseDir, text: &str) -> Verdict {
     let file = dir.write("case.json", text);
     let exe = std::env::current_exe().expect("test binary");
-    let args: Vec<String> = [test_name, "--exact", "--nocapture", "--test-threads=1", "-q"]
-        .iter()
-        .map(|s| s.to_string())
-        .collect();
+    let args: Vec<String> = [
+        test_name,
+        "--exact",
+        "--nocapture",
+        "--test-threads=1",
+        "-q",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
     let run = run_limited(
         &exe.to_string_lossy(),
         &args,

@@ -64,7 +64,12 @@ pub fn measurements() -> Vec<Value> {
                 .collect()
         })
         .collect();
-    let p0 = json!([[0.1, 0, 0, 0], [0, 0.1, 0, 0], [0, 0, 0.01, 0], [0, 0, 0, 0.01]]);
+    let p0 = json!([
+        [0.1, 0, 0, 0],
+        [0, 0.1, 0, 0],
+        [0, 0, 0.01, 0],
+        [0, 0, 0, 0.01]
+    ]);
     let a = json!({"dt_s": 0.1, "process_noise": 0.01, "initial_state": [4, 1, 1.39, 0.25],
                    "initial_covariance": p0, "sigma_s": 3.5e-11, "steps": steps});
     let mut b = a.clone();
@@ -113,7 +118,10 @@ pub fn walk() -> &'static Walk {
             let r = run_cli(&args);
             assert_eq!(r.code, Some(0), "simulate-walk: {}", r.stderr);
             let mut m = read(dir.0.join(start).join("measurements.json"));
-            m["raw_steps"].as_array_mut().expect("raw_steps").truncate(4);
+            m["raw_steps"]
+                .as_array_mut()
+                .expect("raw_steps")
+                .truncate(4);
             out.push(m);
         }
         let snaps_path = dir.0.join("snapshot").join("calibration_snapshots.json");

@@ -60,30 +60,36 @@ pub const EXTREMES: &[f64] = &[
 /// Raw JSON tokens spliced into the text (some are not valid JSON on purpose).
 pub fn raw_tokens() -> &'static [String] {
     static TOKENS: std::sync::OnceLock<Vec<String>> = std::sync::OnceLock::new();
-    TOKENS.get_or_init(|| vec![
-        "-0".into(),
-        "1e400".into(),
-        "-1e400".into(),
-        "1e-400".into(),
-        "123456789012345678901234567890".into(),
-        "-9223372036854775809".into(),
-        "18446744073709551616".into(),
-        "2.4703282292062328e-324".into(),
-        "1.7976931348623159e308".into(),
-        format!("1{}", "0".repeat(100_000)),
-        format!("0.{}1", "0".repeat(100_000)),
-        "NaN".into(),
-        "Infinity".into(),
-        "-Infinity".into(),
-        "\"\\ud800\"".into(),
-        "\"\\u0000\"".into(),
-        format!("{}1{}", "[".repeat(300), "]".repeat(300)),
-        format!("{}{}", "{\"a\":".repeat(200), format!("1{}", "}".repeat(200))),
-        "01".into(),
-        "1.".into(),
-        "+1".into(),
-        "truefalse".into(),
-    ])
+    TOKENS.get_or_init(|| {
+        vec![
+            "-0".into(),
+            "1e400".into(),
+            "-1e400".into(),
+            "1e-400".into(),
+            "123456789012345678901234567890".into(),
+            "-9223372036854775809".into(),
+            "18446744073709551616".into(),
+            "2.4703282292062328e-324".into(),
+            "1.7976931348623159e308".into(),
+            format!("1{}", "0".repeat(100_000)),
+            format!("0.{}1", "0".repeat(100_000)),
+            "NaN".into(),
+            "Infinity".into(),
+            "-Infinity".into(),
+            "\"\\ud800\"".into(),
+            "\"\\u0000\"".into(),
+            format!("{}1{}", "[".repeat(300), "]".repeat(300)),
+            format!(
+                "{}{}",
+                "{\"a\":".repeat(200),
+                format!("1{}", "}".repeat(200))
+            ),
+            "01".into(),
+            "1.".into(),
+            "+1".into(),
+            "truefalse".into(),
+        ]
+    })
 }
 
 /// A generated value.
@@ -343,7 +349,11 @@ fn perturb(v: &Value, k: usize) -> Value {
         Value::Number(n) => {
             let x = n.as_f64().unwrap_or(0.0);
             let f = 1.0 + 0.013 * ((k * 7919) % 97) as f64 / 97.0;
-            num(if n.is_f64() || x.fract() != 0.0 { x * f } else { x })
+            num(if n.is_f64() || x.fract() != 0.0 {
+                x * f
+            } else {
+                x
+            })
         }
         Value::Array(a) => Value::Array(a.iter().map(|x| perturb(x, k)).collect()),
         other => other.clone(),
