@@ -458,9 +458,10 @@ fn bad_inputs_are_named_errors() {
             field: "ranges[4][0]".into()
         }
     );
-    for cs in [0.0, -1.0] {
+    // Outside the documented range 1e-3 ..= 1e3 m (item 3 of issue 12: 1e-320 gave "j": null).
+    for cs in [0.0, -1.0, 1e-200, 1e-320, 9e-4, 1.1e3] {
         assert!(
-            matches!(err(Measurements { c_sigma_m: cs, ..ok }, &cfg), Error::NotPositive { ref field, .. } if field == "c_sigma_m")
+            matches!(err(Measurements { c_sigma_m: cs, ..ok }, &cfg), Error::OutOfRange { ref field, .. } if field == "c_sigma_m")
         );
     }
     assert!(

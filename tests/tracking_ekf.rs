@@ -342,8 +342,9 @@ fn ekf_bad_inputs_are_named_errors() {
             found: 5
         }
     );
-    // Non-finite delays: the first bad link in link order is named.
-    for v in [Real::NAN, Real::INFINITY, Real::NEG_INFINITY] {
+    // Delays that are not a number in 0 < delay ≤ 1 s (issue 12, item 7): the first bad link in
+    // link order is named.
+    for v in [Real::NAN, Real::INFINITY, Real::NEG_INFINITY, 0.0, -5e-8, 1.5, 1e308] {
         let mut z = good.clone();
         z[3] = Some(v);
         z[1] = Some(v);
@@ -352,12 +353,16 @@ fn ekf_bad_inputs_are_named_errors() {
             MeasurementNoise::Fixed(&sig),
         ] {
             let e = f.update(&model, &z, noise, None).unwrap_err();
-            assert_eq!(e, Error::NonFiniteDelay { link: 1 });
+            assert!(
+                matches!(e, Error::InvalidDelay { link: 1, value } if value.to_bits() == v.to_bits()),
+                "{v}: {e:?}"
+            );
             assert!(e.to_string().contains("[1]"), "{e}");
         }
     }
     // σ ≤ 0, NaN or infinite in Fixed noise (and one so small that 1/(cσ)² overflows).
-    for bad in [0.0, -1e-11, Real::NAN, Real::INFINITY, 1e-170] {
+    // And σ outside the documented 1e-15 ..= 1e-3 s (issue 12, item 7: 1e308 gave an exact fit).
+    for bad in [0.0, -1e-11, Real::NAN, Real::INFINITY, 1e-170, 1e-16, 2e-3, 1e308] {
         let mut s = sig;
         s[2] = bad;
         let e = f
@@ -386,11 +391,11 @@ fn ekf_bad_inputs_are_named_errors() {
     z[0] = Some(Real::NAN);
     let mut g = Ekf::new(x0, p0).unwrap();
     let g0 = g;
-    assert_eq!(
+    assert!(matches!(
         g.step(&motion, &model, &z, MeasurementNoise::AtPrediction)
             .unwrap_err(),
-        Error::NonFiniteDelay { link: 0 }
-    );
+        Error::InvalidDelay { link: 0, value } if value.is_nan()
+    ));
     assert_eq!(g, g0);
     // NEES of a singular covariance is None, not NaN.
     let mut h = g0;

@@ -91,12 +91,16 @@ pub enum Error {
         /// Links needed.
         required: usize,
     },
-    /// A measured delay is NaN or infinite.
-    NonFiniteDelay {
+    /// A measured delay is not a number in [`limits::DELAY_S`] (`0 < delay ≤ 1 s`): NaN,
+    /// infinite, zero, negative or absurdly large.
+    InvalidDelay {
         /// Index of the link in scenario link order.
         link: usize,
+        /// The value found.
+        value: f64,
     },
-    /// A delay standard deviation is not a finite number > 0.
+    /// A delay standard deviation is not a finite number > 0, or (when given by the user) not in
+    /// [`limits::DELAY_SIGMA_S`].
     InvalidSigma {
         /// Index of the link in scenario link order.
         link: usize,
@@ -227,7 +231,21 @@ impl fmt::Display for Error {
                 f,
                 "delays_s: {available} link(s) carry a measurement, at least {required} are needed"
             ),
-            Error::NonFiniteDelay { link } => write!(f, "delays_s[{link}]: not a finite number"),
+            Error::InvalidDelay { link, value } if !value.is_finite() => {
+                write!(f, "delays_s[{link}]: not a finite number")
+            }
+            Error::InvalidDelay { link, value } => write!(
+                f,
+                "delays_s[{link}]: {} is out of range ({})",
+                Num(*value),
+                limits::DELAY_S.allowed
+            ),
+            Error::InvalidSigma { link, value } if value.is_finite() && *value > 0.0 => write!(
+                f,
+                "sigma_s[{link}]: {} is out of range ({})",
+                Num(*value),
+                limits::DELAY_SIGMA_S.allowed
+            ),
             Error::InvalidSigma { link, value } => {
                 write!(
                     f,

@@ -13,7 +13,7 @@
 use alloc::format;
 use alloc::vec::Vec;
 
-use crate::error::{check_len, Error, Result};
+use crate::error::{check_len, limits, Error, Result};
 use crate::gating::Calibration;
 use crate::math::Real;
 use crate::track::PredictedDelay;
@@ -127,7 +127,7 @@ pub struct Selection {
 
 /// Gates one snapshot (`estimates[p]` = link `p`'s list) against `calibration` and associates
 /// each link under `rule` (with the filter's predictions when a track exists). Errors: wrong link count
-/// (`LengthMismatch`), a non-finite delay (`NonFiniteDelay`) or amplitude (`NonFinite`), too
+/// (`LengthMismatch`), a delay outside `0 < delay ≤ 1 s` (`InvalidDelay`) or amplitude (`NonFinite`), too
 /// many estimates on a link (`SizeLimit`).
 pub fn select(
     calibration: &Calibration,
@@ -157,8 +157,11 @@ pub fn select(
         }
         kept.clear();
         for (i, e) in list.iter().enumerate() {
-            if !e.delay_s.is_finite() {
-                return Err(Error::NonFiniteDelay { link });
+            if !limits::DELAY_S.contains(e.delay_s) {
+                return Err(Error::InvalidDelay {
+                    link,
+                    value: e.delay_s,
+                });
             }
             if !e.amplitude.is_finite() {
                 return Err(Error::NonFinite {

@@ -22,7 +22,7 @@ use alloc::vec::Vec;
 
 use serde::{Deserialize, Serialize};
 
-use crate::error::{check_len, Error, Result};
+use crate::error::{check_len, limits, Error, Result};
 use crate::math::{sqrt, Real};
 
 /// The gate's half-width in cluster standard deviations (E4).
@@ -160,11 +160,7 @@ impl LinkCalibration {
         let mut delays = Vec::with_capacity(total);
         for (k, snapshot) in lists.enumerate() {
             for (i, &d) in snapshot.iter().enumerate() {
-                if !d.is_finite() {
-                    return Err(Error::NonFinite {
-                        field: format!("calibration[{k}][{link}][{i}]"),
-                    });
-                }
+                limits::DELAY_S.check(&format!("calibration[{k}][{link}][{i}]"), d)?;
                 delays.push((d, k));
             }
         }
@@ -193,11 +189,10 @@ impl LinkCalibration {
     /// every `σ̄` finite and `> 0`; sorted by mean.
     pub fn from_clusters(link: usize, mut clusters: Vec<StaticCluster>) -> Result<LinkCalibration> {
         for (r, c) in clusters.iter().enumerate() {
-            if !c.mean_s.is_finite() {
-                return Err(Error::NonFinite {
-                    field: format!("calibration.links[{link}].clusters[{r}].mean_s"),
-                });
-            }
+            limits::DELAY_S.check(
+                &format!("calibration.links[{link}].clusters[{r}].mean_s"),
+                c.mean_s,
+            )?;
             if !(c.sigma_s.is_finite() && c.sigma_s > 0.0) {
                 return Err(Error::NotPositive {
                     field: format!("calibration.links[{link}].clusters[{r}].sigma_s"),

@@ -88,10 +88,22 @@ fn select_gates_then_associates_per_link() {
     assert_eq!(s.static_removed, vec![2, 0]);
     // Bad input is named.
     let bad = vec![vec![est(Real::NAN, 1.0)], vec![]];
-    assert_eq!(
+    assert!(matches!(
         select(&cal, &bad, None, Spec).unwrap_err(),
-        Error::NonFiniteDelay { link: 0 }
-    );
+        Error::InvalidDelay { link: 0, value } if value.is_nan()
+    ));
+    // Zero, negative and absurd delays too (issue 12, item 7).
+    for d_ns in [0.0, -50.0, 2e9] {
+        let e = est(d_ns, 1.0);
+        let bad = vec![vec![e], vec![]];
+        assert_eq!(
+            select(&cal, &bad, None, Spec).unwrap_err(),
+            Error::InvalidDelay {
+                link: 0,
+                value: e.delay_s
+            }
+        );
+    }
     let bad = vec![vec![], vec![est(50.0, Real::INFINITY)]];
     assert_eq!(
         select(&cal, &bad, None, Spec).unwrap_err().to_string(),

@@ -4,7 +4,7 @@
 use alloc::vec::Vec;
 
 use super::{DelayMeasurements, MIN_LINKS};
-use crate::error::{check_len, Error, Result};
+use crate::error::{check_len, limits, Error, Result};
 use crate::math::{Mat2, Real, Vec2, SPEED_OF_LIGHT};
 use crate::measure::{bistatic_range, range_and_gradient, Network};
 
@@ -30,10 +30,10 @@ impl Problem {
         let mut rows = Vec::with_capacity(n);
         for (p, (d, s)) in m.delays_s.iter().zip(m.sigmas_s).enumerate() {
             let Some(d) = *d else { continue };
-            if !d.is_finite() {
-                return Err(Error::NonFiniteDelay { link: p });
+            if !limits::DELAY_S.contains(d) {
+                return Err(Error::InvalidDelay { link: p, value: d });
             }
-            if !(s.is_finite() && *s > 0.0) {
+            if !limits::DELAY_SIGMA_S.contains(*s) {
                 return Err(Error::InvalidSigma { link: p, value: *s });
             }
             let (tx, rx) = net.link_nodes(p);

@@ -97,7 +97,7 @@ fn bad_networks_and_ranges_are_named_errors() {
     net.c_sigma_m = 0.0;
     assert!(matches!(
         net.validate(),
-        Err(Error::NotPositive { field, .. }) if field == "c_sigma_m"
+        Err(Error::OutOfRange { field, .. }) if field == "c_sigma_m"
     ));
     let mut net = hexagon();
     net.region = Some(RegionInput {

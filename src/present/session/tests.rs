@@ -11,7 +11,7 @@ fn edits_recompile_the_model_and_rejected_ones_change_nothing() {
     let before = s.clone();
     assert!(matches!(
         s.edit(|sc| sc.set_bandwidth_hz(0.0)),
-        Err(Error::NotPositive { .. })
+        Err(Error::OutOfRange { .. })
     ));
     assert!(s.edit(|sc| sc.remove_transmitter(0)).is_err());
     let mut bad = iclgnss2019();

@@ -6,7 +6,7 @@ use super::{
     finite_probe, positive_finite, range_information_per_snr, Ekf, MeasurementNoise, NodeView,
     UpdateSummary,
 };
-use crate::error::{Error, Result};
+use crate::error::{limits, Error, Result};
 use crate::math::{Mat4, Real, Vec2, Vec4, SPEED_OF_LIGHT};
 use crate::measure::Model;
 
@@ -89,7 +89,10 @@ pub(crate) fn update_lanes<const L: usize>(
             let (tv, gain, a) = (tx_view[j], tx_gain[j], &mut acc[j]);
             let rv = NodeView::new(rx, r_pred[j]);
             let (w, sigma_positive) = match noise {
-                MeasurementNoise::Fixed(s) => (information_from_sigma(s[link]), s[link] > 0.0),
+                MeasurementNoise::Fixed(s) => (
+                    information_from_sigma(s[link]),
+                    limits::DELAY_SIGMA_S.contains(s[link]),
+                ),
                 MeasurementNoise::AtPrediction => (
                     info_per_snr * (snr_scale * gain * tv.inv_floored_sq * rv.inv_floored_sq),
                     true,
@@ -99,7 +102,7 @@ pub(crate) fn update_lanes<const L: usize>(
                     (information_from_sigma(sigma), sigma > 0.0)
                 }
             };
-            a.positive &= sigma_positive & (w > 0.0);
+            a.positive &= sigma_positive & (w > 0.0) & limits::DELAY_S.contains(zi);
             a.finite_sum += finite_probe(zi) + w;
             let nu = SPEED_OF_LIGHT * zi - (tv.distance + rv.distance);
             innovation(j, link, nu);
@@ -228,7 +231,8 @@ fn information_from_sigma(sigma: Real) -> Real {
 }
 
 /// The first bad input of an update in link order (slow path, after the accumulated checks
-/// failed): a non-finite delay, or a `σ_p` that is not finite and positive (or so small that
+/// failed): a delay outside [`limits::DELAY_S`], a given (`Fixed`) `σ_p` outside
+/// [`limits::DELAY_SIGMA_S`], or a `σ_p` that is not finite and positive (or so small that
 /// `1/(cσ_p)²` overflows). `None` if all are fine.
 #[cold]
 fn first_input_error(
@@ -239,10 +243,14 @@ fn first_input_error(
 ) -> Option<Error> {
     for (link, zi) in z.iter().enumerate() {
         let Some(zi) = *zi else { continue };
-        if !zi.is_finite() {
-            return Some(Error::NonFiniteDelay { link });
+        if !limits::DELAY_S.contains(zi) {
+            return Some(Error::InvalidDelay { link, value: zi });
         }
         let sigma = noise.sigma(model, link, r_pred);
+        let given = matches!(noise, MeasurementNoise::Fixed(_));
+        if given && !limits::DELAY_SIGMA_S.contains(sigma) {
+            return Some(Error::InvalidSigma { link, value: sigma });
+        }
         if !(positive_finite(sigma) && information_from_sigma(sigma).is_finite()) {
             return Some(Error::InvalidSigma { link, value: sigma });
         }

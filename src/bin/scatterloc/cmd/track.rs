@@ -253,7 +253,14 @@ fn names(choices: &[Choice]) -> Vec<&'static str> {
 /// A core error of step `field` as the CLI reports it.
 fn step_error(field: &str, e: Error, bad: &dyn Fn(&dyn std::fmt::Display) -> CliError) -> CliError {
     match e {
-        Error::NonFiniteDelay { link } => bad(&format!("{field}[{link}]: not a finite number")),
+        Error::InvalidDelay { link, value } => bad(&format!(
+            "{field}[{link}]: {}",
+            Error::InvalidDelay { link, value }
+                .to_string()
+                .split_once(": ")
+                .map_or("", |(_, why)| why)
+                .to_owned()
+        )),
         other => bad(&format!("{field}: {other}")),
     }
 }
