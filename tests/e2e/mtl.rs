@@ -279,7 +279,11 @@ fn mtl_drag_target_detection_follows() {
     assert_eq!(o.after["viewGen"], o.after["gen"]);
     // Bad input: named errors in the banner, nothing changed, no console error.
     assert!(o.banners[0].starts_with("discs[0]:"), "{:?}", o.banners);
-    assert!(o.banners[1].starts_with("range_sigma:"), "{:?}", o.banners);
+    assert!(
+        o.banners[1].starts_with("range_sigma (cσ): -1 is out of range"),
+        "{:?}",
+        o.banners
+    );
     assert_eq!(
         o.after_bad[0], o.after_bad[1],
         "rejected edits change nothing"
