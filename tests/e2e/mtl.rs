@@ -12,12 +12,12 @@ use super::{
     connect, console_errors, drag_on_plot, js, open, runtime, settle, start_server, Driver, SERIAL,
 };
 
-async fn state(c: &Client) -> Result<Value, String> {
+pub(super) async fn state(c: &Client) -> Result<Value, String> {
     js(c, "return window.mtl.state()").await
 }
 
 /// Polls `window.mtl.state()` until the worker has answered the newest scene.
-async fn wait_view(c: &Client, secs: u64) -> Result<Value, String> {
+pub(super) async fn wait_view(c: &Client, secs: u64) -> Result<Value, String> {
     let t0 = Instant::now();
     loop {
         let s = state(c).await?;
@@ -56,7 +56,7 @@ struct Outcome {
 }
 
 /// The error banner's text, if shown.
-async fn banner(c: &Client) -> Result<String, String> {
+pub(super) async fn banner(c: &Client) -> Result<String, String> {
     let v = js(
         c,
         "const e = document.getElementById('error'); \
