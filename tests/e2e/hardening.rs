@@ -264,7 +264,7 @@ fn mtl_bad_numbers_are_named_and_change_nothing() {
 /// Item 6: importing a scenario with `area_m.x = [−1e308, 1e308]` goes through the core's
 /// validation: a banner names the field and the file; the scenario, the probe, the map image and
 /// the view stay, and once the banner is dismissed the plot is pixel for pixel the one before;
-/// a later edit (bandwidth 200 MHz) is shown.
+/// a later edit (bandwidth 200 MHz) is shown, and a scenario file with a UTF-8 BOM imports.
 #[test]
 #[ignore = "needs chromium + chromedriver and www/pkg (wasm-pack build); run with --ignored"]
 fn huge_area_import_is_rejected_and_the_plot_stays() {
@@ -275,6 +275,13 @@ fn huge_area_import_is_rejected_and_the_plot_stays() {
         std::env::temp_dir().join(format!("scatterloc-e2e-huge-{}.json", std::process::id()));
     std::fs::write(&file, serde_json::to_string_pretty(&v).unwrap()).unwrap();
     let path = file.clone();
+    // A valid scenario behind a UTF-8 byte-order mark (still accepted).
+    let mut bom = scatterloc::scenario::presets::sensors2019();
+    bom.name = "with-bom".into();
+    let bom_file =
+        std::env::temp_dir().join(format!("scatterloc-e2e-bom-{}.json", std::process::id()));
+    std::fs::write(&bom_file, format!("\u{feff}{}", bom.to_json())).unwrap();
+    let bom_path = bom_file.clone();
     let o = session(|c, port| async move {
         open(&c, port).await?;
         settle(&c).await?;
@@ -311,10 +318,30 @@ fn huge_area_import_is_rejected_and_the_plot_stays() {
             probe(&c).await?,
             banner(&c).await?,
         );
-        Ok((before, b, rejected, later, console_errors(&c).await?))
+        c.find(Locator::Id("import-file"))
+            .await
+            .map_err(|e| e.to_string())?
+            .send_keys(bom_path.to_str().unwrap())
+            .await
+            .map_err(|e| e.to_string())?;
+        tokio::time::sleep(Duration::from_millis(300)).await;
+        settle(&c).await?;
+        let with_bom = json!([
+            js(&c, "return window.app.scenario().name").await?,
+            banner(&c).await?
+        ]);
+        Ok((
+            before,
+            b,
+            rejected,
+            later,
+            with_bom,
+            console_errors(&c).await?,
+        ))
     });
     let _ = std::fs::remove_file(&file);
-    let (before, b, rejected, later, errors) = o;
+    let _ = std::fs::remove_file(&bom_file);
+    let (before, b, rejected, later, with_bom, errors) = o;
     assert!(errors.is_empty(), "console errors: {errors:?}");
     assert!(
         b.contains("area_m.x") && b.contains("scatterloc-e2e-huge"),
@@ -329,6 +356,11 @@ fn huge_area_import_is_rejected_and_the_plot_stays() {
     assert_ne!(later.1, before.1, "and drawn");
     assert_ne!(later.2, before.2, "and the probe recomputed");
     assert_eq!(later.3, "", "banner cleared");
+    assert_eq!(
+        with_bom,
+        json!(["with-bom", ""]),
+        "a UTF-8 BOM file is imported"
+    );
 }
 
 /// A 64 Tx × 64 Rx network (4096 links, the cap) in the sensors2019 area: nodes on two
