@@ -113,10 +113,16 @@ export class MapView {
     st.mapCanvas.getContext('2d').putImageData(st.image, 0, 0);
   }
 
-  /** Updates the kernel cost per cell·link from a map that took `ms` (timer resolution floored). */
+  /**
+   * Updates the kernel cost per cell·link from a map that took `ms` (timer resolution floored):
+   * the first map of a new link count replaces the estimate (a few links cost more per link
+   * than many), later ones are averaged in.
+   */
   learn(n, links, ms) {
     const v = (Math.max(ms, 0.05) * 1e6) / (n * n * Math.max(1, links));
-    this.nsPerCellLink = this.nsPerCellLink === null ? v : 0.5 * this.nsPerCellLink + 0.5 * v;
+    const fresh = this.nsPerCellLink === null || links !== this.learntLinks;
+    this.nsPerCellLink = fresh ? v : 0.5 * this.nsPerCellLink + 0.5 * v;
+    this.learntLinks = links;
   }
 
   /** The worker's full-resolution map (only the newest job's is shown). */
