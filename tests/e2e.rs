@@ -31,6 +31,11 @@ mod tracking;
 #[path = "e2e/mtl.rs"]
 mod mtl;
 
+/// Issue 12: hostile input bounded, named and harmless (stale recomputes, bad numbers, huge
+/// areas, large networks, URL options).
+#[path = "e2e/hardening.rs"]
+mod hardening;
+
 /// `SCATTERLOC_SCREENSHOT=1`: writes docs/screenshot-tracking.png.
 #[path = "e2e/screenshot.rs"]
 mod screenshot;

@@ -310,6 +310,39 @@ fn labels_and_ticks() {
     assert_eq!(num(&bar, "length_m"), 0.02);
 }
 
+/// Axis ticks stay few and readable for any span and any requested count (issue 12): a span
+/// below the spacing of doubles with a huge count used to overflow the core's `i64` tick
+/// indices (a panic in this debug build; labels like ±9223372036854775808 in release).
+#[wasm_bindgen_test]
+fn axis_ticks_are_bounded() {
+    for (lo, hi, n) in [
+        (1e3, 1e3 + 1e-13, 100_000),
+        (1e3, 1e3 + 1e-13, usize::MAX),
+        (-1e7, 1e7, 1_000_000),
+        (-1e7, -1e7 + 1e-3, 100_000),
+        (-1e308, 1e308, 10),
+        (0.0, 10.0, 0),
+    ] {
+        let t = js_sys::Array::from(&ok(wasm::axis_ticks(lo, hi, n)));
+        assert!(
+            t.length() as usize <= 2 * wasm::MAX_AXIS_TICKS + 2,
+            "{lo} {hi} {n}"
+        );
+        for v in t.iter() {
+            let label = get(&v, "label").as_string().unwrap();
+            assert!(
+                !label.contains("922337203685477") && label.len() <= 24,
+                "{lo} {hi} {n}: {label}"
+            );
+            let x = num(&v, "value");
+            assert!(
+                x >= lo - (hi - lo) && x <= hi + (hi - lo),
+                "{lo} {hi} {n}: {x}"
+            );
+        }
+    }
+}
+
 /// Spec check 12 and the calibration stage in wasm: 1 − erfc(3/√2) = 0.9973, and a calibrated
 /// link gates its static paths and keeps the echo (spec §4).
 #[wasm_bindgen_test]

@@ -32,6 +32,6 @@ pub use montecarlo::MonteCarloJob;
 pub use mtl::{mtl_check_scene, mtl_default_scene, mtl_view_of, MtlSession};
 pub use render::{
     axis_ticks, colorbar_rgba, colorbar_ticks, format_length, render_map_rgba, scale_bar,
-    unbounded_rgb,
+    unbounded_rgb, MAX_AXIS_TICKS,
 };
 pub use tracking::{drag_velocity, track_steps, Track, MAX_TRACK_STEPS};

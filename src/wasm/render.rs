@@ -50,10 +50,15 @@ pub fn colorbar_ticks(min: f64, max: f64, max_labels: Option<usize>) -> Result<J
     to_js(&ColorbarTickJs::all(&ticks))
 }
 
-/// Linear axis ticks over `[lo, hi]` (about `max_count`): `[{value, label}]`.
+/// Most ticks [`axis_ticks`] asks the core for: a plot axis never needs more, and the core's
+/// integer tick indices stay far from overflow (`linear_ticks` multiplies them in `i64`).
+pub const MAX_AXIS_TICKS: usize = 100;
+
+/// Linear axis ticks over `[lo, hi]` (about `max_count`, at most [`MAX_AXIS_TICKS`]):
+/// `[{value, label}]`.
 #[wasm_bindgen]
 pub fn axis_ticks(lo: f64, hi: f64, max_count: usize) -> Result<JsValue, JsError> {
-    to_js(&linear_ticks(lo, hi, max_count))
+    to_js(&linear_ticks(lo, hi, max_count.min(MAX_AXIS_TICKS)))
 }
 
 /// A length as text with a readable unit (`"4.26 mm"`, `"17.7 cm"`, `"∞"`).

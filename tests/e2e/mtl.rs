@@ -12,12 +12,12 @@ use super::{
     connect, console_errors, drag_on_plot, js, open, runtime, settle, start_server, Driver, SERIAL,
 };
 
-async fn state(c: &Client) -> Result<Value, String> {
+pub(super) async fn state(c: &Client) -> Result<Value, String> {
     js(c, "return window.mtl.state()").await
 }
 
 /// Polls `window.mtl.state()` until the worker has answered the newest scene.
-async fn wait_view(c: &Client, secs: u64) -> Result<Value, String> {
+pub(super) async fn wait_view(c: &Client, secs: u64) -> Result<Value, String> {
     let t0 = Instant::now();
     loop {
         let s = state(c).await?;
@@ -56,7 +56,7 @@ struct Outcome {
 }
 
 /// The error banner's text, if shown.
-async fn banner(c: &Client) -> Result<String, String> {
+pub(super) async fn banner(c: &Client) -> Result<String, String> {
     let v = js(
         c,
         "const e = document.getElementById('error'); \
@@ -279,7 +279,11 @@ fn mtl_drag_target_detection_follows() {
     assert_eq!(o.after["viewGen"], o.after["gen"]);
     // Bad input: named errors in the banner, nothing changed, no console error.
     assert!(o.banners[0].starts_with("discs[0]:"), "{:?}", o.banners);
-    assert!(o.banners[1].starts_with("range_sigma:"), "{:?}", o.banners);
+    assert!(
+        o.banners[1].starts_with("range_sigma (cσ): -1 is out of range"),
+        "{:?}",
+        o.banners
+    );
     assert_eq!(
         o.after_bad[0], o.after_bad[1],
         "rejected edits change nothing"

@@ -4,7 +4,7 @@
 // events and draws. Loaded by main.js.
 
 import init, * as wasm from '../pkg/scatterloc.js';
-import { $, errorText, showError } from './dom.js';
+import { $, decimal, decimalIn, errorText, showError } from './dom.js';
 import { registerHooks } from './hooks.js';
 import { View } from './view.js';
 import { MapView } from './map.js';
@@ -15,40 +15,72 @@ import { Mtl } from './mtl.js';
 
 const MODES = ['snapshot', 'tracking', 'mtl'];
 
+/** Most steps of a track (the core's MAX_TRACK_STEPS), for the URL's `step`. */
+const MAX_STEP = 10000;
+/** Most Monte Carlo runs the page offers (its largest choice). */
+const MAX_RUNS = 10000;
+const UINT32 = { min: 0, max: 4294967295, integer: true };
+
 /**
  * `#preset=iclgnss2019&target=6,4&seed=3&res=256` -> options; tracking: `#mode=tracking&track=II&step=45
  * &play=1&runs=200&ex=100&tseed=1&dt=0.1&speed=1&custom=x0,y0,x1,y1`; multi-target: `#mode=mtl`.
+ * Every number is parsed strictly (dom.js `decimal`); a bad option is left at its default and
+ * reported in `errors` (naming the option, the value given and what is allowed).
  */
-function hashOptions() {
+function hashOptions(presets) {
   const h = new URLSearchParams(location.hash.slice(1));
-  const target = (h.get('target') || '').split(',').map(Number);
-  const custom = (h.get('custom') || '').split(',').map(Number);
-  const int = (k) => (Number.isInteger(Number(h.get(k))) && h.get(k) ? Number(h.get(k)) : undefined);
-  return {
-    mode: MODES.includes(h.get('mode')) ? h.get('mode') : 'snapshot',
-    track: h.get('track'),
-    step: int('step'),
-    play: h.get('play') === '1',
-    runs: h.get('runs'),
-    ex: h.get('ex'),
-    tseed: h.get('tseed'),
-    dt: h.get('dt'),
-    speed: h.get('speed'),
-    custom: custom.length === 4 && custom.every(Number.isFinite)
-      ? { x0: custom[0], y0: custom[1], x1: custom[2], y1: custom[3] } : null,
-    preset: h.get('preset'),
-    target: target.length === 2 && target.every(Number.isFinite) ? { x: target[0], y: target[1] } : null,
-    seed: int('seed') ?? 1,
-    res: h.get('res'),
+  const errors = [];
+  const read = (k, parse) => {
+    const t = h.get(k);
+    if (t === null) return undefined;
+    try {
+      return parse(t);
+    } catch (e) {
+      errors.push(`URL option ${errorText(e)}`);
+      return undefined;
+    }
   };
+  const oneOf = (k, values) => read(k, (t) => {
+    if (!values.includes(t)) throw new Error(`${k}: "${t}" is not one of ${values.join(', ')}`);
+    return t;
+  });
+  const option = (k, id) => oneOf(k, [...$(id).options].map((o) => o.value));
+  const numbers = (k, n) => read(k, (t) => {
+    const parts = t.split(',');
+    if (parts.length !== n) throw new Error(`${k}: "${t}" is not ${n} comma-separated numbers`);
+    return parts.map((p, i) => decimal(p, `${k}[${i}]`));
+  });
+  const target = numbers('target', 2);
+  const custom = numbers('custom', 4);
+  const opts = {
+    mode: oneOf('mode', MODES) ?? 'snapshot',
+    track: oneOf('track', ['I', 'II', 'III', 'custom']),
+    step: read('step', (t) => decimalIn(t, 'step', { min: 0, max: MAX_STEP, integer: true })),
+    play: h.get('play') === '1',
+    runs: read('runs', (t) => decimalIn(t, 'runs', { min: 1, max: MAX_RUNS, integer: true })),
+    ex: option('ex', 'track-ex'),
+    tseed: read('tseed', (t) => decimalIn(t, 'tseed', UINT32)),
+    dt: option('dt', 'track-dt'),
+    speed: option('speed', 'track-speed'),
+    custom: custom ? { x0: custom[0], y0: custom[1], x1: custom[2], y1: custom[3] } : null,
+    preset: oneOf('preset', presets),
+    target: target ? { x: target[0], y: target[1] } : null,
+    seed: read('seed', (t) => decimalIn(t, 'seed', UINT32)) ?? 1,
+    res: option('res', 'resolution'),
+  };
+  return { opts, errors };
 }
 
 export async function start() {
-  await init();
-  const opts = hashOptions();
-  const preset = wasm.preset_names().includes(opts.preset) ? opts.preset : 'sensors2019';
+  // Compiled once here and handed to every replaceable worker (workers.js), so a fresh worker
+  // starts in milliseconds.
+  const wasmUrl = new URL('../pkg/scatterloc_bg.wasm', import.meta.url);
+  const module = await WebAssembly.compile(await (await fetch(wasmUrl)).arrayBuffer());
+  await init({ module_or_path: module });
+  const { opts, errors } = hashOptions(wasm.preset_names());
+  const preset = opts.preset ?? 'sensors2019';
   const app = wasm.App.from_preset(preset);
-  if (opts.res && [...$('resolution').options].some((o) => o.value === opts.res)) $('resolution').value = opts.res;
+  if (opts.res) $('resolution').value = opts.res;
 
   const view = new View($('plot'));
   const st = {
@@ -64,6 +96,7 @@ export async function start() {
     insetTitle: 'target zoom',
     insetAvoid: [],
     nextSeed: opts.seed,
+    refreshLog: [], // [{ms, mapMs, res, dragging}] of the last 64 refreshes (main thread)
     // + the map's fields (map.js)
   };
 
@@ -74,6 +107,8 @@ export async function start() {
     scheduled = false;
     const d = { ...dirty };
     for (const k of Object.keys(dirty)) delete dirty[k];
+    const t0 = performance.now();
+    const dragging = !!d.dragging && !d.dragEnd;
     try {
       if (d.reset) {
         view.fit(app.area());
@@ -82,7 +117,7 @@ export async function start() {
         st.selRx = 0;
         st.selected = { kind: 'rx', index: 0 };
       }
-      if (d.map) map.compute();
+      if (d.map) map.compute(dragging);
       if (d.geometry) {
         st.nodes = app.nodes();
         map.probe();
@@ -100,6 +135,12 @@ export async function start() {
       showError(`Internal error: ${errorText(e)}`);
       console.error(e);
     }
+    const el = $('map-ms');
+    st.refreshLog.push({
+      ms: performance.now() - t0, map: !!d.map, mapMs: d.map ? Number(el.dataset.ms) : null,
+      res: d.map ? el.dataset.res : null, dragging,
+    });
+    if (st.refreshLog.length > 64) st.refreshLog.shift();
   }
 
   /** Marks parts stale and schedules one refresh on the next animation frame. */
@@ -113,7 +154,7 @@ export async function start() {
     }
   }
 
-  const ctx = { app, wasm, st, view, changed };
+  const ctx = { app, wasm, module, st, view, changed };
   const map = new MapView(ctx);
   ctx.placeTarget = (x, y) => map.placeTarget(x, y);
   ctx.resample = () => map.resample();
@@ -150,10 +191,11 @@ export async function start() {
   refresh();
   setMode(opts.mode);
   if (opts.play) tracking.play();
+  if (errors.length) showError(errors.join(' · '));
 
   registerHooks({
-    app, wasm, view, st, setMode, panel, tracking, mtl,
-    isIdle: () => !scheduled,
+    app, wasm, view, st, setMode, panel, tracking, mtl, map,
+    isIdle: () => !scheduled && !map.busy(),
     placeTarget: ctx.placeTarget,
   });
 }

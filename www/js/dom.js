@@ -1,14 +1,51 @@
-// The page's DOM helpers, in one place: element lookup, number parsing of inputs, key/value
-// read-outs, the error banner and canvas sizing. Nothing here runs at import time, so a worker
-// may import it too (for errorText).
+// The page's DOM helpers, in one place: element lookup, strict number parsing of inputs and the
+// URL, null-safe number formatting, key/value read-outs, the error banner and canvas sizing.
+// Nothing here runs at import time, so a worker may import it too (for errorText).
 
 /** The element with this id. */
 export const $ = (id) => document.getElementById(id);
 
-/** Text -> number; empty text is NaN, so the core names the field instead of taking 0. */
-export function num(text) {
-  const t = String(text).trim();
-  return t === '' ? NaN : Number(t);
+/** A plain decimal number: optional sign (`-`, `+` or `−`), digits with an optional point, optional exponent. */
+const DECIMAL = /^[+\-\u2212]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?$/;
+
+/**
+ * Text -> number by strict decimal parsing (the one parser of every number the page reads from
+ * an input or the URL): hex (`0x10`), `Infinity`, empty text and trailing junk are rejected with
+ * an Error naming `field`, e.g. `radio.bandwidth_hz: "0x10" is not a decimal number`.
+ */
+export function decimal(text, field) {
+  const t = String(text ?? '').trim();
+  if (t === '') throw new Error(`${field}: empty (a decimal number is required)`);
+  if (!DECIMAL.test(t)) throw new Error(`${field}: "${t}" is not a decimal number`);
+  const v = Number(t.replace('\u2212', '-'));
+  if (!Number.isFinite(v)) throw new Error(`${field}: "${t}" is out of range (not a finite number)`);
+  return v;
+}
+
+/**
+ * Strict decimal parse plus a range check: a number in [min, max] (an integer when `integer`),
+ * else an Error naming `field`, the value and the allowed range (`unit` appended to it).
+ */
+export function decimalIn(text, field, { min, max, integer = false, unit = '' }) {
+  const v = decimal(text, field);
+  const allowed = `allowed ${integer ? 'an integer ' : ''}${fmtBound(min)} … ${fmtBound(max)}${unit ? ` ${unit}` : ''}`;
+  if (integer && !Number.isInteger(v)) throw new Error(`${field}: ${String(text).trim()} is not an integer (${allowed})`);
+  if (!(v >= min && v <= max)) throw new Error(`${field}: ${String(text).trim()} is out of range (${allowed})`);
+  return v;
+}
+
+const fmtBound = (v) => (Number.isInteger(v) ? String(v) : String(v).replace('-', '−'));
+
+/**
+ * A number with `digits` decimals for display, safe for whatever the core sends: null,
+ * undefined or NaN -> "—", ±Infinity -> "∞" / "−∞" (the core serialises non-finite numbers as
+ * null). Use this instead of `toFixed` everywhere in the page.
+ */
+export function fixed(v, digits) {
+  if (v === null || v === undefined || typeof v !== 'number' || Number.isNaN(v)) return '—';
+  if (v === Infinity) return '∞';
+  if (v === -Infinity) return '−∞';
+  return v.toFixed(digits);
 }
 
 /** An exception (or anything thrown or rejected) as message text. */

@@ -8,7 +8,9 @@
 //   window.wasm              the wasm module
 //   window.pageState         the page state (mode, nodes, target, …)
 //   window.mapCanvas         the CRLB map image (one pixel per cell)
-//   window.pageIdle()        true when no redraw is pending
+//   window.pageIdle()        true when no redraw and no full-resolution map (worker) is pending
+//   window.refreshLog()      the last 64 refreshes: [{ms (main thread), map, mapMs, res, dragging}]
+//   window.mapState()        {res, full, source, ms, busy, restarts, nsPerCellLink} of the map
 //   window.placeTarget(x, y) places the snapshot target (m)
 //   window.tracking          {state, setMode, play, pause, seek, restartMc, mcParams, mcResult}
 //   window.mtl               {state, setScene, pixelFromCentre, bench, setMode}
@@ -44,7 +46,7 @@ export function markFailed(msg) {
 
 /**
  * Registers the window hooks once the page is up, then sets body[data-ready].
- * @param {object} p - {app, wasm, view, st, isIdle, setMode, panel, tracking, mtl, placeTarget}
+ * @param {object} p - {app, wasm, view, st, isIdle, setMode, panel, tracking, mtl, map, placeTarget}
  */
 export function registerHooks(p) {
   const { app, st, tracking, mtl } = p;
@@ -55,6 +57,14 @@ export function registerHooks(p) {
     pageState: st,
     mapCanvas: st.mapCanvas,
     pageIdle: p.isIdle,
+    refreshLog: () => st.refreshLog.slice(),
+    mapState: () => {
+      const d = document.getElementById('map-ms').dataset;
+      return {
+        res: d.res, full: d.full, source: d.source, ms: Number(d.ms), busy: p.map.busy(),
+        restarts: p.map.worker.restarts, nsPerCellLink: p.map.nsPerCellLink,
+      };
+    },
     placeTarget: p.placeTarget,
     tracking: {
       state: () => tracking.state(),

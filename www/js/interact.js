@@ -2,7 +2,7 @@
 // click to place a target (snapshot mode) or press-and-drag a trajectory (tracking mode, "draw"),
 // hover read-out. pickNearest is the hit test of every view (mtl.js uses it too).
 
-import { $, errorText, showError, clearError } from './dom.js';
+import { $, errorText, fixed, showError, clearError } from './dom.js';
 
 const HIT_PX = 12; // pick radius around a marker, CSS px
 const CLICK_PX = 4; // a press that moves less than this is a click
@@ -48,7 +48,7 @@ export function attachPointer(ctx) {
     const b = document.createElement('b');
     b.textContent = c.rmse_label;
     readout.append(
-      `x = ${m.x.toFixed(2)} m, y = ${m.y.toFixed(2)} m  ·  RMSE bound `, b,
+      `x = ${fixed(m.x, 2)} m, y = ${fixed(m.y, 2)} m  ·  RMSE bound `, b,
       c.bounded ? `  ·  σx ${c.sigma_x_label}, σy ${c.sigma_y_label}` : '  ·  Fisher matrix singular here',
     );
   };
@@ -98,6 +98,8 @@ export function attachPointer(ctx) {
     const p = view.eventPixel(ev);
     const wasClick = !press.node && !press.moved && ev.type === 'pointerup' && st.mode !== 'tracking';
     if (press.draw) ctx.tracking.drawEnd(view.toMetre(p.x, p.y));
+    // A map reduced while dragging (map.js) is now computed at full resolution.
+    if (press.node && press.moved) ctx.changed({ map: true, dragEnd: true });
     press = null;
     canvas.classList.remove('dragging');
     if (wasClick && view.inPlot(p.x, p.y)) {

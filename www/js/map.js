@@ -1,15 +1,27 @@
-// The snapshot (CRLB map) view: the core's RMSE-bound map over the area (computed on the main
-// thread at the chosen resolution), the probe read-out, the placed target's simulated snapshot
-// (LM fix vs CRLB) and the drawing of the whole scene: heatmap, colour bar, links, nodes, the
-// target's iso-delay ellipses and its zoom inset. The tracking view draws through the same scene
-// (its frame is snapshot-shaped, plus an overlay). Every number comes from the wasm core.
+// The snapshot (CRLB map) view: the core's RMSE-bound map over the area, the probe read-out, the
+// placed target's simulated snapshot (LM fix vs CRLB) and the drawing of the whole scene:
+// heatmap, colour bar, links, nodes, the target's iso-delay ellipses and its zoom inset. The
+// tracking view draws through the same scene (its frame is snapshot-shaped, plus an overlay).
+// Every number comes from the wasm core.
+//
+// The map's cost is bounded per frame: the page learns its own kernel time per cell·link; a map
+// predicted to fit FRAME_MS is computed on the main thread at the chosen resolution. A costlier
+// one is computed at once at the largest resolution that fits (shown as such in #map-ms) and,
+// unless a drag is going on, at full resolution in a worker (map-worker.js; a new edit replaces
+// it, workers.js); a drag's end asks for the full map.
 
-import { $ } from './dom.js';
+import { $, fixed, showError } from './dom.js';
 import { Zoom } from './view.js';
+import { JobWorker } from './workers.js';
 import { C, FONT, FONT_B, FULL, clipTo, cross, drawAxes, drawNodes, ellipsePath, haloText, linkColor, polyline } from './draw.js';
 
+/** Main-thread budget of the map kernel per refresh, ms (about 60 % of a 60 Hz frame). */
+const FRAME_MS = 10;
+/** Smallest resolution of a reduced map (cells per side). */
+const MIN_RES = 8;
+
 export class MapView {
-  /** @param {object} ctx - {app, wasm, st, view, changed}. */
+  /** @param {object} ctx - {app, wasm, module, st, view, changed}. */
   constructor(ctx) {
     this.ctx = ctx;
     const { wasm } = ctx;
@@ -23,12 +35,68 @@ export class MapView {
       range: null,
       res: 256,
     });
+    this.nsPerCellLink = null; // learnt from every map computed (null: none yet)
+    this.worker = new JobWorker(new URL('./map-worker.js', import.meta.url), ctx.module, {
+      staleMs: 0,
+      onResult: (m) => this.receive(m),
+      onError: (message) => showError(`CRLB map: ${message}`),
+    });
   }
 
-  /** Recomputes the map at the resolution of #resolution and shows the kernel time in #map-ms. */
-  compute() {
-    const { app, wasm, st } = this.ctx;
-    const n = Number($('resolution').value) || 256;
+  /** The resolution chosen in #resolution (cells per side). */
+  fullRes() {
+    return Number($('resolution').value) || 256;
+  }
+
+  /** Predicted main-thread kernel time of an n × n map with `links` links, ms. */
+  predictMs(n, links) {
+    return (n * n * links * this.nsPerCellLink) / 1e6;
+  }
+
+  /**
+   * Recomputes the map (see the file comment). `dragging`: a drag is going on (no worker job:
+   * the drag's end asks again).
+   */
+  compute(dragging = false) {
+    const { app } = this.ctx;
+    const n = this.fullRes();
+    const links = app.link_count();
+    if (this.nsPerCellLink === null || this.predictMs(n, links) <= FRAME_MS) {
+      this.worker.cancel();
+      this.show(n, this.run(n, links), 'main');
+      return;
+    }
+    const fit = Math.floor(Math.sqrt((FRAME_MS * 1e6) / (links * this.nsPerCellLink)));
+    const r = Math.max(MIN_RES, Math.min(n, fit));
+    const ms = this.run(r, links);
+    if (dragging) {
+      this.worker.cancel();
+      this.show(r, ms, 'drag');
+    } else {
+      this.jobLinks = links;
+      this.worker.post({ scenario: app.scenario_json(), n });
+      this.show(r, ms, 'preview');
+    }
+  }
+
+  /** True while a full-resolution map is being computed in the worker. */
+  busy() {
+    return this.worker.pending;
+  }
+
+  /** Computes an n × n map on this thread into the state; returns the kernel time, ms. */
+  run(n, links) {
+    const { app, st } = this.ctx;
+    this.resize(n);
+    const ms = app.compute_map(n, n, st.values);
+    this.learn(n, links, ms);
+    this.paint();
+    return ms;
+  }
+
+  /** The state's buffers for an n × n map. */
+  resize(n) {
+    const { st } = this.ctx;
     if (!st.values || st.res !== n) {
       st.values = new Float64Array(n * n);
       st.image = new ImageData(n, n);
@@ -36,13 +104,54 @@ export class MapView {
       st.mapCanvas.height = n;
       st.res = n;
     }
-    const ms = app.compute_map(n, n, st.values);
+  }
+
+  /** Colours st.values into the map image. */
+  paint() {
+    const { wasm, st } = this.ctx;
     st.range = Array.from(wasm.render_map_rgba(st.values, st.image.data));
     st.mapCanvas.getContext('2d').putImageData(st.image, 0, 0);
+  }
+
+  /**
+   * Updates the kernel cost per cell·link from a map that took `ms` (timer resolution floored):
+   * the first map of a new link count replaces the estimate (a few links cost more per link
+   * than many), later ones are averaged in.
+   */
+  learn(n, links, ms) {
+    const v = (Math.max(ms, 0.05) * 1e6) / (n * n * Math.max(1, links));
+    const fresh = this.nsPerCellLink === null || links !== this.learntLinks;
+    this.nsPerCellLink = fresh ? v : 0.5 * this.nsPerCellLink + 0.5 * v;
+    this.learntLinks = links;
+  }
+
+  /** The worker's full-resolution map (only the newest job's is shown). */
+  receive(m) {
+    if (m.gen !== this.worker.gen) return;
+    const { st } = this.ctx;
+    this.resize(m.n);
+    st.values = m.values;
+    this.learn(m.n, this.jobLinks, m.kernelMs);
+    this.paint();
+    this.show(m.n, m.kernelMs, 'worker');
+    this.ctx.changed({ draw: true });
+  }
+
+  /**
+   * #map-ms: the resolution shown (data-res), the full one (data-full), the kernel time (data-ms)
+   * and where it ran (data-source: main, drag, preview, worker).
+   */
+  show(res, ms, source) {
     const el = $('map-ms');
-    el.dataset.ms = String(ms);
-    el.dataset.res = `${n}x${n}`;
-    el.textContent = `map ${n}×${n}: ${ms.toFixed(1)} ms`;
+    const n = this.fullRes();
+    Object.assign(el.dataset, { ms: String(ms), res: `${res}x${res}`, full: `${n}x${n}`, source });
+    const t = `${fixed(ms, 1)} ms`;
+    el.textContent = {
+      main: `map ${res}×${res}: ${t}`,
+      drag: `map ${res}×${res} while dragging (${n}×${n} on release): ${t}`,
+      preview: `map ${res}×${res}: ${t} · ${n}×${n} computing in a worker…`,
+      worker: `map ${res}×${res}: ${t} (worker)`,
+    }[source];
   }
 
   /** The bound at #probe's data-x, data-y (m) into its data-rmse-m and text. */

@@ -2,7 +2,7 @@
 // generation number cancels a run when a newer one starts (every drag restarts it). Shows the
 // progress bar, the status line and the plotters chart (drawn by the wasm core on #track-chart).
 
-import { $, errorText, fitCanvas } from './dom.js';
+import { $, errorText, fitCanvas, fixed } from './dom.js';
 
 export class MonteCarlo {
   /** @param {object} wasm - the wasm module; @param {function} onError - shows a message. */
@@ -120,15 +120,15 @@ export class MonteCarlo {
     if (this.state === 'done' && this.result) {
       const r = JSON.parse(this.result);
       const n = r.t_s.length - 1;
-      const fmt = (v) => (v === null ? '–' : this.wasm.format_length(v, 3));
+      const fmt = (v) => (v === null || v === undefined ? '—' : this.wasm.format_length(v, 3));
       const cold = this.coldStart ? ' (incl. worker start-up)' : '';
-      text = `${size} in ${this.ms.toFixed(0)} ms${cold} · at t = ${r.t_s[n]} s: ε_EKF ${fmt(r.rmse_ekf_m[n])}, `
-        + `ε_PCRLB ${fmt(r.rmse_pcrlb_m[n])}, NEES ${r.nees[n].toFixed(2)} (4 = consistent) · ${failedRuns(r)}`;
+      text = `${size} in ${fixed(this.ms, 0)} ms${cold} · at t = ${r.t_s[n]} s: ε_EKF ${fmt(r.rmse_ekf_m[n])}, `
+        + `ε_PCRLB ${fmt(r.rmse_pcrlb_m[n])}, NEES ${fixed(r.nees[n], 2)} (4 = consistent) · ${failedRuns(r)}`;
     }
     if (this.state === 'error') text = `${size} · failed`;
     el.textContent = text;
     const ms = $('mc-ms');
-    ms.textContent = this.ms === null ? 'MC –' : `MC ${size}: ${this.ms.toFixed(0)} ms`;
+    ms.textContent = this.ms === null ? 'MC –' : `MC ${size}: ${fixed(this.ms, 0)} ms`;
     ms.dataset.ms = this.ms === null ? '' : String(this.ms);
   }
 }

@@ -1,10 +1,13 @@
 // The multi-target view: state and events only. The scene (nodes, targets, scatterer discs, noise,
 // clutter, thresholds, blocking model) lives here as the core's JSON schema; every edit is
-// validated by the core on the main thread (mtl_check_scene: a rejected edit shows the core's
-// message and changes nothing) and the view is computed by the core in a Web Worker
-// (mtl-worker.js; the newest scene wins), then drawn by mtl-draw.js.
+// validated on the main thread, first its numbers by the page (strict decimals in the ranges of
+// FIELDS), then the scene by the core (mtl_check_scene): a rejected edit shows the named message
+// and changes nothing. The view is computed by the core in a Web Worker (mtl-worker.js; the
+// newest scene wins, and a worker still busy with a stale scene STALE_MS after starting it is
+// replaced, workers.js), then drawn by mtl-draw.js; while it computes, #mtl-status says so.
 
-import { $, num, errorText, fillKeyValues, showError, clearError } from './dom.js';
+import { $, decimalIn, errorText, fillKeyValues, fixed, showError, clearError } from './dom.js';
+import { JobWorker } from './workers.js';
 import { View } from './view.js';
 import { pickNearest } from './interact.js';
 import { drawMtl } from './mtl-draw.js';
@@ -12,6 +15,32 @@ import { drawMtl } from './mtl-draw.js';
 const MARGIN_M = 0.4; // shown around the region, m
 /** Where "+ target" / "+ disc" try to put a new one (first valid wins), m. */
 const SPOTS = [[5, 5], [5, 7], [3, 6], [7, 3], [6, 8.5], [8, 6], [3, 2], [1.5, 7], [8.5, 1], [4.5, 2.5]];
+/**
+ * The scene's numeric inputs: [input id, scene key, on-screen name, allowed range]. The page's
+ * documented ranges (README, "The page"); the core checks the scene again.
+ */
+const FIELDS = [
+  ['mtl-seed', 'seed', 'seed', { min: 0, max: Number.MAX_SAFE_INTEGER, integer: true }],
+  ['mtl-clutter', 'clutter_mean', 'clutter', { min: 0, max: 10, unit: 'peaks per TRP' }],
+  ['mtl-sigma', 'range_sigma', 'cσ', { min: 1e-3, max: 1e3, unit: 'm' }],
+  ['mtl-resolution', 'resolution', 'δ', { min: 0, max: 1e3, unit: 'm' }],
+  ['mtl-pd', 'p_d', 'p_d', { min: 0, max: 1 }],
+  ['mtl-lambda', 'lambda', 'λ', { min: 0, max: 10, unit: 'm⁻²' }],
+  ['mtl-diameter', 'diameter', 'D', { min: 1e-3, max: 1e3, unit: 'm' }],
+  ['mtl-te', 't_e', 'T_e', { min: 0, max: 6 }],
+  ['mtl-tb', 't_b', 'T_b', { min: 0, max: 30, unit: 'nats' }],
+  ['mtl-pu', 'model.p_u', 'p_u', { min: 0, max: 1 }],
+  ['mtl-plos', 'model.p_los', 'p_LoS', { min: 0, max: 1 }],
+];
+const FIELD = Object.fromEntries(FIELDS.map(([id, key, name, range]) => [id, { key, name, range }]));
+/** A worker busy this long with a scene an edit has replaced is terminated and replaced, ms. */
+const STALE_MS = 250;
+
+/** Input `id`'s number, strictly parsed and range-checked; throws naming the field (`key (name): …`). */
+function fieldValue(id) {
+  const { key, name, range } = FIELD[id];
+  return decimalIn($(id).value, key === name ? key : `${key} (${name})`, range);
+}
 
 export class Mtl {
   /** @param {object} ctx - {wasm, st, changed}. */
@@ -23,7 +52,7 @@ export class Mtl {
     this.scene = JSON.parse(this.wasm.mtl_default_scene());
     this.result = null; // the last view from the core
     this.resultGen = 0;
-    this.gen = 0; // generation of the scene last posted
+    this.gen = 0; // generation of the scene last posted (the worker's job generation)
     this.ms = null; // the worker's time for the last view, ms
     this.computeMs = null; // the core's own time inside it
     this.msLog = []; // [worker ms, core ms] of the last views (at most 64), oldest first
@@ -31,9 +60,12 @@ export class Mtl {
     this.workerError = null;
     this.selected = null; // {kind: 'tx' | 'rx' | 'target' | 'disc', index}
     this.press = null;
-    this.worker = new Worker(new URL('./mtl-worker.js', import.meta.url), { type: 'module' });
-    this.worker.onmessage = (e) => this.receive(e.data);
-    this.worker.onerror = (e) => showError(`Multi-target worker: ${e.message || 'failed to start'}`);
+    this.job = new JobWorker(new URL('./mtl-worker.js', import.meta.url), ctx.module, {
+      staleMs: STALE_MS,
+      onResult: (m) => this.receive(m),
+      onError: (message, gen) => this.fail(message, gen),
+    });
+    this.statusTimer = null;
     this.bindPanel();
     this.bindPointer();
     this.syncPanel();
@@ -55,8 +87,8 @@ export class Mtl {
    */
   apply(edit, input) {
     const next = structuredClone(this.scene);
-    edit(next);
     try {
+      edit(next);
       this.wasm.mtl_check_scene(JSON.stringify(next));
     } catch (e) {
       showError(errorText(e));
@@ -73,21 +105,24 @@ export class Mtl {
 
   /** Posts the current scene to the worker and redraws (markers move at once). */
   submit() {
-    this.gen += 1;
-    this.worker.postMessage({ gen: this.gen, scene: JSON.stringify(this.scene) });
+    this.gen = this.job.post({ scene: JSON.stringify(this.scene) });
     this.showTiming();
     this.ctx.changed({ mtl: true });
   }
 
+  /**
+   * A scene the core could not compute (e.g. over its candidate budget) or a worker failure: the
+   * banner shows the message, the last view stays drawn.
+   */
+  fail(message, gen) {
+    if (gen !== undefined) this.resultGen = Math.max(this.resultGen, gen);
+    if (gen !== undefined && gen < this.gen) return; // a replaced scene's: not worth a banner
+    this.workerError = message;
+    showError(`Multi-target view: ${message}`);
+    this.showTiming();
+  }
+
   receive(m) {
-    if (m.type === 'ready') return;
-    if (m.type === 'error') {
-      // Not expected (the scene was checked before posting); the view keeps the last result.
-      this.workerError = m.message;
-      this.resultGen = Math.max(this.resultGen, m.gen);
-      showError(m.message);
-      return;
-    }
     if (m.gen < this.resultGen) return;
     this.result = m.view;
     this.resultGen = m.gen;
@@ -102,32 +137,34 @@ export class Mtl {
     if (this.active()) this.ctx.changed({ mtl: true });
   }
 
+  /** The footer's timing and, while the worker computes for longer than STALE_MS, #mtl-status. */
   showTiming() {
     const el = $('mtl-ms');
-    if (this.ms === null) return;
-    el.dataset.ms = String(this.ms);
-    el.dataset.computeMs = String(this.computeMs);
-    el.textContent = `MTL recompute: ${this.ms.toFixed(1)} ms (worker)${this.gen > this.resultGen ? ' …' : ''}`;
+    const pending = this.gen > this.resultGen;
+    if (this.ms !== null) {
+      el.dataset.ms = String(this.ms);
+      el.dataset.computeMs = String(this.computeMs);
+      el.textContent = `MTL recompute: ${fixed(this.ms, 1)} ms (worker)${pending ? ' …' : ''}`;
+    }
+    const busy = pending ? this.job.busyMs() : 0;
+    const status = $('mtl-status');
+    status.hidden = busy < STALE_MS;
+    status.textContent = status.hidden ? '' : `Computing the view… ${fixed(busy / 1000, 1)} s (any edit replaces it)`;
+    clearTimeout(this.statusTimer);
+    if (pending) this.statusTimer = setTimeout(() => this.showTiming(), 100);
   }
 
   // ---------- panel ----------
 
   bindPanel() {
-    const bindNum = (id, key) => $(id).addEventListener('change', () => {
-      this.apply((s) => { s[key] = num($(id).value); }, $(id));
-    });
-    bindNum('mtl-seed', 'seed');
-    bindNum('mtl-clutter', 'clutter_mean');
-    bindNum('mtl-sigma', 'range_sigma');
-    bindNum('mtl-pd', 'p_d');
-    bindNum('mtl-lambda', 'lambda');
-    bindNum('mtl-diameter', 'diameter');
-    bindNum('mtl-resolution', 'resolution');
-    const slider = (id, key) => $(id).addEventListener('input', () => {
-      this.apply((s) => { s[key] = num($(id).value); });
-    });
-    slider('mtl-te', 't_e');
-    slider('mtl-tb', 't_b');
+    for (const id of ['mtl-seed', 'mtl-clutter', 'mtl-sigma', 'mtl-pd', 'mtl-lambda', 'mtl-diameter', 'mtl-resolution']) {
+      $(id).setAttribute('inputmode', 'decimal');
+      $(id).setAttribute('autocomplete', 'off');
+      $(id).addEventListener('change', () => this.apply((s) => { s[FIELD[id].key] = fieldValue(id); }, $(id)));
+    }
+    for (const id of ['mtl-te', 'mtl-tb']) {
+      $(id).addEventListener('input', () => this.apply((s) => { s[FIELD[id].key] = fieldValue(id); }));
+    }
     const model = () => this.apply((s) => { s.model = this.modelFromPanel(); },
       $('mtl-model').value === 'icb-plos' ? $('mtl-plos') : $('mtl-pu'));
     $('mtl-model').addEventListener('change', model);
@@ -150,8 +187,8 @@ export class Mtl {
   modelFromPanel() {
     switch ($('mtl-model').value) {
       case 'ppp-exact': return { kind: 'ppp', exact: true };
-      case 'icb-pu': return { kind: 'icb', p_u: num($('mtl-pu').value) };
-      case 'icb-plos': return { kind: 'icb', p_los: num($('mtl-plos').value) };
+      case 'icb-pu': return { kind: 'icb', p_u: fieldValue('mtl-pu') };
+      case 'icb-plos': return { kind: 'icb', p_los: fieldValue('mtl-plos') };
       default: return { kind: 'ppp', exact: false };
     }
   }
@@ -190,8 +227,8 @@ export class Mtl {
     }
     $('mtl-te').value = String(s.t_e);
     $('mtl-tb').value = String(s.t_b);
-    $('mtl-te-out').textContent = s.t_e.toFixed(1);
-    $('mtl-tb-out').textContent = `${s.t_b.toFixed(2)} nats`;
+    $('mtl-te-out').textContent = fixed(s.t_e, 1);
+    $('mtl-tb-out').textContent = `${fixed(s.t_b, 2)} nats`;
     const m = s.model;
     $('mtl-model').value = m.kind === 'ppp' ? (m.exact ? 'ppp-exact' : 'ppp') : (m.p_los !== undefined ? 'icb-plos' : 'icb-pu');
     if (m.p_u !== undefined) $('mtl-pu').value = String(m.p_u);
@@ -208,21 +245,21 @@ export class Mtl {
     if (!v) return;
     const m = v.metrics;
     const det = v.detected.map((d, i) => [`Detected #${i + 1}`,
-      `(${d.x[0].toFixed(2)}, ${d.x[1].toFixed(2)}) m · |ℳ| ${d.matching.length} · J ${d.j.toFixed(2)} · L_b ${d.l_b.toFixed(2)}`,
+      `(${fixed(d.x[0], 2)}, ${fixed(d.x[1], 2)}) m · |ℳ| ${d.matching.length} · J ${fixed(d.j, 2)} · L_b ${fixed(d.l_b, 2)}`,
       d.hit ? 'fix' : 'fa']);
     const tgt = v.targets.map((t, k) => [`Target T${k + 1}`,
-      `(${t.x[0].toFixed(2)}, ${t.x[1].toFixed(2)}) m · ${t.dp_trps.length} DPs of ${t.los_trps.length} LoS TRPs · ${t.detected ? 'found' : 'missed'}`, '']);
+      `(${fixed(t.x[0], 2)}, ${fixed(t.x[1], 2)}) m · ${t.dp_trps.length} DPs of ${t.los_trps.length} LoS TRPs · ${t.detected ? 'found' : 'missed'}`, '']);
     fillKeyValues($('mtl-info'), [
       ['Model', v.model.label, ''],
       ['TRPs · ranges', `${v.trps.length} · ${v.mpcs} (seeds ${v.seeds.length}, live ${v.hypotheses.length})`, ''],
       ['Detected K̂ / true K', `${m.estimates} / ${m.targets}`, ''],
       ['N_D · N_FA', `${m.detected} · ${m.false_alarms}`, ''],
-      ['P_D · P_FA (this scene)', `${m.p_d === null ? '–' : m.p_d.toFixed(2)} · ${m.p_fa.toFixed(2)}`, ''],
+      ['P_D · P_FA (this scene)', `${fixed(m.p_d, 2)} · ${fixed(m.p_fa, 2)}`, ''],
       ...tgt,
       ...det,
     ]);
     const rows = v.trps.map((t) => `TRP ${t.trp + 1} (Tx${t.tx + 1}–Rx${t.rx + 1}): `
-      + t.ranges.map((r) => `${r.range_m.toFixed(2)}${r.source === 'dp' ? `ᵀ${r.target + 1}` : ''}`).join(', '));
+      + t.ranges.map((r) => `${fixed(r.range_m, 2)}${r.source === 'dp' ? `ᵀ${r.target + 1}` : ''}`).join(', '));
     $('mtl-trps').textContent = rows.join('\n');
     if (!this.active()) return;
     $('readout').textContent = `Multi-target · ${v.trps.length} TRPs, ${v.mpcs} ranges · detected ${m.estimates} `
@@ -317,6 +354,8 @@ export class Mtl {
       msLog: this.msLog.slice(),
       viewCount: this.viewCount,
       error: this.workerError,
+      busyMs: this.job.busyMs(),
+      restarts: this.job.restarts,
     };
   }
 

@@ -2,7 +2,7 @@
 // goes to a validating wasm setter; a rejected value shows its message in the error banner and
 // leaves the scenario unchanged.
 
-import { $, num, errorText, fillKeyValues, showError, clearError } from './dom.js';
+import { $, decimal, errorText, fillKeyValues, fixed, showError, clearError } from './dom.js';
 import { linkColor } from './draw.js';
 
 export class Panel {
@@ -74,8 +74,30 @@ export class Panel {
     $('target-resample').addEventListener('click', () => ctx.resample());
   }
 
+  /** The number in input `id`, strictly parsed; a bad one throws naming the scenario field. */
   field(id) {
-    return num($(id).value);
+    return decimal($(id).value, this.fieldName(id));
+  }
+
+  /** The scenario field input `id` edits (the path the core's messages use). */
+  fieldName(id) {
+    const { selTx, selRx } = this.ctx.st;
+    return {
+      carrier: 'radio.carrier_hz (GHz)',
+      bandwidth: 'radio.bandwidth_hz (MHz)',
+      nf: 'radio.noise_figure_db',
+      rcs: 'target.rcs_m2',
+      'tx-x': `transmitters[${selTx}].position_m[0]`,
+      'tx-y': `transmitters[${selTx}].position_m[1]`,
+      'tx-power': `transmitters[${selTx}].power_dbm`,
+      'tx-gain': `transmitters[${selTx}].gain_dbi`,
+      'tx-boresight': `transmitters[${selTx}].pattern.boresight_deg`,
+      'tx-beamwidth': `transmitters[${selTx}].pattern.beamwidth_deg`,
+      'tx-floor': `transmitters[${selTx}].pattern.floor_db`,
+      'rx-x': `receivers[${selRx}].position_m[0]`,
+      'rx-y': `receivers[${selRx}].position_m[1]`,
+      'rx-gain': `receivers[${selRx}].gain_dbi`,
+    }[id] ?? id;
   }
 
   /** Commits an input on change (Enter or blur). */
@@ -192,7 +214,7 @@ export class Panel {
     $('target-clear').disabled = !fix;
     $('target-resample').disabled = !fix;
     if (!fix) return;
-    const m = (v) => `${v.toFixed(3)} m`;
+    const m = (v) => `${fixed(v, 3)} m`;
     const rows = [
       ['Target', `${m(fix.truth.x)}, ${m(fix.truth.y)}`, ''],
       ['CRLB RMSE', fix.crlb.rmse_label, 'crlb'],

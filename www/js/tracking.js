@@ -3,7 +3,7 @@
 // it is after the run's duration) and keeps the Monte Carlo chart (montecarlo.js) in step: every
 // change of scenario, nodes or trajectory re-simulates the track and restarts the Monte Carlo.
 
-import { $, num, errorText, fillKeyValues, showError, clearError } from './dom.js';
+import { $, decimalIn, errorText, fillKeyValues, fixed, showError, clearError } from './dom.js';
 import { MonteCarlo } from './montecarlo.js';
 import { drawTrack } from './track-draw.js';
 
@@ -23,8 +23,11 @@ export class Tracking {
     this.frame = null;
     this.dragging = false;
     this.mc = new MonteCarlo(ctx.wasm, showError);
+    // URL options arrive checked (app.js); a run count between the offered ones gets its own entry.
+    const runs = opts.runs === undefined ? undefined : String(opts.runs);
+    if (runs && ![...$('mc-runs').options].some((o) => o.value === runs)) $('mc-runs').add(new Option(`${runs} runs`, runs));
     for (const [id, v] of [['track-kind', this.kind], ['track-dt', opts.dt], ['track-seed', opts.tseed],
-      ['track-ex', opts.ex], ['mc-runs', opts.runs], ['track-speed', opts.speed]]) {
+      ['track-ex', opts.ex], ['mc-runs', runs], ['track-speed', opts.speed]]) {
       if (v !== null && v !== undefined && v !== '') $(id).value = String(v);
     }
     const rerun = () => this.rerun();
@@ -50,7 +53,7 @@ export class Tracking {
     let v = [0, 0];
     const d = this.drawn;
     if (this.kind === 'custom') v = w.drag_velocity(d.x0, d.y0, d.x1, d.y1, DURATION_S);
-    const seed = num($('track-seed').value);
+    const seed = decimalIn($('track-seed').value, 'seed', { min: 0, max: 4294967295, integer: true });
     return { kind: this.kind, x0: d.x0, y0: d.y0, vx: v[0], vy: v[1], dt_s: dt, steps, seed };
   }
 
@@ -59,7 +62,6 @@ export class Tracking {
     if (!this.active()) return;
     try {
       const p = this.params();
-      if (!Number.isInteger(p.seed) || p.seed < 0 || p.seed > 0xffffffff) throw new Error('seed: an integer 0 … 4294967295');
       const track = this.ctx.app.simulate_track(p.kind, p.x0, p.y0, p.vx, p.vy, p.dt_s, p.steps, p.seed);
       if (this.track) this.track.free();
       this.track = track;
@@ -164,7 +166,7 @@ export class Tracking {
     let drawn = null;
     if (this.kind === 'custom') {
       const v = this.p && this.p.kind === 'custom' ? this.p : null;
-      drawn = { ...this.drawn, label: v ? `v̄ = (${v.vx.toFixed(2)}, ${v.vy.toFixed(2)}) m/s` : '' };
+      drawn = { ...this.drawn, label: v ? `v̄ = (${fixed(v.vx, 2)}, ${fixed(v.vy, 2)}) m/s` : '' };
     }
     drawTrack(ctx, view, { data: this.data, step: this.step, magnify, drawn });
   }
@@ -190,16 +192,16 @@ export class Tracking {
     $('track-scrub').value = String(this.step);
     if (!f || !this.data) return;
     const tEnd = this.data.t_s[n];
-    $('track-time').textContent = `t = ${f.t_s.toFixed(2)} s / ${tEnd.toFixed(2)} s · step ${f.step}/${n}`;
+    $('track-time').textContent = `t = ${fixed(f.t_s, 2)} s / ${fixed(tEnd, 2)} s · step ${f.step}/${n}`;
     $('track-ex-label').textContent = `×${$('track-ex').value}`;
-    const m2 = (x, y) => `${x.toFixed(3)}, ${y.toFixed(3)} m`;
+    const m2 = (x, y) => `${fixed(x, 3)}, ${fixed(y, 3)} m`;
     const rows = [
       ['Truth', m2(f.truth.x, f.truth.y), ''],
       ['EKF estimate', m2(f.fix.x, f.fix.y), 'fix'],
       ['Error ‖r̂ − r‖', f.fix.error_label, 'fix'],
       ['EKF σ √(P_xx+P_yy)', f.fix.sigma_label, 'fix'],
       ['Snapshot CRLB here', f.crlb.rmse_label, 'crlb'],
-      ['NIS', f.step === 0 ? '–' : `${f.fix.nis.toFixed(2)} (χ²₄ mean 4)`, ''],
+      ['NIS', f.step === 0 ? '–' : `${fixed(f.fix.nis, 2)} (χ²₄ mean 4)`, ''],
     ];
     if (this.data.failed_at !== null) rows.push(['Filter failed at step', String(this.data.failed_at), '']);
     fillKeyValues($('track-info'), rows);
