@@ -420,3 +420,82 @@ fn nees_is_the_quadratic_form() {
     let closed = 0.09 / 0.1 + 0.04 / 0.2 + 0.0025 / 0.01 + 0.01 / 0.04;
     rel_close("NEES diagonal", d.nees(&x).unwrap(), closed, 1e-15);
 }
+
+/// Issue 12, item 8: a prior of 10¹² m² (σ = 1000 km) is legitimate and is tracked. At the true
+/// position (`ν = 0`), with fixed σ and velocity uncorrelated with position, the closed form is
+/// `P⁺_rr = (P_rr⁻¹ + M)⁻¹ → M⁻¹` as the prior widens, `M = Σ g gᵀ/(cσ)²` (computed here from the
+/// link geometry), the velocity block is untouched and the state does not move. The old
+/// covariance-form update cancelled 10¹² against 10¹² and failed with "ekf.covariance: not
+/// positive definite".
+#[test]
+fn a_wide_prior_is_tracked() {
+    let model = model();
+    let r = Vec2::new(20.0, 6.0);
+    let n = model.link_count();
+    let sig = vec![1e-10; n];
+    let z: Vec<Option<Real>> = (0..n).map(|p| Some(model.network.delay(p, r))).collect();
+    let w = 1.0 / (299_792_458.0f64 * 1e-10).powi(2);
+    let mut m = nalgebra::Matrix2::<Real>::zeros();
+    for p in 0..n {
+        let (tx, rx) = model.network.link_nodes(p);
+        let g = (r - tx).normalize() + (r - rx).normalize();
+        m += w * g * g.transpose();
+    }
+    for var in [1e6, 1e8, 1e10, 1e12] {
+        let p0 = Mat4::from_diagonal(&Vec4::new(var, var, 0.01, 0.01));
+        let x0 = Vec4::new(r.x, r.y, 0.3, -0.2);
+        let mut f = Ekf::new(x0, p0).unwrap();
+        let s = f
+            .update(&model, &z, MeasurementNoise::Fixed(&sig), None)
+            .unwrap();
+        assert_eq!(s.links_used, n);
+        let expect = (nalgebra::Matrix2::identity() / var + m).try_inverse().unwrap();
+        let got = f.covariance.fixed_view::<2, 2>(0, 0).into_owned();
+        for (a, b) in got.iter().zip(expect.iter()) {
+            rel_close(&format!("P⁺_rr at prior {var}"), *a, *b, 1e-7);
+        }
+        rel_close("P⁺_vxvx", f.covariance[(2, 2)], 0.01, 1e-12);
+        rel_close("P⁺_vyvy", f.covariance[(3, 3)], 0.01, 1e-12);
+        assert!((f.state - x0).norm() < 1e-9, "{}", f.state - x0);
+    }
+    // Past the limit it is a named error on the input, not on an internal matrix.
+    let p0 = Mat4::from_diagonal(&Vec4::new(0.1, 0.1, 0.01, 1e308));
+    let e = Ekf::new(Vec4::new(r.x, r.y, 0.0, 0.0), p0).unwrap_err();
+    assert!(e.to_string().starts_with("initial_covariance[3][3]: 1e308"), "{e}");
+}
+
+/// The two update forms (covariance form below `tr(M P_rr) = 10⁶`, information form above)
+/// both equal the textbook batch Kalman filter (the reference above) on either side of the
+/// switch, off the true position (`ν ≠ 0`) and with position–velocity correlation; there the
+/// reference's own rounding is ≈ ε·10⁶.
+#[test]
+fn both_update_forms_agree_with_the_reference_at_the_switch() {
+    let model = model();
+    let r = Vec2::new(20.0, 6.0);
+    let n = model.link_count();
+    let sig = vec![3e-10; n];
+    let z: Vec<Option<Real>> = (0..n)
+        .map(|p| Some(model.network.delay(p, r) + 1e-10 * (p as Real - 1.5)))
+        .collect();
+    // tr(M P_rr) = var · tr(M), tr(M) = Σ |g|²/(cσ)² (here at r; the prior mean is 5 cm off).
+    let w = 1.0 / (299_792_458.0f64 * 3e-10).powi(2);
+    let tr_m: Real = (0..n)
+        .map(|p| {
+            let (tx, rx) = model.network.link_nodes(p);
+            w * ((r - tx).normalize() + (r - rx).normalize()).norm_squared()
+        })
+        .sum();
+    let switch = 1e6 / tr_m;
+    for var in [switch * 0.98, switch * 1.02] {
+        let mut p0 = Mat4::from_diagonal(&Vec4::new(var, var, 0.04, 0.04));
+        p0[(0, 2)] = 0.1 * (var * 0.04).sqrt();
+        p0[(2, 0)] = p0[(0, 2)];
+        let x0 = Vec4::new(r.x + 0.05, r.y - 0.03, 0.3, -0.2);
+        let mut f = Ekf::new(x0, p0).unwrap();
+        let s = f
+            .update(&model, &z, MeasurementNoise::Fixed(&sig), None)
+            .unwrap();
+        let reference = reference_update(&model, &x0, &p0, &z, &sig);
+        assert_matches_reference(&format!("prior {var}"), &f, s.nis, &reference, 1e-7, 1e-6);
+    }
+}

@@ -157,3 +157,23 @@ pub const MAX_NODES: usize = 4096;
 /// 256 MiB. The largest legitimate input, a `simulate-walk` raw-steps file, is capped at the
 /// same size when written.
 pub const MAX_INPUT_BYTES: u64 = 256 << 20;
+
+/// The tracker's time step `Δt`: 1 µs to 1 h.
+pub const DT_S: Range = Range {
+    min: 1e-6,
+    max: 3600.0,
+    allowed: "1e-6 to 3600 s",
+};
+
+/// The process-noise intensity `q` of the constant-velocity model (E7): up to 10⁶ m²/s³ (a
+/// random acceleration of ~1000 m/s² over one second; people and cars need 0.01–10).
+pub const PROCESS_NOISE: Range = Range {
+    min: f64::MIN_POSITIVE,
+    max: 1e6,
+    allowed: "0 < q <= 1e6 m²/s³",
+};
+
+/// The largest variance on the diagonal of an initial covariance: 10¹² (σ = 1000 km or
+/// 1000 km/s, a prior that knows nothing on any ground network). Wider priors would overflow
+/// the first prediction's products with the links' information.
+pub const MAX_INITIAL_VARIANCE: f64 = 1e12;

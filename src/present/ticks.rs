@@ -60,11 +60,30 @@ fn nice_above(x: Real) -> Option<(i64, i32)> {
     })
 }
 
-/// Formats `mantissa · 10^exp10` exactly, without exponent (`-25, -1` → `"−2.5"`).
+/// Longest label written without an exponent, digits: past it `mantissa · 10^exp10` is written
+/// as `2.5e12` (spans like ±1e300 would otherwise give 301-digit labels).
+const MAX_PLAIN_DIGITS: usize = 12;
+
+/// Formats `mantissa · 10^exp10` exactly (`-25, -1` → `"−2.5"`), without exponent unless that
+/// would take more than [`MAX_PLAIN_DIGITS`] digits (`25, 20` → `"2.5e21"`).
 fn decimal_label(mantissa: i64, exp10: i32) -> String {
     let neg = mantissa < 0;
     let digits = mantissa.unsigned_abs().to_string();
-    let body = if exp10 >= 0 {
+    let plain_digits = if exp10 >= 0 {
+        digits.len() + exp10 as usize
+    } else {
+        digits.len().max(exp10.unsigned_abs() as usize + 1)
+    };
+    let body = if digits != "0" && plain_digits > MAX_PLAIN_DIGITS {
+        let (lead, rest) = digits.split_at(1);
+        let rest = rest.trim_end_matches('0');
+        let e = exp10 + digits.len() as i32 - 1;
+        if rest.is_empty() {
+            format!("{lead}e{e}")
+        } else {
+            format!("{lead}.{rest}e{e}")
+        }
+    } else if exp10 >= 0 {
         let mut s = digits;
         if s != "0" {
             s.extend(core::iter::repeat_n('0', exp10 as usize));
@@ -104,9 +123,21 @@ pub fn linear_ticks(lo: Real, hi: Real, max_count: usize) -> Vec<Tick> {
         return Vec::new();
     };
     let step = decimal(m, k);
-    let first = libm::ceil(lo / step) as i64;
-    let last = libm::floor(hi / step) as i64;
-    (first..=last)
+    let (first, last) = (libm::ceil(lo / step), libm::floor(hi / step));
+    // Tick indices times the mantissa must be exact integers: past 2⁵³/5 (a span that is tiny
+    // against its distance from 0, e.g. [1e3, 1e3 + 1e-13]) no 1-2-5 step can be labelled
+    // apart, so the axis gets its two ends.
+    const EXACT: Real = 1.8e15;
+    if !(first.abs() <= EXACT && last.abs() <= EXACT) {
+        return [lo, hi]
+            .into_iter()
+            .map(|v| Tick {
+                value: v,
+                label: crate::error::Num(v).to_string().replace('-', "\u{2212}"),
+            })
+            .collect();
+    }
+    (first as i64..=last as i64)
         .take(1000)
         .map(|i| Tick {
             value: decimal(i * m, k),
@@ -230,6 +261,23 @@ pub fn format_length_m(v: Real, significant: usize) -> String {
     };
     let u = v / scale;
     let sig = significant.clamp(1, 17) as i32;
+    if u != 0.0 && !(1e-3..1e6).contains(&u.abs()) {
+        // Below 1 nm or beyond 10⁶ km: a mantissa and an exponent, not hundreds of digits.
+        let p = (sig - 1) as usize;
+        let s = format!("{u:.p$e}");
+        let (mant, exp) = s.split_once('e').unwrap_or((&s, "0"));
+        let mant = if mant.contains('.') {
+            mant.trim_end_matches('0').trim_end_matches('.')
+        } else {
+            mant
+        };
+        let s = format!("{mant}e{exp}");
+        let s = match s.strip_prefix('-') {
+            Some(rest) => format!("\u{2212}{rest}"),
+            None => s,
+        };
+        return format!("{s} {unit}");
+    }
     let decimals = if u == 0.0 {
         0
     } else {

@@ -22,7 +22,7 @@
 
 use nalgebra::Cholesky;
 
-use crate::error::{check_len, Error, Result};
+use crate::error::{check_len, limits, Error, Result};
 use crate::math::{sqrt, Mat4, Real, Vec2, Vec4, PI, SPEED_OF_LIGHT};
 use crate::measure::UNIT_VECTOR_MIN_DISTANCE_M;
 use crate::measure::{Model, SNR_DISTANCE_FLOOR_M};
@@ -163,7 +163,8 @@ pub fn check_covariance(field: &str, p: &Mat4) -> Result<()> {
 }
 
 impl Ekf {
-    /// A filter at `state` with covariance `covariance` (validated: finite, symmetric PD).
+    /// A filter at `state` with covariance `covariance` (validated: finite, symmetric PD, no
+    /// variance above [`limits::MAX_INITIAL_VARIANCE`]).
     pub fn new(state: Vec4, covariance: Mat4) -> Result<Ekf> {
         if state.iter().any(|v| !v.is_finite()) {
             return Err(Error::NonFinite {
@@ -171,6 +172,16 @@ impl Ekf {
             });
         }
         check_covariance("initial_covariance", &covariance)?;
+        for i in 0..4 {
+            let v = covariance[(i, i)];
+            if v > limits::MAX_INITIAL_VARIANCE {
+                return Err(Error::OutOfRange {
+                    field: alloc::format!("initial_covariance[{i}][{i}]"),
+                    value: v,
+                    allowed: "a variance of at most 1e12",
+                });
+            }
+        }
         Ok(Ekf { state, covariance })
     }
 

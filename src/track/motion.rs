@@ -1,6 +1,6 @@
 //! White-noise-acceleration (constant-velocity) motion model (spec §6, E7 = S13, S14).
 
-use crate::error::check_positive;
+use crate::error::limits;
 use crate::math::{sqrt, Mat4, Real, Vec4};
 
 /// The CV model for a step `T` and intensity `q̃`.
@@ -19,10 +19,11 @@ impl ConstantVelocity {
         ConstantVelocity { dt_s, intensity }
     }
 
-    /// The model after checking `dt_s > 0` and `intensity > 0`, both finite.
+    /// The model after checking `dt_s` against [`limits::DT_S`] and `intensity` against
+    /// [`limits::PROCESS_NOISE`].
     pub fn validated(dt_s: Real, intensity: Real) -> crate::Result<ConstantVelocity> {
-        check_positive("dt_s", dt_s)?;
-        check_positive("process_noise", intensity)?;
+        limits::DT_S.check("dt_s", dt_s)?;
+        limits::PROCESS_NOISE.check("process_noise", intensity)?;
         Ok(ConstantVelocity { dt_s, intensity })
     }
 

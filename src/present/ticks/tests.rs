@@ -80,3 +80,35 @@ fn flat_map_keeps_two_labels() {
     let t = colorbar_ticks(0.0079, 0.0081, 8);
     assert!(labels(&t).len() >= 2, "{t:?}");
 }
+
+/// Issue 12, item 6: spans like ±1e300 gave labels of 301 digits or, once the tick index
+/// overflowed `i64`, ±9223372036854775808; a tiny span far from 0 overflowed (a debug panic).
+#[test]
+fn extreme_spans_give_short_exact_labels() {
+    let t = linear_ticks(-1e300, 1e300, 3);
+    assert_eq!(labels(&t), ["\u{2212}1e300", "0", "1e300"]);
+    assert_eq!(t[2].value, 1e300);
+    let t = linear_ticks(0.0, 2.5e13, 5);
+    assert_eq!(
+        labels(&t),
+        ["0", "5e12", "1e13", "1.5e13", "2e13", "2.5e13"]
+    );
+    // Twelve digits are still written out.
+    assert_eq!(labels(&linear_ticks(0.0, 2e11, 2))[2], "200000000000");
+    assert_eq!(labels(&linear_ticks(0.0, 2e-12, 2))[1], "1e-12");
+    assert_eq!(labels(&linear_ticks(0.0, 2e-11, 2))[1], "0.00000000001");
+    assert_eq!(labels(&linear_ticks(0.0, 2e-10, 2))[1], "0.0000000001");
+    // No 1-2-5 step fits: the two ends.
+    let t = linear_ticks(1e3, 1e3 + 1e-13, 1000);
+    assert_eq!(t.len(), 2);
+    assert_eq!((t[0].value, t[1].value), (1e3, 1e3 + 1e-13));
+    let t = linear_ticks(-1e300, -1e300 + 1e285, 3);
+    assert!(t.iter().all(|t| t.label.len() < 30), "{t:?}");
+    for t in log_length_ticks(5e-324, 1.7e308) {
+        assert!(t.label.chars().count() < 16, "{t:?}");
+    }
+    assert_eq!(format_length_m(1.5e12, 3), "1.5e9 km");
+    assert_eq!(format_length_m(-2e300, 3), "\u{2212}2e297 km");
+    assert_eq!(format_length_m(5e-324, 3), "4.94e-318 \u{b5}m");
+    assert_eq!(format_length_m(9.99e8, 3), "999000 km");
+}

@@ -133,8 +133,10 @@ pub fn one_list_per_link(field: &str, len: usize, n: usize) -> Result<(), String
     }
 }
 
-/// Largest expected number of estimates `simulate-walk` writes (≈ 0.5 GB of JSON).
-const MAX_WALK_ESTIMATES: f64 = 2e7;
+/// Largest expected number of estimates `simulate-walk` writes: at most 46 bytes each (a
+/// `[delay, amplitude]` pair with a comma), so every file it writes stays below the input cap
+/// of 256 MiB ([`scatterloc::error::limits::MAX_INPUT_BYTES`]) and `track` can read it.
+const MAX_WALK_ESTIMATES: f64 = 5e6;
 
 /// One raw step of a measurements file: per link, `[delay_s, amplitude]` estimates.
 pub type RawStep = Vec<Vec<[f64; 2]>>;

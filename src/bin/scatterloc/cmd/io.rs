@@ -6,6 +6,7 @@ use std::io::{Read, Write};
 use serde::de::DeserializeOwned;
 use serde::Serialize;
 
+use scatterloc::error::limits;
 use scatterloc::scenario::parse_json;
 use scatterloc::{Model, Scenario};
 
@@ -26,22 +27,33 @@ pub fn emit_json<T: Serialize>(v: &T) -> Result<(), CliError> {
     emit(&text)
 }
 
-/// Reads a file (or stdin for `-`) named by `--flag`. A leading UTF-8 byte-order mark is
-/// dropped (editors on some systems write one; the page accepts it too).
+/// Reads a file (or stdin for `-`) named by `--flag`, at most [`limits::MAX_INPUT_BYTES`]
+/// (a larger input, or an endless one such as `/dev/zero`, is refused after reading one byte
+/// past the cap). A leading UTF-8 byte-order mark is dropped (editors on some systems write
+/// one; the page accepts it too).
 pub fn read_input(flag: &str, path: &str) -> Result<String, CliError> {
-    let res = if path == "-" {
-        let mut s = String::new();
-        std::io::stdin().read_to_string(&mut s).map(|_| s)
-    } else {
-        std::fs::read_to_string(path)
+    let cannot = |e: &dyn std::fmt::Display| {
+        CliError::usage(format!("--{flag}: cannot read '{path}': {e}"))
     };
-    res.map(|mut s| {
-        if s.starts_with('\u{feff}') {
-            s.drain(..'\u{feff}'.len_utf8());
-        }
-        s
-    })
-    .map_err(|e| CliError::usage(format!("--{flag}: cannot read '{path}': {e}")))
+    let mut bytes = Vec::new();
+    let cap = limits::MAX_INPUT_BYTES;
+    let res = if path == "-" {
+        std::io::stdin().lock().take(cap + 1).read_to_end(&mut bytes)
+    } else {
+        std::fs::File::open(path).and_then(|f| f.take(cap + 1).read_to_end(&mut bytes))
+    };
+    res.map_err(|e| cannot(&e))?;
+    if bytes.len() as u64 > cap {
+        return Err(CliError::usage(format!(
+            "--{flag}: '{path}' is larger than {} MiB, the largest input read",
+            cap >> 20
+        )));
+    }
+    let mut s = String::from_utf8(bytes).map_err(|e| cannot(&e))?;
+    if s.starts_with('\u{feff}') {
+        s.drain(..'\u{feff}'.len_utf8());
+    }
+    Ok(s)
 }
 
 /// Reads and validates the scenario file `path` of `--scenario`.

@@ -61,7 +61,9 @@ pub fn flag_error(e: Error) -> CliError {
     };
     let text = match &e {
         Error::SizeLimit { field, .. } => e.to_string().replacen(field, &flag(field), 1),
-        Error::NonFinite { field } | Error::NotPositive { field, .. } => {
+        Error::NonFinite { field }
+        | Error::NotPositive { field, .. }
+        | Error::OutOfRange { field, .. } => {
             e.to_string().replacen(field.as_str(), &flag(field), 1)
         }
         Error::Cancelled => return cancelled(),
