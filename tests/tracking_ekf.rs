@@ -344,7 +344,15 @@ fn ekf_bad_inputs_are_named_errors() {
     );
     // Delays that are not a number in 0 < delay ≤ 1 s (issue 12, item 7): the first bad link in
     // link order is named.
-    for v in [Real::NAN, Real::INFINITY, Real::NEG_INFINITY, 0.0, -5e-8, 1.5, 1e308] {
+    for v in [
+        Real::NAN,
+        Real::INFINITY,
+        Real::NEG_INFINITY,
+        0.0,
+        -5e-8,
+        1.5,
+        1e308,
+    ] {
         let mut z = good.clone();
         z[3] = Some(v);
         z[1] = Some(v);
@@ -362,7 +370,16 @@ fn ekf_bad_inputs_are_named_errors() {
     }
     // σ ≤ 0, NaN or infinite in Fixed noise (and one so small that 1/(cσ)² overflows).
     // And σ outside the documented 1e-15 ..= 1e-3 s (issue 12, item 7: 1e308 gave an exact fit).
-    for bad in [0.0, -1e-11, Real::NAN, Real::INFINITY, 1e-170, 1e-16, 2e-3, 1e308] {
+    for bad in [
+        0.0,
+        -1e-11,
+        Real::NAN,
+        Real::INFINITY,
+        1e-170,
+        1e-16,
+        2e-3,
+        1e308,
+    ] {
         let mut s = sig;
         s[2] = bad;
         let e = f
@@ -449,7 +466,9 @@ fn a_wide_prior_is_tracked() {
             .update(&model, &z, MeasurementNoise::Fixed(&sig), None)
             .unwrap();
         assert_eq!(s.links_used, n);
-        let expect = (nalgebra::Matrix2::identity() / var + m).try_inverse().unwrap();
+        let expect = (nalgebra::Matrix2::identity() / var + m)
+            .try_inverse()
+            .unwrap();
         let got = f.covariance.fixed_view::<2, 2>(0, 0).into_owned();
         for (a, b) in got.iter().zip(expect.iter()) {
             rel_close(&format!("P⁺_rr at prior {var}"), *a, *b, 1e-7);
@@ -461,7 +480,10 @@ fn a_wide_prior_is_tracked() {
     // Past the limit it is a named error on the input, not on an internal matrix.
     let p0 = Mat4::from_diagonal(&Vec4::new(0.1, 0.1, 0.01, 1e308));
     let e = Ekf::new(Vec4::new(r.x, r.y, 0.0, 0.0), p0).unwrap_err();
-    assert!(e.to_string().starts_with("initial_covariance[3][3]: 1e308"), "{e}");
+    assert!(
+        e.to_string().starts_with("initial_covariance[3][3]: 1e308"),
+        "{e}"
+    );
 }
 
 /// The two update forms (covariance form below `tr(M P_rr) = 10⁶`, information form above)

@@ -180,7 +180,7 @@ impl fmt::Display for Error {
             Error::NonFinite { field } => write!(f, "{field}: not a finite number"),
             Error::NotPositive { field, value } => {
                 write!(f, "{field}: must be > 0 (got {})", Num(*value))
-            },
+            }
             Error::OutOfRange {
                 field,
                 value,
@@ -193,7 +193,7 @@ impl fmt::Display for Error {
             Error::DuplicateName { name } => write!(f, "duplicate node name \"{}\"", Clip(name)),
             Error::UnknownNode { field, name } => {
                 write!(f, "{field}: unknown node \"{}\"", Clip(name))
-            },
+            }
             Error::DuplicateLink { tx, rx } => {
                 write!(
                     f,

@@ -48,6 +48,9 @@ pub fn mtl_view_cached(scene: &MtlScene, cache: &mut ViewCache) -> Result<MtlVie
         t_b: scene.t_b,
         region: Some(rect),
         consistency: model_view.consistency,
+        max_candidates: scene
+            .max_candidates
+            .unwrap_or(crate::mtl::algorithm::DEFAULT_MAX_CANDIDATES),
         ..MtlConfig::default()
     };
     let sc = &data.scene;

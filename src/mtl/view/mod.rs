@@ -117,6 +117,11 @@ pub struct MtlScene {
     pub t_b: Real,
     /// The blocking model.
     pub model: BlockingChoice,
+    /// The work budget of Algorithm 1, candidates (absent: the default
+    /// [`crate::mtl::algorithm::DEFAULT_MAX_CANDIDATES`], as the CLI): a scene past it is the
+    /// named [`Error::WorkLimit`] (`ranges`), not minutes of work.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_candidates: Option<usize>,
 }
 
 impl Default for MtlScene {
@@ -152,6 +157,7 @@ impl MtlScene {
             t_e: 3.0,
             t_b: 6.0,
             model: BlockingChoice::Ppp { exact: false },
+            max_candidates: None,
         }
     }
 

@@ -281,6 +281,56 @@ fn cache_is_transparent() {
     assert!(cache.len() < n + 2000 && !cache.is_empty());
 }
 
+/// Issue 12, item 2: the page's stuck scene (8 targets, clutter 10, cσ 2, `T_e` 6, `T_b` 30)
+/// ran for minutes. The view has the CLI's work budget: past it a named error, within it the
+/// same view as without a budget.
+#[test]
+fn the_view_has_the_work_budget() {
+    let mut s = MtlScene::vb();
+    let used = |v: &MtlView| -> usize {
+        v.stages
+            .iter()
+            .map(|c| c.kept + c.blocking + c.inconsistent + c.unlocatable + c.duplicate + c.capped)
+            .sum()
+    };
+    let free = mtl_view(&s).unwrap();
+    let n = used(&free);
+    assert!(n > 10, "{n}");
+    s.max_candidates = Some(n);
+    assert_eq!(mtl_view(&s).unwrap(), free);
+    s.max_candidates = Some(n / 4);
+    let e = mtl_view(&s).unwrap_err();
+    assert!(
+        matches!(&e, Error::WorkLimit { field, limit } if field == "ranges" && *limit == n / 4),
+        "{e:?}"
+    );
+    s.max_candidates = Some(0);
+    assert!(mtl_view(&s)
+        .unwrap_err()
+        .to_string()
+        .starts_with("max_candidates:"));
+    // The stuck scene, with a budget small enough for a debug test.
+    let mut stuck = MtlScene::vb();
+    stuck.targets = alloc::vec![
+        [2.0, 2.0],
+        [3.0, 6.0],
+        [5.0, 5.0],
+        [6.5, 2.5],
+        [7.5, 7.5],
+        [4.0, 8.5],
+        [8.5, 4.5],
+        [1.5, 4.0]
+    ];
+    stuck.discs.clear();
+    stuck.clutter_mean = 10.0;
+    stuck.range_sigma = 2.0;
+    stuck.t_e = 6.0;
+    stuck.t_b = 30.0;
+    stuck.max_candidates = Some(20_000);
+    let e = mtl_view(&stuck).unwrap_err();
+    assert!(matches!(e, Error::WorkLimit { .. }), "{e:?}");
+}
+
 #[test]
 #[ignore = "timing; run with --release --include-ignored --nocapture"]
 fn timing() {

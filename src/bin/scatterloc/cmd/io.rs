@@ -32,13 +32,15 @@ pub fn emit_json<T: Serialize>(v: &T) -> Result<(), CliError> {
 /// past the cap). A leading UTF-8 byte-order mark is dropped (editors on some systems write
 /// one; the page accepts it too).
 pub fn read_input(flag: &str, path: &str) -> Result<String, CliError> {
-    let cannot = |e: &dyn std::fmt::Display| {
-        CliError::usage(format!("--{flag}: cannot read '{path}': {e}"))
-    };
+    let cannot =
+        |e: &dyn std::fmt::Display| CliError::usage(format!("--{flag}: cannot read '{path}': {e}"));
     let mut bytes = Vec::new();
     let cap = limits::MAX_INPUT_BYTES;
     let res = if path == "-" {
-        std::io::stdin().lock().take(cap + 1).read_to_end(&mut bytes)
+        std::io::stdin()
+            .lock()
+            .take(cap + 1)
+            .read_to_end(&mut bytes)
     } else {
         std::fs::File::open(path).and_then(|f| f.take(cap + 1).read_to_end(&mut bytes))
     };
