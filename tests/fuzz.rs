@@ -47,167 +47,11 @@ use runner::{fuzz, Case, Known};
 
 // ------------------------------------------------------------------------------- known failures
 
-/// Failures of the current code, each an issue 12 item being fixed in `src/` (not here). They
-/// are counted, not failed (unless `SCATTERLOC_FUZZ_STRICT=1`); delete an entry once its fix is
-/// merged and the count printed for it is 0.
-const KNOWN: &[Known] = &[
-    // Item: error messages truncate long strings and numbers (a 1 MB string is echoed in full).
-    Known {
-        kind: "*",
-        class: Class::LongMessage,
-        any_of: &[],
-        needles: &[],
-        issue: TRUNCATE,
-    },
-    // Item: range checks of the EKF's inputs (a wide prior such as diag(1e12, 1e12, 0.01, 0.01)
-    // fails mid-run with "ekf.covariance: not a symmetric positive-definite matrix").
-    Known {
-        kind: "*",
-        class: Class::InternalError,
-        any_of: &[],
-        needles: &["\"ekf."],
-        issue: EKF_PRIOR,
-    },
-    // Item: positions |v| <= 1e7 m (scenario nodes, page drags and points).
-    Known {
-        kind: "scenario",
-        class: Class::NonFinite,
-        any_of: &[],
-        needles: &["position_m"],
-        issue: POSITIONS,
-    },
-    Known {
-        kind: "page_edits",
-        class: Class::NonFinite,
-        any_of: &[],
-        needles: &["after AddRx"],
-        issue: POSITIONS,
-    },
-    Known {
-        kind: "page_edits",
-        class: Class::NonFinite,
-        any_of: &[],
-        needles: &["after AddTx"],
-        issue: POSITIONS,
-    },
-    Known {
-        kind: "page_edits",
-        class: Class::NonFinite,
-        any_of: &[],
-        needles: &["after MoveRx"],
-        issue: POSITIONS,
-    },
-    Known {
-        kind: "page_edits",
-        class: Class::NonFinite,
-        any_of: &[],
-        needles: &["after MoveTx"],
-        issue: POSITIONS,
-    },
-    Known {
-        kind: "page_edits",
-        class: Class::NonFinite,
-        any_of: &[],
-        needles: &["after SimulateFix"],
-        issue: POSITIONS,
-    },
-    Known {
-        kind: "page_edits",
-        class: Class::NonFinite,
-        any_of: &[],
-        needles: &["after CrlbAt"],
-        issue: POSITIONS,
-    },
-    Known {
-        kind: "scenario",
-        class: Class::NonFinite,
-        any_of: LINK_BUDGET_NEEDLES,
-        needles: &[],
-        issue: LINK_BUDGET,
-    },
-    Known {
-        kind: "page_edits",
-        class: Class::NonFinite,
-        any_of: LINK_BUDGET_NEEDLES,
-        needles: &[],
-        issue: LINK_BUDGET,
-    },
-    // Item: a candidate budget in multi-target localization (9 TRPs × 50 ranges runs for
-    // minutes and takes GBs).
-    Known {
-        kind: "cli_mtl",
-        class: Class::OverTime,
-        any_of: &["GrowSiblings"],
-        needles: &[],
-        issue: MTL_BUDGET,
-    },
-    Known {
-        kind: "network_ranges",
-        class: Class::OverTime,
-        any_of: &["GrowSiblings"],
-        needles: &[],
-        issue: MTL_BUDGET,
-    },
-    Known {
-        kind: "cli_mtl",
-        class: Class::OverMemory,
-        any_of: &["GrowSiblings"],
-        needles: &[],
-        issue: MTL_BUDGET,
-    },
-    // The page's multi-target view: a huge ellipse gate T_e (u64::MAX) runs for minutes (the
-    // same missing candidate budget, on the page).
-    Known {
-        kind: "mtl_scene",
-        class: Class::OverTime,
-        any_of: &["t_e", "t_b", "Grow"],
-        needles: &[],
-        issue: MTL_BUDGET,
-    },
-    // Item: range checks of the area (±1e308 accepted by crlb/locate).
-    Known {
-        kind: "scenario",
-        class: Class::NonFinite,
-        any_of: &[],
-        needles: &["area_m"],
-        issue: AREA,
-    },
-    Known {
-        kind: "page_edits",
-        class: Class::NonFinite,
-        any_of: &[],
-        needles: &["after Area"],
-        issue: AREA,
-    },
-];
-
-const TRUNCATE: &str = "error messages echo long strings/numbers in full (truncation)";
-const EKF_PRIOR: &str = "wide prior/covariance: 'ekf.covariance: not SPD' mid-run";
-const POSITIONS: &str = "positions beyond 1e7 m accepted (NaN/inf outputs)";
-const AREA: &str = "area ±1e308 accepted (NaN/inf outputs)";
-const MTL_BUDGET: &str = "mtl locate: no candidate budget (many ranges on every TRP: minutes, GBs)";
-const LINK_BUDGET: &str = "link-budget values out of range accepted (NaN/inf outputs)";
-
-/// The link-budget fields of a scenario and the page's setters of them.
-const LINK_BUDGET_NEEDLES: &[&str] = &[
-    "power_dbm",
-    "gain_dbi",
-    "rcs_m2",
-    "carrier_hz",
-    "bandwidth_hz",
-    "noise_figure_db",
-    "noise_power_dbm",
-    "processing_gain_db",
-    "floor_db",
-    "after TxPower",
-    "after TxGain",
-    "after RxGain",
-    "after Rcs",
-    "after Carrier",
-    "after Bandwidth",
-    "after NoiseFigure",
-    "after TxPattern",
-];
+/// Failures the current code is known to have, each naming its issue: counted and printed, not
+/// failed (unless `SCATTERLOC_FUZZ_STRICT=1`). Empty: every failure the fuzzer found for
+/// issue 12 (long messages, wide priors, positions and link-budget values out of range, areas
+/// of ±1e308, the unbounded multi-target work) is fixed, so any failure now fails the test.
+const KNOWN: &[Known] = &[];
 
 // ------------------------------------------------------------------------------- helpers
 
@@ -429,8 +273,10 @@ fn page_op() -> impl Strategy<Value = PageOp> {
 }
 
 /// The page's `point()` check: non-finite coordinates are refused (named) before the core.
+/// The page's points pass `wasm::point` first: both coordinates within ±1e7 m.
 fn page_point(p: [f64; 2]) -> Option<Vec2> {
-    (p[0].is_finite() && p[1].is_finite()).then(|| Vec2::new(p[0], p[1]))
+    let ok = |v: f64| scatterloc::error::limits::COORDINATE_M.contains(v);
+    (ok(p[0]) && ok(p[1])).then(|| Vec2::new(p[0], p[1]))
 }
 
 /// Runs the page's calls in order on a session of the preset; after every accepted edit the

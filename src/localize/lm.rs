@@ -7,7 +7,7 @@
 //! Internally the problem is solved in range units (`cτ`, `c²R`, `cJ`), which the spec states is
 //! identical to the delay domain and keeps the normal equations well scaled.
 
-use crate::error::{Error, Result};
+use crate::error::{limits, Error, Result};
 use crate::math::{Mat2, Real, Vec2};
 use crate::measure::Network;
 use crate::scenario::Area;
@@ -147,6 +147,10 @@ pub fn locate(
     area: &Area,
 ) -> Result<LmReport> {
     let problem = Problem::new(net, m)?;
+    if let Some(p) = initial {
+        limits::COORDINATE_M.check("initial_m", p.x)?;
+        limits::COORDINATE_M.check("initial_m", p.y)?;
+    }
     let from_grid = |problem: &Problem| -> Result<LmReport> {
         area.validate()?;
         if !(config.grid_step_m.is_finite() && config.grid_step_m > 0.0) {

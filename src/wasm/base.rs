@@ -7,7 +7,7 @@ use alloc::vec::Vec;
 
 use wasm_bindgen::prelude::*;
 
-use crate::error::{check_finite, Error};
+use crate::error::{limits, Error};
 use crate::{scenario::presets, Vec2};
 
 /// Module start: route Rust panics to `console.error` with their message.
@@ -38,7 +38,7 @@ pub(super) fn err(e: Error) -> JsError {
 
 /// A point from JavaScript numbers, which must be finite (named `x`, `y`).
 pub(super) fn point(x: f64, y: f64) -> Result<Vec2, JsError> {
-    check_finite("x", x).map_err(err)?;
-    check_finite("y", y).map_err(err)?;
+    limits::COORDINATE_M.check("x", x).map_err(err)?;
+    limits::COORDINATE_M.check("y", y).map_err(err)?;
     Ok(Vec2::new(x, y))
 }

@@ -115,10 +115,11 @@ pub struct MtlConfig {
     pub max_candidates: usize,
 }
 
-/// The default work budget of one run of Algorithm 1, candidates: about 4 s and 50 MB on the
-/// reference machine (3.6 µs per candidate measured; docs/cli.md, "Limits"). The paper's
-/// experiments need at most 23 577 (V-B/V-C, 300 realisations) and 6 266 (V-A): a margin of 40.
-pub const DEFAULT_MAX_CANDIDATES: usize = 1_000_000;
+/// The default work budget of one run of Algorithm 1, candidates: about 1 s and 25 MB on the
+/// reference machine (3.6 µs per candidate measured; docs/cli.md, "Limits"), so a page edit or
+/// a study realisation past it fails fast. The paper's experiments need at most 23 577 (V-B/V-C,
+/// 300 realisations) and 6 266 (V-A): a margin of 10.
+pub const DEFAULT_MAX_CANDIDATES: usize = 250_000;
 
 /// The largest work budget a caller may set, candidates.
 pub const MAX_CANDIDATES: usize = 100_000_000;

@@ -68,8 +68,8 @@ pub struct MtlLocateArgs {
     /// Largest number of candidates per family B_max, >= 1 or inf [default: 16].
     #[arg(long, value_name = "N|inf", value_parser = count_or_inf)]
     pub b_max: Option<usize>,
-    /// Work budget: the most candidates Algorithm 1 may evaluate, 1 ..= 100000000 (about 2 us
-    /// and 200 bytes each) [default: 1000000].
+    /// Work budget: the most candidates Algorithm 1 may evaluate, 1 ..= 100000000 (about 4 us
+    /// and at most 100 bytes each) [default: 250000].
     #[arg(long, value_name = "N", value_parser = whole)]
     pub max_candidates: Option<usize>,
     /// Smallest matching size n_min of a target (TRPs that see it) [default: 3].
@@ -153,6 +153,10 @@ pub struct RocArgs {
     /// Use the exact PPP blocking probability (M11) (vb, vc).
     #[arg(long)]
     pub exact: bool,
+    /// Work budget of Algorithm 1 per run, candidates, 1 ..= 100000000 (see `mtl locate`)
+    /// [default: 250000].
+    #[arg(long, value_name = "N", value_parser = whole)]
+    pub max_candidates: Option<usize>,
     /// Figure: .svg or .png.
     #[arg(long, value_name = "FIG.{svg,png}")]
     pub out: Option<String>,

@@ -3,6 +3,7 @@
 //! hand-written parser this replaced.
 
 use clap::ValueEnum;
+use scatterloc::error::limits;
 
 /// A finite number (`--dt 0.1`, `--x-min -5`).
 pub fn finite(v: &str) -> Result<f64, String> {
@@ -25,13 +26,18 @@ pub fn seed(v: &str) -> Result<u64, String> {
     whole(v).map(|s| s as u64)
 }
 
-/// `X,Y`: two finite numbers in metres.
+/// `X,Y`: two numbers in metres, each within [`limits::COORDINATE_M`].
 pub fn xy(v: &str) -> Result<[f64; 2], String> {
-    let bad = || format!("expected X,Y (two numbers in metres), got '{v}'");
+    let bad = || {
+        format!(
+            "expected X,Y (two numbers in metres, each {}), got '{v}'",
+            limits::COORDINATE_M.allowed
+        )
+    };
     let (x, y) = v.split_once(',').ok_or_else(bad)?;
     let x: f64 = x.trim().parse().map_err(|_| bad())?;
     let y: f64 = y.trim().parse().map_err(|_| bad())?;
-    if x.is_finite() && y.is_finite() {
+    if limits::COORDINATE_M.contains(x) && limits::COORDINATE_M.contains(y) {
         Ok([x, y])
     } else {
         Err(bad())

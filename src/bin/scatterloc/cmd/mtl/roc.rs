@@ -342,6 +342,9 @@ pub fn mtl_roc(args: &RocArgs) -> Result<(), CliError> {
         }
     }
     cfg.ppp_exact = args.exact;
+    if let Some(n) = args.max_candidates {
+        cfg.mtl.max_candidates = n;
+    }
     if args.empirical {
         cfg.empirical = Some(EmpiricalTraining::default());
     }
