@@ -392,7 +392,7 @@ fn gating_commands_name_their_bad_input() {
             "--dt",
             "0",
         ],
-        &["--dt", "must be > 0"],
+        &["--dt", "0 is out of range (1e-6 to 3600 s)"],
     );
     fails(
         &[

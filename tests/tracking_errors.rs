@@ -20,33 +20,33 @@ use scatterloc::Error;
 
 #[test]
 fn motion_and_study_bad_inputs_are_named_errors() {
-    assert_eq!(
-        ConstantVelocity::validated(0.0, 0.01).unwrap_err(),
-        Error::NotPositive {
-            field: "dt_s".into(),
-            value: 0.0
-        }
-    );
-    assert_eq!(
-        ConstantVelocity::validated(-0.1, 0.01).unwrap_err(),
-        Error::NotPositive {
-            field: "dt_s".into(),
-            value: -0.1
-        }
-    );
+    // Δt in 1e-6 ..= 3600 s and q in (0, 1e6] (docs/cli.md, "Limits"; issue 12 item 8: 1e308
+    // reached the filter and failed as "ekf.covariance").
+    let out = |field: &str, value: Real, allowed: &'static str| Error::OutOfRange {
+        field: field.into(),
+        value,
+        allowed,
+    };
+    for dt in [0.0, -0.1, 1e-7, 3601.0, 1e308] {
+        assert_eq!(
+            ConstantVelocity::validated(dt, 0.01).unwrap_err(),
+            out("dt_s", dt, "1e-6 to 3600 s")
+        );
+    }
     assert_eq!(
         ConstantVelocity::validated(Real::NAN, 0.01).unwrap_err(),
         Error::NonFinite {
             field: "dt_s".into()
         }
     );
-    assert_eq!(
-        ConstantVelocity::validated(0.1, 0.0).unwrap_err(),
-        Error::NotPositive {
-            field: "process_noise".into(),
-            value: 0.0
-        }
-    );
+    for q in [0.0, -1.0, 1.1e6, 1e308] {
+        assert_eq!(
+            ConstantVelocity::validated(0.1, q).unwrap_err(),
+            out("process_noise", q, "0 < q <= 1e6 m²/s³")
+        );
+    }
+    assert!(ConstantVelocity::validated(1e-6, 1e6).is_ok());
+    assert!(ConstantVelocity::validated(3600.0, 1e-300).is_ok());
     assert!(ConstantVelocity::validated(0.1, 0.01).is_ok());
 
     let ok = study(TrackScenario::I, FAST_STEP_S, 10, 2);
@@ -103,20 +103,14 @@ fn motion_and_study_bad_inputs_are_named_errors() {
                 motion: ConstantVelocity::new(0.0, PAPER_INTENSITY),
                 ..ok
             },
-            Error::NotPositive {
-                field: "dt_s".into(),
-                value: 0.0,
-            },
+            out("dt_s", 0.0, "1e-6 to 3600 s"),
         ),
         (
             MonteCarloConfig {
                 motion: ConstantVelocity::new(0.1, -1.0),
                 ..ok
             },
-            Error::NotPositive {
-                field: "process_noise".into(),
-                value: -1.0,
-            },
+            out("process_noise", -1.0, "0 < q <= 1e6 m²/s³"),
         ),
         (
             MonteCarloConfig {
