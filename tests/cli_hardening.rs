@@ -282,6 +282,13 @@ fn wide_priors_track_and_absurd_filter_settings_are_named() {
         &["track", "--scenario", &s, "--measurements", &m],
         &["initial_covariance[3][3]", "1e308"],
     );
+    let mut far = plain_walk(wide.clone(), 0.1, 0.1);
+    far["initial_state"][0] = json!(1e308);
+    let m = dir.write("m.json", &far);
+    fails(
+        &["track", "--scenario", &s, "--measurements", &m],
+        &["initial_state[0]", "1e308", "out of range"],
+    );
     let out = dir.path("walk");
     fails(
         &[

@@ -123,6 +123,12 @@ fn track_rejects_bad_input_naming_the_field() {
     let mut m = good.clone();
     m["steps"][3] = json!([1e-7, 1e-7]);
     cases.push((m.to_string(), "steps[3]"));
+    // A delay that is not a propagation delay is named by step and link (issue 12, item 7).
+    for bad in [json!(-4.5e-8), json!(0.0), json!(1e308)] {
+        let mut m = good.clone();
+        m["steps"][2][1] = bad;
+        cases.push((m.to_string(), "steps[2][1]: "));
+    }
     let mut m = good.clone();
     m.as_object_mut().unwrap().remove("steps");
     cases.push((m.to_string(), "steps"));

@@ -177,3 +177,10 @@ pub const PROCESS_NOISE: Range = Range {
 /// 1000 km/s, a prior that knows nothing on any ground network). Wider priors would overflow
 /// the first prediction's products with the links' information.
 pub const MAX_INITIAL_VARIANCE: f64 = 1e12;
+
+/// A velocity component of a tracker state: ±10⁶ m/s (1000 km/s, beyond any vehicle).
+pub const VELOCITY_M_S: Range = Range {
+    min: -1e6,
+    max: 1e6,
+    allowed: "-1e6 to 1e6 m/s",
+};

@@ -163,13 +163,25 @@ pub fn check_covariance(field: &str, p: &Mat4) -> Result<()> {
 }
 
 impl Ekf {
-    /// A filter at `state` with covariance `covariance` (validated: finite, symmetric PD, no
-    /// variance above [`limits::MAX_INITIAL_VARIANCE`]).
+    /// A filter at `state` with covariance `covariance` (validated: position within
+    /// [`limits::COORDINATE_M`], velocity within [`limits::VELOCITY_M_S`], covariance finite,
+    /// symmetric PD, no variance above [`limits::MAX_INITIAL_VARIANCE`]).
     pub fn new(state: Vec4, covariance: Mat4) -> Result<Ekf> {
         if state.iter().any(|v| !v.is_finite()) {
             return Err(Error::NonFinite {
                 field: "initial_state".into(),
             });
+        }
+        for (i, range) in [
+            limits::COORDINATE_M,
+            limits::COORDINATE_M,
+            limits::VELOCITY_M_S,
+            limits::VELOCITY_M_S,
+        ]
+        .iter()
+        .enumerate()
+        {
+            range.check(&alloc::format!("initial_state[{i}]"), state[i])?;
         }
         check_covariance("initial_covariance", &covariance)?;
         for i in 0..4 {

@@ -22,6 +22,20 @@ pub fn mtl_default_scene() -> String {
     MtlScene::vb().to_json()
 }
 
+/// The core's ranges of the scene's numbers the page range-checks before the core does
+/// ([`crate::error::limits`]): `{"range_sigma": [min, max], "clutter_mean": [0, max]}`, so the
+/// page's fields and the core share one definition.
+#[wasm_bindgen]
+pub fn mtl_field_ranges() -> String {
+    let cs = crate::error::limits::C_SIGMA_M;
+    alloc::format!(
+        "{{\"range_sigma\":[{:e},{:e}],\"clutter_mean\":[0,{:e}]}}",
+        cs.min,
+        cs.max,
+        crate::mtl::view::MAX_VIEW_CLUTTER
+    )
+}
+
 /// Parses and validates a scene; returns it re-serialised (canonical JSON). Throws the named
 /// error of [`MtlScene::from_json`].
 #[wasm_bindgen]

@@ -82,7 +82,8 @@ fn nearest(det: &[[f64; 2]], t: [f64; 2]) -> f64 {
 /// Item 1: a slow multi-target scene (8 targets, clutter 10, cσ 2 m, T_e 6, T_b 30 nats) is
 /// replaced by a later cheap edit (Reset, a real click): the worker busy with the stale scene is
 /// terminated and a fresh one shows the later edit's view within seconds, with no reload; while
-/// busy, the status says so and the last view stays drawn.
+/// busy, the status says so and the last view stays drawn. The work budget of Algorithm 1 holds
+/// in the page too: past it, a banner naming the budget, and the last view stays.
 #[test]
 #[ignore = "needs chromium + chromedriver and www/pkg (wasm-pack build); run with --ignored"]
 fn mtl_stale_recompute_is_replaced_by_a_later_edit() {
@@ -104,6 +105,9 @@ fn mtl_stale_recompute_is_replaced_by_a_later_edit() {
         slow["range_sigma"] = json!(2.0);
         slow["t_e"] = json!(6.0);
         slow["t_b"] = json!(30.0);
+        // Past the default work budget (it would stop with a banner after about a second):
+        // a budget of 10⁸ keeps the worker busy on the stale scene for minutes.
+        slow["max_candidates"] = json!(100_000_000);
         let rejected = js(&c, &format!("return window.mtl.setScene({slow})")).await?;
         if !rejected.is_null() {
             return Err(format!("slow scene rejected: {rejected}"));
@@ -140,6 +144,17 @@ fn mtl_stale_recompute_is_replaced_by_a_later_edit() {
             .map_err(|e| e.to_string())?;
         let after = wait_view(&c, 20).await?;
         let recover = t_edit.elapsed();
+        // The work budget applies in the page: the same scene with a small budget is a banner
+        // naming the budget, and the last view stays.
+        slow["max_candidates"] = json!(5000);
+        js(&c, &format!("return window.mtl.setScene({slow})")).await?;
+        let budget = wait_banner(&c).await?;
+        let kept = state(&c).await?;
+        let budget_ok =
+            budget.contains("more than 5000 candidates") && kept["detected"] == after["detected"];
+        if !budget_ok {
+            return Err(format!("budget banner {budget:?}, state {kept}"));
+        }
         Ok((
             first,
             busy,

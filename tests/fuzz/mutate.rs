@@ -6,8 +6,9 @@
 //! cannot hold — `-0` as an integer, `1e400`, 10⁵-digit integers, `NaN`, lone surrogates, very
 //! deep nesting — are spliced into the serialised text as raw tokens.
 //!
-//! Every size is bounded (arrays to [`MAX_GROW`] elements, strings to [`LONG_STRING`] bytes,
-//! nesting to 300 levels) so one case stays cheap.
+//! Every size is bounded (arrays to [`MAX_GROW`] elements, the whole document to
+//! [`MAX_DOC_NODES`] nodes, strings to [`LONG_STRING`] bytes, nesting to 300 levels) so one case
+//! stays cheap.
 
 use proptest::prelude::*;
 use proptest::sample::Index;
@@ -18,6 +19,10 @@ use serde_json::{Map, Value};
 pub const LONG_STRING: usize = 1 << 20;
 /// Most elements an array may grow to (a few hundred for most, one long case per list).
 pub const MAX_GROW: usize = 20_000;
+/// Most nodes a mutated document may have (about 10 MB of JSON): a mutation that would take it
+/// past this is skipped. Growth compounds (a list of lists grown, then every inner list grown),
+/// and an unbounded case once asked for 4.3 GB in the test process itself.
+pub const MAX_DOC_NODES: usize = 400_000;
 
 /// Numbers at and beyond the edges: zeros, subnormals, the largest finite values, huge
 /// integers, negative counts, and a few plain ones so that a "small" change also occurs.
@@ -384,14 +389,35 @@ pub fn apply(base: &Value, muts: &[Mutation]) -> Mutated {
         let mut all = vec![];
         paths(&doc, &mut vec![], &mut all);
         let path = all[m.target.index(all.len())].clone();
-        what.push(format!("{}: {}", show(&path), op_name(&m.op)));
+        let before = doc.clone();
+        let raws = ctx.raws.len();
         apply_one(&mut doc, &path, &m.op, &mut ctx);
+        if nodes(&doc) > MAX_DOC_NODES {
+            doc = before;
+            ctx.raws.truncate(raws);
+            what.push(format!(
+                "{}: {} (skipped: too large)",
+                show(&path),
+                op_name(&m.op)
+            ));
+        } else {
+            what.push(format!("{}: {}", show(&path), op_name(&m.op)));
+        }
     }
     let mut text = serde_json::to_string(&doc).expect("serialise");
     for (i, &r) in ctx.raws.iter().enumerate() {
         text = text.replacen(&format!("\"{}\"", marker(i)), &raw_tokens()[r], 1);
     }
     Mutated { text, what }
+}
+
+/// The number of nodes of `v` (itself, and every element and value below it).
+fn nodes(v: &Value) -> usize {
+    1 + match v {
+        Value::Array(a) => a.iter().map(nodes).sum(),
+        Value::Object(m) => m.values().map(nodes).sum(),
+        _ => 0,
+    }
 }
 
 fn show(path: &[Seg]) -> String {

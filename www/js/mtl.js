@@ -17,7 +17,8 @@ const MARGIN_M = 0.4; // shown around the region, m
 const SPOTS = [[5, 5], [5, 7], [3, 6], [7, 3], [6, 8.5], [8, 6], [3, 2], [1.5, 7], [8.5, 1], [4.5, 2.5]];
 /**
  * The scene's numeric inputs: [input id, scene key, on-screen name, allowed range]. The page's
- * documented ranges (README, "The page"); the core checks the scene again.
+ * documented ranges (README, "The page"; cσ and clutter from the core, mtl_field_ranges); the core
+ * checks the scene again.
  */
 const FIELDS = [
   ['mtl-seed', 'seed', 'seed', { min: 0, max: Number.MAX_SAFE_INTEGER, integer: true }],
@@ -47,6 +48,10 @@ export class Mtl {
   constructor(ctx) {
     this.ctx = ctx;
     this.wasm = ctx.wasm;
+    // The ranges the core also checks come from the core (one definition).
+    for (const [key, [min, max]] of Object.entries(JSON.parse(this.wasm.mtl_field_ranges()))) {
+      Object.assign(FIELDS.find((f) => f[1] === key)[3], { min, max });
+    }
     this.canvas = $('plot');
     this.view = new View(this.canvas);
     this.scene = JSON.parse(this.wasm.mtl_default_scene());

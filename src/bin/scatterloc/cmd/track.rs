@@ -253,14 +253,8 @@ fn names(choices: &[Choice]) -> Vec<&'static str> {
 /// A core error of step `field` as the CLI reports it.
 fn step_error(field: &str, e: Error, bad: &dyn Fn(&dyn std::fmt::Display) -> CliError) -> CliError {
     match e {
-        Error::InvalidDelay { link, value } => bad(&format!(
-            "{field}[{link}]: {}",
-            Error::InvalidDelay { link, value }
-                .to_string()
-                .split_once(": ")
-                .map_or("", |(_, why)| why)
-                .to_owned()
-        )),
+        // `delays_s[p]: …` of the core becomes `steps[k][p]: …`.
+        Error::InvalidDelay { .. } => bad(&e.to_string().replacen("delays_s", field, 1)),
         other => bad(&format!("{field}: {other}")),
     }
 }
