@@ -353,17 +353,19 @@ pub fn run_limited(program: &str, args: &[String], envs: &[(&str, &str)]) -> Cli
         .stderr(Stdio::piped())
         .spawn()
         .expect("spawn prlimit scatterloc");
-    let reader = |mut r: Box<dyn Read + Send>| {
+    let reader = |mut r: Box<dyn Read + Send>, cap: u64| {
         thread::spawn(move || {
             let mut buf = Vec::new();
-            // Keep at most 4 MB (an echoed 1 MB input fits); drain the rest.
-            let _ = r.by_ref().take(4 << 20).read_to_end(&mut buf);
+            // Keep at most `cap` bytes; drain the rest.
+            let _ = r.by_ref().take(cap).read_to_end(&mut buf);
             let _ = std::io::copy(&mut r, &mut std::io::sink());
             String::from_utf8_lossy(&buf).into_owned()
         })
     };
-    let out = reader(Box::new(child.stdout.take().expect("stdout")));
-    let err = reader(Box::new(child.stderr.take().expect("stderr")));
+    // stdout: a legitimate result can be tens of MB (20 000 track steps with covariances);
+    // stderr: 4 MB (an echoed 1 MB input fits).
+    let out = reader(Box::new(child.stdout.take().expect("stdout")), 256 << 20);
+    let err = reader(Box::new(child.stderr.take().expect("stderr")), 4 << 20);
     let t0 = Instant::now();
     let limit = cli_time_limit();
     let mut nap = Duration::from_micros(200);

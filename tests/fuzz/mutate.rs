@@ -19,10 +19,10 @@ use serde_json::{Map, Value};
 pub const LONG_STRING: usize = 1 << 20;
 /// Most elements an array may grow to (a few hundred for most, one long case per list).
 pub const MAX_GROW: usize = 20_000;
-/// Most nodes a mutated document may have (about 10 MB of JSON): a mutation that would take it
+/// Most nodes a mutated document may have (about 5 MB of JSON): a mutation that would take it
 /// past this is skipped. Growth compounds (a list of lists grown, then every inner list grown),
 /// and an unbounded case once asked for 4.3 GB in the test process itself.
-pub const MAX_DOC_NODES: usize = 400_000;
+pub const MAX_DOC_NODES: usize = 200_000;
 
 /// Numbers at and beyond the edges: zeros, subnormals, the largest finite values, huge
 /// integers, negative counts, and a few plain ones so that a "small" change also occurs.
