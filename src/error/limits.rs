@@ -184,3 +184,12 @@ pub const VELOCITY_M_S: Range = Range {
     max: 1e6,
     allowed: "-1e6 to 1e6 m/s",
 };
+
+/// A bistatic range (path length) of multi-target localization, and the clutter's `r_max`:
+/// `0 … 10⁸ m`. Nodes and targets within [`COORDINATE_M`] give paths below 5.7·10⁷ m; far larger
+/// ranges gave ellipses with infinite axes.
+pub const RANGE_M: Range = Range {
+    min: 0.0,
+    max: 1e8,
+    allowed: "0 to 1e8 m",
+};

@@ -2,7 +2,7 @@
 
 use alloc::vec::Vec;
 
-use crate::error::{check_len, check_non_negative, limits, Error, Result};
+use crate::error::{check_finite, check_len, check_non_negative, limits, Error, Result};
 use crate::math::Real;
 use crate::mtl::algorithm::{Measurements, MtlConfig, MAX_CANDIDATES};
 use crate::mtl::blocking::BlockingModel;
@@ -59,10 +59,16 @@ pub fn validate<B: BlockingModel + ?Sized>(
         }
     }
     for (m, rs) in input.ranges.iter().enumerate() {
-        if let Some(i) = rs.iter().position(|r| !r.is_finite()) {
-            return Err(Error::NonFinite {
-                field: format!("ranges[{m}][{i}]"),
-            });
+        // Measured ranges with noise may dip below 0 (cσ up to 1 km); only their size is bounded.
+        for (i, &r) in rs.iter().enumerate() {
+            check_finite(&format!("ranges[{m}][{i}]"), r)?;
+            if r.abs() > limits::RANGE_M.max {
+                return Err(Error::OutOfRange {
+                    field: format!("ranges[{m}][{i}]"),
+                    value: r,
+                    allowed: "|range| <= 1e8 m",
+                });
+            }
         }
     }
     check_non_negative("t_e", cfg.t_e, false, "a threshold ≥ 0")?;

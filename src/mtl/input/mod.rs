@@ -251,18 +251,7 @@ impl RangesInput {
                 });
             }
             for (i, &r) in rs.iter().enumerate() {
-                if !r.is_finite() {
-                    return Err(Error::NonFinite {
-                        field: format!("ranges_m[{t}][{i}]"),
-                    });
-                }
-                if r < 0.0 {
-                    return Err(Error::OutOfRange {
-                        field: format!("ranges_m[{t}][{i}]"),
-                        value: r,
-                        allowed: "a range ≥ 0 m",
-                    });
-                }
+                limits::RANGE_M.check(&format!("ranges_m[{t}][{i}]"), r)?;
             }
         }
         Ok(())

@@ -247,6 +247,7 @@ impl MtlScene {
         }
         if let Some(r) = self.r_max {
             check_positive("r_max", r)?;
+            limits::RANGE_M.check("r_max", r)?;
         }
         check_positive("detection_radius", self.detection_radius)?;
         check_non_negative("t_e", self.t_e, false, "a value ≥ 0")?;

@@ -191,6 +191,9 @@ fn errors_are_named() {
     assert!(m.starts_with("t_b:"), "{m}");
     let m = e(&|s| s.range_sigma = 0.0);
     assert!(m.starts_with("range_sigma:"), "{m}");
+    // Fuzz (issue 12): r_max 3e301 gave ellipses with infinite axes.
+    let m = e(&|s| s.r_max = Some(3e301));
+    assert!(m.starts_with("r_max: 3e301 is out of range"), "{m}");
     let m = e(&|s| s.p_d = 1.5);
     assert!(m.starts_with("p_d:"), "{m}");
     let m = e(&|s| s.clutter_mean = 50.0);
