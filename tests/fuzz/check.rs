@@ -121,7 +121,7 @@ pub fn hard_limit() -> Duration {
     Duration::from_secs_f64(env_f64("SCATTERLOC_FUZZ_HARD_S").unwrap_or(120.0))
 }
 
-/// A CLI case is killed after this long (`SCATTERLOC_FUZZ_CLI_S`; default 5 s optimised, 20 s
+/// A CLI case is killed after this long (`SCATTERLOC_FUZZ_CLI_S`; default 15 s optimised, 60 s
 /// debug).
 pub fn cli_time_limit() -> Duration {
     // A case stopped by the multi-target work budget (250 000 candidates) takes up to about
