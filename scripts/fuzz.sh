@@ -14,7 +14,7 @@
 #                empirical_table calibration ekf cli_delays cli_measurements cli_raw_steps
 #                cli_calibration_file cli_snapshots cli_mtl (test names without `fuzz_`)
 #
-# Budgets: an in-process case over 2 s fails (SCATTERLOC_FUZZ_BUDGET_S), one over 120 s stops
+# Budgets: an in-process case over 5 s fails (SCATTERLOC_FUZZ_BUDGET_S), one over 120 s stops
 # the run (SCATTERLOC_FUZZ_HARD_S); a CLI case is killed after 15 s (SCATTERLOC_FUZZ_CLI_S) and
 # runs under `prlimit --as` of 2048 MB (SCATTERLOC_FUZZ_CLI_MB); the test process itself runs
 # under `prlimit --as` of FUZZ_MEM_MB (default 8192) MB.

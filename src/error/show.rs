@@ -19,8 +19,9 @@ impl fmt::Display for Num {
     }
 }
 
-/// Shows a string, clipped to its first [`Clip::HEAD`] and last [`Clip::TAIL`] characters with
-/// the number left out in between when it is longer than [`Clip::MAX`] characters.
+/// Shows a string on one line: control characters escaped, and clipped to its first
+/// [`Clip::HEAD`] and last [`Clip::TAIL`] characters with the number left out in between when it
+/// is longer than [`Clip::MAX`] characters.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Clip<'a>(pub &'a str);
 
@@ -38,7 +39,7 @@ impl fmt::Display for Clip<'_> {
         let s = self.0;
         let n = s.chars().count();
         if n <= Self::MAX {
-            return f.write_str(s);
+            return write_escaped(f, s);
         }
         let head_end = s.char_indices().nth(Self::HEAD).map_or(s.len(), |(i, _)| i);
         let tail_start = s
@@ -46,13 +47,22 @@ impl fmt::Display for Clip<'_> {
             .nth(n - Self::TAIL)
             .map_or(s.len(), |(i, _)| i);
         let left_out = n - Self::HEAD - Self::TAIL;
-        write!(
-            f,
-            "{}…[{left_out} characters left out]…{}",
-            &s[..head_end],
-            &s[tail_start..]
-        )
+        write_escaped(f, &s[..head_end])?;
+        write!(f, "…[{left_out} characters left out]…")?;
+        write_escaped(f, &s[tail_start..])
     }
+}
+
+/// `s` with control characters escaped (`\n`, `\u{7}`), so a message stays one line.
+fn write_escaped(f: &mut fmt::Formatter<'_>, s: &str) -> fmt::Result {
+    for c in s.chars() {
+        if c.is_control() {
+            write!(f, "{}", c.escape_default())?;
+        } else {
+            fmt::Write::write_char(f, c)?;
+        }
+    }
+    Ok(())
 }
 
 #[cfg(test)]
@@ -84,5 +94,13 @@ mod tests {
         assert!(shown.ends_with(" at line 1 column 9"));
         let left_out = 1_000_019 - Clip::HEAD - Clip::TAIL;
         assert!(shown.contains(&alloc::format!("[{left_out} characters left out]")));
+    }
+
+    /// Fuzz (issue 12): a model kind of "\n" made a two-line error message.
+    #[test]
+    fn control_characters_are_escaped() {
+        assert_eq!(Clip("a\nb\r\u{7}").to_string(), "a\\nb\\r\\u{7}");
+        let long = "\n".repeat(1000);
+        assert!(!Clip(&long).to_string().contains('\n'));
     }
 }
