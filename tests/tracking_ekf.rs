@@ -11,7 +11,7 @@ use nalgebra::{DMatrix, DVector};
 use common::rel_close;
 use common::sensors_model as model;
 use common::tracking::{covariance_close, fast_motion};
-use scatterloc::math::{Mat4, Real, Vec2, Vec4};
+use scatterloc::math::{Mat4, Real, Vec2, Vec4, SPEED_OF_LIGHT};
 use scatterloc::track::ConstantVelocity;
 use scatterloc::track::{paper_initial_covariance, TrackScenario, TruthSampler};
 use scatterloc::track::{Ekf, MeasurementNoise, UpdateSummary};
@@ -438,6 +438,19 @@ fn nees_is_the_quadratic_form() {
     rel_close("NEES diagonal", d.nees(&x).unwrap(), closed, 1e-15);
 }
 
+/// The links' position information at `r` with the same σ on every link, written out here from
+/// the geometry: `M = Σ_p g_p g_pᵀ/(cσ)²`, `g_p` the sum of the unit vectors from Tx and Rx (E3).
+fn link_information(model: &Model, r: Vec2, sigma: Real) -> nalgebra::Matrix2<Real> {
+    let w = 1.0 / (SPEED_OF_LIGHT * sigma).powi(2);
+    (0..model.link_count())
+        .map(|p| {
+            let (tx, rx) = model.network.link_nodes(p);
+            let g = (r - tx).normalize() + (r - rx).normalize();
+            w * g * g.transpose()
+        })
+        .sum()
+}
+
 /// Issue 12, item 8: a prior of 10¹² m² (σ = 1000 km) is legitimate and is tracked. At the true
 /// position (`ν = 0`), with fixed σ and velocity uncorrelated with position, the closed form is
 /// `P⁺_rr = (P_rr⁻¹ + M)⁻¹ → M⁻¹` as the prior widens, `M = Σ g gᵀ/(cσ)²` (computed here from the
@@ -451,13 +464,7 @@ fn a_wide_prior_is_tracked() {
     let n = model.link_count();
     let sig = vec![1e-10; n];
     let z: Vec<Option<Real>> = (0..n).map(|p| Some(model.network.delay(p, r))).collect();
-    let w = 1.0 / (299_792_458.0f64 * 1e-10).powi(2);
-    let mut m = nalgebra::Matrix2::<Real>::zeros();
-    for p in 0..n {
-        let (tx, rx) = model.network.link_nodes(p);
-        let g = (r - tx).normalize() + (r - rx).normalize();
-        m += w * g * g.transpose();
-    }
+    let m = link_information(&model, r, 1e-10);
     for var in [1e6, 1e8, 1e10, 1e12] {
         let p0 = Mat4::from_diagonal(&Vec4::new(var, var, 0.01, 0.01));
         let x0 = Vec4::new(r.x, r.y, 0.3, -0.2);
@@ -499,15 +506,8 @@ fn both_update_forms_agree_with_the_reference_at_the_switch() {
     let z: Vec<Option<Real>> = (0..n)
         .map(|p| Some(model.network.delay(p, r) + 1e-10 * (p as Real - 1.5)))
         .collect();
-    // tr(M P_rr) = var · tr(M), tr(M) = Σ |g|²/(cσ)² (here at r; the prior mean is 5 cm off).
-    let w = 1.0 / (299_792_458.0f64 * 3e-10).powi(2);
-    let tr_m: Real = (0..n)
-        .map(|p| {
-            let (tx, rx) = model.network.link_nodes(p);
-            w * ((r - tx).normalize() + (r - rx).normalize()).norm_squared()
-        })
-        .sum();
-    let switch = 1e6 / tr_m;
+    // tr(M P_rr) = var · tr(M) (M here at r; the prior mean is 5 cm off).
+    let switch = 1e6 / link_information(&model, r, 3e-10).trace();
     for var in [switch * 0.98, switch * 1.02] {
         let mut p0 = Mat4::from_diagonal(&Vec4::new(var, var, 0.04, 0.04));
         p0[(0, 2)] = 0.1 * (var * 0.04).sqrt();

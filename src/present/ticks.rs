@@ -133,7 +133,7 @@ pub fn linear_ticks(lo: Real, hi: Real, max_count: usize) -> Vec<Tick> {
             .into_iter()
             .map(|v| Tick {
                 value: v,
-                label: crate::error::Num(v).to_string().replace('-', "\u{2212}"),
+                label: typographic_minus(crate::error::Num(v).to_string()),
             })
             .collect();
     }
@@ -261,36 +261,38 @@ pub fn format_length_m(v: Real, significant: usize) -> String {
     };
     let u = v / scale;
     let sig = significant.clamp(1, 17) as i32;
-    if u != 0.0 && !(1e-3..1e6).contains(&u.abs()) {
+    let s = if u != 0.0 && !(1e-3..1e6).contains(&u.abs()) {
         // Below 1 nm or beyond 10⁶ km: a mantissa and an exponent, not hundreds of digits.
         let p = (sig - 1) as usize;
         let s = format!("{u:.p$e}");
         let (mant, exp) = s.split_once('e').unwrap_or((&s, "0"));
-        let mant = if mant.contains('.') {
-            mant.trim_end_matches('0').trim_end_matches('.')
-        } else {
-            mant
-        };
-        let s = format!("{mant}e{exp}");
-        let s = match s.strip_prefix('-') {
-            Some(rest) => format!("\u{2212}{rest}"),
-            None => s,
-        };
-        return format!("{s} {unit}");
-    }
-    let decimals = if u == 0.0 {
-        0
+        format!("{}e{exp}", trim_fraction(mant))
     } else {
-        (sig - 1 - decade(u.abs())).max(0) as usize
+        let decimals = if u == 0.0 {
+            0
+        } else {
+            (sig - 1 - decade(u.abs())).max(0) as usize
+        };
+        trim_fraction(&format!("{u:.decimals$}")).to_string()
     };
-    let mut s = format!("{u:.decimals$}");
+    format!("{} {unit}", typographic_minus(s))
+}
+
+/// `s` without trailing zeros of its fraction (and without a bare `.`).
+fn trim_fraction(s: &str) -> &str {
     if s.contains('.') {
-        s = s.trim_end_matches('0').trim_end_matches('.').to_string();
+        s.trim_end_matches('0').trim_end_matches('.')
+    } else {
+        s
     }
-    if let Some(rest) = s.strip_prefix('-') {
-        s = format!("\u{2212}{rest}");
+}
+
+/// `s` with a leading ASCII `-` written as the minus sign `−` (U+2212).
+fn typographic_minus(s: String) -> String {
+    match s.strip_prefix('-') {
+        Some(rest) => format!("\u{2212}{rest}"),
+        None => s,
     }
-    format!("{s} {unit}")
 }
 
 /// A scale bar: the longest 1-2-5 length `≤ max_len_m`, with its label; `None` unless

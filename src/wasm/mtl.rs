@@ -28,12 +28,11 @@ pub fn mtl_default_scene() -> String {
 #[wasm_bindgen]
 pub fn mtl_field_ranges() -> String {
     let cs = crate::error::limits::C_SIGMA_M;
-    alloc::format!(
-        "{{\"range_sigma\":[{:e},{:e}],\"clutter_mean\":[0,{:e}]}}",
-        cs.min,
-        cs.max,
-        crate::mtl::view::MAX_VIEW_CLUTTER
-    )
+    serde_json::json!({
+        "range_sigma": [cs.min, cs.max],
+        "clutter_mean": [0.0, crate::mtl::view::MAX_VIEW_CLUTTER],
+    })
+    .to_string()
 }
 
 /// Parses and validates a scene; returns it re-serialised (canonical JSON). Throws the named

@@ -397,10 +397,9 @@ pub fn run_limited(program: &str, args: &[String], envs: &[(&str, &str)]) -> Cli
     }
 }
 
-/// The CLI invariant: exit 0 and JSON whose nulls `allow_null(path, doc)` accepts, or exit 2 and
-/// one `error: …` line that names a flag; anything else is a failure.
-pub fn check_cli(run: &CliRun, allow_null: &dyn Fn(&str, &Value) -> bool) -> Verdict {
-    let first = |s: &str| clip(s.lines().next().unwrap_or(""), 300);
+/// A limited run (CLI or child case) killed at the time limit, or out of memory under the
+/// address-space limit.
+fn over_limits(run: &CliRun) -> Result<(), Failure> {
     if run.timed_out {
         return Err(fail(
             Class::OverTime,
@@ -412,15 +411,23 @@ pub fn check_cli(run: &CliRun, allow_null: &dyn Fn(&str, &Value) -> bool) -> Ver
         ));
     }
     if run.stderr.contains("memory allocation of") {
+        let first = clip(run.stderr.lines().next().unwrap_or(""), 300);
         return Err(fail(
             Class::OverMemory,
             format!(
-                "allocation failure under {} MB: {}",
-                cli_memory_bytes() >> 20,
-                first(&run.stderr)
+                "allocation failure under {} MB: {first}",
+                cli_memory_bytes() >> 20
             ),
         ));
     }
+    Ok(())
+}
+
+/// The CLI invariant: exit 0 and JSON whose nulls `allow_null(path, doc)` accepts, or exit 2 and
+/// one `error: …` line that names a flag; anything else is a failure.
+pub fn check_cli(run: &CliRun, allow_null: &dyn Fn(&str, &Value) -> bool) -> Verdict {
+    let first = |s: &str| clip(s.lines().next().unwrap_or(""), 300);
+    over_limits(run)?;
     match (run.code, run.signal) {
         (Some(0), _) => {
             let doc: Value = match serde_json::from_str(&run.stdout) {
@@ -563,22 +570,7 @@ pub fn run_child(kind: &str, test_name: &str, dir: &CaseDir, text: &str) -> Verd
             ("RUST_BACKTRACE", "0"),
         ],
     );
-    if run.timed_out {
-        return Err(fail(
-            Class::OverTime,
-            format!(
-                "killed after {:.1} s (limit {:.0} s)",
-                run.elapsed.as_secs_f64(),
-                cli_time_limit().as_secs_f64()
-            ),
-        ));
-    }
-    if run.stderr.contains("memory allocation of") {
-        return Err(fail(
-            Class::OverMemory,
-            format!("allocation failure under {} MB", cli_memory_bytes() >> 20),
-        ));
-    }
+    over_limits(&run)?;
     let Some(line) = run.stdout.lines().find_map(|l| l.strip_prefix(VERDICT)) else {
         return Err(fail(
             Class::Abort,
