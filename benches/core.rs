@@ -1,8 +1,9 @@
 #![cfg(not(target_arch = "wasm32"))]
 #![allow(missing_docs)] // criterion_group! generates an undocumented pub fn
 //! Core benchmarks (criterion): the LM snapshot fix (ours vs the `levenberg-marquardt` crate on the
-//! same weighted problem), LM with the default grid-search start, the CRLB map kernel and a single
-//! CRLB point. Scenario: preset `sensors2019` (layout L4, 4 links), truth (4, 1) m.
+//! same weighted problem), LM with the default grid-search start, the CRLB map kernel (scalar
+//! reference, SIMD on one thread, SIMD on all cores; 256² and 512² at 4 links, 256² at 16 links)
+//! and a single CRLB point. Scenario: preset `sensors2019` (layout L4, 4 links), truth (4, 1) m.
 //!
 //! Run: `cargo bench --bench core` (shorter: `-- --warm-up-time 1 --measurement-time 3`).
 
@@ -14,9 +15,10 @@ use nalgebra::storage::Owned;
 use nalgebra::{DVector, Dyn, OMatrix, Vector2, U2};
 
 use scatterloc::localize::{self, DelayMeasurements, LmConfig};
-use scatterloc::localize::{crlb_at, crlb_map, Grid};
+use scatterloc::localize::{crlb_at, crlb_map, crlb_map_scalar, Grid};
 use scatterloc::math::{Real, Vec2, SPEED_OF_LIGHT};
 use scatterloc::measure::unit_from;
+use scatterloc::native::crlb_map_parallel;
 use scatterloc::scenario::Scenario;
 use scatterloc::{measure, scenario::presets, Model};
 
@@ -188,16 +190,58 @@ fn benches(c: &mut Criterion) {
     });
     g.finish();
 
-    let grid = Grid::new(s.scenario.area_m, 256, 256).unwrap();
-    let mut out = vec![0.0; grid.len()];
-    c.bench_function("crlb_map_256x256_4_links", |b| {
-        b.iter(|| crlb_map(&s.model, black_box(&grid), &mut out).unwrap())
-    });
-    assert!(out.iter().all(|v| !v.is_nan()));
+    // The map kernel: scalar reference, SIMD on one thread, SIMD with rows on both cores.
+    for (name, scenario, side) in [
+        ("crlb_map_256x256_4_links", s.scenario.clone(), 256),
+        ("crlb_map_512x512_4_links", s.scenario.clone(), 512),
+        ("crlb_map_256x256_16_links", sixteen_links(), 256),
+    ] {
+        let model = Model::new(&scenario).unwrap();
+        let grid = Grid::new(scenario.area_m, side, side).unwrap();
+        let mut out = vec![0.0; grid.len()];
+        let mut g = c.benchmark_group(name);
+        g.bench_function("scalar", |b| {
+            b.iter(|| crlb_map_scalar(&model, black_box(&grid), &mut out).unwrap())
+        });
+        g.bench_function("simd_1_thread", |b| {
+            b.iter(|| crlb_map(&model, black_box(&grid), &mut out).unwrap())
+        });
+        g.bench_function("simd_2_threads", |b| {
+            b.iter(|| crlb_map_parallel(&model, black_box(&grid), &mut out, 0).unwrap())
+        });
+        g.finish();
+        assert!(out.iter().all(|v| !v.is_nan()));
+    }
 
     c.bench_function("crlb_at_single_point", |b| {
         b.iter(|| crlb_at(&s.model, black_box(truth)))
     });
+}
+
+/// sensors2019 with 4 transmitters (the preset's parabolic Tx turned to four boresights) and its 4
+/// receivers: 16 links, the page's third timing target.
+fn sixteen_links() -> Scenario {
+    let mut s = presets::sensors2019();
+    let tx = s.transmitters[0].clone();
+    s.transmitters = [
+        (0.0, 0.0, 10.0),
+        (20.0, 0.0, 100.0),
+        (20.0, 20.0, 190.0),
+        (0.0, 20.0, 280.0),
+    ]
+    .iter()
+    .enumerate()
+    .map(|(i, &(x, y, boresight))| {
+        let mut t = tx.clone();
+        t.name = format!("Tx{i}");
+        t.position_m = [x, y];
+        if let scatterloc::scenario::Pattern::Parabolic { boresight_deg, .. } = &mut t.pattern {
+            *boresight_deg = boresight;
+        }
+        t
+    })
+    .collect();
+    s
 }
 
 criterion_group!(core, benches);

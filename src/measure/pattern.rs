@@ -180,6 +180,34 @@ impl GainPolynomial {
     }
 }
 
+impl GainPolynomial {
+    /// [`GainPolynomial::gains_at_cos`] for `N` SIMD vectors of four directions (the CRLB map
+    /// kernel; `N = 2` interleaves two recurrences so their latencies overlap): the same
+    /// operations in the same order, so each lane is bitwise equal to the scalar result; the
+    /// floor is a branch-free blend.
+    #[inline(always)]
+    pub(crate) fn gains_at_cos_x4<const N: usize>(&self, c: [wide::f64x4; N]) -> [wide::f64x4; N] {
+        use wide::{f64x4, CmpGt};
+        let t = c.map(|c| (c * 2.0 - 1.0 - self.floor_cos) / (1.0 - self.floor_cos));
+        let t2 = t.map(|t| t * 2.0);
+        let (mut b1, mut b2) = ([f64x4::ZERO; N], [f64x4::ZERO; N]);
+        for &a in self.coefficients[1..].iter().rev() {
+            let a = f64x4::splat(a);
+            for i in 0..N {
+                let b0 = (a - b2[i]) + t2[i] * b1[i];
+                b2[i] = b1[i];
+                b1[i] = b0;
+            }
+        }
+        let floor = f64x4::splat(self.floor_gain);
+        let fc = f64x4::splat(self.floor_cos);
+        core::array::from_fn(|i| {
+            let main = (t[i] * b1[i] + self.coefficients[0] - b2[i]).max(floor);
+            c[i].cmp_gt(fc).blend(main, floor)
+        })
+    }
+}
+
 impl TxPattern {
     /// Exact gain for `c = cos ψ` (the §9.3 formula), linear.
     pub fn gain_toward_cos(&self, c: Real) -> Real {

@@ -11,7 +11,8 @@ use scatterloc::chart::{
     check_area, default_titles, draw_crlb_map, scenario_nodes, suggested_size,
 };
 use scatterloc::chart::{ChartError, ChartNode, ChartOptions, MapData};
-use scatterloc::localize::{crlb_map as map_kernel, Grid};
+use scatterloc::localize::Grid;
+use scatterloc::native::crlb_map_parallel;
 use scatterloc::scenario::Area;
 use scatterloc::{Error, Model, Scenario};
 
@@ -75,7 +76,8 @@ pub fn crlb_map(args: &CrlbMapArgs) -> Result<(), CliError> {
 
     let t0 = Instant::now();
     let mut values = vec![0.0; grid.len()];
-    map_kernel(&model, &grid, &mut values).map_err(|e| CliError::output(e.to_string()))?;
+    crlb_map_parallel(&model, &grid, &mut values, 0)
+        .map_err(|e| CliError::output(e.to_string()))?;
     let compute_ms = t0.elapsed().as_secs_f64() * 1e3;
 
     let t1 = Instant::now();
