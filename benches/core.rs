@@ -213,9 +213,64 @@ fn benches(c: &mut Criterion) {
         assert!(out.iter().all(|v| !v.is_nan()));
     }
 
+    cpu_peaks(c);
+
     c.bench_function("crlb_at_single_point", |b| {
         b.iter(|| crlb_at(&s.model, black_box(truth)))
     });
+}
+
+/// This CPU's throughput for the map kernel's operations, in the kernel's vector type
+/// (`wide::f64x4`: 2 SSE2 registers in the default build, one AVX register with
+/// `-C target-cpu=x86-64-v3`): 8 independent chains so that throughput, not latency, limits.
+/// Criterion's throughput is lanes (f64 results) per second.
+fn cpu_peaks(c: &mut Criterion) {
+    use criterion::Throughput;
+    use wide::f64x4;
+    const CHAINS: usize = 8;
+    const REPS: usize = 1000;
+    let mut g = c.benchmark_group("cpu_peak_f64x4");
+    g.throughput(Throughput::Elements((CHAINS * REPS * 4) as u64));
+    let one = black_box(f64x4::ONE);
+    g.bench_function("sqrt", |b| {
+        b.iter(|| {
+            let mut acc = [f64x4::splat(2.0); CHAINS];
+            for _ in 0..REPS {
+                for x in acc.iter_mut() {
+                    *x = (*x + one).sqrt();
+                }
+            }
+            acc
+        })
+    });
+    g.bench_function("div", |b| {
+        let three = black_box(f64x4::splat(3.0));
+        b.iter(|| {
+            let mut acc = [f64x4::splat(2.0); CHAINS];
+            for _ in 0..REPS {
+                for x in acc.iter_mut() {
+                    *x = three / (*x + one);
+                }
+            }
+            acc
+        })
+    });
+    // One multiply and one add per lane and step (2 flops), 16 chains to cover their latency.
+    g.throughput(Throughput::Elements((16 * REPS * 4 * 2) as u64));
+    g.bench_function("mul_add_flops", |b| {
+        let m = black_box(f64x4::splat(1.000_000_1));
+        let a = black_box(f64x4::splat(1e-9));
+        b.iter(|| {
+            let mut acc = [f64x4::splat(1.0); 16];
+            for _ in 0..REPS {
+                for x in acc.iter_mut() {
+                    *x = *x * m + a;
+                }
+            }
+            acc
+        })
+    });
+    g.finish();
 }
 
 /// sensors2019 with 4 transmitters (the preset's parabolic Tx turned to four boresights) and its 4

@@ -36,6 +36,10 @@ mod mtl;
 #[path = "e2e/hardening.rs"]
 mod hardening;
 
+/// Issue 13: the page's own map-kernel timing (SIMD) while a receiver is dragged.
+#[path = "e2e/speed.rs"]
+mod speed;
+
 /// `SCATTERLOC_SCREENSHOT=1`: writes docs/screenshot-tracking.png.
 #[path = "e2e/screenshot.rs"]
 mod screenshot;

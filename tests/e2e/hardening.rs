@@ -21,7 +21,7 @@ use super::{
 };
 
 /// One browser session: `f(client, port)`, then the browser is closed.
-fn session<T, F, Fut>(f: F) -> T
+pub(super) fn session<T, F, Fut>(f: F) -> T
 where
     F: FnOnce(Client, u16) -> Fut,
     Fut: Future<Output = Result<T, String>>,
