@@ -1,3 +1,4 @@
+#![cfg(not(target_arch = "wasm32"))]
 //! The SIMD CRLB map kernel against its scalar reference (issue 13 §1): random scenarios with
 //! omni and beam patterns (with and without the gain polynomial), 1–64 links, bounded and
 //! unbounded cells, cells exactly on nodes and row lengths that are not a multiple of the vector
