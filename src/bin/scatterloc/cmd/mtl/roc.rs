@@ -358,11 +358,14 @@ fn roc_config(f: &RocFlags) -> Result<ExperimentConfig, CliError> {
     Ok(cfg)
 }
 
+/// A figure to write: its path and format.
+type FigureOut<'a> = Option<(&'a str, Format)>;
+
 /// `--out` and `--json` of a result: formats checked, both writable.
 fn result_outputs<'a>(
     out: Option<&'a str>,
     json: Option<&'a str>,
-) -> Result<(Option<(&'a str, Format)>, Option<&'a str>), CliError> {
+) -> Result<(FigureOut<'a>, Option<&'a str>), CliError> {
     let figure = match out {
         Some(p) => Some((p, Format::of("out", p, &[Format::Svg, Format::Png])?)),
         None => None,
@@ -514,7 +517,7 @@ fn write_result(
     wall: f64,
     used: usize,
     json: Option<&str>,
-    figure: Option<(&str, Format)>,
+    figure: FigureOut,
 ) -> Result<(), CliError> {
     let experiment = cfg.experiment;
     if let Some(p) = json {
