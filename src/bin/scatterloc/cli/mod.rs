@@ -189,7 +189,7 @@ pub enum Command {
         #[command(subcommand)]
         command: MtlCommand,
     },
-    /// Merge the part files of a sharded study into the result of the unsharded run.
+    /// Merge the part files of a sharded study into the unsharded run's result (spec §9.5).
     ///
     /// A study run with --shard I/N (montecarlo, mtl roc) writes the sufficient statistics of
     /// its shard to a part file (--json PART.json) instead of the result. `merge` checks that
