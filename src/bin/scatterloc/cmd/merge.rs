@@ -98,10 +98,9 @@ fn ranges(indices: &[usize]) -> String {
         i += 1;
     }
     let shown: Vec<String> = out.iter().take(20).cloned().collect();
-    let more = out.len().saturating_sub(20);
-    match more {
+    match out.len().saturating_sub(20) {
         0 => shown.join(", "),
-        n => format!("{}, … ({n} more runs of shards)", shown.join(", ")),
+        n => format!("{}, … and {n} more ranges", shown.join(", ")),
     }
 }
 
