@@ -669,7 +669,7 @@ fn typos_get_a_suggestion_on_one_line() {
 
 #[test]
 fn every_command_has_help_citing_the_spec() {
-    let commands: [&[&str]; 13] = [
+    let commands: [&[&str]; 14] = [
         &["preset"],
         &["crlb"],
         &["crlb-map"],
@@ -683,6 +683,7 @@ fn every_command_has_help_citing_the_spec() {
         &["mtl", "locate"],
         &["mtl", "table2"],
         &["mtl", "roc"],
+        &["merge"],
     ];
     for cmd in commands {
         for how in ["--help", "-h"] {

@@ -1,16 +1,18 @@
 //! The Monte Carlo study ([`crate::track`]) on the ordered driver ([`run_ordered`]): chunks of
-//! trajectories run in parallel and their partial sums are merged in chunk order, so the result
-//! is identical for any thread count.
+//! trajectories run in parallel and their sums are combined exactly ([`StudySums`]), so the
+//! result is identical for any thread count, and a shard's sums ([`run_chunks_parallel`])
+//! merge into exactly the sums of the whole study.
 
+use std::ops::Range;
 use std::sync::atomic::AtomicBool;
 
 use super::driver::run_ordered;
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::math::Real;
 use crate::measure::Model;
 use crate::track::{
     finish, pcrlb_from_sums, run_chunk, run_truth_chunk, MonteCarloConfig, MonteCarloResult,
-    PartialSums, CHUNK_TRAJECTORIES,
+    PartialSums, StudySums,
 };
 
 /// Runs the study on `threads` worker threads (0 = all cores). `on_progress(runs_done,
@@ -23,17 +25,42 @@ pub fn run_parallel(
     cancel: &AtomicBool,
     on_progress: impl FnMut(usize, usize),
 ) -> Result<MonteCarloResult> {
-    cfg.validate()?;
-    let sums = run_waves(
+    let sums = run_chunks_parallel(
         model,
         cfg,
+        0..cfg.chunk_count(),
+        threads,
+        cancel,
+        on_progress,
+    )?;
+    finish(cfg, &sums)
+}
+
+/// The sums of the chunks `chunks` of the study (a shard: see
+/// [`MonteCarloConfig::shard_chunks`]) on `threads` worker threads (0 = all cores); progress
+/// and cancel as in [`run_parallel`], counting the runs of these chunks. Sums of disjoint
+/// ranges merged with [`StudySums::merge`] equal those of their union exactly. An empty range
+/// gives zero sums. [`Error::IndexOutOfRange`] (`chunks`) past the last chunk.
+pub fn run_chunks_parallel(
+    model: &Model,
+    cfg: &MonteCarloConfig,
+    chunks: Range<usize>,
+    threads: usize,
+    cancel: &AtomicBool,
+    on_progress: impl FnMut(usize, usize),
+) -> Result<StudySums> {
+    cfg.validate()?;
+    check_chunks(cfg, &chunks)?;
+    run_waves(
+        model,
+        cfg,
+        chunks,
         threads,
         cancel,
         on_progress,
         run_chunk,
         cfg.noise_runs,
-    )?;
-    finish(cfg, &sums)
+    )
 }
 
 /// The Monte Carlo PCRLB alone (spec §8, check 10) in parallel: truth trajectories and
@@ -51,35 +78,59 @@ pub fn run_pcrlb_parallel(
         ..*cfg
     }
     .validate()?;
-    let sums = run_waves(model, cfg, threads, cancel, on_progress, run_truth_chunk, 1)?;
+    let all = 0..cfg.chunk_count();
+    let sums = run_waves(
+        model,
+        cfg,
+        all,
+        threads,
+        cancel,
+        on_progress,
+        run_truth_chunk,
+        1,
+    )?;
     pcrlb_from_sums(cfg, &sums)
 }
 
-/// Runs `chunk` for every chunk of the study through [`run_ordered`] and merges the sums in
-/// chunk order. Progress is reported in units of `per_trajectory` runs per trajectory.
+/// `chunks` must end at or before the last chunk.
+fn check_chunks(cfg: &MonteCarloConfig, chunks: &Range<usize>) -> Result<()> {
+    let len = cfg.chunk_count();
+    if chunks.end > len || chunks.start > chunks.end {
+        return Err(Error::IndexOutOfRange {
+            field: "chunks",
+            index: chunks.end.max(chunks.start),
+            len,
+        });
+    }
+    Ok(())
+}
+
+/// Runs `chunk` for every chunk of `chunks` through [`run_ordered`] and adds the sums exactly.
+/// Progress is reported in runs: `per_trajectory` per trajectory of the range.
+#[allow(clippy::too_many_arguments)]
 fn run_waves(
     model: &Model,
     cfg: &MonteCarloConfig,
+    chunks: Range<usize>,
     threads: usize,
     cancel: &AtomicBool,
     mut on_progress: impl FnMut(usize, usize),
     chunk: fn(&Model, &MonteCarloConfig, usize) -> Result<PartialSums>,
     per_trajectory: usize,
-) -> Result<PartialSums> {
-    let total = cfg.trajectories * per_trajectory;
-    let mut sums = PartialSums::new(cfg.steps);
+) -> Result<StudySums> {
+    let first = chunks.start;
+    let total = cfg.trajectories_in(&chunks) * per_trajectory;
+    let mut sums = StudySums::new(cfg.steps);
     run_ordered(
-        cfg.chunk_count(),
+        chunks.len(),
         threads,
         4,
         cancel,
-        |c| chunk(model, cfg, c),
-        |part| sums.merge(&part),
+        |c| chunk(model, cfg, first + c),
+        |part| sums.add(&part),
         |done| {
-            on_progress(
-                (done * CHUNK_TRAJECTORIES * per_trajectory).min(total),
-                total,
-            )
+            let runs = cfg.trajectories_in(&(first..first + done)) * per_trajectory;
+            on_progress(runs, total)
         },
     )?;
     Ok(sums)

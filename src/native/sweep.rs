@@ -1,11 +1,13 @@
 //! The §8 experiments ([`crate::mtl::experiment`]) on the ordered driver ([`run_ordered`]):
-//! realisations run in parallel and their counts are merged in realisation order, so the result
-//! is identical for any thread count (and equal to [`crate::mtl::experiment::run_sequential`]).
+//! realisations run in parallel and their counts are added exactly ([`Tally`]), so the result is
+//! identical for any thread count (and equal to [`crate::mtl::experiment::run_sequential`]), and
+//! the tallies of shards ([`run_experiment_range`]) merge into exactly the whole run's.
 
+use std::ops::Range;
 use std::sync::atomic::AtomicBool;
 
 use super::driver::run_ordered;
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::mtl::experiment::{evaluate, ExperimentConfig, ExperimentResult, Tally};
 
 /// Runs `cfg` on `threads` worker threads (0 = all cores). `on_progress(done, total)` is called
@@ -15,19 +17,42 @@ pub fn run_experiment_parallel(
     cfg: &ExperimentConfig,
     threads: usize,
     cancel: &AtomicBool,
-    mut on_progress: impl FnMut(usize, usize),
+    on_progress: impl FnMut(usize, usize),
 ) -> Result<ExperimentResult> {
+    let tally = run_experiment_range(cfg, 0..cfg.realisations, threads, cancel, on_progress)?;
+    Ok(tally.finish(cfg))
+}
+
+/// The tally of the realisations `realisations` of `cfg` (a shard: [`crate::math::Shard::range`]
+/// of `cfg.realisations`) on `threads` worker threads; progress (counting these realisations)
+/// and cancel as in [`run_experiment_parallel`]. Tallies of disjoint ranges merged with
+/// [`Tally::merge`] equal the tally of their union exactly; an empty range gives an empty
+/// tally. [`Error::IndexOutOfRange`] (`realisations`) past the last realisation.
+pub fn run_experiment_range(
+    cfg: &ExperimentConfig,
+    realisations: Range<usize>,
+    threads: usize,
+    cancel: &AtomicBool,
+    mut on_progress: impl FnMut(usize, usize),
+) -> Result<Tally> {
     cfg.validate()?;
-    let total = cfg.realisations;
+    if realisations.end > cfg.realisations || realisations.start > realisations.end {
+        return Err(Error::IndexOutOfRange {
+            field: "realisations",
+            index: realisations.end.max(realisations.start),
+            len: cfg.realisations,
+        });
+    }
+    let (first, total) = (realisations.start, realisations.len());
     let mut tally = Tally::new(cfg.curves().len(), cfg.sweep.len());
     run_ordered(
         total,
         threads,
         8,
         cancel,
-        |i| evaluate(cfg, i as u64),
+        |i| evaluate(cfg, (first + i) as u64),
         |part| tally.add(&part),
         |done| on_progress(done, total),
     )?;
-    Ok(tally.finish(cfg))
+    Ok(tally)
 }

@@ -3,27 +3,31 @@
 //! `ε_EKF(t_n) = √(mean ‖r̂ − r‖²)`, `ε_PCRLB(t_n)` from (E9) with `E[F̃]` the mean over the same
 //! truth trajectories, and the average NEES.
 //!
-//! Work is split into fixed chunks of trajectories whose partial sums are combined in chunk
-//! order, and every trajectory and noise run draws from its own stream `rng(seed, index)`, so
-//! the result depends on the seed only — not on how many threads run the chunks. This module
-//! is `no_std`: the browser worker runs chunks one after another; `crate::native` runs them on
-//! threads.
+//! Work is split into fixed chunks of trajectories; every trajectory and noise run draws from
+//! its own stream `rng(seed, index)`, and the chunks' sums are combined exactly
+//! ([`StudySums`], [`ExactSum`](crate::math::ExactSum)), so the result depends on the seed
+//! only — not on how many threads run the chunks, nor on how the chunks are split into shards
+//! ([`MonteCarloConfig::shard_chunks`]) run by separate processes and merged later. This
+//! module is `no_std`: the browser worker runs chunks one after another; `crate::native` runs
+//! them on threads.
 
-use alloc::vec;
 use alloc::vec::Vec;
 
 use crate::error::{Error, Result};
-use crate::math::{sqrt, Mat2, Mat4, Real, Vec4};
+use crate::math::{sqrt, Mat2, Mat4, Real, Shard, Vec4};
 use crate::measure::Model;
 use crate::track::pcrlb_rmse;
 use crate::track::step_count;
 use crate::track::ConstantVelocity;
 
 mod chunk;
+mod sums;
 
 pub use chunk::{run_chunk, run_truth_chunk};
+pub use sums::{PartialSums, StudySums};
 
-/// Trajectories per chunk (the unit of parallel work and of deterministic reduction).
+/// Trajectories per chunk (the unit of parallel work, of the fixed-order sums inside a chunk and
+/// of shards).
 pub const CHUNK_TRAJECTORIES: usize = 16;
 /// Largest number of EKF runs (`trajectories × noise_runs`) accepted.
 pub const MAX_RUNS: usize = 10_000_000;
@@ -94,56 +98,20 @@ impl MonteCarloConfig {
         self.trajectories.div_ceil(CHUNK_TRAJECTORIES)
     }
 
+    /// The chunks of `shard`: [`Shard::range`] of the [`chunk_count`](Self::chunk_count).
+    pub fn shard_chunks(&self, shard: Shard) -> core::ops::Range<usize> {
+        shard.range(self.chunk_count())
+    }
+
+    /// Trajectories in `chunks` (a range of chunk indices).
+    pub fn trajectories_in(&self, chunks: &core::ops::Range<usize>) -> usize {
+        let at = |c: usize| c.saturating_mul(CHUNK_TRAJECTORIES).min(self.trajectories);
+        at(chunks.end).saturating_sub(at(chunks.start))
+    }
+
     /// Total EKF runs.
     pub fn runs(&self) -> usize {
         self.trajectories * self.noise_runs
-    }
-}
-
-/// Per-step sums of a set of runs (combined in a fixed order).
-#[derive(Debug, Clone, PartialEq)]
-pub struct PartialSums {
-    /// Σ ‖r̂ − r‖² over runs, per step `0 … steps`.
-    pub squared_error: Vec<Real>,
-    /// Σ NEES over runs, per step.
-    pub nees: Vec<Real>,
-    /// Σ F(r_true) over trajectories, per step (index 0 unused: no measurement at t₀).
-    pub fisher: Vec<Mat2>,
-    /// Runs counted (those that did not fail).
-    pub runs: usize,
-    /// Runs whose filter reported a numerical failure (excluded from the sums).
-    pub failed_runs: usize,
-    /// Trajectories counted.
-    pub trajectories: usize,
-}
-
-impl PartialSums {
-    /// Zero sums for `steps` steps.
-    pub fn new(steps: usize) -> PartialSums {
-        PartialSums {
-            squared_error: vec![0.0; steps + 1],
-            nees: vec![0.0; steps + 1],
-            fisher: vec![Mat2::zeros(); steps + 1],
-            runs: 0,
-            failed_runs: 0,
-            trajectories: 0,
-        }
-    }
-
-    /// Adds `other` (call in chunk order for a thread-count-independent result).
-    pub fn merge(&mut self, other: &PartialSums) {
-        for (a, b) in self.squared_error.iter_mut().zip(&other.squared_error) {
-            *a += b;
-        }
-        for (a, b) in self.nees.iter_mut().zip(&other.nees) {
-            *a += b;
-        }
-        for (a, b) in self.fisher.iter_mut().zip(&other.fisher) {
-            *a += b;
-        }
-        self.runs += other.runs;
-        self.failed_runs += other.failed_runs;
-        self.trajectories += other.trajectories;
     }
 }
 
@@ -166,8 +134,10 @@ pub struct MonteCarloResult {
     pub seed: u64,
 }
 
-/// Turns the combined sums into the curves (E9 with the Monte Carlo mean Fisher matrices).
-pub fn finish(cfg: &MonteCarloConfig, sums: &PartialSums) -> Result<MonteCarloResult> {
+/// Turns the combined sums into the curves (E9 with the Monte Carlo mean Fisher matrices): each
+/// sum is rounded once ([`ExactSum::value`](crate::math::ExactSum::value)), then divided by the
+/// count. [`Error::SizeLimit`] (`runs (successful)`) when no run was counted.
+pub fn finish(cfg: &MonteCarloConfig, sums: &StudySums) -> Result<MonteCarloResult> {
     if sums.runs == 0 {
         return Err(Error::SizeLimit {
             field: "runs (successful)",
@@ -181,9 +151,13 @@ pub fn finish(cfg: &MonteCarloConfig, sums: &PartialSums) -> Result<MonteCarloRe
         t_s: (0..=cfg.steps)
             .map(|n| n as Real * cfg.motion.dt_s)
             .collect(),
-        rmse_ekf_m: sums.squared_error.iter().map(|v| sqrt(v / runs)).collect(),
+        rmse_ekf_m: sums
+            .squared_error
+            .iter()
+            .map(|v| sqrt(v.value() / runs))
+            .collect(),
         rmse_pcrlb_m: pcrlb_from_sums(cfg, sums)?,
-        nees: sums.nees.iter().map(|v| v / runs).collect(),
+        nees: sums.nees.iter().map(|v| v.value() / runs).collect(),
         runs: sums.runs,
         failed_runs: sums.failed_runs,
         seed: cfg.seed,
@@ -199,9 +173,9 @@ pub fn run_sequential(
 ) -> Result<MonteCarloResult> {
     cfg.validate()?;
     let total = cfg.chunk_count();
-    let mut sums = PartialSums::new(cfg.steps);
+    let mut sums = StudySums::new(cfg.steps);
     for chunk in 0..total {
-        sums.merge(&run_chunk(model, cfg, chunk)?);
+        sums.add(&run_chunk(model, cfg, chunk)?);
         if !on_chunk(chunk + 1, total) {
             return Err(Error::Cancelled);
         }
@@ -210,8 +184,8 @@ pub fn run_sequential(
 }
 
 /// The Monte Carlo PCRLB alone (spec §8, check 10): `ε_PCRLB(t_n)` from (E9) with `E[F̃]` the
-/// mean over the study's truth trajectories — the same trajectories (streams `rng(seed, 2i)`),
-/// chunks and merge order as [`run_sequential`], so the curve equals its `rmse_pcrlb_m`, but
+/// mean over the study's truth trajectories — the same trajectories (streams `rng(seed, 2i)`)
+/// and chunks as [`run_sequential`], so the curve equals its `rmse_pcrlb_m`, but
 /// without the EKF runs (`noise_runs` is ignored). `on_chunk` as in [`run_sequential`].
 pub fn run_pcrlb_sequential(
     model: &Model,
@@ -224,9 +198,9 @@ pub fn run_pcrlb_sequential(
     }
     .validate()?;
     let total = cfg.chunk_count();
-    let mut sums = PartialSums::new(cfg.steps);
+    let mut sums = StudySums::new(cfg.steps);
     for chunk in 0..total {
-        sums.merge(&run_truth_chunk(model, cfg, chunk)?);
+        sums.add(&run_truth_chunk(model, cfg, chunk)?);
         if !on_chunk(chunk + 1, total) {
             return Err(Error::Cancelled);
         }
@@ -235,8 +209,10 @@ pub fn run_pcrlb_sequential(
 }
 
 /// `ε_PCRLB(t_n)` (E9) with `E[F̃]` the mean of the summed truth Fisher matrices.
-pub fn pcrlb_from_sums(cfg: &MonteCarloConfig, sums: &PartialSums) -> Result<Vec<Option<Real>>> {
+pub fn pcrlb_from_sums(cfg: &MonteCarloConfig, sums: &StudySums) -> Result<Vec<Option<Real>>> {
     let trajectories = sums.trajectories.max(1) as Real;
-    let mean_fishers: Vec<Mat2> = sums.fisher[1..].iter().map(|f| f / trajectories).collect();
+    let mean_fishers: Vec<Mat2> = (1..sums.fisher.len())
+        .map(|n| sums.fisher_at(n) / trajectories)
+        .collect();
     pcrlb_rmse(&cfg.motion, &cfg.initial_covariance, &mean_fishers)
 }

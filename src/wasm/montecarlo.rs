@@ -1,7 +1,8 @@
 //! The worker-facing Monte Carlo job: the core's chunked study ([`crate::track`]) run a few
 //! chunks per call, so a Web Worker can report progress and drop a job between calls. Chunks are
-//! merged in order, so the result equals [`run_sequential`](crate::track::run_sequential)
-//! (and the native CLI) for the same inputs.
+//! combined exactly ([`StudySums`]), so the result equals
+//! [`run_sequential`](crate::track::run_sequential) (and the native CLI, sharded or not) for the
+//! same inputs.
 
 use wasm_bindgen::prelude::*;
 
@@ -9,7 +10,7 @@ use super::err;
 use super::json::{to_json, MonteCarloJs};
 use super::tracking::{checked_steps, prior_and_motion};
 use crate::track::paper_initial_covariance;
-use crate::track::{finish, run_chunk, MonteCarloConfig, PartialSums};
+use crate::track::{finish, run_chunk, MonteCarloConfig, StudySums};
 use crate::{Model, Scenario};
 
 /// A Monte Carlo study of ε_EKF(t) and ε_PCRLB(t) in progress.
@@ -17,7 +18,7 @@ use crate::{Model, Scenario};
 pub struct MonteCarloJob {
     model: Model,
     cfg: MonteCarloConfig,
-    sums: PartialSums,
+    sums: StudySums,
     chunks_done: usize,
 }
 
@@ -58,7 +59,7 @@ impl MonteCarloJob {
         cfg.validate().map_err(err)?;
         Ok(MonteCarloJob {
             model,
-            sums: PartialSums::new(steps),
+            sums: StudySums::new(steps),
             cfg,
             chunks_done: 0,
         })
@@ -91,7 +92,7 @@ impl MonteCarloJob {
                 break;
             }
             let part = run_chunk(&self.model, &self.cfg, self.chunks_done).map_err(err)?;
-            self.sums.merge(&part);
+            self.sums.add(&part);
             self.chunks_done += 1;
         }
         Ok(self.is_done())

@@ -93,7 +93,11 @@ fn ok_json_output(args: &[&str], out: &Output) -> Value {
 /// Runs, expects exit status 2, empty stdout and exactly one newline-terminated stderr line
 /// containing every needle; returns that line.
 pub fn fails(args: &[&str], needles: &[&str]) -> String {
-    let out = run(args);
+    fails_output(args, &run(args), needles)
+}
+
+/// [`fails`] for an `out` already run (e.g. with environment variables set).
+pub fn fails_output(args: &[&str], out: &Output, needles: &[&str]) -> String {
     let err = String::from_utf8_lossy(&out.stderr).into_owned();
     assert_eq!(out.status.code(), Some(2), "{args:?}: stderr {err}");
     assert!(out.stdout.is_empty(), "{args:?}: stdout not empty");

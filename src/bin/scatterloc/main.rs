@@ -1,7 +1,7 @@
 //! `scatterloc`: command-line front end of the scatterloc core — presets, the CRLB at a point,
 //! CRLB maps (JSON, SVG, PNG), Levenberg–Marquardt fixes from measured delays, the EKF tracker
 //! (spec §6) and its Monte Carlo evaluation against the posterior CRLB (§8, §9.5, [S] Fig. 3),
-//! and the multi-target method (`mtl`).
+//! the multi-target method (`mtl`), and the merge of sharded studies (`merge`).
 //!
 //! `cli` declares the command line (clap), `cmd` runs the commands. Results are JSON on stdout.
 //! Bad input exits with status 2 and one line on stderr that names the offending flag or field;
@@ -83,6 +83,7 @@ fn run(command: cli::Command) -> Result<(), CliError> {
             MtlCommand::Table2(a) => cmd::mtl_table2(&a),
             MtlCommand::Roc(a) => cmd::mtl_roc(&a),
         },
+        Command::Merge(a) => cmd::merge(&a),
         Command::Completions { shell } => cli::completions(shell),
     }
 }

@@ -4,10 +4,11 @@
 //! method, sweeping `T_b`).
 //!
 //! Every realisation `i` is drawn by the §7 generator from the stream `rng(seed, i)` and
-//! evaluated on its own ([`realisation::evaluate`]); the sums over realisations are merged in
-//! realisation order ([`Tally`]), so results depend on the configuration and seed only — the
-//! native parallel driver (`native`) gives bitwise the same numbers as
-//! [`run_sequential`].
+//! evaluated on its own ([`realisation::evaluate`]; the empirical model trains on its own stream
+//! `rng(seed, 2⁴⁰ + i)`); the sums over realisations are exact ([`Tally`]), so results depend
+//! on the configuration and seed only — the native parallel driver (`native`) gives bitwise the
+//! same numbers as [`run_sequential`], and tallies of disjoint ranges of realisations (shards,
+//! [`crate::math::Shard`]) merge into exactly the tally of their union.
 //!
 //! - [`config`]: the configuration and its curves; [`result`]: ROC points and the sums.
 //! - [`realisation`]: one realisation, every curve and threshold.

@@ -1,10 +1,13 @@
-//! Experiment results: ROC points (M12) per curve and threshold, and the order-preserving sums
-//! over realisations that make them independent of the thread count.
+//! Experiment results: ROC points (M12) per curve and threshold, and the exact sums over
+//! realisations that make them independent of the thread count and of how the realisations are
+//! split into shards.
 
 use alloc::string::String;
 use alloc::vec::Vec;
 
-use crate::math::Real;
+use serde::{Deserialize, Serialize};
+
+use crate::math::{ExactSum, Real};
 use crate::mtl::experiment::{CurveSpec, Experiment, ExperimentConfig, RealisationCounts};
 use crate::mtl::sim::DetectionCounts;
 
@@ -52,8 +55,15 @@ pub struct ExperimentResult {
     pub disagreements: u64,
 }
 
-/// Per-curve, per-threshold sums over realisations, merged in realisation order.
-#[derive(Debug, Clone, PartialEq)]
+/// Per-curve, per-threshold sums over a set of realisations: counts, and the ratio sums of
+/// (M12) as [`ExactSum`]s, so adding realisations ([`add`](Tally::add)) or combining tallies of
+/// disjoint sets ([`merge`](Tally::merge)) in any order gives the same result. (The ratio sums
+/// were plain `f64` added in realisation order before; on V-B with 20 realisations, seed 1,
+/// `P_D` did not change and 101 of 162 `P_FA` values changed by at most 4.3·10⁻¹⁶ relative.)
+///
+/// Serde (the sums of a shard's part file): `{realisations, targets, disagreements, sums:
+/// [curve][point] {detection_ratio, false_alarm_ratio, detections, false_alarms, estimates}}`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Tally {
     realisations: usize,
     targets: u64,
@@ -73,7 +83,7 @@ impl Tally {
         }
     }
 
-    /// Adds one realisation (call in realisation order for reproducible sums).
+    /// Adds one realisation (any order).
     pub fn add(&mut self, r: &RealisationCounts) {
         self.realisations += 1;
         self.targets += r.targets as u64;
@@ -83,6 +93,27 @@ impl Tally {
                 add_counts(s, c);
             }
         }
+    }
+
+    /// Adds the sums of another set of realisations (disjoint from this one's; any order).
+    pub fn merge(&mut self, other: &Tally) {
+        self.realisations += other.realisations;
+        self.targets += other.targets;
+        self.disagreements += other.disagreements;
+        for (curve, theirs) in self.sums.iter_mut().zip(&other.sums) {
+            for (s, o) in curve.iter_mut().zip(theirs) {
+                s.detection_ratio.merge(&o.detection_ratio);
+                s.false_alarm_ratio.merge(&o.false_alarm_ratio);
+                s.detections += o.detections;
+                s.false_alarms += o.false_alarms;
+                s.estimates += o.estimates;
+            }
+        }
+    }
+
+    /// Whether the sums are `curves × points` (those of [`Tally::new`]`(curves, points)`).
+    pub fn has_shape(&self, curves: usize, points: usize) -> bool {
+        self.sums.len() == curves && self.sums.iter().all(|c| c.len() == points)
     }
 
     /// Realisations added.
@@ -106,8 +137,8 @@ impl Tally {
                     .zip(sums)
                     .map(|(&threshold, s)| RocPoint {
                         threshold,
-                        p_d: s.detection_ratio / n,
-                        p_fa: s.false_alarm_ratio / n,
+                        p_d: s.detection_ratio.value() / n,
+                        p_fa: s.false_alarm_ratio.value() / n,
                         detections: s.detections,
                         false_alarms: s.false_alarms,
                         estimates: s.estimates,
@@ -126,12 +157,12 @@ impl Tally {
 }
 
 /// Sums of one curve point over realisations.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 struct PointSums {
     /// `Σ N_D/K`.
-    detection_ratio: Real,
+    detection_ratio: ExactSum,
     /// `Σ N_FA/max(K̂, 1)`.
-    false_alarm_ratio: Real,
+    false_alarm_ratio: ExactSum,
     /// `Σ N_D`.
     detections: u64,
     /// `Σ N_FA`.
@@ -141,8 +172,10 @@ struct PointSums {
 }
 
 fn add_counts(s: &mut PointSums, c: &DetectionCounts) {
-    s.detection_ratio += c.detected as Real / c.targets.max(1) as Real;
-    s.false_alarm_ratio += c.false_alarms as Real / c.estimates.max(1) as Real;
+    s.detection_ratio
+        .add(c.detected as Real / c.targets.max(1) as Real);
+    s.false_alarm_ratio
+        .add(c.false_alarms as Real / c.estimates.max(1) as Real);
     s.detections += c.detected as u64;
     s.false_alarms += c.false_alarms as u64;
     s.estimates += c.estimates as u64;

@@ -15,7 +15,7 @@ use crate::present::{linear_ticks, scale_bar, simulate_snapshot, track_estimate}
 use crate::present::{track_frame, track_mean_state, LogScale};
 use crate::scenario::presets::{iclgnss2019, sensors2019};
 use crate::track::{finish, paper_initial_covariance, run_chunk, simulate_track};
-use crate::track::{ConstantVelocity, MonteCarloConfig, PartialSums, PAPER_INTENSITY};
+use crate::track::{ConstantVelocity, MonteCarloConfig, StudySums, PAPER_INTENSITY};
 
 wasm_bindgen_test_configure!(run_in_browser);
 
@@ -269,9 +269,9 @@ fn monte_carlo_progress_and_result() {
         seed: 4,
         oracle_noise: false,
     };
-    let mut sums = PartialSums::new(cfg.steps);
+    let mut sums = StudySums::new(cfg.steps);
     for chunk in 0..cfg.chunk_count() {
-        sums.merge(&run_chunk(&model, &cfg, chunk).unwrap());
+        sums.add(&run_chunk(&model, &cfg, chunk).unwrap());
         let mut r = finish(&cfg, &sums).unwrap();
         r.rmse_pcrlb_m[0] = None;
         r.nees[1] = f64::NAN;

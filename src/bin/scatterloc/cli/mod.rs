@@ -7,6 +7,7 @@
 mod error;
 mod mtl;
 mod scenario;
+mod shard;
 mod study;
 mod track;
 mod values;
@@ -17,9 +18,10 @@ use clap::{CommandFactory, FromArgMatches, Parser, Subcommand, ValueEnum};
 
 pub use mtl::{MtlCommand, MtlLocateArgs, RocArgs, Table2Args};
 pub use scenario::{CrlbArgs, CrlbMapArgs, LocateArgs, PresetArgs};
+pub use shard::{MergeArgs, ShardArgs};
 pub use study::{MontecarloArgs, PcrlbArgs, StudyArgs};
 pub use track::{CalibrateArgs, SimulateWalkArgs, TrackArgs};
-pub use values::{Association, MtlModel, RocExperiment, Trajectory, WalkStart};
+pub use values::{Association, MtlModel, RocExperiment, ShardSpec, Trajectory, WalkStart};
 
 use crate::CliError;
 
@@ -41,7 +43,7 @@ Commands at a glance (`scatterloc help COMMAND` for every flag):
   scatterloc montecarlo [--preset NAME | --scenario FILE] [--trajectory I|II|III|all]
                         [--runs N] [--noise-runs N] [--dt T] [--duration S] [--process-noise Q]
                         [--seed N] [--threads N] [--oracle-noise] [--out FIG.{svg,png}]
-                        [--json OUT.json]
+                        [--json OUT.json] [--shard I/N|env [--shards N] --json PART.json]
   scatterloc pcrlb --nominal [--preset NAME | --scenario FILE] [--trajectory I|II|III|all]
                    [--dt T] [--duration S] [--process-noise Q] [--json OUT.json] [--out FIG]
   scatterloc pcrlb [same flags without --nominal] [--runs N] [--seed N] [--threads N]
@@ -52,6 +54,8 @@ Commands at a glance (`scatterloc help COMMAND` for every flag):
   scatterloc mtl table2 [--draws N] [--seed N] [--json OUT.json]
   scatterloc mtl roc --experiment va|vb|vc [--realizations N] [--seed N] [--threads N]
                      [--empirical] [--exact] [--out FIG.{svg,png}] [--json OUT.json]
+                     [--shard I/N|env [--shards N] --json PART.json]
+  scatterloc merge --json OUT.json [--out FIG.{svg,png}] PART...
   scatterloc completions bash|zsh|fish
   scatterloc help [COMMAND] | --help | -h | --version
 
@@ -164,6 +168,10 @@ pub enum Command {
     /// {"scenarios": [..]}); ns_per_ekf_step = wall x threads / (runs x steps). Prints a one-line
     /// summary with the values at 1, 2, 5 and 10 s (without --json and --out: the whole JSON
     /// document instead).
+    ///
+    /// --shard I/N: only the chunks [I*C/N, (I+1)*C/N) of the C = ceil(runs/16) chunks of 16
+    /// trajectories, their sums written to the part file --json PART.json (no --out); `scatterloc
+    /// merge` turns the parts into the result of the unsharded run.
     Montecarlo(MontecarloArgs),
     /// The posterior CRLB of tracking alone, without the EKF (spec §8; checks 9, 10).
     ///
@@ -181,6 +189,17 @@ pub enum Command {
         #[command(subcommand)]
         command: MtlCommand,
     },
+    /// Merge the part files of a sharded study into the unsharded run's result (spec §9.5).
+    ///
+    /// A study run with --shard I/N (montecarlo, mtl roc) writes the sufficient statistics of
+    /// its shard to a part file (--json PART.json) instead of the result. `merge` checks that
+    /// the parts are one study (same configuration, seed and scatterloc version) and cover every
+    /// shard exactly once (missing, duplicate or foreign parts: exit 2, naming them), adds their
+    /// sums exactly and writes the same JSON (--json) and figure (--out) as the unsharded run,
+    /// equal to it bit for bit except the timing fields (wall_time_s, the sum over the parts;
+    /// threads, the most of any part; ns_per_ekf_step, wall_ns_per_ekf_step). See
+    /// docs/scale-out.md.
+    Merge(MergeArgs),
     /// Print a shell completion script (bash, zsh or fish) on stdout.
     ///
     /// For example `scatterloc completions bash > ~/.local/share/bash-completion/completions/scatterloc`,

@@ -2,6 +2,8 @@
 
 use clap::{Args, Subcommand};
 
+use super::shard::ShardArgs;
+
 use super::values::{
     count_or_inf, finite, probability, seed, threshold, threshold_or_inf, trp_order, whole,
     MtlModel, RocExperiment, TrpOrder,
@@ -43,7 +45,8 @@ pub enum MtlCommand {
     ///
     /// Progress on stderr; Ctrl-C stops (exit 130, no files written). Prints a summary table;
     /// --json: {config, curves: [{method, label, points: [{threshold, p_d, p_fa, detections,
-    /// false_alarms, estimates}]}], disagreements, ..}.
+    /// false_alarms, estimates}]}], disagreements, ..}. With --shard I/N: only realisations
+    /// [I*R/N, (I+1)*R/N) into the part file --json PART.json (see `scatterloc merge`).
     Roc(RocArgs),
 }
 
@@ -160,7 +163,9 @@ pub struct RocArgs {
     /// Figure: .svg or .png.
     #[arg(long, value_name = "FIG.{svg,png}")]
     pub out: Option<String>,
-    /// The curves as a .json file.
+    /// The curves as a .json file (with --shard: the part file).
     #[arg(long, value_name = "OUT.json")]
     pub json: Option<String>,
+    #[command(flatten)]
+    pub shard: ShardArgs,
 }

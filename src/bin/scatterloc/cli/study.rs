@@ -2,6 +2,7 @@
 
 use clap::Args;
 
+use super::shard::ShardArgs;
 use super::values::{finite, seed, whole, Trajectory};
 
 /// The flags every study takes: the node layout, the trajectories and the time grid.
@@ -56,9 +57,11 @@ pub struct MontecarloArgs {
     /// Figure of the curves ([S] Fig. 3): .svg or .png.
     #[arg(long, value_name = "FIG.{svg,png}")]
     pub out: Option<String>,
-    /// The curves as a .json file.
+    /// The curves as a .json file (with --shard: the part file).
     #[arg(long, value_name = "OUT.json")]
     pub json: Option<String>,
+    #[command(flatten)]
+    pub shard: ShardArgs,
 }
 
 /// `scatterloc pcrlb`.

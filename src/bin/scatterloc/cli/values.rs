@@ -171,3 +171,29 @@ pub enum RocExperiment {
     #[value(alias = "v-c")]
     Vc,
 }
+
+/// `--shard`: shard `I` of `N` (0-based), or `env` (from the batch system's variables).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ShardSpec {
+    /// `I/N`, checked: `1 ≤ N ≤` [`scatterloc::math::MAX_SHARDS`], `I < N`.
+    Given(scatterloc::math::Shard),
+    /// `env`: `SLURM_ARRAY_TASK_ID` (+ `SLURM_ARRAY_TASK_COUNT`) or `JOB_COMPLETION_INDEX`
+    /// (+ `--shards N`).
+    Env,
+}
+
+/// Parses [`ShardSpec`]: `I/N` or `env`.
+pub fn shard_spec(v: &str) -> Result<ShardSpec, String> {
+    use scatterloc::math::{Shard, MAX_SHARDS};
+    let t = v.trim();
+    if t.eq_ignore_ascii_case("env") {
+        return Ok(ShardSpec::Env);
+    }
+    let bad = || {
+        format!("expected I/N (shard I of N, 0-based: 0 ≤ I < N ≤ {MAX_SHARDS}) or env, got '{v}'")
+    };
+    let (i, n) = t.split_once('/').ok_or_else(bad)?;
+    let i: usize = i.trim().parse().map_err(|_| bad())?;
+    let n: usize = n.trim().parse().map_err(|_| bad())?;
+    Shard::new(i, n).map(ShardSpec::Given).ok_or_else(bad)
+}

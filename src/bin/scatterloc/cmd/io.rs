@@ -32,8 +32,14 @@ pub fn emit_json<T: Serialize>(v: &T) -> Result<(), CliError> {
 /// past the cap). A leading UTF-8 byte-order mark is dropped (editors on some systems write
 /// one; the page accepts it too).
 pub fn read_input(flag: &str, path: &str) -> Result<String, CliError> {
+    read_input_named(&format!("--{flag}"), path)
+}
+
+/// [`read_input`] with `what` (a flag with its dashes, or e.g. `PART a.json`) naming the input
+/// in errors.
+pub fn read_input_named(what: &str, path: &str) -> Result<String, CliError> {
     let cannot =
-        |e: &dyn std::fmt::Display| CliError::usage(format!("--{flag}: cannot read '{path}': {e}"));
+        |e: &dyn std::fmt::Display| CliError::usage(format!("{what}: cannot read '{path}': {e}"));
     let mut bytes = Vec::new();
     let cap = limits::MAX_INPUT_BYTES;
     let res = if path == "-" {
@@ -47,7 +53,7 @@ pub fn read_input(flag: &str, path: &str) -> Result<String, CliError> {
     res.map_err(|e| cannot(&e))?;
     if bytes.len() as u64 > cap {
         return Err(CliError::usage(format!(
-            "--{flag}: '{path}' is larger than {} MiB, the largest input read",
+            "{what}: '{path}' is larger than {} MiB, the largest input read",
             cap >> 20
         )));
     }

@@ -1,24 +1,28 @@
 //! The commands of `scatterloc`, one file per family: the single-snapshot commands (`preset`,
 //! `crlb`, `locate` in `scenario`, `crlb-map` in `crlb_map`), tracking (`track` with its figure
 //! in `track_fig`), gating (`calibrate`, `simulate-walk`), the tracking studies (`montecarlo`,
-//! `pcrlb`, sharing `study` and `report`) and the multi-target commands (`mtl`). Each takes its
+//! `pcrlb`, sharing `study` and `report`), the multi-target commands (`mtl`), and scale-out:
+//! one shard of a study (`--shard`, its part file in `shard`) and `merge`. Each takes its
 //! parsed flags from `crate::cli`, reads its inputs (`io`), calls the library and writes JSON to
 //! stdout and files atomically (`output`).
 
 mod crlb_map;
 mod gating;
 mod io;
+mod merge;
 mod montecarlo;
 mod mtl;
 mod output;
 mod report;
 mod scenario;
+mod shard;
 mod study;
 mod track;
 mod track_fig;
 
 pub use crlb_map::crlb_map;
 pub use gating::{calibrate, simulate_walk};
+pub use merge::merge;
 pub use montecarlo::{montecarlo, pcrlb};
 pub use mtl::{mtl_locate, mtl_roc, mtl_table2};
 pub use scenario::{crlb, locate, preset};

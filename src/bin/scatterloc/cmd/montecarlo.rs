@@ -1,15 +1,25 @@
 //! `scatterloc montecarlo`: the EKF against its posterior CRLB ([S] §5.2, spec §9.5, Fig. 3 of
-//! §10), and `scatterloc pcrlb`: the bound alone, at the nominal path (check 9) or with `E[F̃]`
-//! over truth trajectories (check 10).
+//! §10), sharded (`--shard I/N`: a part file) or whole, the merge of its part files, and
+//! `scatterloc pcrlb`: the bound alone, at the nominal path (check 9) or with `E[F̃]` over truth
+//! trajectories (check 10).
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use scatterloc::chart::TrackingChartOptions;
-use scatterloc::track::nominal_pcrlb_rmse;
-use scatterloc::track::paper_initial_covariance;
+use scatterloc::math::Shard;
+use scatterloc::track::{
+    finish, nominal_pcrlb_rmse, paper_initial_covariance, ConstantVelocity, MonteCarloConfig,
+    MonteCarloResult, StudySums, TrackScenario, MAX_STEPS,
+};
+use scatterloc::Scenario;
 
+use super::merge::{differs, inconsistent, merged_timing, sums_of, Part};
 use super::report::{which, CurveDoc, Outputs};
-use super::study::{flag_error, parse_study, run_pcrlb_with_progress, run_with_progress, threads};
+use super::shard::{self, ShardDoc, Timing};
+use super::study::{
+    flag_error, parse_study, run_chunks_with_progress, run_pcrlb_with_progress, run_with_progress,
+    threads, Study,
+};
 use crate::cli::{MontecarloArgs, PcrlbArgs};
 use crate::CliError;
 
@@ -36,6 +46,145 @@ struct McMeta {
     layout: String,
 }
 
+/// The run time of one trajectory's study: wall time, thread time (`Σ wall · threads`) and
+/// threads.
+struct RunTime {
+    wall_s: f64,
+    thread_s: f64,
+    threads: usize,
+}
+
+/// The JSON document (and figure panel) of trajectory `t`'s result.
+fn mc_doc(
+    study: &Study,
+    t: TrackScenario,
+    cfg: &MonteCarloConfig,
+    r: MonteCarloResult,
+    time: RunTime,
+) -> CurveDoc<McMeta> {
+    let steps_run = cfg.runs() as f64 * cfg.steps as f64;
+    let meta = McMeta {
+        runs: r.runs,
+        seed: cfg.seed,
+        trajectory: t.name(),
+        dt_s: cfg.motion.dt_s,
+        noise_runs: cfg.noise_runs,
+        trajectories: cfg.trajectories,
+        failed_runs: r.failed_runs,
+        wall_time_s: time.wall_s,
+        ns_per_ekf_step: 1e9 * time.thread_s / steps_run,
+        wall_ns_per_ekf_step: 1e9 * time.wall_s / steps_run,
+        threads: time.threads,
+        steps: cfg.steps,
+        process_noise: cfg.motion.intensity,
+        oracle_noise: cfg.oracle_noise,
+        layout: study.layout.clone(),
+    };
+    CurveDoc {
+        t_s: r.t_s,
+        rmse_ekf_m: Some(r.rmse_ekf_m),
+        rmse_pcrlb_m: r.rmse_pcrlb_m,
+        nees: Some(r.nees),
+        caption_note: Some(failed_note(r.failed_runs, r.runs + r.failed_runs)),
+        meta,
+    }
+}
+
+/// The figure's title and subtitle.
+fn chart_options(study: &Study, c: &McConfig) -> TrackingChartOptions {
+    TrackingChartOptions {
+        title: format!("EKF vs posterior CRLB — {}", which(study)),
+        subtitle: Some(format!(
+            "{} trajectories × {} noise runs · step T = {} · σq² = {} m²/s³ · seed {}",
+            c.runs,
+            c.noise_runs,
+            study.step_label(),
+            study.motion.intensity,
+            c.seed
+        )),
+    }
+}
+
+/// Everything a Monte Carlo study's result depends on: the `config` of its part files.
+#[derive(Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct McConfig {
+    /// The layout's name (preset or scenario file's `name`).
+    layout: String,
+    /// The scenario document (schema v1) as read and validated.
+    scenario: serde_json::Value,
+    /// Trajectories of spec §9.4, in order.
+    trajectories: Vec<String>,
+    dt_s: f64,
+    steps: usize,
+    process_noise: f64,
+    /// Truth trajectories per trajectory (`--runs`).
+    runs: usize,
+    noise_runs: usize,
+    seed: u64,
+    oracle_noise: bool,
+}
+
+impl McConfig {
+    fn of(
+        study: &Study,
+        runs: usize,
+        noise_runs: usize,
+        seed: u64,
+        oracle_noise: bool,
+    ) -> Result<McConfig, CliError> {
+        Ok(McConfig {
+            layout: study.layout.clone(),
+            scenario: serde_json::to_value(&study.scenario)
+                .map_err(|e| CliError::output(format!("encoding the scenario: {e}")))?,
+            trajectories: study
+                .trajectories
+                .iter()
+                .map(|t| t.name().to_string())
+                .collect(),
+            dt_s: study.motion.dt_s,
+            steps: study.steps,
+            process_noise: study.motion.intensity,
+            runs,
+            noise_runs,
+            seed,
+            oracle_noise,
+        })
+    }
+
+    /// The study and its configurations (one per trajectory) again, as the unsharded run built
+    /// them; errors say what is wrong.
+    fn study(&self) -> Result<(Study, Vec<MonteCarloConfig>), String> {
+        let scenario = Scenario::from_json(&self.scenario.to_string())
+            .map_err(|e| format!("config.scenario: {e}"))?;
+        let trajectories = self
+            .trajectories
+            .iter()
+            .map(|t| TrackScenario::parse(t).map_err(|e| format!("config.trajectories: {e}")))
+            .collect::<Result<Vec<_>, _>>()?;
+        let motion = ConstantVelocity::validated(self.dt_s, self.process_noise)
+            .map_err(|e| format!("config: {e}"))?;
+        if !(1..=MAX_STEPS).contains(&self.steps) || trajectories.is_empty() {
+            return Err("config: no steps or no trajectories".into());
+        }
+        let study = Study::new(
+            self.layout.clone(),
+            scenario,
+            trajectories,
+            motion,
+            self.steps,
+        )
+        .map_err(|e| e.message)?;
+        let configs = study
+            .trajectories
+            .iter()
+            .map(|t| study.config(*t, self.runs, self.noise_runs, self.seed, self.oracle_noise))
+            .collect::<Result<Vec<_>, _>>()
+            .map_err(|e| format!("config: {}", e.message))?;
+        Ok((study, configs))
+    }
+}
+
 /// `scatterloc montecarlo`.
 pub fn montecarlo(args: &MontecarloArgs) -> Result<(), CliError> {
     let study = parse_study(&args.study)?;
@@ -48,48 +197,149 @@ pub fn montecarlo(args: &MontecarloArgs) -> Result<(), CliError> {
         .iter()
         .map(|t| study.config(*t, runs, noise_runs, seed, oracle))
         .collect::<Result<Vec<_>, _>>()?;
+    let config = McConfig::of(&study, runs, noise_runs, seed, oracle)?;
+    if let Some(shard) = shard::resolve(&args.shard)? {
+        let path = shard::part_path(args.json.as_deref(), args.out.as_deref())?;
+        return run_shard(&study, &configs, &config, shard, (threads, used), &path);
+    }
     let outputs = Outputs::parse(args.out.as_deref(), args.json.as_deref())?;
 
     let mut docs = Vec::new();
     for (t, cfg) in study.trajectories.iter().zip(&configs) {
         let label = format!("scenario {:>3}", t.name());
         let (r, wall) = run_with_progress(&study.model, cfg, threads, &label)?;
-        let per_step = 1e9 * wall / (cfg.runs() as f64 * cfg.steps as f64);
-        let meta = McMeta {
-            runs: r.runs,
-            seed,
-            trajectory: t.name(),
-            dt_s: cfg.motion.dt_s,
-            noise_runs,
-            trajectories: runs,
-            failed_runs: r.failed_runs,
-            wall_time_s: wall,
-            ns_per_ekf_step: per_step * used as f64,
-            wall_ns_per_ekf_step: per_step,
+        let time = RunTime {
+            wall_s: wall,
+            thread_s: wall * used as f64,
             threads: used,
-            steps: cfg.steps,
-            process_noise: cfg.motion.intensity,
-            oracle_noise: oracle,
-            layout: study.layout.clone(),
         };
-        docs.push(CurveDoc {
-            t_s: r.t_s,
-            rmse_ekf_m: Some(r.rmse_ekf_m),
-            rmse_pcrlb_m: r.rmse_pcrlb_m,
-            nees: Some(r.nees),
-            caption_note: Some(failed_note(r.failed_runs, r.runs + r.failed_runs)),
-            meta,
-        });
+        docs.push(mc_doc(&study, *t, cfg, r, time));
     }
-    let opts = TrackingChartOptions {
-        title: format!("EKF vs posterior CRLB — {}", which(&study)),
-        subtitle: Some(format!(
-            "{runs} trajectories × {noise_runs} noise runs · step T = {} · σq² = {} m²/s³ · seed {seed}",
-            study.step_label(),
-            study.motion.intensity
-        )),
+    outputs.finish(&study, &docs, &chart_options(&study, &config))
+}
+
+/// Runs shard `shard` (its chunks of every trajectory) and writes its part file `path`.
+fn run_shard(
+    study: &Study,
+    configs: &[MonteCarloConfig],
+    config: &McConfig,
+    shard: Shard,
+    (threads, used): (usize, usize),
+    path: &str,
+) -> Result<(), CliError> {
+    let total = configs[0].chunk_count();
+    let chunks = shard.range(total);
+    let mut sums = Vec::new();
+    let mut walls = Vec::new();
+    for (t, cfg) in study.trajectories.iter().zip(configs) {
+        let label = format!(
+            "scenario {:>3} shard {}/{}",
+            t.name(),
+            shard.index(),
+            shard.count()
+        );
+        let (s, wall) =
+            run_chunks_with_progress(&study.model, cfg, chunks.clone(), threads, &label)?;
+        sums.push(s);
+        walls.push(wall);
+    }
+    #[derive(Serialize)]
+    struct Counted {
+        runs: usize,
+        failed_runs: usize,
+    }
+    let counted = Counted {
+        runs: sums.iter().map(|s| s.runs).sum(),
+        failed_runs: sums.iter().map(|s| s.failed_runs).sum(),
     };
-    outputs.finish(&study, &docs, &opts)
+    let timing = Timing {
+        threads: used,
+        wall_time_s: walls,
+    };
+    let doc = ShardDoc::new(shard, "chunks", total);
+    shard::write_part(path, "montecarlo", config, &doc, &timing, &sums, &counted)
+}
+
+/// `scatterloc merge` of Monte Carlo parts (checked as a set by `merge`): the sums of every
+/// shard added exactly, then the outputs of the unsharded run.
+pub fn merge_parts(parts: &[Part], json: &str, out: Option<&str>) -> Result<(), CliError> {
+    let first = &parts[0];
+    let config = McConfig::deserialize(&first.config)
+        .map_err(|e| inconsistent(&first.path, format!("config: {e}")))?;
+    let (study, configs) = config.study().map_err(|e| inconsistent(&first.path, e))?;
+    // The configuration must be the one this build writes for that study.
+    let again = McConfig::of(
+        &study,
+        config.runs,
+        config.noise_runs,
+        config.seed,
+        config.oracle_noise,
+    )?;
+    let again = serde_json::to_value(&again)
+        .map_err(|e| CliError::output(format!("encoding JSON: {e}")))?;
+    if let Some(d) = differs(&again, &first.config) {
+        return Err(inconsistent(
+            &first.path,
+            format!("config is not as this scatterloc writes it ({d})"),
+        ));
+    }
+    let total = configs[0].chunk_count();
+    if first.shard.total != total {
+        return Err(inconsistent(
+            &first.path,
+            format!(
+                "shard.total {} is not the study's {total} chunks",
+                first.shard.total
+            ),
+        ));
+    }
+    let outputs = Outputs::parse(out, Some(json))?;
+
+    let mut merged: Vec<StudySums> = configs.iter().map(|c| StudySums::new(c.steps)).collect();
+    for part in parts {
+        let sums: Vec<StudySums> = sums_of(part)?;
+        let chunks = part.shard.range[0]..part.shard.range[1];
+        if sums.len() != configs.len() {
+            return Err(inconsistent(
+                &part.path,
+                format!("{} sums for {} trajectories", sums.len(), configs.len()),
+            ));
+        }
+        for ((m, s), cfg) in merged.iter_mut().zip(&sums).zip(&configs) {
+            let trajectories = cfg.trajectories_in(&chunks);
+            if !s.has_steps(cfg.steps)
+                || s.trajectories != trajectories
+                || s.runs + s.failed_runs != trajectories * cfg.noise_runs
+            {
+                return Err(inconsistent(
+                    &part.path,
+                    format!(
+                        "sums do not match chunks [{}, {}) of the study ({} steps, {trajectories} trajectories × {} noise runs)",
+                        chunks.start, chunks.end, cfg.steps, cfg.noise_runs
+                    ),
+                ));
+            }
+            m.merge(s);
+        }
+    }
+    let (timing, thread_s) = merged_timing(parts, configs.len())?;
+    let mut docs = Vec::new();
+    for (k, ((t, cfg), sums)) in study
+        .trajectories
+        .iter()
+        .zip(&configs)
+        .zip(&merged)
+        .enumerate()
+    {
+        let r = finish(cfg, sums).map_err(flag_error)?;
+        let time = RunTime {
+            wall_s: timing.wall_time_s[k],
+            thread_s: thread_s[k],
+            threads: timing.threads,
+        };
+        docs.push(mc_doc(&study, *t, cfg, r, time));
+    }
+    outputs.finish(&study, &docs, &chart_options(&study, &config))
 }
 
 /// The figure's note on the EKF runs that failed numerically (left out of `ε_EKF`), shown

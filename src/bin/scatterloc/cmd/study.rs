@@ -9,13 +9,13 @@ use std::time::{Duration, Instant};
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
 
-use scatterloc::native::{run_parallel, run_pcrlb_parallel};
+use scatterloc::native::{run_chunks_parallel, run_parallel, run_pcrlb_parallel};
 use scatterloc::track::ConstantVelocity;
 use scatterloc::track::{
     paper_initial_covariance, step_count, TrackScenario, PAPER_DURATION_S, PAPER_INTENSITY,
     PAPER_STEP_S,
 };
-use scatterloc::track::{MonteCarloConfig, MonteCarloResult, MAX_STEPS};
+use scatterloc::track::{MonteCarloConfig, MonteCarloResult, StudySums, MAX_STEPS};
 use scatterloc::{scenario::presets, Error, Model, Scenario};
 
 use super::io::{model_of, read_scenario};
@@ -34,6 +34,8 @@ static CANCEL: AtomicBool = AtomicBool::new(false);
 pub struct Study {
     /// Name of the node layout (preset or scenario file).
     pub layout: String,
+    /// The scenario (validated).
+    pub scenario: Scenario,
     /// The measurement model.
     pub model: Model,
     /// Trajectories to evaluate, in order.
@@ -110,16 +112,28 @@ pub fn parse_study(args: &StudyArgs) -> Result<Study, CliError> {
     let motion = ConstantVelocity::validated(dt, q).map_err(flag_error)?;
     let duration = args.duration.unwrap_or(PAPER_DURATION_S);
     let steps = checked_steps(duration, dt)?;
-    Ok(Study {
-        layout,
-        model: model_of(&scenario)?,
-        trajectories,
-        motion,
-        steps,
-    })
+    Study::new(layout, scenario, trajectories, motion, steps)
 }
 
 impl Study {
+    /// A study of `scenario` (validated) named `layout`.
+    pub fn new(
+        layout: String,
+        scenario: Scenario,
+        trajectories: Vec<TrackScenario>,
+        motion: ConstantVelocity,
+        steps: usize,
+    ) -> Result<Study, CliError> {
+        Ok(Study {
+            layout,
+            model: model_of(&scenario)?,
+            scenario,
+            trajectories,
+            motion,
+            steps,
+        })
+    }
+
     /// The Monte Carlo study of spec §9.5 for trajectory `t`: prior mean `x̄₀` of §9.4,
     /// `P(t₀) = diag(0.1, 0.1, 0.01, 0.01)`, validated (errors name the flags).
     pub fn config(
@@ -203,6 +217,21 @@ pub fn run_with_progress(
 ) -> Result<(MonteCarloResult, f64), CliError> {
     with_progress(cfg.runs(), "runs", label, |cancel, progress| {
         run_parallel(model, cfg, threads, cancel, progress)
+    })
+}
+
+/// The sums of the chunks `chunks` of `cfg` (a shard) with the progress bar of
+/// [`run_with_progress`] (counting the runs of these chunks) and its Ctrl-C handling.
+pub fn run_chunks_with_progress(
+    model: &Model,
+    cfg: &MonteCarloConfig,
+    chunks: std::ops::Range<usize>,
+    threads: usize,
+    label: &str,
+) -> Result<(StudySums, f64), CliError> {
+    let total = cfg.trajectories_in(&chunks) * cfg.noise_runs;
+    with_progress(total, "runs", label, |cancel, progress| {
+        run_chunks_parallel(model, cfg, chunks, threads, cancel, progress)
     })
 }
 

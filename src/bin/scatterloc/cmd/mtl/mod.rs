@@ -1,12 +1,12 @@
 //! `scatterloc mtl …`: the multi-target method of spec `multi-target.md` — `locate` (Algorithm 1
 //! on a network and ranges file, §4), `table2` (Table II, §8) and `roc` (the §8 experiments V-A,
-//! V-B, V-C with a progress bar, a summary table, JSON and a figure). The math is in
-//! `scatterloc::mtl`; these files turn the flags into its settings, call it and format the
-//! results.
+//! V-B, V-C with a progress bar, a summary table, JSON and a figure; sharded, and the merge of
+//! its parts). The math is in `scatterloc::mtl`; these files turn the flags into its settings,
+//! call it and format the results.
 
 use plotters::coord::Shift;
 use plotters::prelude::*;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use scatterloc::chart::{
     curve_chart_size, draw_curves, ChartError, CurveChartOptions, CurveSeries, LineKind, Marker,
@@ -14,7 +14,8 @@ use scatterloc::chart::{
 use scatterloc::mtl::algorithm::{locate, MtlConfig};
 use scatterloc::mtl::empirical::EmpiricalTable;
 use scatterloc::mtl::experiment::{
-    EmpiricalTraining, Experiment, ExperimentConfig, ExperimentResult, Method, MAX_REALISATIONS,
+    EmpiricalTraining, Experiment, ExperimentConfig, ExperimentResult, Method, Tally,
+    MAX_REALISATIONS,
 };
 use scatterloc::mtl::input::{
     from_json, target_reports, ModelSpec, NetworkInput, RangesInput, TargetReport, TrainingSpec,
@@ -22,11 +23,13 @@ use scatterloc::mtl::input::{
 };
 use scatterloc::mtl::sim::table2::{icb_row, table2_buckets, true_row};
 use scatterloc::mtl::sim::{LosModel, NodeLayout, SimSettings, VB_ICB_P_U};
-use scatterloc::native::run_experiment_parallel;
+use scatterloc::native::run_experiment_range;
 use scatterloc::Error;
 
 use super::io::{emit, read_input};
+use super::merge::{differs, inconsistent, merged_timing, sums_of, Part};
 use super::output::{check_writable, write_figure, write_json_file, Figure, Format};
+use super::shard::{self, ShardDoc, Timing};
 use super::study::{cancelled, run_with_bar, threads};
 use crate::cli::{MtlLocateArgs, MtlModel, RocArgs, RocExperiment, Table2Args};
 use crate::CliError;
@@ -36,7 +39,7 @@ mod roc;
 mod table2;
 
 pub use locate::mtl_locate;
-pub use roc::mtl_roc;
+pub use roc::{merge_roc, mtl_roc};
 pub use table2::mtl_table2;
 
 /// The flag that sets a core field, for messages.

@@ -1,21 +1,21 @@
 //! `scatterloc mtl roc`: the §8 experiments (V-A, V-B, V-C) under a progress bar, with a summary
-//! table, JSON and a figure.
+//! table, JSON and a figure; sharded (`--shard I/N`: a part file of the tally of its
+//! realisations) or whole, and the merge of its part files.
 
 use super::*;
 
-/// Runs `cfg` on `threads` threads under the shared progress bar ([`run_with_bar`]); Ctrl-C
-/// stops it with exit status 130. Returns the result and the wall time, s.
+/// Runs the realisations `range` of `cfg` on `threads` threads under the shared progress bar
+/// ([`run_with_bar`]) labelled `label`; Ctrl-C stops it with exit status 130. Returns the tally
+/// and the wall time, s.
 fn run_with_progress(
     cfg: &ExperimentConfig,
+    range: std::ops::Range<usize>,
     threads: usize,
-) -> Result<(ExperimentResult, f64), CliError> {
-    let label = format!("experiment {}", cfg.experiment.name());
-    let (res, wall) = run_with_bar(
-        cfg.realisations,
-        "realisations",
-        &label,
-        |cancel, progress| run_experiment_parallel(cfg, threads, cancel, progress),
-    )?;
+    label: &str,
+) -> Result<(Tally, f64), CliError> {
+    let (res, wall) = run_with_bar(range.len(), "realisations", label, |cancel, progress| {
+        run_experiment_range(cfg, range.clone(), threads, cancel, progress)
+    })?;
     Ok((res.map_err(|e| core_error(&e, "mtl roc"))?, wall))
 }
 
@@ -317,44 +317,60 @@ fn summary_table(r: &ExperimentResult, cfg: &ExperimentConfig, wall: f64, used: 
     t
 }
 
-/// `scatterloc mtl roc`.
-pub fn mtl_roc(args: &RocArgs) -> Result<(), CliError> {
-    let experiment = match args.experiment {
-        RocExperiment::Va => Experiment::Va,
-        RocExperiment::Vb => Experiment::Vb,
-        RocExperiment::Vc => Experiment::Vc,
-    };
+/// The flags that define an experiment (and its part files' `config`).
+struct RocFlags {
+    experiment: Experiment,
+    realisations: Option<usize>,
+    seed: u64,
+    exact: bool,
+    empirical: bool,
+    max_candidates: Option<usize>,
+}
+
+/// The validated configuration of `f` (errors name the flags).
+fn roc_config(f: &RocFlags) -> Result<ExperimentConfig, CliError> {
+    let experiment = f.experiment;
     let mut cfg = ExperimentConfig::new(experiment);
-    let n = args.realizations.unwrap_or(cfg.realisations);
+    let n = f.realisations.unwrap_or(cfg.realisations);
     if !(1..=MAX_REALISATIONS).contains(&n) {
         return Err(CliError::usage(format!(
             "--realizations: {n} is outside the allowed range 1..={MAX_REALISATIONS}"
         )));
     }
     cfg.realisations = n;
-    cfg.seed = args.seed.unwrap_or(1);
+    cfg.seed = f.seed;
     if experiment == Experiment::Va {
-        let only = [("empirical", args.empirical), ("exact", args.exact)];
-        if let Some((f, _)) = only.iter().find(|(_, given)| *given) {
+        let only = [("empirical", f.empirical), ("exact", f.exact)];
+        if let Some((flag, _)) = only.iter().find(|(_, given)| *given) {
             return Err(CliError::usage(format!(
-                "--{f}: not used with --experiment va (i.c.b only)"
+                "--{flag}: not used with --experiment va (i.c.b only)"
             )));
         }
     }
-    cfg.ppp_exact = args.exact;
-    if let Some(n) = args.max_candidates {
+    cfg.ppp_exact = f.exact;
+    if let Some(n) = f.max_candidates {
         cfg.mtl.max_candidates = n;
     }
-    if args.empirical {
+    if f.empirical {
         cfg.empirical = Some(EmpiricalTraining::default());
     }
     cfg.validate().map_err(|e| core_error(&e, "mtl roc"))?;
-    let (threads, used) = threads(args.threads)?;
-    let figure = match args.out.as_deref() {
+    Ok(cfg)
+}
+
+/// A figure to write: its path and format.
+type FigureOut<'a> = Option<(&'a str, Format)>;
+
+/// `--out` and `--json` of a result: formats checked, both writable.
+fn result_outputs<'a>(
+    out: Option<&'a str>,
+    json: Option<&'a str>,
+) -> Result<(FigureOut<'a>, Option<&'a str>), CliError> {
+    let figure = match out {
         Some(p) => Some((p, Format::of("out", p, &[Format::Svg, Format::Png])?)),
         None => None,
     };
-    let json = match args.json.as_deref() {
+    let json = match json {
         Some(p) => Format::of("json", p, &[Format::Json]).map(|_| Some(p))?,
         None => None,
     };
@@ -364,11 +380,149 @@ pub fn mtl_roc(args: &RocArgs) -> Result<(), CliError> {
     if let Some(p) = json {
         check_writable("json", p)?;
     }
+    Ok((figure, json))
+}
 
-    let (r, wall) = run_with_progress(&cfg, threads)?;
+/// `scatterloc mtl roc`.
+pub fn mtl_roc(args: &RocArgs) -> Result<(), CliError> {
+    let experiment = match args.experiment {
+        RocExperiment::Va => Experiment::Va,
+        RocExperiment::Vb => Experiment::Vb,
+        RocExperiment::Vc => Experiment::Vc,
+    };
+    let cfg = roc_config(&RocFlags {
+        experiment,
+        realisations: args.realizations,
+        seed: args.seed.unwrap_or(1),
+        exact: args.exact,
+        empirical: args.empirical,
+        max_candidates: args.max_candidates,
+    })?;
+    let (threads, used) = threads(args.threads)?;
+    if let Some(shard) = shard::resolve(&args.shard)? {
+        let path = shard::part_path(args.json.as_deref(), args.out.as_deref())?;
+        let range = shard.range(cfg.realisations);
+        let label = format!(
+            "experiment {} shard {}/{}",
+            experiment.name(),
+            shard.index(),
+            shard.count()
+        );
+        let (tally, wall) = run_with_progress(&cfg, range, threads, &label)?;
+        #[derive(Serialize)]
+        struct Counted {
+            realisations: usize,
+        }
+        let timing = Timing {
+            threads: used,
+            wall_time_s: vec![wall],
+        };
+        let doc = ShardDoc::new(shard, "realisations", cfg.realisations);
+        let counted = Counted {
+            realisations: tally.realisations(),
+        };
+        return shard::write_part(
+            &path,
+            "mtl-roc",
+            &config_doc(&cfg),
+            &doc,
+            &timing,
+            &tally,
+            &counted,
+        );
+    }
+    let (figure, json) = result_outputs(args.out.as_deref(), args.json.as_deref())?;
+    let label = format!("experiment {}", experiment.name());
+    let (tally, wall) = run_with_progress(&cfg, 0..cfg.realisations, threads, &label)?;
+    write_result(&cfg, &tally.finish(&cfg), wall, used, json, figure)
+}
+
+/// What a part's `config` says about the flags (the rest is checked against
+/// [`config_doc`]).
+#[derive(Deserialize)]
+struct RocKey {
+    experiment: String,
+    realisations: usize,
+    seed: u64,
+    ppp_exact: bool,
+    empirical: Option<serde::de::IgnoredAny>,
+    algorithm: AlgorithmKey,
+}
+
+#[derive(Deserialize)]
+struct AlgorithmKey {
+    max_candidates: usize,
+}
+
+/// `scatterloc merge` of `mtl roc` parts (checked as a set by `merge`): the tallies of every
+/// shard added exactly, then the outputs of the unsharded run.
+pub fn merge_roc(parts: &[Part], json: &str, out: Option<&str>) -> Result<(), CliError> {
+    let first = &parts[0];
+    let bad = |what: String| inconsistent(&first.path, what);
+    let key = RocKey::deserialize(&first.config).map_err(|e| bad(format!("config: {e}")))?;
+    let experiment = Experiment::parse(&key.experiment)
+        .ok_or_else(|| bad(format!("config.experiment: {:?}", key.experiment)))?;
+    let cfg = roc_config(&RocFlags {
+        experiment,
+        realisations: Some(key.realisations),
+        seed: key.seed,
+        exact: key.ppp_exact,
+        empirical: key.empirical.is_some(),
+        max_candidates: Some(key.algorithm.max_candidates),
+    })
+    .map_err(|e| bad(format!("config: {}", e.message)))?;
+    let again = serde_json::to_value(config_doc(&cfg))
+        .map_err(|e| CliError::output(format!("encoding JSON: {e}")))?;
+    if let Some(d) = differs(&again, &first.config) {
+        return Err(bad(format!(
+            "config is not as this scatterloc writes it ({d})"
+        )));
+    }
+    if first.shard.total != cfg.realisations {
+        return Err(bad(format!(
+            "shard.total {} is not the study's {} realisations",
+            first.shard.total, cfg.realisations
+        )));
+    }
+    let (figure, json) = result_outputs(out, Some(json))?;
+    let (curves, points) = (cfg.curves().len(), cfg.sweep.len());
+    let mut merged = Tally::new(curves, points);
+    for part in parts {
+        let tally: Tally = sums_of(part)?;
+        let len = part.shard.range[1] - part.shard.range[0];
+        if !tally.has_shape(curves, points) || tally.realisations() != len {
+            return Err(inconsistent(
+                &part.path,
+                format!("sums are not {len} realisations of {curves} curves × {points} thresholds"),
+            ));
+        }
+        merged.merge(&tally);
+    }
+    let (timing, _) = merged_timing(parts, 1)?;
+    let r = merged.finish(&cfg);
+    write_result(
+        &cfg,
+        &r,
+        timing.wall_time_s[0],
+        timing.threads,
+        json,
+        figure,
+    )
+}
+
+/// Writes the outputs of a result: the JSON file, the figure and the summary table on stdout.
+fn write_result(
+    cfg: &ExperimentConfig,
+    r: &ExperimentResult,
+    wall: f64,
+    used: usize,
+    json: Option<&str>,
+    figure: FigureOut,
+) -> Result<(), CliError> {
+    let experiment = cfg.experiment;
     if let Some(p) = json {
         let doc = RocDoc {
-            config: config_doc(&cfg),
+            config: config_doc(cfg),
             realisations: r.realisations,
             targets: r.targets,
             disagreements: r.disagreements,
@@ -412,8 +566,8 @@ pub fn mtl_roc(args: &RocArgs) -> Result<(), CliError> {
                     .collect()
             })
             .collect();
-        let fig = figure_of(&r, &cfg, &xy);
+        let fig = figure_of(r, cfg, &xy);
         write_figure("out", p, format, curve_chart_size(), &fig)?;
     }
-    emit(&summary_table(&r, &cfg, wall, used))
+    emit(&summary_table(r, cfg, wall, used))
 }
