@@ -24,11 +24,11 @@ use nalgebra::Cholesky;
 
 use crate::error::{check_len, limits, Error, Result};
 use crate::math::{sqrt, Mat4, Real, Vec2, Vec4, PI, SPEED_OF_LIGHT};
-use crate::measure::UNIT_VECTOR_MIN_DISTANCE_M;
-use crate::measure::{Model, SNR_DISTANCE_FLOOR_M};
+use crate::measure::Model;
 use crate::track::ConstantVelocity;
 
 mod batch;
+mod links;
 mod nees;
 
 pub(crate) use batch::update_lanes;
@@ -116,23 +116,11 @@ pub(crate) struct NodeView {
 impl NodeView {
     #[inline(always)]
     pub(crate) fn new(node: Vec2, r: Vec2) -> NodeView {
-        let (dx, dy) = (r.x - node.x, r.y - node.y);
-        let distance = sqrt(dx * dx + dy * dy);
-        let inv = 1.0 / distance;
-        let unit = if distance < UNIT_VECTOR_MIN_DISTANCE_M {
-            Vec2::zeros()
-        } else {
-            Vec2::new(dx * inv, dy * inv)
-        };
-        let inv_floored = if distance >= SNR_DISTANCE_FLOOR_M {
-            inv
-        } else {
-            1.0 / SNR_DISTANCE_FLOOR_M
-        };
+        let v = links::NodeViews::<1>::new(&[node.x], &[node.y], r);
         NodeView {
-            unit,
-            distance,
-            inv_floored_sq: inv_floored * inv_floored,
+            unit: Vec2::new(v.ux[0], v.uy[0]),
+            distance: v.distance[0],
+            inv_floored_sq: v.inv_floored_sq[0],
         }
     }
 }
@@ -141,6 +129,13 @@ impl NodeView {
 #[inline(always)]
 pub(crate) fn range_information_per_snr(model: &Model) -> Real {
     8.0 * PI * PI * model.beta2 / (SPEED_OF_LIGHT * SPEED_OF_LIGHT)
+}
+
+/// `1/(cσ)²` for a delay standard deviation `σ`, 1/m² (checked by the caller).
+#[inline(always)]
+fn information_from_sigma(sigma: Real) -> Real {
+    let r = SPEED_OF_LIGHT * sigma;
+    1.0 / (r * r)
 }
 
 /// Relative asymmetry tolerated in a user-supplied covariance.
