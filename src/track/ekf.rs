@@ -116,7 +116,7 @@ pub(crate) struct NodeView {
 impl NodeView {
     #[inline(always)]
     pub(crate) fn new(node: Vec2, r: Vec2) -> NodeView {
-        let v = links::NodeViews::<1>::new(&[node.x], &[node.y], r);
+        let v = links::NodeViews::<1>::new(&[node.x], &[node.y], &[r.x], &[r.y]);
         NodeView {
             unit: Vec2::new(v.ux[0], v.uy[0]),
             distance: v.distance[0],

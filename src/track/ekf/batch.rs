@@ -23,24 +23,25 @@ pub(crate) fn update_lanes<const L: usize>(
     z: [&[Option<Real>]; L],
     active: [bool; L],
     noise: MeasurementNoise,
-    mut innovation: impl FnMut(usize, usize, Real),
+    innovation: impl FnMut(usize, usize, Real),
 ) -> [Result<UpdateSummary>; L] {
+    let r_pred: [Vec2; L] = core::array::from_fn(|j| filters[j].position());
+    let info = link_information(model, &r_pred, &z, &active, noise, innovation);
     let mut out = [NO_UPDATE; L];
     for (j, out) in out.iter_mut().enumerate() {
+        let a = &info[j];
         if !active[j] {
             continue;
         }
-        let r_pred = filters[j].position();
-        let a = link_information(model, r_pred, z[j], noise, |p, nu| innovation(j, p, nu));
         if !a.valid {
             // On failure the inputs are re-scanned in link order for the named error.
-            if let Some(e) = first_input_error(model, z[j], noise, r_pred) {
+            if let Some(e) = first_input_error(model, z[j], noise, r_pred[j]) {
                 *out = Err(e);
                 continue;
             }
         }
         if a.links_used > 0 {
-            *out = filters[j].apply_information(&a);
+            *out = filters[j].apply_information(a);
         }
     }
     out

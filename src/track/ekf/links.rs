@@ -55,7 +55,8 @@ const NO_INFORMATION: Information = Information {
     valid: true,
 };
 
-/// Geometry of `B` nodes as seen from a point `r`, lane by lane: distance, unit vector node → `r`
+/// Geometry of `B` nodes as seen from `B` points (lane `i`: node `i` from point `i`): distance,
+/// unit vector node → point
 /// (zero closer than [`UNIT_VECTOR_MIN_DISTANCE_M`], as [`crate::measure::unit_from`]) and
 /// `1/max(d, 1 m)²` (the floored distance factor of the SNR, E8). One square root and one
 /// division per node.
@@ -68,8 +69,14 @@ pub(super) struct NodeViews<const B: usize> {
 }
 
 impl<const B: usize> NodeViews<B> {
+    /// Nodes `(x[i], y[i])` seen from the points `(px[i], py[i])`.
     #[inline(always)]
-    pub(super) fn new(x: &[Real; B], y: &[Real; B], r: Vec2) -> NodeViews<B> {
+    pub(super) fn new(
+        x: &[Real; B],
+        y: &[Real; B],
+        px: &[Real; B],
+        py: &[Real; B],
+    ) -> NodeViews<B> {
         let mut v = NodeViews {
             distance: [0.0; B],
             ux: [0.0; B],
@@ -77,7 +84,7 @@ impl<const B: usize> NodeViews<B> {
             inv_floored_sq: [0.0; B],
         };
         for i in 0..B {
-            let (dx, dy) = (r.x - x[i], r.y - y[i]);
+            let (dx, dy) = (px[i] - x[i], py[i] - y[i]);
             let distance = sqrt(dx * dx + dy * dy);
             let inv = 1.0 / distance;
             let near = distance < UNIT_VECTOR_MIN_DISTANCE_M;
@@ -106,6 +113,14 @@ struct TxView {
     gain: Real,
 }
 
+const NO_TX: TxView = TxView {
+    distance: 0.0,
+    ux: 0.0,
+    uy: 0.0,
+    inv_floored_sq: 0.0,
+    gain: 0.0,
+};
+
 /// Transmitters `first ..` (at most `B`, lanes past the last one unused) as seen from `r`.
 #[inline(always)]
 fn tx_views<const B: usize>(model: &Model, first: usize, r: Vec2, gain: bool) -> [TxView; B] {
@@ -114,14 +129,8 @@ fn tx_views<const B: usize>(model: &Model, first: usize, r: Vec2, gain: bool) ->
     for (i, node) in nodes.iter().take(B).enumerate() {
         (x[i], y[i]) = (node.x, node.y);
     }
-    let v = NodeViews::new(&x, &y, r);
-    let mut out = [TxView {
-        distance: 0.0,
-        ux: 0.0,
-        uy: 0.0,
-        inv_floored_sq: 0.0,
-        gain: 0.0,
-    }; B];
+    let v = NodeViews::new(&x, &y, &[r.x; B], &[r.y; B]);
+    let mut out = [NO_TX; B];
     for (i, pattern) in model.patterns[first..].iter().take(B).enumerate() {
         out[i] = TxView {
             distance: v.distance[i],
@@ -136,6 +145,25 @@ fn tx_views<const B: usize>(model: &Model, first: usize, r: Vec2, gain: bool) ->
         };
     }
     out
+}
+
+/// Transmitter `k` as seen from each of the points `r` (their gains evaluated side by side).
+#[inline(always)]
+fn tx_seen_from<const L: usize>(model: &Model, k: usize, r: &[Vec2; L], gain: bool) -> [TxView; L] {
+    let node = model.network.transmitters[k];
+    let v = NodeViews::new(&[node.x; L], &[node.y; L], &r.map(|r| r.x), &r.map(|r| r.y));
+    let gains = if gain {
+        model.patterns[k].gains_toward(v.ux, v.uy)
+    } else {
+        [0.0; L]
+    };
+    core::array::from_fn(|l| TxView {
+        distance: v.distance[l],
+        ux: v.ux[l],
+        uy: v.uy[l],
+        inv_floored_sq: v.inv_floored_sq[l],
+        gain: gains[l],
+    })
 }
 
 /// How a link's `w = 1/(cσ_p)²` follows from the noise option: one implementation per
@@ -207,107 +235,132 @@ impl Weights for AtPoint<'_> {
     }
 }
 
-/// Pass 1 for one filter with predicted position `r` and delays `z` (one per link, length checked
-/// by the caller): the sums over the available links (module docs). `innovation(p, ν_p)`
-/// receives each used link's range innovation, m, in link order.
+/// Pass 1 for `L` filters with predicted positions `r[j]` and delays `z[j]` (one per link,
+/// lengths checked by the caller; `active[j] = false` skips filter `j`): the sums over the
+/// available links (module docs). The filters' transmitter gains, the longest dependency chain
+/// of an update, are evaluated side by side. `innovation(j, p, ν_p)` receives each used link's
+/// range innovation, m, in link order.
 #[inline(always)]
-pub(super) fn link_information(
+pub(super) fn link_information<const L: usize>(
     model: &Model,
-    r: Vec2,
-    z: &[Option<Real>],
+    r: &[Vec2; L],
+    z: &[&[Option<Real>]; L],
+    active: &[bool; L],
     noise: MeasurementNoise,
-    innovation: impl FnMut(usize, Real),
-) -> Information {
+    innovation: impl FnMut(usize, usize, Real),
+) -> [Information; L] {
     match noise {
         MeasurementNoise::AtPrediction => {
             let w = AtPrediction {
                 snr_scale: &model.snr_scale,
                 info_per_snr: range_information_per_snr(model),
             };
-            with_transmitters(model, r, z, &w, innovation)
+            with_transmitters(model, r, z, active, &w, innovation)
         }
-        MeasurementNoise::Fixed(sigma) => with_transmitters(model, r, z, &Given(sigma), innovation),
+        MeasurementNoise::Fixed(sigma) => {
+            with_transmitters(model, r, z, active, &Given(sigma), innovation)
+        }
         MeasurementNoise::At(point) => {
-            with_transmitters(model, r, z, &AtPoint { model, point }, innovation)
+            let w = AtPoint { model, point };
+            with_transmitters(model, r, z, active, &w, innovation)
         }
     }
 }
 
-/// [`link_information`] with the transmitters' views evaluated once.
+/// [`link_information`] with the transmitters' views evaluated once per filter.
 #[inline(always)]
-fn with_transmitters<W: Weights>(
+fn with_transmitters<W: Weights, const L: usize>(
     model: &Model,
-    r: Vec2,
-    z: &[Option<Real>],
+    r: &[Vec2; L],
+    z: &[&[Option<Real>]; L],
+    active: &[bool; L],
     w: &W,
-    innovation: impl FnMut(usize, Real),
-) -> Information {
+    innovation: impl FnMut(usize, usize, Real),
+) -> [Information; L] {
     if model.network.transmitters.len() == 1 {
-        // One transmitter (both presets): the same view for every link.
-        let [tx] = tx_views::<1>(model, 0, r, W::GAIN);
-        return blocks(model, r, z, w, |_| tx, innovation);
+        // One transmitter (both presets): the same view for every link of a filter.
+        let tx = tx_seen_from(model, 0, r, W::GAIN);
+        return blocks(model, r, z, active, w, |j, _| tx[j], innovation);
     }
-    let table = tx_views::<TX_TABLE>(model, 0, r, W::GAIN);
-    // The last transmitter past the table that a link needed, and its view.
-    let mut spill = (usize::MAX, table[0]);
-    let tx_view = |k: usize| {
+    let table: [[TxView; TX_TABLE]; L] =
+        core::array::from_fn(|j| tx_views::<TX_TABLE>(model, 0, r[j], W::GAIN));
+    // Per filter the last transmitter past the table that a link needed, and its view.
+    let mut spill = [(usize::MAX, NO_TX); L];
+    let tx_view = |j: usize, k: usize| {
         if k < TX_TABLE {
-            table[k]
+            table[j][k]
         } else {
-            if spill.0 != k {
-                spill = (k, tx_views::<1>(model, k, r, W::GAIN)[0]);
+            if spill[j].0 != k {
+                spill[j] = (k, tx_views::<1>(model, k, r[j], W::GAIN)[0]);
             }
-            spill.1
+            spill[j].1
         }
     };
-    blocks(model, r, z, w, tx_view, innovation)
+    blocks(model, r, z, active, w, tx_view, innovation)
 }
 
 /// The full blocks of links, then the last one padded with unused lanes (which repeat the last
-/// link, without a measurement).
+/// link, without a measurement); per block the active filters one after the other.
 #[inline(always)]
-fn blocks<W: Weights>(
+fn blocks<W: Weights, const L: usize>(
     model: &Model,
-    r: Vec2,
-    z: &[Option<Real>],
+    r: &[Vec2; L],
+    z: &[&[Option<Real>]; L],
+    active: &[bool; L],
     w: &W,
-    mut tx_view: impl FnMut(usize) -> TxView,
-    mut innovation: impl FnMut(usize, Real),
-) -> Information {
+    mut tx_view: impl FnMut(usize, usize) -> TxView,
+    mut innovation: impl FnMut(usize, usize, Real),
+) -> [Information; L] {
     let links = &model.network.links[..];
     let n = links.len();
-    let z = &z[..n];
+    let z = z.map(|z| &z[..n]);
     let full = n - n % BLOCK;
-    let mut acc = NO_INFORMATION;
+    let mut acc = [NO_INFORMATION; L];
     for first in (0..full).step_by(BLOCK) {
-        let (links, z) = (fixed(&links[first..]), fixed(&z[first..]));
-        add_block(
-            &mut acc,
-            model,
-            r,
-            w,
-            first,
-            &links,
-            &z,
-            &mut tx_view,
-            &mut innovation,
-        );
+        let block_links = fixed(&links[first..]);
+        for j in 0..L {
+            if active[j] {
+                let block_z = fixed(&z[j][first..]);
+                let (a, r) = (&mut acc[j], r[j]);
+                let mut tx = |k| tx_view(j, k);
+                let mut inn = |p, nu| innovation(j, p, nu);
+                add_block(
+                    a,
+                    model,
+                    r,
+                    w,
+                    first,
+                    &block_links,
+                    &block_z,
+                    &mut tx,
+                    &mut inn,
+                );
+            }
+        }
     }
     if full < n {
-        let (mut block_links, mut block_z) = ([links[n - 1]; BLOCK], [None; BLOCK]);
+        let mut block_links = [links[n - 1]; BLOCK];
         block_links[..n - full].copy_from_slice(&links[full..]);
-        block_z[..n - full].copy_from_slice(&z[full..]);
-        add_block(
-            &mut acc,
-            model,
-            r,
-            w,
-            full,
-            &block_links,
-            &block_z,
-            &mut tx_view,
-            &mut innovation,
-        );
+        for j in 0..L {
+            if active[j] {
+                let mut block_z = [None; BLOCK];
+                block_z[..n - full].copy_from_slice(&z[j][full..]);
+                let (a, r) = (&mut acc[j], r[j]);
+                let mut tx = |k| tx_view(j, k);
+                let mut inn = |p, nu| innovation(j, p, nu);
+                add_block(
+                    a,
+                    model,
+                    r,
+                    w,
+                    full,
+                    &block_links,
+                    &block_z,
+                    &mut tx,
+                    &mut inn,
+                );
+            }
+        }
     }
     acc
 }
@@ -348,7 +401,7 @@ fn add_block<W: Weights>(
             valid &= ok & limits::DELAY_S.contains(v);
         }
     }
-    let rv = NodeViews::<BLOCK>::new(&rx_x, &rx_y, r);
+    let rv = NodeViews::<BLOCK>::new(&rx_x, &rx_y, &[r.x; BLOCK], &[r.y; BLOCK]);
     // Per link the terms of the sums; every used w positive, every z and w finite.
     let mut t = [[0.0; BLOCK]; 6];
     let mut nu = [0.0; BLOCK];
