@@ -77,7 +77,7 @@ pub fn mesh(k: usize, l: usize) -> Model {
             pattern: if i % 2 == 1 {
                 Pattern::Omni
             } else {
-                tx.pattern.clone()
+                tx.pattern
             },
             ..tx.clone()
         })

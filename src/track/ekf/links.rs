@@ -403,7 +403,7 @@ fn add_block<W: Weights>(
     }
     let rv = NodeViews::<BLOCK>::new(&rx_x, &rx_y, &[r.x; BLOCK], &[r.y; BLOCK]);
     // Per link the terms of the sums; every used w positive, every z and w finite.
-    let mut t = [[0.0; BLOCK]; 6];
+    let mut t = [[0.0; 6]; BLOCK];
     let mut nu = [0.0; BLOCK];
     let (mut positive, mut finite) = (0, 0.0);
     for i in 0..BLOCK {
@@ -417,23 +417,25 @@ fn add_block<W: Weights>(
         nu[i] = if used[i] { range } else { 0.0 };
         let (gx, gy) = (tx[i].ux + rv.ux[i], tx[i].uy + rv.uy[i]);
         let (wgx, wgy) = (wi * gx, wi * gy);
-        t[0][i] = wgx * gx;
-        t[1][i] = wgx * gy;
-        t[2][i] = wgy * gy;
-        t[3][i] = wgx * nu[i];
-        t[4][i] = wgy * nu[i];
-        t[5][i] = wi * nu[i] * nu[i];
+        t[i] = [
+            wgx * gx,
+            wgx * gy,
+            wgy * gy,
+            wgx * nu[i],
+            wgy * nu[i],
+            wi * nu[i] * nu[i],
+        ];
         positive += (wi > 0.0) as usize;
         finite += finite_probe(zv[i]) + wi;
     }
     // The sums in link order.
-    for i in 0..BLOCK {
-        acc.m00 += t[0][i];
-        acc.m01 += t[1][i];
-        acc.m11 += t[2][i];
-        acc.b0 += t[3][i];
-        acc.b1 += t[4][i];
-        acc.nu_info_nu += t[5][i];
+    for [m00, m01, m11, b0, b1, nu_info_nu] in t {
+        acc.m00 += m00;
+        acc.m01 += m01;
+        acc.m11 += m11;
+        acc.b0 += b0;
+        acc.b1 += b1;
+        acc.nu_info_nu += nu_info_nu;
     }
     // Unused lanes have w = 0: every used one has w > 0 iff `positive` counts the used lanes.
     let count = used.iter().filter(|&&u| u).count();
