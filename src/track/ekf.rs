@@ -19,6 +19,14 @@
 //! No allocation, one 2 × 2 inverse per update and no per-row division: `R⁻¹` is the link's
 //! delay information from the link budget (E8). Internally ranges (`cτ`, `c²R`, `cJ`) are used,
 //! which the spec states is identical to the delay domain.
+//!
+//! A step (issue 13 §3) uses fixed-size types only: the predict works on the 10 unique entries
+//! of `P` (E7), pass 1 (`links`) evaluates the delays (E1), Jacobian rows (E3) and SNR (E8) of
+//! the links together in fixed blocks of 4 links, with each transmitter's geometry and gain
+//! evaluated once, and pass 2 (`batch`) is the 2 × 2 batch update above (S16–S17). The noise
+//! option is resolved once per update; the Monte Carlo harness updates 4 filters per call with
+//! their transmitter gains, the longest dependency chain of an update, side by side. The sums
+//! of pass 1 are added in link order, so the results are bitwise those of a link-by-link loop.
 
 use nalgebra::Cholesky;
 
@@ -105,7 +113,8 @@ pub struct Ekf {
 
 /// Geometry of one node as seen from a point `r`: the unit vector node → `r` (zero when they
 /// nearly coincide, as [`crate::measure::unit_from`]), the distance and `1/max(d, 1 m)²` (the
-/// floored distance factor of the SNR, E8). One division and one square root.
+/// floored distance factor of the SNR, E8). One division and one square root; lane 0 of the
+/// EKF's `links::NodeViews`.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct NodeView {
     pub(crate) unit: Vec2,

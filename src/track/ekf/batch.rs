@@ -1,6 +1,6 @@
-//! The EKF update of `L` filters at once: pass 1 per filter ([`link_information`]), the folded
-//! input checks, and pass 2, the batch Joseph-form update in the position space (derivation in
-//! the [`ekf`](super) module docs).
+//! The EKF update of `L` filters at once: pass 1 ([`link_information`], E1, E3, E8), the folded
+//! input checks, and pass 2, the batch Joseph-form update in the position space (S16–S17;
+//! derivation in the [`ekf`](super) module docs).
 
 use super::links::{link_information, Information};
 use super::{finite_probe, information_from_sigma, positive_finite};
