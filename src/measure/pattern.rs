@@ -64,19 +64,28 @@ impl TxPattern {
     /// bound, map, simulation, EKF — sees the same gain without an `acos` and `exp` per call.
     #[inline(always)]
     pub fn gain_toward(&self, u: Vec2) -> Real {
-        match &self.beam {
-            None => self.peak_gain,
-            Some(b) => {
-                if u.x == 0.0 && u.y == 0.0 {
-                    return self.peak_gain;
-                }
-                let c = u.x * b.boresight.x + u.y * b.boresight.y;
-                match &self.polynomial {
-                    Some(poly) => poly.gain_at_cos(c),
-                    None => self.gain_toward_cos(c),
-                }
+        self.gains_toward([u.x], [u.y])[0]
+    }
+
+    /// [`TxPattern::gain_toward`] for `L` directions `(ux[l], uy[l])` at once, lane by lane the
+    /// same operations (bitwise equal results); the Chebyshev recurrences of the lanes run side
+    /// by side (the EKF updating several filters, the map kernel).
+    #[inline(always)]
+    pub fn gains_toward<const L: usize>(&self, ux: [Real; L], uy: [Real; L]) -> [Real; L] {
+        let Some(b) = &self.beam else {
+            return [self.peak_gain; L];
+        };
+        let c: [Real; L] = core::array::from_fn(|l| ux[l] * b.boresight.x + uy[l] * b.boresight.y);
+        let mut gains = match &self.polynomial {
+            Some(poly) => poly.gains_at_cos(c),
+            None => c.map(|c| self.gain_toward_cos(c)),
+        };
+        for l in 0..L {
+            if ux[l] == 0.0 && uy[l] == 0.0 {
+                gains[l] = self.peak_gain;
             }
         }
+        gains
     }
 }
 

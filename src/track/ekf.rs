@@ -19,16 +19,24 @@
 //! No allocation, one 2 × 2 inverse per update and no per-row division: `R⁻¹` is the link's
 //! delay information from the link budget (E8). Internally ranges (`cτ`, `c²R`, `cJ`) are used,
 //! which the spec states is identical to the delay domain.
+//!
+//! A step (issue 13 §3) uses fixed-size types only: the predict works on the 10 unique entries
+//! of `P` (E7), pass 1 (`links`) evaluates the delays (E1), Jacobian rows (E3) and SNR (E8) of
+//! the links together in fixed blocks of 4 links, with each transmitter's geometry and gain
+//! evaluated once, and pass 2 (`batch`) is the 2 × 2 batch update above (S16–S17). The noise
+//! option is resolved once per update; the Monte Carlo harness updates 4 filters per call with
+//! their transmitter gains, the longest dependency chain of an update, side by side. The sums
+//! of pass 1 are added in link order, so the results are bitwise those of a link-by-link loop.
 
 use nalgebra::Cholesky;
 
 use crate::error::{check_len, limits, Error, Result};
 use crate::math::{sqrt, Mat4, Real, Vec2, Vec4, PI, SPEED_OF_LIGHT};
-use crate::measure::UNIT_VECTOR_MIN_DISTANCE_M;
-use crate::measure::{Model, SNR_DISTANCE_FLOOR_M};
+use crate::measure::Model;
 use crate::track::ConstantVelocity;
 
 mod batch;
+mod links;
 mod nees;
 
 pub(crate) use batch::update_lanes;
@@ -105,7 +113,8 @@ pub struct Ekf {
 
 /// Geometry of one node as seen from a point `r`: the unit vector node → `r` (zero when they
 /// nearly coincide, as [`crate::measure::unit_from`]), the distance and `1/max(d, 1 m)²` (the
-/// floored distance factor of the SNR, E8). One division and one square root.
+/// floored distance factor of the SNR, E8). One division and one square root; lane 0 of the
+/// EKF's `links::NodeViews`.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct NodeView {
     pub(crate) unit: Vec2,
@@ -116,23 +125,11 @@ pub(crate) struct NodeView {
 impl NodeView {
     #[inline(always)]
     pub(crate) fn new(node: Vec2, r: Vec2) -> NodeView {
-        let (dx, dy) = (r.x - node.x, r.y - node.y);
-        let distance = sqrt(dx * dx + dy * dy);
-        let inv = 1.0 / distance;
-        let unit = if distance < UNIT_VECTOR_MIN_DISTANCE_M {
-            Vec2::zeros()
-        } else {
-            Vec2::new(dx * inv, dy * inv)
-        };
-        let inv_floored = if distance >= SNR_DISTANCE_FLOOR_M {
-            inv
-        } else {
-            1.0 / SNR_DISTANCE_FLOOR_M
-        };
+        let v = links::NodeViews::<1>::new(&[node.x], &[node.y], &[r.x], &[r.y]);
         NodeView {
-            unit,
-            distance,
-            inv_floored_sq: inv_floored * inv_floored,
+            unit: Vec2::new(v.ux[0], v.uy[0]),
+            distance: v.distance[0],
+            inv_floored_sq: v.inv_floored_sq[0],
         }
     }
 }
@@ -141,6 +138,13 @@ impl NodeView {
 #[inline(always)]
 pub(crate) fn range_information_per_snr(model: &Model) -> Real {
     8.0 * PI * PI * model.beta2 / (SPEED_OF_LIGHT * SPEED_OF_LIGHT)
+}
+
+/// `1/(cσ)²` for a delay standard deviation `σ`, 1/m² (checked by the caller).
+#[inline(always)]
+fn information_from_sigma(sigma: Real) -> Real {
+    let r = SPEED_OF_LIGHT * sigma;
+    1.0 / (r * r)
 }
 
 /// Relative asymmetry tolerated in a user-supplied covariance.

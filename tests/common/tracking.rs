@@ -1,9 +1,12 @@
 //! Helpers of the `tracking_*` tests (spec §6, §8, §9.5): the fast-profile motion model, the
-//! §9.5 Monte Carlo study of a scenario, step indices and covariance comparisons.
+//! §9.5 Monte Carlo study of a scenario, step indices, covariance comparisons and larger
+//! networks than the presets.
 
 use scatterloc::math::{Mat4, Real};
+use scatterloc::scenario::{presets, Pattern, Receiver, Transmitter};
 use scatterloc::track::{paper_initial_covariance, step_count, TrackScenario, PAPER_INTENSITY};
 use scatterloc::track::{ConstantVelocity, MonteCarloConfig};
+use scatterloc::Model;
 
 /// The spec's fast profile step (§9.5), s.
 pub const FAST_STEP_S: Real = 0.1;
@@ -56,4 +59,36 @@ pub fn covariance_close(what: &str, a: &Mat4, b: &Mat4, rel: Real) {
             );
         }
     }
+}
+
+/// A full mesh of `k` transmitters and `l` receivers around the `sensors2019` area (its radio
+/// and node parameters; the odd-numbered transmitters omni, the others its parabolic pattern):
+/// `k·l` links, transmitter fastest (spec §1). The EKF evaluates links in blocks of 4 and keeps
+/// the views of the first 4 transmitters in a table, so meshes such as 3 × 3 and 5 × 2 exercise
+/// a padded last block, links of different transmitters in one block and transmitters past the
+/// table.
+pub fn mesh(k: usize, l: usize) -> Model {
+    let mut s = presets::sensors2019();
+    let tx = s.transmitters[0].clone();
+    s.transmitters = (0..k)
+        .map(|i| Transmitter {
+            name: format!("T{i}"),
+            position_m: [3.0 * i as Real - 2.0, -1.0 + 0.5 * i as Real],
+            pattern: if i % 2 == 1 {
+                Pattern::Omni
+            } else {
+                tx.pattern
+            },
+            ..tx.clone()
+        })
+        .collect();
+    let rx = s.receivers[0].clone();
+    s.receivers = (0..l)
+        .map(|i| Receiver {
+            name: format!("R{i}"),
+            position_m: [-6.0 + 4.5 * i as Real, if i % 2 == 0 { 12.0 } else { -8.0 }],
+            ..rx.clone()
+        })
+        .collect();
+    Model::new(&s).expect("a valid mesh")
 }

@@ -53,3 +53,45 @@ fn spec_gains_toward_l4_receivers() {
     assert!((toward(-6.0, -8.0) + 11.0).abs() < 1e-12);
     assert!((toward(12.0, -6.0) - 5.73).abs() < 5e-3);
 }
+
+/// `gains_toward` for 4 directions at once is, lane by lane and bitwise, the one-direction gain:
+/// the peak gain for a zero direction (a point on the Tx), else the polynomial (or, without one,
+/// the exact formula) at `c = u·boresight`; for omni patterns the peak gain.
+#[test]
+fn gains_toward_is_gain_toward_per_lane() {
+    let patterns = [
+        parabolic(70.0, 20.0),
+        parabolic(70.0, 80.0),
+        TxPattern::new(8.0, &Pattern::Omni),
+    ];
+    for p in &patterns {
+        let one = |u: Vec2| -> Real {
+            let Some(b) = &p.beam else {
+                return p.peak_gain;
+            };
+            if u.x == 0.0 && u.y == 0.0 {
+                return p.peak_gain;
+            }
+            let c = u.x * b.boresight.x + u.y * b.boresight.y;
+            match &p.polynomial {
+                Some(poly) => poly.gain_at_cos(c),
+                None => p.gain_toward_cos(c),
+            }
+        };
+        for i in 0..250 {
+            let dirs: [Vec2; 4] = core::array::from_fn(|l| {
+                if (i + l) % 7 == 0 {
+                    Vec2::zeros()
+                } else {
+                    let phi = 2.0 * PI * (4 * i + l) as Real / 997.0;
+                    Vec2::new(cos(phi), sin(phi))
+                }
+            });
+            let got = p.gains_toward(dirs.map(|u| u.x), dirs.map(|u| u.y));
+            for (g, u) in got.iter().zip(&dirs) {
+                assert_eq!(g.to_bits(), one(*u).to_bits(), "{u:?}");
+                assert_eq!(g.to_bits(), p.gain_toward(*u).to_bits(), "{u:?}");
+            }
+        }
+    }
+}

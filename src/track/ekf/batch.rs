@@ -1,57 +1,21 @@
-//! Pass 1 and pass 2 of the EKF update for `L` filters at once: the links' position
-//! information `M`, `b`, `νᵀR⁻¹ν` and the batch Joseph-form update in the position space
-//! (derivation in the [`ekf`](super) module docs), with the folded input checks.
+//! The EKF update of `L` filters at once: pass 1 ([`link_information`], E1, E3, E8), the folded
+//! input checks, and pass 2, the batch Joseph-form update in the position space (S16–S17;
+//! derivation in the [`ekf`](super) module docs).
 
-use super::{
-    finite_probe, positive_finite, range_information_per_snr, Ekf, MeasurementNoise, NodeView,
-    UpdateSummary,
-};
+use super::links::{link_information, Information};
+use super::{finite_probe, information_from_sigma, positive_finite};
+use super::{Ekf, MeasurementNoise, UpdateSummary};
 use crate::error::{limits, Error, Result};
-use crate::math::{Mat4, Real, Vec2, Vec4, SPEED_OF_LIGHT};
+use crate::math::{Mat4, Real, Vec2, Vec4};
 use crate::measure::Model;
-
-/// Running sums of pass 1 of an update for one filter (module docs): `M`, `b`, `νᵀR⁻¹ν`, the
-/// number of links used and the folded input checks.
-#[derive(Debug, Clone, Copy)]
-struct Information {
-    m00: Real,
-    m01: Real,
-    m11: Real,
-    b0: Real,
-    b1: Real,
-    nu_info_nu: Real,
-    links_used: usize,
-    /// Every `σ_p` and `w` positive.
-    positive: bool,
-    /// `Σ (z_p − z_p) + w`: finite iff every used `z_p` and `w` is finite (`is_finite` becomes
-    /// an integer classification sequence in the hot loop; this is two float operations).
-    finite_sum: Real,
-}
-
-const NO_INFORMATION: Information = Information {
-    m00: 0.0,
-    m01: 0.0,
-    m11: 0.0,
-    b0: 0.0,
-    b1: 0.0,
-    nu_info_nu: 0.0,
-    links_used: 0,
-    positive: true,
-    finite_sum: 0.0,
-};
-
-const NO_VIEW: NodeView = NodeView {
-    unit: Vec2::new(0.0, 0.0),
-    distance: 0.0,
-    inv_floored_sq: 0.0,
-};
 
 /// The EKF update of `L` independent filters against the same model and noise option, each
 /// with its own delays `z[j]` (lengths checked by the caller); `active[j] = false` skips filter
 /// `j` (its result is a zero summary). `L = 1` is [`Ekf::update`]; the Monte Carlo harness
-/// advances a few noise runs together so that the processor overlaps their dependency chains
+/// updates a few noise runs in one call so that the processor overlaps their dependency chains
 /// (the arithmetic of each filter is the same as with `L = 1`, so results are bitwise equal).
-/// `innovation(j, p, ν_p)` receives each used link's range innovation, m.
+/// `innovation(j, p, ν_p)` receives each used link's range innovation, m. No allocation unless
+/// an input is bad (the error names it).
 #[inline(always)]
 pub(crate) fn update_lanes<const L: usize>(
     filters: &mut [Ekf; L],
@@ -59,76 +23,24 @@ pub(crate) fn update_lanes<const L: usize>(
     z: [&[Option<Real>]; L],
     active: [bool; L],
     noise: MeasurementNoise,
-    mut innovation: impl FnMut(usize, usize, Real),
+    innovation: impl FnMut(usize, usize, Real),
 ) -> [Result<UpdateSummary>; L] {
-    let r_pred: [Vec2; L] =
-        core::array::from_fn(|j| Vec2::new(filters[j].state[0], filters[j].state[1]));
-    let info_per_snr = range_information_per_snr(model);
-    // Pass 1: M = Σ w g gᵀ, b = Σ w ν g, νᵀR⁻¹ν over the available links, with g = cJ_p(r̂⁻),
-    // ν = cz_p − (d_Tx + d_Rx), w = 1/(cσ_p)². The links are independent (no chain through P).
-    let mut acc = [NO_INFORMATION; L];
-    // Geometry and gain toward r̂⁻ of the current transmitter (links of one Tx share it).
-    let (mut tx_seen, mut tx_view, mut tx_gain) = (usize::MAX, [NO_VIEW; L], [0.0; L]);
-    let links = model.network.links.iter().zip(&model.snr_scale);
-    for (link, (l, snr_scale)) in links.enumerate() {
-        if l.tx != tx_seen {
-            tx_seen = l.tx;
-            let tx = model.network.transmitters[l.tx];
-            for j in 0..L {
-                tx_view[j] = NodeView::new(tx, r_pred[j]);
-                if matches!(noise, MeasurementNoise::AtPrediction) {
-                    tx_gain[j] = model.patterns[l.tx].gain_toward(tx_view[j].unit);
-                }
-            }
-        }
-        let rx = model.network.receivers[l.rx];
-        for j in 0..L {
-            let (Some(zi), true) = (z[j][link], active[j]) else {
-                continue;
-            };
-            let (tv, gain, a) = (tx_view[j], tx_gain[j], &mut acc[j]);
-            let rv = NodeView::new(rx, r_pred[j]);
-            let (w, sigma_positive) = match noise {
-                MeasurementNoise::Fixed(s) => (
-                    information_from_sigma(s[link]),
-                    limits::DELAY_SIGMA_S.contains(s[link]),
-                ),
-                MeasurementNoise::AtPrediction => (
-                    info_per_snr * (snr_scale * gain * tv.inv_floored_sq * rv.inv_floored_sq),
-                    true,
-                ),
-                MeasurementNoise::At(r) => {
-                    let sigma = model.sigma_delay(link, r);
-                    (information_from_sigma(sigma), sigma > 0.0)
-                }
-            };
-            a.positive &= sigma_positive & (w > 0.0) & limits::DELAY_S.contains(zi);
-            a.finite_sum += finite_probe(zi) + w;
-            let nu = SPEED_OF_LIGHT * zi - (tv.distance + rv.distance);
-            innovation(j, link, nu);
-            let (gx, gy) = (tv.unit.x + rv.unit.x, tv.unit.y + rv.unit.y);
-            let (wgx, wgy) = (w * gx, w * gy);
-            a.m00 += wgx * gx;
-            a.m01 += wgx * gy;
-            a.m11 += wgy * gy;
-            a.b0 += wgx * nu;
-            a.b1 += wgy * nu;
-            a.nu_info_nu += w * nu * nu;
-            a.links_used += 1;
-        }
-    }
-    // Pass 2, per filter.
+    let r_pred: [Vec2; L] = core::array::from_fn(|j| filters[j].position());
+    let info = link_information(model, &r_pred, &z, &active, noise, innovation);
     let mut out = [NO_UPDATE; L];
     for (j, out) in out.iter_mut().enumerate() {
-        let a = &acc[j];
-        if !(a.positive && a.finite_sum < Real::INFINITY) {
+        let a = &info[j];
+        if !active[j] {
+            continue;
+        }
+        if !a.valid {
             // On failure the inputs are re-scanned in link order for the named error.
             if let Some(e) = first_input_error(model, z[j], noise, r_pred[j]) {
                 *out = Err(e);
                 continue;
             }
         }
-        if active[j] && a.links_used > 0 {
+        if a.links_used > 0 {
             *out = filters[j].apply_information(a);
         }
     }
@@ -271,13 +183,6 @@ impl Ekf {
 /// ([`Ekf::apply_information_wide`]): the covariance form's relative rounding error grows like
 /// `ε·tr(M P_rr)`, here ≈ 2·10⁻¹⁰.
 const WIDE_PRIOR: Real = 1e6;
-
-/// `1/(cσ)²` for a delay standard deviation `σ`, 1/m² (checked by the caller).
-#[inline(always)]
-fn information_from_sigma(sigma: Real) -> Real {
-    let r = SPEED_OF_LIGHT * sigma;
-    1.0 / (r * r)
-}
 
 /// The first bad input of an update in link order (slow path, after the accumulated checks
 /// failed): a delay outside [`limits::DELAY_S`], a given (`Fixed`) `σ_p` outside
