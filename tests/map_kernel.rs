@@ -235,6 +235,9 @@ fn row_ranges_outside_the_grid_are_errors() {
     assert!(crlb_map_rows(&m, &grid, 3, &mut two_rows).is_err());
     let mut ragged = vec![0.0; 12];
     assert!(crlb_map_rows(&m, &grid, 0, &mut ragged).is_err());
+    // A whole number of rows that is not the whole grid is still the wrong buffer for a map.
+    let mut three_rows = vec![0.0; 24];
+    assert!(crlb_map(&m, &grid, &mut three_rows).is_err());
     let mut whole = vec![0.0; 31];
     assert!(scatterloc::native::crlb_map_parallel(&m, &grid, &mut whole, 0).is_err());
 }

@@ -94,6 +94,7 @@ impl Grid {
 /// relative from the exact §9.3 formula) when it can be fitted, else the exact formula. One
 /// thread; `crate::native::crlb_map_parallel` splits the rows over threads.
 pub fn crlb_map(model: &Model, grid: &Grid, out: &mut [Real]) -> Result<()> {
+    check_len("map buffer", grid.len(), out.len())?;
     crlb_map_rows(model, grid, 0, out)
 }
 
