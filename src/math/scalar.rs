@@ -1,14 +1,6 @@
 //! Scalar and small-matrix aliases, physical constants and the few elementary functions the
 //! core needs. With `std` the platform's libm is used; without it the `libm` crate, so the same
-//! code builds for `wasm32v1-none`. Also the two pieces that make a study's result independent
-//! of how its work is split: [`ExactSum`] (exact, order-independent sums) and [`Shard`] (one of
-//! `N` contiguous shares of a study's work units).
-
-mod exact_sum;
-mod shard;
-
-pub use exact_sum::ExactSum;
-pub use shard::{Shard, MAX_SHARDS};
+//! code builds for `wasm32v1-none`.
 
 /// The one floating-point type of the crate.
 pub type Real = f64;
