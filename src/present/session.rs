@@ -32,15 +32,21 @@ impl Session {
 
     /// Applies `f` to a copy of the scenario; commits it and its recompiled model only if `f`
     /// succeeds and the result compiles. Returns `f`'s result.
+    /// Unchanged transmitter patterns are not refitted ([`Model::recompile`]).
     pub fn edit<T>(&mut self, f: impl FnOnce(&mut Scenario) -> Result<T>) -> Result<T> {
-        let (out, model) = self.scenario.apply_checked(f, Model::new)?;
+        let mut copy = self.scenario.clone();
+        let out = f(&mut copy)?;
+        let model = self.model.recompile(&self.scenario, &copy)?;
+        self.scenario = copy;
         self.model = model;
         Ok(out)
     }
 
-    /// Replaces the scenario (validated and compiled first).
+    /// Replaces the scenario (validated and compiled first; patterns it shares with the current
+    /// one are not refitted, [`Model::recompile`]).
     pub fn replace(&mut self, scenario: Scenario) -> Result<()> {
-        *self = Session::new(scenario)?;
+        self.model = self.model.recompile(&self.scenario, &scenario)?;
+        self.scenario = scenario;
         Ok(())
     }
 }
