@@ -21,6 +21,8 @@
 //! - [`gating`]: calibration, 3σ gating (E4), association (§4), the gated tracker and the §9.6
 //!   stand-in.
 //! - [`mtl`]: multi-target localization under correlated blocking (`multi-target.md`).
+//! - [`plan`]: network planning — move nodes to minimise a CRLB objective over a region
+//!   (CMA-ES with restarts, constraints).
 //! - [`present`]: view models shared by the page and the figures: ticks, colour map, snapshot and
 //!   track views, the interactive session.
 //!
@@ -42,6 +44,7 @@ pub mod localize;
 pub mod math;
 pub mod measure;
 pub mod mtl;
+pub mod plan;
 pub mod present;
 pub mod scenario;
 pub mod track;

@@ -164,6 +164,15 @@ pub enum Error {
         /// The names accepted there, e.g. `I, II, III`.
         known: &'static str,
     },
+    /// A planning problem that no layout can satisfy, or that has nothing to optimise: no
+    /// movable node, fixed nodes closer than the spacing, more nodes than the bounds can hold
+    /// at that spacing, no feasible layout found within the budget.
+    Infeasible {
+        /// The input at fault, e.g. `move` or `min_spacing`.
+        field: String,
+        /// Why, in words.
+        reason: String,
+    },
     /// An antenna pattern kind that is not known (spec §9.3: `omni`, `parabolic`).
     UnknownPattern {
         /// Path of the field, e.g. `transmitters[0].pattern.kind`.
@@ -273,6 +282,7 @@ impl fmt::Display for Error {
                  multi-target localization); give fewer ranges per TRP, or lower T_e or c_sigma_m"
             ),
             Error::Cancelled => write!(f, "cancelled"),
+            Error::Infeasible { field, reason } => write!(f, "{field}: {}", Clip(reason)),
             Error::UnknownPreset { name } => write!(
                 f,
                 "unknown preset \"{}\" (known: {})",

@@ -180,3 +180,34 @@ pub fn deg_to_rad(deg: Real) -> Real {
 pub fn rad_to_deg(rad: Real) -> Real {
     rad * (180.0 / PI)
 }
+
+/// The elementary functions of iterations whose path must not depend on the platform (the
+/// planner's CMA-ES): always the `libm` crate, so native and wasm builds get the same bits. (With
+/// `std`, [`exp`] and [`ln`] are the platform's, which may differ in the last bit.)
+pub mod portable {
+    use super::Real;
+
+    /// Natural exponential, the same bits on every platform.
+    #[inline]
+    pub fn exp(x: Real) -> Real {
+        libm::exp(x)
+    }
+
+    /// Natural logarithm, the same bits on every platform.
+    #[inline]
+    pub fn ln(x: Real) -> Real {
+        libm::log(x)
+    }
+
+    /// Cosine, the same bits on every platform.
+    #[inline]
+    pub fn cos(x: Real) -> Real {
+        libm::cos(x)
+    }
+
+    /// Sine, the same bits on every platform.
+    #[inline]
+    pub fn sin(x: Real) -> Real {
+        libm::sin(x)
+    }
+}

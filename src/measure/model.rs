@@ -10,7 +10,7 @@ use crate::math::{
 };
 use crate::measure::TxPattern;
 use crate::measure::{unit_from, Network};
-use crate::scenario::{Radio, Scenario, Transmitter};
+use crate::scenario::{Pattern, Radio, Scenario, Transmitter};
 
 /// Default receiver noise figure `F`, dB (spec §7).
 pub const DEFAULT_NOISE_FIGURE_DB: Real = 10.0;
@@ -31,6 +31,26 @@ pub struct Model {
     pub beta2: Real,
     /// Receiver noise power `P_n`, W.
     pub noise_power_w: Real,
+}
+
+/// Whether two patterns are the same beam up to its boresight (both parabolic, same beamwidth
+/// and floor).
+fn same_beam(a: &Pattern, b: &Pattern) -> bool {
+    match (a, b) {
+        (
+            Pattern::Parabolic {
+                beamwidth_deg: w1,
+                floor_db: f1,
+                ..
+            },
+            Pattern::Parabolic {
+                beamwidth_deg: w2,
+                floor_db: f2,
+                ..
+            },
+        ) => w1 == w2 && f1 == f2,
+        _ => false,
+    }
 }
 
 /// Noise power `P_n`, W: `k_B T₀ B F` or the explicit `noise_power_dbm` (spec §7).
@@ -63,17 +83,23 @@ impl Model {
     /// [`TxPattern`] (its fitted [`GainPolynomial`](crate::measure::GainPolynomial) is most of a
     /// compile, ≈ 0.15 ms), so a drag that moves a node recompiles in microseconds. The result is
     /// equal to `Model::new(s)` (compiling is deterministic; tested).
+    /// A pattern that differs only in its boresight is turned ([`TxPattern::set_boresight_deg`]).
     pub fn recompile(&self, previous: &Scenario, s: &Scenario) -> Result<Model> {
         Model::compile(s, |t| {
-            previous
-                .transmitters
-                .iter()
-                .zip(&self.patterns)
-                .find(|(p, _)| p.gain_dbi == t.gain_dbi && p.pattern == t.pattern)
-                .map_or_else(
-                    || TxPattern::new(t.gain_dbi, &t.pattern),
-                    |(_, c)| c.clone(),
-                )
+            let same = |p: &&Transmitter| p.gain_dbi == t.gain_dbi && p.pattern == t.pattern;
+            let turned = |p: &&Transmitter| p.gain_dbi == t.gain_dbi && same_beam(&p.pattern, &t.pattern);
+            let pairs = || previous.transmitters.iter().zip(&self.patterns);
+            if let Some((_, c)) = pairs().find(|(p, _)| same(p)) {
+                return c.clone();
+            }
+            match (pairs().find(|(p, _)| turned(p)), t.pattern) {
+                (Some((_, c)), Pattern::Parabolic { boresight_deg, .. }) => {
+                    let mut c = c.clone();
+                    c.set_boresight_deg(boresight_deg);
+                    c
+                }
+                _ => TxPattern::new(t.gain_dbi, &t.pattern),
+            }
         })
     }
 

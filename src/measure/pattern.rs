@@ -58,6 +58,19 @@ impl TxPattern {
         pattern
     }
 
+    /// Turns the beam to `boresight_deg` (an omni pattern is unchanged). The fitted polynomial
+    /// does not depend on the boresight, so this equals compiling the turned pattern afresh
+    /// (tested) without refitting: the planner turns beams per evaluation.
+    pub fn set_boresight_deg(&mut self, boresight_deg: Real) {
+        if let Some(b) = &mut self.beam {
+            let phi = deg_to_rad(boresight_deg);
+            b.boresight = Vec2::new(cos(phi), sin(phi));
+            if let Some(p) = &mut self.polynomial {
+                p.boresight = b.boresight;
+            }
+        }
+    }
+
     /// Linear gain toward the unit direction `u` (Tx → point). A zero `u` (point on the Tx)
     /// gets the peak gain. Uses the verified [`GainPolynomial`] when there is one (≤ 1e-12
     /// relative from the exact formula [`TxPattern::gain_toward_cos`]), so every consumer — point

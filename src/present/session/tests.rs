@@ -41,6 +41,11 @@ fn reused_patterns_give_the_model_of_a_fresh_compile() {
         .unwrap();
     s.edit(|sc| sc.set_tx_pattern(1, beam(70.0))).unwrap();
     assert_eq!(s.model(), &fresh(&s));
+    // Only the boresight turns: the pattern is turned, not refitted, and equals a fresh one.
+    for b in [71.5, -123.25, 359.9, 0.0] {
+        s.edit(|sc| sc.set_tx_pattern(1, beam(b))).unwrap();
+        assert_eq!(s.model(), &fresh(&s), "boresight {b}");
+    }
     s.edit(|sc| sc.move_transmitter(0, [4.0, -1.0])).unwrap();
     s.edit(|sc| sc.set_tx_gain_dbi(0, 3.0)).unwrap();
     assert_eq!(s.model(), &fresh(&s));

@@ -64,7 +64,7 @@ impl Scenario {
             limits::GAIN_DBI.check(&format!("receivers[{i}].gain_dbi"), rx.gain_dbi)?;
         }
         limits::RCS_M2.check("target.rcs_m2", self.target.rcs_m2)?;
-        area(&self.area_m)?;
+        self.area_m.validate()?;
         let links = self.link_indices()?.len();
         if links > limits::MAX_LINKS {
             return Err(Error::SizeLimit {
@@ -82,7 +82,13 @@ impl Area {
     /// Validates the rectangle: finite, within [`limits::COORDINATE_M`], min < max and a span of at
     /// least [`limits::MIN_AREA_SPAN_M`] on both axes.
     pub fn validate(&self) -> Result<()> {
-        area(self)
+        self.validate_as(["area_m.x", "area_m.y"])
+    }
+
+    /// [`Area::validate`] for a rectangle of another name: errors name `fields` (x, y), e.g.
+    /// `["roi.x", "roi.y"]`.
+    pub fn validate_as(&self, fields: [&'static str; 2]) -> Result<()> {
+        area(self, fields)
     }
 }
 
@@ -119,24 +125,24 @@ fn unique_name<'a>(names: &mut BTreeSet<&'a str>, name: &'a str) -> Result<()> {
     Ok(())
 }
 
-fn area(a: &Area) -> Result<()> {
-    position("area_m.x", a.x)?;
-    position("area_m.y", a.y)?;
+fn area(a: &Area, [fx, fy]: [&'static str; 2]) -> Result<()> {
+    position(fx, a.x)?;
+    position(fy, a.y)?;
     if a.x[0] >= a.x[1] {
         return Err(Error::InvertedArea {
-            field: "area_m.x",
+            field: fx,
             min: a.x[0],
             max: a.x[1],
         });
     }
     if a.y[0] >= a.y[1] {
         return Err(Error::InvertedArea {
-            field: "area_m.y",
+            field: fy,
             min: a.y[0],
             max: a.y[1],
         });
     }
-    for (field, [lo, hi]) in [("area_m.x", a.x), ("area_m.y", a.y)] {
+    for (field, [lo, hi]) in [(fx, a.x), (fy, a.y)] {
         if hi - lo < limits::MIN_AREA_SPAN_M {
             return Err(Error::OutOfRange {
                 field: field.into(),
