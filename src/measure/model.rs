@@ -87,7 +87,8 @@ impl Model {
     pub fn recompile(&self, previous: &Scenario, s: &Scenario) -> Result<Model> {
         Model::compile(s, |t| {
             let same = |p: &&Transmitter| p.gain_dbi == t.gain_dbi && p.pattern == t.pattern;
-            let turned = |p: &&Transmitter| p.gain_dbi == t.gain_dbi && same_beam(&p.pattern, &t.pattern);
+            let turned =
+                |p: &&Transmitter| p.gain_dbi == t.gain_dbi && same_beam(&p.pattern, &t.pattern);
             let pairs = || previous.transmitters.iter().zip(&self.patterns);
             if let Some((_, c)) = pairs().find(|(p, _)| same(p)) {
                 return c.clone();

@@ -274,7 +274,8 @@ impl Run {
         let cc = (4.0 + mueff / nf) / (nf + 4.0 + 2.0 * mueff / nf);
         let cs = (mueff + 2.0) / (nf + mueff + 5.0);
         let c1 = 2.0 / ((nf + 1.3) * (nf + 1.3) + mueff);
-        let cmu = (1.0 - c1).min(2.0 * (mueff - 2.0 + 1.0 / mueff) / ((nf + 2.0) * (nf + 2.0) + mueff));
+        let cmu =
+            (1.0 - c1).min(2.0 * (mueff - 2.0 + 1.0 / mueff) / ((nf + 2.0) * (nf + 2.0) + mueff));
         let damps = 1.0 + 2.0 * (sqrt((mueff - 1.0) / (nf + 1.0)) - 1.0).max(0.0) + cs;
         let mut c = vec![0.0; n * n];
         let mut b = vec![0.0; n * n];
@@ -326,9 +327,13 @@ impl Run {
         let mu = self.weights.len();
         let old = self.mean.clone();
         for i in 0..n {
-            self.mean[i] = (0..mu).map(|r| self.weights[r] * self.xs[order[r]][i]).sum();
+            self.mean[i] = (0..mu)
+                .map(|r| self.weights[r] * self.xs[order[r]][i])
+                .sum();
         }
-        let yw: Vec<Real> = (0..n).map(|i| (self.mean[i] - old[i]) / self.sigma).collect();
+        let yw: Vec<Real> = (0..n)
+            .map(|i| (self.mean[i] - old[i]) / self.sigma)
+            .collect();
         // C^(-1/2) y_w = B D⁻¹ Bᵀ y_w.
         let bty: Vec<Real> = (0..n)
             .map(|j| (0..n).map(|i| self.b[i * n + j] * yw[i]).sum::<Real>() / self.d[j])
@@ -341,18 +346,21 @@ impl Run {
         self.generation += 1;
         self.ps_decay *= (1.0 - self.cs) * (1.0 - self.cs);
         let ps_norm = sqrt(self.ps.iter().map(|v| v * v).sum());
-        let hsig = ps_norm / sqrt(1.0 - self.ps_decay) / self.chi_n
-            < 1.4 + 2.0 / (n as Real + 1.0);
+        let hsig = ps_norm / sqrt(1.0 - self.ps_decay) / self.chi_n < 1.4 + 2.0 / (n as Real + 1.0);
         let hsig_f = if hsig { 1.0 } else { 0.0 };
         let cc_norm = sqrt(self.cc * (2.0 - self.cc) * self.mueff);
-        for i in 0..n {
-            self.pc[i] = (1.0 - self.cc) * self.pc[i] + hsig_f * cc_norm * yw[i];
+        for (pc, y) in self.pc.iter_mut().zip(&yw) {
+            *pc = (1.0 - self.cc) * *pc + hsig_f * cc_norm * y;
         }
         // C ← (1 − c1 − cμ + (1 − h_σ) c1 cc (2 − cc)) C + c1 pc pcᵀ + cμ Σ w_r y_r y_rᵀ.
         let keep = 1.0 - self.c1 - self.cmu + (1.0 - hsig_f) * self.c1 * self.cc * (2.0 - self.cc);
         let ys: Vec<Vec<Real>> = order[..mu]
             .iter()
-            .map(|&k| (0..n).map(|i| (self.xs[k][i] - old[i]) / self.sigma).collect())
+            .map(|&k| {
+                (0..n)
+                    .map(|i| (self.xs[k][i] - old[i]) / self.sigma)
+                    .collect()
+            })
             .collect();
         for i in 0..n {
             for j in 0..=i {
@@ -385,8 +393,11 @@ impl Run {
         let (dmin, dmax) = self
             .d
             .iter()
-            .fold((Real::INFINITY, 0.0 as Real), |(lo, hi), &v| (lo.min(v), hi.max(v)));
-        !(self.sigma * max_sd >= self.tol_x) || self.sigma > 1e8 || dmax > 1e7 * dmin
+            .fold((Real::INFINITY, 0.0 as Real), |(lo, hi), &v| {
+                (lo.min(v), hi.max(v))
+            });
+        let spread = self.sigma * max_sd;
+        spread.is_nan() || spread < self.tol_x || self.sigma > 1e8 || dmax > 1e7 * dmin
     }
 }
 

@@ -10,7 +10,7 @@ use crate::scenario::{Area, Scenario};
 
 use super::cmaes::{minimize, CmaesConfig, Termination};
 use super::objective::{Objective, RoiObjective, Score};
-use super::problem::{Constraints, Layout, MoveSpec, PlanScore, PlanSearch, PlanSpace};
+use super::problem::{Constraints, Layout, MoveSpec, NodeRef, PlanScore, PlanSearch, PlanSpace};
 
 /// Largest ROI grid side of a plan.
 pub const MAX_PLAN_GRID: usize = 512;
@@ -90,6 +90,8 @@ pub struct PlanProgress<'a> {
     pub budget: usize,
     /// A new best feasible layout, when this generation found one.
     pub improvement: Option<&'a Improvement>,
+    /// The plan's space (e.g. to turn a layout into a scenario).
+    pub space: &'a PlanSpace,
 }
 
 /// The result of [`plan`].
@@ -113,6 +115,8 @@ pub struct PlanReport {
     pub search_grid: usize,
     /// The moved nodes' names.
     pub moved: Vec<alloc::string::String>,
+    /// The moved nodes.
+    pub moved_nodes: Vec<NodeRef>,
     /// The base layout and the chosen one (for drawing the moves).
     pub layouts: (Layout, Layout),
 }
@@ -153,7 +157,14 @@ pub fn plan(
             field: "roi".into(),
             reason: alloc::format!(
                 "[{}, {}] x [{}, {}] m must lie inside the scenario area [{}, {}] x [{}, {}] m",
-                r.x[0], r.x[1], r.y[0], r.y[1], a.x[0], a.x[1], a.y[0], a.y[1]
+                r.x[0],
+                r.x[1],
+                r.y[0],
+                r.y[1],
+                a.x[0],
+                a.x[1],
+                a.y[0],
+                a.y[1]
             ),
         });
     }
@@ -195,6 +206,7 @@ pub fn plan(
             evaluations: g.evaluations,
             budget: config.budget,
             improvement,
+            space: &space,
         })
     });
     if report.termination == Termination::Cancelled {
@@ -207,9 +219,8 @@ pub fn plan(
         roi: RoiObjective::new(config.objective, config.roi, config.grid)?,
     };
     let before = fine.score_layout(&base_layout, 0.0);
-    let mut chosen: Option<(PlanScore, Layout)> = before
-        .feasible()
-        .then(|| (before, base_layout.clone()));
+    let mut chosen: Option<(PlanScore, Layout)> =
+        before.feasible().then(|| (before, base_layout.clone()));
     for imp in history.iter().rev().take(FINALISTS) {
         let s = fine.score_layout(&imp.layout, 0.0);
         if chosen.as_ref().is_none_or(|(c, _)| s.rank(c).is_lt()) {
@@ -245,6 +256,7 @@ pub fn plan(
             .iter()
             .map(|&n| space.name(n).into())
             .collect(),
+        moved_nodes: space.moved().to_vec(),
         layouts: (base_layout, layout),
     })
 }

@@ -172,7 +172,12 @@ impl PlanSpace {
                         .iter()
                         .position(|t| &t.name == name)
                         .map(NodeRef::Tx)
-                        .or_else(|| base.receivers.iter().position(|r| &r.name == name).map(NodeRef::Rx))
+                        .or_else(|| {
+                            base.receivers
+                                .iter()
+                                .position(|r| &r.name == name)
+                                .map(NodeRef::Rx)
+                        })
                         .ok_or_else(|| Error::UnknownNode {
                             field: "move".into(),
                             name: name.clone(),
@@ -284,7 +289,11 @@ impl PlanSpace {
     /// The base scenario's layout.
     pub fn base_layout(&self) -> Layout {
         Layout {
-            positions: self.moved.iter().map(|&n| position(&self.base, n)).collect(),
+            positions: self
+                .moved
+                .iter()
+                .map(|&n| position(&self.base, n))
+                .collect(),
             boresights_deg: self
                 .turned
                 .iter()
@@ -360,7 +369,10 @@ impl PlanSpace {
                     .fold(Real::INFINITY, Real::min);
             }
             if s > 0.0 {
-                for q in layout.positions[i + 1..].iter().chain(self.fixed.iter().map(|(_, q)| q)) {
+                for q in layout.positions[i + 1..]
+                    .iter()
+                    .chain(self.fixed.iter().map(|(_, q)| q))
+                {
                     v += (s - (p - q).norm()).max(0.0);
                 }
             }

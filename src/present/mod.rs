@@ -1,16 +1,21 @@
 //! View models shared by every front end (the page through `wasm`, the figures through `chart`):
 //! axis ticks and length labels, the log colour scale of CRLB maps, one simulated snapshot as the
-//! page draws it, a simulated track's frames, and the interactive [`Session`] (a validated
+//! page draws it, a simulated track's frames, the planner's request and report (`plan.json`), and the interactive [`Session`] (a validated
 //! scenario and its compiled model, kept in step). Pure `no_std` functions of the core's results:
 //! no maths of their own beyond layout.
 
 mod colormap;
+mod plan_view;
 mod session;
 mod snapshot;
 mod ticks;
 mod track_view;
 
 pub use colormap::{colorbar_rgba, fill_rgba, render_rgba, viridis, LogScale, UNBOUNDED_RGB};
+pub use plan_view::{
+    area_of, run_plan, PlanHistoryJson, PlanImprovementJson, PlanJson, PlanObjectiveJson,
+    PlanPathJson, PlanProgressJson, PlanRequest, DEFAULT_PLAN_BUDGET,
+};
 pub use session::Session;
 pub(crate) use snapshot::{link_sim, view_radius};
 pub use snapshot::{

@@ -13,7 +13,7 @@
 //! `json.rs` (the page's object shapes and `to_js`), `tracking.rs` (`App.simulate_track` and the
 //! `Track` it returns), `montecarlo.rs` (`MonteCarloJob`, run chunk by chunk in a Web Worker),
 //! `chart.rs` (the plotters ε_EKF / ε_PCRLB chart on a canvas), `mtl.rs` (the multi-target view
-//! of a scene, [`crate::mtl::view`]).
+//! of a scene, [`crate::mtl::view`]), `plan.rs` (the planner, run in a Web Worker).
 
 mod app;
 mod base;
@@ -21,6 +21,7 @@ mod chart;
 mod json;
 mod montecarlo;
 mod mtl;
+mod plan;
 mod render;
 mod tracking;
 
@@ -30,6 +31,7 @@ pub use base::{preset_json, preset_names, start};
 pub use chart::draw_tracking_chart;
 pub use montecarlo::MonteCarloJob;
 pub use mtl::{mtl_check_scene, mtl_default_scene, mtl_view_of, MtlSession};
+pub use plan::plan_network;
 pub use render::{
     axis_ticks, colorbar_rgba, colorbar_ticks, format_length, render_map_rgba, scale_bar,
     unbounded_rgb, MAX_AXIS_TICKS,
