@@ -28,7 +28,7 @@ pub struct PlanConfig {
     pub roi: Area,
     /// ROI grid side of the reported objective (`before`, `after`).
     pub grid: usize,
-    /// ROI grid side of the search; `0` = `clamp(grid / 2, 16, grid)`.
+    /// ROI grid side of the search; `0` = `min(max(grid / 2, 16), grid)`.
     pub coarse_grid: usize,
     /// Which nodes move.
     pub movable: MoveSpec,
@@ -64,7 +64,7 @@ impl PlanConfig {
     /// The search grid side.
     pub fn search_grid(&self) -> usize {
         match self.coarse_grid {
-            0 => (self.grid / 2).clamp(16, self.grid),
+            0 => (self.grid / 2).max(16).min(self.grid),
             n => n.min(self.grid),
         }
     }
