@@ -411,3 +411,51 @@ fn gating_in_wasm() {
         assert!((s.delays[p].unwrap() - tau).abs() < 6.0 * model.sigma_delay(p, r));
     }
 }
+
+/// The planner in the browser (issue 14, check 4): the short plan of the native test
+/// `plans_depend_on_the_seed_only` (tests/planning.rs) through the page's binding gives the same
+/// bits; progress is reported per generation, a `false` from the callback cancels, and bad
+/// requests are named errors.
+#[wasm_bindgen_test]
+fn plan_in_wasm_equals_native_and_cancels() {
+    use js_sys::Function;
+    let scenario = ok(wasm::preset_json("sensors2019"));
+    let request = r#"{"move": "Rx2", "objective": "mean", "roi": [-7.5, 30.0, -10.0, 26.0],
+        "grid": 8, "budget": 300, "seed": 7}"#;
+    let calls = Function::new_with_args(
+        "p",
+        "globalThis.__planCalls = (globalThis.__planCalls || 0) + 1; return true;",
+    );
+    let plan = ok(wasm::plan_network(&scenario, request, &calls));
+    let rx2 = get(&get(&get(&plan, "scenario"), "receivers"), "1");
+    let pos = get(&rx2, "position_m");
+    let bits = [num(&pos, "0").to_bits(), num(&pos, "1").to_bits()];
+    // tests/planning.rs DETERMINISM_RX2_BITS.
+    assert_eq!(bits, [0x4021_e4d3_ec16_58ec, 0x4037_c8ac_686a_6934]);
+    assert_eq!(num(&plan, "evaluations"), 300.0);
+    let calls_made = num(&js_sys::global().into(), "__planCalls");
+    assert!(calls_made >= 10.0, "{calls_made} progress calls");
+    let objective = get(&plan, "objective");
+    assert!(num(&objective, "after") <= num(&objective, "before"));
+    let stop = Function::new_with_args("p", "return false;");
+    let m = err(wasm::plan_network(&scenario, request, &stop));
+    assert!(m.contains("cancelled"), "{m}");
+    for (bad, field) in [
+        (
+            r#"{"move": "Nobody", "objective": "mean", "roi": [0, 1, 0, 1]}"#,
+            "Nobody",
+        ),
+        (
+            r#"{"move": "rx", "objective": "p95", "roi": [0, 1, 0, 1]}"#,
+            "objective",
+        ),
+        (
+            r#"{"move": "rx", "objective": "mean", "roi": [0, 100, 0, 1]}"#,
+            "roi",
+        ),
+        (r#"{"move": "rx", "objective": "mean"}"#, "roi"),
+    ] {
+        let m = err(wasm::plan_network(&scenario, bad, &calls));
+        assert!(m.contains(field), "{bad}: {m}");
+    }
+}
