@@ -195,9 +195,10 @@ pub enum Command {
     /// mean, p90 (90th percentile; unbounded cells count as infinite) or max, minimised, or
     /// coverage:T, the fraction of cells with a bound <= T m, maximised. Moved nodes stay inside
     /// --bounds (default: area_m) and the --allowed polygons, and every pair of nodes at least
-    /// --min-spacing apart. Seeded CMA-ES with restarts on a coarse grid (max(16, N/2)), the best
-    /// layouts re-scored on the N grid: `after` is never worse than `before`. Deterministic per
-    /// seed. Progress on stderr; Ctrl-C stops (exit 130, no files written).
+    /// --min-spacing apart. Seeded CMA-ES with restarts on a coarser grid (N/2 a side, at least
+    /// min(16, N)), the best layouts re-scored on the N grid: `after` is never worse than
+    /// `before` when the base layout keeps the constraints. Deterministic per seed. Progress on
+    /// stderr; Ctrl-C stops (exit 130, no files written).
     ///
     /// --out plan.json: {scenario (the optimised scenario, for every command), objective {kind,
     /// label, maximised, before, after, unbounded_before, unbounded_after, roi, grid,
