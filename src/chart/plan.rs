@@ -323,39 +323,54 @@ fn draw_paths<'a, DB: DrawingBackend + 'a>(
     let width = (2.0 * s).round().max(1.0) as u32;
     let square = marker;
     let ring = marker + (5.0 * s).round() as i32;
+    let (xr, yr) = (chart.x_range(), chart.y_range());
+    let view = [xr.start, xr.end, yr.start, yr.end];
+    let shown =
+        |q: (Real, Real)| (view[0]..=view[1]).contains(&q.0) && (view[2]..=view[3]).contains(&q.1);
     for p in paths {
         let points: alloc::vec::Vec<(Real, Real)> =
             p.points_m.iter().map(|q| (q[0], q[1])).collect();
         let (Some(&start), Some(&end)) = (points.first(), points.last()) else {
             continue;
         };
+        // The parts of the segments inside the plotted area (plotters would pin points outside
+        // it to the frame, bending the lines).
+        let segments: alloc::vec::Vec<[(Real, Real); 2]> = points
+            .windows(2)
+            .filter_map(|w| clip_segment(w[0], w[1], view))
+            .collect();
         let plot = chart.plotting_area();
         // Segment by segment with round joins: a polyline's miter joins spike at sharp turns.
         for (colour, w) in [(BLACK, width + 2), (PATH_RGB, width)] {
-            for pair in points.windows(2) {
-                plot.draw(&PathElement::new(pair.to_vec(), colour.stroke_width(w)))
+            for seg in &segments {
+                plot.draw(&PathElement::new(seg.to_vec(), colour.stroke_width(w)))
                     .map_err(chart_err)?;
             }
             let joint = (w as i32 / 2).max(1);
-            for &q in points.iter().skip(1).take(points.len().saturating_sub(2)) {
+            let inner = points.iter().skip(1).take(points.len().saturating_sub(2));
+            for &q in inner.filter(|&&q| shown(q)) {
                 plot.draw(&Circle::new(q, joint, colour.filled()))
                     .map_err(chart_err)?;
             }
         }
-        let start_mark = EmptyElement::at(start)
-            + Rectangle::new(
-                [(-square, -square), (square, square)],
-                BLACK.stroke_width(width + 2),
-            )
-            + Rectangle::new(
-                [(-square, -square), (square, square)],
-                PATH_RGB.stroke_width(width),
-            );
-        plot.draw(&start_mark).map_err(chart_err)?;
-        let end_mark = EmptyElement::at(end)
-            + Circle::new((0, 0), ring, BLACK.stroke_width(width + 2))
-            + Circle::new((0, 0), ring, PATH_RGB.stroke_width(width));
-        plot.draw(&end_mark).map_err(chart_err)?;
+        if shown(start) {
+            let start_mark = EmptyElement::at(start)
+                + Rectangle::new(
+                    [(-square, -square), (square, square)],
+                    BLACK.stroke_width(width + 2),
+                )
+                + Rectangle::new(
+                    [(-square, -square), (square, square)],
+                    PATH_RGB.stroke_width(width),
+                );
+            plot.draw(&start_mark).map_err(chart_err)?;
+        }
+        if shown(end) {
+            let end_mark = EmptyElement::at(end)
+                + Circle::new((0, 0), ring, BLACK.stroke_width(width + 2))
+                + Circle::new((0, 0), ring, PATH_RGB.stroke_width(width));
+            plot.draw(&end_mark).map_err(chart_err)?;
+        }
     }
     if !paths.is_empty() {
         let half = marker.max(4);
@@ -372,4 +387,63 @@ fn draw_paths<'a, DB: DrawingBackend + 'a>(
             });
     }
     Ok(())
+}
+
+/// The part of the segment `a`–`b` inside the rectangle `[x0, x1, y0, y1]` (Liang–Barsky), or
+/// `None` when it misses it.
+fn clip_segment(a: (Real, Real), b: (Real, Real), r: [Real; 4]) -> Option<[(Real, Real); 2]> {
+    let (dx, dy) = (b.0 - a.0, b.1 - a.1);
+    let (mut t0, mut t1): (Real, Real) = (0.0, 1.0);
+    for (p, q) in [
+        (-dx, a.0 - r[0]),
+        (dx, r[1] - a.0),
+        (-dy, a.1 - r[2]),
+        (dy, r[3] - a.1),
+    ] {
+        if p == 0.0 {
+            if q < 0.0 {
+                return None;
+            }
+        } else {
+            let t = q / p;
+            if p < 0.0 {
+                t0 = t0.max(t);
+            } else {
+                t1 = t1.min(t);
+            }
+        }
+    }
+    (t0 <= t1).then_some([
+        (a.0 + t0 * dx, a.1 + t0 * dy),
+        (a.0 + t1 * dx, a.1 + t1 * dy),
+    ])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::clip_segment;
+
+    #[test]
+    fn segments_are_clipped_to_the_view() {
+        let r = [0.0, 10.0, 0.0, 10.0];
+        assert_eq!(
+            clip_segment((1.0, 1.0), (2.0, 3.0), r),
+            Some([(1.0, 1.0), (2.0, 3.0)])
+        );
+        assert_eq!(
+            clip_segment((5.0, 5.0), (15.0, 5.0), r),
+            Some([(5.0, 5.0), (10.0, 5.0)])
+        );
+        assert_eq!(
+            clip_segment((-5.0, -5.0), (15.0, 15.0), r),
+            Some([(0.0, 0.0), (10.0, 10.0)])
+        );
+        // Touching a corner only.
+        assert_eq!(
+            clip_segment((-10.0, 0.0), (20.0, 30.0), r),
+            Some([(0.0, 10.0), (0.0, 10.0)])
+        );
+        assert_eq!(clip_segment((20.0, 20.0), (30.0, 25.0), r), None);
+        assert_eq!(clip_segment((-1.0, 5.0), (-1.0, 6.0), r), None);
+    }
 }
