@@ -363,6 +363,10 @@ fn bad_input_exits_2_naming_the_flag_and_writes_nothing() {
     let two = dir.write("two.json", &serde_json::json!([[[0, 0], [1, 1]]]));
     let broken = dir.write_text("broken.json", "[[[0, 0], [1, 0], [1, 1]]");
     let not_pairs = dir.write("pairs.json", &serde_json::json!([[0, 0]]));
+    let far = dir.write(
+        "far.json",
+        &serde_json::json!([[[100, 100], [110, 100], [110, 110]]]),
+    );
     let fig = dir.path("f.pdf");
     let before = dir.files();
     let base = [
@@ -425,12 +429,17 @@ fn bad_input_exits_2_naming_the_flag_and_writes_nothing() {
             vec!["--allowed", "pairs.json"],
         ),
         (
+            vec!["--allowed", &far],
+            vec!["--min-spacing / --allowed", "no layout"],
+        ),
+        (
             vec!["--allowed", "/nonexistent/rooms.json"],
             vec!["--allowed", "cannot read"],
         ),
         // Limits.
-        (vec!["--grid", "513"], vec!["--grid", "2..=512"]),
-        (vec!["--grid", "1"], vec!["--grid"]),
+        (vec!["--grid", "513"], vec!["--grid", "16..=512"]),
+        (vec!["--grid", "1"], vec!["--grid", "16..=512"]),
+        (vec!["--grid", "15"], vec!["--grid", "16..=512"]),
         (vec!["--budget", "0"], vec!["--budget", "1..=1000000"]),
         (vec!["--budget", "1000001"], vec!["--budget"]),
         (vec!["--seed", "-1"], vec!["--seed"]),

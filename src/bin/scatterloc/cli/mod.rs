@@ -196,7 +196,7 @@ pub enum Command {
     /// coverage:T, the fraction of cells with a bound <= T m, maximised. Moved nodes stay inside
     /// --bounds (default: area_m) and the --allowed polygons, and every pair of nodes at least
     /// --min-spacing apart. Seeded CMA-ES with restarts on a coarser grid (N/2 a side, at least
-    /// min(16, N)), the best layouts re-scored on the N grid: `after` is never worse than
+    /// 16), the best layouts re-scored on the N grid: `after` is never worse than
     /// `before` when the base layout keeps the constraints. Deterministic per seed. Progress on
     /// stderr; Ctrl-C stops (exit 130, no files written).
     ///

@@ -13,7 +13,7 @@ use scatterloc::chart::{
 };
 use scatterloc::localize::Grid;
 use scatterloc::native::crlb_map_parallel;
-use scatterloc::plan::Polygon;
+use scatterloc::plan::{Polygon, MAX_PLAN_GRID};
 use scatterloc::present::{run_plan, PlanJson, PlanRequest, DEFAULT_PLAN_BUDGET};
 use scatterloc::{Error, Model, Scenario};
 
@@ -27,6 +27,9 @@ use crate::CliError;
 const FIGURE_GRID: usize = 256;
 /// Width of the figure, pixels.
 const FIGURE_WIDTH: u32 = 1600;
+/// Smallest `--grid`: below 16 cells a side the core's search grid (`PlanConfig::search_grid`,
+/// `clamp(grid / 2, 16, grid)`) is not defined (it panics), so the CLI refuses such grids.
+const MIN_GRID: usize = 16;
 
 /// `scatterloc plan`.
 pub fn plan(args: &PlanArgs) -> Result<(), CliError> {
@@ -53,6 +56,14 @@ pub fn plan(args: &PlanArgs) -> Result<(), CliError> {
         seed: args.seed,
     };
     let errors = |e: Error| plan_error(e, args);
+    if let Some(g) = args
+        .grid
+        .filter(|g| !(MIN_GRID..=MAX_PLAN_GRID).contains(g))
+    {
+        return Err(CliError::usage(format!(
+            "--grid: {g} is outside the allowed range {MIN_GRID}..={MAX_PLAN_GRID}"
+        )));
+    }
     // The objective is parsed here so that a bad one is reported before any file is touched.
     let config = request.config().map_err(errors)?;
     if let Some((path, _)) = figure {
@@ -135,6 +146,10 @@ fn plan_error(e: Error, args: &PlanArgs) -> CliError {
         "roi" => "--roi".to_string(),
         "bounds" => "--bounds".to_string(),
         "move" => "--move".to_string(),
+        // No feasible layout found: the spacing, the polygons and the bounds together.
+        "min_spacing" if args.allowed.is_some() && matches!(e, Error::Infeasible { .. }) => {
+            "--min-spacing / --allowed".to_string()
+        }
         "min_spacing" => "--min-spacing".to_string(),
         "objective" => "--objective".to_string(),
         "grid" => "--grid".to_string(),
