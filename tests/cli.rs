@@ -618,6 +618,7 @@ fn completions_for_bash_zsh_fish() {
             "crlb-map",
             "simulate-walk",
             "montecarlo",
+            "plan",
             "mtl",
             "scenario",
         ] {
@@ -669,7 +670,7 @@ fn typos_get_a_suggestion_on_one_line() {
 
 #[test]
 fn every_command_has_help_citing_the_spec() {
-    let commands: [&[&str]; 14] = [
+    let commands: [&[&str]; 15] = [
         &["preset"],
         &["crlb"],
         &["crlb-map"],
@@ -679,6 +680,7 @@ fn every_command_has_help_citing_the_spec() {
         &["simulate-walk"],
         &["montecarlo"],
         &["pcrlb"],
+        &["plan"],
         &["mtl"],
         &["mtl", "locate"],
         &["mtl", "table2"],

@@ -10,7 +10,7 @@ use plotters::prelude::*;
 
 use super::axis_label;
 use super::layout::{self, chart_err, register_fonts, ChartError};
-use super::raster;
+use super::raster::{self, Chart};
 
 use crate::localize::Grid;
 use crate::math::Real;
@@ -149,9 +149,35 @@ pub fn draw_crlb_map<DB: DrawingBackend>(
         opts.subtitle.as_deref(),
     )?;
 
-    let area = &map.grid.area;
     let chart_area = root.clone().shrink(lay.chart_origin, lay.chart_size);
-    let mut chart = ChartBuilder::on(&chart_area)
+    let mut chart = map_panel(&chart_area, &lay, map, scale.as_ref())?;
+    finish_panel(&mut chart, nodes, &lay)?;
+
+    let bar_area = root.clone().shrink(lay.bar_origin, lay.bar_size);
+    raster::draw_colorbar(
+        &bar_area,
+        scale.as_ref(),
+        unbounded_cells > 0,
+        &opts.colorbar_label,
+        &lay.font,
+    )?;
+    Ok(ChartSummary {
+        scale,
+        unbounded_cells,
+    })
+}
+
+/// The plot of one map in `chart_area` (laid out by `lay`): the coloured cells on `scale` (grey
+/// where unbounded or without a scale) and metre axes at equal scale. Overlays go on the returned
+/// chart, then [`finish_panel`] draws the nodes and the frame.
+pub(crate) fn map_panel<'a, DB: DrawingBackend + 'a>(
+    chart_area: &'a DrawingArea<DB, Shift>,
+    lay: &layout::Layout,
+    map: &MapData,
+    scale: Option<&LogScale>,
+) -> Result<Chart<'a, DB>, ChartError> {
+    let area = &map.grid.area;
+    let mut chart = ChartBuilder::on(chart_area)
         .margin_top(lay.plot_margin_top)
         .margin_right(lay.plot_margin_right)
         .x_label_area_size(lay.x_label_area)
@@ -159,11 +185,7 @@ pub fn draw_crlb_map<DB: DrawingBackend>(
         .build_cartesian_2d(area.x[0]..area.x[1], area.y[0]..area.y[1])
         .map_err(chart_err)?;
 
-    raster::draw_heatmap(
-        &chart.plotting_area().strip_coord_spec(),
-        map,
-        scale.as_ref(),
-    )?;
+    raster::draw_heatmap(&chart.plotting_area().strip_coord_spec(), map, scale)?;
 
     let tick_font = ("sans-serif", lay.font.ticks).into_font();
     let axis_font = ("sans-serif", lay.font.axis).into_font();
@@ -181,22 +203,17 @@ pub fn draw_crlb_map<DB: DrawingBackend>(
         .y_label_formatter(&|v| axis_label(*v))
         .draw()
         .map_err(chart_err)?;
+    Ok(chart)
+}
 
-    raster::draw_nodes(&mut chart, nodes, lay.font.nodes)?;
-    layout::frame_plot(&chart)?;
-
-    let bar_area = root.clone().shrink(lay.bar_origin, lay.bar_size);
-    raster::draw_colorbar(
-        &bar_area,
-        scale.as_ref(),
-        unbounded_cells > 0,
-        &opts.colorbar_label,
-        &lay.font,
-    )?;
-    Ok(ChartSummary {
-        scale,
-        unbounded_cells,
-    })
+/// The nodes (with the legend of every labelled series) and the frame of a [`map_panel`].
+pub(crate) fn finish_panel<'a, DB: DrawingBackend + 'a>(
+    chart: &mut Chart<'a, DB>,
+    nodes: &[ChartNode],
+    lay: &layout::Layout,
+) -> Result<(), ChartError> {
+    raster::draw_nodes(chart, nodes, lay.font.nodes)?;
+    layout::frame_plot(chart)
 }
 
 /// The default title and subtitle of a scenario's map figure.

@@ -3,10 +3,12 @@
 //!
 //! [`draw_crlb_map`] draws the CRLB map figure (the same colours and colour-bar ticks as the page).
 //! [`draw_tracking_rmse`] draws the tracking figure of [S] Fig. 3 (spec §10) in the same style.
+//! [`draw_plan_maps`] draws a network plan: the maps before and after side by side.
 //! [`draw_curves`] draws the ROC and missed-detection curves of the multi-target experiments.
 
 mod layout;
 mod map;
+mod plan;
 mod raster;
 mod roc;
 mod tracking;
@@ -16,6 +18,9 @@ pub use layout::{register_fonts, suggested_size, ChartError};
 pub use map::{
     check_area, default_titles, draw_crlb_map, scenario_nodes, ChartNode, ChartOptions,
     ChartSummary, MapData, NodeKind,
+};
+pub use plan::{
+    draw_plan_maps, plan_caption, plan_chart_size, PlanChartOptions, PlanPanel, PlanPath,
 };
 pub use roc::{
     curve_chart_size, draw_curves, CurveChartOptions, CurveSeries, LineKind, Marker, CURVE_PALETTE,

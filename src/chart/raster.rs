@@ -13,7 +13,8 @@ use crate::math::Real;
 use crate::present::colorbar_ticks;
 use crate::present::{viridis, LogScale, UNBOUNDED_RGB};
 
-type Chart<'a, DB> = ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
+/// A map plot: metre axes in both directions.
+pub(crate) type Chart<'a, DB> = ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
 
 const TX_RGB: RGBColor = RGBColor(228, 26, 28);
 

@@ -1,7 +1,8 @@
 //! `scatterloc`: command-line front end of the scatterloc core — presets, the CRLB at a point,
 //! CRLB maps (JSON, SVG, PNG), Levenberg–Marquardt fixes from measured delays, the EKF tracker
 //! (spec §6) and its Monte Carlo evaluation against the posterior CRLB (§8, §9.5, [S] Fig. 3),
-//! the multi-target method (`mtl`), and the merge of sharded studies (`merge`).
+//! network planning (`plan`), the multi-target method (`mtl`), and the merge of sharded studies
+//! (`merge`).
 //!
 //! `cli` declares the command line (clap), `cmd` runs the commands. Results are JSON on stdout.
 //! Bad input exits with status 2 and one line on stderr that names the offending flag or field;
@@ -78,6 +79,7 @@ fn run(command: cli::Command) -> Result<(), CliError> {
         Command::SimulateWalk(a) => cmd::simulate_walk(&a),
         Command::Montecarlo(a) => cmd::montecarlo(&a),
         Command::Pcrlb(a) => cmd::pcrlb(&a),
+        Command::Plan(a) => cmd::plan(&a),
         Command::Mtl { command } => match command {
             MtlCommand::Locate(a) => cmd::mtl_locate(&a),
             MtlCommand::Table2(a) => cmd::mtl_table2(&a),

@@ -6,6 +6,7 @@
 
 mod error;
 mod mtl;
+mod plan;
 mod scenario;
 mod shard;
 mod study;
@@ -17,6 +18,7 @@ use std::ffi::OsString;
 use clap::{CommandFactory, FromArgMatches, Parser, Subcommand, ValueEnum};
 
 pub use mtl::{MtlCommand, MtlLocateArgs, RocArgs, Table2Args};
+pub use plan::PlanArgs;
 pub use scenario::{CrlbArgs, CrlbMapArgs, LocateArgs, PresetArgs};
 pub use shard::{MergeArgs, ShardArgs};
 pub use study::{MontecarloArgs, PcrlbArgs, StudyArgs};
@@ -47,6 +49,10 @@ Commands at a glance (`scatterloc help COMMAND` for every flag):
   scatterloc pcrlb --nominal [--preset NAME | --scenario FILE] [--trajectory I|II|III|all]
                    [--dt T] [--duration S] [--process-noise Q] [--json OUT.json] [--out FIG]
   scatterloc pcrlb [same flags without --nominal] [--runs N] [--seed N] [--threads N]
+  scatterloc plan [--preset NAME | --scenario FILE] --move rx|tx|all|tx-boresight|NAME[,NAME..]
+                  --objective mean|p90|max|coverage:T --roi X0,X1,Y0,Y1 [--bounds X0,X1,Y0,Y1]
+                  [--allowed FILE] [--min-spacing M] [--grid N] [--budget EVALS] [--seed S]
+                  --out plan.json [--figure F.{svg,png}]
   scatterloc mtl locate --network FILE --ranges FILE [--model icb|ppp|empirical]
                         [--te T] [--tb T|inf] [--b-max N|inf] [--n-min N] [--order 0,1,..]
                         [--p-u P | --p-d P --p-los P] [--lambda L] [--diameter D] [--exact]
@@ -60,7 +66,8 @@ Commands at a glance (`scatterloc help COMMAND` for every flag):
   scatterloc help [COMMAND] | --help | -h | --version
 
 FILE may be '-' for standard input. Units: metres, seconds, hertz; dB only where named.
-Spec sections (§) are those of delay-localization.md; `mtl` cites multi-target.md.
+Spec sections (§) are those of delay-localization.md; `mtl` cites multi-target.md, `plan`
+filters-and-planning.md.
 Exit status: 0 success, 2 bad input (one line on stderr naming the flag or field), 1 output
 failure, 130 cancelled (Ctrl-C). Output files are written atomically (a temporary file renamed
 into place).";
@@ -180,6 +187,27 @@ pub enum Command {
     /// (several trajectories: {"scenarios": [..]}) unless --json/--out are given (then a
     /// one-line summary with the values at 1, 2, 5 and 10 s).
     Pcrlb(PcrlbArgs),
+    /// Plan a network: move nodes to minimise the CRLB over a region (spec
+    /// filters-and-planning.md §3).
+    ///
+    /// Moves the chosen nodes (--move; tx-boresight also turns the parabolic beams) to optimise
+    /// an objective of the RMSE bound (spec §7) over the cells of an N x N grid over the ROI:
+    /// mean, p90 (90th percentile; unbounded cells count as infinite) or max, minimised, or
+    /// coverage:T, the fraction of cells with a bound <= T m, maximised. Moved nodes stay inside
+    /// --bounds (default: area_m) and the --allowed polygons, and every pair of nodes at least
+    /// --min-spacing apart. Seeded CMA-ES with restarts on a coarser grid (N/2 a side, at least
+    /// 16), the best layouts re-scored on the N grid: `after` is never worse than
+    /// `before` when the base layout keeps the constraints. Deterministic per seed. Progress on
+    /// stderr; Ctrl-C stops (exit 130, no files written).
+    ///
+    /// --out plan.json: {scenario (the optimised scenario, for every command), objective {kind,
+    /// label, maximised, before, after, unbounded_before, unbounded_after, roi, grid,
+    /// search_grid}, history [{evaluations, best}], evaluations, seed, runs, termination, moved,
+    /// paths [{name, transmitter, points}]}. --figure: the maps before and after side by side on
+    /// one colour scale, the ROI and each moved node's path. Prints a one-line JSON summary {out,
+    /// figure, objective, before, after, evaluations, runs, termination, moved, seed,
+    /// wall_time_s}.
+    Plan(PlanArgs),
     /// Several targets from range lists: locate, Table II, ROC (spec multi-target.md §4, §8).
     ///
     /// The multi-target method of spec multi-target.md: `mtl locate` (Algorithm 1, §4),

@@ -44,6 +44,29 @@ pub fn xy(v: &str) -> Result<[f64; 2], String> {
     }
 }
 
+/// `X0,X1,Y0,Y1`: a rectangle, four numbers in metres, each within [`limits::COORDINATE_M`]
+/// (the order of the edges is checked where the rectangle is used).
+pub fn rect(v: &str) -> Result<[f64; 4], String> {
+    let bad = || {
+        format!(
+            "expected X0,X1,Y0,Y1 (four numbers in metres, each {}), got '{v}'",
+            limits::COORDINATE_M.allowed
+        )
+    };
+    let parts: Vec<&str> = v.split(',').collect();
+    if parts.len() != 4 {
+        return Err(bad());
+    }
+    let mut out = [0.0; 4];
+    for (o, p) in out.iter_mut().zip(parts) {
+        *o = p.trim().parse().map_err(|_| bad())?;
+        if !limits::COORDINATE_M.contains(*o) {
+            return Err(bad());
+        }
+    }
+    Ok(out)
+}
+
 /// A probability in `[0, 1]`.
 pub fn probability(v: &str) -> Result<f64, String> {
     match finite(v)? {

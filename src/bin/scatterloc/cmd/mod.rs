@@ -1,7 +1,7 @@
 //! The commands of `scatterloc`, one file per family: the single-snapshot commands (`preset`,
 //! `crlb`, `locate` in `scenario`, `crlb-map` in `crlb_map`), tracking (`track` with its figure
 //! in `track_fig`), gating (`calibrate`, `simulate-walk`), the tracking studies (`montecarlo`,
-//! `pcrlb`, sharing `study` and `report`), the multi-target commands (`mtl`), and scale-out:
+//! `pcrlb`, sharing `study` and `report`), network planning (`plan`), the multi-target commands (`mtl`), and scale-out:
 //! one shard of a study (`--shard`, its part file in `shard`) and `merge`. Each takes its
 //! parsed flags from `crate::cli`, reads its inputs (`io`), calls the library and writes JSON to
 //! stdout and files atomically (`output`).
@@ -13,6 +13,7 @@ mod merge;
 mod montecarlo;
 mod mtl;
 mod output;
+mod plan;
 mod report;
 mod scenario;
 mod shard;
@@ -25,5 +26,6 @@ pub use gating::{calibrate, simulate_walk};
 pub use merge::merge;
 pub use montecarlo::{montecarlo, pcrlb};
 pub use mtl::{mtl_locate, mtl_roc, mtl_table2};
+pub use plan::plan;
 pub use scenario::{crlb, locate, preset};
 pub use track::track;

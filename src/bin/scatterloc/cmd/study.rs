@@ -85,22 +85,7 @@ pub fn cancelled() -> CliError {
 /// Parses the study flags: `--preset` (default `sensors2019`) or `--scenario`, `--trajectory`
 /// (`I`, `II`, `III` or `all`, the default), `--dt`, `--duration`, `--process-noise`.
 pub fn parse_study(args: &StudyArgs) -> Result<Study, CliError> {
-    let (layout, scenario): (String, Scenario) = match (&args.preset, &args.scenario) {
-        (Some(_), Some(_)) => {
-            return Err(CliError::usage(
-                "--preset / --scenario: give one of them, not both",
-            ))
-        }
-        (_, Some(path)) => {
-            let s = read_scenario(path)?;
-            (s.name.clone(), s)
-        }
-        (p, None) => {
-            let name = p.as_deref().unwrap_or("sensors2019");
-            let s = presets::preset(name).map_err(|e| CliError::usage(format!("--preset: {e}")))?;
-            (name.to_string(), s)
-        }
-    };
+    let (layout, scenario) = load_layout(args.preset.as_deref(), args.scenario.as_deref())?;
     let trajectories = match args.trajectory {
         None | Some(Trajectory::All) => TrackScenario::ALL.to_vec(),
         Some(Trajectory::One) => vec![TrackScenario::I],
@@ -113,6 +98,28 @@ pub fn parse_study(args: &StudyArgs) -> Result<Study, CliError> {
     let duration = args.duration.unwrap_or(PAPER_DURATION_S);
     let steps = checked_steps(duration, dt)?;
     Study::new(layout, scenario, trajectories, motion, steps)
+}
+
+/// The node layout of `--preset NAME` (default `sensors2019`) or `--scenario FILE` (not both):
+/// its name (the preset's, or the scenario's `name`) and the validated scenario.
+pub fn load_layout(
+    preset: Option<&str>,
+    scenario: Option<&str>,
+) -> Result<(String, Scenario), CliError> {
+    match (preset, scenario) {
+        (Some(_), Some(_)) => Err(CliError::usage(
+            "--preset / --scenario: give one of them, not both",
+        )),
+        (_, Some(path)) => {
+            let s = read_scenario(path)?;
+            Ok((s.name.clone(), s))
+        }
+        (p, None) => {
+            let name = p.unwrap_or("sensors2019");
+            let s = presets::preset(name).map_err(|e| CliError::usage(format!("--preset: {e}")))?;
+            Ok((name.to_string(), s))
+        }
+    }
 }
 
 impl Study {
@@ -205,6 +212,11 @@ pub fn checked_steps(duration: f64, dt: f64) -> Result<usize, CliError> {
         )));
     }
     Ok(steps)
+}
+
+/// Whether Ctrl-C was pressed (after a run of [`run_with_bar`], e.g. while a figure is drawn).
+pub fn interrupted() -> bool {
+    CANCEL.load(Ordering::SeqCst)
 }
 
 /// Runs `cfg` on `threads` threads with a progress bar labelled `label` (drawn only when stderr

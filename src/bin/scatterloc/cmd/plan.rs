@@ -1,0 +1,261 @@
+//! `scatterloc plan`: network planning (`filters-and-planning.md` §3). The flags become a
+//! [`PlanRequest`] run by [`run_plan`] (the same function as the page's Plan panel) under the
+//! progress bar and Ctrl-C handling of the long commands; the result is `plan.json` and, with
+//! `--figure`, the maps before and after ([`draw_plan_maps`]).
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use serde_json::json;
+
+use scatterloc::chart::{
+    check_area, draw_plan_maps, plan_caption, plan_chart_size, scenario_nodes, ChartError,
+    ChartNode, MapData, PlanChartOptions, PlanPanel, PlanPath,
+};
+use scatterloc::localize::Grid;
+use scatterloc::native::crlb_map_parallel;
+use scatterloc::plan::{Polygon, MAX_PLAN_GRID};
+use scatterloc::present::{run_plan, PlanJson, PlanRequest, DEFAULT_PLAN_BUDGET};
+use scatterloc::{Error, Model, Scenario};
+
+use super::io::{emit, read_json_file};
+use super::output::{check_writable, write_figure, write_json_file, Figure, Format};
+use super::study::{cancelled, interrupted, load_layout, run_with_bar};
+use crate::cli::PlanArgs;
+use crate::CliError;
+
+/// Grid side of the figure's maps (as `crlb-map`'s default).
+const FIGURE_GRID: usize = 256;
+/// Width of the figure, pixels.
+const FIGURE_WIDTH: u32 = 1600;
+/// Smallest `--grid`: below 16 cells a side the core's search grid (`PlanConfig::search_grid`,
+/// `clamp(grid / 2, 16, grid)`) is not defined (it panics), so the CLI refuses such grids.
+const MIN_GRID: usize = 16;
+
+/// `scatterloc plan`.
+pub fn plan(args: &PlanArgs) -> Result<(), CliError> {
+    let out = args.out.as_str();
+    Format::of("out", out, &[Format::Json])?;
+    let figure = match args.figure.as_deref() {
+        Some(p) => Some((p, Format::of("figure", p, &[Format::Svg, Format::Png])?)),
+        None => None,
+    };
+    let (_, scenario) = load_layout(args.preset.as_deref(), args.scenario.as_deref())?;
+    let allowed: Vec<Polygon> = match args.allowed.as_deref() {
+        Some(path) => read_json_file("allowed", path)?,
+        None => Vec::new(),
+    };
+    let request = PlanRequest {
+        movable: args.movable.clone(),
+        objective: args.objective.clone(),
+        roi: args.roi,
+        bounds: args.bounds,
+        allowed,
+        min_spacing_m: args.min_spacing.unwrap_or(0.0),
+        grid: args.grid,
+        budget: args.budget,
+        seed: args.seed,
+    };
+    let errors = |e: Error| plan_error(e, args);
+    if let Some(g) = args
+        .grid
+        .filter(|g| !(MIN_GRID..=MAX_PLAN_GRID).contains(g))
+    {
+        return Err(CliError::usage(format!(
+            "--grid: {g} is outside the allowed range {MIN_GRID}..={MAX_PLAN_GRID}"
+        )));
+    }
+    // The objective is parsed here so that a bad one is reported before any file is touched.
+    let config = request.config().map_err(errors)?;
+    if let Some((path, _)) = figure {
+        check_area(&scenario.area_m)
+            .map_err(|e| CliError::usage(format!("--figure: area_m: {e}")))?;
+        check_writable("figure", path)?;
+    }
+    check_writable("out", out)?;
+
+    let budget = args.budget.unwrap_or(DEFAULT_PLAN_BUDGET);
+    let (result, wall) = run_with_bar(budget, "evaluations", "plan", |cancel, progress| {
+        run_plan(&scenario, &request, |p| {
+            progress(p.evaluations.min(p.budget), p.budget);
+            !cancel.load(std::sync::atomic::Ordering::SeqCst)
+        })
+    })?;
+    let plan = result.map_err(errors)?;
+
+    if let Some((path, format)) = figure {
+        let maps = PlanMaps::compute(&scenario, &plan.scenario)?;
+        if interrupted() {
+            return Err(cancelled());
+        }
+        let figure = PlanFigure {
+            maps: &maps,
+            plan: &plan,
+            before_nodes: scenario_nodes(&scenario),
+            after_nodes: scenario_nodes(&plan.scenario),
+            opts: chart_options(&scenario, &plan, &args.movable),
+        };
+        let size = plan_chart_size(&scenario.area_m, FIGURE_WIDTH);
+        write_figure("figure", path, format, size, &figure)?;
+    }
+    if interrupted() {
+        return Err(cancelled());
+    }
+    write_json_file("out", out, &plan)?;
+
+    let summary = json!({
+        "out": out,
+        "figure": figure.map(|(p, _)| p),
+        "objective": plan.objective.label,
+        "before": plan.objective.before,
+        "after": plan.objective.after,
+        "evaluations": plan.evaluations,
+        "runs": plan.runs,
+        "termination": plan.termination,
+        "moved": plan.moved,
+        "seed": config.seed,
+        "wall_time_s": (wall * 1e3).round() / 1e3,
+    });
+    emit(&summary.to_string())
+}
+
+/// A core error of the plan as the flag that caused it: `--roi: …`, `--move: …`,
+/// `--min-spacing: …`, `--objective: …`, `--allowed FILE: …`; Ctrl-C as exit status 130.
+fn plan_error(e: Error, args: &PlanArgs) -> CliError {
+    let field = match &e {
+        Error::Cancelled => return cancelled(),
+        Error::OutOfRange { field, value, .. } if field == "objective" && value.is_nan() => {
+            return CliError::usage(format!(
+                "--objective: '{}' is not mean, p90, max or coverage:T (T > 0 m)",
+                args.objective
+            ))
+        }
+        Error::SizeLimit { field, .. } | Error::InvertedArea { field, .. } => field.to_string(),
+        Error::NonFinite { field }
+        | Error::NotPositive { field, .. }
+        | Error::OutOfRange { field, .. }
+        | Error::UnknownNode { field, .. }
+        | Error::Infeasible { field, .. } => field.clone(),
+        _ => String::new(),
+    };
+    let base = field
+        .split(['.', '[', ' '])
+        .next()
+        .unwrap_or_default()
+        .to_string();
+    let flag = match base.as_str() {
+        "roi" => "--roi".to_string(),
+        "bounds" => "--bounds".to_string(),
+        "move" => "--move".to_string(),
+        // No feasible layout found: the spacing, the polygons and the bounds together.
+        "min_spacing" if args.allowed.is_some() && matches!(e, Error::Infeasible { .. }) => {
+            "--min-spacing / --allowed".to_string()
+        }
+        "min_spacing" => "--min-spacing".to_string(),
+        "objective" => "--objective".to_string(),
+        "grid" => "--grid".to_string(),
+        "budget" => "--budget".to_string(),
+        "allowed" => match &args.allowed {
+            Some(path) => format!("--allowed {path}"),
+            None => "--allowed".to_string(),
+        },
+        _ => return CliError::usage(format!("--scenario: {e}")),
+    };
+    let text = e.to_string();
+    // `roi: …` becomes `--roi: …`; a longer path (`roi.x`, `allowed[2]`) is kept after the flag.
+    let message = match text.strip_prefix(&format!("{field}: ")) {
+        Some(rest) if field == base => rest.to_string(),
+        _ => text,
+    };
+    CliError::usage(format!("{flag}: {message}"))
+}
+
+/// The title and subtitle of the figure.
+fn chart_options(s: &Scenario, plan: &PlanJson, movable: &str) -> PlanChartOptions {
+    let o = &plan.objective;
+    let [x0, x1, y0, y1] = o.roi;
+    PlanChartOptions {
+        title: format!("Network plan — {}", s.name),
+        subtitle: Some(format!(
+            "move {} · objective {} over ROI [{x0}, {x1}] × [{y0}, {y1}] m ({}×{} grid) · {} \
+             evaluations · seed {}",
+            movable.trim(),
+            o.label,
+            o.grid,
+            o.grid,
+            plan.evaluations,
+            plan.seed
+        )),
+        ..PlanChartOptions::default()
+    }
+}
+
+/// The CRLB maps of the scenario before and after, over its area.
+struct PlanMaps {
+    grid: Grid,
+    before: Vec<f64>,
+    after: Vec<f64>,
+}
+
+impl PlanMaps {
+    fn compute(before: &Scenario, after: &Scenario) -> Result<PlanMaps, CliError> {
+        let grid = Grid::new(before.area_m, FIGURE_GRID, FIGURE_GRID)
+            .map_err(|e| CliError::usage(format!("--figure: area_m: {e}")))?;
+        let map = |s: &Scenario| -> Result<Vec<f64>, CliError> {
+            let model = Model::new(s).map_err(|e| CliError::usage(format!("--scenario: {e}")))?;
+            let mut values = vec![0.0; grid.len()];
+            crlb_map_parallel(&model, &grid, &mut values, 0)
+                .map_err(|e| CliError::output(format!("--figure: {e}")))?;
+            Ok(values)
+        };
+        Ok(PlanMaps {
+            grid,
+            before: map(before)?,
+            after: map(after)?,
+        })
+    }
+}
+
+/// The figure of [`draw_plan_maps`] as a [`Figure`].
+struct PlanFigure<'a> {
+    maps: &'a PlanMaps,
+    plan: &'a PlanJson,
+    before_nodes: Vec<ChartNode>,
+    after_nodes: Vec<ChartNode>,
+    opts: PlanChartOptions,
+}
+
+impl Figure for PlanFigure<'_> {
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), ChartError> {
+        let o = &self.plan.objective;
+        let (cap_before, cap_after) = (
+            plan_caption("before", o, false),
+            plan_caption("after", o, true),
+        );
+        let before = PlanPanel {
+            caption: &cap_before,
+            map: MapData {
+                grid: self.maps.grid,
+                values_m: &self.maps.before,
+            },
+            nodes: &self.before_nodes,
+        };
+        let after = PlanPanel {
+            caption: &cap_after,
+            map: MapData {
+                grid: self.maps.grid,
+                values_m: &self.maps.after,
+            },
+            nodes: &self.after_nodes,
+        };
+        let paths: Vec<PlanPath> = self
+            .plan
+            .paths
+            .iter()
+            .map(|p| PlanPath {
+                points_m: &p.points,
+            })
+            .collect();
+        let roi = scatterloc::present::area_of(o.roi);
+        draw_plan_maps(root, &before, &after, &roi, &paths, &self.opts).map(|_| ())
+    }
+}
