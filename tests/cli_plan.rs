@@ -421,7 +421,7 @@ fn bad_input_exits_2_naming_the_flag_and_writes_nothing() {
         ),
         (
             vec!["--allowed", &two],
-            vec!["--allowed", "vertices", "3..=1000"],
+            vec!["--allowed", "allowed[0]", "2 vertices", "3 to 1000"],
         ),
         (vec!["--allowed", &broken], vec!["--allowed", "broken.json"]),
         (
@@ -437,9 +437,8 @@ fn bad_input_exits_2_naming_the_flag_and_writes_nothing() {
             vec!["--allowed", "cannot read"],
         ),
         // Limits.
-        (vec!["--grid", "513"], vec!["--grid", "16..=512"]),
-        (vec!["--grid", "1"], vec!["--grid", "16..=512"]),
-        (vec!["--grid", "15"], vec!["--grid", "16..=512"]),
+        (vec!["--grid", "513"], vec!["--grid", "2..=512"]),
+        (vec!["--grid", "1"], vec!["--grid", "2..=512"]),
         (vec!["--budget", "0"], vec!["--budget", "1..=1000000"]),
         (vec!["--budget", "1000001"], vec!["--budget"]),
         (vec!["--seed", "-1"], vec!["--seed"]),

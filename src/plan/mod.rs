@@ -13,6 +13,7 @@ pub use cmaes::{minimize, CmaesConfig, CmaesReport, Generation, SearchProblem, T
 pub use objective::{Objective, RoiObjective, Score};
 pub use planner::{
     plan, Improvement, PlanConfig, PlanProgress, PlanReport, MAX_PLAN_BUDGET, MAX_PLAN_GRID,
+    MIN_PLAN_GRID,
 };
 pub use problem::{
     Constraints, Layout, MoveSpec, NodeRef, PlanScore, PlanSpace, Polygon, MAX_PLAN_DIMENSION,

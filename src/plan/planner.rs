@@ -12,6 +12,8 @@ use super::cmaes::{minimize, CmaesConfig, Termination};
 use super::objective::{Objective, RoiObjective, Score};
 use super::problem::{Constraints, Layout, MoveSpec, NodeRef, PlanScore, PlanSearch, PlanSpace};
 
+/// Smallest ROI grid side of a plan.
+pub const MIN_PLAN_GRID: usize = 2;
 /// Largest ROI grid side of a plan.
 pub const MAX_PLAN_GRID: usize = 512;
 /// Largest evaluation budget of a plan.
@@ -136,15 +138,15 @@ pub fn plan(
     mut observe: impl FnMut(&PlanProgress<'_>) -> bool,
 ) -> Result<PlanReport> {
     scenario.validate()?;
-    for (field, v, max) in [
-        ("grid", config.grid, MAX_PLAN_GRID),
-        ("budget", config.budget, MAX_PLAN_BUDGET),
+    for (field, v, min, max) in [
+        ("grid", config.grid, MIN_PLAN_GRID, MAX_PLAN_GRID),
+        ("budget", config.budget, 1, MAX_PLAN_BUDGET),
     ] {
-        if !(if field == "grid" { 2 } else { 1 }..=max).contains(&v) {
+        if !(min..=max).contains(&v) {
             return Err(Error::SizeLimit {
                 field,
                 value: v,
-                min: if field == "grid" { 2 } else { 1 },
+                min,
                 max,
             });
         }

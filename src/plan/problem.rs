@@ -84,11 +84,12 @@ impl Constraints {
         }
         for (i, poly) in self.allowed.iter().enumerate() {
             if !(3..=MAX_POLYGON_VERTICES).contains(&poly.len()) {
-                return Err(Error::SizeLimit {
-                    field: "allowed polygon vertices",
-                    value: poly.len(),
-                    min: 3,
-                    max: MAX_POLYGON_VERTICES,
+                return Err(Error::Infeasible {
+                    field: format!("allowed[{i}]"),
+                    reason: format!(
+                        "{} vertices; a polygon has 3 to {MAX_POLYGON_VERTICES}",
+                        poly.len()
+                    ),
                 });
             }
             for (j, v) in poly.iter().enumerate() {

@@ -36,8 +36,8 @@ pub struct PlanArgs {
     /// Smallest distance between any two nodes (moved or fixed), m [default: 0].
     #[arg(long, value_name = "M", value_parser = finite)]
     pub min_spacing: Option<f64>,
-    /// ROI grid side of the reported objective, 16..=512 [default: 64] (the search uses N/2, at
-    /// least 16).
+    /// ROI grid side of the reported objective, 2..=512 [default: 64] (the search uses N/2, at
+    /// least 16, at most N).
     #[arg(long, value_name = "N", value_parser = whole)]
     pub grid: Option<usize>,
     /// Objective evaluations of the search, 1..=1000000 [default: 10000].

@@ -13,7 +13,7 @@ use scatterloc::chart::{
 };
 use scatterloc::localize::Grid;
 use scatterloc::native::crlb_map_parallel;
-use scatterloc::plan::{Polygon, MAX_PLAN_GRID};
+use scatterloc::plan::{Polygon, MAX_PLAN_GRID, MIN_PLAN_GRID};
 use scatterloc::present::{run_plan, PlanJson, PlanRequest, DEFAULT_PLAN_BUDGET};
 use scatterloc::{Error, Model, Scenario};
 
@@ -27,9 +27,6 @@ use crate::CliError;
 const FIGURE_GRID: usize = 256;
 /// Width of the figure, pixels.
 const FIGURE_WIDTH: u32 = 1600;
-/// Smallest `--grid`: below 16 cells a side the core's search grid (`PlanConfig::search_grid`,
-/// `clamp(grid / 2, 16, grid)`) is not defined (it panics), so the CLI refuses such grids.
-const MIN_GRID: usize = 16;
 
 /// `scatterloc plan`.
 pub fn plan(args: &PlanArgs) -> Result<(), CliError> {
@@ -58,10 +55,10 @@ pub fn plan(args: &PlanArgs) -> Result<(), CliError> {
     let errors = |e: Error| plan_error(e, args);
     if let Some(g) = args
         .grid
-        .filter(|g| !(MIN_GRID..=MAX_PLAN_GRID).contains(g))
+        .filter(|g| !(MIN_PLAN_GRID..=MAX_PLAN_GRID).contains(g))
     {
         return Err(CliError::usage(format!(
-            "--grid: {g} is outside the allowed range {MIN_GRID}..={MAX_PLAN_GRID}"
+            "--grid: {g} is outside the allowed range {MIN_PLAN_GRID}..={MAX_PLAN_GRID}"
         )));
     }
     // The objective is parsed here so that a bad one is reported before any file is touched.
