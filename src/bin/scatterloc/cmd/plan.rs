@@ -244,14 +244,15 @@ impl Figure for PlanFigure<'_> {
             },
             nodes: &self.after_nodes,
         };
-        let paths: Vec<PlanPath> = self
+        // Each node's move, start to end: the whole search path (plan.json `paths`) jumps
+        // between the basins the restarts explore and would hide the maps.
+        let moves: Vec<[[f64; 2]; 2]> = self
             .plan
             .paths
             .iter()
-            .map(|p| PlanPath {
-                points_m: &p.points,
-            })
+            .filter_map(|p| Some([*p.points.first()?, *p.points.last()?]))
             .collect();
+        let paths: Vec<PlanPath> = moves.iter().map(|m| PlanPath { points_m: m }).collect();
         let roi = scatterloc::present::area_of(o.roi);
         draw_plan_maps(root, &before, &after, &roi, &paths, &self.opts).map(|_| ())
     }
