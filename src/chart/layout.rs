@@ -285,7 +285,7 @@ pub(crate) fn chart_err<E: fmt::Display>(e: E) -> ChartError {
 }
 
 /// Registers the bundled DejaVu Sans as plotters' `sans-serif` font (native only; in the browser
-/// the page's fonts are used). Idempotent; [`draw_crlb_map`] calls it.
+/// the page's fonts are used). Idempotent; [`draw_crlb_map`](super::draw_crlb_map) calls it.
 #[cfg(not(target_arch = "wasm32"))]
 pub fn register_fonts() {
     static ONCE: std::sync::Once = std::sync::Once::new();

@@ -1,8 +1,8 @@
-//! Publication-style figures of CRLB maps, drawn with plotters on any [`DrawingBackend`]: SVG and
+//! Publication-style figures of CRLB maps, drawn with plotters on any [`DrawingBackend`](plotters::prelude::DrawingBackend): SVG and
 //! PNG natively (the CLI), a `<canvas>` in the browser.
 //!
 //! [`draw_crlb_map`] draws the CRLB map figure (the same colours and colour-bar ticks as the page).
-//! [`draw_tracking_rmse`] draws the tracking figure of [S] Fig. 3 (spec §10) in the same style.
+//! [`draw_tracking_rmse`] draws the tracking figure of \[S\] Fig. 3 (spec §10) in the same style.
 //! [`draw_plan_maps`] draws a network plan: the maps before and after side by side.
 //! [`draw_curves`] draws the ROC and missed-detection curves of the multi-target experiments.
 

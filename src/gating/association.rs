@@ -2,7 +2,7 @@
 //! `τ̂^full_kl` (S5, I6) is gated against the calibration (E4: static estimates are discarded),
 //! and the remaining candidates are associated to the one mobile scatterer (S6, I7).
 //!
-//! Association rule (spec §4 **[choice]**): if one candidate remains take it; if several remain,
+//! Association rule (spec §4 **\[choice\]**): if one candidate remains take it; if several remain,
 //! take the one nearest the EKF-predicted delay when its normalised innovation
 //! `|τ̂ − h_p(r̂⁻)|/√S_pp` is ≤ 3, else (in particular with no track yet) the one of largest
 //! amplitude. A link with no candidate is absent from `τ̂` at that time (the EKF skips its row).
@@ -61,7 +61,7 @@ impl Choice {
 /// Which association rule to apply.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum AssociationRule {
-    /// The spec's rule (§4 **[choice]**), for a unique scatterer without clutter: one candidate is
+    /// The spec's rule (§4 **\[choice\]**), for a unique scatterer without clutter: one candidate is
     /// always taken; of several, the nearest if it passes the innovation gate, else the largest
     /// amplitude.
     #[default]

@@ -1,4 +1,4 @@
-//! Calibration stage and 3σ gating (spec §4, [S] §3.1–3.2, [I] §III-A/B).
+//! Calibration stage and 3σ gating (spec §4, \[S\] §3.1–3.2, \[I\] §III-A/B).
 //!
 //! With no mobile object in the area (`Q = 0`) every link records `⌊T_cal/T_g⌋` snapshots, each a
 //! list of estimated delays `τ̂` (from a parameter estimator such as KEST, which is outside this
@@ -7,7 +7,7 @@
 //! In the estimation stage a delay is *static* and discarded when it lies within `3σ̄` of a
 //! cluster mean (E4); the rest are the candidates of the mobile scatterer.
 //!
-//! The default clusterer is the spec's **[choice]** (delay only): sort all calibration delays of
+//! The default clusterer is the spec's **\[choice\]** (delay only): sort all calibration delays of
 //! the link, split where consecutive values differ by more than the gap `g = 1/B`, drop clusters
 //! holding fewer than 50 % of the snapshots (counted as the snapshots with a delay in the
 //! cluster, so one snapshot's repeated estimates count once), and floor `σ̄` at `σ_min = 0.01/B`.
@@ -34,7 +34,7 @@ pub const MAX_CALIBRATION_SNAPSHOTS: usize = 1_000_000;
 /// Largest number of delays accepted in one link's calibration (all snapshots together).
 pub const MAX_CALIBRATION_DELAYS: usize = 10_000_000;
 
-/// Settings of the default delay-only clusterer (spec §4 **[choice]**).
+/// Settings of the default delay-only clusterer (spec §4 **\[choice\]**).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ClusterConfig {
     /// Split between sorted consecutive delays further apart than this, s (`g`, default `1/B`).

@@ -77,7 +77,7 @@ impl<'a> GatedTracker<'a> {
 }
 
 /// Standard deviation of each velocity component when the filter starts from a snapshot fix
-/// (the fix says nothing about velocity), m/s: spec §9.6 **[choice]**, walking speeds.
+/// (the fix says nothing about velocity), m/s: spec §9.6 **\[choice\]**, walking speeds.
 pub const START_SPEED_SIGMA_MPS: Real = 2.0;
 
 /// The start of a track from one snapshot: the filter and how it was made.

@@ -27,7 +27,7 @@ use start::grid_starts;
 /// Fewest links a snapshot fix needs (spec §5).
 pub const MIN_LINKS: usize = 3;
 
-/// LM settings; the defaults are spec §5's [choice] values.
+/// LM settings; the defaults are spec §5's \[choice\] values.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LmConfig {
     /// `λ⁽⁰⁾ = factor · max diag(J₀ᵀR⁻¹J₀)`; default 1e-3.
@@ -48,7 +48,7 @@ pub struct LmConfig {
     /// tail probability (m − 2 degrees of freedom), it is a spurious local minimum with
     /// overwhelming likelihood (they occur near nodes, where ellipses of a start 3 m off can
     /// fold over); the fix is then repeated from the grid-search start and the better one kept.
-    /// Default 1e-3; `None` disables the restart. **[choice]** beyond spec §5.
+    /// Default 1e-3; `None` disables the restart. **\[choice\]** beyond spec §5.
     pub restart_tail_probability: Option<Real>,
 }
 

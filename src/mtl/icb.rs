@@ -80,7 +80,7 @@ impl IcbModel {
 
     /// The threshold (M8) `T_b(N_u) = −N_u ln p_u − (M − N_u) ln(1 − p_u)`: `L_b` of a full
     /// matching with `N_u` undetected DPs. For `p_u < 0.5`, `L_b ≤ T_b(N_u)` accepts exactly
-    /// the matchings with at least `M − N_u` DPs (the size rule of [SM]).
+    /// the matchings with at least `M − N_u` DPs (the size rule of \[SM\]).
     ///
     /// Errors: [`Error::SizeLimit`] (`n_u`) when `N_u > M`.
     pub fn threshold(&self, n_u: usize) -> Result<Real> {

@@ -126,7 +126,7 @@ pub struct PlanReport {
 /// Plans a network: moves the chosen nodes of `scenario` (and turns beams) to optimise the
 /// objective over the ROI, keeping the constraints (`filters-and-planning.md` §3).
 ///
-/// The search is CMA-ES with IPOP restarts ([`super::cmaes`]) over the moved nodes' positions
+/// The search is CMA-ES with IPOP restarts ([`minimize`](super::minimize)) over the moved nodes' positions
 /// scaled to the bounds, ranked by constraint violation, then the objective on the search grid.
 /// The first run starts at the base layout; restarts at uniform random layouts. The last
 /// improvements and the base layout are re-scored on the requested grid, and the best feasible

@@ -43,7 +43,7 @@ fn radio() -> Radio {
     }
 }
 
-/// [S] pedestrian tracking: layout L4 (§9.2), [S] Table 1, parabolic Tx pattern (§9.3),
+/// \[S\] pedestrian tracking: layout L4 (§9.2), \[S\] Table 1, parabolic Tx pattern (§9.3),
 /// RCS 1 m², area x ∈ [−7.5, 30], y ∈ [−10, 26] m (§9.1).
 pub fn sensors2019() -> Scenario {
     Scenario {
@@ -73,7 +73,7 @@ pub fn sensors2019() -> Scenario {
     }
 }
 
-/// [I] car localization: layout L3 (§9.2), [I] Table I, omni Tx 8 dBi, RCS 100 m²,
+/// \[I\] car localization: layout L3 (§9.2), \[I\] Table I, omni Tx 8 dBi, RCS 100 m²,
 /// area x ∈ [−45, 30], y ∈ [−5, 15] m (§9.1).
 pub fn iclgnss2019() -> Scenario {
     Scenario {

@@ -42,7 +42,7 @@ mod nees;
 pub(crate) use batch::update_lanes;
 pub(crate) use nees::spd_quadratic_form;
 
-/// Where the measurement noise `R = diag(σ_p²)` comes from (spec §6 [choice]).
+/// Where the measurement noise `R = diag(σ_p²)` comes from (spec §6 \[choice\]).
 #[derive(Debug, Clone, Copy)]
 pub enum MeasurementNoise<'a> {
     /// Fixed `σ_p` per link, s (e.g. the parameter estimator's variances).

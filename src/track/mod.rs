@@ -1,6 +1,6 @@
 //! Tracking a moving scatterer: the white-noise-acceleration motion model (E7), the EKF with the
 //! Joseph-form update (spec §6, S16–S17), the posterior CRLB recursion (E9, §8), the trajectories
-//! of [S] Fig. 2b and the Monte Carlo prior (§9.4–9.5), one simulated run for display, and the
+//! of \[S\] Fig. 2b and the Monte Carlo prior (§9.4–9.5), one simulated run for display, and the
 //! Monte Carlo study of the tracker against its bound, chunked so that any driver (sequential,
 //! `native`, the page's worker) gives the same result.
 

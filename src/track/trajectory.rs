@@ -1,4 +1,4 @@
-//! Tracking scenarios of [S] Fig. 2b (spec §9.4), the Monte Carlo prior of §9.5, and sampling
+//! Tracking scenarios of \[S\] Fig. 2b (spec §9.4), the Monte Carlo prior of §9.5, and sampling
 //! of truth trajectories with process noise (E7).
 
 use nalgebra::Cholesky;
@@ -8,14 +8,14 @@ use crate::math::{Mat4, Real, Vec2, Vec4};
 use crate::measure::{standard_normal, Rng};
 use crate::track::ConstantVelocity;
 
-/// Process-noise intensity of [S] §5.2 (σ_q² = 0.01 m²/s³).
+/// Process-noise intensity of \[S\] §5.2 (σ_q² = 0.01 m²/s³).
 pub const PAPER_INTENSITY: Real = 0.01;
-/// Duration of the [S] scenarios, s.
+/// Duration of the \[S\] scenarios, s.
 pub const PAPER_DURATION_S: Real = 10.0;
-/// Time step `T_g` of [S] Table 1, s.
+/// Time step `T_g` of \[S\] Table 1, s.
 pub const PAPER_STEP_S: Real = 2.048e-3;
 
-/// The three scenarios of [S] Fig. 2b on layout L4 (spec §9.4 [choice]).
+/// The three scenarios of \[S\] Fig. 2b on layout L4 (spec §9.4 \[choice\]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum TrackScenario {
     /// Start (4, 1), heading 10°: main beam, far from baselines.
@@ -80,7 +80,7 @@ impl TrackScenario {
     }
 }
 
-/// `P(t₀) = diag(0.1, 0.1, 0.01, 0.01)` (m², m²/s²) of [S] §5.2 / spec §9.5.
+/// `P(t₀) = diag(0.1, 0.1, 0.01, 0.01)` (m², m²/s²) of \[S\] §5.2 / spec §9.5.
 pub fn paper_initial_covariance() -> Mat4 {
     Mat4::from_diagonal(&Vec4::new(0.1, 0.1, 0.01, 0.01))
 }

@@ -1,4 +1,4 @@
-//! The experiments of spec `multi-target.md` §8 as ROC sweeps: V-A (Fig. 3, [SM]'s size rule vs
+//! The experiments of spec `multi-target.md` §8 as ROC sweeps: V-A (Fig. 3, \[SM\]'s size rule vs
 //! Bayesian MTL with i.c.b, sweeping `T_e`), V-B (Fig. 4, PPP vs i.c.b (and optionally the
 //! empirical model of §6.3), sweeping `T_b`) and V-C (Fig. 5, Bayesian MTL vs the genie-aided
 //! method, sweeping `T_b`).
