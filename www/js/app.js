@@ -1,7 +1,7 @@
 // The page: loads the wasm core, owns the state, the refresh loop (one redraw per animation frame
-// at most) and the mode switch between the three views: snapshot (map.js), tracking
-// (tracking.js) and multi-target (mtl.js). All numbers come from the core; JavaScript routes
-// events and draws. Loaded by main.js.
+// at most) and the mode switch between the three views: snapshot (map.js, with the Plan panel of
+// plan.js), tracking (tracking.js) and multi-target (mtl.js). All numbers come from the core;
+// JavaScript routes events and draws. Loaded by main.js.
 
 import init, * as wasm from '../pkg/scatterloc.js';
 import { $, decimal, decimalIn, errorText, showError } from './dom.js';
@@ -12,6 +12,7 @@ import { Panel } from './panel.js';
 import { attachPointer } from './interact.js';
 import { Tracking } from './tracking.js';
 import { Mtl } from './mtl.js';
+import { Plan } from './plan.js';
 
 const MODES = ['snapshot', 'tracking', 'mtl'];
 
@@ -116,6 +117,7 @@ export async function start() {
         st.selTx = 0;
         st.selRx = 0;
         st.selected = { kind: 'rx', index: 0 };
+        plan.onReset();
       }
       if (d.map) map.compute(dragging);
       if (d.geometry) {
@@ -127,7 +129,8 @@ export async function start() {
       if (d.panel) panel.sync();
       const tr = st.mode === 'tracking';
       st.fix = tr ? tracking.frame : st.snap;
-      st.overlay = tr ? (c, v) => tracking.overlay(c, v) : null;
+      st.overlay = tr ? (c, v) => tracking.overlay(c, v)
+        : plan.showsRoi() ? (c, v) => plan.overlay(c, v) : null;
       st.insetTitle = tr ? 'EKF zoom · true scale' : 'target zoom';
       st.insetAvoid = tr ? tracking.avoidPoints() : [];
       if (st.mode === 'mtl') mtl.draw(); else map.draw();
@@ -164,6 +167,8 @@ export async function start() {
   const tracking = new Tracking(ctx, opts);
   ctx.tracking = tracking;
   const mtl = new Mtl(ctx);
+  const plan = new Plan(ctx);
+  ctx.plan = plan;
   /** Snapshot view (click to place a target), tracking (animated EKF track + Monte Carlo) or multi-target. */
   const setMode = (mode) => {
     st.mode = MODES.includes(mode) ? mode : 'snapshot';
@@ -172,12 +177,17 @@ export async function start() {
     for (const m of MODES) $(`mode-${m}`).setAttribute('aria-pressed', String(st.mode === m));
     tracking.setActive(st.mode === 'tracking');
     mtl.setActive(st.mode === 'mtl');
+    if (st.mode !== 'snapshot') {
+      plan.cancel('view changed');
+      plan.arm(false);
+    }
     pointer.showHint();
     changed({ draw: true });
   };
   for (const m of MODES) $(`mode-${m}`).addEventListener('click', () => setMode(m));
   $('preset').value = preset;
   const pointer = attachPointer(ctx);
+  ctx.showHint = () => pointer.showHint();
 
   view.resize();
   view.fit(app.area());
@@ -194,7 +204,7 @@ export async function start() {
   if (errors.length) showError(errors.join(' · '));
 
   registerHooks({
-    app, wasm, view, st, setMode, panel, tracking, mtl, map,
+    app, wasm, view, st, setMode, panel, tracking, mtl, map, plan,
     isIdle: () => !scheduled && !map.busy(),
     placeTarget: ctx.placeTarget,
   });
