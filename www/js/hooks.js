@@ -23,6 +23,7 @@
 //                            request with `overrides`' fields); stop(); undo(); result() (plan.json
 //                            of the last finished plan, or null); setRoi([x0, x1, y0, y1] | null)
 //                            -> null | message; setOpen(bool); armRoi(bool) ("Draw ROI")
+//   window.shareLink()       Promise of the link to this view ("Copy link" shows the same in #share-url)
 //   window.importScenarioText(text, name)  loads scenario JSON as an imported file would
 //   window.benchMap(n)       n runs of the map kernel at the current resolution: core-timed ms
 //   body[data-ready='1']     the page is up;  body[data-error]  it failed (the message)
@@ -55,7 +56,7 @@ export function markFailed(msg) {
 
 /**
  * Registers the window hooks once the page is up, then sets body[data-ready].
- * @param {object} p - {app, wasm, view, st, isIdle, setMode, panel, tracking, mtl, map, plan,
+ * @param {object} p - {app, wasm, view, st, isIdle, setMode, panel, tracking, mtl, map, plan, link,
  *   placeTarget}
  */
 export function registerHooks(p) {
@@ -110,6 +111,7 @@ export function registerHooks(p) {
       setOpen: (on) => p.plan.setOpen(on),
       armRoi: (on) => p.plan.arm(on),
     },
+    shareLink: () => p.link(),
     importScenarioText: (text, name) => p.panel.importText(text, name),
     benchMap: (n = 9) => {
       const r = st.res;
