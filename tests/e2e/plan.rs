@@ -208,10 +208,11 @@ fn plan_optimize_moves_receivers_and_lowers_p90() {
     assert_eq!(st["points"], history);
     assert_eq!(st["chartPoints"], history);
     assert!(st["improvements"].as_u64().unwrap() >= 1, "{st}");
-    // At most about 30 progress messages per second of planning (+ the last flush).
+    // At most about 30 progress messages per second of planning, besides those carrying an
+    // improvement (at most one per frame), and the last flush.
     let messages = st["messages"].as_f64().unwrap();
     assert!(
-        messages <= secs("workerMs") * 31.0 + 2.0,
+        messages <= secs("workerMs") * 31.0 + st["improvements"].as_f64().unwrap() + 2.0,
         "{messages} messages in {:.2} s",
         secs("workerMs")
     );
@@ -313,10 +314,33 @@ fn plan_stop_drag_and_preset_cancel_and_undo_restores() {
             plan_state(&c).await?,
             js(&c, "return window.app.scenario().name").await?
         ]);
+        let banner_ok = banner(&c).await?;
+        // 4. Bad requests: a typed budget that is not a number (named at once), an ROI outside
+        // the area (named by the core, from the worker); nothing changes.
+        let json1 = js(&c, "return window.app.scenario_json()").await?;
+        let typed = js(
+            &c,
+            "document.getElementById('plan-budget').value = '1e3x'; \
+             return [window.plan.start(), document.getElementById('error-text').textContent, \
+             window.plan.state().state, document.getElementById('plan-budget').classList.contains('invalid')]",
+        )
+        .await?;
+        js(
+            &c,
+            "document.getElementById('plan-budget').value = '10000'; window.plan.start({roi: [-100, 1, 2, 3]})",
+        )
+        .await?;
+        let failed = wait_plan(&c, 30, |s| s["state"] != "running").await?;
+        let bad = json!([
+            typed,
+            failed,
+            banner(&c).await?,
+            js(&c, "return window.app.scenario_json()").await? == json1,
+        ]);
         Ok(json!({
             "stopped": stopped, "layout": layout, "later": later, "undone": undone,
-            "dragged": dragged, "preset": preset,
-            "errors": console_errors(&c).await?, "banner": banner(&c).await?,
+            "dragged": dragged, "preset": preset, "bad": bad,
+            "errors": console_errors(&c).await?, "banner": banner_ok,
         }))
     });
     println!(
@@ -356,6 +380,21 @@ fn plan_stop_drag_and_preset_cancel_and_undo_restores() {
     assert_eq!(p["state"], "idle", "{p}");
     assert_eq!(p["stopped"], "scenario edited");
     assert_eq!(o["preset"][1], "iclgnss2019");
+    // Bad requests: named in the banner, nothing runs or changes.
+    let bad = &o["bad"];
+    let typed = "plan budget: \"1e3x\" is not a decimal number";
+    assert_eq!(
+        bad[0],
+        json!([typed, format!("Plan: {typed}"), "idle", true])
+    );
+    assert_eq!(bad[1]["state"], "error", "{}", bad[1]);
+    assert_eq!(bad[1]["undo"], false, "nothing to undo");
+    let b = bad[2].as_str().unwrap_or_default();
+    assert!(
+        b.starts_with("Plan: ") && b.contains("roi") && b.contains("must lie inside"),
+        "{b:?}"
+    );
+    assert_eq!(bad[3], true, "the scenario is unchanged");
 }
 
 /// Issue 14 (c): after a short plan and an ROI drawn on the map (a real drag), "Copy link" and

@@ -6,15 +6,18 @@
 // Messages in: {type: 'init', module} (first), then {type: 'run', id, scenario (JSON text),
 // request (JSON text)}. Messages out: {type: 'ready'}; {type: 'progress', id, evaluations,
 // budget, points: [[evaluations, best]], improvement: null | {evaluations, best, scenario (JSON
-// text)}} at most every PROGRESS_MS (every improvement's point is delivered; of the layouts only
-// the newest since the last message, which is all the page shows); {type: 'done', id, result
-// (plan.json), ms}; {type: 'error', id, message}.
+// text)}} at most every PROGRESS_MS, or every IMPROVEMENT_MS (a frame) when there is an
+// improvement (every improvement's point is delivered; of the layouts the newest since the last
+// message, which is all the page shows); {type: 'done', id, result (plan.json), ms};
+// {type: 'error', id, message}.
 
 import init, { plan_network } from '../pkg/scatterloc.js';
 import { errorText } from './dom.js';
 
-/** Least time between progress messages, ms (about 30 per second). */
+/** Least time between progress messages, ms (about 30 per second)… */
 const PROGRESS_MS = 33;
+/** …or between messages carrying an improvement (about one per frame). */
+const IMPROVEMENT_MS = 16;
 
 let ready = null;
 
@@ -52,7 +55,8 @@ async function run(m) {
       points.push([p.evaluations, p.improvement.best]);
       improvement = { evaluations: p.evaluations, best: p.improvement.best, scenario: p.improvement.scenario };
     }
-    if (performance.now() - last >= PROGRESS_MS) flush();
+    const since = performance.now() - last;
+    if (since >= PROGRESS_MS || (improvement && since >= IMPROVEMENT_MS)) flush();
     return true;
   });
   if (progress && (points.length || improvement)) flush();

@@ -292,7 +292,6 @@ export class Plan {
    * current scenario. Returns null, or the message of a bad input (also shown in the banner).
    */
   start(overrides = {}) {
-    this.cancel('restarted');
     let request;
     try {
       request = { ...this.request(), ...overrides };
@@ -300,6 +299,7 @@ export class Plan {
       showError(`Plan: ${errorText(e)}`);
       return errorText(e);
     }
+    this.cancel('restarted');
     clearError();
     const { app } = this.ctx;
     this.undoJson = app.scenario_json();
@@ -424,6 +424,7 @@ export class Plan {
     this.status = 'error';
     this.error = message;
     if (this.run) this.run.wallMs = performance.now() - this.run.t0;
+    if (this.applied === null) this.undoJson = null; // nothing to undo
     showError(`Plan: ${message}`);
     this.sync();
     this.ctx.changed({ draw: true });
