@@ -555,9 +555,10 @@ export class Plan {
     if (!canvas.getClientRects().length) return; // hidden
     const { width, height, dpr } = fitCanvas(canvas);
     const g = canvas.getContext('2d');
-    g.setTransform(dpr, 0, 0, dpr, 0, 0);
+    g.setTransform(1, 0, 0, 1, 0, 0);
     g.fillStyle = C.bg;
-    g.fillRect(0, 0, width, height);
+    g.fillRect(0, 0, canvas.width, canvas.height);
+    g.setTransform(dpr, 0, 0, dpr, 0, 0);
     const box = { x: 52, y: 10, w: Math.max(10, width - 80), h: Math.max(10, height - 34) };
     const r = this.run;
     const budget = Math.max(1, r ? r.budget : DEFAULT_BUDGET);
