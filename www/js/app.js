@@ -266,6 +266,7 @@ async function copyLink(link) {
   $('share-note').textContent = '';
   field.focus();
   field.select();
+  field.scrollLeft = 0;
   let note = 'select and copy it';
   if (navigator.clipboard && window.isSecureContext) {
     try {
