@@ -40,6 +40,10 @@ mod hardening;
 #[path = "e2e/speed.rs"]
 mod speed;
 
+/// Issue 14: the Plan panel (planner in a Web Worker, Stop/Undo) and shared links.
+#[path = "e2e/plan.rs"]
+mod plan;
+
 /// `SCATTERLOC_SCREENSHOT=1`: writes docs/screenshot-tracking.png.
 #[path = "e2e/screenshot.rs"]
 mod screenshot;

@@ -1,10 +1,12 @@
 // The page: loads the wasm core, owns the state, the refresh loop (one redraw per animation frame
-// at most) and the mode switch between the three views: snapshot (map.js), tracking
-// (tracking.js) and multi-target (mtl.js). All numbers come from the core; JavaScript routes
-// events and draws. Loaded by main.js.
+// at most) and the mode switch between the three views: snapshot (map.js, with the Plan panel of
+// plan.js), tracking (tracking.js) and multi-target (mtl.js); reads its options, and a shared
+// scenario, from the URL hash and writes them back for "Copy link" (share.js). All numbers come
+// from the core; JavaScript routes events and draws. Loaded by main.js.
 
 import init, * as wasm from '../pkg/scatterloc.js';
 import { $, decimal, decimalIn, errorText, showError } from './dom.js';
+import { decodeScenario, viewLink } from './share.js';
 import { registerHooks } from './hooks.js';
 import { View } from './view.js';
 import { MapView } from './map.js';
@@ -12,6 +14,7 @@ import { Panel } from './panel.js';
 import { attachPointer } from './interact.js';
 import { Tracking } from './tracking.js';
 import { Mtl } from './mtl.js';
+import { Plan } from './plan.js';
 
 const MODES = ['snapshot', 'tracking', 'mtl'];
 
@@ -23,9 +26,12 @@ const UINT32 = { min: 0, max: 4294967295, integer: true };
 
 /**
  * `#preset=iclgnss2019&target=6,4&seed=3&res=256` -> options; tracking: `#mode=tracking&track=II&step=45
- * &play=1&runs=200&ex=100&tseed=1&dt=0.1&speed=1&custom=x0,y0,x1,y1`; multi-target: `#mode=mtl`.
- * Every number is parsed strictly (dom.js `decimal`); a bad option is left at its default and
- * reported in `errors` (naming the option, the value given and what is allowed).
+ * &play=1&runs=200&ex=100&tseed=1&dt=0.1&speed=1&custom=x0,y0,x1,y1`; multi-target: `#mode=mtl`;
+ * a shared view ("Copy link"): `roi=x0,x1,y0,y1` (the Plan panel's region of interest, m) and
+ * the scenario as `scenario=<base64url of its JSON>` or `z=<base64url of its raw-deflated JSON>`
+ * (share.js; a scenario replaces the preset). Every number is parsed strictly (dom.js
+ * `decimal`); a bad option is left at its default and reported in `errors` (naming the option,
+ * the value given and what is allowed); the scenario and the ROI are judged in start().
  */
 function hashOptions(presets) {
   const h = new URLSearchParams(location.hash.slice(1));
@@ -52,6 +58,7 @@ function hashOptions(presets) {
   });
   const target = numbers('target', 2);
   const custom = numbers('custom', 4);
+  const scenarioKey = ['z', 'scenario'].find((k) => h.has(k));
   const opts = {
     mode: oneOf('mode', MODES) ?? 'snapshot',
     track: oneOf('track', ['I', 'II', 'III', 'custom']),
@@ -67,6 +74,8 @@ function hashOptions(presets) {
     target: target ? { x: target[0], y: target[1] } : null,
     seed: read('seed', (t) => decimalIn(t, 'seed', UINT32)) ?? 1,
     res: option('res', 'resolution'),
+    roi: numbers('roi', 4),
+    scenario: scenarioKey ? [scenarioKey, h.get(scenarioKey)] : null,
   };
   return { opts, errors };
 }
@@ -80,6 +89,17 @@ export async function start() {
   const { opts, errors } = hashOptions(wasm.preset_names());
   const preset = opts.preset ?? 'sensors2019';
   const app = wasm.App.from_preset(preset);
+  let shared = false;
+  if (opts.scenario) {
+    // A shared scenario; a bad one is named in the banner and the preset stays.
+    const [key, value] = opts.scenario;
+    try {
+      app.set_scenario_json(await decodeScenario(key, value));
+      shared = true;
+    } catch (e) {
+      errors.push(`URL option ${key}: ${errorText(e)}`);
+    }
+  }
   if (opts.res) $('resolution').value = opts.res;
 
   const view = new View($('plot'));
@@ -116,6 +136,7 @@ export async function start() {
         st.selTx = 0;
         st.selRx = 0;
         st.selected = { kind: 'rx', index: 0 };
+        plan.onReset();
       }
       if (d.map) map.compute(dragging);
       if (d.geometry) {
@@ -127,7 +148,8 @@ export async function start() {
       if (d.panel) panel.sync();
       const tr = st.mode === 'tracking';
       st.fix = tr ? tracking.frame : st.snap;
-      st.overlay = tr ? (c, v) => tracking.overlay(c, v) : null;
+      st.overlay = tr ? (c, v) => tracking.overlay(c, v)
+        : plan.showsRoi() ? (c, v) => plan.overlay(c, v) : null;
       st.insetTitle = tr ? 'EKF zoom · true scale' : 'target zoom';
       st.insetAvoid = tr ? tracking.avoidPoints() : [];
       if (st.mode === 'mtl') mtl.draw(); else map.draw();
@@ -164,6 +186,8 @@ export async function start() {
   const tracking = new Tracking(ctx, opts);
   ctx.tracking = tracking;
   const mtl = new Mtl(ctx);
+  const plan = new Plan(ctx);
+  ctx.plan = plan;
   /** Snapshot view (click to place a target), tracking (animated EKF track + Monte Carlo) or multi-target. */
   const setMode = (mode) => {
     st.mode = MODES.includes(mode) ? mode : 'snapshot';
@@ -172,12 +196,17 @@ export async function start() {
     for (const m of MODES) $(`mode-${m}`).setAttribute('aria-pressed', String(st.mode === m));
     tracking.setActive(st.mode === 'tracking');
     mtl.setActive(st.mode === 'mtl');
+    if (st.mode !== 'snapshot') {
+      plan.cancel('view changed');
+      plan.arm(false);
+    }
     pointer.showHint();
     changed({ draw: true });
   };
   for (const m of MODES) $(`mode-${m}`).addEventListener('click', () => setMode(m));
-  $('preset').value = preset;
+  $('preset').value = shared ? '' : preset;
   const pointer = attachPointer(ctx);
+  ctx.showHint = () => pointer.showHint();
 
   view.resize();
   view.fit(app.area());
@@ -186,6 +215,14 @@ export async function start() {
     changed({ draw: true });
   }).observe($('plot').parentElement);
 
+  if (opts.roi) {
+    try {
+      plan.setRoi(opts.roi);
+      plan.setOpen(true);
+    } catch (e) {
+      errors.push(`URL option roi: ${errorText(e)}`);
+    }
+  }
   if (opts.target) st.target = { x: opts.target.x, y: opts.target.y, seed: st.nextSeed++ };
   Object.assign(dirty, { map: true, geometry: true, target: true, panel: true });
   refresh();
@@ -193,9 +230,51 @@ export async function start() {
   if (opts.play) tracking.play();
   if (errors.length) showError(errors.join(' · '));
 
+  /** The link to this view: mode, map grid, target, ROI and the scenario (share.js). */
+  const link = () => viewLink({
+    mode: st.mode,
+    res: $('resolution').value,
+    target: st.target,
+    roi: plan.roi,
+    scenario: app.scenario_json(),
+  });
+  $('share-copy').addEventListener('click', () => copyLink(link));
+  $('share-close').addEventListener('click', () => { $('share').hidden = true; });
+
   registerHooks({
-    app, wasm, view, st, setMode, panel, tracking, mtl, map,
+    app, wasm, view, st, setMode, panel, tracking, mtl, map, plan, link,
     isIdle: () => !scheduled && !map.busy(),
     placeTarget: ctx.placeTarget,
   });
+}
+
+/**
+ * "Copy link": shows the link in the read-only field (selected, for copying by hand) and writes
+ * it to the clipboard where the browser allows it.
+ */
+async function copyLink(link) {
+  let url;
+  try {
+    url = await link();
+  } catch (e) {
+    showError(`Copy link: ${errorText(e)}`);
+    return;
+  }
+  const field = $('share-url');
+  field.value = url;
+  $('share').hidden = false;
+  $('share-note').textContent = '';
+  field.focus();
+  field.select();
+  field.scrollLeft = 0;
+  let note = 'select and copy it';
+  if (navigator.clipboard && window.isSecureContext) {
+    try {
+      await navigator.clipboard.writeText(url);
+      note = 'copied to the clipboard';
+    } catch (_) {
+      note = 'the clipboard refused it: select and copy it';
+    }
+  }
+  $('share-note').textContent = note;
 }

@@ -14,6 +14,16 @@
 //   window.placeTarget(x, y) places the snapshot target (m)
 //   window.tracking          {state, setMode, play, pause, seek, restartMc, mcParams, mcResult}
 //   window.mtl               {state, setScene, pixelFromCentre, bench, setMode}
+//   window.plan              the Plan panel: state() {state: 'idle' | 'running' | 'done' | 'error',
+//                            evaluations, budget, messages (progress messages received), improvements
+//                            (layouts applied), points (history), chartPoints (drawn), gliding,
+//                            wallMs (Optimize to result), workerMs, stopped (reason), request,
+//                            applied (the last layout applied, JSON), undo, roi, roiCustom, open,
+//                            drawing, error}; start(overrides?) -> null | message (the panel's
+//                            request with `overrides`' fields); stop(); undo(); result() (plan.json
+//                            of the last finished plan, or null); setRoi([x0, x1, y0, y1] | null)
+//                            -> null | message; setOpen(bool); armRoi(bool) ("Draw ROI")
+//   window.shareLink()       Promise of the link to this view ("Copy link" shows the same in #share-url)
 //   window.importScenarioText(text, name)  loads scenario JSON as an imported file would
 //   window.benchMap(n)       n runs of the map kernel at the current resolution: core-timed ms
 //   body[data-ready='1']     the page is up;  body[data-error]  it failed (the message)
@@ -46,7 +56,8 @@ export function markFailed(msg) {
 
 /**
  * Registers the window hooks once the page is up, then sets body[data-ready].
- * @param {object} p - {app, wasm, view, st, isIdle, setMode, panel, tracking, mtl, map, placeTarget}
+ * @param {object} p - {app, wasm, view, st, isIdle, setMode, panel, tracking, mtl, map, plan, link,
+ *   placeTarget}
  */
 export function registerHooks(p) {
   const { app, st, tracking, mtl } = p;
@@ -83,6 +94,24 @@ export function registerHooks(p) {
       bench: (n) => mtl.bench(n),
       setMode: p.setMode,
     },
+    plan: {
+      state: () => p.plan.state(),
+      start: (overrides) => p.plan.start(overrides),
+      stop: () => p.plan.stop(),
+      undo: () => p.plan.undo(),
+      result: () => p.plan.result,
+      setRoi: (r) => {
+        try {
+          p.plan.setRoi(r);
+          return null;
+        } catch (e) {
+          return e.message;
+        }
+      },
+      setOpen: (on) => p.plan.setOpen(on),
+      armRoi: (on) => p.plan.arm(on),
+    },
+    shareLink: () => p.link(),
     importScenarioText: (text, name) => p.panel.importText(text, name),
     benchMap: (n = 9) => {
       const r = st.res;

@@ -1,6 +1,7 @@
 // Mouse/pointer handling on the plot for the snapshot and tracking views: drag Tx/Rx markers,
-// click to place a target (snapshot mode) or press-and-drag a trajectory (tracking mode, "draw"),
-// hover read-out. pickNearest is the hit test of every view (mtl.js uses it too).
+// click to place a target (snapshot mode), press-and-drag a trajectory (tracking mode, "draw") or
+// the Plan panel's region of interest (after "Draw ROI", plan.js), hover read-out. A node drag
+// cancels a running plan. pickNearest is the hit test of every view (mtl.js uses it too).
 
 import { $, errorText, fixed, showError, clearError } from './dom.js';
 
@@ -37,6 +38,7 @@ export function attachPointer(ctx) {
   const hover = (p) => {
     if (!view.inPlot(p.x, p.y)) {
       if (st.mode === 'mtl') readout.textContent = 'Multi-target · drag Tx, Rx, targets (×) and discs';
+      else if (ctx.plan && ctx.plan.wantsRoi()) readout.textContent = 'Press and drag on the map to draw the region of interest';
       else readout.textContent = st.mode !== 'tracking'
         ? 'Move over the map to read the bound · drag Tx/Rx markers · click to place a target'
         : `Move over the map to read the bound · drag Tx/Rx markers${ctx.tracking.wantsDraw() ? ' · press and drag to draw a trajectory' : ''}`;
@@ -56,9 +58,12 @@ export function attachPointer(ctx) {
   canvas.addEventListener('pointerdown', (ev) => {
     if (ev.button !== 0) return;
     const p = view.eventPixel(ev);
-    const node = hitNode(view, st.nodes, p);
-    const draw = !node && view.inPlot(p.x, p.y) && ctx.tracking.wantsDraw();
-    press = { start: p, node, moved: false, draw };
+    // "Draw ROI" armed: the press draws the ROI, even over a node.
+    const roi = !!ctx.plan && ctx.plan.wantsRoi() && view.inPlot(p.x, p.y);
+    const node = roi ? null : hitNode(view, st.nodes, p);
+    const draw = !node && !roi && view.inPlot(p.x, p.y) && ctx.tracking.wantsDraw();
+    press = { start: p, node, moved: false, draw, roi };
+    if (roi) ctx.plan.roiStart(p);
     if (node) {
       ctx.panel.select(node.kind, node.index);
       canvas.classList.add('dragging');
@@ -71,6 +76,7 @@ export function attachPointer(ctx) {
   canvas.addEventListener('pointermove', (ev) => {
     const p = view.eventPixel(ev);
     if (press && press.node) {
+      if (!press.moved && ctx.plan) ctx.plan.cancel('node dragged');
       press.moved = true;
       // Keep the node inside the plotted area (clamped in pixels).
       const r = view.rect;
@@ -83,6 +89,8 @@ export function attachPointer(ctx) {
       } catch (e) {
         showError(errorText(e));
       }
+    } else if (press && press.roi) {
+      ctx.plan.roiMove(p);
     } else if (press && press.draw) {
       ctx.tracking.drawMove(view.toMetre(p.x, p.y));
     } else if (press) {
@@ -96,7 +104,8 @@ export function attachPointer(ctx) {
   const end = (ev) => {
     if (!press) return;
     const p = view.eventPixel(ev);
-    const wasClick = !press.node && !press.moved && ev.type === 'pointerup' && st.mode !== 'tracking';
+    const wasClick = !press.node && !press.roi && !press.moved && ev.type === 'pointerup' && st.mode !== 'tracking';
+    if (press.roi) ctx.plan.roiEnd(p, ev.type === 'pointerup');
     if (press.draw) ctx.tracking.drawEnd(view.toMetre(p.x, p.y));
     // A map reduced while dragging (map.js) is now computed at full resolution.
     if (press.node && press.moved) ctx.changed({ map: true, dragEnd: true });

@@ -383,8 +383,7 @@ function drawInset(ctx, view, fix, w, title, avoid) {
  */
 function drawScene(view, st, w) {
   const ctx = view.context();
-  ctx.fillStyle = C.bg;
-  ctx.fillRect(0, 0, view.width, view.height);
+  view.clear(ctx, C.bg);
   drawMap(ctx, view, st);
   drawAxes(ctx, view, w);
   drawColorbar(ctx, view, st, w);

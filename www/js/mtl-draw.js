@@ -132,8 +132,7 @@ function targets(ctx, view, scene, v, sel) {
  */
 export function drawMtl(view, scene, v, sel, w) {
   const ctx = view.context();
-  ctx.fillStyle = BG;
-  ctx.fillRect(0, 0, view.width, view.height);
+  view.clear(ctx, BG);
   const r = view.rect;
   region(ctx, view, scene);
   drawAxes(ctx, view, w);

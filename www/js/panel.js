@@ -16,7 +16,9 @@ export class Panel {
     for (const name of wasm.preset_names()) preset.add(new Option(name, name));
     preset.add(new Option('(imported / edited)', ''));
     preset.addEventListener('change', () => {
-      if (preset.value) this.run(null, () => this.ctx.app.load_preset(preset.value), { all: true, reset: true });
+      // Read first: run() cancels a running plan, whose last layout marks the select "edited".
+      const name = preset.value;
+      if (name && this.run(null, () => this.ctx.app.load_preset(name), { all: true, reset: true })) preset.value = name;
     });
     $('error-close').addEventListener('click', clearError);
 
@@ -108,8 +110,12 @@ export class Panel {
     $(id).setAttribute('spellcheck', 'false');
   }
 
-  /** Runs a wasm edit; on success refreshes, on failure shows the core's message. */
+  /**
+   * Runs a wasm edit; on success refreshes, on failure shows the core's message. Any edit cancels
+   * a running plan first (plan.js), which would otherwise overwrite it with its next layout.
+   */
   run(input, edit, flags = { all: true }) {
+    if (this.ctx.plan) this.ctx.plan.cancel('scenario edited');
     try {
       edit();
       if (input) input.classList.remove('invalid');

@@ -67,6 +67,18 @@ export class View {
     return ctx;
   }
 
+  /**
+   * Fills every pixel of the backing store with `color`. (A fill of the CSS size only blends into
+   * the last row or column when that size is fractional, so redraws would pile up there.)
+   */
+  clear(ctx, color) {
+    ctx.save();
+    ctx.setTransform(1, 0, 0, 1, 0, 0);
+    ctx.fillStyle = color;
+    ctx.fillRect(0, 0, this.canvas.width, this.canvas.height);
+    ctx.restore();
+  }
+
   /** Event -> canvas-relative CSS pixels. */
   eventPixel(ev) {
     const r = this.canvas.getBoundingClientRect();
