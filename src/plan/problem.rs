@@ -299,7 +299,7 @@ impl PlanSpace {
                 .turned
                 .iter()
                 .map(|&i| match self.base.transmitters[i].pattern {
-                    Pattern::Parabolic { boresight_deg, .. } => boresight_deg.rem_euclid(360.0),
+                    Pattern::Parabolic { boresight_deg, .. } => wrap_degrees(boresight_deg),
                     Pattern::Omni => 0.0,
                 })
                 .collect(),
@@ -338,7 +338,7 @@ impl PlanSpace {
             .collect();
         let boresights_deg = x[2 * self.moved.len()..]
             .iter()
-            .map(|t| (t - libm::floor(*t)) * 360.0 % 360.0)
+            .map(|t| wrap_degrees(t * 360.0))
             .collect();
         (
             Layout {
@@ -409,6 +409,16 @@ impl PlanSpace {
             }
         }
         s
+    }
+}
+
+/// An angle in degrees wrapped into `[0, 360)`.
+fn wrap_degrees(d: Real) -> Real {
+    let w = d - 360.0 * libm::floor(d / 360.0);
+    if w >= 360.0 {
+        0.0
+    } else {
+        w
     }
 }
 
