@@ -39,7 +39,7 @@ mod batch;
 mod links;
 mod nees;
 
-pub(crate) use batch::update_lanes;
+pub(crate) use batch::{first_input_error, update_lanes};
 pub(crate) use nees::spd_quadratic_form;
 
 /// Where the measurement noise `R = diag(σ_p²)` comes from (spec §6 \[choice\]).
@@ -147,6 +147,28 @@ fn information_from_sigma(sigma: Real) -> Real {
     1.0 / (r * r)
 }
 
+/// Checks a user-supplied state: finite, position within [`limits::COORDINATE_M`], velocity
+/// within [`limits::VELOCITY_M_S`] (errors name `initial_state[i]`).
+pub(crate) fn check_state(state: &Vec4) -> Result<()> {
+    if state.iter().any(|v| !v.is_finite()) {
+        return Err(Error::NonFinite {
+            field: "initial_state".into(),
+        });
+    }
+    for (i, range) in [
+        limits::COORDINATE_M,
+        limits::COORDINATE_M,
+        limits::VELOCITY_M_S,
+        limits::VELOCITY_M_S,
+    ]
+    .iter()
+    .enumerate()
+    {
+        range.check(&alloc::format!("initial_state[{i}]"), state[i])?;
+    }
+    Ok(())
+}
+
 /// Relative asymmetry tolerated in a user-supplied covariance.
 const SYMMETRY_TOLERANCE: Real = 1e-9;
 
@@ -171,22 +193,7 @@ impl Ekf {
     /// [`limits::COORDINATE_M`], velocity within [`limits::VELOCITY_M_S`], covariance finite,
     /// symmetric PD, no variance above [`limits::MAX_INITIAL_VARIANCE`]).
     pub fn new(state: Vec4, covariance: Mat4) -> Result<Ekf> {
-        if state.iter().any(|v| !v.is_finite()) {
-            return Err(Error::NonFinite {
-                field: "initial_state".into(),
-            });
-        }
-        for (i, range) in [
-            limits::COORDINATE_M,
-            limits::COORDINATE_M,
-            limits::VELOCITY_M_S,
-            limits::VELOCITY_M_S,
-        ]
-        .iter()
-        .enumerate()
-        {
-            range.check(&alloc::format!("initial_state[{i}]"), state[i])?;
-        }
+        check_state(&state)?;
         check_covariance("initial_covariance", &covariance)?;
         for i in 0..4 {
             let v = covariance[(i, i)];

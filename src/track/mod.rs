@@ -10,6 +10,7 @@ mod motion;
 mod pcrlb;
 mod track_sim;
 mod trajectory;
+mod ukf;
 
 pub use ekf::{check_covariance, Ekf, MeasurementNoise, PredictedDelay, UpdateSummary};
 pub(crate) use ekf::{range_information_per_snr, spd_quadratic_form, update_lanes, NodeView};
@@ -25,3 +26,4 @@ pub use trajectory::{
     paper_initial_covariance, step_count, TrackScenario, TruthSampler, PAPER_DURATION_S,
     PAPER_INTENSITY, PAPER_STEP_S,
 };
+pub use ukf::{Ukf, UkfParams};

@@ -189,7 +189,7 @@ const WIDE_PRIOR: Real = 1e6;
 /// [`limits::DELAY_SIGMA_S`], or a `σ_p` that is not finite and positive (or so small that
 /// `1/(cσ_p)²` overflows). `None` if all are fine.
 #[cold]
-fn first_input_error(
+pub(crate) fn first_input_error(
     model: &Model,
     z: &[Option<Real>],
     noise: MeasurementNoise,
