@@ -164,6 +164,12 @@ pub enum Error {
         /// The names accepted there, e.g. `I, II, III`.
         known: &'static str,
     },
+    /// A particle filter's weights degenerated: every log-weight is `−∞` or not a number (e.g.
+    /// measurements infinitely unlikely under every particle). The filter is left unchanged.
+    Degenerate {
+        /// Which quantity, e.g. `pf.weights`.
+        field: String,
+    },
     /// A planning problem that no layout can satisfy, or that has nothing to optimise: no
     /// movable node, fixed nodes closer than the spacing, more nodes than the bounds can hold
     /// at that spacing, no feasible layout found within the budget.
@@ -282,6 +288,10 @@ impl fmt::Display for Error {
                  multi-target localization); give fewer ranges per TRP, or lower T_e or c_sigma_m"
             ),
             Error::Cancelled => write!(f, "cancelled"),
+            Error::Degenerate { field } => write!(
+                f,
+                "{field}: degenerate (every particle's likelihood is zero or not a number)"
+            ),
             Error::Infeasible { field, reason } => write!(f, "{field}: {}", Clip(reason)),
             Error::UnknownPreset { name } => write!(
                 f,

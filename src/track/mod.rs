@@ -1,5 +1,6 @@
 //! Tracking a moving scatterer: the white-noise-acceleration motion model (E7), the EKF with the
-//! Joseph-form update (spec §6, S16–S17), the posterior CRLB recursion (E9, §8), the trajectories
+//! Joseph-form update (spec §6, S16–S17), the UKF and the bootstrap particle filter
+//! (`filters-and-planning.md` §1–2), the posterior CRLB recursion (E9, §8), the trajectories
 //! of \[S\] Fig. 2b and the Monte Carlo prior (§9.4–9.5), one simulated run for display, and the
 //! Monte Carlo study of the tracker against its bound, chunked so that any driver (sequential,
 //! `native`, the page's worker) gives the same result.
@@ -8,6 +9,7 @@ mod ekf;
 mod montecarlo;
 mod motion;
 mod pcrlb;
+mod pf;
 mod track_sim;
 mod trajectory;
 mod ukf;
@@ -21,6 +23,7 @@ pub use montecarlo::{
 };
 pub use motion::ConstantVelocity;
 pub use pcrlb::{nominal_pcrlb_rmse, pcrlb_rmse, PosteriorInformation};
+pub use pf::{ParticleFilter, PfConfig, PfUpdate, MAX_PARTICLES};
 pub use track_sim::{simulate_track, TrackRun};
 pub use trajectory::{
     paper_initial_covariance, step_count, TrackScenario, TruthSampler, PAPER_DURATION_S,

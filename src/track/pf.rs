@@ -1,0 +1,417 @@
+//! Bootstrap SIR particle filter for the bistatic-delay tracker (`filters-and-planning.md` §2),
+//! on the EKF's motion model (E7) and measurement model (E1, `σ_p` from E8).
+//!
+//! - `N` particles drawn from `𝒩(x̄₀, P(t₀))`; each is propagated by `x ← A x + w`, `w ~ 𝒩(0, Q)`.
+//! - Log-weights `ℓ_j += −½ Σ_links (z − h(x_j))² / σ_p²`, normalised with log-sum-exp, so a step
+//!   whose likelihoods all underflow in linear space still has weights; only non-finite
+//!   log-weights are a reported outcome ([`Error::Degenerate`]), never NaN.
+//! - `σ_p` from the link budget at the weighted mean of the predicted particles (as the EKF's
+//!   "at the prediction"), or fixed, or at a given position ([`MeasurementNoise`]).
+//! - The estimate is the weighted mean and covariance, taken before resampling.
+//! - Effective sample size `1/Σ w_j² < N/2` → systematic resampling (one uniform draw), then the
+//!   optional roughening `𝒩(0, c·diag(spread²)·N^(−1/5))` (spread = the particles' range per
+//!   state component; off by default).
+//!
+//! Each filter owns its random stream, so a result depends on the seed only, whatever the thread
+//! count.
+
+use alloc::vec;
+use alloc::vec::Vec;
+
+use rand::Rng as _;
+
+use crate::error::{check_len, Error, Result};
+use crate::math::portable::{exp, ln};
+use crate::math::{sqrt, Mat4, Real, Vec2, Vec4, SPEED_OF_LIGHT};
+use crate::measure::{standard_normal, Model, Rng};
+use crate::track::ekf::{check_covariance, check_state, first_input_error};
+use crate::track::{spd_quadratic_form, ConstantVelocity, MeasurementNoise, UpdateSummary};
+
+/// Most particles of a filter.
+pub const MAX_PARTICLES: usize = 1_000_000;
+
+/// Settings of a [`ParticleFilter`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PfConfig {
+    /// `N`, 1 … [`MAX_PARTICLES`].
+    pub particles: usize,
+    /// Roughening constant `c` (≥ 0, ≤ 10); `None` = off (the default).
+    pub roughening: Option<Real>,
+}
+
+impl Default for PfConfig {
+    fn default() -> Self {
+        PfConfig {
+            particles: 1000,
+            roughening: None,
+        }
+    }
+}
+
+impl PfConfig {
+    /// Checks the ranges (errors name `particles`, `roughening`).
+    pub fn validate(&self) -> Result<()> {
+        if !(1..=MAX_PARTICLES).contains(&self.particles) {
+            return Err(Error::SizeLimit {
+                field: "particles",
+                value: self.particles,
+                min: 1,
+                max: MAX_PARTICLES,
+            });
+        }
+        if let Some(c) = self.roughening {
+            if !(c.is_finite() && (0.0..=10.0).contains(&c)) {
+                return Err(Error::OutOfRange {
+                    field: "roughening".into(),
+                    value: c,
+                    allowed: "0 to 10",
+                });
+            }
+        }
+        Ok(())
+    }
+}
+
+/// What an update did, beyond [`UpdateSummary`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PfUpdate {
+    /// Links used and the NIS of the weighted predicted measurement
+    /// (`ν = z − ẑ`, `S = Σ w_j (h_j − ẑ)(h_j − ẑ)ᵀ + R`).
+    pub summary: UpdateSummary,
+    /// Effective sample size after the update, before resampling.
+    pub ess: Real,
+    /// Whether the particles were resampled.
+    pub resampled: bool,
+}
+
+/// The particle filter: particles, their normalised log-weights, the estimate and the stream.
+#[derive(Debug, Clone)]
+pub struct ParticleFilter {
+    particles: Vec<Vec4>,
+    log_weights: Vec<Real>,
+    /// `exp(log_weights)`, kept in step.
+    weights: Vec<Real>,
+    config: PfConfig,
+    rng: Rng,
+    /// Weighted mean, m and m/s.
+    pub state: Vec4,
+    /// Weighted covariance.
+    pub covariance: Mat4,
+    /// Scratch: the predicted ranges of every particle (`N × m`).
+    ranges: Vec<Real>,
+}
+
+impl ParticleFilter {
+    /// `config.particles` particles drawn from `𝒩(mean, covariance)` (validated as for the EKF)
+    /// with `rng`, which the filter then owns.
+    pub fn new(
+        mean: Vec4,
+        covariance: Mat4,
+        config: PfConfig,
+        mut rng: Rng,
+    ) -> Result<ParticleFilter> {
+        check_state(&mean)?;
+        check_covariance("initial_covariance", &covariance)?;
+        config.validate()?;
+        let l = nalgebra::Cholesky::new(covariance)
+            .ok_or_else(|| Error::NotPositiveDefinite {
+                field: "initial_covariance".into(),
+            })?
+            .l();
+        let n = config.particles;
+        let particles: Vec<Vec4> = (0..n).map(|_| mean + l * normal4(&mut rng)).collect();
+        let mut f = ParticleFilter {
+            particles,
+            log_weights: vec![-ln(n as Real); n],
+            weights: vec![1.0 / n as Real; n],
+            config,
+            rng,
+            state: mean,
+            covariance,
+            ranges: Vec::new(),
+        };
+        f.estimate();
+        Ok(f)
+    }
+
+    /// The particles.
+    pub fn particles(&self) -> &[Vec4] {
+        &self.particles
+    }
+
+    /// Their normalised log-weights.
+    pub fn log_weights(&self) -> &[Real] {
+        &self.log_weights
+    }
+
+    /// Position part of the estimate, m.
+    pub fn position(&self) -> Vec2 {
+        Vec2::new(self.state[0], self.state[1])
+    }
+
+    /// Predict: every particle `x ← A x + w`, `w ~ 𝒩(0, Q)` (E7); the estimate follows.
+    pub fn predict(&mut self, motion: &ConstantVelocity) {
+        // `Q`'s Cholesky factor is block-diagonal per axis: [[l11, 0], [l21, l22]] on (x, vx)
+        // and on (y, vy).
+        let lq = motion.process_noise_factor();
+        let (l11, l21, l22) = (lq[(0, 0)], lq[(2, 0)], lq[(2, 2)]);
+        let t = motion.dt_s;
+        for x in self.particles.iter_mut() {
+            let w = normal4(&mut self.rng);
+            let (px, py, vx, vy) = (x[0], x[1], x[2], x[3]);
+            *x = Vec4::new(
+                px + t * vx + l11 * w[0],
+                py + t * vy + l11 * w[1],
+                vx + l21 * w[0] + l22 * w[2],
+                vy + l21 * w[1] + l22 * w[3],
+            );
+        }
+        self.estimate();
+    }
+
+    /// Update with delays `z` (s, one per link, `None` = missing): weights, estimate, and
+    /// resampling when the effective sample size falls below `N/2`. No link: nothing to do. On
+    /// error the filter is unchanged.
+    pub fn update(
+        &mut self,
+        model: &Model,
+        z: &[Option<Real>],
+        noise: MeasurementNoise,
+    ) -> Result<PfUpdate> {
+        let links = model.link_count();
+        check_len("measurement", links, z.len())?;
+        noise.check_links(links)?;
+        let n = self.particles.len();
+        let used: Vec<usize> = (0..links).filter(|&p| z[p].is_some()).collect();
+        let m = used.len();
+        if m == 0 {
+            return Ok(PfUpdate {
+                summary: UpdateSummary {
+                    nis: 0.0,
+                    links_used: 0,
+                },
+                ess: ess(&self.weights),
+                resampled: false,
+            });
+        }
+        let r_pred = self.position();
+        if let Some(e) = first_input_error(model, z, noise, r_pred) {
+            return Err(e);
+        }
+        // Range domain: c·z and the information 1/(cσ_p)².
+        let zc: Vec<Real> = used
+            .iter()
+            .map(|&p| SPEED_OF_LIGHT * z[p].unwrap_or_default())
+            .collect();
+        let info: Vec<Real> = used
+            .iter()
+            .map(|&p| {
+                let s = SPEED_OF_LIGHT * noise.sigma(model, p, r_pred);
+                1.0 / (s * s)
+            })
+            .collect();
+        self.ranges.clear();
+        self.ranges.resize(n * m, 0.0);
+        let net = &model.network;
+        let (ntx, nrx) = (net.transmitters.len(), net.receivers.len());
+        let mut d = vec![0.0; ntx + nrx];
+        let mut log_w = self.log_weights.clone();
+        for (j, x) in self.particles.iter().enumerate() {
+            // Each node's distance once (E1: a link's range is the sum of its two).
+            for (k, node) in net.transmitters.iter().chain(&net.receivers).enumerate() {
+                let (dx, dy) = (x[0] - node.x, x[1] - node.y);
+                d[k] = sqrt(dx * dx + dy * dy);
+            }
+            let mut q = 0.0;
+            for (k, &p) in used.iter().enumerate() {
+                let l = net.links[p];
+                let h = d[l.tx] + d[ntx + l.rx];
+                self.ranges[j * m + k] = h;
+                let e = zc[k] - h;
+                q += e * e * info[k];
+            }
+            log_w[j] -= 0.5 * q;
+        }
+        let nis = self.nis(&zc, &info, m);
+        let max = log_w.iter().copied().fold(Real::NEG_INFINITY, Real::max);
+        if !max.is_finite() {
+            return Err(Error::Degenerate {
+                field: "pf.weights".into(),
+            });
+        }
+        let sum: Real = log_w.iter().map(|l| exp(l - max)).sum();
+        let norm = max + ln(sum);
+        for l in log_w.iter_mut() {
+            *l -= norm;
+        }
+        if log_w.iter().any(|l| l.is_nan()) {
+            return Err(Error::Degenerate {
+                field: "pf.weights".into(),
+            });
+        }
+        self.weights = log_w.iter().map(|l| exp(*l)).collect();
+        self.log_weights = log_w;
+        self.estimate();
+        let e = ess(&self.weights);
+        let resampled = e < 0.5 * n as Real;
+        if resampled {
+            self.resample();
+        }
+        Ok(PfUpdate {
+            summary: UpdateSummary { nis, links_used: m },
+            ess: e,
+            resampled,
+        })
+    }
+
+    /// Predict then update (one filter step); on error the filter is left as before the step.
+    pub fn step(
+        &mut self,
+        motion: &ConstantVelocity,
+        model: &Model,
+        z: &[Option<Real>],
+        noise: MeasurementNoise,
+    ) -> Result<PfUpdate> {
+        let before = self.clone();
+        self.predict(motion);
+        self.update(model, z, noise).inspect_err(|_| *self = before)
+    }
+
+    /// Normalised estimation error squared of the estimate against a true state (`None` if the
+    /// covariance is not positive definite, e.g. after collapsing onto one particle).
+    pub fn nees(&self, truth: &Vec4) -> Option<Real> {
+        spd_quadratic_form(&self.covariance, &(self.state - truth))
+    }
+
+    /// NIS of the weighted predicted measurement, from the ranges just computed and the
+    /// weights before this update.
+    fn nis(&self, zc: &[Real], info: &[Real], m: usize) -> Real {
+        let w = &self.weights;
+        let mut zhat = vec![0.0; m];
+        for (wj, h) in w.iter().zip(self.ranges.chunks_exact(m)) {
+            for (z, hk) in zhat.iter_mut().zip(h) {
+                *z += wj * hk;
+            }
+        }
+        let mut sm = vec![0.0; m * m];
+        for (j, wj) in w.iter().enumerate() {
+            let h = &self.ranges[j * m..(j + 1) * m];
+            for a in 0..m {
+                let da = wj * (h[a] - zhat[a]);
+                for b in 0..=a {
+                    sm[a * m + b] += da * (h[b] - zhat[b]);
+                }
+            }
+        }
+        let mut s = nalgebra::DMatrix::<Real>::zeros(m, m);
+        for a in 0..m {
+            for b in 0..=a {
+                s[(a, b)] = sm[a * m + b];
+                s[(b, a)] = sm[a * m + b];
+            }
+            s[(a, a)] += 1.0 / info[a];
+        }
+        let nu = nalgebra::DVector::from_iterator(m, (0..m).map(|k| zc[k] - zhat[k]));
+        match nalgebra::Cholesky::new(s) {
+            Some(c) => nu.dot(&c.solve(&nu)),
+            None => Real::INFINITY,
+        }
+    }
+
+    /// Weighted mean and covariance of the particles (plain arithmetic on the 10 unique entries:
+    /// the hot loop of the filter).
+    fn estimate(&mut self) {
+        let w = &self.weights;
+        let total: Real = w.iter().sum();
+        let mut mean = [0.0; 4];
+        for (x, wj) in self.particles.iter().zip(w) {
+            for (m, xi) in mean.iter_mut().zip(x.iter()) {
+                *m += wj * xi;
+            }
+        }
+        for m in mean.iter_mut() {
+            *m /= total;
+        }
+        let mut c = [0.0; 10];
+        for (x, wj) in self.particles.iter().zip(w) {
+            let d = [
+                x[0] - mean[0],
+                x[1] - mean[1],
+                x[2] - mean[2],
+                x[3] - mean[3],
+            ];
+            let mut k = 0;
+            for a in 0..4 {
+                for b in a..4 {
+                    c[k] += wj * d[a] * d[b];
+                    k += 1;
+                }
+            }
+        }
+        let mut cov = Mat4::zeros();
+        let mut k = 0;
+        for a in 0..4 {
+            for b in a..4 {
+                cov[(a, b)] = c[k] / total;
+                cov[(b, a)] = c[k] / total;
+                k += 1;
+            }
+        }
+        self.state = Vec4::new(mean[0], mean[1], mean[2], mean[3]);
+        self.covariance = cov;
+    }
+
+    /// Systematic resampling (one uniform draw), then the optional roughening.
+    fn resample(&mut self) {
+        let n = self.particles.len();
+        let step = 1.0 / n as Real;
+        let mut u = self.rng.random::<Real>() * step;
+        let mut cumulative = 0.0;
+        let mut out = Vec::with_capacity(n);
+        let mut j = 0;
+        for (i, w) in self.weights.iter().enumerate() {
+            cumulative += w;
+            while j < n && u < cumulative {
+                out.push(self.particles[i]);
+                u += step;
+                j += 1;
+            }
+        }
+        // Rounding can leave the last slots unfilled: they take the last particle.
+        while out.len() < n {
+            out.push(self.particles[n - 1]);
+        }
+        self.particles = out;
+        self.log_weights.fill(-ln(n as Real));
+        self.weights.fill(step);
+        if let Some(c) = self.config.roughening {
+            let mut lo = Vec4::repeat(Real::INFINITY);
+            let mut hi = Vec4::repeat(Real::NEG_INFINITY);
+            for x in &self.particles {
+                lo = lo.inf(x);
+                hi = hi.sup(x);
+            }
+            let scale = sqrt(c * libm::pow(n as Real, -0.2));
+            let sd = (hi - lo) * scale;
+            for x in self.particles.iter_mut() {
+                let z = normal4(&mut self.rng);
+                *x += sd.component_mul(&z);
+            }
+        }
+    }
+}
+
+/// `1/Σ w_j²` of normalised weights.
+fn ess(weights: &[Real]) -> Real {
+    1.0 / weights.iter().map(|w| w * w).sum::<Real>()
+}
+
+/// Four standard normals.
+fn normal4(rng: &mut Rng) -> Vec4 {
+    Vec4::new(
+        standard_normal(rng),
+        standard_normal(rng),
+        standard_normal(rng),
+        standard_normal(rng),
+    )
+}
