@@ -22,7 +22,7 @@ use scatterloc::track::{
     PAPER_STEP_S,
 };
 use scatterloc::track::{run_chunk, run_truth_chunk, MonteCarloConfig, CHUNK_TRAJECTORIES};
-use scatterloc::track::{Ekf, MeasurementNoise};
+use scatterloc::track::{Ekf, MeasurementNoise, ParticleFilter, PfConfig, Ukf, UkfParams};
 use scatterloc::{measure, scenario::presets, Model};
 
 const SEED: u64 = 2019;
@@ -184,6 +184,59 @@ fn benches(c: &mut Criterion) {
                 .sum::<Real>()
         })
     });
+    g.finish();
+
+    // The UKF and the particle filter (issue 15) on the same steps, from the warm EKF's state
+    // and covariance: consecutive dependent steps, R from the link budget at the prediction.
+    let mut g = c.benchmark_group("ukf_step_4_links");
+    g.throughput(Throughput::Elements(BENCH_STEPS as u64));
+    let ukf = Ukf::new(s.ekf.state, s.ekf.covariance, UkfParams::default()).unwrap();
+    g.bench_function("predict+update_R_at_prediction", |b| {
+        b.iter(|| {
+            let mut f = ukf;
+            for z in &s.z {
+                f.step(
+                    &s.motion,
+                    &s.model,
+                    black_box(z),
+                    MeasurementNoise::AtPrediction,
+                )
+                .unwrap();
+            }
+            f
+        })
+    });
+    g.finish();
+    let mut g = c.benchmark_group("pf_step_4_links");
+    g.throughput(Throughput::Elements(BENCH_STEPS as u64));
+    g.sample_size(20);
+    for n in [1000, 10_000] {
+        let pf = ParticleFilter::new(
+            s.ekf.state,
+            s.ekf.covariance,
+            PfConfig {
+                particles: n,
+                roughening: None,
+            },
+            measure::rng(SEED, 7),
+        )
+        .unwrap();
+        g.bench_function(format!("{n}_particles"), |b| {
+            b.iter(|| {
+                let mut f = pf.clone();
+                for z in &s.z {
+                    f.step(
+                        &s.motion,
+                        &s.model,
+                        black_box(z),
+                        MeasurementNoise::AtPrediction,
+                    )
+                    .unwrap();
+                }
+                f.state
+            })
+        });
+    }
     g.finish();
 
     gated_step(c);

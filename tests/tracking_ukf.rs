@@ -10,7 +10,7 @@ mod common;
 use nalgebra::{Cholesky, DMatrix, DVector};
 
 use common::sensors_model as model;
-use common::tracking::fast_motion;
+use common::tracking::{fast_motion, mesh};
 use scatterloc::math::{Mat4, Real, Vec2, Vec4, SPEED_OF_LIGHT};
 use scatterloc::track::{paper_initial_covariance, TrackScenario, TruthSampler};
 use scatterloc::track::{ConstantVelocity, Ekf, MeasurementNoise, Ukf, UkfParams};
@@ -92,12 +92,12 @@ fn reference_step(
 /// A truth of `steps` steps and its noisy delays, every 7th step missing link 2, every 23rd
 /// missing all links.
 fn sequence(
+    model: &Model,
     s: TrackScenario,
     motion: &ConstantVelocity,
     steps: usize,
     seed: u64,
 ) -> Vec<Vec<Option<Real>>> {
-    let model = model();
     let sampler = TruthSampler::new(*motion, s.mean_state(), &paper_initial_covariance()).unwrap();
     let mut truth = Vec::new();
     sampler.sample(steps + 1, &mut measure::rng(seed, 0), &mut truth);
@@ -107,7 +107,7 @@ fn sequence(
         .enumerate()
         .map(|(k, x)| {
             let mut z: Vec<Option<Real>> =
-                measure::noisy_delays(&model, Vec2::new(x[0], x[1]), &mut noise)
+                measure::noisy_delays(model, Vec2::new(x[0], x[1]), &mut noise)
                     .into_iter()
                     .map(Some)
                     .collect();
@@ -122,14 +122,16 @@ fn sequence(
         .collect()
 }
 
+/// sensors2019 (4 links), a 2 × 3 mesh (6 links) and a 3 × 3 mesh (9 links): the UKF's
+/// stack path for up to 4 and up to 8 links and its heap path.
 #[test]
 fn ukf_equals_the_spec_formulas_over_200_steps() {
-    let model = model();
     let motion = fast_motion();
-    for (s, params) in [
-        (TrackScenario::I, UkfParams::default()),
-        (TrackScenario::II, UkfParams::default()),
+    for (model, s, params) in [
+        (model(), TrackScenario::I, UkfParams::default()),
+        (model(), TrackScenario::II, UkfParams::default()),
         (
+            model(),
             TrackScenario::III,
             UkfParams {
                 alpha: 0.5,
@@ -137,8 +139,10 @@ fn ukf_equals_the_spec_formulas_over_200_steps() {
                 kappa: 1.0,
             },
         ),
+        (mesh(2, 3), TrackScenario::I, UkfParams::default()),
+        (mesh(3, 3), TrackScenario::II, UkfParams::default()),
     ] {
-        let zs = sequence(s, &motion, 200, 4);
+        let zs = sequence(&model, s, &motion, 200, 4);
         let mut f = Ukf::new(s.mean_state(), paper_initial_covariance(), params).unwrap();
         let mut x = DVector::from_column_slice(s.mean_state().as_slice());
         let mut p = DMatrix::from_fn(4, 4, |i, j| paper_initial_covariance()[(i, j)]);
@@ -172,7 +176,10 @@ fn ukf_equals_the_spec_formulas_over_200_steps() {
                 }
             }
         }
-        println!("{s:?}: largest state difference over 200 steps {worst:.2e}");
+        println!(
+            "{s:?}, {} links: largest state difference over 200 steps {worst:.2e}",
+            model.link_count()
+        );
     }
 }
 

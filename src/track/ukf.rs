@@ -17,8 +17,8 @@ use alloc::vec::Vec;
 
 use nalgebra::{Cholesky, DMatrix, DVector};
 
-use crate::error::{check_len, Error, Result};
-use crate::math::{Mat4, Real, Vec2, Vec4, SPEED_OF_LIGHT};
+use crate::error::{check_len, limits, Error, Result};
+use crate::math::{sqrt, Mat4, Real, Vec2, Vec4, SPEED_OF_LIGHT};
 use crate::measure::Model;
 use crate::track::ekf::{check_covariance, check_state, first_input_error};
 use crate::track::{ConstantVelocity, MeasurementNoise, UpdateSummary};
@@ -136,8 +136,7 @@ impl Ukf {
         let links = model.link_count();
         check_len("measurement", links, z.len())?;
         noise.check_links(links)?;
-        let used: Vec<usize> = (0..links).filter(|&p| z[p].is_some()).collect();
-        let m = used.len();
+        let m = z.iter().filter(|v| v.is_some()).count();
         if m == 0 {
             return Ok(UpdateSummary {
                 nis: 0.0,
@@ -146,62 +145,29 @@ impl Ukf {
         }
         let (x, p) = (self.state, self.covariance);
         let r_pred = self.position();
-        if let Some(e) = first_input_error(model, z, noise, r_pred) {
-            return Err(e);
-        }
-        let mut r_diag = DVector::<Real>::zeros(m);
-        let mut zc = DVector::<Real>::zeros(m);
-        for (k, &link) in used.iter().enumerate() {
-            let s = SPEED_OF_LIGHT * noise.sigma(model, link, r_pred);
-            r_diag[k] = s * s;
-            zc[k] = SPEED_OF_LIGHT * z[link].unwrap_or_default();
-        }
         let points = sigma_points(&x, &p, &self.params)?;
-        let (wm0, wc0, wi) = self.params.weights();
-        let weight = |i: usize| if i == 0 { (wm0, wc0) } else { (wi, wi) };
-        // 𝒵_i = c·h(χ_i) for the links present.
-        let zs: Vec<DVector<Real>> = points
-            .iter()
-            .map(|chi| {
-                let r = Vec2::new(chi[0], chi[1]);
-                DVector::from_iterator(
-                    m,
-                    used.iter()
-                        .map(|&link| SPEED_OF_LIGHT * model.network.delay(link, r)),
-                )
-            })
-            .collect();
-        let mut z_hat = DVector::<Real>::zeros(m);
-        for (i, zi) in zs.iter().enumerate() {
-            z_hat += weight(i).0 * zi;
-        }
-        let mut s = DMatrix::<Real>::from_diagonal(&r_diag);
-        let mut pxz = DMatrix::<Real>::zeros(N, m);
-        for (i, (zi, chi)) in zs.iter().zip(&points).enumerate() {
-            let wc = weight(i).1;
-            let dz = zi - &z_hat;
-            let dx = DVector::from_column_slice((chi - x).as_slice());
-            s += wc * &dz * dz.transpose();
-            pxz += wc * dx * dz.transpose();
-        }
-        let s = (&s + s.transpose()) * 0.5;
-        let chol = Cholesky::new(s.clone()).ok_or_else(|| Error::NotPositiveDefinite {
-            field: "ukf.innovation_covariance".into(),
-        })?;
-        // K = P_xz S⁻¹ = (S⁻¹ P_zx)ᵀ.
-        let k = chol.solve(&pxz.transpose()).transpose();
-        let nu = &zc - &z_hat;
-        let nis = nu.dot(&chol.solve(&nu));
-        let dx = &k * &nu;
-        let ksk = &k * &s * k.transpose();
-        let mut p_new = p;
-        for i in 0..N {
-            for j in 0..N {
-                p_new[(i, j)] = p[(i, j)] - ksk[(i, j)];
+        let weights = self.params.weights();
+        // Up to 8 links on the stack (no allocation), more in dynamic matrices.
+        let (dx, ksk, nis) = if m <= 8 {
+            let mut used = [0usize; 8];
+            for (slot, link) in used.iter_mut().zip((0..links).filter(|&l| z[l].is_some())) {
+                *slot = link;
             }
-        }
+            let used = &used[..m];
+            let (zc, r) = measurement(model, z, noise, r_pred, used)?;
+            if m <= 4 {
+                ut_update::<4>(model, used, &points, weights, &zc, &r)?
+            } else {
+                ut_update::<8>(model, used, &points, weights, &zc, &r)?
+            }
+        } else {
+            let used: Vec<usize> = (0..links).filter(|&l| z[l].is_some()).collect();
+            let (zc, r) = measurement(model, z, noise, r_pred, &used)?;
+            ut_update_dyn(model, &used, &points, weights, &zc, &r)?
+        };
+        let p_new = p - ksk;
         let p_new = (p_new + p_new.transpose()) * 0.5;
-        let x_new = x + Vec4::new(dx[0], dx[1], dx[2], dx[3]);
+        let x_new = x + dx;
         if x_new.iter().any(|v| !v.is_finite()) || Cholesky::new(p_new).is_none() {
             return Err(Error::NotPositiveDefinite {
                 field: "ukf.covariance".into(),
@@ -230,6 +196,155 @@ impl Ukf {
     pub fn nees(&self, truth: &Vec4) -> Option<Real> {
         crate::track::spd_quadratic_form(&self.covariance, &(self.state - truth))
     }
+}
+
+/// The measured ranges `c·z` and the range variances `(cσ_p)²` of the links `used` (σ from
+/// `noise` at `r_pred`), each σ evaluated once; a bad delay or σ is the EKF's named error
+/// ([`first_input_error`]).
+fn measurement(
+    model: &Model,
+    z: &[Option<Real>],
+    noise: MeasurementNoise,
+    r_pred: Vec2,
+    used: &[usize],
+) -> Result<(Vec<Real>, Vec<Real>)> {
+    let fixed = matches!(noise, MeasurementNoise::Fixed(_));
+    let mut zc = Vec::with_capacity(used.len());
+    let mut r = Vec::with_capacity(used.len());
+    let mut ok = true;
+    for &link in used {
+        let tau = z[link].unwrap_or_default();
+        let sigma = noise.sigma(model, link, r_pred);
+        ok &= limits::DELAY_S.contains(tau)
+            && sigma.is_finite()
+            && sigma > 0.0
+            && (!fixed || limits::DELAY_SIGMA_S.contains(sigma));
+        let s = SPEED_OF_LIGHT * sigma;
+        zc.push(SPEED_OF_LIGHT * tau);
+        r.push(s * s);
+    }
+    if !ok || r.iter().any(|v| !v.is_finite() || *v == 0.0) {
+        return Err(
+            first_input_error(model, z, noise, r_pred).unwrap_or(Error::InvalidSigma {
+                link: used[0],
+                value: Real::NAN,
+            }),
+        );
+    }
+    Ok((zc, r))
+}
+
+/// `𝒵_i = c·h(χ_i)` of the links `used` (ranges, m): each node's distance once (E1: a link's
+/// range is the sum of its two).
+#[inline]
+fn ranges(model: &Model, used: &[usize], chi: &Vec4, out: &mut [Real]) {
+    let net = &model.network;
+    let dist = |n: Vec2| {
+        let (dx, dy) = (chi[0] - n.x, chi[1] - n.y);
+        sqrt(dx * dx + dy * dy)
+    };
+    // The links of one transmitter are consecutive for a full mesh; reuse its distance.
+    let mut last_tx = (usize::MAX, 0.0);
+    for (o, &link) in out.iter_mut().zip(used) {
+        let l = net.links[link];
+        if last_tx.0 != l.tx {
+            last_tx = (l.tx, dist(net.transmitters[l.tx]));
+        }
+        *o = last_tx.1 + dist(net.receivers[l.rx]);
+    }
+}
+
+/// The unscented update for at most `M` links in fixed-size (stack) matrices: the `m` links
+/// present fill the leading block, the rest of `S` is the identity and of `P_xz`, `ν` zero, so
+/// the padded solve leaves the leading block's results. Returns `K ν`, `K S Kᵀ` and the NIS.
+fn ut_update<const M: usize>(
+    model: &Model,
+    used: &[usize],
+    points: &[Vec4; 2 * N + 1],
+    (wm0, wc0, wi): (Real, Real, Real),
+    zc: &[Real],
+    r: &[Real],
+) -> Result<(Vec4, Mat4, Real)> {
+    use nalgebra::{SMatrix, SVector};
+    let m = used.len();
+    let mut zs = [SVector::<Real, M>::zeros(); 2 * N + 1];
+    for (zi, chi) in zs.iter_mut().zip(points) {
+        ranges(model, used, chi, &mut zi.as_mut_slice()[..m]);
+    }
+    let mut z_hat = zs[0] * wm0;
+    for zi in &zs[1..] {
+        z_hat += zi * wi;
+    }
+    let mut s = SMatrix::<Real, M, M>::identity();
+    let mut nu = SVector::<Real, M>::zeros();
+    for k in 0..m {
+        s[(k, k)] = r[k];
+        nu[k] = zc[k] - z_hat[k];
+    }
+    let mut pxz = SMatrix::<Real, N, M>::zeros();
+    for (i, (zi, chi)) in zs.iter().zip(points).enumerate() {
+        let wc = if i == 0 { wc0 } else { wi };
+        let mut dz = zi - z_hat;
+        for v in dz.as_mut_slice()[m..].iter_mut() {
+            *v = 0.0;
+        }
+        let dx = chi - points[0];
+        s += (dz * dz.transpose()) * wc;
+        pxz += (dx * dz.transpose()) * wc;
+    }
+    let chol = Cholesky::new(s).ok_or_else(|| Error::NotPositiveDefinite {
+        field: "ukf.innovation_covariance".into(),
+    })?;
+    // K = P_xz S⁻¹ = (S⁻¹ P_zx)ᵀ.
+    let k = chol.solve(&pxz.transpose()).transpose();
+    let nis = nu.dot(&chol.solve(&nu));
+    Ok((k * nu, k * s * k.transpose(), nis))
+}
+
+/// [`ut_update`] for any number of links, in heap matrices.
+fn ut_update_dyn(
+    model: &Model,
+    used: &[usize],
+    points: &[Vec4; 2 * N + 1],
+    (wm0, wc0, wi): (Real, Real, Real),
+    zc: &[Real],
+    r: &[Real],
+) -> Result<(Vec4, Mat4, Real)> {
+    let m = used.len();
+    let zs: Vec<DVector<Real>> = points
+        .iter()
+        .map(|chi| {
+            let mut v = DVector::zeros(m);
+            ranges(model, used, chi, v.as_mut_slice());
+            v
+        })
+        .collect();
+    let mut z_hat = &zs[0] * wm0;
+    for zi in &zs[1..] {
+        z_hat += zi * wi;
+    }
+    let mut s = DMatrix::<Real>::from_diagonal(&DVector::from_column_slice(r));
+    let nu = DVector::from_fn(m, |k, _| zc[k] - z_hat[k]);
+    let mut pxz = DMatrix::<Real>::zeros(N, m);
+    for (i, (zi, chi)) in zs.iter().zip(points).enumerate() {
+        let wc = if i == 0 { wc0 } else { wi };
+        let dz = zi - &z_hat;
+        let dx = DVector::from_column_slice((chi - points[0]).as_slice());
+        s += wc * &dz * dz.transpose();
+        pxz += wc * dx * dz.transpose();
+    }
+    let chol = Cholesky::new(s.clone()).ok_or_else(|| Error::NotPositiveDefinite {
+        field: "ukf.innovation_covariance".into(),
+    })?;
+    let k = chol.solve(&pxz.transpose()).transpose();
+    let nis = nu.dot(&chol.solve(&nu));
+    let dx = &k * &nu;
+    let ksk = &k * &s * k.transpose();
+    Ok((
+        Vec4::new(dx[0], dx[1], dx[2], dx[3]),
+        Mat4::from_fn(|i, j| ksk[(i, j)]),
+        nis,
+    ))
 }
 
 /// The `2n + 1` sigma points of `(x, P)`: `x`, `x ± L_{:,i}` with `L Lᵀ = (n + λ) P`.
