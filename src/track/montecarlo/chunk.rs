@@ -14,6 +14,35 @@ use crate::track::TruthSampler;
 use crate::track::{
     range_information_per_snr, spd_quadratic_form, update_lanes, Ekf, MeasurementNoise, NodeView,
 };
+use crate::track::{ParticleFilter, PfConfig, Ukf, UkfParams};
+
+/// The tracker a study runs (issue 15): the EKF (spec §6), the UKF or the bootstrap particle
+/// filter (`filters-and-planning.md` §1–2), all on the same motion and measurement models.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum FilterKind {
+    /// The EKF (the studies of \[S\] Fig. 3).
+    #[default]
+    Ekf,
+    /// The UKF with these parameters.
+    Ukf(UkfParams),
+    /// The particle filter with these settings.
+    Pf(PfConfig),
+}
+
+impl FilterKind {
+    /// `ekf`, `ukf` or `pf`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            FilterKind::Ekf => "ekf",
+            FilterKind::Ukf(_) => "ukf",
+            FilterKind::Pf(_) => "pf",
+        }
+    }
+}
+
+/// Salt of the particle filters' own streams (particles, resampling), apart from the
+/// measurement-noise streams, so every filter of a study sees the same measurements.
+const PF_STREAM_SALT: u64 = 0x5046_5f53_5452_4541;
 
 /// Per step and link of one truth trajectory: the true delay and `σ_p` at the truth (E8). Shared
 /// by all noise runs of the trajectory, interleaved so a measurement reads one cache line.
@@ -163,6 +192,119 @@ pub fn run_chunk(model: &Model, cfg: &MonteCarloConfig, chunk: usize) -> Result<
         }
     }
     Ok(sums)
+}
+
+/// [`run_chunk`] for any [`FilterKind`]. The truth trajectories, their streams and every noise
+/// run's measurements are those of the EKF study (run `j` of trajectory `i` draws its noise from
+/// the same stream in the same order), so the filters of one study are compared on the same
+/// data; the EKF takes [`run_chunk`] itself. A particle filter's own draws come from a salted
+/// stream per run.
+pub fn run_filter_chunk(
+    model: &Model,
+    cfg: &MonteCarloConfig,
+    filter: FilterKind,
+    chunk: usize,
+) -> Result<PartialSums> {
+    if filter == FilterKind::Ekf {
+        return run_chunk(model, cfg, chunk);
+    }
+    let steps = cfg.steps;
+    let sampler = TruthSampler::new(cfg.motion, cfg.mean_state, &cfg.initial_covariance)?;
+    // Validated once (a bad prior or bad settings fail the study, as for the EKF).
+    match filter {
+        FilterKind::Ukf(p) => {
+            Ukf::new(cfg.mean_state, cfg.initial_covariance, p)?;
+        }
+        FilterKind::Pf(c) => c.validate()?,
+        FilterKind::Ekf => {}
+    }
+    let mut sums = PartialSums::new(steps);
+    let mut s = Scratch::new(model, steps, true);
+    for traj in chunk_range(cfg, chunk) {
+        prepare_trajectory(model, cfg, &sampler, traj, &mut s, &mut sums);
+        for j in 0..cfg.noise_runs {
+            let stream = 2 * (traj as u64 * cfg.noise_runs as u64 + j as u64) + 1;
+            if run_other_filter(model, cfg, filter, &mut s, stream) {
+                for ((a, e), (b, v)) in sums
+                    .squared_error
+                    .iter_mut()
+                    .zip(&s.squared_error[..steps + 1])
+                    .zip(sums.nees.iter_mut().zip(&s.nees[..steps + 1]))
+                {
+                    *a += e;
+                    *b += v;
+                }
+                sums.runs += 1;
+            } else {
+                sums.failed_runs += 1;
+            }
+        }
+    }
+    Ok(sums)
+}
+
+/// A UKF or particle filter over the prepared truth with the measurements of noise stream
+/// `stream`; fills lane 0 of `s.squared_error` and `s.nees`; `false` if the filter failed.
+fn run_other_filter(
+    model: &Model,
+    cfg: &MonteCarloConfig,
+    filter: FilterKind,
+    s: &mut Scratch,
+    stream: u64,
+) -> bool {
+    enum F {
+        U(Ukf),
+        P(ParticleFilter),
+    }
+    let links = model.link_count();
+    let steps = s.truth.len();
+    let mut noise_rng = rng(cfg.seed, stream);
+    let built = match filter {
+        FilterKind::Ukf(p) => Ukf::new(cfg.mean_state, cfg.initial_covariance, p).map(F::U),
+        FilterKind::Pf(c) => ParticleFilter::new(
+            cfg.mean_state,
+            cfg.initial_covariance,
+            c,
+            rng(cfg.seed ^ PF_STREAM_SALT, stream),
+        )
+        .map(F::P),
+        FilterKind::Ekf => return false,
+    };
+    let Ok(mut f) = built else { return false };
+    let (truth, table) = (&s.truth[..steps], &s.table[..links * steps]);
+    let z = &mut s.measurement[..links];
+    for n in 0..steps {
+        let x = &truth[n];
+        if n > 0 {
+            let row = &table[n * links..(n + 1) * links];
+            for (m, t) in z.iter_mut().zip(row) {
+                *m = Some(t.delay + t.sigma * standard_normal(&mut noise_rng));
+            }
+            let noise = if cfg.oracle_noise {
+                MeasurementNoise::At(Vec2::new(x[0], x[1]))
+            } else {
+                MeasurementNoise::AtPrediction
+            };
+            let ok = match &mut f {
+                F::U(u) => u.step(&cfg.motion, model, z, noise).is_ok(),
+                F::P(p) => p.step(&cfg.motion, model, z, noise).is_ok(),
+            };
+            if !ok {
+                return false;
+            }
+        }
+        let (state, cov) = match &f {
+            F::U(u) => (u.state, u.covariance),
+            F::P(p) => (p.state, p.covariance),
+        };
+        let e = state - x;
+        s.squared_error[n] = e[0] * e[0] + e[1] * e[1];
+        match spd_quadratic_form(&cov, &e) {
+            Some(v) => s.nees[n] = v,
+            None => return false,
+        }
+    }
+    true
 }
 
 /// The truth half of [`run_chunk`] alone: the same trajectories (same streams) and their Fisher
