@@ -21,7 +21,9 @@ use scatterloc::track::{
     paper_initial_covariance, step_count, TrackScenario, TruthSampler, PAPER_INTENSITY,
     PAPER_STEP_S,
 };
-use scatterloc::track::{run_chunk, run_truth_chunk, MonteCarloConfig, CHUNK_TRAJECTORIES};
+use scatterloc::track::{
+    run_chunk, run_filter_chunk, run_truth_chunk, FilterKind, MonteCarloConfig, CHUNK_TRAJECTORIES,
+};
 use scatterloc::track::{Ekf, MeasurementNoise, ParticleFilter, PfConfig, Ukf, UkfParams};
 use scatterloc::{measure, scenario::presets, Model};
 
@@ -258,6 +260,25 @@ fn benches(c: &mut Criterion) {
     ));
     g.bench_function("run_truth_chunk_fast_16x100", |b| {
         b.iter(|| run_truth_chunk(&s.model, black_box(&fast), 0).unwrap())
+    });
+    // The other filters on the same chunk (issue 15): the UKF on the fast profile, the PF with
+    // 1000 particles on one noise run per trajectory.
+    g.throughput(Throughput::Elements(chunk_steps(&fast)));
+    let ukf = FilterKind::Ukf(UkfParams::default());
+    g.bench_function("run_filter_chunk_ukf_fast_0.1s_16x10x100", |b| {
+        b.iter(|| run_filter_chunk(&s.model, black_box(&fast), ukf, 0).unwrap())
+    });
+    let fast_one = MonteCarloConfig {
+        noise_runs: 1,
+        ..fast
+    };
+    g.throughput(Throughput::Elements(chunk_steps(&fast_one)));
+    let pf = FilterKind::Pf(PfConfig {
+        particles: 1000,
+        roughening: None,
+    });
+    g.bench_function("run_filter_chunk_pf1000_fast_0.1s_16x1x100", |b| {
+        b.iter(|| run_filter_chunk(&s.model, black_box(&fast_one), pf, 0).unwrap())
     });
     g.finish();
 
