@@ -154,15 +154,17 @@ impl Ukf {
                 *slot = link;
             }
             let used = &used[..m];
-            let (zc, r) = measurement(model, z, noise, r_pred, used)?;
+            let (mut zc, mut r) = ([0.0; 8], [0.0; 8]);
+            measurement(model, z, noise, r_pred, used, &mut zc[..m], &mut r[..m])?;
             if m <= 4 {
-                ut_update::<4>(model, used, &points, weights, &zc, &r)?
+                ut_update::<4>(model, used, &points, weights, &zc[..m], &r[..m])?
             } else {
-                ut_update::<8>(model, used, &points, weights, &zc, &r)?
+                ut_update::<8>(model, used, &points, weights, &zc[..m], &r[..m])?
             }
         } else {
             let used: Vec<usize> = (0..links).filter(|&l| z[l].is_some()).collect();
-            let (zc, r) = measurement(model, z, noise, r_pred, &used)?;
+            let (mut zc, mut r) = (vec![0.0; m], vec![0.0; m]);
+            measurement(model, z, noise, r_pred, &used, &mut zc, &mut r)?;
             ut_update_dyn(model, &used, &points, weights, &zc, &r)?
         };
         let p_new = p - ksk;
@@ -199,31 +201,33 @@ impl Ukf {
 }
 
 /// The measured ranges `c·z` and the range variances `(cσ_p)²` of the links `used` (σ from
-/// `noise` at `r_pred`), each σ evaluated once; a bad delay or σ is the EKF's named error
-/// ([`first_input_error`]).
+/// `noise` at `r_pred`) into `zc` and `r`, each σ evaluated once; a bad delay or σ is the EKF's
+/// named error ([`first_input_error`]).
 fn measurement(
     model: &Model,
     z: &[Option<Real>],
     noise: MeasurementNoise,
     r_pred: Vec2,
     used: &[usize],
-) -> Result<(Vec<Real>, Vec<Real>)> {
+    zc: &mut [Real],
+    r: &mut [Real],
+) -> Result<()> {
     let fixed = matches!(noise, MeasurementNoise::Fixed(_));
-    let mut zc = Vec::with_capacity(used.len());
-    let mut r = Vec::with_capacity(used.len());
     let mut ok = true;
-    for &link in used {
+    for ((&link, zk), rk) in used.iter().zip(zc.iter_mut()).zip(r.iter_mut()) {
         let tau = z[link].unwrap_or_default();
         let sigma = noise.sigma(model, link, r_pred);
+        let s = SPEED_OF_LIGHT * sigma;
+        *zk = SPEED_OF_LIGHT * tau;
+        *rk = s * s;
         ok &= limits::DELAY_S.contains(tau)
             && sigma.is_finite()
             && sigma > 0.0
-            && (!fixed || limits::DELAY_SIGMA_S.contains(sigma));
-        let s = SPEED_OF_LIGHT * sigma;
-        zc.push(SPEED_OF_LIGHT * tau);
-        r.push(s * s);
+            && (!fixed || limits::DELAY_SIGMA_S.contains(sigma))
+            && rk.is_finite()
+            && *rk > 0.0;
     }
-    if !ok || r.iter().any(|v| !v.is_finite() || *v == 0.0) {
+    if !ok {
         return Err(
             first_input_error(model, z, noise, r_pred).unwrap_or(Error::InvalidSigma {
                 link: used[0],
@@ -231,7 +235,7 @@ fn measurement(
             }),
         );
     }
-    Ok((zc, r))
+    Ok(())
 }
 
 /// `𝒵_i = c·h(χ_i)` of the links `used` (ranges, m): each node's distance once (E1: a link's
