@@ -64,7 +64,10 @@ fn ukf_and_pf_studies_share_the_ekf_data_and_agree_where_near_linear() {
             ekf.rmse_pcrlb_m[n].unwrap_or(Real::NAN)
         );
         assert!((u / e - 1.0).abs() < 0.05, "UKF {u} vs EKF {e} at {t} s");
-        assert!(p.is_finite() && p / e > 0.5 && p / e < 2.0, "PF {p} vs EKF {e} at {t} s");
+        assert!(
+            p.is_finite() && p / e > 0.5 && p / e < 2.0,
+            "PF {p} vs EKF {e} at {t} s"
+        );
     }
     assert_eq!(
         (ukf.runs + ukf.failed_runs, pf.runs + pf.failed_runs),

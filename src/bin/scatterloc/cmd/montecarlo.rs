@@ -7,20 +7,22 @@ use serde::{Deserialize, Serialize};
 
 use scatterloc::chart::TrackingChartOptions;
 use scatterloc::math::Shard;
+use scatterloc::track::FilterKind;
 use scatterloc::track::{
     finish, nominal_pcrlb_rmse, paper_initial_covariance, ConstantVelocity, MonteCarloConfig,
     MonteCarloResult, StudySums, TrackScenario, MAX_STEPS,
 };
 use scatterloc::Scenario;
 
+use super::filters::filter_kinds;
 use super::merge::{differs, inconsistent, merged_timing, sums_of, Part};
 use super::report::{which, CurveDoc, Outputs};
 use super::shard::{self, ShardDoc, Timing};
 use super::study::{
-    flag_error, parse_study, run_chunks_with_progress, run_pcrlb_with_progress, run_with_progress,
-    threads, Study,
+    flag_error, parse_study, run_chunks_with_progress, run_filters_with_progress,
+    run_pcrlb_with_progress, run_with_progress, threads, Study,
 };
-use crate::cli::{MontecarloArgs, PcrlbArgs};
+use crate::cli::{FilterName, MontecarloArgs, PcrlbArgs};
 use crate::CliError;
 
 /// Scalars of one Monte Carlo study, after the curves in the JSON file and in the summary.
@@ -44,6 +46,101 @@ struct McMeta {
     process_noise: f64,
     oracle_noise: bool,
     layout: String,
+    /// `--filters` other than `ekf` alone: each filter's curves, in the order asked.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    filters: Option<FilterCurves>,
+}
+
+/// The curves of one filter of `--filters`.
+#[derive(Serialize)]
+struct FilterDoc {
+    /// The filter's RMSE, m.
+    rmse_m: Vec<f64>,
+    /// Its average NEES.
+    nees: Vec<f64>,
+    /// Its runs counted.
+    runs: usize,
+    /// Its runs that failed numerically (left out of `rmse_m`).
+    failed_runs: usize,
+}
+
+/// `{"ekf": {..}, "ukf": {..}, ..}` in the order of `--filters`.
+struct FilterCurves(Vec<(&'static str, FilterDoc)>);
+
+impl Serialize for FilterCurves {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeMap;
+        let mut map = s.serialize_map(Some(self.0.len()))?;
+        for (name, doc) in &self.0 {
+            map.serialize_entry(name, doc)?;
+        }
+        map.end()
+    }
+}
+
+/// The document of several filters' results `rs` (in the order of `kinds`): the PCRLB and
+/// times once, the EKF's curves and counts at the top level when it ran (else the first
+/// filter's counts), and every filter's curves under `filters`.
+fn multi_doc(
+    study: &Study,
+    t: TrackScenario,
+    cfg: &MonteCarloConfig,
+    kinds: &[FilterKind],
+    rs: Vec<MonteCarloResult>,
+    time: RunTime,
+) -> CurveDoc<McMeta> {
+    let main = kinds.iter().position(|k| *k == FilterKind::Ekf);
+    let lead = &rs[main.unwrap_or(0)];
+    let mut doc = mc_doc(
+        study,
+        t,
+        cfg,
+        MonteCarloResult {
+            t_s: lead.t_s.clone(),
+            rmse_ekf_m: lead.rmse_ekf_m.clone(),
+            rmse_pcrlb_m: lead.rmse_pcrlb_m.clone(),
+            nees: lead.nees.clone(),
+            runs: lead.runs,
+            failed_runs: lead.failed_runs,
+            seed: lead.seed,
+        },
+        time,
+    );
+    if main.is_none() {
+        doc.rmse_ekf_m = None;
+        doc.nees = None;
+    }
+    let notes: Vec<String> = kinds
+        .iter()
+        .zip(&rs)
+        .map(|(k, r)| {
+            format!(
+                "{}: {} of {} failed",
+                k.name(),
+                r.failed_runs,
+                r.runs + r.failed_runs
+            )
+        })
+        .collect();
+    doc.caption_note = Some(notes.join(", "));
+    doc.meta.filters = Some(FilterCurves(
+        kinds
+            .iter()
+            .zip(rs)
+            .map(|(k, r)| {
+                (
+                    k.name(),
+                    FilterDoc {
+                        rmse_m: r.rmse_ekf_m,
+                        nees: r.nees,
+                        runs: r.runs,
+                        failed_runs: r.failed_runs,
+                    },
+                )
+            })
+            .collect(),
+    ));
+    doc
 }
 
 /// The run time of one trajectory's study: wall time, thread time (`Σ wall · threads`) and
@@ -79,6 +176,7 @@ fn mc_doc(
         process_noise: cfg.motion.intensity,
         oracle_noise: cfg.oracle_noise,
         layout: study.layout.clone(),
+        filters: None,
     };
     CurveDoc {
         t_s: r.t_s,
@@ -198,6 +296,17 @@ pub fn montecarlo(args: &MontecarloArgs) -> Result<(), CliError> {
         .map(|t| study.config(*t, runs, noise_runs, seed, oracle))
         .collect::<Result<Vec<_>, _>>()?;
     let config = McConfig::of(&study, runs, noise_runs, seed, oracle)?;
+    let names = match &args.filters {
+        Some(list) => list.0.clone(),
+        None => vec![FilterName::Ekf],
+    };
+    let kinds = filter_kinds(&names, &args.settings, "--filters")?;
+    let ekf_only = kinds == [FilterKind::Ekf];
+    if !ekf_only && args.shard.shard.is_some() {
+        return Err(CliError::usage(
+            "--shard: only with --filters ekf (part files hold the EKF's sums)",
+        ));
+    }
     if let Some(shard) = shard::resolve(&args.shard)? {
         let path = shard::part_path(args.json.as_deref(), args.out.as_deref())?;
         return run_shard(&study, &configs, &config, shard, (threads, used), &path);
@@ -207,13 +316,23 @@ pub fn montecarlo(args: &MontecarloArgs) -> Result<(), CliError> {
     let mut docs = Vec::new();
     for (t, cfg) in study.trajectories.iter().zip(&configs) {
         let label = format!("scenario {:>3}", t.name());
-        let (r, wall) = run_with_progress(&study.model, cfg, threads, &label)?;
-        let time = RunTime {
-            wall_s: wall,
-            thread_s: wall * used as f64,
-            threads: used,
-        };
-        docs.push(mc_doc(&study, *t, cfg, r, time));
+        if ekf_only {
+            let (r, wall) = run_with_progress(&study.model, cfg, threads, &label)?;
+            let time = RunTime {
+                wall_s: wall,
+                thread_s: wall * used as f64,
+                threads: used,
+            };
+            docs.push(mc_doc(&study, *t, cfg, r, time));
+        } else {
+            let (rs, wall) = run_filters_with_progress(&study.model, cfg, &kinds, threads, &label)?;
+            let time = RunTime {
+                wall_s: wall,
+                thread_s: wall * used as f64,
+                threads: used,
+            };
+            docs.push(multi_doc(&study, *t, cfg, &kinds, rs, time));
+        }
     }
     outputs.finish(&study, &docs, &chart_options(&study, &config))
 }

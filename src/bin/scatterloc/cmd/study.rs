@@ -9,8 +9,11 @@ use std::time::{Duration, Instant};
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
 
-use scatterloc::native::{run_chunks_parallel, run_parallel, run_pcrlb_parallel};
+use scatterloc::native::{
+    run_chunks_parallel, run_filter_chunks_parallel, run_parallel, run_pcrlb_parallel,
+};
 use scatterloc::track::ConstantVelocity;
+use scatterloc::track::{finish, FilterKind};
 use scatterloc::track::{
     paper_initial_covariance, step_count, TrackScenario, PAPER_DURATION_S, PAPER_INTENSITY,
     PAPER_STEP_S,
@@ -244,6 +247,37 @@ pub fn run_chunks_with_progress(
     let total = cfg.trajectories_in(&chunks) * cfg.noise_runs;
     with_progress(total, "runs", label, |cancel, progress| {
         run_chunks_parallel(model, cfg, chunks, threads, cancel, progress)
+    })
+}
+
+/// The whole study of `cfg` once per filter of `filters` (in order, on the same truth and
+/// measurements) under one progress bar counting the runs of every filter, with the Ctrl-C
+/// handling of [`run_with_progress`]: the results in the order of `filters` and the wall time.
+pub fn run_filters_with_progress(
+    model: &Model,
+    cfg: &MonteCarloConfig,
+    filters: &[FilterKind],
+    threads: usize,
+    label: &str,
+) -> Result<(Vec<MonteCarloResult>, f64), CliError> {
+    let per_filter = cfg.runs();
+    let total = per_filter * filters.len();
+    with_progress(total, "runs", label, |cancel, progress| {
+        let mut out = Vec::with_capacity(filters.len());
+        for (k, &filter) in filters.iter().enumerate() {
+            let offset = k * per_filter;
+            let sums = run_filter_chunks_parallel(
+                model,
+                cfg,
+                filter,
+                0..cfg.chunk_count(),
+                threads,
+                cancel,
+                |done, _| progress(offset + done, total),
+            )?;
+            out.push(finish(cfg, &sums)?);
+        }
+        Ok(out)
     })
 }
 
