@@ -258,6 +258,9 @@ fn montecarlo_multi_filter_files_and_figure() {
     assert!(raw.find("\"ukf\":{").unwrap() < raw.find("\"ekf\":{").unwrap());
     let text = std::fs::read_to_string(&svg).unwrap();
     assert!(text.starts_with("<svg") && text.contains("Scenario I"));
+    for label in ["UKF RMSE", "EKF RMSE", "UKF, EKF vs posterior CRLB"] {
+        assert!(text.contains(label), "{label}");
+    }
     // ukf alone: no EKF curve at the top level.
     let u = ok_json(&refs(&tiny(&["--filters", "ukf"])));
     assert!(u.get("rmse_ekf_m").is_none() && u.get("nees").is_none());

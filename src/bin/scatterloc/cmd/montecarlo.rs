@@ -123,6 +123,16 @@ fn multi_doc(
         })
         .collect();
     doc.caption_note = Some(notes.join(", "));
+    doc.figure_curves = Some(
+        kinds
+            .iter()
+            .zip(&rs)
+            .map(|(k, r)| {
+                let label = format!("{} RMSE", k.name().to_uppercase());
+                (label, r.rmse_ekf_m.clone())
+            })
+            .collect(),
+    );
     doc.meta.filters = Some(FilterCurves(
         kinds
             .iter()
@@ -184,14 +194,16 @@ fn mc_doc(
         rmse_pcrlb_m: r.rmse_pcrlb_m,
         nees: Some(r.nees),
         caption_note: Some(failed_note(r.failed_runs, r.runs + r.failed_runs)),
+        figure_curves: None,
         meta,
     }
 }
 
 /// The figure's title and subtitle.
-fn chart_options(study: &Study, c: &McConfig) -> TrackingChartOptions {
+fn chart_options(study: &Study, c: &McConfig, kinds: &[FilterKind]) -> TrackingChartOptions {
+    let names: Vec<String> = kinds.iter().map(|k| k.name().to_uppercase()).collect();
     TrackingChartOptions {
-        title: format!("EKF vs posterior CRLB — {}", which(study)),
+        title: format!("{} vs posterior CRLB — {}", names.join(", "), which(study)),
         subtitle: Some(format!(
             "{} trajectories × {} noise runs · step T = {} · σq² = {} m²/s³ · seed {}",
             c.runs,
@@ -334,7 +346,7 @@ pub fn montecarlo(args: &MontecarloArgs) -> Result<(), CliError> {
             docs.push(multi_doc(&study, *t, cfg, &kinds, rs, time));
         }
     }
-    outputs.finish(&study, &docs, &chart_options(&study, &config))
+    outputs.finish(&study, &docs, &chart_options(&study, &config, &kinds))
 }
 
 /// Runs shard `shard` (its chunks of every trajectory) and writes its part file `path`.
@@ -458,7 +470,11 @@ pub fn merge_parts(parts: &[Part], json: &str, out: Option<&str>) -> Result<(), 
         };
         docs.push(mc_doc(&study, *t, cfg, r, time));
     }
-    outputs.finish(&study, &docs, &chart_options(&study, &config))
+    outputs.finish(
+        &study,
+        &docs,
+        &chart_options(&study, &config, &[FilterKind::Ekf]),
+    )
 }
 
 /// The figure's note on the EKF runs that failed numerically (left out of `ε_EKF`), shown
@@ -540,6 +556,7 @@ pub fn pcrlb(args: &PcrlbArgs) -> Result<(), CliError> {
             rmse_pcrlb_m: rmse,
             nees: None,
             caption_note: None,
+            figure_curves: None,
             meta,
         });
     }
