@@ -1,7 +1,7 @@
 //! End-to-end tests of the trackers on the command line (issue 15): `track --filter ekf|ukf|pf`
 //! (same output shape, the UKF close to the EKF on an easy path, raw_steps refused), and
 //! `montecarlo --filters` (every filter's curves, the EKF's equal to the single-filter run's,
-//! determinism, bad flags named, --shard limited to ekf).
+//! determinism, bad flags named, two shards merged equal to the unsharded run).
 #![cfg(not(target_arch = "wasm32"))]
 
 mod common;
@@ -269,7 +269,7 @@ fn montecarlo_multi_filter_files_and_figure() {
 
 #[test]
 fn montecarlo_rejects_bad_filter_flags_naming_them() {
-    let cases: [(&[&str], &[&str]); 8] = [
+    let cases: [(&[&str], &[&str]); 7] = [
         (&["--filters", "ekf,kf"], &["--filters", "kf"]),
         (&["--filters", ""], &["--filters"]),
         (&["--filters", "ekf,ekf"], &["--filters", "twice"]),
@@ -280,12 +280,48 @@ fn montecarlo_rejects_bad_filter_flags_naming_them() {
             &["--filters", "pf", "--roughening", "-1"],
             &["--roughening"],
         ),
-        (
-            &["--filters", "ekf,ukf", "--shard", "0/2", "--json", "p.json"],
-            &["--shard", "--filters"],
-        ),
     ];
     for (extra, needles) in cases {
         fails(&refs(&tiny(extra)), needles);
     }
+}
+
+#[test]
+fn montecarlo_filters_sharded_and_merged_equal_the_whole_run() {
+    let dir = TempDir::new();
+    // 40 trajectories: 3 chunks of 16, split 2 + 1.
+    let study = [
+        "montecarlo",
+        "--trajectory",
+        "I",
+        "--runs",
+        "40",
+        "--noise-runs",
+        "2",
+        "--dt",
+        "0.1",
+        "--duration",
+        "1",
+        "--filters",
+        "ukf,pf,ekf",
+        "--particles",
+        "100",
+        "--roughening",
+        "0.2",
+    ];
+    let whole = dir.path("whole.json");
+    ok_json_line(&[&study[..], &["--json", &whole]].concat());
+    let (p0, p1, merged) = (dir.path("p0.json"), dir.path("p1.json"), dir.path("m.json"));
+    ok_json_line(&[&study[..], &["--shard", "0/2", "--json", &p0]].concat());
+    ok_json_line(&[&study[..], &["--shard", "1/2", "--json", &p1]].concat());
+    let part = read_json(&p0);
+    assert_eq!(
+        part["config"]["filters"]["names"],
+        json!(["ukf", "pf", "ekf"])
+    );
+    assert_eq!(part["sums"].as_array().unwrap().len(), 3);
+    ok_json_line(&["merge", "--json", &merged, &p1, &p0]);
+    let (a, b) = (untimed(read_json(&whole)), untimed(read_json(&merged)));
+    assert!(a.get("filters").is_some());
+    assert_eq!(a, b, "merged parts equal the unsharded run");
 }

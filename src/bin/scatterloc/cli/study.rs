@@ -62,7 +62,7 @@ pub struct MontecarloArgs {
     #[arg(long, value_name = "OUT.json")]
     pub json: Option<String>,
     /// Trackers run on the same truth and measurements, in this order: ekf, ukf, pf, comma
-    /// separated [default: ekf]. More than ekf adds "filters" to the JSON (not with --shard).
+    /// separated [default: ekf]. More than ekf adds "filters" to the JSON.
     #[arg(long, value_name = "LIST", value_parser = filters)]
     pub filters: Option<FilterList>,
     #[command(flatten)]

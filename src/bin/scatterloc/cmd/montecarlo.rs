@@ -22,8 +22,9 @@ use super::study::{
     flag_error, parse_study, run_chunks_with_progress, run_filters_with_progress,
     run_pcrlb_with_progress, run_with_progress, threads, Study,
 };
-use crate::cli::{FilterName, MontecarloArgs, PcrlbArgs};
+use crate::cli::{FilterName, FilterSettings, MontecarloArgs, PcrlbArgs};
 use crate::CliError;
+use clap::ValueEnum;
 
 /// Scalars of one Monte Carlo study, after the curves in the JSON file and in the summary.
 #[derive(Serialize)]
@@ -233,6 +234,69 @@ struct McConfig {
     noise_runs: usize,
     seed: u64,
     oracle_noise: bool,
+    /// `--filters` other than `ekf` alone: the filters and their settings (absent: the EKF).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    filters: Option<FiltersConfig>,
+}
+
+/// The trackers of a study with several (`--filters`), as its part files record them.
+#[derive(Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+struct FiltersConfig {
+    /// `ekf`, `ukf`, `pf`, in the order run.
+    names: Vec<String>,
+    /// UKF `alpha`, `beta`, `kappa` (when `ukf` runs).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    ukf: Option<[f64; 3]>,
+    /// Particles (when `pf` runs).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    particles: Option<usize>,
+    /// Roughening constant (when `pf` runs with it).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    roughening: Option<f64>,
+}
+
+impl FiltersConfig {
+    /// `None` for the EKF alone.
+    fn of(kinds: &[FilterKind]) -> Option<FiltersConfig> {
+        if kinds == [FilterKind::Ekf] {
+            return None;
+        }
+        let mut c = FiltersConfig {
+            names: kinds.iter().map(|k| k.name().to_string()).collect(),
+            ukf: None,
+            particles: None,
+            roughening: None,
+        };
+        for k in kinds {
+            match k {
+                FilterKind::Ekf => {}
+                FilterKind::Ukf(p) => c.ukf = Some([p.alpha, p.beta, p.kappa]),
+                FilterKind::Pf(p) => {
+                    c.particles = Some(p.particles);
+                    c.roughening = p.roughening;
+                }
+            }
+        }
+        Some(c)
+    }
+
+    /// The filters again (validated).
+    fn kinds(&self) -> Result<Vec<FilterKind>, String> {
+        let names = self
+            .names
+            .iter()
+            .map(|n| FilterName::from_str(n, false).map_err(|_| format!("unknown filter '{n}'")))
+            .collect::<Result<Vec<_>, _>>()?;
+        let settings = FilterSettings {
+            particles: self.particles,
+            roughening: self.roughening,
+            ukf_alpha: self.ukf.map(|u| u[0]),
+            ukf_beta: self.ukf.map(|u| u[1]),
+            ukf_kappa: self.ukf.map(|u| u[2]),
+        };
+        filter_kinds(&names, &settings, "--filters").map_err(|e| e.message)
+    }
 }
 
 impl McConfig {
@@ -242,6 +306,7 @@ impl McConfig {
         noise_runs: usize,
         seed: u64,
         oracle_noise: bool,
+        kinds: &[FilterKind],
     ) -> Result<McConfig, CliError> {
         Ok(McConfig {
             layout: study.layout.clone(),
@@ -259,6 +324,7 @@ impl McConfig {
             noise_runs,
             seed,
             oracle_noise,
+            filters: FiltersConfig::of(kinds),
         })
     }
 
@@ -307,21 +373,24 @@ pub fn montecarlo(args: &MontecarloArgs) -> Result<(), CliError> {
         .iter()
         .map(|t| study.config(*t, runs, noise_runs, seed, oracle))
         .collect::<Result<Vec<_>, _>>()?;
-    let config = McConfig::of(&study, runs, noise_runs, seed, oracle)?;
     let names = match &args.filters {
         Some(list) => list.0.clone(),
         None => vec![FilterName::Ekf],
     };
     let kinds = filter_kinds(&names, &args.settings, "--filters")?;
     let ekf_only = kinds == [FilterKind::Ekf];
-    if !ekf_only && args.shard.shard.is_some() {
-        return Err(CliError::usage(
-            "--shard: only with --filters ekf (part files hold the EKF's sums)",
-        ));
-    }
+    let config = McConfig::of(&study, runs, noise_runs, seed, oracle, &kinds)?;
     if let Some(shard) = shard::resolve(&args.shard)? {
         let path = shard::part_path(args.json.as_deref(), args.out.as_deref())?;
-        return run_shard(&study, &configs, &config, shard, (threads, used), &path);
+        return run_shard(
+            &study,
+            &configs,
+            &config,
+            &kinds,
+            shard,
+            (threads, used),
+            &path,
+        );
     }
     let outputs = Outputs::parse(args.out.as_deref(), args.json.as_deref())?;
 
@@ -337,7 +406,14 @@ pub fn montecarlo(args: &MontecarloArgs) -> Result<(), CliError> {
             };
             docs.push(mc_doc(&study, *t, cfg, r, time));
         } else {
-            let (rs, wall) = run_filters_with_progress(&study.model, cfg, &kinds, threads, &label)?;
+            let all = 0..cfg.chunk_count();
+            let (sums, wall) =
+                run_filters_with_progress(&study.model, cfg, &kinds, all, threads, &label)?;
+            let rs = sums
+                .iter()
+                .map(|s| finish(cfg, s))
+                .collect::<Result<Vec<_>, _>>()
+                .map_err(flag_error)?;
             let time = RunTime {
                 wall_s: wall,
                 thread_s: wall * used as f64,
@@ -354,6 +430,7 @@ fn run_shard(
     study: &Study,
     configs: &[MonteCarloConfig],
     config: &McConfig,
+    kinds: &[FilterKind],
     shard: Shard,
     (threads, used): (usize, usize),
     path: &str,
@@ -369,10 +446,24 @@ fn run_shard(
             shard.index(),
             shard.count()
         );
-        let (s, wall) =
-            run_chunks_with_progress(&study.model, cfg, chunks.clone(), threads, &label)?;
-        sums.push(s);
-        walls.push(wall);
+        if kinds == [FilterKind::Ekf] {
+            let (s, wall) =
+                run_chunks_with_progress(&study.model, cfg, chunks.clone(), threads, &label)?;
+            sums.push(s);
+            walls.push(wall);
+        } else {
+            // Per trajectory, one entry per filter in order.
+            let (s, wall) = run_filters_with_progress(
+                &study.model,
+                cfg,
+                kinds,
+                chunks.clone(),
+                threads,
+                &label,
+            )?;
+            sums.extend(s);
+            walls.push(wall);
+        }
     }
     #[derive(Serialize)]
     struct Counted {
@@ -399,12 +490,19 @@ pub fn merge_parts(parts: &[Part], json: &str, out: Option<&str>) -> Result<(), 
         .map_err(|e| inconsistent(&first.path, format!("config: {e}")))?;
     let (study, configs) = config.study().map_err(|e| inconsistent(&first.path, e))?;
     // The configuration must be the one this build writes for that study.
+    let kinds = match &config.filters {
+        Some(f) => f
+            .kinds()
+            .map_err(|e| inconsistent(&first.path, format!("config.filters: {e}")))?,
+        None => vec![FilterKind::Ekf],
+    };
     let again = McConfig::of(
         &study,
         config.runs,
         config.noise_runs,
         config.seed,
         config.oracle_noise,
+        &kinds,
     )?;
     let again = serde_json::to_value(&again)
         .map_err(|e| CliError::output(format!("encoding JSON: {e}")))?;
@@ -426,17 +524,28 @@ pub fn merge_parts(parts: &[Part], json: &str, out: Option<&str>) -> Result<(), 
     }
     let outputs = Outputs::parse(out, Some(json))?;
 
-    let mut merged: Vec<StudySums> = configs.iter().map(|c| StudySums::new(c.steps)).collect();
+    // Per trajectory, one entry per filter in order.
+    let per = kinds.len();
+    let mut merged: Vec<StudySums> = configs
+        .iter()
+        .flat_map(|c| std::iter::repeat_n(c.steps, per))
+        .map(StudySums::new)
+        .collect();
     for part in parts {
         let sums: Vec<StudySums> = sums_of(part)?;
         let chunks = part.shard.range[0]..part.shard.range[1];
-        if sums.len() != configs.len() {
+        if sums.len() != configs.len() * per {
             return Err(inconsistent(
                 &part.path,
-                format!("{} sums for {} trajectories", sums.len(), configs.len()),
+                format!(
+                    "{} sums for {} trajectories × {per} filters",
+                    sums.len(),
+                    configs.len()
+                ),
             ));
         }
-        for ((m, s), cfg) in merged.iter_mut().zip(&sums).zip(&configs) {
+        let cfg_of = configs.iter().flat_map(|c| std::iter::repeat_n(c, per));
+        for ((m, s), cfg) in merged.iter_mut().zip(&sums).zip(cfg_of) {
             let trajectories = cfg.trajectories_in(&chunks);
             if !s.has_steps(cfg.steps)
                 || s.trajectories != trajectories
@@ -459,22 +568,26 @@ pub fn merge_parts(parts: &[Part], json: &str, out: Option<&str>) -> Result<(), 
         .trajectories
         .iter()
         .zip(&configs)
-        .zip(&merged)
+        .zip(merged.chunks(per))
         .enumerate()
     {
-        let r = finish(cfg, sums).map_err(flag_error)?;
+        let mut rs = sums
+            .iter()
+            .map(|s| finish(cfg, s))
+            .collect::<Result<Vec<_>, _>>()
+            .map_err(flag_error)?;
         let time = RunTime {
             wall_s: timing.wall_time_s[k],
             thread_s: thread_s[k],
             threads: timing.threads,
         };
-        docs.push(mc_doc(&study, *t, cfg, r, time));
+        if config.filters.is_none() {
+            docs.push(mc_doc(&study, *t, cfg, rs.remove(0), time));
+        } else {
+            docs.push(multi_doc(&study, *t, cfg, &kinds, rs, time));
+        }
     }
-    outputs.finish(
-        &study,
-        &docs,
-        &chart_options(&study, &config, &[FilterKind::Ekf]),
-    )
+    outputs.finish(&study, &docs, &chart_options(&study, &config, &kinds))
 }
 
 /// The figure's note on the EKF runs that failed numerically (left out of `ε_EKF`), shown
