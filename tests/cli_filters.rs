@@ -1,7 +1,7 @@
 //! End-to-end tests of the trackers on the command line (issue 15): `track --filter ekf|ukf|pf`
 //! (same output shape, the UKF close to the EKF on an easy path, raw_steps refused), and
 //! `montecarlo --filters` (every filter's curves, the EKF's equal to the single-filter run's,
-//! determinism, bad flags named, two shards merged equal to the unsharded run).
+//! determinism, bad flags named, two shards merged equal to the unsharded run, Ctrl-C).
 #![cfg(not(target_arch = "wasm32"))]
 
 mod common;
@@ -9,7 +9,10 @@ mod common;
 use scatterloc::{scenario::presets, Model, Vec2};
 use serde_json::{json, Value};
 
-use common::cli::{fails, floats, ok_json, ok_json_line, read_json, TempDir};
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+use common::cli::{fails, floats, ok_json, ok_json_line, read_json, TempDir, BIN};
 
 /// A straight path from (4, 1) at (1.4, 0.25) m/s sampled every 0.1 s.
 fn truth(n: usize) -> Vec2 {
@@ -324,4 +327,37 @@ fn montecarlo_filters_sharded_and_merged_equal_the_whole_run() {
     let (a, b) = (untimed(read_json(&whole)), untimed(read_json(&merged)));
     assert!(a.get("filters").is_some());
     assert_eq!(a, b, "merged parts equal the unsharded run");
+}
+
+#[test]
+fn montecarlo_filters_ctrl_c_stops_without_writing_files() {
+    let dir = TempDir::new();
+    let js = dir.path("c.json");
+    let mut child = Command::new(BIN)
+        .args(["montecarlo", "--trajectory", "I", "--runs", "5000000"])
+        .args(["--noise-runs", "1", "--dt", "0.1", "--filters", "ukf,pf"])
+        .args(["--particles", "100", "--json", &js])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(Duration::from_millis(1500));
+    let kill = Command::new("sh")
+        .args(["-c", &format!("kill -INT {}", child.id())])
+        .status();
+    assert!(kill.unwrap().success());
+    let start = Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if start.elapsed() > Duration::from_secs(60) {
+            let _ = child.kill();
+            panic!("montecarlo did not stop after SIGINT");
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(130), "{err}");
+    assert!(out.stdout.is_empty());
+    assert!(err.contains("cancelled"), "{err}");
+    assert!(dir.files().is_empty(), "{:?}", dir.files());
 }

@@ -29,7 +29,8 @@ use clap::ValueEnum;
 /// Scalars of one Monte Carlo study, after the curves in the JSON file and in the summary.
 #[derive(Serialize)]
 struct McMeta {
-    /// EKF runs counted (`trajectories × noise_runs − failed_runs`).
+    /// EKF runs counted (`trajectories × noise_runs − failed_runs`); with `--filters` without
+    /// `ekf`, the first filter's.
     runs: usize,
     seed: u64,
     trajectory: &'static str,
@@ -38,7 +39,8 @@ struct McMeta {
     trajectories: usize,
     failed_runs: usize,
     wall_time_s: f64,
-    /// `wall · threads / (runs · steps)`: thread time per EKF step, truth simulation included.
+    /// `wall · threads / (runs · steps)`: thread time per EKF step, truth simulation included
+    /// (with several filters the wall time is all filters').
     ns_per_ekf_step: f64,
     /// `wall / (runs · steps)`.
     wall_ns_per_ekf_step: f64,
