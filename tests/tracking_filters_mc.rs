@@ -97,3 +97,57 @@ fn filter_studies_depend_on_the_seed_only() {
         assert_ne!(a.rmse_ekf_m, c.rmse_ekf_m);
     }
 }
+
+/// The native driver with a filter (`run_filter_chunks_parallel`): the EKF gives exactly
+/// `run_chunks_parallel`'s sums; the UKF and the PF give the chunk-by-chunk sums of
+/// `run_filter_chunk` whatever the thread count; bad settings are named errors; progress ends
+/// at the total.
+#[test]
+fn native_filter_driver_matches_the_chunks_for_any_thread_count() {
+    use scatterloc::native::{run_chunks_parallel, run_filter_chunks_parallel};
+    use std::sync::atomic::AtomicBool;
+    let model = model();
+    let cfg = study(TrackScenario::II, 0.1, 40, 2);
+    let cfg = scatterloc::track::MonteCarloConfig { steps: 10, ..cfg };
+    let cancel = AtomicBool::new(false);
+    let all = 0..cfg.chunk_count();
+    let ekf = run_chunks_parallel(&model, &cfg, all.clone(), 2, &cancel, |_, _| {}).unwrap();
+    let via = run_filter_chunks_parallel(
+        &model,
+        &cfg,
+        FilterKind::Ekf,
+        all.clone(),
+        2,
+        &cancel,
+        |_, _| {},
+    );
+    assert_eq!(via.unwrap(), ekf);
+    let pf = PfConfig {
+        particles: 100,
+        roughening: None,
+    };
+    for filter in [FilterKind::Ukf(UkfParams::default()), FilterKind::Pf(pf)] {
+        let want = run(filter, &cfg, &[0, 1, 2]);
+        for threads in [1, 2] {
+            let mut last = (0, 0);
+            let got = run_filter_chunks_parallel(
+                &model,
+                &cfg,
+                filter,
+                all.clone(),
+                threads,
+                &cancel,
+                |d, t| last = (d, t),
+            )
+            .unwrap();
+            assert_eq!(got, want, "{} on {threads} threads", filter.name());
+            assert_eq!(last, (80, 80));
+        }
+    }
+    let bad = FilterKind::Pf(PfConfig {
+        particles: 0,
+        roughening: None,
+    });
+    let e = run_filter_chunks_parallel(&model, &cfg, bad, all, 1, &cancel, |_, _| {});
+    assert!(e.unwrap_err().to_string().contains("particles"));
+}

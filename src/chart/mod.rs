@@ -25,4 +25,7 @@ pub use plan::{
 pub use roc::{
     curve_chart_size, draw_curves, CurveChartOptions, CurveSeries, LineKind, Marker, CURVE_PALETTE,
 };
-pub use tracking::{draw_tracking_rmse, tracking_size, TrackingChartOptions, TrackingPanel};
+pub use tracking::{
+    draw_tracking_filters, draw_tracking_rmse, tracking_size, FilterCurve, FiltersPanel,
+    TrackingChartOptions, TrackingPanel,
+};

@@ -19,6 +19,17 @@ use crate::present::nice_below;
 const EKF_RGB: RGBColor = RGBColor(0, 94, 184);
 /// Colour of the PCRLB curve (dashed).
 const PCRLB_RGB: RGBColor = RGBColor(214, 39, 40);
+/// Colours of the RMSE curves of [`draw_tracking_filters`], in curve order (the first is the
+/// EKF curve's colour; cycled beyond four).
+const CURVE_RGB: [RGBColor; 4] = [
+    EKF_RGB,
+    RGBColor(44, 160, 44),
+    RGBColor(148, 103, 189),
+    RGBColor(255, 127, 14),
+];
+
+/// The legend label of the EKF curve of [`draw_tracking_rmse`].
+const EKF_LABEL: &str = "EKF RMSE  ε_EKF";
 
 /// One panel: the curves of one scenario.
 #[derive(Debug, Clone, Copy)]
@@ -29,6 +40,28 @@ pub struct TrackingPanel<'a> {
     pub t_s: &'a [Real],
     /// `ε_EKF(t_n)`, m, one per time (empty: not drawn; non-finite: a gap).
     pub rmse_ekf_m: &'a [Real],
+    /// `ε_PCRLB(t_n)`, m, one per time (empty: not drawn; `None`: a gap).
+    pub rmse_pcrlb_m: &'a [Option<Real>],
+}
+
+/// One named RMSE curve of a [`FiltersPanel`].
+#[derive(Debug, Clone, Copy)]
+pub struct FilterCurve<'a> {
+    /// Legend label, e.g. `UKF RMSE`.
+    pub label: &'a str,
+    /// The RMSE, m, one per time (empty: not drawn; non-finite: a gap).
+    pub rmse_m: &'a [Real],
+}
+
+/// One panel of [`draw_tracking_filters`]: several trackers' RMSE curves of one scenario.
+#[derive(Debug, Clone, Copy)]
+pub struct FiltersPanel<'a> {
+    /// Panel caption, e.g. `Scenario II`.
+    pub title: &'a str,
+    /// Times `t_n`, s (ascending).
+    pub t_s: &'a [Real],
+    /// The RMSE curves, solid, in distinct colours (the first in the EKF's blue).
+    pub curves: &'a [FilterCurve<'a>],
     /// `ε_PCRLB(t_n)`, m, one per time (empty: not drawn; `None`: a gap).
     pub rmse_pcrlb_m: &'a [Option<Real>],
 }
@@ -53,10 +86,10 @@ pub fn tracking_size(panels: usize) -> (u32, u32) {
 
 /// The y range `[lo, hi]`, m: the positive values of every panel, with a margin, widened to
 /// 1-2-5 numbers.
-fn y_range(panels: &[TrackingPanel]) -> (Real, Real) {
+fn y_range(panels: &[FiltersPanel]) -> (Real, Real) {
     let values = panels.iter().flat_map(|p| {
-        let ekf = p.rmse_ekf_m.iter().copied();
-        ekf.chain(p.rmse_pcrlb_m.iter().flatten().copied())
+        let curves = p.curves.iter().flat_map(|c| c.rmse_m.iter().copied());
+        curves.chain(p.rmse_pcrlb_m.iter().flatten().copied())
     });
     let (min, max) = values
         .filter(|v| v.is_finite() && *v > 0.0)
@@ -104,6 +137,61 @@ pub fn draw_tracking_rmse<DB: DrawingBackend>(
             )));
         }
     }
+    let curves: Vec<[FilterCurve; 1]> = panels
+        .iter()
+        .map(|p| {
+            [FilterCurve {
+                label: EKF_LABEL,
+                rmse_m: p.rmse_ekf_m,
+            }]
+        })
+        .collect();
+    let panels: Vec<FiltersPanel> = panels
+        .iter()
+        .zip(&curves)
+        .map(|(p, c)| FiltersPanel {
+            title: p.title,
+            t_s: p.t_s,
+            curves: c,
+            rmse_pcrlb_m: p.rmse_pcrlb_m,
+        })
+        .collect();
+    draw_panels(root, &panels, opts)
+}
+
+/// [`draw_tracking_rmse`] with several trackers' RMSE curves per panel (issue 15): each curve
+/// solid in its own colour (the first in the EKF's blue) with its label in the legend, next to
+/// the dashed PCRLB. Returns the shared y range `(lo, hi)`, m. Does not call `present()`.
+pub fn draw_tracking_filters<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    panels: &[FiltersPanel],
+    opts: &TrackingChartOptions,
+) -> Result<(Real, Real), ChartError> {
+    register_fonts();
+    for p in panels {
+        let bad = p
+            .curves
+            .iter()
+            .map(|c| (c.label, c.rmse_m.len()))
+            .chain([("PCRLB", p.rmse_pcrlb_m.len())])
+            .find(|&(_, n)| n != 0 && n != p.t_s.len());
+        if let Some((label, n)) = bad {
+            return Err(ChartError(alloc::format!(
+                "{}: {} times but {n} values of {label}",
+                p.title,
+                p.t_s.len(),
+            )));
+        }
+    }
+    draw_panels(root, panels, opts)
+}
+
+/// The figure of checked `panels`.
+fn draw_panels<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    panels: &[FiltersPanel],
+    opts: &TrackingChartOptions,
+) -> Result<(Real, Real), ChartError> {
     let (w, h) = root.dim_in_pixel();
     let n = panels.len().max(1);
     // Panels side by side are shown scaled down as one wide figure: larger text per panel.
@@ -126,7 +214,7 @@ pub fn draw_tracking_rmse<DB: DrawingBackend>(
 
 fn draw_panel<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
-    p: &TrackingPanel,
+    p: &FiltersPanel,
     (lo, hi): (Real, Real),
     y_desc: &str,
     font: &Fonts,
@@ -175,27 +263,29 @@ fn draw_panel<DB: DrawingBackend>(
         .map_err(chart_err)?;
 
     let width = (2.0 * s).round().max(1.0) as u32;
-    let ekf = EKF_RGB.stroke_width(width);
     let pcrlb = PCRLB_RGB.stroke_width(width);
     let (dash, gap) = ((9.0 * s) as u32, (5.0 * s) as u32);
     // Drawable on the log axis: finite, `v > 0`.
     let drawable = |t: Real, v: Real| t.is_finite() && v.is_finite() && v > 0.0;
-    let ekf_parts = segments(
-        p.t_s.iter().copied().zip(p.rmse_ekf_m.iter().copied()),
-        drawable,
-    );
-    let bound = p.rmse_pcrlb_m.iter().map(|v| v.unwrap_or(Real::NAN));
-    let pcrlb_parts = segments(p.t_s.iter().copied().zip(bound), drawable);
-    for (k, part) in ekf_parts.into_iter().enumerate() {
-        let series = chart
-            .draw_series(LineSeries::new(part, ekf))
-            .map_err(chart_err)?;
-        if k == 0 {
-            series
-                .label("EKF RMSE  ε_EKF")
-                .legend(move |(x, y)| PathElement::new([(x, y), (x + 24, y)], ekf));
+    for (c, curve) in p.curves.iter().enumerate() {
+        let style = CURVE_RGB[c % CURVE_RGB.len()].stroke_width(width);
+        let parts = segments(
+            p.t_s.iter().copied().zip(curve.rmse_m.iter().copied()),
+            drawable,
+        );
+        for (k, part) in parts.into_iter().enumerate() {
+            let series = chart
+                .draw_series(LineSeries::new(part, style))
+                .map_err(chart_err)?;
+            if k == 0 {
+                series
+                    .label(curve.label)
+                    .legend(move |(x, y)| PathElement::new([(x, y), (x + 24, y)], style));
+            }
         }
     }
+    let bound = p.rmse_pcrlb_m.iter().map(|v| v.unwrap_or(Real::NAN));
+    let pcrlb_parts = segments(p.t_s.iter().copied().zip(bound), drawable);
     for (k, part) in pcrlb_parts.into_iter().enumerate() {
         let series = chart
             .draw_series(DashedLineSeries::new(part, dash, gap, pcrlb))

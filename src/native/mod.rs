@@ -2,7 +2,8 @@
 //! split over rayon workers), [`run_ordered`], the one ordered parallel driver (rayon waves,
 //! results merged in job order, progress and cancel between waves), and the two studies that
 //! run on it: the tracker's Monte Carlo ([`run_parallel`], [`run_pcrlb_parallel`], and
-//! [`run_chunks_parallel`] for a shard) and the multi-target experiment sweeps
+//! [`run_chunks_parallel`] for a shard, [`run_filter_chunks_parallel`] for
+//! the UKF or the particle filter) and the multi-target experiment sweeps
 //! ([`run_experiment_parallel`], and [`run_experiment_range`] for a shard). Results never
 //! depend on the thread count, and the sums of shards merge exactly into the whole study's.
 
@@ -13,5 +14,7 @@ mod sweep;
 
 pub use driver::{run_ordered, thread_pool};
 pub use map::{crlb_map_parallel, PARALLEL_MAP_MIN_CELLS};
-pub use parallel::{run_chunks_parallel, run_parallel, run_pcrlb_parallel};
+pub use parallel::{
+    run_chunks_parallel, run_filter_chunks_parallel, run_parallel, run_pcrlb_parallel,
+};
 pub use sweep::{run_experiment_parallel, run_experiment_range};

@@ -11,8 +11,8 @@ use crate::error::{Error, Result};
 use crate::math::Real;
 use crate::measure::Model;
 use crate::track::{
-    finish, pcrlb_from_sums, run_chunk, run_truth_chunk, MonteCarloConfig, MonteCarloResult,
-    PartialSums, StudySums,
+    finish, pcrlb_from_sums, run_chunk, run_filter_chunk, run_truth_chunk, FilterKind,
+    MonteCarloConfig, MonteCarloResult, PartialSums, StudySums,
 };
 
 /// Runs the study on `threads` worker threads (0 = all cores). `on_progress(runs_done,
@@ -59,6 +59,42 @@ pub fn run_chunks_parallel(
         cancel,
         on_progress,
         run_chunk,
+        cfg.noise_runs,
+    )
+}
+
+/// [`run_chunks_parallel`] with any tracker (issue 15): the sums of the chunks `chunks` of the
+/// study run by `filter` ([`run_filter_chunk`]: the EKF study's truth and measurements), on
+/// `threads` worker threads (0 = all cores), with progress and cancel as in [`run_parallel`].
+/// [`FilterKind::Ekf`] gives exactly [`run_chunks_parallel`]'s sums. The filter's settings are
+/// validated first (errors name `ukf_alpha`, `ukf_beta`, `ukf_kappa`, `particles`,
+/// `roughening`).
+pub fn run_filter_chunks_parallel(
+    model: &Model,
+    cfg: &MonteCarloConfig,
+    filter: FilterKind,
+    chunks: Range<usize>,
+    threads: usize,
+    cancel: &AtomicBool,
+    on_progress: impl FnMut(usize, usize),
+) -> Result<StudySums> {
+    match filter {
+        FilterKind::Ekf => {
+            return run_chunks_parallel(model, cfg, chunks, threads, cancel, on_progress)
+        }
+        FilterKind::Ukf(p) => p.validate()?,
+        FilterKind::Pf(c) => c.validate()?,
+    }
+    cfg.validate()?;
+    check_chunks(cfg, &chunks)?;
+    run_waves(
+        model,
+        cfg,
+        chunks,
+        threads,
+        cancel,
+        on_progress,
+        |m, c, k| run_filter_chunk(m, c, filter, k),
         cfg.noise_runs,
     )
 }
@@ -115,7 +151,7 @@ fn run_waves(
     threads: usize,
     cancel: &AtomicBool,
     mut on_progress: impl FnMut(usize, usize),
-    chunk: fn(&Model, &MonteCarloConfig, usize) -> Result<PartialSums>,
+    chunk: impl Fn(&Model, &MonteCarloConfig, usize) -> Result<PartialSums> + Sync,
     per_trajectory: usize,
 ) -> Result<StudySums> {
     let first = chunks.start;

@@ -5,10 +5,14 @@ fn range_and_gaps() {
     let t = [0.0, 1.0, 2.0, 3.0];
     let ekf = [0.447, 0.02, Real::NAN, 0.004];
     let pcrlb = [Some(0.447), None, Some(0.01), Some(0.0022)];
-    let p = TrackingPanel {
+    let curves = [FilterCurve {
+        label: EKF_LABEL,
+        rmse_m: &ekf,
+    }];
+    let p = FiltersPanel {
         title: "I",
         t_s: &t,
-        rmse_ekf_m: &ekf,
+        curves: &curves,
         rmse_pcrlb_m: &pcrlb,
     };
     let (lo, hi) = y_range(&[p]);
@@ -21,4 +25,72 @@ fn range_and_gaps() {
     let bound = pcrlb.iter().map(|v| v.unwrap_or(Real::NAN));
     assert_eq!(segments(t.iter().copied().zip(bound), drawable).len(), 2);
     assert_eq!(y_range(&[]), (1e-3, 1.0));
+}
+
+/// The SVG of `draw` on a 1000 × 620 canvas.
+fn svg_of(
+    draw: impl FnOnce(&DrawingArea<SVGBackend, Shift>) -> Result<(Real, Real), ChartError>,
+) -> String {
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (1000, 620)).into_drawing_area();
+        draw(&root).unwrap();
+        root.present().unwrap();
+    }
+    svg
+}
+
+#[test]
+fn filters_figure_with_the_ekf_alone_is_the_ekf_figure() {
+    let t = [0.0, 1.0, 2.0, 3.0];
+    let ekf = [0.447, 0.02, 0.01, 0.004];
+    let ukf = [0.447, 0.03, 0.012, 0.005];
+    let pcrlb = [Some(0.447), Some(0.015), Some(0.01), Some(0.0022)];
+    let opts = TrackingChartOptions {
+        title: "t".into(),
+        subtitle: None,
+    };
+    let single = svg_of(|root| {
+        let p = TrackingPanel {
+            title: "I",
+            t_s: &t,
+            rmse_ekf_m: &ekf,
+            rmse_pcrlb_m: &pcrlb,
+        };
+        draw_tracking_rmse(root, &[p], &opts)
+    });
+    let one = [FilterCurve {
+        label: EKF_LABEL,
+        rmse_m: &ekf,
+    }];
+    let panel = |curves| FiltersPanel {
+        title: "I",
+        t_s: &t,
+        curves,
+        rmse_pcrlb_m: &pcrlb,
+    };
+    assert_eq!(
+        svg_of(|root| draw_tracking_filters(root, &[panel(&one)], &opts)),
+        single
+    );
+    let two = [
+        one[0],
+        FilterCurve {
+            label: "UKF RMSE",
+            rmse_m: &ukf,
+        },
+    ];
+    let both = svg_of(|root| draw_tracking_filters(root, &[panel(&two)], &opts));
+    assert!(
+        both.contains("UKF RMSE") && both.contains("#2CA02C"),
+        "{both}"
+    );
+    let short = [FilterCurve {
+        label: "PF RMSE",
+        rmse_m: &ukf[..2],
+    }];
+    let mut svg = String::new();
+    let root = SVGBackend::with_string(&mut svg, (1000, 620)).into_drawing_area();
+    let e = draw_tracking_filters(&root, &[panel(&short)], &opts).unwrap_err();
+    assert!(e.0.contains("PF RMSE"), "{}", e.0);
 }

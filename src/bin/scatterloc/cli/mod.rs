@@ -5,6 +5,7 @@
 //! to stdout with status 0). The commands themselves are in `crate::cmd`.
 
 mod error;
+mod filters;
 mod mtl;
 mod plan;
 mod scenario;
@@ -17,6 +18,7 @@ use std::ffi::OsString;
 
 use clap::{CommandFactory, FromArgMatches, Parser, Subcommand, ValueEnum};
 
+pub use filters::{FilterName, FilterSettings};
 pub use mtl::{MtlCommand, MtlLocateArgs, RocArgs, Table2Args};
 pub use plan::PlanArgs;
 pub use scenario::{CrlbArgs, CrlbMapArgs, LocateArgs, PresetArgs};

@@ -2,6 +2,7 @@
 
 use clap::Args;
 
+use super::filters::{filters, FilterList, FilterSettings};
 use super::shard::ShardArgs;
 use super::values::{finite, seed, whole, Trajectory};
 
@@ -60,6 +61,12 @@ pub struct MontecarloArgs {
     /// The curves as a .json file (with --shard: the part file).
     #[arg(long, value_name = "OUT.json")]
     pub json: Option<String>,
+    /// Trackers run on the same truth and measurements, in this order: ekf, ukf, pf, comma
+    /// separated [default: ekf]. More than ekf adds "filters" to the JSON.
+    #[arg(long, value_name = "LIST", value_parser = filters)]
+    pub filters: Option<FilterList>,
+    #[command(flatten)]
+    pub settings: FilterSettings,
     #[command(flatten)]
     pub shard: ShardArgs,
 }

@@ -2,6 +2,7 @@
 
 use clap::Args;
 
+use super::filters::{FilterName, FilterSettings};
 use super::values::{finite, seed, whole, Association, WalkStart};
 
 /// `scatterloc track`.
@@ -28,6 +29,20 @@ pub struct TrackArgs {
     /// the --out figure.
     #[arg(long, value_name = "FILE")]
     pub truth: Option<String>,
+    /// The tracker: ekf, ukf or pf [default: ekf]. ukf and pf take the plain form only (steps,
+    /// initial_state and initial_covariance; not raw_steps).
+    #[arg(
+        long,
+        value_name = "ekf|ukf|pf",
+        ignore_case = true,
+        hide_possible_values = true
+    )]
+    pub filter: Option<FilterName>,
+    /// Seed of the particle filter's particles [default: 1] (--filter pf only).
+    #[arg(long, value_name = "N", value_parser = seed)]
+    pub seed: Option<u64>,
+    #[command(flatten)]
+    pub settings: FilterSettings,
 }
 
 /// `scatterloc calibrate`.

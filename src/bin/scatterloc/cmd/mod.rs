@@ -7,6 +7,7 @@
 //! stdout and files atomically (`output`).
 
 mod crlb_map;
+mod filters;
 mod gating;
 mod io;
 mod merge;

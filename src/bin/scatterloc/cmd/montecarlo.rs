@@ -7,26 +7,30 @@ use serde::{Deserialize, Serialize};
 
 use scatterloc::chart::TrackingChartOptions;
 use scatterloc::math::Shard;
+use scatterloc::track::FilterKind;
 use scatterloc::track::{
     finish, nominal_pcrlb_rmse, paper_initial_covariance, ConstantVelocity, MonteCarloConfig,
     MonteCarloResult, StudySums, TrackScenario, MAX_STEPS,
 };
 use scatterloc::Scenario;
 
+use super::filters::filter_kinds;
 use super::merge::{differs, inconsistent, merged_timing, sums_of, Part};
 use super::report::{which, CurveDoc, Outputs};
 use super::shard::{self, ShardDoc, Timing};
 use super::study::{
-    flag_error, parse_study, run_chunks_with_progress, run_pcrlb_with_progress, run_with_progress,
-    threads, Study,
+    flag_error, parse_study, run_chunks_with_progress, run_filters_with_progress,
+    run_pcrlb_with_progress, run_with_progress, threads, Study,
 };
-use crate::cli::{MontecarloArgs, PcrlbArgs};
+use crate::cli::{FilterName, FilterSettings, MontecarloArgs, PcrlbArgs};
 use crate::CliError;
+use clap::ValueEnum;
 
 /// Scalars of one Monte Carlo study, after the curves in the JSON file and in the summary.
 #[derive(Serialize)]
 struct McMeta {
-    /// EKF runs counted (`trajectories × noise_runs − failed_runs`).
+    /// EKF runs counted (`trajectories × noise_runs − failed_runs`); with `--filters` without
+    /// `ekf`, the first filter's.
     runs: usize,
     seed: u64,
     trajectory: &'static str,
@@ -35,7 +39,8 @@ struct McMeta {
     trajectories: usize,
     failed_runs: usize,
     wall_time_s: f64,
-    /// `wall · threads / (runs · steps)`: thread time per EKF step, truth simulation included.
+    /// `wall · threads / (runs · steps)`: thread time per EKF step, truth simulation included
+    /// (with several filters the wall time is all filters').
     ns_per_ekf_step: f64,
     /// `wall / (runs · steps)`.
     wall_ns_per_ekf_step: f64,
@@ -44,6 +49,111 @@ struct McMeta {
     process_noise: f64,
     oracle_noise: bool,
     layout: String,
+    /// `--filters` other than `ekf` alone: each filter's curves, in the order asked.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    filters: Option<FilterCurves>,
+}
+
+/// The curves of one filter of `--filters`.
+#[derive(Serialize)]
+struct FilterDoc {
+    /// The filter's RMSE, m.
+    rmse_m: Vec<f64>,
+    /// Its average NEES.
+    nees: Vec<f64>,
+    /// Its runs counted.
+    runs: usize,
+    /// Its runs that failed numerically (left out of `rmse_m`).
+    failed_runs: usize,
+}
+
+/// `{"ekf": {..}, "ukf": {..}, ..}` in the order of `--filters`.
+struct FilterCurves(Vec<(&'static str, FilterDoc)>);
+
+impl Serialize for FilterCurves {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeMap;
+        let mut map = s.serialize_map(Some(self.0.len()))?;
+        for (name, doc) in &self.0 {
+            map.serialize_entry(name, doc)?;
+        }
+        map.end()
+    }
+}
+
+/// The document of several filters' results `rs` (in the order of `kinds`): the PCRLB and
+/// times once, the EKF's curves and counts at the top level when it ran (else the first
+/// filter's counts), and every filter's curves under `filters`.
+fn multi_doc(
+    study: &Study,
+    t: TrackScenario,
+    cfg: &MonteCarloConfig,
+    kinds: &[FilterKind],
+    rs: Vec<MonteCarloResult>,
+    time: RunTime,
+) -> CurveDoc<McMeta> {
+    let main = kinds.iter().position(|k| *k == FilterKind::Ekf);
+    let lead = &rs[main.unwrap_or(0)];
+    let mut doc = mc_doc(
+        study,
+        t,
+        cfg,
+        MonteCarloResult {
+            t_s: lead.t_s.clone(),
+            rmse_ekf_m: lead.rmse_ekf_m.clone(),
+            rmse_pcrlb_m: lead.rmse_pcrlb_m.clone(),
+            nees: lead.nees.clone(),
+            runs: lead.runs,
+            failed_runs: lead.failed_runs,
+            seed: lead.seed,
+        },
+        time,
+    );
+    if main.is_none() {
+        doc.rmse_ekf_m = None;
+        doc.nees = None;
+    }
+    let notes: Vec<String> = kinds
+        .iter()
+        .zip(&rs)
+        .map(|(k, r)| {
+            format!(
+                "{}: {} of {} failed",
+                k.name(),
+                r.failed_runs,
+                r.runs + r.failed_runs
+            )
+        })
+        .collect();
+    doc.caption_note = Some(notes.join(", "));
+    doc.figure_curves = Some(
+        kinds
+            .iter()
+            .zip(&rs)
+            .map(|(k, r)| {
+                let label = format!("{} RMSE", k.name().to_uppercase());
+                (label, r.rmse_ekf_m.clone())
+            })
+            .collect(),
+    );
+    doc.meta.filters = Some(FilterCurves(
+        kinds
+            .iter()
+            .zip(rs)
+            .map(|(k, r)| {
+                (
+                    k.name(),
+                    FilterDoc {
+                        rmse_m: r.rmse_ekf_m,
+                        nees: r.nees,
+                        runs: r.runs,
+                        failed_runs: r.failed_runs,
+                    },
+                )
+            })
+            .collect(),
+    ));
+    doc
 }
 
 /// The run time of one trajectory's study: wall time, thread time (`Σ wall · threads`) and
@@ -79,6 +189,7 @@ fn mc_doc(
         process_noise: cfg.motion.intensity,
         oracle_noise: cfg.oracle_noise,
         layout: study.layout.clone(),
+        filters: None,
     };
     CurveDoc {
         t_s: r.t_s,
@@ -86,14 +197,16 @@ fn mc_doc(
         rmse_pcrlb_m: r.rmse_pcrlb_m,
         nees: Some(r.nees),
         caption_note: Some(failed_note(r.failed_runs, r.runs + r.failed_runs)),
+        figure_curves: None,
         meta,
     }
 }
 
 /// The figure's title and subtitle.
-fn chart_options(study: &Study, c: &McConfig) -> TrackingChartOptions {
+fn chart_options(study: &Study, c: &McConfig, kinds: &[FilterKind]) -> TrackingChartOptions {
+    let names: Vec<String> = kinds.iter().map(|k| k.name().to_uppercase()).collect();
     TrackingChartOptions {
-        title: format!("EKF vs posterior CRLB — {}", which(study)),
+        title: format!("{} vs posterior CRLB — {}", names.join(", "), which(study)),
         subtitle: Some(format!(
             "{} trajectories × {} noise runs · step T = {} · σq² = {} m²/s³ · seed {}",
             c.runs,
@@ -123,6 +236,69 @@ struct McConfig {
     noise_runs: usize,
     seed: u64,
     oracle_noise: bool,
+    /// `--filters` other than `ekf` alone: the filters and their settings (absent: the EKF).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    filters: Option<FiltersConfig>,
+}
+
+/// The trackers of a study with several (`--filters`), as its part files record them.
+#[derive(Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+struct FiltersConfig {
+    /// `ekf`, `ukf`, `pf`, in the order run.
+    names: Vec<String>,
+    /// UKF `alpha`, `beta`, `kappa` (when `ukf` runs).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    ukf: Option<[f64; 3]>,
+    /// Particles (when `pf` runs).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    particles: Option<usize>,
+    /// Roughening constant (when `pf` runs with it).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    roughening: Option<f64>,
+}
+
+impl FiltersConfig {
+    /// `None` for the EKF alone.
+    fn of(kinds: &[FilterKind]) -> Option<FiltersConfig> {
+        if kinds == [FilterKind::Ekf] {
+            return None;
+        }
+        let mut c = FiltersConfig {
+            names: kinds.iter().map(|k| k.name().to_string()).collect(),
+            ukf: None,
+            particles: None,
+            roughening: None,
+        };
+        for k in kinds {
+            match k {
+                FilterKind::Ekf => {}
+                FilterKind::Ukf(p) => c.ukf = Some([p.alpha, p.beta, p.kappa]),
+                FilterKind::Pf(p) => {
+                    c.particles = Some(p.particles);
+                    c.roughening = p.roughening;
+                }
+            }
+        }
+        Some(c)
+    }
+
+    /// The filters again (validated).
+    fn kinds(&self) -> Result<Vec<FilterKind>, String> {
+        let names = self
+            .names
+            .iter()
+            .map(|n| FilterName::from_str(n, false).map_err(|_| format!("unknown filter '{n}'")))
+            .collect::<Result<Vec<_>, _>>()?;
+        let settings = FilterSettings {
+            particles: self.particles,
+            roughening: self.roughening,
+            ukf_alpha: self.ukf.map(|u| u[0]),
+            ukf_beta: self.ukf.map(|u| u[1]),
+            ukf_kappa: self.ukf.map(|u| u[2]),
+        };
+        filter_kinds(&names, &settings, "--filters").map_err(|e| e.message)
+    }
 }
 
 impl McConfig {
@@ -132,6 +308,7 @@ impl McConfig {
         noise_runs: usize,
         seed: u64,
         oracle_noise: bool,
+        kinds: &[FilterKind],
     ) -> Result<McConfig, CliError> {
         Ok(McConfig {
             layout: study.layout.clone(),
@@ -149,6 +326,7 @@ impl McConfig {
             noise_runs,
             seed,
             oracle_noise,
+            filters: FiltersConfig::of(kinds),
         })
     }
 
@@ -197,25 +375,56 @@ pub fn montecarlo(args: &MontecarloArgs) -> Result<(), CliError> {
         .iter()
         .map(|t| study.config(*t, runs, noise_runs, seed, oracle))
         .collect::<Result<Vec<_>, _>>()?;
-    let config = McConfig::of(&study, runs, noise_runs, seed, oracle)?;
+    let names = match &args.filters {
+        Some(list) => list.0.clone(),
+        None => vec![FilterName::Ekf],
+    };
+    let kinds = filter_kinds(&names, &args.settings, "--filters")?;
+    let ekf_only = kinds == [FilterKind::Ekf];
+    let config = McConfig::of(&study, runs, noise_runs, seed, oracle, &kinds)?;
     if let Some(shard) = shard::resolve(&args.shard)? {
         let path = shard::part_path(args.json.as_deref(), args.out.as_deref())?;
-        return run_shard(&study, &configs, &config, shard, (threads, used), &path);
+        return run_shard(
+            &study,
+            &configs,
+            &config,
+            &kinds,
+            shard,
+            (threads, used),
+            &path,
+        );
     }
     let outputs = Outputs::parse(args.out.as_deref(), args.json.as_deref())?;
 
     let mut docs = Vec::new();
     for (t, cfg) in study.trajectories.iter().zip(&configs) {
         let label = format!("scenario {:>3}", t.name());
-        let (r, wall) = run_with_progress(&study.model, cfg, threads, &label)?;
-        let time = RunTime {
-            wall_s: wall,
-            thread_s: wall * used as f64,
-            threads: used,
-        };
-        docs.push(mc_doc(&study, *t, cfg, r, time));
+        if ekf_only {
+            let (r, wall) = run_with_progress(&study.model, cfg, threads, &label)?;
+            let time = RunTime {
+                wall_s: wall,
+                thread_s: wall * used as f64,
+                threads: used,
+            };
+            docs.push(mc_doc(&study, *t, cfg, r, time));
+        } else {
+            let all = 0..cfg.chunk_count();
+            let (sums, wall) =
+                run_filters_with_progress(&study.model, cfg, &kinds, all, threads, &label)?;
+            let rs = sums
+                .iter()
+                .map(|s| finish(cfg, s))
+                .collect::<Result<Vec<_>, _>>()
+                .map_err(flag_error)?;
+            let time = RunTime {
+                wall_s: wall,
+                thread_s: wall * used as f64,
+                threads: used,
+            };
+            docs.push(multi_doc(&study, *t, cfg, &kinds, rs, time));
+        }
     }
-    outputs.finish(&study, &docs, &chart_options(&study, &config))
+    outputs.finish(&study, &docs, &chart_options(&study, &config, &kinds))
 }
 
 /// Runs shard `shard` (its chunks of every trajectory) and writes its part file `path`.
@@ -223,6 +432,7 @@ fn run_shard(
     study: &Study,
     configs: &[MonteCarloConfig],
     config: &McConfig,
+    kinds: &[FilterKind],
     shard: Shard,
     (threads, used): (usize, usize),
     path: &str,
@@ -238,10 +448,24 @@ fn run_shard(
             shard.index(),
             shard.count()
         );
-        let (s, wall) =
-            run_chunks_with_progress(&study.model, cfg, chunks.clone(), threads, &label)?;
-        sums.push(s);
-        walls.push(wall);
+        if kinds == [FilterKind::Ekf] {
+            let (s, wall) =
+                run_chunks_with_progress(&study.model, cfg, chunks.clone(), threads, &label)?;
+            sums.push(s);
+            walls.push(wall);
+        } else {
+            // Per trajectory, one entry per filter in order.
+            let (s, wall) = run_filters_with_progress(
+                &study.model,
+                cfg,
+                kinds,
+                chunks.clone(),
+                threads,
+                &label,
+            )?;
+            sums.extend(s);
+            walls.push(wall);
+        }
     }
     #[derive(Serialize)]
     struct Counted {
@@ -268,12 +492,19 @@ pub fn merge_parts(parts: &[Part], json: &str, out: Option<&str>) -> Result<(), 
         .map_err(|e| inconsistent(&first.path, format!("config: {e}")))?;
     let (study, configs) = config.study().map_err(|e| inconsistent(&first.path, e))?;
     // The configuration must be the one this build writes for that study.
+    let kinds = match &config.filters {
+        Some(f) => f
+            .kinds()
+            .map_err(|e| inconsistent(&first.path, format!("config.filters: {e}")))?,
+        None => vec![FilterKind::Ekf],
+    };
     let again = McConfig::of(
         &study,
         config.runs,
         config.noise_runs,
         config.seed,
         config.oracle_noise,
+        &kinds,
     )?;
     let again = serde_json::to_value(&again)
         .map_err(|e| CliError::output(format!("encoding JSON: {e}")))?;
@@ -295,17 +526,28 @@ pub fn merge_parts(parts: &[Part], json: &str, out: Option<&str>) -> Result<(), 
     }
     let outputs = Outputs::parse(out, Some(json))?;
 
-    let mut merged: Vec<StudySums> = configs.iter().map(|c| StudySums::new(c.steps)).collect();
+    // Per trajectory, one entry per filter in order.
+    let per = kinds.len();
+    let mut merged: Vec<StudySums> = configs
+        .iter()
+        .flat_map(|c| std::iter::repeat_n(c.steps, per))
+        .map(StudySums::new)
+        .collect();
     for part in parts {
         let sums: Vec<StudySums> = sums_of(part)?;
         let chunks = part.shard.range[0]..part.shard.range[1];
-        if sums.len() != configs.len() {
+        if sums.len() != configs.len() * per {
             return Err(inconsistent(
                 &part.path,
-                format!("{} sums for {} trajectories", sums.len(), configs.len()),
+                format!(
+                    "{} sums for {} trajectories × {per} filters",
+                    sums.len(),
+                    configs.len()
+                ),
             ));
         }
-        for ((m, s), cfg) in merged.iter_mut().zip(&sums).zip(&configs) {
+        let cfg_of = configs.iter().flat_map(|c| std::iter::repeat_n(c, per));
+        for ((m, s), cfg) in merged.iter_mut().zip(&sums).zip(cfg_of) {
             let trajectories = cfg.trajectories_in(&chunks);
             if !s.has_steps(cfg.steps)
                 || s.trajectories != trajectories
@@ -328,18 +570,26 @@ pub fn merge_parts(parts: &[Part], json: &str, out: Option<&str>) -> Result<(), 
         .trajectories
         .iter()
         .zip(&configs)
-        .zip(&merged)
+        .zip(merged.chunks(per))
         .enumerate()
     {
-        let r = finish(cfg, sums).map_err(flag_error)?;
+        let mut rs = sums
+            .iter()
+            .map(|s| finish(cfg, s))
+            .collect::<Result<Vec<_>, _>>()
+            .map_err(flag_error)?;
         let time = RunTime {
             wall_s: timing.wall_time_s[k],
             thread_s: thread_s[k],
             threads: timing.threads,
         };
-        docs.push(mc_doc(&study, *t, cfg, r, time));
+        if config.filters.is_none() {
+            docs.push(mc_doc(&study, *t, cfg, rs.remove(0), time));
+        } else {
+            docs.push(multi_doc(&study, *t, cfg, &kinds, rs, time));
+        }
     }
-    outputs.finish(&study, &docs, &chart_options(&study, &config))
+    outputs.finish(&study, &docs, &chart_options(&study, &config, &kinds))
 }
 
 /// The figure's note on the EKF runs that failed numerically (left out of `ε_EKF`), shown
@@ -421,6 +671,7 @@ pub fn pcrlb(args: &PcrlbArgs) -> Result<(), CliError> {
             rmse_pcrlb_m: rmse,
             nees: None,
             caption_note: None,
+            figure_curves: None,
             meta,
         });
     }

@@ -8,7 +8,8 @@ use plotters::prelude::*;
 use serde::Serialize;
 
 use scatterloc::chart::{
-    draw_tracking_rmse, tracking_size, ChartError, TrackingChartOptions, TrackingPanel,
+    draw_tracking_filters, draw_tracking_rmse, tracking_size, ChartError, FilterCurve,
+    FiltersPanel, TrackingChartOptions, TrackingPanel,
 };
 
 use super::io::emit;
@@ -36,6 +37,10 @@ pub struct CurveDoc<M: Serialize> {
     /// `ε_EKF` leaves out); not part of the JSON.
     #[serde(skip)]
     pub caption_note: Option<String>,
+    /// Several trackers (`montecarlo --filters`): the figure draws these labelled RMSE curves
+    /// instead of `rmse_ekf_m`; not part of the JSON (the meta holds them).
+    #[serde(skip)]
+    pub figure_curves: Option<Vec<(String, Vec<f64>)>>,
 }
 
 /// The scalars and the values at the reporting times.
@@ -91,6 +96,18 @@ struct TrackingFigure<'a> {
 impl Figure for TrackingFigure<'_> {
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), ChartError> {
         draw_tracking_rmse(root, &self.panels, self.opts).map(|_| ())
+    }
+}
+
+/// The figure of several trackers' curves as a [`Figure`].
+struct FiltersFigure<'a> {
+    panels: Vec<FiltersPanel<'a>>,
+    opts: &'a TrackingChartOptions,
+}
+
+impl Figure for FiltersFigure<'_> {
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), ChartError> {
+        draw_tracking_filters(root, &self.panels, self.opts).map(|_| ())
     }
 }
 
@@ -155,18 +172,46 @@ impl Outputs {
                     None => format!("Scenario {}", t.name()),
                 })
                 .collect();
-            let panels = docs
-                .iter()
-                .zip(&captions)
-                .map(|(d, title)| TrackingPanel {
-                    title,
-                    t_s: &d.t_s,
-                    rmse_ekf_m: d.rmse_ekf_m.as_deref().unwrap_or(&[]),
-                    rmse_pcrlb_m: &d.rmse_pcrlb_m,
-                })
-                .collect();
-            let figure = TrackingFigure { panels, opts };
-            write_figure("out", path, *format, tracking_size(docs.len()), &figure)?;
+            let size = tracking_size(docs.len());
+            if docs.iter().any(|d| d.figure_curves.is_some()) {
+                let curves: Vec<Vec<FilterCurve>> = docs
+                    .iter()
+                    .map(|d| {
+                        d.figure_curves
+                            .iter()
+                            .flatten()
+                            .map(|(label, rmse)| FilterCurve {
+                                label,
+                                rmse_m: rmse,
+                            })
+                            .collect()
+                    })
+                    .collect();
+                let panels = docs
+                    .iter()
+                    .zip(&captions)
+                    .zip(&curves)
+                    .map(|((d, title), curves)| FiltersPanel {
+                        title,
+                        t_s: &d.t_s,
+                        curves,
+                        rmse_pcrlb_m: &d.rmse_pcrlb_m,
+                    })
+                    .collect();
+                write_figure("out", path, *format, size, &FiltersFigure { panels, opts })?;
+            } else {
+                let panels = docs
+                    .iter()
+                    .zip(&captions)
+                    .map(|(d, title)| TrackingPanel {
+                        title,
+                        t_s: &d.t_s,
+                        rmse_ekf_m: d.rmse_ekf_m.as_deref().unwrap_or(&[]),
+                        rmse_pcrlb_m: &d.rmse_pcrlb_m,
+                    })
+                    .collect();
+                write_figure("out", path, *format, size, &TrackingFigure { panels, opts })?;
+            }
         }
         let summaries: Vec<Summary<M>> = docs
             .iter()

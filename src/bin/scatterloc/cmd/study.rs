@@ -9,8 +9,11 @@ use std::time::{Duration, Instant};
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
 
-use scatterloc::native::{run_chunks_parallel, run_parallel, run_pcrlb_parallel};
+use scatterloc::native::{
+    run_chunks_parallel, run_filter_chunks_parallel, run_parallel, run_pcrlb_parallel,
+};
 use scatterloc::track::ConstantVelocity;
+use scatterloc::track::FilterKind;
 use scatterloc::track::{
     paper_initial_covariance, step_count, TrackScenario, PAPER_DURATION_S, PAPER_INTENSITY,
     PAPER_STEP_S,
@@ -244,6 +247,38 @@ pub fn run_chunks_with_progress(
     let total = cfg.trajectories_in(&chunks) * cfg.noise_runs;
     with_progress(total, "runs", label, |cancel, progress| {
         run_chunks_parallel(model, cfg, chunks, threads, cancel, progress)
+    })
+}
+
+/// The sums of chunks `chunks` of `cfg` once per filter of `filters` (in order, on the same
+/// truth and measurements) under one progress bar counting the runs of every filter, with the
+/// Ctrl-C handling of [`run_with_progress`]: the sums in the order of `filters` and the wall
+/// time.
+pub fn run_filters_with_progress(
+    model: &Model,
+    cfg: &MonteCarloConfig,
+    filters: &[FilterKind],
+    chunks: std::ops::Range<usize>,
+    threads: usize,
+    label: &str,
+) -> Result<(Vec<StudySums>, f64), CliError> {
+    let per_filter = cfg.trajectories_in(&chunks) * cfg.noise_runs;
+    let total = per_filter * filters.len();
+    with_progress(total, "runs", label, |cancel, progress| {
+        let mut out = Vec::with_capacity(filters.len());
+        for (k, &filter) in filters.iter().enumerate() {
+            let offset = k * per_filter;
+            out.push(run_filter_chunks_parallel(
+                model,
+                cfg,
+                filter,
+                chunks.clone(),
+                threads,
+                cancel,
+                |done, _| progress(offset + done, total),
+            )?);
+        }
+        Ok(out)
     })
 }
 

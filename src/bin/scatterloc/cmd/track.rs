@@ -3,6 +3,8 @@
 //! predict only), `R` fixed from `sigma_s` or from the link budget (E8) at the predicted position.
 //! With `raw_steps` (every link's full list of `[delay, amplitude]` estimates) each step is first
 //! gated against `--calibration` (E4) and associated (spec §4) before the update.
+//! `--filter ukf|pf` runs the UKF or the particle filter instead (plain form only: gating and
+//! association use the EKF's predicted delays and innovation σ).
 
 use serde::{Deserialize, Serialize};
 
@@ -10,18 +12,21 @@ use scatterloc::gating::Calibration;
 use scatterloc::gating::{start_from_snapshot, GatedTracker, START_SPEED_SIGMA_MPS};
 use scatterloc::gating::{AssociationRule, Choice, DelayEstimate};
 use scatterloc::math::{Mat4, Vec4};
+use scatterloc::measure::rng;
 use scatterloc::scenario::Area;
 use scatterloc::track::ConstantVelocity;
 use scatterloc::track::MAX_STEPS;
-use scatterloc::track::{Ekf, MeasurementNoise, UpdateSummary};
+use scatterloc::track::{Ekf, FilterKind, MeasurementNoise, UpdateSummary};
+use scatterloc::track::{ParticleFilter, Ukf};
 use scatterloc::{Error, Model};
 
+use super::filters::filter_kinds;
 use super::gating::{one_list_per_link, read_calibration, RawStep};
 use super::io::{emit, model_of, read_json_file, read_scenario};
 use super::output::{check_writable, Format};
 use super::scenario::Sigma;
 use super::track_fig::{read_truth, write_track_figure, TrackSeries};
-use crate::cli::{Association, TrackArgs};
+use crate::cli::{Association, FilterName, TrackArgs};
 use crate::CliError;
 
 /// The `--measurements` file.
@@ -114,6 +119,13 @@ pub fn track(args: &TrackArgs) -> Result<(), CliError> {
         }
         None => None,
     };
+    let name = args.filter.unwrap_or(FilterName::Ekf);
+    let kind = filter_kinds(&[name], &args.settings, "--filter")?[0];
+    if args.seed.is_some() && name != FilterName::Pf {
+        return Err(CliError::usage(
+            "--seed: only for the pf filter (--filter is not pf)",
+        ));
+    }
     let scenario = read_scenario(&args.scenario)?;
     let mut m: MeasurementsFile = read_json_file("measurements", mpath)?;
     let bad = |e: &dyn std::fmt::Display| CliError::usage(format!("--measurements {mpath}: {e}"));
@@ -140,6 +152,12 @@ pub fn track(args: &TrackArgs) -> Result<(), CliError> {
         // No calibration: nothing is static (every estimate is a candidate).
         links: vec![Default::default(); n],
     });
+    if name != FilterName::Ekf && m.raw_steps.is_some() {
+        return Err(CliError::usage(format!(
+            "--filter {}: the plain form (steps) only; raw_steps gating needs the EKF",
+            name.name()
+        )));
+    }
     let (ekf, start) = initial_filter(&m, &model, &cal, &scenario.area_m, &bad)?;
     let len = match (&m.steps, &m.raw_steps) {
         (Some(s), None) => s.len(),
@@ -168,7 +186,12 @@ pub fn track(args: &TrackArgs) -> Result<(), CliError> {
         start,
     };
     match (m.steps, m.raw_steps) {
-        (Some(steps), _) => plain(&model, ekf, &motion, noise, &steps, m.dt_s, &mut out, &bad)?,
+        (Some(steps), _) => {
+            let filter = Tracker::new(ekf, kind, args.seed.unwrap_or(1)).map_err(|e| bad(&e))?;
+            plain(
+                &model, filter, &motion, noise, &steps, m.dt_s, &mut out, &bad,
+            )?
+        }
         (_, Some(raw)) => {
             let tracker =
                 GatedTracker::new(ekf, &model, &cal, motion, noise, rule).map_err(|e| bad(&e))?;
@@ -259,11 +282,65 @@ fn step_error(field: &str, e: Error, bad: &dyn Fn(&dyn std::fmt::Display) -> Cli
     }
 }
 
+/// The filter of `track --filter`.
+enum Tracker {
+    Ekf(Ekf),
+    Ukf(Ukf),
+    Pf(Box<ParticleFilter>),
+}
+
+impl Tracker {
+    /// `kind` started at the EKF's state and covariance; the particle filter draws its
+    /// particles from stream 0 of `seed`.
+    fn new(ekf: Ekf, kind: FilterKind, seed: u64) -> Result<Tracker, Error> {
+        Ok(match kind {
+            FilterKind::Ekf => Tracker::Ekf(ekf),
+            FilterKind::Ukf(p) => Tracker::Ukf(Ukf::new(ekf.state, ekf.covariance, p)?),
+            FilterKind::Pf(c) => Tracker::Pf(Box::new(ParticleFilter::new(
+                ekf.state,
+                ekf.covariance,
+                c,
+                rng(seed, 0),
+            )?)),
+        })
+    }
+
+    fn predict(&mut self, motion: &ConstantVelocity) {
+        match self {
+            Tracker::Ekf(f) => f.predict(motion),
+            Tracker::Ukf(f) => f.predict(motion),
+            Tracker::Pf(f) => f.predict(motion),
+        }
+    }
+
+    fn update(
+        &mut self,
+        model: &Model,
+        z: &[Option<f64>],
+        noise: MeasurementNoise,
+    ) -> Result<UpdateSummary, Error> {
+        match self {
+            Tracker::Ekf(f) => f.update(model, z, noise, None),
+            Tracker::Ukf(f) => f.update(model, z, noise),
+            Tracker::Pf(f) => f.update(model, z, noise).map(|u| u.summary),
+        }
+    }
+
+    /// State and covariance.
+    fn estimate(&self) -> (&Vec4, &Mat4) {
+        match self {
+            Tracker::Ekf(f) => (&f.state, &f.covariance),
+            Tracker::Ukf(f) => (&f.state, &f.covariance),
+            Tracker::Pf(f) => (&f.state, &f.covariance),
+        }
+    }
+}
+
 /// The plain form: one delay (or null) per link and step.
 #[allow(clippy::too_many_arguments)]
 fn plain(
     model: &Model,
-    mut ekf: Ekf,
+    mut filter: Tracker,
     motion: &ConstantVelocity,
     noise: MeasurementNoise,
     steps: &[Vec<Option<f64>>],
@@ -280,11 +357,12 @@ fn plain(
                 z.len()
             )));
         }
-        ekf.predict(motion);
-        let summary = ekf
-            .update(model, z, noise, None)
+        filter.predict(motion);
+        let summary = filter
+            .update(model, z, noise)
             .map_err(|e| step_error(&field, e, bad))?;
-        record(out, &ekf, k, dt_s, &summary);
+        let (x, p) = filter.estimate();
+        record(out, x, p, k, dt_s, &summary);
     }
     Ok(())
 }
@@ -306,7 +384,8 @@ fn gated(
         let s = tracker
             .step(&estimates(step))
             .map_err(|e| step_error(&field, e, bad))?;
-        record(out, &tracker.ekf, k, dt_s, &s.summary);
+        let ekf = &tracker.ekf;
+        record(out, &ekf.state, &ekf.covariance, k, dt_s, &s.summary);
         choices.push(names(&s.selection.choices));
         used.push(s.selection.delays);
         removed.push(s.selection.static_removed);
@@ -317,11 +396,10 @@ fn gated(
     Ok(())
 }
 
-/// Appends step `k`'s filter state to the output.
-fn record(out: &mut TrackOut, ekf: &Ekf, k: usize, dt_s: f64, summary: &UpdateSummary) {
-    let p = &ekf.covariance;
+/// Appends step `k`'s filter state `x` and covariance `p` to the output.
+fn record(out: &mut TrackOut, x: &Vec4, p: &Mat4, k: usize, dt_s: f64, summary: &UpdateSummary) {
     out.t_s.push((k + 1) as f64 * dt_s);
-    out.states.push(ekf.state.into());
+    out.states.push((*x).into());
     out.covariances
         .push(std::array::from_fn(|i| std::array::from_fn(|j| p[(i, j)])));
     out.nis

@@ -1,0 +1,363 @@
+//! End-to-end tests of the trackers on the command line (issue 15): `track --filter ekf|ukf|pf`
+//! (same output shape, the UKF close to the EKF on an easy path, raw_steps refused), and
+//! `montecarlo --filters` (every filter's curves, the EKF's equal to the single-filter run's,
+//! determinism, bad flags named, two shards merged equal to the unsharded run, Ctrl-C).
+#![cfg(not(target_arch = "wasm32"))]
+
+mod common;
+
+use scatterloc::{scenario::presets, Model, Vec2};
+use serde_json::{json, Value};
+
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+use common::cli::{fails, floats, ok_json, ok_json_line, read_json, TempDir, BIN};
+
+/// A straight path from (4, 1) at (1.4, 0.25) m/s sampled every 0.1 s.
+fn truth(n: usize) -> Vec2 {
+    Vec2::new(4.0, 1.0) + (n as f64 * 0.1) * Vec2::new(1.4, 0.25)
+}
+
+/// Noise-free delays of 20 steps (link 1 missing at step 10), fixed σ.
+fn measurements() -> Value {
+    let model = Model::new(&presets::sensors2019()).unwrap();
+    let steps: Vec<Value> = (1..=20)
+        .map(|n| {
+            let d = model.network.delays(truth(n));
+            let row: Vec<Value> = d
+                .iter()
+                .enumerate()
+                .map(|(p, d)| {
+                    if (n, p) == (10, 1) {
+                        Value::Null
+                    } else {
+                        json!(d)
+                    }
+                })
+                .collect();
+            json!(row)
+        })
+        .collect();
+    json!({
+        "dt_s": 0.1, "process_noise": 0.01, "initial_state": [4.1, 0.95, 1.4, 0.25],
+        "initial_covariance": [[0.01, 0, 0, 0], [0, 0.01, 0, 0], [0, 0, 0.01, 0], [0, 0, 0, 0.01]],
+        "sigma_s": 3e-11,
+        "steps": steps,
+    })
+}
+
+/// Scenario and measurements files in `dir`.
+fn files(dir: &TempDir) -> (String, String) {
+    let s = dir.write(
+        "s.json",
+        &serde_json::from_str(&presets::sensors2019().to_json()).unwrap(),
+    );
+    (s, dir.write("m.json", &measurements()))
+}
+
+fn keys(v: &Value) -> Vec<String> {
+    v.as_object().unwrap().keys().cloned().collect()
+}
+
+#[test]
+fn track_runs_every_filter_with_the_same_output_shape() {
+    let dir = TempDir::new();
+    let (s, m) = files(&dir);
+    let base = ["track", "--scenario", &s, "--measurements", &m];
+    let ekf = ok_json_line(&base);
+    let explicit = ok_json_line(&[&base[..], &["--filter", "ekf"]].concat());
+    assert_eq!(ekf, explicit, "--filter ekf is the default");
+    let ukf = ok_json_line(&[&base[..], &["--filter", "ukf"]].concat());
+    let pf = ok_json_line(
+        &[
+            &base[..],
+            &["--filter", "pf", "--particles", "2000", "--seed", "3"],
+        ]
+        .concat(),
+    );
+    for v in [&ukf, &pf] {
+        assert_eq!(keys(v), keys(&ekf));
+        assert_eq!(v["t_s"], ekf["t_s"]);
+        assert_eq!(v["links_used"], ekf["links_used"]);
+        assert_eq!(v["states"].as_array().unwrap().len(), 20);
+        for k in 0..20 {
+            assert!(floats(&v["states"][k]).iter().all(|x| x.is_finite()));
+            for row in v["covariances"][k].as_array().unwrap() {
+                assert!(floats(row).iter().all(|x| x.is_finite()));
+            }
+        }
+    }
+    // Easy case: the UKF within 1 mm of the EKF at every step, and on the path at the end.
+    for k in 0..20 {
+        let (a, b) = (floats(&ekf["states"][k]), floats(&ukf["states"][k]));
+        let d = Vec2::new(a[0] - b[0], a[1] - b[1]).norm();
+        assert!(d < 1e-3, "step {k}: {d}");
+    }
+    let x = floats(&pf["states"][19]);
+    let err = (Vec2::new(x[0], x[1]) - truth(20)).norm();
+    assert!(err < 0.05, "pf error {err}");
+    // Same seed, same particles; the seed matters.
+    let again = ok_json_line(
+        &[
+            &base[..],
+            &["--filter", "pf", "--particles", "2000", "--seed", "3"],
+        ]
+        .concat(),
+    );
+    assert_eq!(pf, again);
+    let other = ok_json_line(
+        &[
+            &base[..],
+            &["--filter", "pf", "--particles", "2000", "--seed", "4"],
+        ]
+        .concat(),
+    );
+    assert_ne!(pf["states"], other["states"]);
+}
+
+#[test]
+fn track_rejects_bad_filter_flags_naming_them() {
+    let dir = TempDir::new();
+    let (s, m) = files(&dir);
+    let base = ["track", "--scenario", &s, "--measurements", &m];
+    let cases: [(&[&str], &[&str]); 8] = [
+        (&["--filter", "kf"], &["--filter"]),
+        (&["--filter", "pf", "--particles", "0"], &["--particles"]),
+        (
+            &["--filter", "pf", "--particles", "1000001"],
+            &["--particles"],
+        ),
+        (&["--filter", "ukf", "--ukf-alpha", "0"], &["--ukf-alpha"]),
+        (&["--filter", "ukf", "--ukf-kappa", "-4"], &["--ukf-kappa"]),
+        (&["--particles", "10"], &["--particles", "pf"]),
+        (&["--filter", "ukf", "--seed", "2"], &["--seed"]),
+        (
+            &["--filter", "pf", "--ukf-beta", "1"],
+            &["--ukf-beta", "ukf"],
+        ),
+    ];
+    for (extra, needles) in cases {
+        fails(&[&base[..], extra].concat(), needles);
+    }
+    // raw_steps: the gated mode needs the EKF.
+    let mut raw = measurements();
+    let o = raw.as_object_mut().unwrap();
+    o.remove("steps");
+    o.insert("raw_steps".into(), json!([[[[1e-8, 1.0]], [], [], []]]));
+    let r = dir.write("raw.json", &raw);
+    fails(
+        &[
+            "track",
+            "--scenario",
+            &s,
+            "--measurements",
+            &r,
+            "--filter",
+            "ukf",
+        ],
+        &["--filter ukf", "raw_steps"],
+    );
+}
+
+/// A tiny study: scenario I, 16 trajectories × 2 noise runs, 20 steps.
+const TINY: [&str; 10] = [
+    "montecarlo",
+    "--trajectory",
+    "I",
+    "--runs",
+    "16",
+    "--noise-runs",
+    "2",
+    "--dt",
+    "0.1",
+    "--duration",
+];
+
+fn tiny(extra: &[&str]) -> Vec<String> {
+    let mut a: Vec<String> = TINY.iter().map(|s| s.to_string()).collect();
+    a.push("2".into());
+    a.extend(extra.iter().map(|s| s.to_string()));
+    a
+}
+
+fn refs(a: &[String]) -> Vec<&str> {
+    a.iter().map(|s| s.as_str()).collect()
+}
+
+/// The document without its timing fields.
+fn untimed(mut v: Value) -> Value {
+    let o = v.as_object_mut().unwrap();
+    for k in ["wall_time_s", "ns_per_ekf_step", "wall_ns_per_ekf_step"] {
+        o.remove(k);
+    }
+    v
+}
+
+#[test]
+fn montecarlo_runs_every_filter_on_the_same_data() {
+    let three = tiny(&["--filters", "ekf,ukf,pf", "--particles", "200"]);
+    let v = ok_json(&refs(&three));
+    let single = ok_json(&refs(&tiny(&[])));
+    assert!(single.get("filters").is_none(), "ekf alone: no 'filters'");
+    let f = &v["filters"];
+    assert_eq!(keys(f).len(), 3);
+    for name in ["ekf", "ukf", "pf"] {
+        let c = &f[name];
+        assert_eq!(c["rmse_m"].as_array().unwrap().len(), 21, "{name}");
+        assert_eq!(c["nees"].as_array().unwrap().len(), 21, "{name}");
+        assert_eq!(
+            c["runs"].as_u64().unwrap() + c["failed_runs"].as_u64().unwrap(),
+            32
+        );
+    }
+    // Every counted filter's curves are finite.
+    for name in ["ekf", "ukf"] {
+        assert!(floats(&f[name]["rmse_m"]).iter().all(|x| x.is_finite()));
+        assert_eq!(f[name]["runs"], 32);
+    }
+    if f["pf"]["runs"].as_u64().unwrap() > 0 {
+        assert!(floats(&f["pf"]["rmse_m"]).iter().all(|x| x.is_finite()));
+    }
+    // The EKF's curve is the single-filter run's, bitwise (and kept at the top level).
+    let bits = |v: &Value| -> Vec<u64> { floats(v).iter().map(|x| x.to_bits()).collect() };
+    assert_eq!(bits(&f["ekf"]["rmse_m"]), bits(&single["rmse_ekf_m"]));
+    assert_eq!(bits(&f["ekf"]["nees"]), bits(&single["nees"]));
+    assert_eq!(v["rmse_ekf_m"], single["rmse_ekf_m"]);
+    assert_eq!(v["rmse_pcrlb_m"], single["rmse_pcrlb_m"]);
+    assert_eq!(v["t_s"], single["t_s"]);
+    // The UKF within 10 % of the EKF on this easy study.
+    let (e, u) = (floats(&f["ekf"]["rmse_m"]), floats(&f["ukf"]["rmse_m"]));
+    assert!(
+        (u[20] - e[20]).abs() < 0.1 * e[20],
+        "{} vs {}",
+        u[20],
+        e[20]
+    );
+    // Determinism: same seed, same results.
+    assert_eq!(untimed(ok_json(&refs(&three))), untimed(v));
+}
+
+#[test]
+fn montecarlo_multi_filter_files_and_figure() {
+    let dir = TempDir::new();
+    let (js, svg) = (dir.path("mc.json"), dir.path("fig.svg"));
+    let a = tiny(&[
+        "--filters",
+        "ukf,ekf",
+        "--ukf-alpha",
+        "0.5",
+        "--json",
+        &js,
+        "--out",
+        &svg,
+    ]);
+    let summary = ok_json_line(&refs(&a));
+    assert_eq!(summary["trajectory"], "I");
+    let v = read_json(&js);
+    assert_eq!(keys(&v["filters"]).len(), 2);
+    // In the order asked.
+    let raw = std::fs::read_to_string(&js).unwrap();
+    assert!(raw.find("\"ukf\":{").unwrap() < raw.find("\"ekf\":{").unwrap());
+    let text = std::fs::read_to_string(&svg).unwrap();
+    assert!(text.starts_with("<svg") && text.contains("Scenario I"));
+    for label in ["UKF RMSE", "EKF RMSE", "UKF, EKF vs posterior CRLB"] {
+        assert!(text.contains(label), "{label}");
+    }
+    // ukf alone: no EKF curve at the top level.
+    let u = ok_json(&refs(&tiny(&["--filters", "ukf"])));
+    assert!(u.get("rmse_ekf_m").is_none() && u.get("nees").is_none());
+    assert_eq!(keys(&u["filters"]), ["ukf"]);
+}
+
+#[test]
+fn montecarlo_rejects_bad_filter_flags_naming_them() {
+    let cases: [(&[&str], &[&str]); 7] = [
+        (&["--filters", "ekf,kf"], &["--filters", "kf"]),
+        (&["--filters", ""], &["--filters"]),
+        (&["--filters", "ekf,ekf"], &["--filters", "twice"]),
+        (&["--filters", "pf", "--particles", "0"], &["--particles"]),
+        (&["--filters", "ukf", "--ukf-beta", "11"], &["--ukf-beta"]),
+        (&["--particles", "100"], &["--particles", "pf"]),
+        (
+            &["--filters", "pf", "--roughening", "-1"],
+            &["--roughening"],
+        ),
+    ];
+    for (extra, needles) in cases {
+        fails(&refs(&tiny(extra)), needles);
+    }
+}
+
+#[test]
+fn montecarlo_filters_sharded_and_merged_equal_the_whole_run() {
+    let dir = TempDir::new();
+    // 40 trajectories: 3 chunks of 16, split 2 + 1.
+    let study = [
+        "montecarlo",
+        "--trajectory",
+        "I",
+        "--runs",
+        "40",
+        "--noise-runs",
+        "2",
+        "--dt",
+        "0.1",
+        "--duration",
+        "1",
+        "--filters",
+        "ukf,pf,ekf",
+        "--particles",
+        "100",
+        "--roughening",
+        "0.2",
+    ];
+    let whole = dir.path("whole.json");
+    ok_json_line(&[&study[..], &["--json", &whole]].concat());
+    let (p0, p1, merged) = (dir.path("p0.json"), dir.path("p1.json"), dir.path("m.json"));
+    ok_json_line(&[&study[..], &["--shard", "0/2", "--json", &p0]].concat());
+    ok_json_line(&[&study[..], &["--shard", "1/2", "--json", &p1]].concat());
+    let part = read_json(&p0);
+    assert_eq!(
+        part["config"]["filters"]["names"],
+        json!(["ukf", "pf", "ekf"])
+    );
+    assert_eq!(part["sums"].as_array().unwrap().len(), 3);
+    ok_json_line(&["merge", "--json", &merged, &p1, &p0]);
+    let (a, b) = (untimed(read_json(&whole)), untimed(read_json(&merged)));
+    assert!(a.get("filters").is_some());
+    assert_eq!(a, b, "merged parts equal the unsharded run");
+}
+
+#[test]
+fn montecarlo_filters_ctrl_c_stops_without_writing_files() {
+    let dir = TempDir::new();
+    let js = dir.path("c.json");
+    let mut child = Command::new(BIN)
+        .args(["montecarlo", "--trajectory", "I", "--runs", "5000000"])
+        .args(["--noise-runs", "1", "--dt", "0.1", "--filters", "ukf,pf"])
+        .args(["--particles", "100", "--json", &js])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(Duration::from_millis(1500));
+    let kill = Command::new("sh")
+        .args(["-c", &format!("kill -INT {}", child.id())])
+        .status();
+    assert!(kill.unwrap().success());
+    let start = Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if start.elapsed() > Duration::from_secs(60) {
+            let _ = child.kill();
+            panic!("montecarlo did not stop after SIGINT");
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(130), "{err}");
+    assert!(out.stdout.is_empty());
+    assert!(err.contains("cancelled"), "{err}");
+    assert!(dir.files().is_empty(), "{:?}", dir.files());
+}
