@@ -13,6 +13,7 @@
 //! `P⁻` or `S` that is not positive definite, or a `P` that stops being so, is
 //! [`Error::NotPositiveDefinite`] and leaves the filter unchanged.
 
+use alloc::vec;
 use alloc::vec::Vec;
 
 use nalgebra::{Cholesky, DMatrix, DVector};
