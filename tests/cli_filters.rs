@@ -9,10 +9,9 @@ mod common;
 use scatterloc::{scenario::presets, Model, Vec2};
 use serde_json::{json, Value};
 
-use std::process::{Command, Stdio};
-use std::time::{Duration, Instant};
+use std::process::Command;
 
-use common::cli::{fails, floats, ok_json, ok_json_line, read_json, TempDir, BIN};
+use common::cli::{fails, floats, interrupted, ok_json, ok_json_line, read_json, TempDir, BIN};
 
 /// A straight path from (4, 1) at (1.4, 0.25) m/s sampled every 0.1 s.
 fn truth(n: usize) -> Vec2 {
@@ -333,28 +332,13 @@ fn montecarlo_filters_sharded_and_merged_equal_the_whole_run() {
 fn montecarlo_filters_ctrl_c_stops_without_writing_files() {
     let dir = TempDir::new();
     let js = dir.path("c.json");
-    let mut child = Command::new(BIN)
-        .args(["montecarlo", "--trajectory", "I", "--runs", "5000000"])
-        .args(["--noise-runs", "1", "--dt", "0.1", "--filters", "ukf,pf"])
-        .args(["--particles", "100", "--json", &js])
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    std::thread::sleep(Duration::from_millis(1500));
-    let kill = Command::new("sh")
-        .args(["-c", &format!("kill -INT {}", child.id())])
-        .status();
-    assert!(kill.unwrap().success());
-    let start = Instant::now();
-    while child.try_wait().unwrap().is_none() {
-        if start.elapsed() > Duration::from_secs(60) {
-            let _ = child.kill();
-            panic!("montecarlo did not stop after SIGINT");
-        }
-        std::thread::sleep(Duration::from_millis(50));
-    }
-    let out = child.wait_with_output().unwrap();
+    let out = interrupted(
+        Command::new(BIN)
+            .args(["montecarlo", "--trajectory", "I", "--runs", "5000000"])
+            .args(["--noise-runs", "1", "--dt", "0.1", "--filters", "ukf,pf"])
+            .args(["--particles", "100", "--json", &js]),
+        "montecarlo",
+    );
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(130), "{err}");
     assert!(out.stdout.is_empty());

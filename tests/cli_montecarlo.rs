@@ -5,12 +5,11 @@
 
 mod common;
 
-use std::process::{Command, Stdio};
-use std::time::{Duration, Instant};
+use std::process::Command;
 
 use serde_json::json;
 
-use common::cli::{floats, ok_json_line, read_json, TempDir, BIN, FAST};
+use common::cli::{floats, interrupted, ok_json_line, read_json, TempDir, BIN, FAST};
 
 #[test]
 fn montecarlo_fast_profile_writes_curves_and_figure() {
@@ -121,37 +120,20 @@ fn montecarlo_all_draws_three_panels() {
 fn ctrl_c_stops_without_writing_files() {
     let dir = TempDir::new();
     let (js, png) = (dir.path("c.json"), dir.path("c.png"));
-    let mut child = Command::new(BIN)
-        .args([
-            "montecarlo",
-            "--trajectory",
-            "I",
-            "--runs",
-            "5000000",
-            "--noise-runs",
-            "1",
-        ])
-        .args(["--dt", "0.1", "--json", &js, "--out", &png])
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    // Leave time to install the handler and start (a debug build, possibly a busy machine).
-    std::thread::sleep(Duration::from_millis(1500));
-    // SIGINT as Ctrl-C sends it (the shell's built-in kill: no extra package needed).
-    let kill = Command::new("sh")
-        .args(["-c", &format!("kill -INT {}", child.id())])
-        .status();
-    assert!(kill.unwrap().success());
-    let start = Instant::now();
-    while child.try_wait().unwrap().is_none() {
-        if start.elapsed() > Duration::from_secs(60) {
-            let _ = child.kill();
-            panic!("montecarlo did not stop after SIGINT");
-        }
-        std::thread::sleep(Duration::from_millis(50));
-    }
-    let out = child.wait_with_output().unwrap();
+    let out = interrupted(
+        Command::new(BIN)
+            .args([
+                "montecarlo",
+                "--trajectory",
+                "I",
+                "--runs",
+                "5000000",
+                "--noise-runs",
+                "1",
+            ])
+            .args(["--dt", "0.1", "--json", &js, "--out", &png]),
+        "montecarlo",
+    );
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(130), "{err}");
     assert!(out.stdout.is_empty());

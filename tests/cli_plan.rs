@@ -7,12 +7,11 @@
 
 mod common;
 
-use std::process::{Command, Stdio};
-use std::time::{Duration, Instant};
+use std::process::Command;
 
 use serde_json::Value;
 
-use common::cli::{fails, ok_json, ok_json_line, read_json, run, TempDir, BIN};
+use common::cli::{fails, interrupted, ok_json, ok_json_line, read_json, run, TempDir, BIN};
 use scatterloc::present::format_length_m;
 use scatterloc::scenario::presets;
 
@@ -587,8 +586,8 @@ fn ctrl_c_stops_without_writing_files() {
     let dir = TempDir::new();
     let s = preset_file(&dir);
     let (out, fig) = (dir.path("c.json"), dir.path("c.png"));
-    let mut child = Command::new(BIN)
-        .args(plan_args(
+    let out = interrupted(
+        Command::new(BIN).args(plan_args(
             &s,
             &out,
             &[
@@ -603,26 +602,9 @@ fn ctrl_c_stops_without_writing_files() {
                 "--figure",
                 &fig,
             ],
-        ))
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    // Leave time to install the handler and start (a debug build, possibly a busy machine).
-    std::thread::sleep(Duration::from_millis(1500));
-    let kill = Command::new("sh")
-        .args(["-c", &format!("kill -INT {}", child.id())])
-        .status();
-    assert!(kill.unwrap().success());
-    let start = Instant::now();
-    while child.try_wait().unwrap().is_none() {
-        if start.elapsed() > Duration::from_secs(60) {
-            let _ = child.kill();
-            panic!("plan did not stop after SIGINT");
-        }
-        std::thread::sleep(Duration::from_millis(50));
-    }
-    let out = child.wait_with_output().unwrap();
+        )),
+        "plan",
+    );
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(130), "{err}");
     assert!(out.stdout.is_empty());

@@ -8,11 +8,10 @@
 mod common;
 
 use std::process::{Child, Command, Output, Stdio};
-use std::time::{Duration, Instant};
 
 use serde_json::Value;
 
-use common::cli::{fails, fails_output, ok_json_line, read_json, TempDir, BIN};
+use common::cli::{fails, fails_output, interrupted, ok_json_line, read_json, TempDir, BIN};
 
 /// The fields that may differ between a merged and an unsharded result.
 const TIMING: [&str; 4] = [
@@ -529,26 +528,7 @@ fn ctrl_c_stops_a_sharded_run_without_writing_its_part() {
         "--json",
         &part,
     ];
-    let mut child = command(&args, &[])
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    // Leave time to install the handler and start (a debug build, possibly a busy machine).
-    std::thread::sleep(Duration::from_millis(1500));
-    let kill = Command::new("sh")
-        .args(["-c", &format!("kill -INT {}", child.id())])
-        .status();
-    assert!(kill.unwrap().success());
-    let start = Instant::now();
-    while child.try_wait().unwrap().is_none() {
-        if start.elapsed() > Duration::from_secs(60) {
-            let _ = child.kill();
-            panic!("the sharded run did not stop after SIGINT");
-        }
-        std::thread::sleep(Duration::from_millis(50));
-    }
-    let out = child.wait_with_output().unwrap();
+    let out = interrupted(&mut command(&args, &[]), "the sharded run");
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(130), "{err}");
     assert!(out.stdout.is_empty());

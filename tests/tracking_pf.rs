@@ -14,7 +14,7 @@ use scatterloc::track::{paper_initial_covariance, TrackScenario, TruthSampler};
 use scatterloc::track::{
     ConstantVelocity, Ekf, MeasurementNoise, ParticleFilter, PfConfig, Ukf, UkfParams,
 };
-use scatterloc::Error;
+use scatterloc::{Error, Model};
 
 fn pf(n: usize, mean: Vec4, cov: Mat4, seed: u64) -> ParticleFilter {
     ParticleFilter::new(
@@ -66,6 +66,27 @@ fn cloud_and_prediction_match_their_moments() {
     }
 }
 
+/// `−½ Σ_p (z_p − h_p(x_j))² / σ_p²` of every particle, σ_p at `r_pred` (spec §2), written out.
+fn log_likelihoods(
+    model: &Model,
+    particles: &[Vec4],
+    z: &[Option<Real>],
+    r_pred: Vec2,
+) -> Vec<Real> {
+    particles
+        .iter()
+        .map(|x| {
+            let r = Vec2::new(x[0], x[1]);
+            -0.5 * (0..z.len())
+                .map(|p| {
+                    let s = model.sigma_delay(p, r_pred);
+                    ((z[p].unwrap() - model.network.delay(p, r)) / s).powi(2)
+                })
+                .sum::<Real>()
+        })
+        .collect()
+}
+
 /// After one update, the weights are `∝ exp(−½ Σ (z − h(x_j))²/σ_p²)` (σ_p at the predicted
 /// mean), recomputed here from the particles; they sum to 1; the estimate is their weighted mean.
 #[test]
@@ -82,18 +103,7 @@ fn weights_are_the_gaussian_likelihood_normalised() {
         .update(&model, &z, MeasurementNoise::AtPrediction)
         .unwrap();
     assert_eq!(u.summary.links_used, 4);
-    let loglik: Vec<Real> = before
-        .iter()
-        .map(|x| {
-            let r = Vec2::new(x[0], x[1]);
-            -0.5 * (0..4)
-                .map(|p| {
-                    let s = model.sigma_delay(p, r_pred);
-                    ((z[p].unwrap() - model.network.delay(p, r)) / s).powi(2)
-                })
-                .sum::<Real>()
-        })
-        .collect();
+    let loglik = log_likelihoods(&model, &before, &z, r_pred);
     let max = loglik.iter().copied().fold(Real::NEG_INFINITY, Real::max);
     let w: Vec<Real> = loglik.iter().map(|l| (l - max).exp()).collect();
     let total: Real = w.iter().sum();
@@ -134,18 +144,7 @@ fn systematic_resampling_copies_in_proportion_to_the_weights() {
             u.resampled,
             "seed {seed}: a 10 cm prior against cm-level delays collapses"
         );
-        let loglik: Vec<Real> = before
-            .iter()
-            .map(|x| {
-                let r = Vec2::new(x[0], x[1]);
-                -0.5 * (0..4)
-                    .map(|p| {
-                        let s = model.sigma_delay(p, r_pred);
-                        ((z[p].unwrap() - model.network.delay(p, r)) / s).powi(2)
-                    })
-                    .sum::<Real>()
-            })
-            .collect();
+        let loglik = log_likelihoods(&model, &before, &z, r_pred);
         let max = loglik.iter().copied().fold(Real::NEG_INFINITY, Real::max);
         let total: Real = loglik.iter().map(|l| (l - max).exp()).sum();
         let n = before.len() as Real;

@@ -11,8 +11,8 @@ use crate::error::{Error, Result};
 use crate::math::Real;
 use crate::measure::Model;
 use crate::track::{
-    finish, pcrlb_from_sums, run_chunk, run_filter_chunk, run_truth_chunk, FilterKind,
-    MonteCarloConfig, MonteCarloResult, PartialSums, StudySums,
+    finish, pcrlb_from_sums, run_filter_chunk, run_truth_chunk, FilterKind, MonteCarloConfig,
+    MonteCarloResult, PartialSums, StudySums,
 };
 
 /// Runs the study on `threads` worker threads (0 = all cores). `on_progress(runs_done,
@@ -49,17 +49,14 @@ pub fn run_chunks_parallel(
     cancel: &AtomicBool,
     on_progress: impl FnMut(usize, usize),
 ) -> Result<StudySums> {
-    cfg.validate()?;
-    check_chunks(cfg, &chunks)?;
-    run_waves(
+    run_filter_chunks_parallel(
         model,
         cfg,
+        FilterKind::Ekf,
         chunks,
         threads,
         cancel,
         on_progress,
-        run_chunk,
-        cfg.noise_runs,
     )
 }
 
@@ -78,13 +75,7 @@ pub fn run_filter_chunks_parallel(
     cancel: &AtomicBool,
     on_progress: impl FnMut(usize, usize),
 ) -> Result<StudySums> {
-    match filter {
-        FilterKind::Ekf => {
-            return run_chunks_parallel(model, cfg, chunks, threads, cancel, on_progress)
-        }
-        FilterKind::Ukf(p) => p.validate()?,
-        FilterKind::Pf(c) => c.validate()?,
-    }
+    filter.validate()?;
     cfg.validate()?;
     check_chunks(cfg, &chunks)?;
     run_waves(

@@ -23,8 +23,9 @@ use rand::Rng as _;
 use crate::error::{check_len, Error, Result};
 use crate::math::portable::{exp, ln};
 use crate::math::{sqrt, Mat4, Real, Vec2, Vec4, SPEED_OF_LIGHT};
-use crate::measure::{standard_normal, Model, Rng};
+use crate::measure::{Model, Rng};
 use crate::track::ekf::{check_covariance, check_state, first_input_error};
+use crate::track::trajectory::normal4;
 use crate::track::{spd_quadratic_form, ConstantVelocity, MeasurementNoise, UpdateSummary};
 
 /// Most particles of a filter.
@@ -404,14 +405,4 @@ impl ParticleFilter {
 /// `1/Σ w_j²` of normalised weights.
 fn ess(weights: &[Real]) -> Real {
     1.0 / weights.iter().map(|w| w * w).sum::<Real>()
-}
-
-/// Four standard normals.
-fn normal4(rng: &mut Rng) -> Vec4 {
-    Vec4::new(
-        standard_normal(rng),
-        standard_normal(rng),
-        standard_normal(rng),
-        standard_normal(rng),
-    )
 }

@@ -139,7 +139,8 @@ impl TruthSampler {
     }
 }
 
-fn normal4(rng: &mut Rng) -> Vec4 {
+/// Four independent standard normals (a state-sized draw).
+pub(crate) fn normal4(rng: &mut Rng) -> Vec4 {
     Vec4::new(
         standard_normal(rng),
         standard_normal(rng),

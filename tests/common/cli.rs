@@ -3,8 +3,9 @@
 //! for bad input.
 
 use std::path::PathBuf;
-use std::process::{Command, Output};
+use std::process::{Command, Output, Stdio};
 use std::sync::atomic::{AtomicUsize, Ordering};
+use std::time::{Duration, Instant};
 
 use serde_json::Value;
 
@@ -116,4 +117,30 @@ pub fn read_json(path: &str) -> Value {
 pub fn floats(v: &Value) -> Vec<f64> {
     let a = v.as_array().unwrap_or_else(|| panic!("not an array: {v}"));
     a.iter().map(|x| x.as_f64().unwrap()).collect()
+}
+
+/// Starts `cmd` (stdout and stderr captured), sends it SIGINT as Ctrl-C does after 1.5 s (time
+/// to install the handler and start, in a debug build on a possibly busy machine; the shell's
+/// built-in `kill`, no extra package), waits up to 60 s for it to stop and returns its output.
+/// Panics, naming `what`, if it does not stop.
+pub fn interrupted(cmd: &mut Command, what: &str) -> Output {
+    let mut child = cmd
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("run scatterloc");
+    std::thread::sleep(Duration::from_millis(1500));
+    let kill = Command::new("sh")
+        .args(["-c", &format!("kill -INT {}", child.id())])
+        .status();
+    assert!(kill.unwrap().success());
+    let start = Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if start.elapsed() > Duration::from_secs(60) {
+            let _ = child.kill();
+            panic!("{what} did not stop after SIGINT");
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    child.wait_with_output().unwrap()
 }

@@ -38,6 +38,15 @@ impl FilterKind {
             FilterKind::Pf(_) => "pf",
         }
     }
+
+    /// Checks the filter's settings ([`UkfParams::validate`], [`PfConfig::validate`]).
+    pub fn validate(&self) -> Result<()> {
+        match self {
+            FilterKind::Ekf => Ok(()),
+            FilterKind::Ukf(p) => p.validate(),
+            FilterKind::Pf(c) => c.validate(),
+        }
+    }
 }
 
 /// Salt of the particle filters' own streams (particles, resampling), apart from the
@@ -210,14 +219,8 @@ pub fn run_filter_chunk(
     }
     let steps = cfg.steps;
     let sampler = TruthSampler::new(cfg.motion, cfg.mean_state, &cfg.initial_covariance)?;
-    // Validated once (a bad prior or bad settings fail the study, as for the EKF).
-    match filter {
-        FilterKind::Ukf(p) => {
-            Ukf::new(cfg.mean_state, cfg.initial_covariance, p)?;
-        }
-        FilterKind::Pf(c) => c.validate()?,
-        FilterKind::Ekf => {}
-    }
+    // Validated once (bad settings fail the study; a bad prior fails every run, as for the EKF).
+    filter.validate()?;
     let mut sums = PartialSums::new(steps);
     let mut s = Scratch::new(model, steps, true);
     for traj in chunk_range(cfg, chunk) {
