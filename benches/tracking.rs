@@ -294,10 +294,10 @@ fn benches(c: &mut Criterion) {
 /// first 256 snapshots of the 60 s loop at T = 0.1 s with 0.5 false alarms per link and
 /// snapshot (about 3.5 estimates per link); and the gating + association alone.
 fn gated_step(c: &mut Criterion) {
-    use scatterloc::gating::GatedTracker;
-    use scatterloc::gating::{default_channel, LoopPath};
-    use scatterloc::gating::{select, AssociationRule};
-    use scatterloc::gating::{Calibration, ClusterConfig};
+    use scatterloc::track::gating::GatedTracker;
+    use scatterloc::track::gating::{default_channel, LoopPath};
+    use scatterloc::track::gating::{select, AssociationRule};
+    use scatterloc::track::gating::{Calibration, ClusterConfig};
     let model = Model::new(&presets::sensors2019()).unwrap();
     let b = presets::sensors2019().radio.bandwidth_hz;
     let mut rng = measure::rng(SEED, 7);

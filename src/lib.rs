@@ -18,8 +18,8 @@
 //!   Levenberg–Marquardt fix (E5–E6).
 //! - [`track`]: the motion model (E7), the EKF (§6), the posterior CRLB (E9), trajectories and
 //!   the Monte Carlo study (§8, §9.5).
-//! - [`gating`]: calibration, 3σ gating (E4), association (§4), the gated tracker and the §9.6
-//!   stand-in.
+//! - [`track::gating`], a stage of tracking: calibration, 3σ gating (E4), association (§4), the
+//!   gated tracker and the §9.6 stand-in.
 //! - [`mtl`]: multi-target localization under correlated blocking (`multi-target.md`).
 //! - [`plan`]: network planning — move nodes to minimise a CRLB objective over a region
 //!   (CMA-ES with restarts, constraints).
@@ -39,7 +39,6 @@
 extern crate alloc;
 
 pub mod error;
-pub mod gating;
 pub mod localize;
 pub mod math;
 pub mod measure;

@@ -17,7 +17,6 @@ use proptest::prelude::*;
 use serde::Deserialize;
 use serde_json::Value;
 
-use scatterloc::gating::{Calibration, ClusterConfig};
 use scatterloc::localize::{crlb_at, crlb_map, locate, DelayMeasurements, Grid, LmConfig};
 use scatterloc::math::{Mat4, Vec2, Vec4};
 use scatterloc::mtl::algorithm::{locate as mtl_locate, MtlConfig};
@@ -26,6 +25,7 @@ use scatterloc::mtl::input::{from_json, target_reports, LocateRequest, ModelSpec
 use scatterloc::mtl::view::{mtl_view, MtlScene};
 use scatterloc::present::{simulate_snapshot, Session};
 use scatterloc::scenario::{parse_json, presets, Area, Scenario};
+use scatterloc::track::gating::{Calibration, ClusterConfig};
 use scatterloc::track::{ConstantVelocity, Ekf, MeasurementNoise};
 use scatterloc::{Error, Model};
 

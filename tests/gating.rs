@@ -7,12 +7,12 @@
 //! Every tolerance is derived next to its assertion (binomial Monte Carlo error, the sampling
 //! error of a calibrated σ̄); the runs are seeded, so each test is deterministic.
 
-use scatterloc::gating::StaticChannel;
-use scatterloc::gating::{default_channel, LoopPath};
-use scatterloc::gating::{select, AssociationRule, Choice};
-use scatterloc::gating::{start_from_snapshot, GatedTracker, START_SPEED_SIGMA_MPS};
-use scatterloc::gating::{Calibration, ClusterConfig, LinkCalibration, StaticCluster};
 use scatterloc::math::{erfc, sqrt, Real, Vec2, Vec4};
+use scatterloc::track::gating::StaticChannel;
+use scatterloc::track::gating::{default_channel, LoopPath};
+use scatterloc::track::gating::{select, AssociationRule, Choice};
+use scatterloc::track::gating::{start_from_snapshot, GatedTracker, START_SPEED_SIGMA_MPS};
+use scatterloc::track::gating::{Calibration, ClusterConfig, LinkCalibration, StaticCluster};
 use scatterloc::track::paper_initial_covariance;
 use scatterloc::track::ConstantVelocity;
 use scatterloc::track::{Ekf, MeasurementNoise};

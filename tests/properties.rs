@@ -457,7 +457,7 @@ proptest! {
             proptest::collection::vec(0.0..300e-9f64, 0..6), 1..40),
         seed in any::<u64>(),
     ) {
-        use scatterloc::gating::{ClusterConfig, LinkCalibration};
+        use scatterloc::track::gating::{ClusterConfig, LinkCalibration};
         let cfg = ClusterConfig::for_bandwidth(120e6).unwrap();
         let a = LinkCalibration::from_snapshots(0, &snaps, &cfg).unwrap();
         // A deterministic shuffle of the snapshots and of each snapshot's estimates.

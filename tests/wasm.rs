@@ -386,9 +386,9 @@ fn axis_ticks_are_bounded() {
 /// link gates its static paths and keeps the echo (spec §4).
 #[wasm_bindgen_test]
 fn gating_in_wasm() {
-    use scatterloc::gating::default_channel;
-    use scatterloc::gating::{select, AssociationRule, Choice};
-    use scatterloc::gating::{Calibration, ClusterConfig};
+    use scatterloc::track::gating::default_channel;
+    use scatterloc::track::gating::{select, AssociationRule, Choice};
+    use scatterloc::track::gating::{Calibration, ClusterConfig};
     let p = 1.0 - scatterloc::math::erfc(3.0 / 2f64.sqrt());
     assert!((p - 0.9973).abs() < 5e-5, "{p}");
     let model = Model::new(&presets::sensors2019()).unwrap();

@@ -6,6 +6,7 @@
 //! `native`, the page's worker) gives the same result.
 
 mod ekf;
+pub mod gating;
 mod montecarlo;
 mod motion;
 mod pcrlb;

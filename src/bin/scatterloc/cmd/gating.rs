@@ -6,8 +6,10 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use scatterloc::gating::{default_channel, LoopPath, LOOP_DURATION_S};
-use scatterloc::gating::{Calibration, ClusterConfig, LinkCalibration, MAX_CALIBRATION_SNAPSHOTS};
+use scatterloc::track::gating::{default_channel, LoopPath, LOOP_DURATION_S};
+use scatterloc::track::gating::{
+    Calibration, ClusterConfig, LinkCalibration, MAX_CALIBRATION_SNAPSHOTS,
+};
 use scatterloc::track::paper_initial_covariance;
 use scatterloc::track::ConstantVelocity;
 use scatterloc::{measure, Model};
@@ -217,7 +219,7 @@ pub fn simulate_walk(args: &SimulateWalkArgs) -> Result<(), CliError> {
     let mut rng = measure::rng(seed, 0);
     let cal_snaps = clean.calibration_snapshots(&model, ncal, &mut rng);
     let states = path.states(dt, steps);
-    let raw = |snap: Vec<Vec<scatterloc::gating::DelayEstimate>>| -> RawStep {
+    let raw = |snap: Vec<Vec<scatterloc::track::gating::DelayEstimate>>| -> RawStep {
         snap.iter()
             .map(|l| l.iter().map(|e| [e.delay_s, e.amplitude]).collect())
             .collect()

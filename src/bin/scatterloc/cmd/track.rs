@@ -8,12 +8,12 @@
 
 use serde::{Deserialize, Serialize};
 
-use scatterloc::gating::Calibration;
-use scatterloc::gating::{start_from_snapshot, GatedTracker, START_SPEED_SIGMA_MPS};
-use scatterloc::gating::{AssociationRule, Choice, DelayEstimate};
 use scatterloc::math::{Mat4, Vec4};
 use scatterloc::measure::rng;
 use scatterloc::scenario::Area;
+use scatterloc::track::gating::Calibration;
+use scatterloc::track::gating::{start_from_snapshot, GatedTracker, START_SPEED_SIGMA_MPS};
+use scatterloc::track::gating::{AssociationRule, Choice, DelayEstimate};
 use scatterloc::track::ConstantVelocity;
 use scatterloc::track::MAX_STEPS;
 use scatterloc::track::{Ekf, FilterKind, MeasurementNoise, UpdateSummary};

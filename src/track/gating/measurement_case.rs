@@ -1,14 +1,14 @@
 //! The synthetic stand-in for the measurement case of [S] §5.3 (spec §9.6 **[choice]**): a
 //! pedestrian walking a 60 s loop (circle of radius 8 m about (12, 6) m at 1.4 m/s) through
 //! layout L4, observed through a static channel (the LoS and static reflectors, see
-//! [`crate::gating`]), so that links drop out where the echo falls in the blind zone of a
+//! [`crate::track::gating`]), so that links drop out where the echo falls in the blind zone of a
 //! static path (`cΔτ_p < c/B`) and the delays carry the noise of (E8).
 
 use alloc::vec::Vec;
 
 use crate::error::{Error, Result};
-use crate::gating::StaticChannel;
 use crate::math::{cos, sin, Real, Vec2, Vec4};
+use crate::track::gating::StaticChannel;
 
 /// Duration of the loop walk, s (spec §9.6).
 pub const LOOP_DURATION_S: Real = 60.0;

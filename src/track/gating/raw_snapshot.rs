@@ -6,7 +6,7 @@
 //! resolve it, the link drops out), and uniformly drawn false alarms of unit amplitude.
 //!
 //! This stands in for KEST on measured channel sounder data, which is outside this crate; it is
-//! what the gating and association of [`crate::gating`] are tested on.
+//! what the gating and association of [`crate::track::gating`] are tested on.
 
 use alloc::vec::Vec;
 
@@ -14,10 +14,10 @@ use rand::Rng as _;
 use rand_distr::{Distribution, Poisson};
 
 use crate::error::{Error, Result};
-use crate::gating::DelayEstimate;
 use crate::math::{sqrt, Real, Vec2};
 use crate::measure::Model;
 use crate::measure::{standard_normal, Rng};
+use crate::track::gating::DelayEstimate;
 
 /// Largest mean number of false alarms per link and snapshot accepted.
 pub const MAX_FALSE_ALARMS: Real = 100.0;
@@ -135,7 +135,7 @@ impl StaticChannel {
     }
 
     /// `count` calibration snapshots of the empty area as delays only (`[k][p]` = link `p`'s
-    /// delays in snapshot `k`), as [`crate::gating::Calibration::from_snapshots`] takes them.
+    /// delays in snapshot `k`), as [`crate::track::gating::Calibration::from_snapshots`] takes them.
     pub fn calibration_snapshots(
         &self,
         model: &Model,

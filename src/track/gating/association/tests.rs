@@ -1,6 +1,6 @@
 use super::AssociationRule::{Gated, Spec};
 use super::*;
-use crate::gating::{LinkCalibration, StaticCluster};
+use crate::track::gating::{LinkCalibration, StaticCluster};
 use alloc::vec;
 
 fn est(delay_ns: Real, amplitude: Real) -> DelayEstimate {

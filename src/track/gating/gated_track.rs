@@ -11,12 +11,12 @@
 use alloc::vec::Vec;
 
 use crate::error::{Error, Result};
-use crate::gating::Calibration;
-use crate::gating::{select, AssociationRule, DelayEstimate, Selection};
 use crate::localize::{locate, DelayMeasurements, LmConfig, LmReport};
 use crate::math::{Mat4, Real, Vec4};
 use crate::measure::Model;
 use crate::scenario::Area;
+use crate::track::gating::Calibration;
+use crate::track::gating::{select, AssociationRule, DelayEstimate, Selection};
 use crate::track::ConstantVelocity;
 use crate::track::{Ekf, MeasurementNoise, UpdateSummary};
 

@@ -14,8 +14,8 @@ use alloc::format;
 use alloc::vec::Vec;
 
 use crate::error::{check_len, limits, Error, Result};
-use crate::gating::Calibration;
 use crate::math::Real;
+use crate::track::gating::Calibration;
 use crate::track::PredictedDelay;
 
 /// Gate on the normalised innovation of the nearest candidate (spec §4).
