@@ -75,7 +75,7 @@ pub fn sigma_delay_from_snr(beta2: Real, snr: Real) -> Real {
 impl Model {
     /// Validates and compiles a scenario.
     pub fn new(s: &Scenario) -> Result<Model> {
-        Model::compile(s, |t| TxPattern::new(t.gain_dbi, &t.pattern))
+        Model::compile(s, |_, t| TxPattern::new(t.gain_dbi, &t.pattern))
     }
 
     /// [`Model::new`] for `s`, an edit of `previous` (compiled as `self`): a transmitter whose
@@ -85,11 +85,17 @@ impl Model {
     /// equal to `Model::new(s)` (compiling is deterministic; tested).
     /// A pattern that differs only in its boresight is turned ([`TxPattern::set_boresight_deg`]).
     pub fn recompile(&self, previous: &Scenario, s: &Scenario) -> Result<Model> {
-        Model::compile(s, |t| {
+        Model::compile(s, |i, t| {
             let same = |p: &&Transmitter| p.gain_dbi == t.gain_dbi && p.pattern == t.pattern;
             let turned =
                 |p: &&Transmitter| p.gain_dbi == t.gain_dbi && same_beam(&p.pattern, &t.pattern);
-            let pairs = || previous.transmitters.iter().zip(&self.patterns);
+            // The transmitter at the same index first: an edit of one node finds every other
+            // pattern there at once (no search over large networks).
+            let at_i = previous.transmitters.get(i).zip(self.patterns.get(i));
+            let pairs = || {
+                at_i.into_iter()
+                    .chain(previous.transmitters.iter().zip(&self.patterns))
+            };
             if let Some((_, c)) = pairs().find(|(p, _)| same(p)) {
                 return c.clone();
             }
@@ -104,7 +110,7 @@ impl Model {
         })
     }
 
-    fn compile(s: &Scenario, pattern: impl Fn(&Transmitter) -> TxPattern) -> Result<Model> {
+    fn compile(s: &Scenario, pattern: impl Fn(usize, &Transmitter) -> TxPattern) -> Result<Model> {
         s.validate()?;
         let links = s.link_indices()?;
         let pn = noise_power_w(&s.radio);
@@ -139,7 +145,12 @@ impl Model {
                     .collect(),
                 links,
             },
-            patterns: s.transmitters.iter().map(pattern).collect(),
+            patterns: s
+                .transmitters
+                .iter()
+                .enumerate()
+                .map(|(i, t)| pattern(i, t))
+                .collect(),
             snr_scale,
             beta2: s.radio.bandwidth_hz * s.radio.bandwidth_hz / 12.0,
             noise_power_w: pn,
