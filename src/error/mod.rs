@@ -186,6 +186,13 @@ pub enum Error {
         /// The kind given.
         kind: String,
     },
+    /// A tracker name that is not known (`ekf`, `ukf`, `pf`; issue 15).
+    UnknownFilter {
+        /// Path of the field, e.g. `filters[1]`.
+        field: String,
+        /// The name given.
+        name: String,
+    },
 }
 
 impl fmt::Display for Error {
@@ -317,6 +324,11 @@ impl fmt::Display for Error {
                 f,
                 "{field}: unknown pattern \"{}\" (known: omni, parabolic)",
                 Clip(kind)
+            ),
+            Error::UnknownFilter { field, name } => write!(
+                f,
+                "{field}: unknown filter \"{}\" (known: ekf, ukf, pf)",
+                Clip(name)
             ),
         }
     }

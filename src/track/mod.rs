@@ -6,6 +6,7 @@
 //! `native`, the page's worker) gives the same result.
 
 mod ekf;
+mod filter;
 pub mod gating;
 mod montecarlo;
 mod motion;
@@ -17,9 +18,10 @@ mod ukf;
 
 pub use ekf::{check_covariance, Ekf, MeasurementNoise, PredictedDelay, UpdateSummary};
 pub(crate) use ekf::{range_information_per_snr, spd_quadratic_form, update_lanes, NodeView};
+pub use filter::{FilterKind, Tracker};
 pub use montecarlo::{
     finish, pcrlb_from_sums, run_chunk, run_filter_chunk, run_pcrlb_sequential, run_sequential,
-    run_truth_chunk, FilterKind, MonteCarloConfig, MonteCarloResult, PartialSums, StudySums,
+    run_truth_chunk, MonteCarloConfig, MonteCarloResult, PartialSums, StudySums,
     CHUNK_TRAJECTORIES, MAX_RUNS, MAX_STEPS,
 };
 pub use motion::ConstantVelocity;

@@ -1,6 +1,7 @@
 //! One simulated tracking run for display and examples: a truth trajectory from the prior
-//! (E7), noisy delays with `σ_p` from the link budget at the truth (E2, E8), and the EKF track
-//! (§6) with its covariance and NIS at every step.
+//! (E7), noisy delays with `σ_p` from the link budget at the truth (E2, E8), and the track of
+//! any [`FilterKind`] — the EKF (§6), the UKF or the particle filter — with its covariance and
+//! NIS at every step.
 
 use alloc::vec::Vec;
 
@@ -10,7 +11,7 @@ use crate::measure::Model;
 use crate::measure::{rng, standard_normal};
 use crate::track::ConstantVelocity;
 use crate::track::TruthSampler;
-use crate::track::{Ekf, MeasurementNoise};
+use crate::track::{FilterKind, MeasurementNoise, Tracker};
 
 /// A simulated run, `steps + 1` entries per series (`t₀ … t_steps`; no measurement at `t₀`).
 #[derive(Debug, Clone, PartialEq)]
@@ -23,9 +24,9 @@ pub struct TrackRun {
     pub delays_s: Vec<Vec<Real>>,
     /// `σ_p` at the truth per step, s (empty at `t₀`).
     pub sigmas_s: Vec<Vec<Real>>,
-    /// EKF estimates.
+    /// The filter's estimates.
     pub estimates: Vec<Vec4>,
-    /// EKF covariances.
+    /// The filter's covariances.
     pub covariances: Vec<Mat4>,
     /// NIS per step (0 at `t₀`).
     pub nis: Vec<Real>,
@@ -33,9 +34,10 @@ pub struct TrackRun {
     pub failed_at: Option<usize>,
 }
 
-/// Simulates one run. Truth `x(t₀) ~ 𝒩(mean, P₀)` (stream `rng(seed, 0)`), measurement noise
-/// from stream `rng(seed, 1)`; the EKF starts at `mean`, `P₀` and uses `R` at the predicted
-/// position (spec §6, §9.5).
+/// Simulates one run of `filter`. Truth `x(t₀) ~ 𝒩(mean, P₀)` (stream `rng(seed, 0)`),
+/// measurement noise from stream `rng(seed, 1)`, so every filter sees the same truth and
+/// delays for one seed; a particle filter draws its particles from `rng(seed, 2)`. The filter
+/// starts at `mean`, `P₀` and uses `R` at the predicted position (spec §6, §9.5).
 pub fn simulate_track(
     model: &Model,
     motion: &ConstantVelocity,
@@ -43,12 +45,13 @@ pub fn simulate_track(
     initial_covariance: &Mat4,
     steps: usize,
     seed: u64,
+    filter: FilterKind,
 ) -> Result<TrackRun> {
     let sampler = TruthSampler::new(*motion, *mean, initial_covariance)?;
     let mut truth = Vec::with_capacity(steps + 1);
     sampler.sample(steps, &mut rng(seed, 0), &mut truth);
     let mut noise = rng(seed, 1);
-    let mut ekf = Ekf::new(*mean, *initial_covariance)?;
+    let mut tracker = Tracker::new(filter, *mean, *initial_covariance, rng(seed, 2))?;
     let links = model.link_count();
     let mut run = TrackRun {
         t_s: Vec::with_capacity(steps + 1),
@@ -71,8 +74,8 @@ pub fn simulate_track(
                 .collect();
             z.clear();
             z.extend(delays.iter().map(|d| Some(*d)));
-            ekf.predict(motion);
-            match ekf.update(model, &z, MeasurementNoise::AtPrediction, None) {
+            tracker.predict(motion);
+            match tracker.update(model, &z, MeasurementNoise::AtPrediction) {
                 Ok(s) => nis = s.nis,
                 Err(_) => {
                     run.failed_at = Some(n);
@@ -84,8 +87,8 @@ pub fn simulate_track(
         run.truth.push(*x);
         run.delays_s.push(delays);
         run.sigmas_s.push(sigmas);
-        run.estimates.push(ekf.state);
-        run.covariances.push(ekf.covariance);
+        run.estimates.push(*tracker.state());
+        run.covariances.push(*tracker.covariance());
         run.nis.push(nis);
     }
     Ok(run)

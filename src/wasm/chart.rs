@@ -1,5 +1,6 @@
-//! The tracking chart on a `<canvas>`: [`draw_tracking_rmse`] (plotters) through
-//! `plotters-canvas`, fed with a `MonteCarloJob.result_json()` text.
+//! The tracking chart on a `<canvas>`: [`draw_tracking_filters`] (plotters) through
+//! `plotters-canvas`, fed with a `MonteCarloJob.result_json()` text — one RMSE curve per
+//! tracker of the result next to the PCRLB, as the CLI's `montecarlo --filters` figure.
 
 use plotters::prelude::IntoDrawingArea;
 use plotters_canvas::CanvasBackend;
@@ -7,25 +8,47 @@ use serde::Deserialize;
 use wasm_bindgen::prelude::*;
 use web_sys::HtmlCanvasElement;
 
-use crate::chart::{draw_tracking_rmse, TrackingChartOptions, TrackingPanel};
+use crate::chart::{draw_tracking_filters, FilterCurve, FiltersPanel, TrackingChartOptions};
 use crate::error::Error;
+
+/// One tracker's curve in a result (other keys are ignored; `null` is a gap).
+#[derive(Deserialize)]
+struct FilterRmse {
+    rmse_m: Vec<Option<f64>>,
+    runs: usize,
+}
 
 /// The curves read from a result (other keys are ignored; `null` is a gap).
 #[derive(Deserialize, Default)]
 struct Curves {
     t_s: Vec<f64>,
+    #[serde(default)]
     rmse_ekf_m: Vec<Option<f64>>,
     rmse_pcrlb_m: Vec<Option<f64>>,
+    #[serde(default)]
+    filters: Option<serde_json::Map<String, serde_json::Value>>,
+    #[serde(default)]
+    particles: Option<usize>,
+}
+
+/// The legend label of filter `name`: `EKF RMSE`, `PF RMSE (192 runs × 1000 particles)`.
+fn label(name: &str, runs: usize, particles: Option<usize>) -> String {
+    let upper = name.to_uppercase();
+    match (name, particles) {
+        ("pf", Some(n)) => format!("{upper} RMSE ({runs} runs × {n} particles)"),
+        _ => format!("{upper} RMSE"),
+    }
 }
 
 fn drawable(v: &Option<f64>) -> bool {
     v.is_some_and(|v| v.is_finite() && v > 0.0)
 }
 
-/// Draws ε_EKF(t) (solid) and ε_PCRLB(t) (dashed) from `result_json` (a Monte Carlo result;
-/// `""` draws empty axes) onto `canvas` at its pixel size, with a figure `title`, optional
-/// `subtitle` and a panel `caption`. Returns how many curves were drawn (0 … 2). Throws on
-/// malformed JSON or a drawing failure.
+/// Draws each tracker's RMSE (solid, one colour per filter, in the order EKF, UKF, PF;
+/// a result without `filters` draws `rmse_ekf_m` as the EKF's) and ε_PCRLB(t) (dashed) from
+/// `result_json` (a Monte Carlo result; `""` draws empty axes) onto `canvas` at its pixel size,
+/// with a figure `title`, optional `subtitle` and a panel `caption`. Returns how many curves were
+/// drawn (0 … filters + 1). Throws on malformed JSON or a drawing failure.
 #[wasm_bindgen]
 pub fn draw_tracking_chart(
     canvas: HtmlCanvasElement,
@@ -43,14 +66,40 @@ pub fn draw_tracking_chart(
             })
         })?
     };
-    let ekf: Vec<f64> = c.rmse_ekf_m.iter().map(|v| v.unwrap_or(f64::NAN)).collect();
+    let parse = |e: serde_json::Error| {
+        super::err(Error::Parse {
+            message: e.to_string(),
+        })
+    };
+    let series: Vec<(String, Vec<Option<f64>>)> = match c.filters {
+        // In a fixed order (the first curve takes the EKF's blue), whatever the map's order.
+        Some(mut map) if !map.is_empty() => ["ekf", "ukf", "pf"]
+            .into_iter()
+            .filter_map(|name| map.remove(name).map(|v| (name, v)))
+            .map(|(name, v)| {
+                let f: FilterRmse = serde_json::from_value(v).map_err(parse)?;
+                Ok((label(name, f.runs, c.particles), f.rmse_m))
+            })
+            .collect::<Result<_, JsError>>()?,
+        _ if c.rmse_ekf_m.is_empty() => Vec::new(),
+        _ => vec![(label("ekf", 0, None), c.rmse_ekf_m)],
+    };
+    let values: Vec<Vec<f64>> = series
+        .iter()
+        .map(|(_, v)| v.iter().map(|x| x.unwrap_or(f64::NAN)).collect())
+        .collect();
+    let curves: Vec<FilterCurve> = series
+        .iter()
+        .zip(&values)
+        .map(|((label, _), v)| FilterCurve { label, rmse_m: v })
+        .collect();
     let root = CanvasBackend::with_canvas_object(canvas)
         .ok_or_else(|| JsError::new("chart: the canvas has no 2-D context"))?
         .into_drawing_area();
-    let panel = TrackingPanel {
+    let panel = FiltersPanel {
         title: caption,
         t_s: &c.t_s,
-        rmse_ekf_m: &ekf,
+        curves: &curves,
         rmse_pcrlb_m: &c.rmse_pcrlb_m,
     };
     let opts = TrackingChartOptions {
@@ -58,11 +107,11 @@ pub fn draw_tracking_chart(
         subtitle: (!subtitle.is_empty()).then(|| subtitle.to_string()),
     };
     let js = |e: &dyn core::fmt::Display| JsError::new(&e.to_string());
-    draw_tracking_rmse(&root, &[panel], &opts).map_err(|e| js(&e))?;
+    draw_tracking_filters(&root, &[panel], &opts).map_err(|e| js(&e))?;
     root.present().map_err(|e| js(&e))?;
-    let series = [
-        c.rmse_ekf_m.iter().any(drawable),
-        c.rmse_pcrlb_m.iter().any(drawable),
-    ];
-    Ok(series.iter().filter(|s| **s).count() as u32)
+    let drawn = series
+        .iter()
+        .filter(|(_, v)| v.iter().any(drawable))
+        .count();
+    Ok((drawn + usize::from(c.rmse_pcrlb_m.iter().any(drawable))) as u32)
 }

@@ -16,7 +16,7 @@ use crate::present::Session;
 use crate::present::{format_length_m, Tick};
 use crate::present::{LinkSim, SnapshotFix, SnapshotSimulation};
 use crate::present::{TrackEstimate, TrackFrame};
-use crate::track::{MonteCarloConfig, MonteCarloResult, TrackRun};
+use crate::track::{FilterKind, MonteCarloConfig, MonteCarloResult, TrackRun};
 use crate::{Model, Scenario, Vec2};
 
 /// `v` as JSON text. serde_json writes non-finite numbers as `null`, so no NaN reaches
@@ -351,6 +351,8 @@ impl<'a> FrameJs<'a> {
 #[derive(Serialize)]
 pub(super) struct TrackDataJs<'a> {
     kind: &'a str,
+    filter: &'static str,
+    particles: Option<usize>,
     seed: u32,
     steps: usize,
     dt_s: Option<Real>,
@@ -368,9 +370,10 @@ pub(super) struct TrackDataJs<'a> {
 }
 
 impl<'a> TrackDataJs<'a> {
-    /// The run `run` (simulated on `model`) with its estimates `est` (one per entry).
+    /// The run `run` of `filter` (simulated on `model`) with its estimates `est` (one per entry).
     pub(super) fn new(
         kind: &'a str,
+        filter: FilterKind,
         seed: u32,
         steps: usize,
         run: &'a TrackRun,
@@ -380,6 +383,11 @@ impl<'a> TrackDataJs<'a> {
         let net = &model.network;
         TrackDataJs {
             kind,
+            filter: filter.name(),
+            particles: match filter {
+                FilterKind::Pf(c) => Some(c.particles),
+                _ => None,
+            },
             seed,
             steps,
             dt_s: run.t_s.get(1).copied(),
@@ -407,7 +415,9 @@ impl<'a> TrackDataJs<'a> {
 
 /// A Monte Carlo result so far: the core's curves `{t_s, rmse_ekf_m, rmse_pcrlb_m, nees, runs,
 /// failed_runs, seed}` ([`MonteCarloResult`]) plus the study's set-up and progress
-/// `{trajectories, noise_runs, trajectories_done, steps, dt_s, chunks_done, chunk_count, done}`.
+/// `{trajectories, noise_runs, trajectories_done, steps, dt_s, chunks_done, chunk_count, done}`,
+/// each tracker's curves `filters: {name: {..}}` and the particle filter's `particles` and
+/// `particle_budget` (null without it).
 #[derive(Serialize)]
 pub(super) struct MonteCarloJs<'a> {
     #[serde(flatten)]
@@ -420,16 +430,50 @@ pub(super) struct MonteCarloJs<'a> {
     chunks_done: usize,
     chunk_count: usize,
     done: bool,
+    #[serde(serialize_with = "filter_map")]
+    filters: Vec<FilterCurvesJs<'a>>,
+    particles: Option<usize>,
+    particle_budget: Option<usize>,
+}
+
+/// One tracker's curves in a [`MonteCarloJs`]: `{rmse_m, nees, runs, failed_runs, chunks_done,
+/// chunk_count, runs_planned}`, keyed by `name`.
+#[derive(Serialize)]
+pub(super) struct FilterCurvesJs<'a> {
+    #[serde(skip)]
+    pub(super) name: &'static str,
+    pub(super) rmse_m: &'a [Real],
+    pub(super) nees: &'a [Real],
+    pub(super) runs: usize,
+    pub(super) failed_runs: usize,
+    pub(super) chunks_done: usize,
+    pub(super) chunk_count: usize,
+    pub(super) runs_planned: usize,
+}
+
+/// The filters as a JSON object in their order.
+fn filter_map<S: serde::Serializer>(f: &[FilterCurvesJs], s: S) -> Result<S::Ok, S::Error> {
+    use serde::ser::SerializeMap;
+    let mut map = s.serialize_map(Some(f.len()))?;
+    for c in f {
+        map.serialize_entry(c.name, c)?;
+    }
+    map.end()
 }
 
 impl<'a> MonteCarloJs<'a> {
-    /// `curves` of the study `cfg` after `chunks_done` chunks covering `trajectories_done`
-    /// trajectories.
+    /// `curves` of the study `cfg` after `chunks_done` of `chunk_count` work items, the lead
+    /// filter's covering `trajectories_done` trajectories, with every filter's curves.
+    #[allow(clippy::too_many_arguments)]
     pub(super) fn new(
         curves: &'a MonteCarloResult,
         cfg: &MonteCarloConfig,
         trajectories_done: usize,
         chunks_done: usize,
+        chunk_count: usize,
+        filters: Vec<FilterCurvesJs<'a>>,
+        particles: Option<usize>,
+        particle_budget: Option<usize>,
     ) -> MonteCarloJs<'a> {
         MonteCarloJs {
             curves,
@@ -439,8 +483,11 @@ impl<'a> MonteCarloJs<'a> {
             steps: cfg.steps,
             dt_s: cfg.motion.dt_s,
             chunks_done,
-            chunk_count: cfg.chunk_count(),
-            done: chunks_done >= cfg.chunk_count(),
+            chunk_count,
+            done: chunks_done >= chunk_count,
+            filters,
+            particles,
+            particle_budget,
         }
     }
 }

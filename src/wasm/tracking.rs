@@ -1,6 +1,7 @@
 //! Tracking for the page's animation: `App::simulate_track` runs the core's
-//! [`simulate_track`] (truth, noisy delays, EKF) and hands back a [`Track`], whose `data()` is
-//! the whole run and `frame(n)` one step shaped like a snapshot ([`crate::present`]).
+//! [`simulate_track`] (truth, noisy delays, and the EKF, UKF or particle filter) and hands back a
+//! [`Track`], whose `data()` is the whole run and `frame(n)` one step shaped like a snapshot
+//! ([`crate::present`]).
 
 use wasm_bindgen::prelude::*;
 
@@ -9,14 +10,28 @@ use super::{err, App};
 use crate::error::Error;
 use crate::math::{Real, Vec2, Vec4};
 use crate::present::{track_estimate, track_frame, track_mean_state, velocity_through};
-use crate::track::ConstantVelocity;
 use crate::track::{paper_initial_covariance, step_count, PAPER_INTENSITY};
 use crate::track::{simulate_track, TrackRun};
+use crate::track::{ConstantVelocity, FilterKind, PfConfig, UkfParams};
 use crate::{Model, Scenario};
 
 /// Most steps of one simulated track or browser Monte Carlo study (keeps the JSON and the
 /// worker's memory bounded; 10 s at 1 ms).
 pub const MAX_TRACK_STEPS: usize = 10_000;
+
+/// Most particle-steps (`steps × particles`) of one animated particle-filter track: it runs on
+/// the page's main thread (about 1 s in Chromium on a 2020s laptop core).
+pub const MAX_TRACK_PARTICLE_STEPS: usize = 10_000_000;
+
+/// The tracker `name` of the page (`ekf`, `ukf` with the default α, β, κ, `pf` with
+/// `particles` particles), named in errors as `field`.
+pub(super) fn page_filter(field: &str, name: &str, particles: usize) -> crate::Result<FilterKind> {
+    let pf = PfConfig {
+        particles,
+        roughening: None,
+    };
+    FilterKind::named(field, name, UkfParams::default(), pf)
+}
 
 /// `steps` within `1..=MAX_TRACK_STEPS`, else [`Error::SizeLimit`] naming `steps`.
 pub(super) fn checked_steps(steps: usize) -> crate::Result<usize> {
@@ -52,6 +67,7 @@ pub struct Track {
     kind: String,
     seed: u32,
     steps: usize,
+    filter: FilterKind,
 }
 
 #[wasm_bindgen]
@@ -59,7 +75,10 @@ impl App {
     /// Simulates one track ([`simulate_track`]): trajectory `kind` = `"I"`, `"II"`, `"III"`
     /// (spec §9.4; `x0 … vy` ignored) or `"custom"` (prior mean start `(x0, y0)` m, velocity
     /// `(vx, vy)` m/s), `P(t₀)` and `q̃` of §9.5, step `dt_s`, `steps` steps (1 … 10 000),
-    /// noise streams from `seed`. The EKF starts at the prior mean. Throws on bad input.
+    /// noise streams from `seed`, tracked by `filter` (`ekf`, `ukf`, or `pf` with `particles`
+    /// particles; `steps × particles` at most [`MAX_TRACK_PARTICLE_STEPS`]). Every filter sees
+    /// the same truth and delays for one seed. The filter starts at the prior mean. Throws on
+    /// bad input.
     #[allow(clippy::too_many_arguments)]
     pub fn simulate_track(
         &self,
@@ -71,13 +90,32 @@ impl App {
         dt_s: f64,
         steps: usize,
         seed: u32,
+        filter: &str,
+        particles: usize,
     ) -> Result<Track, JsError> {
         let (mean, motion) = prior_and_motion(kind, [x0, y0, vx, vy], dt_s).map_err(err)?;
         let steps = checked_steps(steps).map_err(err)?;
+        let tracker = page_filter("filter", filter, particles).map_err(err)?;
+        if matches!(tracker, FilterKind::Pf(_))
+            && steps.saturating_mul(particles) > MAX_TRACK_PARTICLE_STEPS
+        {
+            return Err(err(Error::WorkLimit {
+                field: "particles × steps".into(),
+                limit: MAX_TRACK_PARTICLE_STEPS,
+            }));
+        }
         let session = self.session();
         let p0 = paper_initial_covariance();
-        let run = simulate_track(session.model(), &motion, &mean, &p0, steps, seed.into())
-            .map_err(err)?;
+        let run = simulate_track(
+            session.model(),
+            &motion,
+            &mean,
+            &p0,
+            steps,
+            seed.into(),
+            tracker,
+        )
+        .map_err(err)?;
         Ok(Track {
             scenario: session.scenario().clone(),
             model: session.model().clone(),
@@ -85,6 +123,7 @@ impl App {
             kind: kind.to_string(),
             seed,
             steps,
+            filter: tracker,
         })
     }
 }
@@ -96,7 +135,8 @@ impl Track {
         self.run.truth.len()
     }
 
-    /// The whole run: `{kind, seed, steps, dt_s, failed_at, t_s: [..], truth: [[x, y], ..],
+    /// The whole run: `{kind, filter ("ekf" | "ukf" | "pf"), particles (null but for the
+    /// particle filter), seed, steps, dt_s, failed_at, t_s: [..], truth: [[x, y], ..],
     /// estimates: [[x, y, vx, vy], ..], ellipses: [1σ position ellipse of P | null, ..],
     /// sigma_m: [√(Pxx+Pyy), ..], error_m: [..], nis: [..], measurements: [[iso-delay ellipse
     /// per link | null], ..] (empty at t₀)}`.
@@ -108,6 +148,7 @@ impl Track {
             .map_err(err)?;
         to_js(&TrackDataJs::new(
             &self.kind,
+            self.filter,
             self.seed,
             self.steps,
             run,
@@ -116,7 +157,7 @@ impl Track {
         ))
     }
 
-    /// Step `n` shaped like `App.simulate_fix`'s snapshot (`fix` is the EKF estimate: `{x, y,
+    /// Step `n` shaped like `App.simulate_fix`'s snapshot (`fix` is the filter's estimate: `{x, y,
     /// vx, vy, ellipse, error_m, error_label, sigma_m, sigma_label, nis}`), plus `step`, `t_s`
     /// and the truth's velocity. Throws for a step past the end.
     pub fn frame(&self, n: usize) -> Result<JsValue, JsError> {

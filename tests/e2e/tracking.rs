@@ -358,3 +358,174 @@ fn tracking_scenario_ii_plays_and_monte_carlo_restarts_on_drag() {
     println!("e2e: browser vs native Monte Carlo: max relative difference {worst:e}");
     assert!(worst < 1e-9, "browser vs native: {worst:e}");
 }
+
+/// What the filters test saw in the page.
+struct FiltersOutcome {
+    /// State after the animated track switched to the particle filter.
+    pf_track: Value,
+    /// That track's `failed_at`, `filter`, `particles` and entries.
+    pf_data: Value,
+    /// State once the three-filter study finished, its parameters and its result.
+    done: Value,
+    params: Value,
+    result: Value,
+    errors: Vec<String>,
+}
+
+async fn select(c: &Client, id: &str, value: &str) -> Result<(), String> {
+    let e = c.find(Locator::Id(id)).await.map_err(|e| e.to_string())?;
+    e.select_by_value(value).await.map_err(|e| e.to_string())
+}
+
+async fn three_filters(c: &Client, port: u16) -> Result<FiltersOutcome, String> {
+    open(c, port).await?;
+    settle(c).await?;
+    click(c, "mode-tracking").await?;
+    select(c, "track-kind", "II").await?;
+    wait_state(c, 60, |s| s["kind"] == "II" && mc_done(s)).await?;
+    select(c, "track-filter", "pf").await?;
+    let pf_track = wait_state(c, 60, |s| s["filter"] == "pf").await?;
+    let pf_data = js(
+        c,
+        "const d = window.tracking.trackData(); \
+         return {failed_at: d.failed_at, filter: d.filter, particles: d.particles, \
+                 entries: d.truth.length, ellipses: d.ellipses.filter((e) => e).length};",
+    )
+    .await?;
+    let gen = state(c).await?["mcGeneration"].as_u64().unwrap_or(0);
+    click(c, "mc-ukf").await?;
+    click(c, "mc-pf").await?;
+    let done = wait_state(c, 180, |s| {
+        mc_done(s)
+            && s["mcFilters"] == "ekf,ukf,pf"
+            && s["mcGeneration"].as_u64().unwrap_or(0) > gen
+    })
+    .await?;
+    let params = js(
+        c,
+        "return {...window.tracking.mcParams(), note: document.getElementById('mc-pf-note').textContent, \
+                 status: document.getElementById('mc-status').textContent};",
+    )
+    .await?;
+    let result = js(c, "return window.tracking.mcResult()").await?;
+    let errors = console_errors(c).await?;
+    Ok(FiltersOutcome {
+        pf_track,
+        pf_data,
+        done,
+        params,
+        result,
+        errors,
+    })
+}
+
+/// Issue 15, the page: the animated track runs the chosen filter (the particle filter, with its
+/// 1σ ellipses), and the Monte Carlo runs the ticked filters in the worker on the same truth and
+/// delays — the EKF and UKF over every run, the PF over the runs its particle budget allows — with
+/// one chart curve per filter; the browser's UKF and PF curves are the native core's.
+#[test]
+#[ignore = "needs chromium + chromedriver and www/pkg (wasm-pack build); run with --ignored"]
+fn tracking_page_runs_the_chosen_filters() {
+    let _serial = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
+    let port = start_server();
+    let driver = Driver::start();
+    let outcome = runtime().block_on(async {
+        let c = connect(&driver).await;
+        let r = three_filters(&c, port).await;
+        let _ = c.close().await;
+        r
+    });
+    drop(driver);
+    let o = outcome.unwrap_or_else(|e| panic!("{e}"));
+    assert!(o.errors.is_empty(), "console errors: {:?}", o.errors);
+
+    // The animated particle-filter track: 100 steps, every step with its 1σ ellipse.
+    assert_eq!(o.pf_track["particles"], 1000, "{}", o.pf_track);
+    let d = &o.pf_data;
+    assert_eq!(
+        (&d["filter"], &d["particles"]),
+        (&Value::from("pf"), &Value::from(1000))
+    );
+    assert_eq!(d["entries"], 101, "{d}");
+    assert!(d["failed_at"].is_null(), "{d}");
+    assert_eq!(d["ellipses"], 101, "{d}");
+
+    // The study: every filter's curve and the PCRLB on the chart; the PF within its budget.
+    let ms = o.done["mcMs"].as_f64().unwrap_or(f64::NAN);
+    println!(
+        "e2e: browser Monte Carlo EKF + UKF (200 runs) + PF (192 runs × 1000 particles) × 100 \
+         steps: {ms:.0} ms; {}",
+        o.params["note"]
+    );
+    assert_eq!(o.done["chartSeries"], 4, "{}", o.done);
+    let r = &o.result;
+    let names: Vec<&String> = r["filters"].as_object().unwrap().keys().collect();
+    assert_eq!(names.len(), 3, "{names:?}");
+    // 2·10⁷ particle-steps / (100 steps × 1000 particles) = 200 runs: 12 whole chunks of 16.
+    assert_eq!(r["filters"]["pf"]["runs_planned"], 192);
+    assert_eq!(r["filters"]["ukf"]["runs_planned"], 200);
+    assert!(
+        o.params["note"]
+            .as_str()
+            .unwrap()
+            .contains("192 runs × 1000 particles"),
+        "{}",
+        o.params["note"]
+    );
+    assert_eq!(r["particles"], 1000);
+    assert_eq!(r["filters"]["ekf"]["rmse_m"], r["rmse_ekf_m"]);
+
+    // The browser's filters against the native core's chunks on the same scenario.
+    let worst = native_filters_difference(&o.params, r);
+    println!("e2e: browser vs native UKF and PF curves: max relative difference {worst:e}");
+    assert!(worst < 1e-9, "browser vs native: {worst:e}");
+}
+
+/// The browser's UKF and PF curves against [`run_filter_chunk`] natively on the page's scenario:
+/// the largest relative difference of RMSE and NEES (runs counted must be equal).
+fn native_filters_difference(params: &Value, result: &Value) -> f64 {
+    use scatterloc::track::{finish, run_filter_chunk, FilterKind, PfConfig, StudySums};
+    let p = |k: &str| params[k].as_f64().unwrap();
+    let scenario = Scenario::from_json(params["scenario"].as_str().unwrap()).unwrap();
+    let model = Model::new(&scenario).unwrap();
+    let mean = track_mean_state(
+        params["kind"].as_str().unwrap(),
+        Vec2::new(p("x0"), p("y0")),
+        Vec2::new(p("vx"), p("vy")),
+    )
+    .unwrap();
+    let cfg = MonteCarloConfig {
+        motion: ConstantVelocity::new(p("dt_s"), PAPER_INTENSITY),
+        steps: p("steps") as usize,
+        mean_state: mean,
+        initial_covariance: paper_initial_covariance(),
+        trajectories: p("trajectories") as usize,
+        noise_runs: p("noise_runs") as usize,
+        seed: p("seed") as u64,
+        oracle_noise: false,
+    };
+    let pf = FilterKind::Pf(PfConfig {
+        particles: p("particles") as usize,
+        roughening: None,
+    });
+    let mut worst: f64 = 0.0;
+    for (name, kind) in [("ukf", FilterKind::Ukf(Default::default())), ("pf", pf)] {
+        let b = &result["filters"][name];
+        let chunks = b["chunk_count"].as_u64().unwrap() as usize;
+        let mut sums = StudySums::new(cfg.steps);
+        for c in 0..chunks {
+            sums.add(&run_filter_chunk(&model, &cfg, kind, c).unwrap());
+        }
+        let native = finish(&cfg, &sums).unwrap();
+        assert_eq!(b["runs"].as_u64(), Some(native.runs as u64), "{name}");
+        for (key, n) in [("rmse_m", &native.rmse_ekf_m), ("nees", &native.nees)] {
+            let v = floats(&b[key]);
+            assert_eq!(v.len(), n.len(), "{name} {key}");
+            for (x, y) in v.iter().zip(n) {
+                let rel = if x == y { 0.0 } else { (x / y - 1.0).abs() };
+                worst = worst.max(rel);
+            }
+        }
+    }
+    worst
+}

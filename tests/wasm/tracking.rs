@@ -28,7 +28,7 @@ fn stringify(v: &JsValue) -> String {
 #[wasm_bindgen_test]
 fn simulate_track_is_deterministic_and_complete() {
     let app = sensors();
-    let track = ok(app.simulate_track("II", 0.0, 0.0, 0.0, 0.0, 0.1, 100, 7));
+    let track = ok(app.simulate_track("II", 0.0, 0.0, 0.0, 0.0, 0.1, 100, 7, "ekf", 1000));
     assert_eq!(track.entries(), 101);
     let d = ok(track.data());
     for key in [
@@ -65,9 +65,9 @@ fn simulate_track_is_deterministic_and_complete() {
     assert!((sig.get(0).as_f64().unwrap() - 0.2_f64.sqrt()).abs() < 1e-12);
     assert!(sig.get(100).as_f64().unwrap() < 0.05);
 
-    let again = ok(app.simulate_track("II", 0.0, 0.0, 0.0, 0.0, 0.1, 100, 7));
+    let again = ok(app.simulate_track("II", 0.0, 0.0, 0.0, 0.0, 0.1, 100, 7, "ekf", 1000));
     assert_eq!(stringify(&ok(again.data())), stringify(&d));
-    let other = ok(app.simulate_track("II", 0.0, 0.0, 0.0, 0.0, 0.1, 100, 8));
+    let other = ok(app.simulate_track("II", 0.0, 0.0, 0.0, 0.0, 0.1, 100, 8, "ekf", 1000));
     assert_ne!(stringify(&ok(other.data())), stringify(&d));
 
     // A frame is snapshot-shaped: links with ellipse, outline and arc; the estimate as `fix`.
@@ -94,7 +94,7 @@ fn custom_track_starts_where_drawn() {
     let app = sensors();
     let v = ok(wasm::drag_velocity(2.0, 3.0, 12.0, -2.0, 10.0));
     assert_eq!(v, vec![1.0, -0.5]);
-    let t = ok(app.simulate_track("custom", 2.0, 3.0, v[0], v[1], 0.05, 40, 1));
+    let t = ok(app.simulate_track("custom", 2.0, 3.0, v[0], v[1], 0.05, 40, 1, "ekf", 1000));
     assert_eq!(t.entries(), 41);
     let e = Array::from(&Array::from(&get(&ok(t.data()), "estimates")).get(0));
     let e: Vec<f64> = e.iter().map(|x| x.as_f64().unwrap()).collect();
@@ -108,7 +108,11 @@ fn custom_track_starts_where_drawn() {
 fn tracking_errors_are_exceptions() {
     let app = sensors();
     let sim = |kind: &str, vx: f64, dt: f64, steps: usize| {
-        app.simulate_track(kind, 1.0, 2.0, vx, 0.5, dt, steps, 1)
+        app.simulate_track(kind, 1.0, 2.0, vx, 0.5, dt, steps, 1, "ekf", 1000)
+            .map(|_| ())
+    };
+    let filter = |name: &str, particles: usize, steps: usize| {
+        app.simulate_track("I", 0.0, 0.0, 0.0, 0.0, 0.1, steps, 1, name, particles)
             .map(|_| ())
     };
     for (m, field) in [
@@ -125,6 +129,13 @@ fn tracking_errors_are_exceptions() {
         (err(wasm::drag_velocity(0.0, f64::NAN, 1.0, 1.0, 1.0)), "y0"),
         (err(wasm::track_steps(1e9, 1e-3)), "steps"),
         (err(wasm::track_steps(10.0, -1.0)), "dt_s"),
+        (
+            err(filter("kf", 1000, 100)),
+            "filter: unknown filter \"kf\"",
+        ),
+        (err(filter("pf", 0, 100)), "particles: 0"),
+        (err(filter("pf", 2_000_000, 100)), "particles"),
+        (err(filter("pf", 5000, 10_000)), "particles × steps"),
     ] {
         assert!(m.contains(field), "message {m:?} should name {field}");
     }
@@ -304,4 +315,148 @@ fn chart_draws_both_curves_on_a_canvas() {
     assert!(
         err(wasm::draw_tracking_chart(bad, "{\"t_s\": [1", "", "", "")).contains("invalid JSON")
     );
+}
+
+/// The UKF and the particle filter animate like the EKF: the same truth and delays for one
+/// seed, their own estimates, a 1σ ellipse at every step, and `filter`/`particles` in the data.
+#[wasm_bindgen_test]
+fn simulate_track_runs_every_filter_on_the_same_data() {
+    let app = sensors();
+    let run = |name: &str| {
+        let t = ok(app.simulate_track("II", 0.0, 0.0, 0.0, 0.0, 0.1, 100, 7, name, 500));
+        parse(&stringify(&ok(t.data())))
+    };
+    let (ekf, ukf, pf) = (run("ekf"), run("ukf"), run("pf"));
+    for (name, d) in [("ekf", &ekf), ("ukf", &ukf), ("pf", &pf)] {
+        assert_eq!(d["filter"], name);
+        assert_eq!(d["truth"], ekf["truth"], "{name}");
+        assert_eq!(d["measurements"], ekf["measurements"], "{name}");
+        assert!(d["failed_at"].is_null(), "{name}");
+        let ellipses = d["ellipses"].as_array().unwrap();
+        assert!(
+            ellipses.iter().all(|e| !e.is_null()),
+            "{name}: a 1σ ellipse per step"
+        );
+        // Every filter settles to the cm scale (σ √(Pxx+Pyy) at the end below 5 cm).
+        assert!(d["sigma_m"][100].as_f64().unwrap() < 0.05, "{name}");
+    }
+    assert_eq!(
+        (&pf["particles"], &ekf["particles"]),
+        (&Value::from(500), &Value::Null)
+    );
+    assert_ne!(ukf["estimates"], ekf["estimates"]);
+    assert_ne!(pf["estimates"], ekf["estimates"]);
+}
+
+/// Several filters in one job: each filter's curves equal the core's chunks
+/// ([`run_filter_chunk`], what the CLI's `montecarlo --filters` runs) to the bit; the particle
+/// filter runs only the leading chunks its budget allows; the top level is the EKF's. Bad
+/// filter lists throw, and so does a change after the first chunk.
+#[wasm_bindgen_test]
+fn monte_carlo_job_runs_several_filters() {
+    use scatterloc::track::{finish, run_filter_chunk, FilterKind, PfConfig, StudySums};
+    let (steps, trajectories) = (20, 40);
+    let mut j = ok(job("II", steps, trajectories, 1));
+    // 2 chunks' worth of PF runs: 32 runs × 20 steps × 300 particles = 192 000 particle-steps.
+    ok(j.set_filters("ekf, ukf,pf", 300, 200_000));
+    assert_eq!(j.chunk_count(), 3 + 3 + 2);
+    let mut first = true;
+    while !ok(j.run_chunks(1)) {
+        if first {
+            first = false;
+            assert!(err(j.set_filters("ekf", 300, 1)).contains("started"));
+        }
+    }
+    let text = ok(j.result_json());
+    let r = parse(&text);
+    assert_eq!(r["done"], Value::Bool(true));
+    // The chart draws one curve per filter and the PCRLB.
+    let make = Function::new_with_args(
+        "w, h",
+        "const c = document.createElement('canvas'); c.width = w; c.height = h; return c;",
+    );
+    let canvas = make
+        .call2(&JsValue::NULL, &600.into(), &400.into())
+        .unwrap();
+    let n = ok(wasm::draw_tracking_chart(
+        canvas.dyn_into().unwrap(),
+        &text,
+        "RMSE",
+        "",
+        "II",
+    ));
+    assert_eq!(n, 4);
+    assert_eq!(
+        (r["particles"].as_u64(), r["particle_budget"].as_u64()),
+        (Some(300), Some(200_000))
+    );
+    let model = Model::new(&presets::sensors2019()).unwrap();
+    let cfg = MonteCarloConfig {
+        motion: ConstantVelocity::new(0.1, PAPER_INTENSITY),
+        steps,
+        mean_state: TrackScenario::II.mean_state(),
+        initial_covariance: paper_initial_covariance(),
+        trajectories,
+        noise_runs: 1,
+        seed: 11,
+        oracle_noise: false,
+    };
+    let pf = FilterKind::Pf(PfConfig {
+        particles: 300,
+        roughening: None,
+    });
+    for (name, kind, chunks, planned) in [
+        ("ekf", FilterKind::Ekf, 3, 40),
+        ("ukf", FilterKind::Ukf(Default::default()), 3, 40),
+        ("pf", pf, 2, 32),
+    ] {
+        let mut sums = StudySums::new(steps);
+        for c in 0..chunks {
+            sums.add(&run_filter_chunk(&model, &cfg, kind, c).unwrap());
+        }
+        let native = finish(&cfg, &sums).unwrap();
+        let f = &r["filters"][name];
+        assert_eq!(f["runs"].as_u64(), Some(native.runs as u64), "{name}");
+        assert_eq!(
+            (f["chunk_count"].as_u64(), f["runs_planned"].as_u64()),
+            (Some(chunks as u64), Some(planned))
+        );
+        let v: Vec<f64> = f["rmse_m"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|x| x.as_f64().unwrap())
+            .collect();
+        assert_eq!(v, native.rmse_ekf_m, "{name}");
+        let v: Vec<f64> = f["nees"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|x| x.as_f64().unwrap())
+            .collect();
+        assert_eq!(v, native.nees, "{name}");
+    }
+    assert_eq!(r["rmse_ekf_m"], r["filters"]["ekf"]["rmse_m"]);
+
+    // Without the EKF the top level is the first filter's; a budget below one chunk still
+    // runs one chunk.
+    let mut j = ok(job("II", steps, trajectories, 1));
+    ok(j.set_filters("pf", 300, 1));
+    assert_eq!(j.chunk_count(), 1);
+    assert!(ok(j.run_chunks(5)));
+    let r = parse(&ok(j.result_json()));
+    assert_eq!(r["rmse_ekf_m"], r["filters"]["pf"]["rmse_m"]);
+    assert_eq!(r["filters"]["pf"]["runs_planned"], 16);
+
+    for (list, particles, msg) in [
+        ("ekf,kf", 100, "filters[1]: unknown filter \"kf\""),
+        ("ekf,ekf", 100, "filters[1]"),
+        ("", 100, "filters[0]: unknown filter"),
+        ("pf", 0, "particles: 0"),
+        ("ukf,pf", 2_000_000, "particles"),
+    ] {
+        let mut j = ok(job("II", steps, trajectories, 1));
+        let m = err(j.set_filters(list, particles, 1_000_000));
+        assert!(m.contains(msg), "{list}: {m}");
+    }
 }

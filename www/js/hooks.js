@@ -12,7 +12,7 @@
 //   window.refreshLog()      the last 64 refreshes: [{ms (main thread), map, mapMs, res, dragging}]
 //   window.mapState()        {res, full, source, ms, busy, restarts, nsPerCellLink} of the map
 //   window.placeTarget(x, y) places the snapshot target (m)
-//   window.tracking          {state, setMode, play, pause, seek, restartMc, mcParams, mcResult}
+//   window.tracking          {state, setMode, play, pause, seek, restartMc, mcParams, mcResult, trackData}
 //   window.mtl               {state, setScene, pixelFromCentre, bench, setMode}
 //   window.plan              the Plan panel: state() {state: 'idle' | 'running' | 'done' | 'error',
 //                            evaluations, budget, messages (progress messages received), improvements
@@ -86,6 +86,7 @@ export function registerHooks(p) {
       restartMc: () => tracking.startMc(),
       mcParams: () => tracking.mc.params,
       mcResult: () => (tracking.mc.result ? JSON.parse(tracking.mc.result) : null),
+      trackData: () => tracking.data,
     },
     mtl: {
       state: () => mtl.state(),

@@ -1,6 +1,7 @@
 // Monte Carlo worker (a module Web Worker): runs the core's chunked study (MonteCarloJob) off the
 // page's main thread. Messages in: {type: 'run', gen, scenario, kind, x0, y0, vx, vy, dt_s, steps,
-// trajectories, noise_runs, seed} or {type: 'cancel', gen}. A newer generation cancels the job in
+// trajectories, noise_runs, seed, filters ('ekf,ukf,pf' or a part), particles, particle_budget}
+// or {type: 'cancel', gen}. A newer generation cancels the job in
 // progress at its next slice boundary. Messages out: {type: 'progress' | 'done', gen, done, total,
 // result (MonteCarloJob.result_json text), ms}, {type: 'error', gen, message} and, once the wasm
 // module is compiled, {type: 'ready'}.
@@ -30,6 +31,7 @@ async function run(m) {
   const job = new MonteCarloJob(m.scenario, m.kind, m.x0, m.y0, m.vx, m.vy, m.dt_s, m.steps,
     m.trajectories, m.noise_runs, m.seed);
   try {
+    if (m.filters) job.set_filters(m.filters, m.particles, m.particle_budget);
     const report = (type) => self.postMessage({
       type, gen: m.gen, done: job.chunks_done(), total: job.chunk_count(),
       result: job.result_json(), ms: performance.now() - t0,

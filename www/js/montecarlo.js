@@ -28,7 +28,10 @@ export class MonteCarlo {
     new ResizeObserver(() => this.drawChart()).observe($('track-chart').parentElement);
   }
 
-  /** Starts a study: {scenario, kind, x0, y0, vx, vy, dt_s, steps, trajectories, noise_runs, seed}. */
+  /**
+   * Starts a study: {scenario, kind, x0, y0, vx, vy, dt_s, steps, trajectories, noise_runs, seed,
+   * filters ('ekf,ukf,pf' or a part), particles, particle_budget}.
+   */
   start(params, caption) {
     if (this.state === 'running') this.superseded += 1;
     this.gen += 1;
@@ -92,9 +95,10 @@ export class MonteCarlo {
     let sub = p ? `${p.trajectories * p.noise_runs} runs × ${p.steps} steps, T = ${p.dt_s} s` : '';
     if (this.result) sub += ` · ${failedRuns(JSON.parse(this.result))}`;
     if (this.state === 'running') sub += ` · running, ${this.done}/${this.total} chunks`;
+    const names = p && p.filters ? p.filters.toUpperCase().split(',').join(', ') : 'EKF';
     try {
       this.series = this.wasm.draw_tracking_chart(canvas, this.result || '',
-        'Position RMSE: EKF vs posterior CRLB', sub, this.caption);
+        `Position RMSE: ${names} vs posterior CRLB`, sub, this.caption);
     } catch (e) {
       this.series = 0;
       this.onError(`Chart: ${errorText(e)}`);
@@ -117,14 +121,19 @@ export class MonteCarlo {
     const size = p ? `${p.trajectories * p.noise_runs} runs × ${p.steps} steps` : '';
     let text = size;
     if (this.state === 'running') text = `${size} · running ${this.done}/${this.total} chunks…`;
-    if (this.state === 'done' && this.result) {
-      const r = JSON.parse(this.result);
+    const r = this.result ? JSON.parse(this.result) : null;
+    if (this.state === 'done' && r) {
       const n = r.t_s.length - 1;
       const fmt = (v) => (v === null || v === undefined ? '—' : this.wasm.format_length(v, 3));
       const cold = this.coldStart ? ' (incl. worker start-up)' : '';
-      text = `${size} in ${fixed(this.ms, 0)} ms${cold} · at t = ${r.t_s[n]} s: ε_EKF ${fmt(r.rmse_ekf_m[n])}, `
-        + `ε_PCRLB ${fmt(r.rmse_pcrlb_m[n])}, NEES ${fixed(r.nees[n], 2)} (4 = consistent) · ${failedRuns(r)}`;
+      const each = Object.entries(r.filters).map(([name, f]) => `ε_${name.toUpperCase()} ${fmt(f.rmse_m[n])}`
+        + ` (NEES ${fixed(f.nees[n], 2)})`).join(', ');
+      text = `${size} in ${fixed(this.ms, 0)} ms${cold} · at t = ${r.t_s[n]} s: ${each}, `
+        + `ε_PCRLB ${fmt(r.rmse_pcrlb_m[n])} · NEES 4 = consistent · ${failedRuns(r)}`;
     }
+    const pf = r && r.filters.pf;
+    $('mc-pf-note').textContent = pf ? `PF: ${pf.runs_planned} runs × ${r.particles} particles `
+      + `(page budget ${r.particle_budget / 1e6}·10⁶ particle-steps)` : '';
     if (this.state === 'error') text = `${size} · failed`;
     el.textContent = text;
     const ms = $('mc-ms');
@@ -134,10 +143,12 @@ export class MonteCarlo {
 }
 
 /**
- * The failed-run count of a result, shown wherever ε_EKF is (even when 0): "0 failed runs",
- * "3 failed runs (excluded from ε_EKF)".
+ * The failed-run counts of a result, shown wherever the RMSE is (even when 0): "0 failed runs",
+ * "EKF 0, PF 3 failed runs (excluded from the RMSE)".
  */
 function failedRuns(r) {
-  const n = r.failed_runs;
-  return `${n} failed run${n === 1 ? '' : 's'}${n ? ' (excluded from ε_EKF)' : ''}`;
+  const f = Object.entries(r.filters || { ekf: r });
+  const total = f.reduce((a, [, c]) => a + c.failed_runs, 0);
+  const counts = f.length === 1 ? String(total) : f.map(([name, c]) => `${name.toUpperCase()} ${c.failed_runs}`).join(', ');
+  return `${counts} failed run${total === 1 && f.length === 1 ? '' : 's'}${total ? ' (excluded from the RMSE)' : ''}`;
 }

@@ -1,13 +1,18 @@
-// The tracking view: simulates a track with the wasm core (App.simulate_track), animates it over the
-// CRLB map (play/pause, scrub, speed), lets the user draw a trajectory (press = start, drag = where
-// it is after the run's duration) and keeps the Monte Carlo chart (montecarlo.js) in step: every
-// change of scenario, nodes or trajectory re-simulates the track and restarts the Monte Carlo.
+// The tracking view: simulates a track with the wasm core (App.simulate_track: the EKF, UKF or
+// particle filter chosen), animates it over the CRLB map (play/pause, scrub, speed), lets the user
+// draw a trajectory (press = start, drag = where it is after the run's duration) and keeps the
+// Monte Carlo chart (montecarlo.js, the filters ticked) in step: every change of scenario, nodes or
+// trajectory re-simulates the track and restarts the Monte Carlo.
 
 import { $, decimalIn, errorText, fillKeyValues, fixed, showError, clearError } from './dom.js';
 import { MonteCarlo } from './montecarlo.js';
 import { drawTrack } from './track-draw.js';
 
 const DURATION_S = 10; // the scenarios of spec §9.4 last 10 s
+// The particle filter's share of a browser Monte Carlo study: runs × steps × particles at most this
+// (the job runs the leading chunks of 16 runs that fit, at least one); about 3 s in the worker.
+export const PARTICLE_BUDGET = 20_000_000;
+const FILTERS = ['ekf', 'ukf', 'pf'];
 
 export class Tracking {
   /** @param {object} ctx - {app, wasm, st, view, changed}; @param {object} opts - hash options. */
@@ -34,6 +39,9 @@ export class Tracking {
     $('track-kind').addEventListener('change', () => { this.kind = $('track-kind').value; rerun(); });
     $('track-dt').addEventListener('change', rerun);
     $('track-seed').addEventListener('change', rerun);
+    $('track-filter').addEventListener('change', rerun);
+    $('track-particles').addEventListener('change', rerun);
+    for (const f of FILTERS) $(`mc-${f}`).addEventListener('change', () => this.startMc());
     $('mc-runs').addEventListener('change', () => this.startMc());
     $('mc-restart').addEventListener('click', () => this.startMc());
     $('track-ex').addEventListener('change', () => this.redraw());
@@ -54,7 +62,15 @@ export class Tracking {
     const d = this.drawn;
     if (this.kind === 'custom') v = w.drag_velocity(d.x0, d.y0, d.x1, d.y1, DURATION_S);
     const seed = decimalIn($('track-seed').value, 'seed', { min: 0, max: 4294967295, integer: true });
-    return { kind: this.kind, x0: d.x0, y0: d.y0, vx: v[0], vy: v[1], dt_s: dt, steps, seed };
+    const filter = $('track-filter').value;
+    const particles = Number($('track-particles').value);
+    return { kind: this.kind, x0: d.x0, y0: d.y0, vx: v[0], vy: v[1], dt_s: dt, steps, seed, filter, particles };
+  }
+
+  /** The filters ticked for the Monte Carlo, in the order EKF, UKF, PF (at least the EKF). */
+  mcFilters() {
+    const on = FILTERS.filter((f) => $(`mc-${f}`).checked);
+    return on.length ? on : ['ekf'];
   }
 
   /** Re-simulates the track (keeping the step) and restarts the Monte Carlo. */
@@ -62,7 +78,8 @@ export class Tracking {
     if (!this.active()) return;
     try {
       const p = this.params();
-      const track = this.ctx.app.simulate_track(p.kind, p.x0, p.y0, p.vx, p.vy, p.dt_s, p.steps, p.seed);
+      const track = this.ctx.app.simulate_track(p.kind, p.x0, p.y0, p.vx, p.vy, p.dt_s, p.steps, p.seed,
+        p.filter, p.particles);
       if (this.track) this.track.free();
       this.track = track;
       this.p = p;
@@ -80,14 +97,20 @@ export class Tracking {
       this.failed = true;
     }
     $('track-hint').hidden = this.kind !== 'custom';
+    $('track-particles-wrap').hidden = $('track-filter').value !== 'pf' && !$('mc-pf').checked;
+    $('track-filter-label').textContent = $('track-filter').value.toUpperCase();
   }
 
   startMc() {
     if (!this.active() || !this.p) return;
     const p = this.p;
     const runs = Number($('mc-runs').value);
-    this.mc.start({ scenario: this.ctx.app.scenario_json(), ...p, trajectories: runs, noise_runs: 1 },
-      this.kind === 'custom' ? 'drawn trajectory' : `scenario ${this.kind}`);
+    const filters = this.mcFilters();
+    $('track-particles-wrap').hidden = p.filter !== 'pf' && !filters.includes('pf');
+    this.mc.start({
+      scenario: this.ctx.app.scenario_json(), ...p, trajectories: runs, noise_runs: 1,
+      filters: filters.join(','), particle_budget: PARTICLE_BUDGET,
+    }, this.kind === 'custom' ? 'drawn trajectory' : `scenario ${this.kind}`);
   }
 
   /** Shows step `n` (frame from the core, read-outs, redraw). */
@@ -151,13 +174,19 @@ export class Tracking {
   drawMove(m) {
     if (!this.dragging || (m.x === this.drawn.x1 && m.y === this.drawn.y1)) return;
     this.drawn = { ...this.drawn, x1: m.x, y1: m.y };
-    if (this.drawn.x1 !== this.drawn.x0 || this.drawn.y1 !== this.drawn.y0) this.rerun();
+    // The particle filter's track costs tens of ms: it follows the arrow once the drag ends.
+    const live = $('track-filter').value !== 'pf';
+    if (live && (this.drawn.x1 !== this.drawn.x0 || this.drawn.y1 !== this.drawn.y0)) this.rerun();
     this.redraw();
   }
 
   drawEnd(m) {
     this.drawMove(m);
     this.dragging = false;
+    if ($('track-filter').value === 'pf' && (this.drawn.x1 !== this.drawn.x0 || this.drawn.y1 !== this.drawn.y0)) {
+      this.rerun();
+      this.redraw();
+    }
   }
 
   /** The layer drawn under the markers (see draw.js drawScene). */
@@ -195,11 +224,12 @@ export class Tracking {
     $('track-time').textContent = `t = ${fixed(f.t_s, 2)} s / ${fixed(tEnd, 2)} s · step ${f.step}/${n}`;
     $('track-ex-label').textContent = `×${$('track-ex').value}`;
     const m2 = (x, y) => `${fixed(x, 3)}, ${fixed(y, 3)} m`;
+    const name = this.data.filter.toUpperCase();
     const rows = [
       ['Truth', m2(f.truth.x, f.truth.y), ''],
-      ['EKF estimate', m2(f.fix.x, f.fix.y), 'fix'],
+      [`${name} estimate`, m2(f.fix.x, f.fix.y), 'fix'],
       ['Error ‖r̂ − r‖', f.fix.error_label, 'fix'],
-      ['EKF σ √(P_xx+P_yy)', f.fix.sigma_label, 'fix'],
+      [`${name} σ √(P_xx+P_yy)`, f.fix.sigma_label, 'fix'],
       ['Snapshot CRLB here', f.crlb.rmse_label, 'crlb'],
       ['NIS', f.step === 0 ? '–' : `${fixed(f.fix.nis, 2)} (χ²₄ mean 4)`, ''],
     ];
@@ -213,6 +243,8 @@ export class Tracking {
     const mc = this.mc;
     return {
       mode: this.ctx.st.mode, kind: this.kind, step: this.step,
+      filter: this.data ? this.data.filter : null, particles: this.data ? this.data.particles : null,
+      mcFilters: mc.params ? mc.params.filters : null,
       steps: this.track ? this.track.entries() - 1 : 0, playing: this.playing,
       t_s: f ? f.t_s : null, truth: f ? [f.truth.x, f.truth.y] : null, estimate: f ? [f.fix.x, f.fix.y] : null,
       mcState: mc.state, mcGeneration: mc.gen, mcRuns: mc.params ? mc.params.trajectories * mc.params.noise_runs : 0,

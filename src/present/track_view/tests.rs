@@ -32,7 +32,7 @@ fn frames_follow_the_run() {
     let motion = ConstantVelocity::new(0.1, PAPER_INTENSITY);
     let mean = TrackScenario::II.mean_state();
     let p0 = paper_initial_covariance();
-    let run = simulate_track(&model, &motion, &mean, &p0, 100, 3).unwrap();
+    let run = simulate_track(&model, &motion, &mean, &p0, 100, 3, Default::default()).unwrap();
     let f0 = track_frame(&model, &run, 0).unwrap();
     assert!(f0.links.is_empty());
     assert_eq!(f0.estimate.position, Vec2::new(mean[0], mean[1]));

@@ -14,40 +14,7 @@ use crate::track::TruthSampler;
 use crate::track::{
     range_information_per_snr, spd_quadratic_form, update_lanes, Ekf, MeasurementNoise, NodeView,
 };
-use crate::track::{ParticleFilter, PfConfig, Ukf, UkfParams};
-
-/// The tracker a study runs (issue 15): the EKF (spec §6), the UKF or the bootstrap particle
-/// filter (`filters-and-planning.md` §1–2), all on the same motion and measurement models.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub enum FilterKind {
-    /// The EKF (the studies of \[S\] Fig. 3).
-    #[default]
-    Ekf,
-    /// The UKF with these parameters.
-    Ukf(UkfParams),
-    /// The particle filter with these settings.
-    Pf(PfConfig),
-}
-
-impl FilterKind {
-    /// `ekf`, `ukf` or `pf`.
-    pub fn name(&self) -> &'static str {
-        match self {
-            FilterKind::Ekf => "ekf",
-            FilterKind::Ukf(_) => "ukf",
-            FilterKind::Pf(_) => "pf",
-        }
-    }
-
-    /// Checks the filter's settings ([`UkfParams::validate`], [`PfConfig::validate`]).
-    pub fn validate(&self) -> Result<()> {
-        match self {
-            FilterKind::Ekf => Ok(()),
-            FilterKind::Ukf(p) => p.validate(),
-            FilterKind::Pf(c) => c.validate(),
-        }
-    }
-}
+use crate::track::{FilterKind, Tracker};
 
 /// Salt of the particle filters' own streams (particles, resampling), apart from the
 /// measurement-noise streams, so every filter of a study sees the same measurements.
@@ -246,7 +213,7 @@ pub fn run_filter_chunk(
     Ok(sums)
 }
 
-/// A UKF or particle filter over the prepared truth with the measurements of noise stream
+/// A filter (the UKF or the particle filter; the EKF's studies take [`run_chunk`]'s lanes) over the prepared truth with the measurements of noise stream
 /// `stream`; fills lane 0 of `s.squared_error` and `s.nees`; `false` if the filter failed.
 fn run_other_filter(
     model: &Model,
@@ -255,25 +222,13 @@ fn run_other_filter(
     s: &mut Scratch,
     stream: u64,
 ) -> bool {
-    enum F {
-        U(Ukf),
-        P(ParticleFilter),
-    }
     let links = model.link_count();
     let steps = s.truth.len();
     let mut noise_rng = rng(cfg.seed, stream);
-    let built = match filter {
-        FilterKind::Ukf(p) => Ukf::new(cfg.mean_state, cfg.initial_covariance, p).map(F::U),
-        FilterKind::Pf(c) => ParticleFilter::new(
-            cfg.mean_state,
-            cfg.initial_covariance,
-            c,
-            rng(cfg.seed ^ PF_STREAM_SALT, stream),
-        )
-        .map(F::P),
-        FilterKind::Ekf => return false,
+    let own = rng(cfg.seed ^ PF_STREAM_SALT, stream);
+    let Ok(mut f) = Tracker::new(filter, cfg.mean_state, cfg.initial_covariance, own) else {
+        return false;
     };
-    let Ok(mut f) = built else { return false };
     let (truth, table) = (&s.truth[..steps], &s.table[..links * steps]);
     let z = &mut s.measurement[..links];
     for n in 0..steps {
@@ -288,21 +243,13 @@ fn run_other_filter(
             } else {
                 MeasurementNoise::AtPrediction
             };
-            let ok = match &mut f {
-                F::U(u) => u.step(&cfg.motion, model, z, noise).is_ok(),
-                F::P(p) => p.step(&cfg.motion, model, z, noise).is_ok(),
-            };
-            if !ok {
+            if f.step(&cfg.motion, model, z, noise).is_err() {
                 return false;
             }
         }
-        let (state, cov) = match &f {
-            F::U(u) => (u.state, u.covariance),
-            F::P(p) => (p.state, p.covariance),
-        };
-        let e = state - x;
+        let e = f.state() - x;
         s.squared_error[n] = e[0] * e[0] + e[1] * e[1];
-        match spd_quadratic_form(&cov, &e) {
+        match spd_quadratic_form(f.covariance(), &e) {
             Some(v) => s.nees[n] = v,
             None => return false,
         }

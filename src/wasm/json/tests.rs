@@ -16,6 +16,7 @@ use crate::present::{track_frame, track_mean_state, LogScale};
 use crate::scenario::presets::{iclgnss2019, sensors2019};
 use crate::track::{finish, paper_initial_covariance, run_chunk, simulate_track};
 use crate::track::{ConstantVelocity, MonteCarloConfig, StudySums, PAPER_INTENSITY};
+use crate::track::{FilterKind, PfConfig};
 
 wasm_bindgen_test_configure!(run_in_browser);
 
@@ -183,7 +184,8 @@ fn track_frame_estimate_and_data() {
         for kind in ["I", "III"] {
             let mean = track_mean_state(kind, Vec2::new(0.0, 0.0), Vec2::new(0.0, 0.0)).unwrap();
             let p0 = paper_initial_covariance();
-            let mut run = simulate_track(model, &motion, &mean, &p0, 6, 5).unwrap();
+            let mut run =
+                simulate_track(model, &motion, &mean, &p0, 6, 5, Default::default()).unwrap();
             for n in [0, 1, 6] {
                 let f = track_frame(model, &run, n).unwrap();
                 let v = value(&FrameJs::new(&f, s.scenario()));
@@ -230,7 +232,11 @@ fn track_frame_estimate_and_data() {
                 let est: Vec<_> = (0..run.estimates.len())
                     .map(|n| track_estimate(&run, n).unwrap())
                     .collect();
-                let v = value(&TrackDataJs::new(kind, 5, 6, &run, &est, model));
+                let pf = FilterKind::Pf(PfConfig {
+                    particles: 300,
+                    roughening: None,
+                });
+                let v = value(&TrackDataJs::new(kind, pf, 5, 6, &run, &est, model));
                 assert_eq!(
                     keys(&v),
                     [
@@ -239,9 +245,11 @@ fn track_frame_estimate_and_data() {
                         "error_m",
                         "estimates",
                         "failed_at",
+                        "filter",
                         "kind",
                         "measurements",
                         "nis",
+                        "particles",
                         "seed",
                         "sigma_m",
                         "steps",
@@ -250,6 +258,10 @@ fn track_frame_estimate_and_data() {
                     ]
                 );
                 assert!(v["measurements"][2][0].is_null());
+                assert_eq!(
+                    (&v["filter"], &v["particles"]),
+                    (&Value::from("pf"), &Value::from(300))
+                );
                 assert_eq!(v["measurements"][0], Value::Array(vec![]));
             }
         }
@@ -275,7 +287,26 @@ fn monte_carlo_progress_and_result() {
         let mut r = finish(&cfg, &sums).unwrap();
         r.rmse_pcrlb_m[0] = None;
         r.nees[1] = f64::NAN;
-        let v = value(&MonteCarloJs::new(&r, &cfg, sums.trajectories, chunk + 1));
+        let ekf = FilterCurvesJs {
+            name: "ekf",
+            rmse_m: &r.rmse_ekf_m,
+            nees: &r.nees,
+            runs: r.runs,
+            failed_runs: r.failed_runs,
+            chunks_done: chunk + 1,
+            chunk_count: cfg.chunk_count(),
+            runs_planned: cfg.runs(),
+        };
+        let v = value(&MonteCarloJs::new(
+            &r,
+            &cfg,
+            sums.trajectories,
+            chunk + 1,
+            cfg.chunk_count(),
+            vec![ekf],
+            None,
+            None,
+        ));
         assert_eq!(
             keys(&v),
             [
@@ -284,8 +315,11 @@ fn monte_carlo_progress_and_result() {
                 "done",
                 "dt_s",
                 "failed_runs",
+                "filters",
                 "nees",
                 "noise_runs",
+                "particle_budget",
+                "particles",
                 "rmse_ekf_m",
                 "rmse_pcrlb_m",
                 "runs",
@@ -298,6 +332,20 @@ fn monte_carlo_progress_and_result() {
         );
         assert_eq!(v["done"], Value::Bool(chunk + 1 == cfg.chunk_count()));
         assert!(v["rmse_pcrlb_m"][0].is_null() && v["nees"][1].is_null());
+        assert_eq!(
+            keys(&v["filters"]["ekf"]),
+            [
+                "chunk_count",
+                "chunks_done",
+                "failed_runs",
+                "nees",
+                "rmse_m",
+                "runs",
+                "runs_planned"
+            ]
+        );
+        assert_eq!(v["filters"]["ekf"]["rmse_m"], v["rmse_ekf_m"]);
+        assert!(v["particles"].is_null() && v["particle_budget"].is_null());
     }
 }
 

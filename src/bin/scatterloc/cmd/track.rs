@@ -16,8 +16,7 @@ use scatterloc::track::gating::{start_from_snapshot, GatedTracker, START_SPEED_S
 use scatterloc::track::gating::{AssociationRule, Choice, DelayEstimate};
 use scatterloc::track::ConstantVelocity;
 use scatterloc::track::MAX_STEPS;
-use scatterloc::track::{Ekf, FilterKind, MeasurementNoise, UpdateSummary};
-use scatterloc::track::{ParticleFilter, Ukf};
+use scatterloc::track::{Ekf, MeasurementNoise, Tracker, UpdateSummary};
 use scatterloc::{Error, Model};
 
 use super::filters::filter_kinds;
@@ -187,7 +186,9 @@ pub fn track(args: &TrackArgs) -> Result<(), CliError> {
     };
     match (m.steps, m.raw_steps) {
         (Some(steps), _) => {
-            let filter = Tracker::new(ekf, kind, args.seed.unwrap_or(1)).map_err(|e| bad(&e))?;
+            // The particle filter draws its particles from stream 0 of `--seed`.
+            let own = rng(args.seed.unwrap_or(1), 0);
+            let filter = Tracker::new(kind, ekf.state, ekf.covariance, own).map_err(|e| bad(&e))?;
             plain(
                 &model, filter, &motion, noise, &steps, m.dt_s, &mut out, &bad,
             )?
@@ -282,60 +283,6 @@ fn step_error(field: &str, e: Error, bad: &dyn Fn(&dyn std::fmt::Display) -> Cli
     }
 }
 
-/// The filter of `track --filter`.
-enum Tracker {
-    Ekf(Ekf),
-    Ukf(Ukf),
-    Pf(Box<ParticleFilter>),
-}
-
-impl Tracker {
-    /// `kind` started at the EKF's state and covariance; the particle filter draws its
-    /// particles from stream 0 of `seed`.
-    fn new(ekf: Ekf, kind: FilterKind, seed: u64) -> Result<Tracker, Error> {
-        Ok(match kind {
-            FilterKind::Ekf => Tracker::Ekf(ekf),
-            FilterKind::Ukf(p) => Tracker::Ukf(Ukf::new(ekf.state, ekf.covariance, p)?),
-            FilterKind::Pf(c) => Tracker::Pf(Box::new(ParticleFilter::new(
-                ekf.state,
-                ekf.covariance,
-                c,
-                rng(seed, 0),
-            )?)),
-        })
-    }
-
-    fn predict(&mut self, motion: &ConstantVelocity) {
-        match self {
-            Tracker::Ekf(f) => f.predict(motion),
-            Tracker::Ukf(f) => f.predict(motion),
-            Tracker::Pf(f) => f.predict(motion),
-        }
-    }
-
-    fn update(
-        &mut self,
-        model: &Model,
-        z: &[Option<f64>],
-        noise: MeasurementNoise,
-    ) -> Result<UpdateSummary, Error> {
-        match self {
-            Tracker::Ekf(f) => f.update(model, z, noise, None),
-            Tracker::Ukf(f) => f.update(model, z, noise),
-            Tracker::Pf(f) => f.update(model, z, noise).map(|u| u.summary),
-        }
-    }
-
-    /// State and covariance.
-    fn estimate(&self) -> (&Vec4, &Mat4) {
-        match self {
-            Tracker::Ekf(f) => (&f.state, &f.covariance),
-            Tracker::Ukf(f) => (&f.state, &f.covariance),
-            Tracker::Pf(f) => (&f.state, &f.covariance),
-        }
-    }
-}
-
 /// The plain form: one delay (or null) per link and step.
 #[allow(clippy::too_many_arguments)]
 fn plain(
@@ -361,8 +308,7 @@ fn plain(
         let summary = filter
             .update(model, z, noise)
             .map_err(|e| step_error(&field, e, bad))?;
-        let (x, p) = filter.estimate();
-        record(out, x, p, k, dt_s, &summary);
+        record(out, filter.state(), filter.covariance(), k, dt_s, &summary);
     }
     Ok(())
 }
