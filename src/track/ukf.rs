@@ -213,19 +213,13 @@ impl Ukf {
         ];
         // 𝒵₀ and the range differences of the four sigma points off χ₀'s position.
         let at = |sign: Real, col: &Vec4| Vec2::new(x[0] + sign * col[0], x[1] + sign * col[1]);
-        ranges(model, z, Vec2::new(x[0], x[1]), sc.z0);
         let points = [
             at(1.0, &c[0]),
             at(1.0, &c[1]),
             at(-1.0, &c[0]),
             at(-1.0, &c[1]),
         ];
-        for (dk, point) in sc.d.chunks_exact_mut(m).zip(points) {
-            ranges(model, z, point, dk);
-            for (v, z0) in dk.iter_mut().zip(&*sc.z0) {
-                *v -= z0;
-            }
-        }
+        sigma_ranges(model, z, Vec2::new(x[0], x[1]), &points, sc.z0, sc.d);
         let (_, _, wi) = self.params.weights();
         let c_delta = self.params.beta - self.params.alpha * self.params.alpha;
         let (d0, rest) = sc.d.split_at_mut(m);
@@ -262,12 +256,20 @@ impl Ukf {
         // x̂ = x̂⁻ + C g, P = P⁻ − C W Cᵀ (symmetric; P⁻ read as (P⁻ + P⁻ᵀ)/2).
         let state = x + c[0] * g0 + c[1] * g1;
         let wc: [Vec4; 2] = [c[0] * w00 + c[1] * w01, c[0] * w01 + c[1] * w11];
-        let covariance = Mat4::from_fn(|i, j| {
-            // The upper triangle, mirrored: P exactly symmetric.
-            let (i, j) = (i.min(j), i.max(j));
+        // The upper triangle, mirrored: P exactly symmetric.
+        let e = |i: usize, j: usize| {
             let q = c[0][i] * wc[0][j] + c[1][i] * wc[1][j];
             0.5 * (p[(i, j)] + p[(j, i)]) - q
-        });
+        };
+        let (e00, e01, e02, e03) = (e(0, 0), e(0, 1), e(0, 2), e(0, 3));
+        let (e11, e12, e13) = (e(1, 1), e(1, 2), e(1, 3));
+        let (e22, e23, e33) = (e(2, 2), e(2, 3), e(3, 3));
+        let covariance = Mat4::new(
+            e00, e01, e02, e03, //
+            e01, e11, e12, e13, //
+            e02, e12, e22, e23, //
+            e03, e13, e23, e33,
+        );
         if state.iter().any(|v| !v.is_finite()) || Ldl4::new(&covariance).is_none() {
             return Err(not_pd("ukf.covariance"));
         }
@@ -322,23 +324,42 @@ fn measurement(
     Ok(())
 }
 
-/// The ranges `c·h(r)` (m) of the links present at the position `r`, in link order: each
-/// node's distance once (E1: a link's range is the sum of its two).
+/// The ranges `c·h` (m) of the links present, in link order, at `center` into `z0` and their
+/// differences `d_k = 𝒵(points[k]) − 𝒵₀` into `d` (point-major, `z0.len()` per point): each
+/// node's distances once (E1: a link's range is the sum of its two), the four points side by
+/// side.
 #[inline]
-fn ranges(model: &Model, z: &[Option<Real>], r: Vec2, out: &mut [Real]) {
+fn sigma_ranges(
+    model: &Model,
+    z: &[Option<Real>],
+    center: Vec2,
+    points: &[Vec2; 4],
+    z0: &mut [Real],
+    d: &mut [Real],
+) {
+    let m = z0.len();
     let net = &model.network;
+    let (px, py) = (points.map(|p| p.x), points.map(|p| p.y));
     let dist = |n: Vec2| {
-        let (dx, dy) = (r.x - n.x, r.y - n.y);
-        sqrt(dx * dx + dy * dy)
+        let (dx, dy) = (center.x - n.x, center.y - n.y);
+        let at: [Real; 4] = core::array::from_fn(|k| {
+            let (dx, dy) = (px[k] - n.x, py[k] - n.y);
+            sqrt(dx * dx + dy * dy)
+        });
+        (sqrt(dx * dx + dy * dy), at)
     };
     let present = net.links.iter().zip(z).filter(|(_, v)| v.is_some());
-    // The links of one transmitter are consecutive for a full mesh; reuse its distance.
-    let mut last_tx = (usize::MAX, 0.0);
-    for (o, (l, _)) in out.iter_mut().zip(present) {
+    // The links of one transmitter are consecutive for a full mesh; reuse its distances.
+    let mut last_tx = (usize::MAX, (0.0, [0.0; 4]));
+    for ((i, z0), (l, _)) in z0.iter_mut().enumerate().zip(present) {
         if last_tx.0 != l.tx {
             last_tx = (l.tx, dist(net.transmitters[l.tx]));
         }
-        *o = last_tx.1 + dist(net.receivers[l.rx]);
+        let ((t0, t), (r0, r)) = (last_tx.1, dist(net.receivers[l.rx]));
+        *z0 = t0 + r0;
+        for k in 0..4 {
+            d[k * m + i] = (t[k] + r[k]) - *z0;
+        }
     }
 }
 
