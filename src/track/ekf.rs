@@ -40,7 +40,8 @@ mod links;
 mod nees;
 
 pub(crate) use batch::{first_input_error, update_lanes};
-pub(crate) use nees::spd_quadratic_form;
+pub(crate) use links::link_information;
+pub(crate) use nees::{spd_quadratic_form, Ldl4};
 
 /// Where the measurement noise `R = diag(σ_p²)` comes from (spec §6 \[choice\]).
 #[derive(Debug, Clone, Copy)]

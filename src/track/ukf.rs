@@ -9,19 +9,37 @@
 //!   present, `ẑ = Σ Wᵐ_i 𝒵_i`, `S = Σ Wᶜ_i (𝒵_i − ẑ)(𝒵_i − ẑ)ᵀ + R`, `P_xz` likewise,
 //!   `K = P_xz S⁻¹`, `x̂ = x̂⁻ + K (z − ẑ)`, `P = P⁻ − K S Kᵀ`, then `P ← (P + Pᵀ)/2`.
 //!
+//! Evaluation: the same quantities, equal up to rounding, with less work.
+//!
+//! - `h` only sees the position and `L` is lower triangular, so the four sigma points of the
+//!   velocity columns `L_{:,2}`, `L_{:,3}` have `χ₀`'s position and its `𝒵₀`: five range
+//!   evaluations, `𝒵₀` and the differences `d_k = 𝒵(x̂⁻ ± L_{:,j}) − 𝒵₀` (`j = 0, 1`), not nine.
+//!   Columns 0 and 1 of `L` come from `P⁻ = L̃ D L̃ᵀ` ([`Ldl4`]: `L = L̃ √((n + λ) D)`), which is
+//!   also the positive-definiteness test of `P⁻`.
+//! - With `Wᵐ₀ + 2n Wᵢ = 1`: `δ = ẑ − 𝒵₀ = Wᵢ Σ_k d_k`,
+//!   `S = R + Wᵢ Σ_k d_k d_kᵀ + (β − α²) δ δᵀ` (`Wᶜ₀ − Wᵐ₀ − 1 = β − α²`; lower triangle only)
+//!   and `P_xz = C Eᵀ` with `C = [L_{:,0} L_{:,1}]`, `E = Wᵢ [d₀₊ − d₀₋, d₁₊ − d₁₋]`: the
+//!   velocity points' terms cancel in pairs.
+//! - `S = G Gᵀ` (Cholesky), `A = G⁻¹ E`, `b = G⁻¹ ν`: `K ν = C Aᵀ b`,
+//!   `K S Kᵀ = P_xz S⁻¹ P_xzᵀ = C (Aᵀ A) Cᵀ` (a 2 × 2 core, symmetric by construction) and
+//!   `NIS = bᵀ b`, one forward substitution and no `m × m` product.
+//! - The new `P` is checked by its `LDLᵀ` pivots ([`Ldl4`]), not a second Cholesky.
+//! - `R = diag((cσ_p)²)` is `1/w_p` from the EKF's pass 1 ([`link_information`]): each
+//!   transmitter's gain is evaluated once per update, not once per link.
+//!
+//! The same code serves any number of links, with its work arrays on the stack for up to 8 and
+//! on the heap above.
+//!
 //! Internally ranges (`cτ`, `c²R`) are used, as in the EKF (the same filter in other units). A
 //! `P⁻` or `S` that is not positive definite, or a `P` that stops being so, is
 //! [`Error::NotPositiveDefinite`] and leaves the filter unchanged.
 
 use alloc::vec;
-use alloc::vec::Vec;
 
-use nalgebra::{Cholesky, DMatrix, DVector};
-
-use crate::error::{check_len, limits, Error, Result};
+use crate::error::{check_len, Error, Result};
 use crate::math::{sqrt, Mat4, Real, Vec2, Vec4, SPEED_OF_LIGHT};
 use crate::measure::Model;
-use crate::track::ekf::{check_covariance, check_state, first_input_error};
+use crate::track::ekf::{check_covariance, check_state, first_input_error, link_information, Ldl4};
 use crate::track::{ConstantVelocity, MeasurementNoise, UpdateSummary};
 
 /// State dimension `n`.
@@ -126,8 +144,8 @@ impl Ukf {
     }
 
     /// Update with delays `z` (s, one per link, `None` = missing) by the unscented transform of
-    /// `h` around `(x̂⁻, P⁻)` (spec §1). No link: nothing to do. On error the filter is
-    /// unchanged.
+    /// `h` around `(x̂⁻, P⁻)` (spec §1, evaluated as in the module docs). No link: nothing to
+    /// do. On error the filter is unchanged.
     pub fn update(
         &mut self,
         model: &Model,
@@ -144,41 +162,118 @@ impl Ukf {
                 links_used: 0,
             });
         }
-        let (x, p) = (self.state, self.covariance);
-        let r_pred = self.position();
-        let points = sigma_points(&x, &p, &self.params)?;
-        let weights = self.params.weights();
-        // Up to 8 links on the stack (no allocation), more in dynamic matrices.
-        let (dx, ksk, nis) = if m <= 8 {
-            let mut used = [0usize; 8];
-            for (slot, link) in used.iter_mut().zip((0..links).filter(|&l| z[l].is_some())) {
-                *slot = link;
-            }
-            let used = &used[..m];
-            let (mut zc, mut r) = ([0.0; 8], [0.0; 8]);
-            measurement(model, z, noise, r_pred, used, &mut zc[..m], &mut r[..m])?;
-            if m <= 4 {
-                ut_update::<4>(model, used, &points, weights, &zc[..m], &r[..m])?
-            } else {
-                ut_update::<8>(model, used, &points, weights, &zc[..m], &r[..m])?
-            }
+        // Up to 8 links on the stack (no allocation), more on the heap; the same code.
+        let (x, p) = if m <= 4 {
+            self.updated(
+                model,
+                z,
+                noise,
+                &mut Scratch::new(m, &mut [0.0; scratch_len(4)]),
+            )?
+        } else if m <= 8 {
+            self.updated(
+                model,
+                z,
+                noise,
+                &mut Scratch::new(m, &mut [0.0; scratch_len(8)]),
+            )?
         } else {
-            let used: Vec<usize> = (0..links).filter(|&l| z[l].is_some()).collect();
-            let (mut zc, mut r) = (vec![0.0; m], vec![0.0; m]);
-            measurement(model, z, noise, r_pred, &used, &mut zc, &mut r)?;
-            ut_update_dyn(model, &used, &points, weights, &zc, &r)?
+            let mut buf = vec![0.0; scratch_len(m)];
+            self.updated(model, z, noise, &mut Scratch::new(m, &mut buf))?
         };
-        let p_new = p - ksk;
-        let p_new = (p_new + p_new.transpose()) * 0.5;
-        let x_new = x + dx;
-        if x_new.iter().any(|v| !v.is_finite()) || Cholesky::new(p_new).is_none() {
-            return Err(Error::NotPositiveDefinite {
-                field: "ukf.covariance".into(),
-            });
+        (self.state, self.covariance) = (x.0, p);
+        Ok(UpdateSummary {
+            nis: x.1,
+            links_used: m,
+        })
+    }
+
+    /// The updated `(x̂, NIS)` and `P` for the `m ≥ 1` links present (module docs).
+    #[inline(always)]
+    fn updated(
+        &self,
+        model: &Model,
+        z: &[Option<Real>],
+        noise: MeasurementNoise,
+        sc: &mut Scratch,
+    ) -> Result<((Vec4, Real), Mat4)> {
+        let not_pd = |field: &str| Error::NotPositiveDefinite {
+            field: field.into(),
+        };
+        let (x, p) = (&self.state, &self.covariance);
+        let m = sc.m;
+        measurement(model, z, noise, self.position(), &mut *sc.r)?;
+        // Columns 0 and 1 of the Cholesky factor of (n + λ) P⁻ from P⁻ = L D Lᵀ.
+        let f = Ldl4::new(p).ok_or_else(|| not_pd("ukf.covariance"))?;
+        let spread = N as Real + self.params.lambda();
+        let (s0, s1) = (sqrt(spread * f.d[0]), sqrt(spread * f.d[1]));
+        let c = [
+            Vec4::new(s0, f.l10 * s0, f.l20 * s0, f.l30 * s0),
+            Vec4::new(0.0, s1, f.l21 * s1, f.l31 * s1),
+        ];
+        // 𝒵₀ and the range differences of the four sigma points off χ₀'s position.
+        let at = |sign: Real, col: &Vec4| Vec2::new(x[0] + sign * col[0], x[1] + sign * col[1]);
+        let points = [
+            at(1.0, &c[0]),
+            at(1.0, &c[1]),
+            at(-1.0, &c[0]),
+            at(-1.0, &c[1]),
+        ];
+        sigma_ranges(model, z, Vec2::new(x[0], x[1]), &points, sc.z0, sc.d);
+        let (_, _, wi) = self.params.weights();
+        let c_delta = self.params.beta - self.params.alpha * self.params.alpha;
+        let (d0, rest) = sc.d.split_at_mut(m);
+        let (d1, rest) = rest.split_at_mut(m);
+        let (d2, d3) = rest.split_at_mut(m);
+        // δ = ẑ − 𝒵₀, ν = z − ẑ (into z0's place).
+        for (i, tau) in z.iter().filter_map(|v| *v).enumerate() {
+            let delta = wi * (((d0[i] + d1[i]) + d2[i]) + d3[i]);
+            sc.delta[i] = delta;
+            sc.z0[i] = (SPEED_OF_LIGHT * tau - sc.z0[i]) - delta;
         }
-        self.state = x_new;
-        self.covariance = p_new;
-        Ok(UpdateSummary { nis, links_used: m })
+        // S (lower triangle), then E = [e₀ e₁] into d0, d1.
+        let (s, delta) = (&mut *sc.s, &*sc.delta);
+        for i in 0..m {
+            for j in 0..=i {
+                let sum = ((d0[i] * d0[j] + d1[i] * d1[j]) + d2[i] * d2[j]) + d3[i] * d3[j];
+                s[i * m + j] = wi * sum + c_delta * delta[i] * delta[j];
+            }
+            s[i * m + i] += sc.r[i];
+        }
+        for i in 0..m {
+            d0[i] = wi * (d0[i] - d2[i]);
+            d1[i] = wi * (d1[i] - d3[i]);
+        }
+        let nu = &mut *sc.z0;
+        if !whiten(s, m, [d0, d1, &mut *nu]) {
+            return Err(not_pd("ukf.innovation_covariance"));
+        }
+        // W = AᵀA, g = Aᵀb, NIS = bᵀb with A = G⁻¹E, b = G⁻¹ν.
+        let dot = |a: &[Real], b: &[Real]| a.iter().zip(b).fold(0.0, |acc, (x, y)| acc + x * y);
+        let (w00, w01, w11) = (dot(d0, d0), dot(d0, d1), dot(d1, d1));
+        let (g0, g1) = (dot(d0, nu), dot(d1, nu));
+        let nis = dot(nu, nu);
+        // x̂ = x̂⁻ + C g, P = P⁻ − C W Cᵀ (symmetric; P⁻ read as (P⁻ + P⁻ᵀ)/2).
+        let state = x + c[0] * g0 + c[1] * g1;
+        let wc: [Vec4; 2] = [c[0] * w00 + c[1] * w01, c[0] * w01 + c[1] * w11];
+        // The upper triangle, mirrored: P exactly symmetric.
+        let e = |i: usize, j: usize| {
+            let q = c[0][i] * wc[0][j] + c[1][i] * wc[1][j];
+            0.5 * (p[(i, j)] + p[(j, i)]) - q
+        };
+        let (e00, e01, e02, e03) = (e(0, 0), e(0, 1), e(0, 2), e(0, 3));
+        let (e11, e12, e13) = (e(1, 1), e(1, 2), e(1, 3));
+        let (e22, e23, e33) = (e(2, 2), e(2, 3), e(3, 3));
+        let covariance = Mat4::new(
+            e00, e01, e02, e03, //
+            e01, e11, e12, e13, //
+            e02, e12, e22, e23, //
+            e03, e13, e23, e33,
+        );
+        if state.iter().any(|v| !v.is_finite()) || Ldl4::new(&covariance).is_none() {
+            return Err(not_pd("ukf.covariance"));
+        }
+        Ok(((state, nis), covariance))
     }
 
     /// Predict then update (one filter step); on error the filter is left as before the step.
@@ -201,37 +296,27 @@ impl Ukf {
     }
 }
 
-/// The measured ranges `c·z` and the range variances `(cσ_p)²` of the links `used` (σ from
-/// `noise` at `r_pred`) into `zc` and `r`, each σ evaluated once; a bad delay or σ is the EKF's
-/// named error ([`first_input_error`]).
+/// The range variances `(cσ_p)² = 1/w_p` of the links present into `r`, from the EKF's pass 1
+/// ([`link_information`]: each transmitter's gain evaluated once, not per link); a bad delay or
+/// σ is the EKF's named error ([`first_input_error`]).
 fn measurement(
     model: &Model,
     z: &[Option<Real>],
     noise: MeasurementNoise,
     r_pred: Vec2,
-    used: &[usize],
-    zc: &mut [Real],
     r: &mut [Real],
 ) -> Result<()> {
-    let fixed = matches!(noise, MeasurementNoise::Fixed(_));
-    let mut ok = true;
-    for ((&link, zk), rk) in used.iter().zip(zc.iter_mut()).zip(r.iter_mut()) {
-        let tau = z[link].unwrap_or_default();
-        let sigma = noise.sigma(model, link, r_pred);
-        let s = SPEED_OF_LIGHT * sigma;
-        *zk = SPEED_OF_LIGHT * tau;
-        *rk = s * s;
-        ok &= limits::DELAY_S.contains(tau)
-            && sigma.is_finite()
-            && sigma > 0.0
-            && (!fixed || limits::DELAY_SIGMA_S.contains(sigma))
-            && rk.is_finite()
-            && *rk > 0.0;
-    }
-    if !ok {
+    let mut slots = r.iter_mut();
+    let [info] = link_information(model, &[r_pred], &[z], &[true], noise, |_, _, _, w| {
+        if let Some(slot) = slots.next() {
+            *slot = 1.0 / w;
+        }
+    });
+    // Every w finite and positive (checked by pass 1); 1/w may still overflow.
+    if !(info.valid && r.iter().fold(0.0, |a, v| a + v) < Real::INFINITY) {
         return Err(
             first_input_error(model, z, noise, r_pred).unwrap_or(Error::InvalidSigma {
-                link: used[0],
+                link: z.iter().position(Option::is_some).unwrap_or(0),
                 value: Real::NAN,
             }),
         );
@@ -239,132 +324,112 @@ fn measurement(
     Ok(())
 }
 
-/// `𝒵_i = c·h(χ_i)` of the links `used` (ranges, m): each node's distance once (E1: a link's
-/// range is the sum of its two).
+/// The ranges `c·h` (m) of the links present, in link order, at `center` into `z0` and their
+/// differences `d_k = 𝒵(points[k]) − 𝒵₀` into `d` (point-major, `z0.len()` per point): each
+/// node's distances once (E1: a link's range is the sum of its two), the four points side by
+/// side.
 #[inline]
-fn ranges(model: &Model, used: &[usize], chi: &Vec4, out: &mut [Real]) {
+fn sigma_ranges(
+    model: &Model,
+    z: &[Option<Real>],
+    center: Vec2,
+    points: &[Vec2; 4],
+    z0: &mut [Real],
+    d: &mut [Real],
+) {
+    let m = z0.len();
     let net = &model.network;
+    let (px, py) = (points.map(|p| p.x), points.map(|p| p.y));
     let dist = |n: Vec2| {
-        let (dx, dy) = (chi[0] - n.x, chi[1] - n.y);
-        sqrt(dx * dx + dy * dy)
+        let (dx, dy) = (center.x - n.x, center.y - n.y);
+        let at: [Real; 4] = core::array::from_fn(|k| {
+            let (dx, dy) = (px[k] - n.x, py[k] - n.y);
+            sqrt(dx * dx + dy * dy)
+        });
+        (sqrt(dx * dx + dy * dy), at)
     };
-    // The links of one transmitter are consecutive for a full mesh; reuse its distance.
-    let mut last_tx = (usize::MAX, 0.0);
-    for (o, &link) in out.iter_mut().zip(used) {
-        let l = net.links[link];
+    let present = net.links.iter().zip(z).filter(|(_, v)| v.is_some());
+    // The links of one transmitter are consecutive for a full mesh; reuse its distances.
+    let mut last_tx = (usize::MAX, (0.0, [0.0; 4]));
+    for ((i, z0), (l, _)) in z0.iter_mut().enumerate().zip(present) {
         if last_tx.0 != l.tx {
             last_tx = (l.tx, dist(net.transmitters[l.tx]));
         }
-        *o = last_tx.1 + dist(net.receivers[l.rx]);
-    }
-}
-
-/// The unscented update for at most `M` links in fixed-size (stack) matrices: the `m` links
-/// present fill the leading block, the rest of `S` is the identity and of `P_xz`, `ν` zero, so
-/// the padded solve leaves the leading block's results. Returns `K ν`, `K S Kᵀ` and the NIS.
-fn ut_update<const M: usize>(
-    model: &Model,
-    used: &[usize],
-    points: &[Vec4; 2 * N + 1],
-    (wm0, wc0, wi): (Real, Real, Real),
-    zc: &[Real],
-    r: &[Real],
-) -> Result<(Vec4, Mat4, Real)> {
-    use nalgebra::{SMatrix, SVector};
-    let m = used.len();
-    let mut zs = [SVector::<Real, M>::zeros(); 2 * N + 1];
-    for (zi, chi) in zs.iter_mut().zip(points) {
-        ranges(model, used, chi, &mut zi.as_mut_slice()[..m]);
-    }
-    let mut z_hat = zs[0] * wm0;
-    for zi in &zs[1..] {
-        z_hat += zi * wi;
-    }
-    let mut s = SMatrix::<Real, M, M>::identity();
-    let mut nu = SVector::<Real, M>::zeros();
-    for k in 0..m {
-        s[(k, k)] = r[k];
-        nu[k] = zc[k] - z_hat[k];
-    }
-    let mut pxz = SMatrix::<Real, N, M>::zeros();
-    for (i, (zi, chi)) in zs.iter().zip(points).enumerate() {
-        let wc = if i == 0 { wc0 } else { wi };
-        let mut dz = zi - z_hat;
-        for v in dz.as_mut_slice()[m..].iter_mut() {
-            *v = 0.0;
+        let ((t0, t), (r0, r)) = (last_tx.1, dist(net.receivers[l.rx]));
+        *z0 = t0 + r0;
+        for k in 0..4 {
+            d[k * m + i] = (t[k] + r[k]) - *z0;
         }
-        let dx = chi - points[0];
-        s += (dz * dz.transpose()) * wc;
-        pxz += (dx * dz.transpose()) * wc;
     }
-    let chol = Cholesky::new(s).ok_or_else(|| Error::NotPositiveDefinite {
-        field: "ukf.innovation_covariance".into(),
-    })?;
-    // K = P_xz S⁻¹ = (S⁻¹ P_zx)ᵀ.
-    let k = chol.solve(&pxz.transpose()).transpose();
-    let nis = nu.dot(&chol.solve(&nu));
-    Ok((k * nu, k * s * k.transpose(), nis))
 }
 
-/// [`ut_update`] for any number of links, in heap matrices.
-fn ut_update_dyn(
-    model: &Model,
-    used: &[usize],
-    points: &[Vec4; 2 * N + 1],
-    (wm0, wc0, wi): (Real, Real, Real),
-    zc: &[Real],
-    r: &[Real],
-) -> Result<(Vec4, Mat4, Real)> {
-    let m = used.len();
-    let zs: Vec<DVector<Real>> = points
-        .iter()
-        .map(|chi| {
-            let mut v = DVector::zeros(m);
-            ranges(model, used, chi, v.as_mut_slice());
-            v
-        })
-        .collect();
-    let mut z_hat = &zs[0] * wm0;
-    for zi in &zs[1..] {
-        z_hat += zi * wi;
+/// `S = G Gᵀ` (`S` the `m × m` lower triangle of `s`, row-major) into `s` in place (`G` lower,
+/// with `1/G_jj` on the diagonal), then `v ← G⁻¹ v` for each of `vs`. `false` if `S` is not
+/// positive definite (a pivot not finite and positive, the Cholesky criterion).
+fn whiten(s: &mut [Real], m: usize, vs: [&mut [Real]; 3]) -> bool {
+    for j in 0..m {
+        let mut djj = s[j * m + j];
+        for k in 0..j {
+            djj -= s[j * m + k] * s[j * m + k];
+        }
+        let positive = djj > 0.0 && djj < Real::INFINITY;
+        if !positive {
+            return false;
+        }
+        let inv = 1.0 / sqrt(djj);
+        s[j * m + j] = inv;
+        for i in j + 1..m {
+            let mut v = s[i * m + j];
+            for k in 0..j {
+                v -= s[i * m + k] * s[j * m + k];
+            }
+            s[i * m + j] = v * inv;
+        }
     }
-    let mut s = DMatrix::<Real>::from_diagonal(&DVector::from_column_slice(r));
-    let nu = DVector::from_fn(m, |k, _| zc[k] - z_hat[k]);
-    let mut pxz = DMatrix::<Real>::zeros(N, m);
-    for (i, (zi, chi)) in zs.iter().zip(points).enumerate() {
-        let wc = if i == 0 { wc0 } else { wi };
-        let dz = zi - &z_hat;
-        let dx = DVector::from_column_slice((chi - points[0]).as_slice());
-        s += wc * &dz * dz.transpose();
-        pxz += wc * dx * dz.transpose();
+    let [a, b, c] = vs;
+    for i in 0..m {
+        let row = &s[i * m..=i * m + i];
+        let (mut va, mut vb, mut vc) = (a[i], b[i], c[i]);
+        for k in 0..i {
+            va -= row[k] * a[k];
+            vb -= row[k] * b[k];
+            vc -= row[k] * c[k];
+        }
+        (a[i], b[i], c[i]) = (va * row[i], vb * row[i], vc * row[i]);
     }
-    let chol = Cholesky::new(s.clone()).ok_or_else(|| Error::NotPositiveDefinite {
-        field: "ukf.innovation_covariance".into(),
-    })?;
-    let k = chol.solve(&pxz.transpose()).transpose();
-    let nis = nu.dot(&chol.solve(&nu));
-    let dx = &k * &nu;
-    let ksk = &k * &s * k.transpose();
-    Ok((
-        Vec4::new(dx[0], dx[1], dx[2], dx[3]),
-        Mat4::from_fn(|i, j| ksk[(i, j)]),
-        nis,
-    ))
+    true
 }
 
-/// The `2n + 1` sigma points of `(x, P)`: `x`, `x ± L_{:,i}` with `L Lᵀ = (n + λ) P`.
-fn sigma_points(x: &Vec4, p: &Mat4, params: &UkfParams) -> Result<[Vec4; 2 * N + 1]> {
-    let scaled = p * (N as Real + params.lambda());
-    let l = Cholesky::new(scaled)
-        .ok_or_else(|| Error::NotPositiveDefinite {
-            field: "ukf.covariance".into(),
-        })?
-        .l();
-    let mut pts = [*x; 2 * N + 1];
-    for i in 0..N {
-        let col: Vec4 = l.column(i).into_owned();
-        pts[1 + i] = x + col;
-        pts[1 + N + i] = x - col;
+/// Length of the scratch of an update with `m` links: `𝒵₀`/`ν`, the four differences `d_k`,
+/// `δ` and `R` (`m` each), and `S` (`m²`).
+const fn scratch_len(m: usize) -> usize {
+    m * m + 7 * m
+}
+
+/// The work arrays of an update with `m` links, carved from one buffer.
+struct Scratch<'a> {
+    m: usize,
+    z0: &'a mut [Real],
+    d: &'a mut [Real],
+    delta: &'a mut [Real],
+    r: &'a mut [Real],
+    s: &'a mut [Real],
+}
+
+impl<'a> Scratch<'a> {
+    #[inline(always)]
+    fn new(m: usize, buf: &'a mut [Real]) -> Scratch<'a> {
+        let (z0, rest) = buf.split_at_mut(m);
+        let (d, rest) = rest.split_at_mut(4 * m);
+        let (delta, rest) = rest.split_at_mut(m);
+        let (r, rest) = rest.split_at_mut(m);
+        Scratch {
+            m,
+            z0,
+            d,
+            delta,
+            r,
+            s: &mut rest[..m * m],
+        }
     }
-    Ok(pts)
 }

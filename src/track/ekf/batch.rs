@@ -23,10 +23,12 @@ pub(crate) fn update_lanes<const L: usize>(
     z: [&[Option<Real>]; L],
     active: [bool; L],
     noise: MeasurementNoise,
-    innovation: impl FnMut(usize, usize, Real),
+    mut innovation: impl FnMut(usize, usize, Real),
 ) -> [Result<UpdateSummary>; L] {
     let r_pred: [Vec2; L] = core::array::from_fn(|j| filters[j].position());
-    let info = link_information(model, &r_pred, &z, &active, noise, innovation);
+    let info = link_information(model, &r_pred, &z, &active, noise, |j, p, nu, _| {
+        innovation(j, p, nu)
+    });
     let mut out = [NO_UPDATE; L];
     for (j, out) in out.iter_mut().enumerate() {
         let a = &info[j];

@@ -31,17 +31,17 @@ const TX_TABLE: usize = 4;
 /// Running sums of pass 1 for one filter (module docs): `M`, `b`, `νᵀR⁻¹ν`, the number of
 /// links used and whether every used link's inputs were valid.
 #[derive(Debug, Clone, Copy)]
-pub(super) struct Information {
+pub(crate) struct Information {
     pub(super) m00: Real,
     pub(super) m01: Real,
     pub(super) m11: Real,
     pub(super) b0: Real,
     pub(super) b1: Real,
     pub(super) nu_info_nu: Real,
-    pub(super) links_used: usize,
+    pub(crate) links_used: usize,
     /// Every used link has a delay in [`limits::DELAY_S`], a valid `σ_p` and a finite, positive
     /// `w` (otherwise the caller rescans the inputs for the named error).
-    pub(super) valid: bool,
+    pub(crate) valid: bool,
 }
 
 const NO_INFORMATION: Information = Information {
@@ -238,16 +238,17 @@ impl Weights for AtPoint<'_> {
 /// Pass 1 for `L` filters with predicted positions `r[j]` and delays `z[j]` (one per link,
 /// lengths checked by the caller; `active[j] = false` skips filter `j`): the sums over the
 /// available links (module docs). The filters' transmitter gains, the longest dependency chain
-/// of an update, are evaluated side by side. `innovation(j, p, ν_p)` receives each used link's
-/// range innovation, m, in link order.
+/// of an update, are evaluated side by side. `per_link(j, p, ν_p, w_p)` receives each used
+/// link's range innovation, m, and range information `w_p = 1/(cσ_p)²`, 1/m², in link order
+/// (the UKF takes its `R` from these).
 #[inline(always)]
-pub(super) fn link_information<const L: usize>(
+pub(crate) fn link_information<const L: usize>(
     model: &Model,
     r: &[Vec2; L],
     z: &[&[Option<Real>]; L],
     active: &[bool; L],
     noise: MeasurementNoise,
-    innovation: impl FnMut(usize, usize, Real),
+    per_link: impl FnMut(usize, usize, Real, Real),
 ) -> [Information; L] {
     match noise {
         MeasurementNoise::AtPrediction => {
@@ -255,14 +256,14 @@ pub(super) fn link_information<const L: usize>(
                 snr_scale: &model.snr_scale,
                 info_per_snr: range_information_per_snr(model),
             };
-            with_transmitters(model, r, z, active, &w, innovation)
+            with_transmitters(model, r, z, active, &w, per_link)
         }
         MeasurementNoise::Fixed(sigma) => {
-            with_transmitters(model, r, z, active, &Given(sigma), innovation)
+            with_transmitters(model, r, z, active, &Given(sigma), per_link)
         }
         MeasurementNoise::At(point) => {
             let w = AtPoint { model, point };
-            with_transmitters(model, r, z, active, &w, innovation)
+            with_transmitters(model, r, z, active, &w, per_link)
         }
     }
 }
@@ -275,12 +276,12 @@ fn with_transmitters<W: Weights, const L: usize>(
     z: &[&[Option<Real>]; L],
     active: &[bool; L],
     w: &W,
-    innovation: impl FnMut(usize, usize, Real),
+    per_link: impl FnMut(usize, usize, Real, Real),
 ) -> [Information; L] {
     if model.network.transmitters.len() == 1 {
         // One transmitter (both presets): the same view for every link of a filter.
         let tx = tx_seen_from(model, 0, r, W::GAIN);
-        return blocks(model, r, z, active, w, |j, _| tx[j], innovation);
+        return blocks(model, r, z, active, w, |j, _| tx[j], per_link);
     }
     let table: [[TxView; TX_TABLE]; L] =
         core::array::from_fn(|j| tx_views::<TX_TABLE>(model, 0, r[j], W::GAIN));
@@ -296,7 +297,7 @@ fn with_transmitters<W: Weights, const L: usize>(
             spill[j].1
         }
     };
-    blocks(model, r, z, active, w, tx_view, innovation)
+    blocks(model, r, z, active, w, tx_view, per_link)
 }
 
 /// The full blocks of links, then the last one padded with unused lanes (which repeat the last
@@ -309,7 +310,7 @@ fn blocks<W: Weights, const L: usize>(
     active: &[bool; L],
     w: &W,
     mut tx_view: impl FnMut(usize, usize) -> TxView,
-    mut innovation: impl FnMut(usize, usize, Real),
+    mut per_link: impl FnMut(usize, usize, Real, Real),
 ) -> [Information; L] {
     let links = &model.network.links[..];
     let n = links.len();
@@ -323,7 +324,7 @@ fn blocks<W: Weights, const L: usize>(
                 let block_z = fixed(&z[j][first..]);
                 let (a, r) = (&mut acc[j], r[j]);
                 let mut tx = |k| tx_view(j, k);
-                let mut inn = |p, nu| innovation(j, p, nu);
+                let mut inn = |p, nu, w| per_link(j, p, nu, w);
                 add_block(
                     a,
                     model,
@@ -347,7 +348,7 @@ fn blocks<W: Weights, const L: usize>(
                 block_z[..n - full].copy_from_slice(&z[j][full..]);
                 let (a, r) = (&mut acc[j], r[j]);
                 let mut tx = |k| tx_view(j, k);
-                let mut inn = |p, nu| innovation(j, p, nu);
+                let mut inn = |p, nu, w| per_link(j, p, nu, w);
                 add_block(
                     a,
                     model,
@@ -384,7 +385,7 @@ fn add_block<W: Weights>(
     links: &[LinkIndex; BLOCK],
     z: &[Option<Real>; BLOCK],
     tx_view: &mut impl FnMut(usize) -> TxView,
-    innovation: &mut impl FnMut(usize, Real),
+    per_link: &mut impl FnMut(usize, Real, Real),
 ) {
     // Gather: the transmitter's view, the receiver, the delay and the factor of w. An unused lane
     // gets z = 0 and a factor that gives w = 0; its inputs are not checked.
@@ -404,7 +405,7 @@ fn add_block<W: Weights>(
     let rv = NodeViews::<BLOCK>::new(&rx_x, &rx_y, &[r.x; BLOCK], &[r.y; BLOCK]);
     // Per link the terms of the sums; every used w positive, every z and w finite.
     let mut t = [[0.0; 6]; BLOCK];
-    let mut nu = [0.0; BLOCK];
+    let (mut nu, mut weight) = ([0.0; BLOCK], [0.0; BLOCK]);
     let (mut positive, mut finite) = (0, 0.0);
     for i in 0..BLOCK {
         let wi = w.weight(
@@ -415,6 +416,7 @@ fn add_block<W: Weights>(
         );
         let range = SPEED_OF_LIGHT * zv[i] - (tx[i].distance + rv.distance[i]);
         nu[i] = if used[i] { range } else { 0.0 };
+        weight[i] = wi;
         let (gx, gy) = (tx[i].ux + rv.ux[i], tx[i].uy + rv.uy[i]);
         let (wgx, wgy) = (wi * gx, wi * gy);
         t[i] = [
@@ -443,7 +445,7 @@ fn add_block<W: Weights>(
     acc.links_used += count;
     for i in 0..BLOCK {
         if used[i] {
-            innovation(first + i, nu[i]);
+            per_link(first + i, nu[i], weight[i]);
         }
     }
 }
