@@ -4,7 +4,8 @@
 use super::tracking::{mc_done, wait_state};
 use super::{connect, js, open_hash, runtime, settle, start_server, Driver, SERIAL};
 
-/// Writes docs/screenshot-tracking.png (tracking mode, scenario II at 4.5 s, after a warm
+/// Writes docs/screenshot-tracking.png (tracking mode, scenario II at 4.5 s, the particle
+/// filter animated, EKF, UKF and PF in the Monte Carlo, after a warm
 /// Monte Carlo re-run) when `SCATTERLOC_SCREENSHOT=1`; otherwise does nothing.
 /// `SCATTERLOC_SCREENSHOT_HASH` (page options) and `SCATTERLOC_SCREENSHOT_OUT` (a path) override.
 #[test]
@@ -14,7 +15,7 @@ fn tracking_screenshot() {
         return;
     }
     let hash = std::env::var("SCATTERLOC_SCREENSHOT_HASH")
-        .unwrap_or_else(|_| "#mode=tracking&track=II&step=45".into());
+        .unwrap_or_else(|_| "#mode=tracking&track=II&step=45&filter=pf&filters=ekf,ukf,pf".into());
     let out = std::env::var("SCATTERLOC_SCREENSHOT_OUT").unwrap_or_else(|_| {
         concat!(env!("CARGO_MANIFEST_DIR"), "/docs/screenshot-tracking.png").into()
     });

@@ -26,7 +26,9 @@ const UINT32 = { min: 0, max: 4294967295, integer: true };
 
 /**
  * `#preset=iclgnss2019&target=6,4&seed=3&res=256` -> options; tracking: `#mode=tracking&track=II&step=45
- * &play=1&runs=200&ex=100&tseed=1&dt=0.1&speed=1&custom=x0,y0,x1,y1`; multi-target: `#mode=mtl`;
+ * &play=1&runs=200&ex=100&tseed=1&dt=0.1&speed=1&custom=x0,y0,x1,y1&filter=pf&particles=1000
+ * &filters=ekf,ukf,pf` (the animated filter, the particle count and the Monte Carlo's filters);
+ * multi-target: `#mode=mtl`;
  * a shared view ("Copy link"): `roi=x0,x1,y0,y1` (the Plan panel's region of interest, m) and
  * the scenario as `scenario=<base64url of its JSON>` or `z=<base64url of its raw-deflated JSON>`
  * (share.js; a scenario replaces the preset). Every number is parsed strictly (dom.js
@@ -69,6 +71,14 @@ function hashOptions(presets) {
     tseed: read('tseed', (t) => decimalIn(t, 'tseed', UINT32)),
     dt: option('dt', 'track-dt'),
     speed: option('speed', 'track-speed'),
+    filter: option('filter', 'track-filter'),
+    particles: option('particles', 'track-particles'),
+    filters: read('filters', (t) => {
+      const names = t.split(',');
+      const bad = names.find((n) => !['ekf', 'ukf', 'pf'].includes(n));
+      if (bad !== undefined) throw new Error(`filters: "${bad}" is not one of ekf, ukf, pf`);
+      return names;
+    }),
     custom: custom ? { x0: custom[0], y0: custom[1], x1: custom[2], y1: custom[3] } : null,
     preset: oneOf('preset', presets),
     target: target ? { x: target[0], y: target[1] } : null,
@@ -150,7 +160,7 @@ export async function start() {
       st.fix = tr ? tracking.frame : st.snap;
       st.overlay = tr ? (c, v) => tracking.overlay(c, v)
         : plan.showsRoi() ? (c, v) => plan.overlay(c, v) : null;
-      st.insetTitle = tr ? 'EKF zoom · true scale' : 'target zoom';
+      st.insetTitle = tr ? `${tracking.filterName()} zoom · true scale` : 'target zoom';
       st.insetAvoid = tr ? tracking.avoidPoints() : [];
       if (st.mode === 'mtl') mtl.draw(); else map.draw();
     } catch (e) {
@@ -188,7 +198,7 @@ export async function start() {
   const mtl = new Mtl(ctx);
   const plan = new Plan(ctx);
   ctx.plan = plan;
-  /** Snapshot view (click to place a target), tracking (animated EKF track + Monte Carlo) or multi-target. */
+  /** Snapshot view (click to place a target), tracking (animated filter track + Monte Carlo) or multi-target. */
   const setMode = (mode) => {
     st.mode = MODES.includes(mode) ? mode : 'snapshot';
     document.body.classList.toggle('mode-tracking', st.mode === 'tracking');

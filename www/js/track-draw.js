@@ -1,5 +1,5 @@
 // Drawing of a simulated track over the CRLB map (all numbers from the wasm core's Track): the
-// truth path, the EKF track with its 1σ covariance ellipses (magnified by a labelled factor), and
+// truth path, the filter's track (EKF, UKF or PF) with its 1σ covariance ellipses (magnified by a labelled factor), and
 // the arrow of a drawn trajectory. The current step's markers, iso-delay ellipses and the zoom
 // inset are drawn by draw.js from the snapshot-shaped frame.
 
@@ -71,14 +71,14 @@ export function drawTrack(ctx, view, tr) {
     const s = view.toPixel(d.truth[0][0], d.truth[0][1]);
     ctx.beginPath(); ctx.arc(s.x, s.y, 3.5, 0, FULL);
     ctx.fillStyle = TRUTH; ctx.fill();
-    // EKF 1σ ellipses (magnified) along the travelled part, then the current one.
+    // The filter's 1σ ellipses (magnified) along the travelled part, then the current one.
     const stride = Math.max(1, Math.round(d.truth.length / 20));
     ctx.lineWidth = 1;
     ctx.strokeStyle = 'rgba(255,169,77,0.3)';
     for (let n = stride; n < step; n += stride) {
       if (d.ellipses[n]) { ellipsePath(ctx, view, d.ellipses[n], tr.magnify); ctx.stroke(); }
     }
-    // EKF track up to now.
+    // The filter's track up to now.
     const track = d.estimates.slice(0, step + 1);
     halo(ctx, view, track, 4.5);
     ctx.strokeStyle = EKF;

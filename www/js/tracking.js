@@ -32,9 +32,11 @@ export class Tracking {
     const runs = opts.runs === undefined ? undefined : String(opts.runs);
     if (runs && ![...$('mc-runs').options].some((o) => o.value === runs)) $('mc-runs').add(new Option(`${runs} runs`, runs));
     for (const [id, v] of [['track-kind', this.kind], ['track-dt', opts.dt], ['track-seed', opts.tseed],
-      ['track-ex', opts.ex], ['mc-runs', runs], ['track-speed', opts.speed]]) {
+      ['track-ex', opts.ex], ['mc-runs', runs], ['track-speed', opts.speed], ['track-filter', opts.filter],
+      ['track-particles', opts.particles]]) {
       if (v !== null && v !== undefined && v !== '') $(id).value = String(v);
     }
+    if (opts.filters) for (const f of FILTERS) $(`mc-${f}`).checked = opts.filters.includes(f);
     const rerun = () => this.rerun();
     $('track-kind').addEventListener('change', () => { this.kind = $('track-kind').value; rerun(); });
     $('track-dt').addEventListener('change', rerun);
@@ -67,6 +69,9 @@ export class Tracking {
     return { kind: this.kind, x0: d.x0, y0: d.y0, vx: v[0], vy: v[1], dt_s: dt, steps, seed, filter, particles };
   }
 
+  /** The animated track's filter, `EKF`, `UKF` or `PF` (the one chosen until a track exists). */
+  filterName() { return (this.data ? this.data.filter : $('track-filter').value).toUpperCase(); }
+
   /** The filters ticked for the Monte Carlo, in the order EKF, UKF, PF (at least the EKF). */
   mcFilters() {
     const on = FILTERS.filter((f) => $(`mc-${f}`).checked);
@@ -98,7 +103,7 @@ export class Tracking {
     }
     $('track-hint').hidden = this.kind !== 'custom';
     $('track-particles-wrap').hidden = $('track-filter').value !== 'pf' && !$('mc-pf').checked;
-    $('track-filter-label').textContent = $('track-filter').value.toUpperCase();
+    $('track-filter-label').textContent = this.filterName();
   }
 
   startMc() {
@@ -224,7 +229,7 @@ export class Tracking {
     $('track-time').textContent = `t = ${fixed(f.t_s, 2)} s / ${fixed(tEnd, 2)} s · step ${f.step}/${n}`;
     $('track-ex-label').textContent = `×${$('track-ex').value}`;
     const m2 = (x, y) => `${fixed(x, 3)}, ${fixed(y, 3)} m`;
-    const name = this.data.filter.toUpperCase();
+    const name = this.filterName();
     const rows = [
       ['Truth', m2(f.truth.x, f.truth.y), ''],
       [`${name} estimate`, m2(f.fix.x, f.fix.y), 'fix'],
