@@ -231,8 +231,17 @@ fn draw_panel<DB: DrawingBackend>(
         .log_scale()
         .with_key_points(major.iter().map(|t| t.value).collect())
         .with_light_points(minor.iter().map(|t| t.value));
+    // The caption shrinks to the panel's width (long failure notes of several filters).
+    let (w, _) = area.dim_in_pixel();
+    let mut caption_size = font.axis * 1.1;
+    let wide = area
+        .estimate_text_size(p.title, &("sans-serif", caption_size).into_text_style(area))
+        .map_or(0, |(tw, _)| tw);
+    if wide as f64 > 0.96 * w as f64 {
+        caption_size *= 0.96 * w as f64 / wide as f64;
+    }
     let mut chart = ChartBuilder::on(area)
-        .caption(p.title, ("sans-serif", font.axis * 1.1).into_font())
+        .caption(p.title, ("sans-serif", caption_size).into_font())
         .margin_top((6.0 * s) as u32)
         .margin_right((18.0 * s) as u32)
         .margin_left((6.0 * s) as u32)
