@@ -211,12 +211,10 @@ fn floats(v: &Value) -> Vec<f64> {
         .collect()
 }
 
-/// The browser's study against the native core on the page's final scenario: largest relative
-/// difference over t, ε_EKF, ε_PCRLB and NEES.
-fn native_difference(params: &Value, result: &Value) -> f64 {
+/// The model and the study the page ran with `params` (its worker message).
+fn page_study(params: &Value) -> (Model, MonteCarloConfig) {
     let p = |k: &str| params[k].as_f64().unwrap();
     let scenario = Scenario::from_json(params["scenario"].as_str().unwrap()).unwrap();
-    let model = Model::new(&scenario).unwrap();
     let mean = track_mean_state(
         params["kind"].as_str().unwrap(),
         Vec2::new(p("x0"), p("y0")),
@@ -233,6 +231,13 @@ fn native_difference(params: &Value, result: &Value) -> f64 {
         seed: p("seed") as u64,
         oracle_noise: false,
     };
+    (Model::new(&scenario).unwrap(), cfg)
+}
+
+/// The browser's study against the native core on the page's final scenario: largest relative
+/// difference over t, ε_EKF, ε_PCRLB and NEES.
+fn native_difference(params: &Value, result: &Value) -> f64 {
+    let (model, cfg) = page_study(params);
     let native = run_sequential(&model, &cfg, |_, _| true).unwrap();
     assert_eq!(result["runs"].as_u64(), Some(native.runs as u64));
     let pcrlb: Vec<f64> = native
@@ -485,27 +490,9 @@ fn tracking_page_runs_the_chosen_filters() {
 /// the largest relative difference of RMSE and NEES (runs counted must be equal).
 fn native_filters_difference(params: &Value, result: &Value) -> f64 {
     use scatterloc::track::{finish, run_filter_chunk, FilterKind, PfConfig, StudySums};
-    let p = |k: &str| params[k].as_f64().unwrap();
-    let scenario = Scenario::from_json(params["scenario"].as_str().unwrap()).unwrap();
-    let model = Model::new(&scenario).unwrap();
-    let mean = track_mean_state(
-        params["kind"].as_str().unwrap(),
-        Vec2::new(p("x0"), p("y0")),
-        Vec2::new(p("vx"), p("vy")),
-    )
-    .unwrap();
-    let cfg = MonteCarloConfig {
-        motion: ConstantVelocity::new(p("dt_s"), PAPER_INTENSITY),
-        steps: p("steps") as usize,
-        mean_state: mean,
-        initial_covariance: paper_initial_covariance(),
-        trajectories: p("trajectories") as usize,
-        noise_runs: p("noise_runs") as usize,
-        seed: p("seed") as u64,
-        oracle_noise: false,
-    };
+    let (model, cfg) = page_study(params);
     let pf = FilterKind::Pf(PfConfig {
-        particles: p("particles") as usize,
+        particles: params["particles"].as_f64().unwrap() as usize,
         roughening: None,
     });
     let mut worst: f64 = 0.0;

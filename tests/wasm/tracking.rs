@@ -163,6 +163,21 @@ fn job(
     )
 }
 
+/// The native model and study of [`job`]`("II", …)`.
+fn native_study(steps: usize, trajectories: usize, noise: usize) -> (Model, MonteCarloConfig) {
+    let cfg = MonteCarloConfig {
+        motion: ConstantVelocity::new(0.1, PAPER_INTENSITY),
+        steps,
+        mean_state: TrackScenario::II.mean_state(),
+        initial_covariance: paper_initial_covariance(),
+        trajectories,
+        noise_runs: noise,
+        seed: 11,
+        oracle_noise: false,
+    };
+    (Model::new(&presets::sensors2019()).unwrap(), cfg)
+}
+
 fn parse(s: &str) -> Value {
     serde_json::from_str(s).expect("result_json is JSON")
 }
@@ -190,17 +205,7 @@ fn monte_carlo_job_chunked_equals_one_go_and_core() {
     assert_eq!(r["failed_runs"], 0);
     assert_eq!(r["done"], Value::Bool(true));
 
-    let model = Model::new(&presets::sensors2019()).unwrap();
-    let cfg = MonteCarloConfig {
-        motion: ConstantVelocity::new(0.1, PAPER_INTENSITY),
-        steps,
-        mean_state: TrackScenario::II.mean_state(),
-        initial_covariance: paper_initial_covariance(),
-        trajectories,
-        noise_runs: noise,
-        seed: 11,
-        oracle_noise: false,
-    };
+    let (model, cfg) = native_study(steps, trajectories, noise);
     let native = run_sequential(&model, &cfg, |_, _| true).unwrap();
     let floats = |v: &Value| -> Vec<Option<f64>> {
         v.as_array().unwrap().iter().map(Value::as_f64).collect()
@@ -390,17 +395,7 @@ fn monte_carlo_job_runs_several_filters() {
         (r["particles"].as_u64(), r["particle_budget"].as_u64()),
         (Some(300), Some(200_000))
     );
-    let model = Model::new(&presets::sensors2019()).unwrap();
-    let cfg = MonteCarloConfig {
-        motion: ConstantVelocity::new(0.1, PAPER_INTENSITY),
-        steps,
-        mean_state: TrackScenario::II.mean_state(),
-        initial_covariance: paper_initial_covariance(),
-        trajectories,
-        noise_runs: 1,
-        seed: 11,
-        oracle_noise: false,
-    };
+    let (model, cfg) = native_study(steps, trajectories, 1);
     let pf = FilterKind::Pf(PfConfig {
         particles: 300,
         roughening: None,
