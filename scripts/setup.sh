@@ -25,3 +25,30 @@ if [ "$(ver wasm-bindgen || true)" != "$WB_VERSION" ]; then
   cargo install wasm-bindgen-cli --version "$WB_VERSION" --locked --force \
     || cargo install wasm-bindgen-cli --version "$WB_VERSION" --force
 fi
+
+# axe-core (the accessibility engine of tests/e2e/a11y.rs), pinned and checked against the npm
+# registry's sha512 integrity; unpacked into the git-ignored .tools/axe-core/ (never served by the
+# page, no CDN). npm pack when npm is there, else the same tarball from registry.npmjs.org.
+AXE_VERSION=4.10.2
+AXE_SHA512=RE3mdQ7P3FRSe7eqCWoeQ/Z9QXrtniSjp1wUjt5nRC3WIpz5rSCve6o3fsZ2aCpJtrZjSZgjwXAoTO5k4tEI0w==
+AXE_DIR=.tools/axe-core
+if [ "$(cat "$AXE_DIR/VERSION" 2>/dev/null || true)" != "$AXE_VERSION" ] || [ ! -s "$AXE_DIR/axe.min.js" ]; then
+  tmp=$(mktemp -d)
+  tgz="$tmp/axe-core-$AXE_VERSION.tgz"
+  if command -v npm >/dev/null; then
+    (cd "$tmp" && npm pack --silent "axe-core@$AXE_VERSION" >/dev/null)
+  else
+    curl -fsSL -o "$tgz" "https://registry.npmjs.org/axe-core/-/axe-core-$AXE_VERSION.tgz"
+  fi
+  got=$(sha512sum "$tgz" | awk '{print $1}')
+  want=$(printf '%s' "$AXE_SHA512" | base64 -d | od -An -v -tx1 | tr -d ' \n')
+  if [ "$got" != "$want" ]; then
+    echo "setup: axe-core $AXE_VERSION tarball sha512 mismatch (got $got)" >&2
+    rm -rf "$tmp"
+    exit 1
+  fi
+  rm -rf "$AXE_DIR" && mkdir -p "$AXE_DIR"
+  tar -xzf "$tgz" -C "$AXE_DIR" --strip-components=1
+  echo "$AXE_VERSION" >"$AXE_DIR/VERSION"
+  rm -rf "$tmp"
+fi

@@ -44,6 +44,10 @@ mod speed;
 #[path = "e2e/plan.rs"]
 mod plan;
 
+/// Issue 16: keyboard (Tab, arrows, Delete on the plot) and axe-core in the three views.
+#[path = "e2e/a11y.rs"]
+mod a11y;
+
 /// `SCATTERLOC_SCREENSHOT=1`: writes docs/screenshot-tracking.png.
 #[path = "e2e/screenshot.rs"]
 mod screenshot;

@@ -12,6 +12,7 @@ import { View } from './view.js';
 import { MapView } from './map.js';
 import { Panel } from './panel.js';
 import { attachPointer } from './interact.js';
+import { attachKeyboard } from './keyboard.js';
 import { Tracking } from './tracking.js';
 import { Mtl } from './mtl.js';
 import { Plan } from './plan.js';
@@ -216,6 +217,7 @@ export async function start() {
   for (const m of MODES) $(`mode-${m}`).addEventListener('click', () => setMode(m));
   $('preset').value = shared ? '' : preset;
   const pointer = attachPointer(ctx);
+  attachKeyboard(ctx, mtl);
   ctx.showHint = () => pointer.showHint();
 
   view.resize();

@@ -13,6 +13,7 @@ export const C = {
   fix: '#ffa94d',
   crlb: '#5cc8ff',
   sel: '#5cc8ff',
+  focus: '#ffd166',
   iso: 'rgba(255,255,255,0.62)',
   baseline: 'rgba(255,255,255,0.28)',
 };
@@ -104,10 +105,21 @@ export function drawAxes(ctx, view, w) {
   ctx.strokeRect(Math.round(r.x) + 0.5, Math.round(r.y) + 0.5, Math.round(r.w), Math.round(r.h));
 }
 
-/** A selection ring of radius `r` px around pixel `p`. */
+/** The plot has keyboard focus (keyboard.js): the selected object also gets a focus ring. */
+export const plotFocus = { on: false };
+
+/** The keyboard focus ring of radius `r` px around pixel `p` (bright over a dark halo). */
+export function focusRing(ctx, p, r) {
+  ctx.beginPath(); ctx.arc(p.x, p.y, r, 0, FULL);
+  ctx.lineWidth = 5; ctx.strokeStyle = 'rgba(10,12,18,0.9)'; ctx.stroke();
+  ctx.lineWidth = 2.5; ctx.strokeStyle = C.focus; ctx.stroke();
+}
+
+/** A selection ring of radius `r` px around pixel `p` (and the focus ring while focused). */
 export function ring(ctx, p, r) {
   ctx.beginPath(); ctx.arc(p.x, p.y, r, 0, FULL);
   ctx.lineWidth = 2; ctx.strokeStyle = C.sel; ctx.stroke();
+  if (plotFocus.on) focusRing(ctx, p, r + 4);
 }
 
 /** A receiver marker (disc) at pixel `p` with its label above right; ringed when `selected`. */

@@ -29,6 +29,24 @@ export function pickNearest(view, groups, p) {
 /** The Tx/Rx node under a canvas pixel ({kind, index}), or null. */
 const hitNode = (view, nodes, p) => pickNearest(view, [['rx', nodes.receivers], ['tx', nodes.transmitters]], p);
 
+/**
+ * Moves Tx/Rx `node` ({kind, index}) to (x, y) m and marks the map, geometry and panel stale as
+ * a drag does (the map reduced until the drag's end asks for it in full): the one path of a
+ * mouse drag and a keyboard move (keyboard.js). A rejected position shows the core's message.
+ */
+export function moveNode(ctx, node, x, y) {
+  try {
+    if (node.kind === 'tx') ctx.app.move_transmitter(node.index, x, y);
+    else ctx.app.move_receiver(node.index, x, y);
+    clearError();
+    ctx.changed({ all: true, dragging: true });
+    return true;
+  } catch (e) {
+    showError(errorText(e));
+    return false;
+  }
+}
+
 export function attachPointer(ctx) {
   const { view, st, app } = ctx;
   const canvas = view.canvas;
@@ -81,14 +99,7 @@ export function attachPointer(ctx) {
       // Keep the node inside the plotted area (clamped in pixels).
       const r = view.rect;
       const m = view.toMetreWithin(p, r, { x: r.x + r.w, y: r.y + r.h });
-      try {
-        if (press.node.kind === 'tx') app.move_transmitter(press.node.index, m.x, m.y);
-        else app.move_receiver(press.node.index, m.x, m.y);
-        clearError();
-        ctx.changed({ all: true, dragging: true });
-      } catch (e) {
-        showError(errorText(e));
-      }
+      moveNode(ctx, press.node, m.x, m.y);
     } else if (press && press.roi) {
       ctx.plan.roiMove(p);
     } else if (press && press.draw) {

@@ -3,7 +3,7 @@
 // through the view transform. Markers of the scene (nodes, targets, discs) are drawn from the
 // scene itself so they follow a drag at once.
 
-import { C, FONT_B, FULL, clipTo, cross, drawAxes, drawNodes, ellipsePath, haloText, isSelected, linkColor, ring } from './draw.js';
+import { C, FONT_B, FULL, clipTo, cross, drawAxes, drawNodes, ellipsePath, focusRing, haloText, isSelected, linkColor, plotFocus, ring } from './draw.js';
 
 const BG = '#10141c';
 const DISC = 'rgba(150,160,178,0.55)';
@@ -108,6 +108,7 @@ function discs(ctx, view, scene, sel) {
     ctx.lineWidth = on ? 2.5 : 1;
     ctx.strokeStyle = on ? C.sel : '#c9d2e0';
     ctx.stroke();
+    if (on && plotFocus.on) focusRing(ctx, p, r + 4);
   });
 }
 

@@ -216,11 +216,27 @@ export class Mtl {
     this.apply((s) => { s[list].push(SPOTS[0]); });
   }
 
-  /** Removes the selected target/disc, or the last one. */
+  /**
+   * Removes the selected object of `kind` (a target or disc, or on Delete a node), or the last
+   * one; the core judges the scene left. Returns whether it was removed.
+   */
   remove(list, kind) {
-    if (this.scene[list].length === 0) return;
+    if (this.scene[list].length === 0) return false;
     const sel = this.selected && this.selected.kind === kind ? this.selected.index : this.scene[list].length - 1;
-    if (this.apply((s) => { s[list].splice(sel, 1); })) this.selected = null;
+    const ok = this.apply((s) => { s[list].splice(sel, 1); });
+    if (ok) this.selected = null;
+    return ok;
+  }
+
+  /**
+   * Moves object {kind, index} to (x, y) m if the core accepts the scene: the one path of a drag
+   * and a keyboard move (keyboard.js). Returns whether the scene changed.
+   */
+  moveTo({ kind, index }, x, y) {
+    const list = this.listOf(kind);
+    const cur = this.scene[list][index];
+    if (cur[0] === x && cur[1] === y) return false;
+    return this.apply((s) => { s[list][index] = [x, y]; });
   }
 
   /** Panel inputs from the scene. */
@@ -313,11 +329,7 @@ export class Mtl {
       // Keep the dragged object inside the region (clamped in pixels).
       const [x0, x1, y0, y1] = this.scene.region;
       const m = this.view.toMetreWithin(p, this.view.toPixel(x0, y1), this.view.toPixel(x1, y0));
-      const { kind, index } = this.press;
-      const list = this.listOf(kind);
-      const cur = this.scene[list][index];
-      if (cur[0] === m.x && cur[1] === m.y) return;
-      this.apply((s) => { s[list][index] = [m.x, m.y]; });
+      this.moveTo(this.press, m.x, m.y);
     }, true);
     const end = (ev) => {
       if (!mine(ev)) return;
@@ -347,6 +359,7 @@ export class Mtl {
     return {
       mode: this.ctx.st.mode,
       scene: structuredClone(this.scene),
+      selected: this.selected,
       gen: this.gen,
       viewGen: this.resultGen,
       pending: this.gen !== this.resultGen,

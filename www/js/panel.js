@@ -55,10 +55,8 @@ export class Panel {
     $('rx-select').addEventListener('change', (e) => this.select('rx', Number(e.target.value)));
     $('tx-add').addEventListener('click', () => this.addNode('tx'));
     $('rx-add').addEventListener('click', () => this.addNode('rx'));
-    $('tx-remove').addEventListener('click', () =>
-      this.run(null, () => { ctx.app.remove_transmitter(tx()); ctx.st.selTx = Math.max(0, tx() - 1); }));
-    $('rx-remove').addEventListener('click', () =>
-      this.run(null, () => { ctx.app.remove_receiver(rx()); ctx.st.selRx = Math.max(0, rx() - 1); }));
+    $('tx-remove').addEventListener('click', () => this.removeNode('tx'));
+    $('rx-remove').addEventListener('click', () => this.removeNode('rx'));
     $('resolution').addEventListener('change', () => ctx.changed({ map: true }));
 
     // Import / export (same JSON schema as the CLI).
@@ -163,6 +161,19 @@ export class Panel {
     this.run(null, () => {
       const i = kind === 'tx' ? this.ctx.app.add_transmitter(x, y) : this.ctx.app.add_receiver(x, y);
       this.select(kind, i, false);
+    });
+  }
+
+  /**
+   * Removes the selected transmitter or receiver (the Remove buttons and Delete on the plot);
+   * the core refuses the last one (its message in the banner). Returns whether it was removed.
+   */
+  removeNode(kind) {
+    const { app, st } = this.ctx;
+    const i = kind === 'tx' ? st.selTx : st.selRx;
+    return this.run(null, () => {
+      if (kind === 'tx') app.remove_transmitter(i); else app.remove_receiver(i);
+      this.select(kind, Math.max(0, i - 1), false);
     });
   }
 
