@@ -44,6 +44,10 @@ mod speed;
 #[path = "e2e/plan.rs"]
 mod plan;
 
+/// Issue 16: responsive layout at four widths in the three views, and a touch drag (CDP).
+#[path = "e2e/layout.rs"]
+mod layout;
+
 /// `SCATTERLOC_SCREENSHOT=1`: writes docs/screenshot-tracking.png.
 #[path = "e2e/screenshot.rs"]
 mod screenshot;
