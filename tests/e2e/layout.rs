@@ -78,9 +78,12 @@ return {
 };
 "#;
 
-/// Sizes the window so that the page's innerWidth × innerHeight is `w` × `h`.
+/// Sizes the window so that the page's innerWidth × innerHeight is `w` × `h` (the window chrome
+/// measured as outer − inner size; re-measured until the page reports the size, since a resize
+/// lands asynchronously).
 async fn set_viewport(c: &Client, w: u32, h: u32) -> Result<(), String> {
-    for _ in 0..3 {
+    let mut inner = Value::Null;
+    for _ in 0..10 {
         let chrome = js(
             c,
             "return [outerWidth - innerWidth, outerHeight - innerHeight]",
@@ -91,12 +94,14 @@ async fn set_viewport(c: &Client, w: u32, h: u32) -> Result<(), String> {
         c.set_window_size(w + cw, h + ch)
             .await
             .map_err(|e| e.to_string())?;
-        let inner = js(c, "return [innerWidth, innerHeight]").await?;
-        if inner == json!([w, h]) {
-            return Ok(());
+        for _ in 0..10 {
+            inner = js(c, "return [innerWidth, innerHeight]").await?;
+            if inner == json!([w, h]) {
+                return Ok(());
+            }
+            tokio::time::sleep(Duration::from_millis(50)).await;
         }
     }
-    let inner = js(c, "return [innerWidth, innerHeight]").await?;
     Err(format!("viewport {w}×{h} asked, {inner} set"))
 }
 
