@@ -48,6 +48,10 @@ mod plan;
 #[path = "e2e/a11y.rs"]
 mod a11y;
 
+/// Issue 16: responsive layout at four widths in the three views, and a touch drag (CDP).
+#[path = "e2e/layout.rs"]
+mod layout;
+
 /// `SCATTERLOC_SCREENSHOT=1`: writes docs/screenshot-tracking.png.
 #[path = "e2e/screenshot.rs"]
 mod screenshot;

@@ -7,7 +7,8 @@ use super::{connect, js, open_hash, runtime, settle, start_server, Driver, SERIA
 /// Writes docs/screenshot-tracking.png (tracking mode, scenario II at 4.5 s, the particle
 /// filter animated, EKF, UKF and PF in the Monte Carlo, after a warm
 /// Monte Carlo re-run) when `SCATTERLOC_SCREENSHOT=1`; otherwise does nothing.
-/// `SCATTERLOC_SCREENSHOT_HASH` (page options) and `SCATTERLOC_SCREENSHOT_OUT` (a path) override.
+/// `SCATTERLOC_SCREENSHOT_HASH` (page options), `SCATTERLOC_SCREENSHOT_OUT` (a path) and
+/// `SCATTERLOC_SCREENSHOT_SIZE` (the viewport, `WIDTHxHEIGHT` CSS px; 1400x900 by default) override.
 #[test]
 #[ignore = "needs chromium + chromedriver and www/pkg; set SCATTERLOC_SCREENSHOT=1"]
 fn tracking_screenshot() {
@@ -19,20 +20,30 @@ fn tracking_screenshot() {
     let out = std::env::var("SCATTERLOC_SCREENSHOT_OUT").unwrap_or_else(|_| {
         concat!(env!("CARGO_MANIFEST_DIR"), "/docs/screenshot-tracking.png").into()
     });
+    let size: Vec<u32> = std::env::var("SCATTERLOC_SCREENSHOT_SIZE")
+        .unwrap_or_else(|_| "1400x900".into())
+        .split('x')
+        .map(|v| {
+            v.trim()
+                .parse()
+                .expect("SCATTERLOC_SCREENSHOT_SIZE: WIDTHxHEIGHT")
+        })
+        .collect();
+    assert_eq!(size.len(), 2, "SCATTERLOC_SCREENSHOT_SIZE: WIDTHxHEIGHT");
     let _serial = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
     let port = start_server();
     let driver = Driver::start();
     let png = runtime().block_on(async {
         let c = connect(&driver).await;
         let r = async {
-            // A 1400 × 900 viewport, like docs/screenshot.png.
+            // A 1400 × 900 viewport by default, like docs/screenshot.png.
             let chrome = js(
                 &c,
                 "return [outerWidth - innerWidth, outerHeight - innerHeight]",
             )
             .await?;
             let chrome: Vec<u32> = serde_json::from_value(chrome).map_err(|e| e.to_string())?;
-            c.set_window_size(1400 + chrome[0], 900 + chrome[1])
+            c.set_window_size(size[0] + chrome[0], size[1] + chrome[1])
                 .await
                 .map_err(|e| e.to_string())?;
             open_hash(&c, port, &hash).await?;

@@ -226,6 +226,10 @@ export async function start() {
     view.resize();
     changed({ draw: true });
   }).observe($('plot').parentElement);
+  // A new devicePixelRatio (browser zoom, another screen) without a new CSS size: redraw sharp.
+  const watchDpr = () => matchMedia(`(resolution: ${window.devicePixelRatio}dppx)`)
+    .addEventListener('change', () => { view.resize(); changed({ draw: true }); watchDpr(); }, { once: true });
+  watchDpr();
 
   if (opts.roi) {
     try {

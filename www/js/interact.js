@@ -5,17 +5,21 @@
 
 import { $, errorText, fixed, showError, clearError } from './dom.js';
 
-const HIT_PX = 12; // pick radius around a marker, CSS px
+const HIT_PX = 12; // pick radius around a marker, CSS px (mouse)
+const TOUCH_HIT_PX = 22; // the same for a finger or pen: a target about 44 CSS px across
 const CLICK_PX = 4; // a press that moves less than this is a click
 
+/** The pick radius for a pointer event: finger-sized for touch and pen, HIT_PX for a mouse. */
+export const hitRadius = (ev) => (ev && (ev.pointerType === 'touch' || ev.pointerType === 'pen') ? TOUCH_HIT_PX : HIT_PX);
+
 /**
- * The object nearest to canvas pixel `p` within HIT_PX, or null: `groups` = [[kind, points,
- * extraPx = 0], …] with points [x, y] or {x, y} (m) and `extraPx` their radius on screen; on a
- * tie the later group wins. Returns {kind, index}.
+ * The object nearest to canvas pixel `p` within `radius` CSS px (HIT_PX by default; hitRadius(ev)
+ * for a press), or null: `groups` = [[kind, points, extraPx = 0], …] with points [x, y] or {x, y}
+ * (m) and `extraPx` their radius on screen; on a tie the later group wins. Returns {kind, index}.
  */
-export function pickNearest(view, groups, p) {
+export function pickNearest(view, groups, p, radius = HIT_PX) {
   let best = null;
-  let bestD = HIT_PX;
+  let bestD = radius;
   for (const [kind, list, extra = 0] of groups) {
     list.forEach((q, index) => {
       const c = Array.isArray(q) ? view.toPixel(q[0], q[1]) : view.toPixel(q.x, q.y);
@@ -27,7 +31,8 @@ export function pickNearest(view, groups, p) {
 }
 
 /** The Tx/Rx node under a canvas pixel ({kind, index}), or null. */
-const hitNode = (view, nodes, p) => pickNearest(view, [['rx', nodes.receivers], ['tx', nodes.transmitters]], p);
+const hitNode = (view, nodes, p, radius) =>
+  pickNearest(view, [['rx', nodes.receivers], ['tx', nodes.transmitters]], p, radius);
 
 /**
  * Moves Tx/Rx `node` ({kind, index}) to (x, y) m and marks the map, geometry and panel stale as
@@ -78,7 +83,7 @@ export function attachPointer(ctx) {
     const p = view.eventPixel(ev);
     // "Draw ROI" armed: the press draws the ROI, even over a node.
     const roi = !!ctx.plan && ctx.plan.wantsRoi() && view.inPlot(p.x, p.y);
-    const node = roi ? null : hitNode(view, st.nodes, p);
+    const node = roi ? null : hitNode(view, st.nodes, p, hitRadius(ev));
     const draw = !node && !roi && view.inPlot(p.x, p.y) && ctx.tracking.wantsDraw();
     press = { start: p, node, moved: false, draw, roi };
     if (roi) ctx.plan.roiStart(p);

@@ -9,7 +9,7 @@
 import { $, decimalIn, errorText, fillKeyValues, fixed, showError, clearError } from './dom.js';
 import { JobWorker } from './workers.js';
 import { View } from './view.js';
-import { pickNearest } from './interact.js';
+import { hitRadius, pickNearest } from './interact.js';
 import { drawMtl } from './mtl-draw.js';
 
 const MARGIN_M = 0.4; // shown around the region, m
@@ -289,11 +289,14 @@ export class Mtl {
 
   // ---------- pointer (capture phase on the plot's parent, so interact.js never sees MTL events) ----------
 
-  /** The scene object under a canvas pixel: {kind, index} or null (nodes first, then targets, discs). */
-  hit(p) {
+  /**
+   * The scene object under a canvas pixel: {kind, index} or null (nodes first, then targets,
+   * discs); `radius` the pick radius (finger-sized for a touch press, see hitRadius).
+   */
+  hit(p, radius) {
     const s = this.scene;
     return pickNearest(this.view, [['disc', s.discs, this.view.len(s.diameter / 2)], ['target', s.targets],
-      ['rx', s.receivers], ['tx', s.transmitters]], p);
+      ['rx', s.receivers], ['tx', s.transmitters]], p, radius);
   }
 
   listOf(kind) {
@@ -309,7 +312,7 @@ export class Mtl {
       ev.preventDefault();
       if (ev.button !== 0) return;
       const p = this.view.eventPixel(ev);
-      const h = this.hit(p);
+      const h = this.hit(p, hitRadius(ev));
       this.selected = h;
       this.press = h ? { ...h } : null;
       if (h) {
