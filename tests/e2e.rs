@@ -44,6 +44,10 @@ mod speed;
 #[path = "e2e/plan.rs"]
 mod plan;
 
+/// Issue 16 §6: "Save figure" (SVG through the CLI's chart code, PNG of the canvas).
+#[path = "e2e/export.rs"]
+mod export;
+
 /// `SCATTERLOC_SCREENSHOT=1`: writes docs/screenshot-tracking.png.
 #[path = "e2e/screenshot.rs"]
 mod screenshot;

@@ -15,6 +15,7 @@ import { attachPointer } from './interact.js';
 import { Tracking } from './tracking.js';
 import { Mtl } from './mtl.js';
 import { Plan } from './plan.js';
+import { FigureExport } from './export.js';
 
 const MODES = ['snapshot', 'tracking', 'mtl'];
 
@@ -198,6 +199,7 @@ export async function start() {
   const mtl = new Mtl(ctx);
   const plan = new Plan(ctx);
   ctx.plan = plan;
+  const figures = new FigureExport(ctx); // "Save figure" (export.js)
   /** Snapshot view (click to place a target), tracking (animated filter track + Monte Carlo) or multi-target. */
   const setMode = (mode) => {
     st.mode = MODES.includes(mode) ? mode : 'snapshot';
@@ -206,6 +208,7 @@ export async function start() {
     for (const m of MODES) $(`mode-${m}`).setAttribute('aria-pressed', String(st.mode === m));
     tracking.setActive(st.mode === 'tracking');
     mtl.setActive(st.mode === 'mtl');
+    figures.setMode(st.mode);
     if (st.mode !== 'snapshot') {
       plan.cancel('view changed');
       plan.arm(false);
@@ -252,7 +255,7 @@ export async function start() {
   $('share-close').addEventListener('click', () => { $('share').hidden = true; });
 
   registerHooks({
-    app, wasm, view, st, setMode, panel, tracking, mtl, map, plan, link,
+    app, wasm, view, st, setMode, panel, tracking, mtl, map, plan, link, figures,
     isIdle: () => !scheduled && !map.busy(),
     placeTarget: ctx.placeTarget,
   });
