@@ -52,6 +52,10 @@ mod a11y;
 #[path = "e2e/layout.rs"]
 mod layout;
 
+/// Issue 16 §6: "Save figure" (SVG through the CLI's chart code, PNG of the canvas).
+#[path = "e2e/export.rs"]
+mod export;
+
 /// `SCATTERLOC_SCREENSHOT=1`: writes docs/screenshot-tracking.png.
 #[path = "e2e/screenshot.rs"]
 mod screenshot;

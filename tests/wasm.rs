@@ -22,6 +22,10 @@ mod tracking;
 #[path = "wasm/mtl.rs"]
 mod mtl;
 
+/// "Save figure": the SVG figures of the map and the tracking chart.
+#[path = "wasm/export.rs"]
+mod export;
+
 fn message(e: JsError) -> String {
     let v: JsValue = e.into();
     v.dyn_into::<js_sys::Error>()

@@ -10,6 +10,7 @@ use plotters::prelude::*;
 
 use super::axis_label;
 use super::layout::{self, chart_err, register_fonts, ChartError};
+use super::overlay::MapOverlay;
 use super::raster::{self, Chart};
 
 use crate::localize::Grid;
@@ -119,6 +120,18 @@ pub fn draw_crlb_map<DB: DrawingBackend>(
     nodes: &[ChartNode],
     opts: &ChartOptions,
 ) -> Result<ChartSummary, ChartError> {
+    draw_crlb_map_with(root, map, nodes, &MapOverlay::default(), opts)
+}
+
+/// [`draw_crlb_map`] with `overlay` drawn over the map, under the nodes (its labelled lines and
+/// markers join the legend).
+pub fn draw_crlb_map_with<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    map: &MapData,
+    nodes: &[ChartNode],
+    overlay: &MapOverlay,
+    opts: &ChartOptions,
+) -> Result<ChartSummary, ChartError> {
     register_fonts();
     if map.values_m.len() != map.grid.len() {
         return Err(ChartError(alloc::format!(
@@ -151,6 +164,9 @@ pub fn draw_crlb_map<DB: DrawingBackend>(
 
     let chart_area = root.clone().shrink(lay.chart_origin, lay.chart_size);
     let mut chart = map_panel(&chart_area, &lay, map, scale.as_ref())?;
+    if !overlay.is_empty() {
+        super::overlay::draw_overlay(&mut chart, overlay, lay.font.nodes)?;
+    }
     finish_panel(&mut chart, nodes, &lay)?;
 
     let bar_area = root.clone().shrink(lay.bar_origin, lay.bar_size);

@@ -1,13 +1,15 @@
 //! Publication-style figures of CRLB maps, drawn with plotters on any [`DrawingBackend`](plotters::prelude::DrawingBackend): SVG and
 //! PNG natively (the CLI), a `<canvas>` in the browser.
 //!
-//! [`draw_crlb_map`] draws the CRLB map figure (the same colours and colour-bar ticks as the page).
+//! [`draw_crlb_map`] draws the CRLB map figure (the same colours and colour-bar ticks as the page);
+//! [`draw_crlb_map_with`] adds a [`MapOverlay`] (a target's snapshot or a track, as the page shows).
 //! [`draw_tracking_rmse`] draws the tracking figure of \[S\] Fig. 3 (spec §10) in the same style.
 //! [`draw_plan_maps`] draws a network plan: the maps before and after side by side.
 //! [`draw_curves`] draws the ROC and missed-detection curves of the multi-target experiments.
 
 mod layout;
 mod map;
+mod overlay;
 mod plan;
 mod raster;
 mod roc;
@@ -16,9 +18,10 @@ mod tracking;
 pub(crate) use layout::{axis_label, chart_err};
 pub use layout::{register_fonts, suggested_size, ChartError};
 pub use map::{
-    check_area, default_titles, draw_crlb_map, scenario_nodes, ChartNode, ChartOptions,
-    ChartSummary, MapData, NodeKind,
+    check_area, default_titles, draw_crlb_map, draw_crlb_map_with, scenario_nodes, ChartNode,
+    ChartOptions, ChartSummary, MapData, NodeKind,
 };
+pub use overlay::{MapOverlay, OverlayLine, OverlayMark, OverlayMarkKind, OverlayPath};
 pub use plan::{
     draw_plan_maps, plan_caption, plan_chart_size, PlanChartOptions, PlanPanel, PlanPath,
 };

@@ -391,7 +391,11 @@ fn draw_paths<'a, DB: DrawingBackend + 'a>(
 
 /// The part of the segment `a`–`b` inside the rectangle `[x0, x1, y0, y1]` (Liang–Barsky), or
 /// `None` when it misses it.
-fn clip_segment(a: (Real, Real), b: (Real, Real), r: [Real; 4]) -> Option<[(Real, Real); 2]> {
+pub(super) fn clip_segment(
+    a: (Real, Real),
+    b: (Real, Real),
+    r: [Real; 4],
+) -> Option<[(Real, Real); 2]> {
     let (dx, dy) = (b.0 - a.0, b.1 - a.1);
     let (mut t0, mut t1): (Real, Real) = (0.0, 1.0);
     for (p, q) in [

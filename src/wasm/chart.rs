@@ -2,7 +2,8 @@
 //! `plotters-canvas`, fed with a `MonteCarloJob.result_json()` text — one RMSE curve per
 //! tracker of the result next to the PCRLB, as the CLI's `montecarlo --filters` figure.
 
-use plotters::prelude::IntoDrawingArea;
+use plotters::coord::Shift;
+use plotters::prelude::{DrawingArea, DrawingBackend, IntoDrawingArea};
 use plotters_canvas::CanvasBackend;
 use serde::Deserialize;
 use wasm_bindgen::prelude::*;
@@ -57,19 +58,31 @@ pub fn draw_tracking_chart(
     subtitle: &str,
     caption: &str,
 ) -> Result<u32, JsError> {
+    let root = CanvasBackend::with_canvas_object(canvas)
+        .ok_or_else(|| JsError::new("chart: the canvas has no 2-D context"))?
+        .into_drawing_area();
+    draw_result(&root, result_json, title, subtitle, caption).map_err(|e| JsError::new(&e))
+}
+
+/// What [`draw_tracking_chart`] draws, on any backend (the canvas, or SVG for the page's figure
+/// export); presents the drawing. Returns how many curves were drawn, or the error's message.
+pub(super) fn draw_result<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    result_json: &str,
+    title: &str,
+    subtitle: &str,
+    caption: &str,
+) -> Result<u32, String> {
+    let parse = |e: serde_json::Error| {
+        Error::Parse {
+            message: e.to_string(),
+        }
+        .to_string()
+    };
     let c: Curves = if result_json.trim().is_empty() {
         Curves::default()
     } else {
-        serde_json::from_str(result_json).map_err(|e| {
-            super::err(Error::Parse {
-                message: e.to_string(),
-            })
-        })?
-    };
-    let parse = |e: serde_json::Error| {
-        super::err(Error::Parse {
-            message: e.to_string(),
-        })
+        serde_json::from_str(result_json).map_err(parse)?
     };
     let series: Vec<(String, Vec<Option<f64>>)> = match c.filters {
         // In a fixed order (the first curve takes the EKF's blue), whatever the map's order.
@@ -80,7 +93,7 @@ pub fn draw_tracking_chart(
                 let f: FilterRmse = serde_json::from_value(v).map_err(parse)?;
                 Ok((label(name, f.runs, c.particles), f.rmse_m))
             })
-            .collect::<Result<_, JsError>>()?,
+            .collect::<Result<_, String>>()?,
         _ if c.rmse_ekf_m.is_empty() => Vec::new(),
         _ => vec![(label("ekf", 0, None), c.rmse_ekf_m)],
     };
@@ -93,9 +106,6 @@ pub fn draw_tracking_chart(
         .zip(&values)
         .map(|((label, _), v)| FilterCurve { label, rmse_m: v })
         .collect();
-    let root = CanvasBackend::with_canvas_object(canvas)
-        .ok_or_else(|| JsError::new("chart: the canvas has no 2-D context"))?
-        .into_drawing_area();
     let panel = FiltersPanel {
         title: caption,
         t_s: &c.t_s,
@@ -106,9 +116,8 @@ pub fn draw_tracking_chart(
         title: title.to_string(),
         subtitle: (!subtitle.is_empty()).then(|| subtitle.to_string()),
     };
-    let js = |e: &dyn core::fmt::Display| JsError::new(&e.to_string());
-    draw_tracking_filters(&root, &[panel], &opts).map_err(|e| js(&e))?;
-    root.present().map_err(|e| js(&e))?;
+    draw_tracking_filters(root, &[panel], &opts).map_err(|e| e.to_string())?;
+    root.present().map_err(|e| e.to_string())?;
     let drawn = series
         .iter()
         .filter(|(_, v)| v.iter().any(drawable))

@@ -13,11 +13,13 @@
 //! `json.rs` (the page's object shapes and `to_js`), `tracking.rs` (`App.simulate_track` and the
 //! `Track` it returns), `montecarlo.rs` (`MonteCarloJob`, run chunk by chunk in a Web Worker),
 //! `chart.rs` (the plotters ε_EKF / ε_PCRLB chart on a canvas), `mtl.rs` (the multi-target view
-//! of a scene, [`crate::mtl::view`]), `plan.rs` (the planner, run in a Web Worker).
+//! of a scene, [`crate::mtl::view`]), `plan.rs` (the planner, run in a Web Worker), `export.rs`
+//! (the page's "Save figure": the map and tracking figures as SVG through the CLI's chart code).
 
 mod app;
 mod base;
 mod chart;
+mod export;
 mod json;
 mod montecarlo;
 mod mtl;
@@ -29,6 +31,7 @@ pub use app::App;
 use base::{err, point};
 pub use base::{preset_json, preset_names, start};
 pub use chart::draw_tracking_chart;
+pub use export::{tracking_chart_svg, MAX_FIGURE_PX, MAX_FIGURE_RES};
 pub use montecarlo::MonteCarloJob;
 pub use mtl::{mtl_check_scene, mtl_default_scene, mtl_view_of, MtlSession};
 pub use plan::plan_network;

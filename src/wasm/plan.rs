@@ -31,7 +31,7 @@ pub fn plan_network(
     let mut failed = None;
     let result = run_plan(&scenario, &request, |p| {
         let keep_going = to_js(p)
-            .map_err(|e| JsValue::from(e))
+            .map_err(JsValue::from)
             .and_then(|v| on_progress.call1(&JsValue::NULL, &v));
         match keep_going {
             Ok(v) => v.as_bool() != Some(false),

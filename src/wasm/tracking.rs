@@ -128,6 +128,13 @@ impl App {
     }
 }
 
+impl Track {
+    /// The scenario, its model, the run and the filter (for the figure export, `export.rs`).
+    pub(super) fn parts(&self) -> (&Scenario, &Model, &TrackRun, FilterKind) {
+        (&self.scenario, &self.model, &self.run, self.filter)
+    }
+}
+
 #[wasm_bindgen]
 impl Track {
     /// Number of entries (`steps + 1`, fewer if the filter failed: see `failed_at`).

@@ -16,6 +16,7 @@ import { attachKeyboard } from './keyboard.js';
 import { Tracking } from './tracking.js';
 import { Mtl } from './mtl.js';
 import { Plan } from './plan.js';
+import { FigureExport } from './export.js';
 
 const MODES = ['snapshot', 'tracking', 'mtl'];
 
@@ -199,6 +200,7 @@ export async function start() {
   const mtl = new Mtl(ctx);
   const plan = new Plan(ctx);
   ctx.plan = plan;
+  const figures = new FigureExport(ctx); // "Save figure" (export.js)
   /** Snapshot view (click to place a target), tracking (animated filter track + Monte Carlo) or multi-target. */
   const setMode = (mode) => {
     st.mode = MODES.includes(mode) ? mode : 'snapshot';
@@ -207,6 +209,7 @@ export async function start() {
     for (const m of MODES) $(`mode-${m}`).setAttribute('aria-pressed', String(st.mode === m));
     tracking.setActive(st.mode === 'tracking');
     mtl.setActive(st.mode === 'mtl');
+    figures.setMode(st.mode);
     if (st.mode !== 'snapshot') {
       plan.cancel('view changed');
       plan.arm(false);
@@ -258,7 +261,7 @@ export async function start() {
   $('share-close').addEventListener('click', () => { $('share').hidden = true; });
 
   registerHooks({
-    app, wasm, view, st, setMode, panel, tracking, mtl, map, plan, link,
+    app, wasm, view, st, setMode, panel, tracking, mtl, map, plan, link, figures,
     isIdle: () => !scheduled && !map.busy(),
     placeTarget: ctx.placeTarget,
   });

@@ -26,6 +26,9 @@
 //   window.shareLink()       Promise of the link to this view ("Copy link" shows the same in #share-url)
 //   window.importScenarioText(text, name)  loads scenario JSON as an imported file would
 //   window.benchMap(n)       n runs of the map kernel at the current resolution: core-timed ms
+//   window.figureExport      "Save figure" (export.js): last() -> {name, type, size, ms, href (the
+//                            download link's blob URL), mode, what, format} | null; save();
+//                            setDryRun(bool) (build the link without clicking it)
 //   body[data-ready='1']     the page is up;  body[data-error]  it failed (the message)
 
 /**
@@ -57,7 +60,7 @@ export function markFailed(msg) {
 /**
  * Registers the window hooks once the page is up, then sets body[data-ready].
  * @param {object} p - {app, wasm, view, st, isIdle, setMode, panel, tracking, mtl, map, plan, link,
- *   placeTarget}
+ *   placeTarget, figures}
  */
 export function registerHooks(p) {
   const { app, st, tracking, mtl } = p;
@@ -113,6 +116,11 @@ export function registerHooks(p) {
       armRoi: (on) => p.plan.arm(on),
     },
     shareLink: () => p.link(),
+    figureExport: {
+      last: () => p.figures.lastInfo(),
+      save: () => p.figures.save(),
+      setDryRun: (on) => { p.figures.dryRun = !!on; },
+    },
     importScenarioText: (text, name) => p.panel.importText(text, name),
     benchMap: (n = 9) => {
       const r = st.res;

@@ -91,14 +91,9 @@ export class MonteCarlo {
     const r = canvas.getBoundingClientRect();
     if (r.width < 10 || r.height < 10) return;
     fitCanvas(canvas); // the chart fills its background itself
-    const p = this.params;
-    let sub = p ? `${p.trajectories * p.noise_runs} runs × ${p.steps} steps, T = ${p.dt_s} s` : '';
-    if (this.result) sub += ` · ${failedRuns(JSON.parse(this.result))}`;
-    if (this.state === 'running') sub += ` · running, ${this.done}/${this.total} chunks`;
-    const names = p && p.filters ? p.filters.toUpperCase().split(',').join(', ') : 'EKF';
+    const t = this.chartText();
     try {
-      this.series = this.wasm.draw_tracking_chart(canvas, this.result || '',
-        `Position RMSE: ${names} vs posterior CRLB`, sub, this.caption);
+      this.series = this.wasm.draw_tracking_chart(canvas, this.result || '', t.title, t.subtitle, t.caption);
     } catch (e) {
       this.series = 0;
       this.onError(`Chart: ${errorText(e)}`);
@@ -106,6 +101,16 @@ export class MonteCarlo {
     }
     canvas.dataset.series = String(this.series);
     canvas.dataset.generation = String(this.gen);
+  }
+
+  /** The chart's {title, subtitle, caption} (the canvas and the SVG of "Save figure" share them). */
+  chartText() {
+    const p = this.params;
+    let sub = p ? `${p.trajectories * p.noise_runs} runs × ${p.steps} steps, T = ${p.dt_s} s` : '';
+    if (this.result) sub += ` · ${failedRuns(JSON.parse(this.result))}`;
+    if (this.state === 'running') sub += ` · running, ${this.done}/${this.total} chunks`;
+    const names = p && p.filters ? p.filters.toUpperCase().split(',').join(', ') : 'EKF';
+    return { title: `Position RMSE: ${names} vs posterior CRLB`, subtitle: sub, caption: this.caption };
   }
 
   /** Progress bar and status line (numbers and labels from the result). */

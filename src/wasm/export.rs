@@ -1,0 +1,247 @@
+//! The page's "Save figure" as SVG: the figures drawn by the same plotters chart code as the CLI
+//! ([`crate::chart`]) through plotters' SVG backend into a `String`. `App.map_svg` draws the CRLB
+//! map figure of the app's scenario (with a placed target's snapshot), `Track.map_svg` the map
+//! with a simulated track, and [`tracking_chart_svg`] the Monte Carlo RMSE chart of the tracking
+//! view (the canvas chart's [`draw_tracking_chart`](super::draw_tracking_chart) code). Every
+//! error is an exception whose message starts with the function's name; nothing here runs until
+//! the page's Save figure button is pressed.
+
+use plotters::prelude::*;
+use serde::Deserialize;
+use wasm_bindgen::prelude::*;
+
+use super::tracking::Track;
+use super::App;
+use crate::chart::{
+    default_titles, draw_crlb_map_with, scenario_nodes, suggested_size, ChartOptions, MapData,
+    MapOverlay,
+};
+use crate::error::{limits, Error};
+use crate::localize::{crlb_map, Grid};
+use crate::present::simulate_snapshot;
+use crate::scenario::Area;
+use crate::{Model, Scenario, Vec2};
+
+/// Largest width or height of an exported figure, px.
+pub const MAX_FIGURE_PX: u32 = 8000;
+
+/// Largest map grid (cells per side) of an exported map figure.
+pub const MAX_FIGURE_RES: usize = 1024;
+
+/// Default map grid of an exported map figure (cells per side).
+const DEFAULT_RES: usize = 256;
+
+/// A placed target: position (m) and noise seed, as `App.simulate_fix` takes them.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct TargetOpt {
+    x: f64,
+    y: f64,
+    seed: u32,
+}
+
+/// The options of a map figure (all optional; `""` is all defaults).
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct MapOptions {
+    /// `[x_min, x_max, y_min, y_max]`, m: the window shown (default: the scenario's area).
+    #[serde(default)]
+    window: Option<[f64; 4]>,
+    /// Map grid, cells per side (default 256).
+    #[serde(default)]
+    res: Option<usize>,
+    /// Title (default: `Position CRLB — <scenario>`).
+    #[serde(default)]
+    title: Option<String>,
+    /// The snapshot target (App.map_svg only).
+    #[serde(default)]
+    target: Option<TargetOpt>,
+}
+
+fn fail(func: &str, e: impl core::fmt::Display) -> JsError {
+    JsError::new(&format!("{func}: {e}"))
+}
+
+fn parse_options(func: &str, json: &str) -> Result<MapOptions, JsError> {
+    if json.trim().is_empty() {
+        return Ok(MapOptions::default());
+    }
+    serde_json::from_str(json).map_err(|e| {
+        fail(
+            func,
+            Error::Parse {
+                message: e.to_string(),
+            },
+        )
+    })
+}
+
+/// `(width, height)` checked: width in `200..=MAX_FIGURE_PX`, height 0 (fit the plot: the
+/// chart's `suggested_size`) or in `150..=MAX_FIGURE_PX`.
+fn figure_size(area: Option<&Area>, width: u32, height: u32) -> crate::Result<(u32, u32)> {
+    let check = |field: &'static str, v: u32, min: u32| {
+        if (min..=MAX_FIGURE_PX).contains(&v) {
+            Ok(v)
+        } else {
+            Err(Error::SizeLimit {
+                field,
+                value: v as usize,
+                min: min as usize,
+                max: MAX_FIGURE_PX as usize,
+            })
+        }
+    };
+    let w = check("width", width, 200)?;
+    match (height, area) {
+        (0, Some(a)) => Ok(suggested_size(a, w)),
+        (0, None) => Ok((w, (w * 3 / 5).max(150))),
+        (h, _) => Ok((w, check("height", h, 150)?)),
+    }
+}
+
+/// The map figure of `model` (the scenario `s`) over the options' window at their grid, with
+/// `overlay`, as SVG text.
+fn map_figure(
+    func: &str,
+    s: &Scenario,
+    model: &Model,
+    opts: &MapOptions,
+    overlay: &MapOverlay,
+    (width, height): (u32, u32),
+) -> Result<String, JsError> {
+    let area = match opts.window {
+        Some([x0, x1, y0, y1]) => {
+            let a = Area {
+                x: [x0, x1],
+                y: [y0, y1],
+            };
+            a.validate_as(["window.x", "window.y"])
+                .map_err(|e| fail(func, e))?;
+            a
+        }
+        None => s.area_m,
+    };
+    let res = opts.res.unwrap_or(DEFAULT_RES);
+    if !(8..=MAX_FIGURE_RES).contains(&res) {
+        return Err(fail(
+            func,
+            Error::SizeLimit {
+                field: "res",
+                value: res,
+                min: 8,
+                max: MAX_FIGURE_RES,
+            },
+        ));
+    }
+    let size = figure_size(Some(&area), width, height).map_err(|e| fail(func, e))?;
+    let grid = Grid::new(area, res, res).map_err(|e| fail(func, e))?;
+    let mut values = vec![0.0; grid.len()];
+    crlb_map(model, &grid, &mut values).map_err(|e| fail(func, e))?;
+    let (title, subtitle) = default_titles(s, &grid);
+    let chart_opts = ChartOptions {
+        title: opts.title.clone().unwrap_or(title),
+        subtitle: Some(subtitle),
+        ..ChartOptions::default()
+    };
+    let map = MapData {
+        grid,
+        values_m: &values,
+    };
+    let nodes = scenario_nodes(s);
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
+        draw_crlb_map_with(&root, &map, &nodes, overlay, &chart_opts).map_err(|e| fail(func, e))?;
+        root.present().map_err(|e| fail(func, e))?;
+    }
+    Ok(svg)
+}
+
+#[wasm_bindgen]
+impl App {
+    /// The CRLB map figure of the current scenario as SVG text, drawn by the CLI's chart code
+    /// (`crlb-map --out map.svg`): the map, the nodes, the colour bar and, with a `target`, its
+    /// simulated snapshot (iso-delay ellipses, LM fix, CRLB ellipse; as `simulate_fix`).
+    /// `width` 200 … 8000 px, `height` 0 (fit the plot) or 150 … 8000 px. `options_json`: `""`
+    /// or `{window?: [x_min, x_max, y_min, y_max] (m; default the area), res?: cells per side
+    /// (8 … 1024, default 256), title?: text, target?: {x, y, seed}}`. Throws `map_svg: …`.
+    pub fn map_svg(&self, width: u32, height: u32, options_json: &str) -> Result<String, JsError> {
+        const F: &str = "map_svg";
+        let opts = parse_options(F, options_json)?;
+        let (s, model) = (self.session().scenario(), self.session().model());
+        let overlay = match &opts.target {
+            Some(t) => {
+                limits::COORDINATE_M
+                    .check("target.x", t.x)
+                    .and_then(|_| limits::COORDINATE_M.check("target.y", t.y))
+                    .map_err(|e| fail(F, e))?;
+                let sim = simulate_snapshot(model, &s.area_m, Vec2::new(t.x, t.y), t.seed.into());
+                MapOverlay::snapshot(&sim)
+            }
+            None => MapOverlay::default(),
+        };
+        map_figure(F, s, model, &opts, &overlay, (width, height))
+    }
+}
+
+#[wasm_bindgen]
+impl Track {
+    /// The CRLB map figure of the track's scenario with the track up to step `step` as SVG text
+    /// (the map, nodes, colour bar, the truth path, the filter's track and its 1σ ellipses
+    /// magnified `magnify` times, the target and the estimate at `step`), drawn by the CLI's
+    /// chart code. Sizes and `options_json` as `App.map_svg` (`target` is not allowed). Throws
+    /// `Track.map_svg: …`.
+    pub fn map_svg(
+        &self,
+        width: u32,
+        height: u32,
+        step: usize,
+        magnify: f64,
+        options_json: &str,
+    ) -> Result<String, JsError> {
+        const F: &str = "Track.map_svg";
+        let opts = parse_options(F, options_json)?;
+        if opts.target.is_some() {
+            return Err(fail(
+                F,
+                "target: a track's figure shows the track, not a target",
+            ));
+        }
+        if !(magnify.is_finite() && magnify > 0.0) {
+            return Err(fail(
+                F,
+                Error::NotPositive {
+                    field: "magnify".into(),
+                    value: magnify,
+                },
+            ));
+        }
+        let (s, model, run, filter) = self.parts();
+        let name = filter.name().to_uppercase();
+        let overlay = MapOverlay::track(run, step, magnify, &name);
+        map_figure(F, s, model, &opts, &overlay, (width, height))
+    }
+}
+
+/// The tracking view's Monte Carlo chart ([`draw_tracking_chart`](super::draw_tracking_chart),
+/// the same arguments) as SVG text of `width × height` px (200 … 8000 × 150 … 8000; height 0:
+/// 3/5 of the width). Throws `tracking_chart_svg: …` on malformed JSON or a bad size.
+#[wasm_bindgen]
+pub fn tracking_chart_svg(
+    result_json: &str,
+    title: &str,
+    subtitle: &str,
+    caption: &str,
+    width: u32,
+    height: u32,
+) -> Result<String, JsError> {
+    const F: &str = "tracking_chart_svg";
+    let size = figure_size(None, width, height).map_err(|e| fail(F, e))?;
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
+        super::chart::draw_result(&root, result_json, title, subtitle, caption)
+            .map_err(|e| fail(F, e))?;
+    }
+    Ok(svg)
+}

@@ -1,0 +1,120 @@
+// "Save figure": writes the current view as a file. PNG is the canvas as it is (canvas.toBlob);
+// SVG is drawn by the wasm core with the CLI's plotters chart code (App.map_svg, Track.map_svg,
+// tracking_chart_svg): the map, the nodes, the target's snapshot or the track, and the colour
+// bar. The multi-target view has no chart of its own in the core, so it saves PNG only. Files are
+// named `<scenario>-<view>-<figure>.<ext>`, e.g. sensors2019-snapshot-map.svg,
+// sensors2019-tracking-rmse.svg, multi-target-scene.png. Nothing here runs until the button is
+// pressed (the drag stays as fast as it was).
+
+import { $, errorText, showError } from './dom.js';
+
+/** Width of an exported SVG figure, px (the CLI's default); the height fits the plot. */
+const SVG_WIDTH = 1000;
+/** Height of the exported RMSE chart, px (the CLI's tracking figure: 1000 × 620). */
+const CHART_HEIGHT = 620;
+
+/** `name` as a file-name part: lower case, runs of other characters as one dash. */
+export function slug(name) {
+  const s = String(name).toLowerCase().replace(/[^a-z0-9._]+/g, '-').replace(/^-+|-+$/g, '');
+  return s || 'scenario';
+}
+
+export class FigureExport {
+  /** @param {object} ctx - {app, wasm, st, view, tracking} (app.js). */
+  constructor(ctx) {
+    this.ctx = ctx;
+    this.dryRun = false; // true: build the download link but do not click it (tests)
+    this.last = null; // {name, type, size, ms, blob, href, mode, what, format}
+    this.count = 0;
+    $('figure-save').addEventListener('click', () => this.save());
+  }
+
+  /** Shows the choices of `mode`: the RMSE chart only in tracking, SVG not in multi-target. */
+  setMode(mode) {
+    const what = $('figure-what');
+    const rmse = what.querySelector('option[value="rmse"]');
+    rmse.hidden = mode !== 'tracking';
+    rmse.disabled = mode !== 'tracking';
+    if (rmse.disabled && what.value === 'rmse') what.value = 'map';
+    const format = $('figure-format');
+    const svg = format.querySelector('option[value="svg"]');
+    svg.disabled = mode === 'mtl';
+    if (svg.disabled && format.value === 'svg') format.value = 'png';
+    what.querySelector('option[value="map"]').textContent = mode === 'mtl' ? 'Scene' : 'Map';
+  }
+
+  /** The file name of figure `what` ('map' | 'rmse') of the current view. */
+  fileName(what, ext) {
+    const { app, st } = this.ctx;
+    if (st.mode === 'mtl') return `multi-target-scene.${ext}`;
+    return `${slug(app.scenario().name)}-${st.mode}-${what}.${ext}`;
+  }
+
+  /** Saves the figure chosen in #figure-what as #figure-format; errors go to the banner. */
+  async save() {
+    const { st } = this.ctx;
+    const what = st.mode === 'tracking' ? $('figure-what').value : 'map';
+    const format = st.mode === 'mtl' ? 'png' : $('figure-format').value;
+    const t0 = performance.now();
+    try {
+      const blob = format === 'svg' ? this.svg(what) : await this.png(what);
+      this.download(blob, this.fileName(what, format), { mode: st.mode, what, format, ms: performance.now() - t0 });
+    } catch (e) {
+      showError(`Save figure: ${errorText(e)}`);
+      console.error(e);
+    }
+  }
+
+  /** The SVG text of figure `what` from the core, as a Blob. */
+  svg(what) {
+    const { app, wasm, st, view, tracking } = this.ctx;
+    const res = Number($('resolution').value) || 256;
+    const options = { window: Array.from(view.area), res };
+    let text;
+    if (what === 'rmse') {
+      const mc = tracking.mc;
+      const t = mc.chartText();
+      text = wasm.tracking_chart_svg(mc.result || '', t.title, t.subtitle, t.caption, SVG_WIDTH, CHART_HEIGHT);
+    } else if (st.mode === 'tracking') {
+      if (!tracking.track) throw new Error('no track to draw yet');
+      const magnify = Number($('track-ex').value) || 1;
+      text = tracking.track.map_svg(SVG_WIDTH, 0, tracking.step, magnify, JSON.stringify(options));
+    } else {
+      if (st.target) options.target = { x: st.target.x, y: st.target.y, seed: st.target.seed };
+      text = app.map_svg(SVG_WIDTH, 0, JSON.stringify(options));
+    }
+    return new Blob([text], { type: 'image/svg+xml' });
+  }
+
+  /** The canvas of figure `what` as it is, as a PNG Blob. */
+  png(what) {
+    const canvas = what === 'rmse' ? $('track-chart') : $('plot');
+    return new Promise((resolve, reject) => {
+      canvas.toBlob((b) => (b ? resolve(b) : reject(new Error('the canvas gave no image'))), 'image/png');
+    });
+  }
+
+  /** A download link for `blob` named `name`, clicked (unless dryRun); remembered in `last`. */
+  download(blob, name, info) {
+    const href = URL.createObjectURL(blob);
+    const a = document.createElement('a');
+    a.href = href;
+    a.download = name;
+    a.hidden = true;
+    document.body.appendChild(a);
+    if (!this.dryRun) a.click();
+    a.remove();
+    if (this.last) URL.revokeObjectURL(this.last.href);
+    this.count += 1;
+    this.last = { name, type: blob.type, size: blob.size, blob, href, ...info };
+    const btn = $('figure-save');
+    Object.assign(btn.dataset, { saved: name, count: String(this.count) });
+  }
+
+  /** For the hooks: `last` without the Blob, or null. */
+  lastInfo() {
+    if (!this.last) return null;
+    const { blob, ...rest } = this.last;
+    return rest;
+  }
+}
