@@ -13,10 +13,10 @@ use alloc::vec;
 use alloc::vec::Vec;
 
 use super::json::{to_json, FilterCurvesJs, MonteCarloJs};
-use super::tracking::{checked_steps, prior_and_motion};
+use super::tracking::{checked_steps, page_filter, prior_and_motion};
 use crate::error::Error;
 use crate::track::{finish, run_filter_chunk, MonteCarloConfig, StudySums};
-use crate::track::{paper_initial_covariance, FilterKind, PfConfig, UkfParams};
+use crate::track::{paper_initial_covariance, FilterKind};
 use crate::track::{CHUNK_TRAJECTORIES, MAX_PARTICLES};
 use crate::{Model, Scenario};
 
@@ -119,14 +119,10 @@ impl MonteCarloJob {
                 "set_filters: the study has started (set the filters before the first chunk)",
             ));
         }
-        let pf = PfConfig {
-            particles,
-            roughening: None,
-        };
         let mut filters: Vec<FilterStudy> = Vec::new();
         for (i, name) in names.split(',').map(str::trim).enumerate() {
             let field = alloc::format!("filters[{i}]");
-            let kind = FilterKind::named(&field, name, UkfParams::default(), pf).map_err(err)?;
+            let kind = page_filter(&field, name, particles).map_err(err)?;
             if filters.iter().any(|f| f.kind.name() == kind.name()) {
                 return Err(JsError::new(&alloc::format!(
                     "{field}: filter \"{name}\" is already in the list"
