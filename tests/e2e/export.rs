@@ -51,17 +51,21 @@ async fn save(c: &Client, what: &str, format: &str) -> Result<Saved, String> {
     .await?;
     click(c, "figure-save").await?;
     let t0 = Instant::now();
+    // The record and the count are read in one script: read apart, a PNG (saved
+    // asynchronously) can land between the two reads and pair the old record with the new count.
     let info = loop {
-        let info = js(c, "return window.figureExport.last()").await?;
-        if info["href"].is_string() && info["name"].is_string() {
-            let n = js(
-                c,
-                "return Number(document.getElementById('figure-save').dataset.count)",
-            )
-            .await?;
-            if n.as_u64() == Some(before + 1) {
-                break info;
-            }
+        let got = js(
+            c,
+            "return { info: window.figureExport.last(), \
+                      count: Number(document.getElementById('figure-save').dataset.count || 0) }",
+        )
+        .await?;
+        let info = &got["info"];
+        if info["href"].is_string()
+            && info["name"].is_string()
+            && got["count"].as_u64() == Some(before + 1)
+        {
+            break info.clone();
         }
         let errors = console_errors(c).await?;
         if !errors.is_empty() || t0.elapsed() > Duration::from_secs(30) {
