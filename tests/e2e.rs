@@ -56,6 +56,10 @@ mod layout;
 #[path = "e2e/export.rs"]
 mod export;
 
+/// Issue 16 §3: zoom and pan (wheel, pinch, drag, double-click, buttons) in the three views.
+#[path = "e2e/zoom.rs"]
+mod zoom;
+
 /// `SCATTERLOC_SCREENSHOT=1`: writes docs/screenshot-tracking.png.
 #[path = "e2e/screenshot.rs"]
 mod screenshot;

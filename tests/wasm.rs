@@ -148,6 +148,86 @@ fn map_fills_float64array_and_matches_point_queries() {
     );
 }
 
+/// The page's zoom and pan (issue 16 §3): the map of a window is computed in that window at full
+/// resolution, not cropped from the area's map. Every cell equals the core's map over the grid of
+/// the window bit for bit and `crlb_at` at its centre, including a window reaching past the area.
+/// A window that is not a finite, non-empty rectangle is a named error.
+#[wasm_bindgen_test]
+fn map_of_a_window_is_the_core_map_of_that_window() {
+    use scatterloc::localize::crlb_map;
+    use scatterloc::scenario::Area;
+    let app = sensors();
+    let s = presets::sensors2019();
+    let m = Model::new(&s).unwrap();
+    let (nx, ny) = (40, 30);
+    for w in [
+        [2.5, 4.0, -1.0, 0.125],
+        [25.0, 45.0, 20.0, 35.0],
+        [-7.5, 30.0, -10.0, 26.0],
+    ] {
+        let out = Float64Array::new_with_length((nx * ny) as u32);
+        ok(app.compute_map_in(w[0], w[1], w[2], w[3], nx, ny, &out));
+        let grid = Grid::new(
+            Area {
+                x: [w[0], w[1]],
+                y: [w[2], w[3]],
+            },
+            nx,
+            ny,
+        )
+        .unwrap();
+        let mut want = vec![0.0; grid.len()];
+        crlb_map(&m, &grid, &mut want).unwrap();
+        let got = out.to_vec();
+        assert!(
+            got.iter()
+                .zip(&want)
+                .all(|(a, b)| a.to_bits() == b.to_bits()),
+            "window {w:?}"
+        );
+        for (i, j) in [(0, 0), (nx - 1, ny - 1), (13, 21)] {
+            let rmse = ok(app.rmse_at(grid.x(i), grid.y(j)));
+            assert!(
+                (got[j * nx + i] / rmse - 1.0).abs() < 1e-12,
+                "window {w:?} cell ({i},{j})"
+            );
+        }
+    }
+    // The whole area as a window is the area's map.
+    let (a, b) = (
+        Float64Array::new_with_length(64),
+        Float64Array::new_with_length(64),
+    );
+    ok(app.compute_map(8, 8, &a));
+    ok(app.compute_map_in(-7.5, 30.0, -10.0, 26.0, 8, 8, &b));
+    assert_eq!(a.to_vec(), b.to_vec());
+    let buf = Float64Array::new_with_length(64);
+    for (m, field) in [
+        (
+            err(app.compute_map_in(1.0, 1.0, 0.0, 1.0, 8, 8, &buf)),
+            "window.x",
+        ),
+        (
+            err(app.compute_map_in(0.0, 1.0, f64::NAN, 1.0, 8, 8, &buf)),
+            "window.y",
+        ),
+        (
+            err(app.compute_map_in(0.0, 1.0, 2.0, 1.0, 8, 8, &buf)),
+            "window.y",
+        ),
+        (
+            err(app.compute_map_in(0.0, f64::INFINITY, 0.0, 1.0, 8, 8, &buf)),
+            "window.x",
+        ),
+        (
+            err(app.compute_map_in(0.0, 1.0, 0.0, 1.0, 1, 8, &buf)),
+            "nx",
+        ),
+    ] {
+        assert!(m.contains(field), "message {m:?} should name {field}");
+    }
+}
+
 /// The page's map kernel (SIMD on simd128) equals the scalar reference bit for bit, and the page's
 /// map is the core's. Against the native map (values printed by a native run of the same grid)
 /// it agrees to 1e-14 relative, not bitwise: the model's setup (dB → linear, the pattern's

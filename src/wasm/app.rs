@@ -208,7 +208,40 @@ impl App {
     /// lowest y) written into `out` (a `Float64Array` of `nx·ny`), m; unbounded cells are
     /// `Infinity`. Returns the kernel time, ms.
     pub fn compute_map(&self, nx: usize, ny: usize, out: &Float64Array) -> Result<f64, JsError> {
-        let grid = Grid::new(self.session.scenario().area_m, nx, ny).map_err(err)?;
+        self.map_over(self.session.scenario().area_m, nx, ny, out)
+    }
+
+    /// The same map over any window `[x_min, x_max] × [y_min, y_max]`, m (the page's zoomed and
+    /// panned view): every cell computed at full resolution in the window, not a crop of the
+    /// area's map. A window that is not a finite, non-empty rectangle is a named error
+    /// (`window.x` / `window.y`).
+    #[allow(clippy::too_many_arguments)]
+    pub fn compute_map_in(
+        &self,
+        x_min: f64,
+        x_max: f64,
+        y_min: f64,
+        y_max: f64,
+        nx: usize,
+        ny: usize,
+        out: &Float64Array,
+    ) -> Result<f64, JsError> {
+        let window = Area {
+            x: [x_min, x_max],
+            y: [y_min, y_max],
+        };
+        window.validate_as(["window.x", "window.y"]).map_err(err)?;
+        self.map_over(window, nx, ny, out)
+    }
+
+    fn map_over(
+        &self,
+        window: Area,
+        nx: usize,
+        ny: usize,
+        out: &Float64Array,
+    ) -> Result<f64, JsError> {
+        let grid = Grid::new(window, nx, ny).map_err(err)?;
         let mut buf = vec![0.0; out.length() as usize];
         let t0 = performance_now();
         crlb_map(self.session.model(), &grid, &mut buf).map_err(err)?;

@@ -305,7 +305,12 @@ fn layout_at_four_widths_in_three_views() {
 
 /// Chromium's DevTools protocol through chromedriver (`goog/cdp/execute`), for what WebDriver
 /// has no command for (touch events, device emulation). A plain HTTP/1.1 POST, std only.
-fn cdp(driver_port: u16, session: &str, cmd: &str, params: Value) -> Result<Value, String> {
+pub(super) fn cdp(
+    driver_port: u16,
+    session: &str,
+    cmd: &str,
+    params: Value,
+) -> Result<Value, String> {
     let body = json!({ "cmd": cmd, "params": params }).to_string();
     let mut s = TcpStream::connect(("127.0.0.1", driver_port)).map_err(|e| e.to_string())?;
     s.set_read_timeout(Some(Duration::from_secs(30)))

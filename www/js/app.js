@@ -11,12 +11,13 @@ import { registerHooks } from './hooks.js';
 import { View } from './view.js';
 import { MapView } from './map.js';
 import { Panel } from './panel.js';
-import { attachPointer } from './interact.js';
+import { attachPointer, hitNode } from './interact.js';
 import { attachKeyboard } from './keyboard.js';
 import { Tracking } from './tracking.js';
 import { Mtl } from './mtl.js';
 import { Plan } from './plan.js';
 import { FigureExport } from './export.js';
+import { Zoomer } from './zoom.js';
 
 const MODES = ['snapshot', 'tracking', 'mtl'];
 
@@ -143,7 +144,9 @@ export async function start() {
     const dragging = !!d.dragging && !d.dragEnd;
     try {
       if (d.reset) {
-        view.fit(app.area());
+        view.setHome(app.area());
+        view.reset();
+        zoom.show();
         st.target = null;
         st.selTx = 0;
         st.selRx = 0;
@@ -201,6 +204,10 @@ export async function start() {
   const plan = new Plan(ctx);
   ctx.plan = plan;
   const figures = new FigureExport(ctx); // "Save figure" (export.js)
+  // Zoom and pan in the three views (zoom.js); the press handlers below pan on empty map.
+  const zoom = new Zoomer(ctx, mtl, (p) => (st.mode === 'mtl' ? !!mtl.hit(p) : !!hitNode(view, st.nodes, p)));
+  ctx.zoom = zoom;
+  zoom.cancelPress.push(() => mtl.cancelPress());
   /** Snapshot view (click to place a target), tracking (animated filter track + Monte Carlo) or multi-target. */
   const setMode = (mode) => {
     st.mode = MODES.includes(mode) ? mode : 'snapshot';
@@ -210,6 +217,7 @@ export async function start() {
     tracking.setActive(st.mode === 'tracking');
     mtl.setActive(st.mode === 'mtl');
     figures.setMode(st.mode);
+    zoom.show();
     if (st.mode !== 'snapshot') {
       plan.cancel('view changed');
       plan.arm(false);
@@ -224,7 +232,7 @@ export async function start() {
   ctx.showHint = () => pointer.showHint();
 
   view.resize();
-  view.fit(app.area());
+  view.setHome(app.area());
   new ResizeObserver(() => {
     view.resize();
     changed({ draw: true });
@@ -261,7 +269,7 @@ export async function start() {
   $('share-close').addEventListener('click', () => { $('share').hidden = true; });
 
   registerHooks({
-    app, wasm, view, st, setMode, panel, tracking, mtl, map, plan, link, figures,
+    app, wasm, view, st, setMode, panel, tracking, mtl, map, plan, link, figures, zoom,
     isIdle: () => !scheduled && !map.busy(),
     placeTarget: ctx.placeTarget,
   });

@@ -76,6 +76,7 @@ export function drawAxes(ctx, view, w) {
   ctx.lineWidth = 1;
   const xt = w.axis_ticks(x0, x1, Math.max(2, Math.floor(r.w / 70)));
   const yt = w.axis_ticks(y0, y1, Math.max(2, Math.floor(r.h / 50)));
+  view.drawn.ticks = { x: xt.map((t) => t.value), y: yt.map((t) => t.value) };
   ctx.beginPath();
   for (const t of xt) {
     const p = view.toPixel(t.value, y0);
@@ -103,6 +104,29 @@ export function drawAxes(ctx, view, w) {
   ctx.restore();
   ctx.strokeStyle = C.frame;
   ctx.strokeRect(Math.round(r.x) + 0.5, Math.round(r.y) + 0.5, Math.round(r.w), Math.round(r.h));
+}
+
+/**
+ * A scale bar in the plot's lower-left corner: the core's round length (scale_bar) no longer than
+ * a fifth of the window's width, so it follows the zoom.
+ */
+export function drawScaleBar(ctx, view, w) {
+  const r = view.rect;
+  const bar = w.scale_bar((view.area[1] - view.area[0]) / 5);
+  view.drawn.scaleBar = bar ? { length_m: bar.length_m, label: bar.label } : null;
+  if (!bar) return;
+  const len = view.len(bar.length_m);
+  const x = r.x + 10;
+  const y = r.y + r.h - 10;
+  ctx.lineWidth = 2;
+  for (const [color, width] of [['rgba(0,0,0,0.7)', 4], ['#fff', 2]]) {
+    ctx.strokeStyle = color; ctx.lineWidth = width;
+    ctx.beginPath();
+    ctx.moveTo(x, y - 5); ctx.lineTo(x, y); ctx.lineTo(x + len, y); ctx.lineTo(x + len, y - 5);
+    ctx.stroke();
+  }
+  ctx.font = FONT; ctx.fillStyle = '#fff'; ctx.textAlign = 'left'; ctx.textBaseline = 'bottom';
+  haloText(ctx, bar.label, x + len + 5, y + 4);
 }
 
 /** The plot has keyboard focus (keyboard.js): the selected object also gets a focus ring. */

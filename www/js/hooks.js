@@ -29,6 +29,11 @@
 //   window.figureExport      "Save figure" (export.js): last() -> {name, type, size, ms, href (the
 //                            download link's blob URL), mode, what, format} | null; save();
 //                            setDryRun(bool) (build the link without clicking it)
+//   window.zoom              zoom and pan (zoom.js): state() -> {window, home ([x0, x1, y0, y1] m),
+//                            zoomed, factor, rect (the plot, CSS px), gestures, ticks {x, y} and
+//                            scaleBar {length_m, label} of the last frame, level}; reset();
+//                            hitAt(x, y) (an object under canvas pixel x, y: a press drags it);
+//                            toMetre(x, y) (canvas pixel -> {x, y} m in the view on screen)
 //   body[data-ready='1']     the page is up;  body[data-error]  it failed (the message)
 
 /**
@@ -60,7 +65,7 @@ export function markFailed(msg) {
 /**
  * Registers the window hooks once the page is up, then sets body[data-ready].
  * @param {object} p - {app, wasm, view, st, isIdle, setMode, panel, tracking, mtl, map, plan, link,
- *   placeTarget, figures}
+ *   placeTarget, figures, zoom}
  */
 export function registerHooks(p) {
   const { app, st, tracking, mtl } = p;
@@ -120,6 +125,12 @@ export function registerHooks(p) {
       last: () => p.figures.lastInfo(),
       save: () => p.figures.save(),
       setDryRun: (on) => { p.figures.dryRun = !!on; },
+    },
+    zoom: {
+      state: () => p.zoom.state(),
+      reset: () => p.zoom.reset(),
+      hitAt: (x, y) => !!p.zoom.hitAt({ x, y }),
+      toMetre: (x, y) => p.zoom.view().toMetre(x, y),
     },
     importScenarioText: (text, name) => p.panel.importText(text, name),
     benchMap: (n = 9) => {

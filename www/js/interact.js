@@ -1,7 +1,8 @@
 // Mouse/pointer handling on the plot for the snapshot and tracking views: drag Tx/Rx markers,
 // click to place a target (snapshot mode), press-and-drag a trajectory (tracking mode, "draw") or
-// the Plan panel's region of interest (after "Draw ROI", plan.js), hover read-out. A node drag
-// cancels a running plan. pickNearest is the hit test of every view (mtl.js uses it too).
+// the Plan panel's region of interest (after "Draw ROI", plan.js), press-and-drag on empty map to
+// pan (zoom.js), hover read-out. A node drag cancels a running plan. pickNearest is the hit test
+// of every view (mtl.js uses it too).
 
 import { $, errorText, fixed, showError, clearError } from './dom.js';
 
@@ -31,7 +32,7 @@ export function pickNearest(view, groups, p, radius = HIT_PX) {
 }
 
 /** The Tx/Rx node under a canvas pixel ({kind, index}), or null. */
-const hitNode = (view, nodes, p, radius) =>
+export const hitNode = (view, nodes, p, radius) =>
   pickNearest(view, [['rx', nodes.receivers], ['tx', nodes.transmitters]], p, radius);
 
 /**
@@ -56,7 +57,7 @@ export function attachPointer(ctx) {
   const { view, st, app } = ctx;
   const canvas = view.canvas;
   const readout = $('readout');
-  let press = null; // { start: {x, y}, node: {kind, index} | null, moved }
+  let press = null; // { start, last, anchor (of the pan): {x, y}, node: {kind, index} | null, moved, draw, roi, pan }
 
   const hover = (p) => {
     if (!view.inPlot(p.x, p.y)) {
@@ -85,7 +86,9 @@ export function attachPointer(ctx) {
     const roi = !!ctx.plan && ctx.plan.wantsRoi() && view.inPlot(p.x, p.y);
     const node = roi ? null : hitNode(view, st.nodes, p, hitRadius(ev));
     const draw = !node && !roi && view.inPlot(p.x, p.y) && ctx.tracking.wantsDraw();
-    press = { start: p, node, moved: false, draw, roi };
+    // Anything else in the plot: a click (snapshot: place the target) or, once it moves, a pan.
+    const pan = !node && !roi && !draw && view.inPlot(p.x, p.y);
+    press = { start: p, last: p, anchor: p, node, moved: false, draw, roi, pan };
     if (roi) ctx.plan.roiStart(p);
     if (node) {
       ctx.panel.select(node.kind, node.index);
@@ -101,9 +104,9 @@ export function attachPointer(ctx) {
     if (press && press.node) {
       if (!press.moved && ctx.plan) ctx.plan.cancel('node dragged');
       press.moved = true;
-      // Keep the node inside the plotted area (clamped in pixels).
-      const r = view.rect;
-      const m = view.toMetreWithin(p, r, { x: r.x + r.w, y: r.y + r.h });
+      // Keep the node inside the scenario area and the window shown (clamped in pixels).
+      const box = view.dragBox();
+      const m = view.toMetreWithin(p, box.a, box.b);
       moveNode(ctx, press.node, m.x, m.y);
     } else if (press && press.roi) {
       ctx.plan.roiMove(p);
@@ -111,20 +114,29 @@ export function attachPointer(ctx) {
       ctx.tracking.drawMove(view.toMetre(p.x, p.y));
     } else if (press) {
       if (Math.hypot(p.x - press.start.x, p.y - press.start.y) > CLICK_PX) press.moved = true;
+      if (press.pan && press.moved) {
+        ctx.zoom.panBy(p.x - press.anchor.x, p.y - press.anchor.y); // the map follows the pointer
+        press.anchor = p;
+      }
     } else {
       canvas.classList.toggle('over-node', !!hitNode(view, st.nodes, p));
     }
+    if (press) press.last = p;
     hover(p);
   });
 
-  const end = (ev) => {
-    if (!press) return;
-    const p = view.eventPixel(ev);
-    const wasClick = !press.node && !press.roi && !press.moved && ev.type === 'pointerup' && st.mode !== 'tracking';
-    if (press.roi) ctx.plan.roiEnd(p, ev.type === 'pointerup');
+  /** The press ends at canvas pixel p; `up`: released (not cancelled). */
+  const finish = (p, up) => {
+    const wasClick = up && !press.node && !press.roi && !press.moved && st.mode !== 'tracking';
+    if (press.roi) ctx.plan.roiEnd(p, up);
     if (press.draw) ctx.tracking.drawEnd(view.toMetre(p.x, p.y));
     // A map reduced while dragging (map.js) is now computed at full resolution.
     if (press.node && press.moved) ctx.changed({ map: true, dragEnd: true });
+    if (press.pan && press.moved) {
+      // The release point is where the map ends up (a move event may have been resampled).
+      if (up) ctx.zoom.panBy(p.x - press.anchor.x, p.y - press.anchor.y);
+      ctx.zoom.settle();
+    }
     press = null;
     canvas.classList.remove('dragging');
     if (wasClick && view.inPlot(p.x, p.y)) {
@@ -132,6 +144,11 @@ export function attachPointer(ctx) {
       ctx.placeTarget(m.x, m.y);
     }
   };
+  const end = (ev) => {
+    if (press) finish(view.eventPixel(ev), ev.type === 'pointerup');
+  };
+  // A second finger (a pinch, zoom.js) ends the press where it is, as a cancel.
+  ctx.zoom.cancelPress.push(() => { if (press) finish(press.last, false); });
   canvas.addEventListener('pointerup', end);
   canvas.addEventListener('pointercancel', end);
   canvas.addEventListener('pointerleave', () => { if (!press) hover({ x: -1, y: -1 }); });

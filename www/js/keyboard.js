@@ -1,7 +1,8 @@
 // Keyboard on the plot (all three views). The canvas is focusable (tabindex=0); while it has the
 // focus, Tab / Shift+Tab select the map's objects in turn (Tx, then Rx; in the multi-target view
 // also the targets and discs) and leave the canvas after the last (or before the first), so the
-// keyboard is never trapped. The arrow keys move the selected object by STEP_M (Shift:
+// keyboard is never trapped. + and − zoom about the window's centre and 0 resets it (zoom.js).
+// The arrow keys move the selected object by STEP_M (Shift:
 // STEP_SHIFT_M) through the drag's own path (interact.js moveNode, mtl.js moveTo), so the map
 // recomputes exactly as for a mouse drag; Delete (or Backspace) removes it through the panel's
 // remove path (Panel.removeNode, Mtl.remove), where the core refuses the last node (its message
@@ -18,7 +19,7 @@ const ARROWS = { ArrowLeft: [-1, 0], ArrowRight: [1, 0], ArrowUp: [0, 1], ArrowD
 /** A focus this soon after a press on the page came from the pointer (which selects itself), ms. */
 const POINTER_FOCUS_MS = 500;
 
-/** @param {object} ctx - {app, st, view, changed, panel, plan}; `mtl` the multi-target view. */
+/** @param {object} ctx - {app, st, view, changed, panel, plan, zoom}; `mtl` the multi-target view. */
 export function attachKeyboard(ctx, mtl) {
   const { app, st, view } = ctx;
   const canvas = view.canvas;
@@ -99,7 +100,7 @@ export function attachKeyboard(ctx, mtl) {
     if (!d) return;
     // The bounds of a drag (the region, the plotted area) hold here too; a node already outside
     // them (an imported scenario) is not pulled in.
-    const [x0, x1, y0, y1] = isMtl() ? mtl.scene.region : view.area;
+    const [x0, x1, y0, y1] = isMtl() ? mtl.scene.region : app.area();
     const lim = (v, step, lo, hi) => (v >= lo && v <= hi ? Math.min(Math.max(v + step, lo), hi) : v + step);
     const x = lim(d.x, dx, x0, x1);
     const y = lim(d.y, dy, y0, y1);
@@ -153,6 +154,11 @@ export function attachKeyboard(ctx, mtl) {
       if (!sel) { const list = items(); if (list.length) select(list[0]); return; }
       const step = ev.shiftKey ? STEP_SHIFT_M : STEP_M;
       move(sel, ARROWS[ev.key][0] * step, ARROWS[ev.key][1] * step);
+    } else if (ev.key === '+' || ev.key === '=' || ev.key === '-' || ev.key === '0') {
+      ev.preventDefault();
+      if (ev.key === '0') ctx.zoom.reset();
+      else if (ev.key === '-') ctx.zoom.zoomOut();
+      else ctx.zoom.zoomIn();
     } else if (ev.key === 'Delete' || ev.key === 'Backspace') {
       ev.preventDefault();
       if (sel) remove(sel);

@@ -1,6 +1,7 @@
 // CRLB map worker (a module Web Worker, served by worker-loop.js): the full-resolution map when
-// it costs more than a frame on the main thread (map.js). Jobs: {gen, scenario (JSON text), n};
-// results: {n, values (Float64Array, n·n, transferred), kernelMs (the core's kernel time)}.
+// it costs more than a frame on the main thread (map.js). Jobs: {gen, scenario (JSON text), n,
+// window ([x0, x1, y0, y1] m, the view's)}; results: {n, window, values (Float64Array, n·n,
+// transferred), kernelMs (the core's kernel time)}.
 
 import { App } from '../pkg/scatterloc.js';
 import { serveLatest } from './worker-loop.js';
@@ -16,6 +17,7 @@ serveLatest((m) => {
     scenario = m.scenario;
   }
   const values = new Float64Array(m.n * m.n);
-  const kernelMs = app.compute_map(m.n, m.n, values);
-  return { value: { n: m.n, values, kernelMs }, transfer: [values.buffer] };
+  const [x0, x1, y0, y1] = m.window;
+  const kernelMs = app.compute_map_in(x0, x1, y0, y1, m.n, m.n, values);
+  return { value: { n: m.n, window: m.window, values, kernelMs }, transfer: [values.buffer] };
 });

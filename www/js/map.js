@@ -1,6 +1,7 @@
-// The snapshot (CRLB map) view: the core's RMSE-bound map over the area, the probe read-out, the
-// placed target's simulated snapshot (LM fix vs CRLB) and the drawing of the whole scene:
-// heatmap, colour bar, links, nodes, the target's iso-delay ellipses and its zoom inset. The
+// The snapshot (CRLB map) view: the core's RMSE-bound map over the window shown (the area, or the
+// zoomed / panned part of it, zoom.js), the probe read-out, the placed target's simulated
+// snapshot (LM fix vs CRLB) and the drawing of the whole scene: heatmap, colour bar, scale bar,
+// links, nodes, the target's iso-delay ellipses and its zoom inset. The
 // tracking view draws through the same scene (its frame is snapshot-shaped, plus an overlay).
 // Every number comes from the wasm core.
 //
@@ -13,7 +14,7 @@
 import { $, fixed, showError } from './dom.js';
 import { Zoom } from './view.js';
 import { JobWorker } from './workers.js';
-import { C, FONT, FONT_B, FULL, clipTo, cross, drawAxes, drawNodes, ellipsePath, haloText, linkColor, polyline } from './draw.js';
+import { C, FONT, FONT_B, FULL, clipTo, cross, drawAxes, drawNodes, drawScaleBar, ellipsePath, haloText, linkColor, polyline } from './draw.js';
 
 /** Main-thread budget of the map kernel per refresh, ms (about 60 % of a 60 Hz frame). */
 const FRAME_MS = 10;
@@ -31,6 +32,7 @@ export class MapView {
       barCanvas: makeBarCanvas(wasm.colorbar_rgba(256)),
       unboundedColor: `rgb(${rgb[0]},${rgb[1]},${rgb[2]})`,
       values: null,
+      mapWindow: null, // the window [x0, x1, y0, y1] (m) the values were computed for
       image: null,
       range: null,
       res: 256,
@@ -74,7 +76,7 @@ export class MapView {
       this.show(r, ms, 'drag');
     } else {
       this.jobLinks = links;
-      this.worker.post({ scenario: app.scenario_json(), n });
+      this.worker.post({ scenario: app.scenario_json(), n, window: Array.from(this.ctx.view.area) });
       this.show(r, ms, 'preview');
     }
   }
@@ -88,7 +90,9 @@ export class MapView {
   run(n, links) {
     const { app, st } = this.ctx;
     this.resize(n);
-    const ms = app.compute_map(n, n, st.values);
+    const [x0, x1, y0, y1] = this.ctx.view.area;
+    const ms = app.compute_map_in(x0, x1, y0, y1, n, n, st.values);
+    st.mapWindow = [x0, x1, y0, y1];
     this.learn(n, links, ms);
     this.paint();
     return ms;
@@ -131,6 +135,7 @@ export class MapView {
     const { st } = this.ctx;
     this.resize(m.n);
     st.values = m.values;
+    st.mapWindow = m.window;
     this.learn(m.n, this.jobLinks, m.kernelMs);
     this.paint();
     this.show(m.n, m.kernelMs, 'worker');
@@ -208,10 +213,19 @@ function drawFlipped(ctx, image, x, y, w, h, quality) {
   ctx.restore();
 }
 
-/** The heatmap: the wasm-coloured RGBA image (row 0 = lowest y), flipped to y-up. */
+/**
+ * The heatmap: the wasm-coloured RGBA image (row 0 = lowest y), flipped to y-up, over the window
+ * it was computed for (st.mapWindow): until a new window's map arrives, the last one is drawn
+ * where it lies in the new window.
+ */
 function drawMap(ctx, view, st) {
-  const r = view.rect;
-  if (st.mapCanvas) drawFlipped(ctx, st.mapCanvas, r.x, r.y, r.w, r.h, 'high');
+  if (!st.mapCanvas || !st.mapWindow) return;
+  const [x0, x1, y0, y1] = st.mapWindow;
+  const a = view.toPixel(x0, y1);
+  const b = view.toPixel(x1, y0);
+  clipTo(ctx, view.rect);
+  drawFlipped(ctx, st.mapCanvas, a.x, a.y, b.x - a.x, b.y - a.y, 'high');
+  ctx.restore();
 }
 
 function drawColorbar(ctx, view, st, w) {
@@ -387,10 +401,19 @@ function drawScene(view, st, w) {
   drawMap(ctx, view, st);
   drawAxes(ctx, view, w);
   drawColorbar(ctx, view, st, w);
+  // Zoomed in (zoom.js), the layers stay inside the plot; at the whole area the node labels may
+  // reach into the margin.
+  const zoomed = view.zoomed();
+  if (zoomed) clipTo(ctx, view.rect);
   if (st.overlay) st.overlay(ctx, view);
   if (st.fix) drawTargetMain(ctx, view, st.fix);
   drawNetwork(ctx, view, st.nodes, st.selected);
-  if (st.fix) drawInset(ctx, view, st.fix, w, st.insetTitle || 'target zoom', st.insetAvoid || []);
+  if (zoomed) ctx.restore();
+  drawScaleBar(ctx, view, w);
+  if (st.fix) {
+    const t = view.toPixel(st.fix.truth.x, st.fix.truth.y);
+    if (view.inPlot(t.x, t.y)) drawInset(ctx, view, st.fix, w, st.insetTitle || 'target zoom', st.insetAvoid || []);
+  }
 }
 
 /** A 1-pixel-wide canvas holding the colour bar gradient (dark first = bottom). */

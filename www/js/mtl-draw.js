@@ -3,7 +3,7 @@
 // through the view transform. Markers of the scene (nodes, targets, discs) are drawn from the
 // scene itself so they follow a drag at once.
 
-import { C, FONT_B, FULL, clipTo, cross, drawAxes, drawNodes, ellipsePath, focusRing, haloText, isSelected, linkColor, plotFocus, ring } from './draw.js';
+import { C, FONT_B, FULL, clipTo, cross, drawAxes, drawNodes, drawScaleBar, ellipsePath, focusRing, haloText, isSelected, linkColor, plotFocus, ring } from './draw.js';
 
 const BG = '#10141c';
 const DISC = 'rgba(150,160,178,0.55)';
@@ -135,7 +135,12 @@ export function drawMtl(view, scene, v, sel, w) {
   const ctx = view.context();
   view.clear(ctx, BG);
   const r = view.rect;
+  // Zoomed in (zoom.js), everything stays inside the plot; at the home extent the node labels may
+  // reach into the margin.
+  const zoomed = view.zoomed();
+  if (zoomed) clipTo(ctx, r);
   region(ctx, view, scene);
+  if (zoomed) ctx.restore();
   drawAxes(ctx, view, w);
   clipTo(ctx, r);
   if (v) {
@@ -145,8 +150,11 @@ export function drawMtl(view, scene, v, sel, w) {
   discs(ctx, view, scene, sel);
   if (v) candidates(ctx, view, v);
   ctx.restore();
+  if (zoomed) clipTo(ctx, r);
   if (v) detections(ctx, view, v);
   targets(ctx, view, scene, v, sel);
   const named = (prefix) => (q, i) => ({ x: q[0], y: q[1], name: `${prefix}${i + 1}` });
   drawNodes(ctx, view, scene.receivers.map(named('Rx')), scene.transmitters.map(named('Tx')), sel);
+  if (zoomed) ctx.restore();
+  drawScaleBar(ctx, view, w);
 }

@@ -314,10 +314,11 @@ export class Mtl {
       const p = this.view.eventPixel(ev);
       const h = this.hit(p, hitRadius(ev));
       this.selected = h;
-      this.press = h ? { ...h } : null;
-      if (h) {
+      // On an object: drag it; on empty plot: pan the view (zoom.js).
+      this.press = h ? { ...h } : this.view.inPlot(p.x, p.y) ? { pan: p } : null;
+      if (this.press) {
         this.canvas.setPointerCapture(ev.pointerId);
-        this.canvas.classList.add('dragging');
+        if (h) this.canvas.classList.add('dragging');
       }
       this.ctx.changed({ mtl: true });
     }, true);
@@ -329,6 +330,12 @@ export class Mtl {
         this.canvas.classList.toggle('over-node', !!this.hit(p));
         return;
       }
+      if (this.press.pan) {
+        this.ctx.zoom.panBy(p.x - this.press.pan.x, p.y - this.press.pan.y);
+        this.press.pan = p;
+        this.press.panned = true;
+        return;
+      }
       // Keep the dragged object inside the region (clamped in pixels).
       const [x0, x1, y0, y1] = this.scene.region;
       const m = this.view.toMetreWithin(p, this.view.toPixel(x0, y1), this.view.toPixel(x1, y0));
@@ -337,12 +344,23 @@ export class Mtl {
     const end = (ev) => {
       if (!mine(ev)) return;
       ev.stopPropagation();
-      this.press = null;
-      this.canvas.classList.remove('dragging');
+      if (this.press && this.press.panned && ev.type === 'pointerup') {
+        // The release point is where the map ends up (a move event may have been resampled).
+        const p = this.view.eventPixel(ev);
+        this.ctx.zoom.panBy(p.x - this.press.pan.x, p.y - this.press.pan.y);
+      }
+      this.cancelPress();
     };
     wrap.addEventListener('pointerup', end, true);
     wrap.addEventListener('pointercancel', end, true);
     wrap.addEventListener('pointerleave', (ev) => { if (mine(ev)) ev.stopPropagation(); }, true);
+  }
+
+  /** Ends a press (a release, or a second finger starting a pinch, zoom.js). */
+  cancelPress() {
+    if (this.press && this.press.panned) this.ctx.zoom.settle();
+    this.press = null;
+    this.canvas.classList.remove('dragging');
   }
 
   // ---------- drawing ----------
@@ -351,7 +369,8 @@ export class Mtl {
   draw() {
     const [x0, x1, y0, y1] = this.scene.region;
     this.view.resize();
-    this.view.fit([x0 - MARGIN_M, x1 + MARGIN_M, y0 - MARGIN_M, y1 + MARGIN_M]);
+    // The region and a margin; a zoomed window (zoom.js) stays until the region changes.
+    this.view.setHome([x0 - MARGIN_M, x1 + MARGIN_M, y0 - MARGIN_M, y1 + MARGIN_M]);
     this.syncPanel();
     drawMtl(this.view, this.scene, this.result, this.selected, this.wasm);
   }

@@ -156,8 +156,9 @@ export class Panel {
   addNode(kind) {
     const [x0, x1, y0, y1] = this.ctx.app.area();
     const c = this.ctx.view.toMetre(this.ctx.view.rect.x + this.ctx.view.rect.w / 2, this.ctx.view.rect.y + this.ctx.view.rect.h / 3);
-    const x = Number.isFinite(c.x) ? c.x : (x0 + x1) / 2;
-    const y = Number.isFinite(c.y) ? c.y : (y0 + y1) / 2;
+    // In the window shown (zoom.js) and in the area.
+    const x = Number.isFinite(c.x) ? Math.min(Math.max(c.x, x0), x1) : (x0 + x1) / 2;
+    const y = Number.isFinite(c.y) ? Math.min(Math.max(c.y, y0), y1) : (y0 + y1) / 2;
     this.run(null, () => {
       const i = kind === 'tx' ? this.ctx.app.add_transmitter(x, y) : this.ctx.app.add_receiver(x, y);
       this.select(kind, i, false);

@@ -1,9 +1,13 @@
 // Pixel <-> metre transform of the plot: DPR-aware canvas, equal scale on both axes (metres stay
-// square), y up. The only arithmetic in the page's JavaScript lives here.
+// square), y up, and the window shown: the home extent (the scenario area, or the multi-target
+// region) or a zoomed / panned part of it (zoom.js routes the gestures here). The only arithmetic
+// in the page's JavaScript lives here.
 
 import { fitCanvas } from './dom.js';
 
 export const MARGIN = { left: 58, right: 112, top: 16, bottom: 44 };
+/** Zoom limits: the window's width between these multiples of the home extent's width. */
+export const ZOOM_SPAN = { min: 1e-4, max: 8 };
 
 export class View {
   constructor(canvas) {
@@ -11,9 +15,11 @@ export class View {
     this.dpr = 1;
     this.width = 1; // CSS px
     this.height = 1;
-    this.area = [0, 1, 0, 1]; // x_min, x_max, y_min, y_max (m)
+    this.area = [0, 1, 0, 1]; // the window shown: x_min, x_max, y_min, y_max (m)
+    this.home = null; // the extent a reset returns to (same layout), or null before setHome
     this.scale = 1; // CSS px per metre
     this.rect = { x: 0, y: 0, w: 1, h: 1 }; // plot rectangle, CSS px
+    this.drawn = { ticks: null, scaleBar: null }; // what the last frame drew from the window (draw.js)
   }
 
   /** Matches the backing store to the element size and device pixel ratio. */
@@ -32,6 +38,85 @@ export class View {
     const pw = this.scale * (x1 - x0);
     const ph = this.scale * (y1 - y0);
     this.rect = { x: MARGIN.left + (w - pw) / 2, y: MARGIN.top + (h - ph) / 2, w: pw, h: ph };
+  }
+
+  /**
+   * The extent the window resets to. A new home (another scenario area or region) also resets
+   * the window; the same home keeps a zoomed window.
+   */
+  setHome(extent) {
+    const e = Array.from(extent);
+    if (this.home && e.every((v, i) => v === this.home[i])) return;
+    this.home = e;
+    this.fit(e);
+  }
+
+  /** Back to the home extent. */
+  reset() {
+    if (this.home) this.fit(this.home);
+  }
+
+  /** True when the window is not the home extent. */
+  zoomed() {
+    return !!this.home && this.area.some((v, i) => v !== this.home[i]);
+  }
+
+  /** Magnification of the window against the home extent (1: the whole of it). */
+  zoomFactor() {
+    return this.home ? (this.home[1] - this.home[0]) / (this.area[1] - this.area[0]) : 1;
+  }
+
+  /**
+   * Zooms by `factor` (< 1: in; the window's width times factor, within ZOOM_SPAN of the home's)
+   * about the canvas pixel (px, py), whose metre point stays under it. Returns the factor applied.
+   */
+  zoomAt(px, py, factor) {
+    if (!this.home || !(factor > 0) || !Number.isFinite(factor)) return 1;
+    const [x0, x1, y0, y1] = this.area;
+    const homeW = this.home[1] - this.home[0];
+    const w = Math.min(Math.max((x1 - x0) * factor, ZOOM_SPAN.min * homeW), ZOOM_SPAN.max * homeW);
+    const f = w / (x1 - x0);
+    if (f === 1) return 1;
+    const m = this.toMetre(px, py);
+    // The window of the home (f applied to the home's own numbers) lands exactly on the home.
+    const back = Math.abs(w - homeW) <= 1e-9 * homeW;
+    this.fit(back ? this.home : [m.x + (x0 - m.x) * f, m.x + (x1 - m.x) * f, m.y + (y0 - m.y) * f, m.y + (y1 - m.y) * f]);
+    return f;
+  }
+
+  /**
+   * Moves the window by (dx, dy) CSS px of drag (the map follows the pointer); its centre stays
+   * within the home extent grown by its own size on each side.
+   */
+  panBy(dx, dy) {
+    if (!this.home) return;
+    const [x0, x1, y0, y1] = this.area;
+    const [hx0, hx1, hy0, hy1] = this.home;
+    const clampShift = (shift, lo, hi, hlo, hhi) => {
+      const c = (lo + hi) / 2 + shift;
+      const span = hhi - hlo;
+      return Math.min(Math.max(c, hlo - span), hhi + span) - (lo + hi) / 2;
+    };
+    const sx = clampShift(-dx / this.scale, x0, x1, hx0, hx1);
+    const sy = clampShift(dy / this.scale, y0, y1, hy0, hy1);
+    if (sx === 0 && sy === 0) return;
+    this.fit([x0 + sx, x1 + sx, y0 + sy, y1 + sy]);
+  }
+
+  /**
+   * The pixel box ({a: top left, b: bottom right}) a node drag stays in: the home extent where it
+   * is in sight, else the home extent itself.
+   */
+  dragBox() {
+    const r = this.rect;
+    const [x0, x1, y0, y1] = this.home || this.area;
+    const a = this.toPixel(x0, y1);
+    const b = this.toPixel(x1, y0);
+    const box = {
+      a: { x: Math.max(a.x, r.x), y: Math.max(a.y, r.y) },
+      b: { x: Math.min(b.x, r.x + r.w), y: Math.min(b.y, r.y + r.h) },
+    };
+    return box.a.x <= box.b.x && box.a.y <= box.b.y ? box : { a, b };
   }
 
   /** Metres -> CSS pixels relative to the canvas' top-left corner. */
