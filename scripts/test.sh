@@ -7,6 +7,8 @@ export PATH="$HOME/.cargo/bin:$PATH"
 start=$SECONDS
 bash scripts/setup.sh
 export CHROMEDRIVER=/usr/bin/chromedriver WASM_BINDGEN_TEST_TIMEOUT=120
+# Every build here starts from a fresh target on CI: incremental compilation only adds work there.
+export CARGO_INCREMENTAL="${CARGO_INCREMENTAL:-0}"
 
 step() { printf '\n==== [%dm%02ds] %s\n' $(((SECONDS - start) / 60)) $(((SECONDS - start) % 60)) "$*"; }
 log=$(mktemp); trap 'rm -f "$log"' EXIT

@@ -239,7 +239,14 @@ export async function start() {
   }).observe($('plot').parentElement);
   // A new devicePixelRatio (browser zoom, another screen) without a new CSS size: redraw sharp.
   const watchDpr = () => matchMedia(`(resolution: ${window.devicePixelRatio}dppx)`)
-    .addEventListener('change', () => { view.resize(); changed({ draw: true }); watchDpr(); }, { once: true });
+    .addEventListener('change', () => {
+      view.resize();
+      changed({ draw: true });
+      // The charts' CSS size is unchanged, so their ResizeObservers stay silent: redraw them too.
+      tracking.mc.drawChart();
+      plan.drawChart();
+      watchDpr();
+    }, { once: true });
   watchDpr();
 
   if (opts.roi) {
