@@ -198,6 +198,25 @@ async fn connect(driver: &Driver) -> Client {
         .expect("webdriver session")
 }
 
+/// One browser test's set-up and tear-down: the one-browser-at-a-time lock, the page server,
+/// chromedriver and a Chromium session. `f` gets the client, the server's port and chromedriver's
+/// (for [`layout::cdp`]); the session closes whatever `f` returns, and an `Err` fails the test
+/// with its message.
+fn with_browser<T>(f: impl AsyncFnOnce(&Client, u16, u16) -> Result<T, String>) -> T {
+    let _serial = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
+    let port = start_server();
+    let driver = Driver::start();
+    let dport = driver.port;
+    let outcome = runtime().block_on(async {
+        let c = connect(&driver).await;
+        let r = f(&c, port, dport).await;
+        let _ = c.close().await;
+        r
+    });
+    drop(driver);
+    outcome.unwrap_or_else(|e| panic!("{e}"))
+}
+
 /// Loads the page and waits for `data-ready` (or fails fast on `data-error`).
 async fn open(c: &Client, port: u16) -> Result<(), String> {
     open_hash(c, port, "").await
@@ -387,18 +406,7 @@ async fn drag_receiver(c: &Client, port: u16) -> Result<DragOutcome, String> {
 #[test]
 #[ignore = "needs chromium + chromedriver and www/pkg (wasm-pack build); run with --ignored"]
 fn drag_receiver_updates_map_and_probe() {
-    let _serial = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
-    let port = start_server();
-    let driver = Driver::start();
-    let rt = runtime();
-    let outcome = rt.block_on(async {
-        let c = connect(&driver).await;
-        let r = drag_receiver(&c, port).await;
-        let _ = c.close().await;
-        r
-    });
-    drop(driver);
-    let o = outcome.unwrap_or_else(|e| panic!("{e}"));
+    let o = with_browser(async |c, port, _| drag_receiver(c, port).await);
 
     println!(
         "e2e: map {} in Chromium: median {:.2} ms over {} runs (min {:.2}, max {:.2})",

@@ -14,10 +14,7 @@ use fantoccini::Client;
 use serde_json::Value;
 
 use super::mtl::{banner, wait_view};
-use super::{
-    connect, console_errors, js, open, open_hash, runtime, settle, start_server, Driver, MAP_HASH,
-    SERIAL,
-};
+use super::{console_errors, js, open, open_hash, settle, with_browser, MAP_HASH};
 
 const TAB: char = '\u{E004}';
 const SHIFT: char = '\u{E008}';
@@ -119,18 +116,7 @@ async fn axe_views(c: &Client, port: u16) -> Result<Vec<(String, Vec<Value>)>, S
 #[test]
 #[ignore = "needs chromium + chromedriver, www/pkg and .tools/axe-core (scripts/setup.sh); run with --ignored"]
 fn axe_no_serious_violations() {
-    let _serial = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
-    let port = start_server();
-    let driver = Driver::start();
-    let rt = runtime();
-    let r = rt.block_on(async {
-        let c = connect(&driver).await;
-        let r = axe_views(&c, port).await;
-        let _ = c.close().await;
-        r
-    });
-    drop(driver);
-    let views = r.unwrap_or_else(|e| panic!("{e}"));
+    let views = with_browser(async |c, port, _| axe_views(c, port).await);
     let mut bad = Vec::new();
     for (name, v) in &views {
         let [cr, se, mo, mi] = by_impact(v);
@@ -363,18 +349,7 @@ async fn keyboard(c: &Client, port: u16) -> Result<Keys, String> {
 #[test]
 #[ignore = "needs chromium + chromedriver and www/pkg (wasm-pack build); run with --ignored"]
 fn keyboard_selects_moves_and_deletes_nodes() {
-    let _serial = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
-    let port = start_server();
-    let driver = Driver::start();
-    let rt = runtime();
-    let r = rt.block_on(async {
-        let c = connect(&driver).await;
-        let r = keyboard(&c, port).await;
-        let _ = c.close().await;
-        r
-    });
-    drop(driver);
-    let k = r.unwrap_or_else(|e| panic!("{e}"));
+    let k = with_browser(async |c, port, _| keyboard(c, port).await);
     for (i, t) in k.tabs.iter().enumerate() {
         println!("tab {i}: {t}");
     }

@@ -15,7 +15,7 @@ use scatterloc::present::{colorbar_ticks, LogScale};
 use scatterloc::{scenario::presets, Model};
 
 use super::tracking::{mc_done, wait_state};
-use super::{connect, console_errors, js, open, runtime, settle, start_server, Driver, SERIAL};
+use super::{console_errors, js, open, settle, with_browser};
 
 const PNG_SIGNATURE: [u8; 8] = [0x89, b'P', b'N', b'G', 0x0d, 0x0a, 0x1a, 0x0a];
 
@@ -191,17 +191,7 @@ fn assert_png(what: &str, f: &Saved) {
 #[test]
 #[ignore = "needs chromium + chromedriver and www/pkg (wasm-pack build); run with --ignored"]
 fn save_figure_writes_svg_and_png_of_each_view() {
-    let _serial = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
-    let port = start_server();
-    let driver = Driver::start();
-    let outcome = runtime().block_on(async {
-        let c = connect(&driver).await;
-        let r = run(&c, port).await;
-        let _ = c.close().await;
-        r
-    });
-    drop(driver);
-    let o = outcome.unwrap_or_else(|e| panic!("{e}"));
+    let o = with_browser(async |c, port, _| run(c, port).await);
     assert!(o.errors.is_empty(), "console errors: {:?}", o.errors);
 
     let s = presets::sensors2019();

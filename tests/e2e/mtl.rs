@@ -8,9 +8,7 @@ use std::time::{Duration, Instant};
 use fantoccini::{Client, Locator};
 use serde_json::{json, Value};
 
-use super::{
-    connect, console_errors, drag_on_plot, js, open, runtime, settle, start_server, Driver, SERIAL,
-};
+use super::{console_errors, drag_on_plot, js, open, settle, with_browser};
 
 pub(super) async fn state(c: &Client) -> Result<Value, String> {
     js(c, "return window.mtl.state()").await
@@ -194,17 +192,7 @@ async fn drag_target(c: &Client, port: u16) -> Result<Outcome, String> {
 #[test]
 #[ignore = "needs chromium + chromedriver and www/pkg (wasm-pack build); run with --ignored"]
 fn mtl_drag_target_detection_follows() {
-    let _serial = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
-    let port = start_server();
-    let driver = Driver::start();
-    let outcome = runtime().block_on(async {
-        let c = connect(&driver).await;
-        let r = drag_target(&c, port).await;
-        let _ = c.close().await;
-        r
-    });
-    drop(driver);
-    let o = outcome.unwrap_or_else(|e| panic!("{e}"));
+    let o = with_browser(async |c, port, _| drag_target(c, port).await);
     let summary = |ms: &[f64]| {
         let mut sorted = ms.to_vec();
         sorted.sort_by(f64::total_cmp);

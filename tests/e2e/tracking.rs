@@ -15,9 +15,7 @@ use scatterloc::track::{paper_initial_covariance, PAPER_INTENSITY};
 use scatterloc::track::{run_sequential, MonteCarloConfig};
 use scatterloc::{Model, Scenario};
 
-use super::{
-    connect, console_errors, drag_on_plot, js, open, runtime, settle, start_server, Driver, SERIAL,
-};
+use super::{console_errors, drag_on_plot, js, open, settle, with_browser};
 
 pub(super) async fn state(c: &Client) -> Result<Value, String> {
     js(c, "return window.tracking.state()").await
@@ -267,17 +265,7 @@ fn native_difference(params: &Value, result: &Value) -> f64 {
 #[test]
 #[ignore = "needs chromium + chromedriver and www/pkg (wasm-pack build); run with --ignored"]
 fn tracking_scenario_ii_plays_and_monte_carlo_restarts_on_drag() {
-    let _serial = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
-    let port = start_server();
-    let driver = Driver::start();
-    let outcome = runtime().block_on(async {
-        let c = connect(&driver).await;
-        let r = scenario_ii(&c, port).await;
-        let _ = c.close().await;
-        r
-    });
-    drop(driver);
-    let o = outcome.unwrap_or_else(|e| panic!("{e}"));
+    let o = with_browser(async |c, port, _| scenario_ii(c, port).await);
 
     let f = &o.final_state;
     let ms = f["mcMs"].as_f64().unwrap();
@@ -431,17 +419,7 @@ async fn three_filters(c: &Client, port: u16) -> Result<FiltersOutcome, String> 
 #[test]
 #[ignore = "needs chromium + chromedriver and www/pkg (wasm-pack build); run with --ignored"]
 fn tracking_page_runs_the_chosen_filters() {
-    let _serial = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
-    let port = start_server();
-    let driver = Driver::start();
-    let outcome = runtime().block_on(async {
-        let c = connect(&driver).await;
-        let r = three_filters(&c, port).await;
-        let _ = c.close().await;
-        r
-    });
-    drop(driver);
-    let o = outcome.unwrap_or_else(|e| panic!("{e}"));
+    let o = with_browser(async |c, port, _| three_filters(c, port).await);
     assert!(o.errors.is_empty(), "console errors: {:?}", o.errors);
 
     // The animated particle-filter track: 100 steps, every step with its 1σ ellipse.

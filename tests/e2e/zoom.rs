@@ -11,7 +11,7 @@ use scatterloc::{scenario::presets, Model};
 
 use super::layout::cdp;
 use super::tracking::{mc_done, wait_state};
-use super::{connect, console_errors, js, open, runtime, settle, start_server, Driver, SERIAL};
+use super::{console_errors, js, open, settle, with_browser};
 
 /// The map's values, the window and colour range they were drawn with, and its grid size.
 type MapShown = (Vec<f64>, Vec<f64>, Vec<f64>, usize);
@@ -31,8 +31,9 @@ struct Outcome {
     /// The plot pixel under the wheel, its metre point before and after the zoom.
     wheel_anchor: (Vec<f64>, Vec<f64>),
     pinch_anchor: (Vec<f64>, Vec<f64>),
-    /// Drag of the pans, CSS px.
-    pan_px: [f64; 2],
+    /// The pans' pointer travel as the page saw it, CSS px.
+    snapshot_pan: [f64; 2],
+    mtl_pan: [f64; 2],
     mtl_scene: (Value, Value),
     errors: Vec<String>,
 }
@@ -120,16 +121,26 @@ fn mouse(
 }
 
 /// A left-button drag from canvas pixel `p` by `d` CSS px in 4 moves.
+/// Returns the pointer's travel from press to release as the page saw it (its pointerdown and
+/// pointerup positions), CSS px: Chromium may report a synthetic press short of the point sent
+/// when the mouse was moved there just before (seen under load: up to 2.5 px along the way).
 async fn mouse_drag(
+    c: &fantoccini::Client,
     dport: u16,
     session: &str,
     origin: (f64, f64),
     p: [f64; 2],
     d: [f64; 2],
-) -> Result<(), String> {
+) -> Result<[f64; 2], String> {
+    js(
+        c,
+        "window.__press = {}; \
+         for (const t of ['pointerdown', 'pointerup']) document.addEventListener(t, \
+           (e) => { window.__press[t] = [e.clientX, e.clientY]; }, { capture: true, once: true });",
+    )
+    .await?;
     let (x, y) = (origin.0 + p[0], origin.1 + p[1]);
     mouse(dport, session, "mouseMoved", x, y, json!({}))?;
-    // A hand pauses before pressing; without it Chromium reported the press short of the point.
     tokio::time::sleep(std::time::Duration::from_millis(50)).await;
     let down = json!({"button": "left", "buttons": 1, "clickCount": 1});
     mouse(dport, session, "mousePressed", x, y, down.clone())?;
@@ -155,7 +166,14 @@ async fn mouse_drag(
     )?;
     // The release is handled before the caller reads the page.
     tokio::time::sleep(std::time::Duration::from_millis(100)).await;
-    Ok(())
+    let seen = js(
+        c,
+        "const p = window.__press; return [p.pointerup[0] - p.pointerdown[0], p.pointerup[1] - p.pointerdown[1]];",
+    )
+    .await?;
+    let travel: [f64; 2] = serde_json::from_value(seen).map_err(|e| e.to_string())?;
+    println!("e2e zoom: drag of {d:?} px sent, {travel:?} px seen by the page");
+    Ok(travel)
 }
 
 async fn run(c: &fantoccini::Client, port: u16, dport: u16) -> Result<Outcome, String> {
@@ -183,7 +201,7 @@ async fn run(c: &fantoccini::Client, port: u16, dport: u16) -> Result<Outcome, S
             json!({"deltaX": 0, "deltaY": dy}),
         )
     };
-    let pan_px = [80.0, -40.0];
+    let drag = [80.0, -40.0];
 
     // Snapshot: wheel in (300 px up: ×2) about a plot point, pan by a drag, double-click back.
     let mut snapshot = vec![("home", frame(c, true).await?)];
@@ -194,7 +212,7 @@ async fn run(c: &fantoccini::Client, port: u16, dport: u16) -> Result<Outcome, S
     let after = metre_at(c, p).await?;
     snapshot.push(("wheel", f));
     let q = snap(empty_pixel(c, 0.5, 0.5).await?);
-    mouse_drag(dport, &session, origin, q, pan_px).await?;
+    let snapshot_pan = mouse_drag(c, dport, &session, origin, q, drag).await?;
     snapshot.push(("pan", frame(c, true).await?));
     let r = empty_pixel(c, 0.5, 0.5).await?;
     let (x, y) = (origin.0 + r[0], origin.1 + r[1]);
@@ -295,7 +313,7 @@ async fn run(c: &fantoccini::Client, port: u16, dport: u16) -> Result<Outcome, S
     let pinch_after = metre_at(c, mid).await?;
     mtl.push(("pinch", f));
     let q = snap(empty_pixel(c, 0.5, 0.5).await?);
-    mouse_drag(dport, &session, origin, q, pan_px).await?;
+    let mtl_pan = mouse_drag(c, dport, &session, origin, q, drag).await?;
     mtl.push(("pan", frame(c, false).await?));
     let scene_after = js(c, "return window.mtl.state().scene").await?;
     js(c, "document.getElementById('zoom-reset').click()").await?;
@@ -307,7 +325,8 @@ async fn run(c: &fantoccini::Client, port: u16, dport: u16) -> Result<Outcome, S
         mtl,
         wheel_anchor: (before, after),
         pinch_anchor: (pinch_before, pinch_after),
-        pan_px,
+        snapshot_pan,
+        mtl_pan,
         mtl_scene: (scene_before, scene_after),
         errors: console_errors(c).await?,
     })
@@ -397,18 +416,7 @@ fn assert_map_follows(f: &Frame, model: &Model, what: &str) {
 #[test]
 #[ignore = "needs chromium + chromedriver and www/pkg (wasm-pack build); run with --ignored"]
 fn wheel_pinch_and_pan_zoom_the_map_in_every_view() {
-    let _serial = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
-    let port = start_server();
-    let driver = Driver::start();
-    let dport = driver.port;
-    let outcome = runtime().block_on(async {
-        let c = connect(&driver).await;
-        let r = run(&c, port, dport).await;
-        let _ = c.close().await;
-        r
-    });
-    drop(driver);
-    let o = outcome.unwrap_or_else(|e| panic!("{e}"));
+    let o = with_browser(async |c, port, dport| run(c, port, dport).await);
     assert!(o.errors.is_empty(), "console errors: {:?}", o.errors);
     for (view, frames) in [
         ("snapshot", &o.snapshot),
@@ -445,7 +453,7 @@ fn wheel_pinch_and_pan_zoom_the_map_in_every_view() {
     // Pan: the window moves by the drag (x: -dx/scale, y: +dy/scale), same size.
     let w2 = window(&sn[2].1);
     let scale = sn[2].1.zoom["rect"]["w"].as_f64().unwrap() / (w2[1] - w2[0]);
-    let (dx, dy) = (-o.pan_px[0] / scale, o.pan_px[1] / scale);
+    let (dx, dy) = (-o.snapshot_pan[0] / scale, o.snapshot_pan[1] / scale);
     for (k, d) in [(0, dx), (1, dx), (2, dy), (3, dy)] {
         close(
             w2[k],
@@ -483,13 +491,13 @@ fn wheel_pinch_and_pan_zoom_the_map_in_every_view() {
     let scale = mt[2].1.zoom["rect"]["w"].as_f64().unwrap() / (m2[1] - m2[0]);
     close(
         m2[0],
-        m1[0] - o.pan_px[0] / scale,
+        m1[0] - o.mtl_pan[0] / scale,
         (mh[1] - mh[0]) * 1e3,
         "mtl pan x",
     );
     close(
         m2[2],
-        m1[2] + o.pan_px[1] / scale,
+        m1[2] + o.mtl_pan[1] / scale,
         (mh[1] - mh[0]) * 1e3,
         "mtl pan y",
     );
