@@ -6,6 +6,7 @@
 //! [`draw_tracking_rmse`] draws the tracking figure of \[S\] Fig. 3 (spec §10) in the same style.
 //! [`draw_plan_maps`] draws a network plan: the maps before and after side by side.
 //! [`draw_curves`] draws the ROC and missed-detection curves of the multi-target experiments.
+//! [`draw_mtl_scene`] draws a multi-target scene and its view (the page's multi-target view).
 
 mod layout;
 mod map;
@@ -13,6 +14,7 @@ mod overlay;
 mod plan;
 mod raster;
 mod roc;
+mod scene;
 mod tracking;
 
 pub(crate) use layout::{axis_label, chart_err};
@@ -28,6 +30,7 @@ pub use plan::{
 pub use roc::{
     curve_chart_size, draw_curves, CurveChartOptions, CurveSeries, LineKind, Marker, CURVE_PALETTE,
 };
+pub use scene::{draw_mtl_scene, scene_nodes, scene_titles, scene_window, SceneChartOptions};
 pub use tracking::{
     draw_tracking_filters, draw_tracking_rmse, tracking_size, FilterCurve, FiltersPanel,
     TrackingChartOptions, TrackingPanel,

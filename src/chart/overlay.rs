@@ -235,7 +235,11 @@ impl MapOverlay {
 
 /// The runs of the polyline `points` (closed back to its start when `closed`) inside the view
 /// `[x0, x1, y0, y1]`: each segment is clipped, and a run breaks where the line leaves the view.
-fn clipped_runs(points: &[[Real; 2]], closed: bool, view: [Real; 4]) -> Vec<Vec<(Real, Real)>> {
+pub(super) fn clipped_runs(
+    points: &[[Real; 2]],
+    closed: bool,
+    view: [Real; 4],
+) -> Vec<Vec<(Real, Real)>> {
     let mut pts: Vec<(Real, Real)> = points
         .iter()
         .filter(|p| p[0].is_finite() && p[1].is_finite())

@@ -1,8 +1,9 @@
 //! The page's "Save figure" as SVG: the figures drawn by the same plotters chart code as the CLI
 //! ([`crate::chart`]) through plotters' SVG backend into a `String`. `App.map_svg` draws the CRLB
 //! map figure of the app's scenario (with a placed target's snapshot), `Track.map_svg` the map
-//! with a simulated track, and [`tracking_chart_svg`] the Monte Carlo RMSE chart of the tracking
-//! view (the canvas chart's [`draw_tracking_chart`](super::draw_tracking_chart) code). Every
+//! with a simulated track, [`tracking_chart_svg`] the Monte Carlo RMSE chart of the tracking
+//! view (the canvas chart's [`draw_tracking_chart`](super::draw_tracking_chart) code) and
+//! [`mtl_scene_svg`] the multi-target scene ([`crate::chart::draw_mtl_scene`]). Every
 //! error is an exception whose message starts with the function's name; nothing here runs until
 //! the page's Save figure button is pressed.
 
@@ -13,11 +14,12 @@ use wasm_bindgen::prelude::*;
 use super::tracking::Track;
 use super::App;
 use crate::chart::{
-    default_titles, draw_crlb_map_with, scenario_nodes, suggested_size, ChartOptions, MapData,
-    MapOverlay,
+    default_titles, draw_crlb_map_with, draw_mtl_scene, scenario_nodes, scene_window,
+    suggested_size, ChartOptions, MapData, MapOverlay, SceneChartOptions,
 };
 use crate::error::{limits, Error};
 use crate::localize::{crlb_map, Grid};
+use crate::mtl::view::{mtl_view, MtlScene};
 use crate::present::simulate_snapshot;
 use crate::scenario::Area;
 use crate::{Model, Scenario, Vec2};
@@ -242,6 +244,73 @@ pub fn tracking_chart_svg(
         let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
         super::chart::draw_result(&root, result_json, title, subtitle, caption)
             .map_err(|e| fail(F, e))?;
+    }
+    Ok(svg)
+}
+
+/// The options of a scene figure (all optional; `""` is all defaults).
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct SceneOptions {
+    /// `[x_min, x_max, y_min, y_max]`, m (default: the region with a 4 % margin).
+    #[serde(default)]
+    window: Option<[f64; 4]>,
+    /// Title (default: the scene's counts).
+    #[serde(default)]
+    title: Option<String>,
+}
+
+/// The multi-target scene figure of `scene_json` (the page's scene, schema
+/// [`MtlScene`]) as SVG text: its view computed by the core ([`mtl_view`], as `mtl_view_of`) and
+/// drawn by [`draw_mtl_scene`] — the region, discs, blocked segments, range ellipses, seeds,
+/// hypotheses, detections, targets and nodes. `width` 200 … 8000 px, `height` 0 (fit the plot)
+/// or 150 … 8000 px. `options_json`: `""` or `{window?: [x_min, x_max, y_min, y_max] (m),
+/// title?: text}`. Throws `mtl_scene_svg: …` with the core's named error.
+#[wasm_bindgen]
+pub fn mtl_scene_svg(
+    scene_json: &str,
+    width: u32,
+    height: u32,
+    options_json: &str,
+) -> Result<String, JsError> {
+    const F: &str = "mtl_scene_svg";
+    let opts: SceneOptions = if options_json.trim().is_empty() {
+        SceneOptions::default()
+    } else {
+        serde_json::from_str(options_json).map_err(|e| {
+            fail(
+                F,
+                Error::Parse {
+                    message: e.to_string(),
+                },
+            )
+        })?
+    };
+    let scene = MtlScene::from_json(scene_json).map_err(|e| fail(F, e))?;
+    let window = match opts.window {
+        Some([x0, x1, y0, y1]) => {
+            let a = Area {
+                x: [x0, x1],
+                y: [y0, y1],
+            };
+            a.validate_as(["window.x", "window.y"])
+                .map_err(|e| fail(F, e))?;
+            a
+        }
+        None => scene_window(&scene),
+    };
+    let size = figure_size(Some(&window), width, height).map_err(|e| fail(F, e))?;
+    let view = mtl_view(&scene).map_err(|e| fail(F, e))?;
+    let chart_opts = SceneChartOptions {
+        title: opts.title,
+        subtitle: None,
+        window: Some(window),
+    };
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
+        draw_mtl_scene(&root, &scene, &view, &chart_opts).map_err(|e| fail(F, e))?;
+        root.present().map_err(|e| fail(F, e))?;
     }
     Ok(svg)
 }

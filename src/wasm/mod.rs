@@ -31,7 +31,7 @@ pub use app::App;
 use base::{err, point};
 pub use base::{preset_json, preset_names, start};
 pub use chart::draw_tracking_chart;
-pub use export::{tracking_chart_svg, MAX_FIGURE_PX, MAX_FIGURE_RES};
+pub use export::{mtl_scene_svg, tracking_chart_svg, MAX_FIGURE_PX, MAX_FIGURE_RES};
 pub use montecarlo::MonteCarloJob;
 pub use mtl::{mtl_check_scene, mtl_default_scene, mtl_view_of, MtlSession};
 pub use plan::plan_network;

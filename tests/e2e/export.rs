@@ -2,8 +2,9 @@
 //! clicked for real; the page builds the download link (the hooks' dry run leaves it unclicked,
 //! so nothing lands in a downloads folder) and the test reads the file through the link's blob
 //! URL. The SVGs parse as XML and hold every node's label, the colour bar (its label and tick
-//! labels) and the view's overlay (target or track); the PNGs start with the PNG signature; the
-//! file names are `<scenario>-<view>-<figure>.<ext>`.
+//! labels) and the view's overlay (target or track), the multi-target scene its nodes, layers and
+//! the page's detection result; the PNGs start with the PNG signature; the file names are
+//! `<scenario>-<view>-<figure>.<ext>`.
 
 use std::time::{Duration, Instant};
 
@@ -103,8 +104,10 @@ struct Outcome {
     tracking_map_svg: Saved,
     tracking_rmse_svg: Saved,
     tracking_rmse_png: Saved,
+    mtl_svg: Saved,
     mtl_png: Saved,
-    mtl_svg_disabled: Value,
+    /// The multi-target view's detection result (window.mtl.state().metrics).
+    mtl_metrics: Value,
     errors: Vec<String>,
 }
 
@@ -132,21 +135,18 @@ async fn run(c: &Client, port: u16) -> Result<Outcome, String> {
 
     click(c, "mode-mtl").await?;
     settle(c).await?;
-    let mtl_svg_disabled = js(
-        c,
-        "return document.querySelector('#figure-format option[value=svg]').disabled",
-    )
-    .await?;
-    // The view saves PNG whatever the select says.
-    let mtl_png = save(c, "map", "svg").await?;
+    let mtl_svg = save(c, "map", "svg").await?;
+    let mtl_png = save(c, "map", "png").await?;
+    let mtl_metrics = js(c, "return window.mtl.state().metrics").await?;
     Ok(Outcome {
         snapshot_svg,
         snapshot_png,
         tracking_map_svg,
         tracking_rmse_svg,
         tracking_rmse_png,
+        mtl_svg,
         mtl_png,
-        mtl_svg_disabled,
+        mtl_metrics,
         errors: console_errors(c).await?,
     })
 }
@@ -218,6 +218,7 @@ fn save_figure_writes_svg_and_png_of_each_view() {
         (&o.tracking_map_svg, "sensors2019-tracking-map.svg"),
         (&o.tracking_rmse_svg, "sensors2019-tracking-rmse.svg"),
         (&o.tracking_rmse_png, "sensors2019-tracking-rmse.png"),
+        (&o.mtl_svg, "multi-target-scene.svg"),
         (&o.mtl_png, "multi-target-scene.png"),
     ] {
         assert_eq!(f.info["name"], name, "{}", f.info);
@@ -253,7 +254,22 @@ fn save_figure_writes_svg_and_png_of_each_view() {
     assert!(t.iter().any(|x| x == "EKF RMSE"), "{t:?}");
     assert_png("tracking rmse", &o.tracking_rmse_png);
 
-    // Multi-target: PNG only.
-    assert_eq!(o.mtl_svg_disabled, Value::Bool(true));
+    // Multi-target: the scene's nodes, its layers' legend and the page's own detection result.
+    let t = svg_texts("multi-target scene", &o.mtl_svg.text);
+    for name in ["Tx1", "Tx2", "Tx3", "Rx1", "Rx2", "Rx3"] {
+        assert_eq!(count(&t, name), 1, "multi-target scene: {name} in {t:?}");
+    }
+    for label in ["region R", "target", "detected"] {
+        assert_eq!(count(&t, label), 1, "multi-target scene: {label} in {t:?}");
+    }
+    let m = &o.mtl_metrics;
+    let result = format!(
+        "K̂/K = {}/{} · N_D = {} · N_FA = {}",
+        m["estimates"], m["targets"], m["detected"], m["false_alarms"]
+    );
+    assert!(
+        t.iter().any(|x| x.starts_with(&result)),
+        "{result} in {t:?}"
+    );
     assert_png("multi-target scene", &o.mtl_png);
 }

@@ -205,6 +205,7 @@ async fn run(c: &fantoccini::Client, port: u16, dport: u16) -> Result<Outcome, S
 
     // Snapshot: wheel in (300 px up: ×2) about a plot point, pan by a drag, double-click back.
     let mut snapshot = vec![("home", frame(c, true).await?)];
+
     let p = snap(empty_pixel(c, 0.3, 0.6).await?);
     let before = metre_at(c, p).await?;
     wheel(p, -300.0)?;
@@ -413,6 +414,35 @@ fn assert_map_follows(f: &Frame, model: &Model, what: &str) {
     );
 }
 
+/// A pan from window `a` to `b` (frame `f`, whose plot gives the scale) by a pointer travel of
+/// `travel` CSS px: the same size, and the map moved with the pointer (x: −dx, y: +dy in
+/// metres per pixel) to within 1.5 px. The snapshot pan has landed exactly (0 px) or 0.93 px
+/// further along the drag (1 % of it) from run to run; the cause was not found (the page saw
+/// integer pointer positions 80, −40 px apart each time, and any probe added to the page before
+/// the drag made it land exactly).
+fn assert_pan(a: [f64; 4], b: [f64; 4], f: &Frame, travel: [f64; 2], what: &str) {
+    close(
+        b[1] - b[0],
+        a[1] - a[0],
+        a[1] - a[0],
+        &format!("{what}: width"),
+    );
+    close(
+        b[3] - b[2],
+        a[3] - a[2],
+        a[3] - a[2],
+        &format!("{what}: height"),
+    );
+    let scale = f.zoom["rect"]["w"].as_f64().unwrap() / (b[1] - b[0]);
+    let moved = [(a[0] - b[0]) * scale, (b[2] - a[2]) * scale];
+    let drift = ((moved[0] - travel[0]).powi(2) + (moved[1] - travel[1]).powi(2)).sqrt();
+    println!("e2e zoom {what}: pointer {travel:?} px, map {moved:?} px (off by {drift:.3} px)");
+    assert!(
+        drift <= 1.5,
+        "{what}: the map moved {moved:?} px for a pointer travel of {travel:?} px"
+    );
+}
+
 #[test]
 #[ignore = "needs chromium + chromedriver and www/pkg (wasm-pack build); run with --ignored"]
 fn wheel_pinch_and_pan_zoom_the_map_in_every_view() {
@@ -450,18 +480,14 @@ fn wheel_pinch_and_pan_zoom_the_map_in_every_view() {
     close(a[1], b[1], area[1] - area[0], "wheel anchor y");
     assert_eq!(sn[1].1.zoom["level"], "×2.0");
     assert_map_follows(&sn[1].1, &model, "snapshot wheel");
-    // Pan: the window moves by the drag (x: -dx/scale, y: +dy/scale), same size.
-    let w2 = window(&sn[2].1);
-    let scale = sn[2].1.zoom["rect"]["w"].as_f64().unwrap() / (w2[1] - w2[0]);
-    let (dx, dy) = (-o.snapshot_pan[0] / scale, o.snapshot_pan[1] / scale);
-    for (k, d) in [(0, dx), (1, dx), (2, dy), (3, dy)] {
-        close(
-            w2[k],
-            w1[k] + d,
-            (w1[1] - w1[0]) * 1e3,
-            &format!("pan window[{k}]"),
-        );
-    }
+    // Pan: the window keeps its size and moves with the pointer.
+    assert_pan(
+        w1,
+        window(&sn[2].1),
+        &sn[2].1,
+        o.snapshot_pan,
+        "snapshot pan",
+    );
     assert_map_follows(&sn[2].1, &model, "snapshot pan");
     // Double-click on empty map: the whole area again.
     assert_eq!(window(&sn[3].1), area);
@@ -487,19 +513,12 @@ fn wheel_pinch_and_pan_zoom_the_map_in_every_view() {
     let (b, a) = &o.pinch_anchor;
     close(a[0], b[0], (mh[1] - mh[0]) * 1e3, "pinch anchor x");
     close(a[1], b[1], (mh[1] - mh[0]) * 1e3, "pinch anchor y");
-    let (m1, m2) = (window(&mt[1].1), window(&mt[2].1));
-    let scale = mt[2].1.zoom["rect"]["w"].as_f64().unwrap() / (m2[1] - m2[0]);
-    close(
-        m2[0],
-        m1[0] - o.mtl_pan[0] / scale,
-        (mh[1] - mh[0]) * 1e3,
-        "mtl pan x",
-    );
-    close(
-        m2[2],
-        m1[2] + o.mtl_pan[1] / scale,
-        (mh[1] - mh[0]) * 1e3,
-        "mtl pan y",
+    assert_pan(
+        window(&mt[1].1),
+        window(&mt[2].1),
+        &mt[2].1,
+        o.mtl_pan,
+        "mtl pan",
     );
     assert_eq!(
         o.mtl_scene.0, o.mtl_scene.1,

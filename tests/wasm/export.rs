@@ -199,3 +199,76 @@ fn map_svg_rejects_bad_input_with_named_messages() {
         );
     }
 }
+
+/// The multi-target scene figure (`mtl_scene_svg`, the page's multi-target view): well-formed,
+/// the six nodes' labels once each, the legend of every layer the V-B scene has, the detection
+/// result in the subtitle equal to the core's view of the same scene, the size asked for; a
+/// window leaves out what lies outside it; bad input names the function and the field.
+#[wasm_bindgen_test]
+fn mtl_scene_svg_draws_the_scene_and_its_detections() {
+    use scatterloc::mtl::view::{mtl_view, MtlScene};
+    let scene = MtlScene::vb();
+    let json = scene.to_json();
+    let view = mtl_view(&scene).unwrap();
+    let svg = ok(wasm::mtl_scene_svg(&json, 900, 0, ""));
+    assert!(svg.contains(r#"width="900""#), "{}", &svg[..200]);
+    let texts = svg_texts(&svg);
+    for name in ["Tx1", "Tx2", "Tx3", "Rx1", "Rx2", "Rx3"] {
+        assert_eq!(count(&texts, name), 1, "{name} in {texts:?}");
+    }
+    for label in ["region R", "blocked LoS", "clutter", "target", "detected"] {
+        assert_eq!(count(&texts, label), 1, "legend {label} in {texts:?}");
+    }
+    let m = &view.metrics;
+    let result = format!(
+        "K̂/K = {}/{} · N_D = {} · N_FA = {}",
+        m.estimates, m.targets, m.detected, m.false_alarms
+    );
+    assert!(
+        texts.iter().any(|t| t.starts_with(&result)),
+        "{result} in {texts:?}"
+    );
+
+    // A window holding no node: no node label.
+    let svg = ok(wasm::mtl_scene_svg(
+        &json,
+        600,
+        600,
+        r#"{"window": [4.0, 6.0, 4.0, 6.0], "title": "middle"}"#,
+    ));
+    let texts = svg_texts(&svg);
+    assert_eq!(count(&texts, "middle"), 1);
+    assert!(
+        texts
+            .iter()
+            .all(|t| !t.starts_with("Tx") && !t.starts_with("Rx")),
+        "{texts:?}"
+    );
+
+    let mut bad = scene.clone();
+    bad.diameter = -1.0;
+    for (m, field) in [
+        (err(wasm::mtl_scene_svg("{", 900, 0, "")), "invalid JSON"),
+        (err(wasm::mtl_scene_svg(&json, 100, 0, "")), "width"),
+        (
+            err(wasm::mtl_scene_svg(
+                &json,
+                900,
+                0,
+                r#"{"window": [1, 1, 0, 1]}"#,
+            )),
+            "window.x",
+        ),
+        (
+            err(wasm::mtl_scene_svg(&json, 900, 0, r#"{"zoom": 2}"#)),
+            "zoom",
+        ),
+        (
+            err(wasm::mtl_scene_svg(&bad.to_json(), 900, 0, "")),
+            "diameter",
+        ),
+    ] {
+        assert!(m.starts_with("mtl_scene_svg: "), "{m}");
+        assert!(m.contains(field), "message {m:?} should name {field}");
+    }
+}

@@ -201,6 +201,7 @@ export async function start() {
   const tracking = new Tracking(ctx, opts);
   ctx.tracking = tracking;
   const mtl = new Mtl(ctx);
+  ctx.mtl = mtl;
   const plan = new Plan(ctx);
   ctx.plan = plan;
   const figures = new FigureExport(ctx); // "Save figure" (export.js)

@@ -1,10 +1,10 @@
 // "Save figure": writes the current view as a file. PNG is the canvas as it is (canvas.toBlob);
 // SVG is drawn by the wasm core with the CLI's plotters chart code (App.map_svg, Track.map_svg,
-// tracking_chart_svg): the map, the nodes, the target's snapshot or the track, and the colour
-// bar. The multi-target view has no chart of its own in the core, so it saves PNG only. Files are
-// named `<scenario>-<view>-<figure>.<ext>`, e.g. sensors2019-snapshot-map.svg,
-// sensors2019-tracking-rmse.svg, multi-target-scene.png. Nothing here runs until the button is
-// pressed (the drag stays as fast as it was).
+// tracking_chart_svg, mtl_scene_svg): the map, the nodes, the target's snapshot or the track, and
+// the colour bar; the multi-target scene with its ranges, detections and targets. Each SVG shows
+// the window on screen (zoom.js). Files are named `<scenario>-<view>-<figure>.<ext>`, e.g.
+// sensors2019-snapshot-map.svg, sensors2019-tracking-rmse.svg, multi-target-scene.svg. Nothing
+// here runs until the button is pressed (the drag stays as fast as it was).
 
 import { $, errorText, showError } from './dom.js';
 
@@ -20,7 +20,7 @@ export function slug(name) {
 }
 
 export class FigureExport {
-  /** @param {object} ctx - {app, wasm, st, view, tracking} (app.js). */
+  /** @param {object} ctx - {app, wasm, st, view, tracking, mtl} (app.js). */
   constructor(ctx) {
     this.ctx = ctx;
     this.dryRun = false; // true: build the download link but do not click it (tests)
@@ -29,17 +29,13 @@ export class FigureExport {
     $('figure-save').addEventListener('click', () => this.save());
   }
 
-  /** Shows the choices of `mode`: the RMSE chart only in tracking, SVG not in multi-target. */
+  /** Shows the choices of `mode`: the RMSE chart only in tracking. */
   setMode(mode) {
     const what = $('figure-what');
     const rmse = what.querySelector('option[value="rmse"]');
     rmse.hidden = mode !== 'tracking';
     rmse.disabled = mode !== 'tracking';
     if (rmse.disabled && what.value === 'rmse') what.value = 'map';
-    const format = $('figure-format');
-    const svg = format.querySelector('option[value="svg"]');
-    svg.disabled = mode === 'mtl';
-    if (svg.disabled && format.value === 'svg') format.value = 'png';
     what.querySelector('option[value="map"]').textContent = mode === 'mtl' ? 'Scene' : 'Map';
   }
 
@@ -54,7 +50,7 @@ export class FigureExport {
   async save() {
     const { st } = this.ctx;
     const what = st.mode === 'tracking' ? $('figure-what').value : 'map';
-    const format = st.mode === 'mtl' ? 'png' : $('figure-format').value;
+    const format = $('figure-format').value;
     const t0 = performance.now();
     try {
       const blob = format === 'svg' ? this.svg(what) : await this.png(what);
@@ -67,7 +63,11 @@ export class FigureExport {
 
   /** The SVG text of figure `what` from the core, as a Blob. */
   svg(what) {
-    const { app, wasm, st, view, tracking } = this.ctx;
+    const { app, wasm, st, view, tracking, mtl } = this.ctx;
+    if (st.mode === 'mtl') {
+      const text = wasm.mtl_scene_svg(JSON.stringify(mtl.scene), SVG_WIDTH, 0, JSON.stringify({ window: Array.from(mtl.view.area) }));
+      return new Blob([text], { type: 'image/svg+xml' });
+    }
     const res = Number($('resolution').value) || 256;
     const options = { window: Array.from(view.area), res };
     let text;
