@@ -255,7 +255,9 @@ function drawColorbar(ctx, view, st, w) {
   ctx.fillRect(bx, r.y + r.h + 10, bw, 10);
   ctx.strokeRect(bx + 0.5, r.y + r.h + 10.5, bw, 10);
   ctx.fillStyle = C.muted;
-  ctx.fillText('unbounded', bx + bw + 8, r.y + r.h + 15);
+  // Where the canvas is too narrow for the word (a phone), the symbol.
+  const room = view.width - (bx + bw + 8);
+  ctx.fillText(ctx.measureText('unbounded').width <= room ? 'unbounded' : '∞', bx + bw + 8, r.y + r.h + 15);
 }
 
 /** Tx–Rx baselines (dashed), then the node markers (`n` = App.nodes()). */

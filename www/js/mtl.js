@@ -53,7 +53,8 @@ export class Mtl {
       Object.assign(FIELDS.find((f) => f[1] === key)[3], { min, max });
     }
     this.canvas = $('plot');
-    this.view = new View(this.canvas);
+    // No colour bar here: a narrow right margin.
+    this.view = new View(this.canvas, { left: 58, right: 24, top: 16, bottom: 44 });
     this.scene = JSON.parse(this.wasm.mtl_default_scene());
     this.result = null; // the last view from the core
     this.resultGen = 0;

@@ -6,12 +6,17 @@
 import { fitCanvas } from './dom.js';
 
 export const MARGIN = { left: 58, right: 112, top: 16, bottom: 44 };
+/** The margins of a map canvas narrower than NARROW_PX (a phone): the colour bar kept tight. */
+export const MARGIN_NARROW = { left: 50, right: 84, top: 16, bottom: 44 };
+const NARROW_PX = 480;
 /** Zoom limits: the window's width between these multiples of the home extent's width. */
 export const ZOOM_SPAN = { min: 1e-4, max: 8 };
 
 export class View {
-  constructor(canvas) {
+  /** @param {object} [margin] - the plot's margins, CSS px (default MARGIN: room for the colour bar). */
+  constructor(canvas, margin = MARGIN) {
     this.canvas = canvas;
+    this.margin = margin;
     this.dpr = 1;
     this.width = 1; // CSS px
     this.height = 1;
@@ -32,12 +37,13 @@ export class View {
   fit(area) {
     this.area = Array.from(area);
     const [x0, x1, y0, y1] = this.area;
-    const w = Math.max(10, this.width - MARGIN.left - MARGIN.right);
-    const h = Math.max(10, this.height - MARGIN.top - MARGIN.bottom);
+    const M = this.margin === MARGIN && this.width < NARROW_PX ? MARGIN_NARROW : this.margin;
+    const w = Math.max(10, this.width - M.left - M.right);
+    const h = Math.max(10, this.height - M.top - M.bottom);
     this.scale = Math.min(w / (x1 - x0), h / (y1 - y0));
     const pw = this.scale * (x1 - x0);
     const ph = this.scale * (y1 - y0);
-    this.rect = { x: MARGIN.left + (w - pw) / 2, y: MARGIN.top + (h - ph) / 2, w: pw, h: ph };
+    this.rect = { x: M.left + (w - pw) / 2, y: M.top + (h - ph) / 2, w: pw, h: ph };
   }
 
   /**
