@@ -52,6 +52,10 @@ mod a11y;
 #[path = "e2e/layout.rs"]
 mod layout;
 
+/// SVG text checks shared with the other figure-export tests.
+#[path = "common/svg.rs"]
+mod svg;
+
 /// Issue 16 §6: "Save figure" (SVG through the CLI's chart code, PNG of the canvas).
 #[path = "e2e/export.rs"]
 mod export;

@@ -22,6 +22,10 @@ mod tracking;
 #[path = "wasm/mtl.rs"]
 mod mtl;
 
+/// SVG text checks shared with the other figure-export tests.
+#[path = "common/svg.rs"]
+mod svg;
+
 /// "Save figure": the SVG figures of the map and the tracking chart.
 #[path = "wasm/export.rs"]
 mod export;

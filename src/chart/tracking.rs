@@ -10,22 +10,21 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::layout::{font_scale, frame_plot, segments, series_legend, titled_body, Fonts};
-use super::{axis_label, chart_err, register_fonts, ChartError};
+use super::{axis_label, chart_err, register_fonts, ChartError, CURVE_PALETTE};
 use crate::math::Real;
 use crate::present::colorbar_ticks;
 use crate::present::nice_below;
 
-/// Colour of the EKF curve (solid).
-const EKF_RGB: RGBColor = RGBColor(0, 94, 184);
-/// Colour of the PCRLB curve (dashed).
-const PCRLB_RGB: RGBColor = RGBColor(214, 39, 40);
-/// Colours of the RMSE curves of [`draw_tracking_filters`], in curve order (the first is the
-/// EKF curve's colour; cycled beyond four).
+/// Colour of the PCRLB curve (dashed): the palette's red.
+const PCRLB_RGB: RGBColor = CURVE_PALETTE[1];
+/// Colours of the RMSE curves of [`draw_tracking_filters`], in curve order: the figures'
+/// palette without its red, which is the bound's (the first is the EKF curve's colour; cycled
+/// beyond four).
 const CURVE_RGB: [RGBColor; 4] = [
-    EKF_RGB,
-    RGBColor(44, 160, 44),
-    RGBColor(148, 103, 189),
-    RGBColor(255, 127, 14),
+    CURVE_PALETTE[0],
+    CURVE_PALETTE[2],
+    CURVE_PALETTE[4],
+    CURVE_PALETTE[3],
 ];
 
 /// The legend label of the EKF curve of [`draw_tracking_rmse`].

@@ -15,6 +15,7 @@ use scatterloc::localize::{crlb_map, Grid};
 use scatterloc::present::{colorbar_ticks, LogScale};
 use scatterloc::{scenario::presets, Model};
 
+use super::svg::{count, svg_texts};
 use super::tracking::{mc_done, wait_state};
 use super::{console_errors, js, open, settle, with_browser};
 
@@ -149,21 +150,6 @@ async fn run(c: &Client, port: u16) -> Result<Outcome, String> {
         mtl_metrics,
         errors: console_errors(c).await?,
     })
-}
-
-/// The texts of the `<text>` elements of `svg`, which must parse as an SVG document.
-fn svg_texts(what: &str, svg: &str) -> Vec<String> {
-    let doc = roxmltree::Document::parse(svg)
-        .unwrap_or_else(|e| panic!("{what}: the SVG does not parse as XML: {e}"));
-    assert_eq!(doc.root_element().tag_name().name(), "svg", "{what}");
-    doc.descendants()
-        .filter(|n| n.has_tag_name("text"))
-        .map(|n| n.text().unwrap_or("").trim().to_string())
-        .collect()
-}
-
-fn count(texts: &[String], s: &str) -> usize {
-    texts.iter().filter(|t| t.as_str() == s).count()
 }
 
 /// Every node labelled once, the colour bar's label and at least two of its tick labels.

@@ -11,7 +11,7 @@ use scatterloc::{scenario::presets, Model};
 
 use super::layout::cdp;
 use super::tracking::{mc_done, wait_state};
-use super::{console_errors, js, open, settle, with_browser};
+use super::{console_errors, js, open, open_hash, settle, with_browser};
 
 /// The map's values, the window and colour range they were drawn with, and its grid size.
 type MapShown = (Vec<f64>, Vec<f64>, Vec<f64>, usize);
@@ -25,6 +25,10 @@ struct Frame {
 }
 
 struct Outcome {
+    /// "Copy link" after the wheel zoom, the page it opens, and a link with a bad window.
+    link: String,
+    shared: Frame,
+    bad_view: (Value, Frame),
     snapshot: Vec<(&'static str, Frame)>,
     tracking: Vec<(&'static str, Frame)>,
     mtl: Vec<(&'static str, Frame)>,
@@ -212,6 +216,15 @@ async fn run(c: &fantoccini::Client, port: u16, dport: u16) -> Result<Outcome, S
     let f = frame(c, true).await?;
     let after = metre_at(c, p).await?;
     snapshot.push(("wheel", f));
+    let link = c
+        .execute_async(
+            "const done = arguments[arguments.length - 1]; \
+             window.shareLink().then(done, (e) => done('error: ' + e.message));",
+            vec![],
+        )
+        .await
+        .map_err(|e| e.to_string())?;
+    let link = link.as_str().unwrap_or_default().to_string();
     let q = snap(empty_pixel(c, 0.5, 0.5).await?);
     let snapshot_pan = mouse_drag(c, dport, &session, origin, q, drag).await?;
     snapshot.push(("pan", frame(c, true).await?));
@@ -320,7 +333,28 @@ async fn run(c: &fantoccini::Client, port: u16, dport: u16) -> Result<Outcome, S
     js(c, "document.getElementById('zoom-reset').click()").await?;
     mtl.push(("reset", frame(c, false).await?));
 
+    let mut errors = console_errors(c).await?;
+    // "Copy link" carries the zoomed window: the link opens on it, with its map; a bad window in
+    // a link is named in the banner and the area is shown.
+    let hash = link.split_once('#').map(|(_, h)| h).unwrap_or_default();
+    c.goto("about:blank").await.map_err(|e| e.to_string())?;
+    open_hash(c, port, &format!("#{hash}")).await?;
+    let shared = frame(c, true).await?;
+    errors.extend(console_errors(c).await?);
+    c.goto("about:blank").await.map_err(|e| e.to_string())?;
+    open_hash(c, port, "#view=1,1,0,1").await?;
+    let bad_view = (
+        js(
+            c,
+            "return document.getElementById('error-text').textContent",
+        )
+        .await?,
+        frame(c, false).await?,
+    );
     Ok(Outcome {
+        link,
+        shared,
+        bad_view,
         snapshot,
         tracking,
         mtl,
@@ -329,7 +363,7 @@ async fn run(c: &fantoccini::Client, port: u16, dport: u16) -> Result<Outcome, S
         snapshot_pan,
         mtl_pan,
         mtl_scene: (scene_before, scene_after),
-        errors: console_errors(c).await?,
+        errors,
     })
 }
 
@@ -480,6 +514,14 @@ fn wheel_pinch_and_pan_zoom_the_map_in_every_view() {
     close(a[1], b[1], area[1] - area[0], "wheel anchor y");
     assert_eq!(sn[1].1.zoom["level"], "×2.0");
     assert_map_follows(&sn[1].1, &model, "snapshot wheel");
+    // The shared link opens on the same window (to the last bit), with the map of that window.
+    assert!(o.link.contains("view="), "{}", o.link);
+    assert_eq!(window(&o.shared), w1, "{}", o.link);
+    assert_map_follows(&o.shared, &model, "shared link");
+    let (message, f) = &o.bad_view;
+    let message = message.as_str().unwrap_or_default();
+    assert!(message.contains("URL option view"), "{message}");
+    assert_eq!(window(f), area, "a bad view option leaves the area shown");
     // Pan: the window keeps its size and moves with the pointer.
     assert_pan(
         w1,

@@ -10,22 +10,8 @@ use scatterloc::present::{colorbar_ticks, LogScale};
 use scatterloc::wasm::{self, App};
 use scatterloc::Model;
 
+use super::svg::{count, svg_texts};
 use super::{err, ok, sensors};
-
-/// The texts of every `<text>` element of `svg`, which must parse as an SVG document.
-fn svg_texts(svg: &str) -> Vec<String> {
-    let doc = roxmltree::Document::parse(svg)
-        .unwrap_or_else(|e| panic!("the SVG does not parse as XML: {e}"));
-    assert_eq!(doc.root_element().tag_name().name(), "svg");
-    doc.descendants()
-        .filter(|n| n.has_tag_name("text"))
-        .map(|n| n.text().unwrap_or("").trim().to_string())
-        .collect()
-}
-
-fn count(texts: &[String], s: &str) -> usize {
-    texts.iter().filter(|t| t.as_str() == s).count()
-}
 
 /// The node names of `app`'s scenario.
 fn node_names(app: &App) -> Vec<String> {
@@ -56,7 +42,7 @@ fn colorbar_labels(app: &App, res: usize) -> Vec<String> {
 fn map_svg_parses_and_has_nodes_and_colour_bar() {
     let app = sensors();
     let svg = ok(app.map_svg(1000, 0, r#"{"res": 64}"#));
-    let texts = svg_texts(&svg);
+    let texts = svg_texts("figure", &svg);
     assert!(svg.contains(r#"width="1000""#), "{}", &svg[..200]);
     let names = node_names(&app);
     assert!(names.len() >= 2);
@@ -83,7 +69,7 @@ fn map_svg_draws_the_target_snapshot_and_window() {
         600,
         r#"{"res": 32, "title": "A & B <figure>", "target": {"x": 4, "y": 1, "seed": 3}}"#,
     ));
-    let texts = svg_texts(&svg);
+    let texts = svg_texts("figure", &svg);
     for label in ["target", "LM fix ±1σ", "CRLB 1σ", "iso-delay (measured)"] {
         assert_eq!(count(&texts, label), 1, "{label} in {texts:?}");
     }
@@ -107,7 +93,7 @@ fn map_svg_draws_the_target_snapshot_and_window() {
         r#"{{"res": 16, "window": [{}, {xm}, {}, {ym}]}}"#,
         a.x[0], a.y[0]
     );
-    let texts = svg_texts(&ok(app.map_svg(600, 0, &opts)));
+    let texts = svg_texts("figure", &ok(app.map_svg(600, 0, &opts)));
     let shown: Vec<_> = node_names(&app)
         .into_iter()
         .filter(|n| count(&texts, n) == 1)
@@ -121,7 +107,10 @@ fn map_svg_draws_the_target_snapshot_and_window() {
 fn track_map_svg_draws_the_track() {
     let app = sensors();
     let track = ok(app.simulate_track("II", 0.0, 0.0, 0.0, 0.0, 0.1, 50, 7, "ukf", 1000));
-    let texts = svg_texts(&ok(track.map_svg(1000, 0, 30, 100.0, r#"{"res": 32}"#)));
+    let texts = svg_texts(
+        "figure",
+        &ok(track.map_svg(1000, 0, 30, 100.0, r#"{"res": 32}"#)),
+    );
     for label in ["truth", "UKF track", "UKF 1σ ×100", "target"] {
         assert_eq!(count(&texts, label), 1, "{label} in {texts:?}");
     }
@@ -157,11 +146,14 @@ fn tracking_chart_svg_parses() {
         1000,
         620,
     ));
-    let texts = svg_texts(&svg);
+    let texts = svg_texts("figure", &svg);
     assert_eq!(count(&texts, "Position RMSE"), 1, "{texts:?}");
     assert_eq!(count(&texts, "scenario II"), 1, "{texts:?}");
     assert!(texts.iter().any(|t| t == "EKF RMSE"), "{texts:?}");
-    svg_texts(&ok(wasm::tracking_chart_svg("", "t", "", "", 400, 0)));
+    svg_texts(
+        "figure",
+        &ok(wasm::tracking_chart_svg("", "t", "", "", 400, 0)),
+    );
     let e = err(wasm::tracking_chart_svg("{", "t", "", "", 1000, 620));
     assert!(e.starts_with("tracking_chart_svg: invalid JSON"), "{e}");
     let e = err(wasm::tracking_chart_svg("", "t", "", "", 100, 620));
@@ -212,7 +204,7 @@ fn mtl_scene_svg_draws_the_scene_and_its_detections() {
     let view = mtl_view(&scene).unwrap();
     let svg = ok(wasm::mtl_scene_svg(&json, 900, 0, ""));
     assert!(svg.contains(r#"width="900""#), "{}", &svg[..200]);
-    let texts = svg_texts(&svg);
+    let texts = svg_texts("figure", &svg);
     for name in ["Tx1", "Tx2", "Tx3", "Rx1", "Rx2", "Rx3"] {
         assert_eq!(count(&texts, name), 1, "{name} in {texts:?}");
     }
@@ -236,7 +228,7 @@ fn mtl_scene_svg_draws_the_scene_and_its_detections() {
         600,
         r#"{"window": [4.0, 6.0, 4.0, 6.0], "title": "middle"}"#,
     ));
-    let texts = svg_texts(&svg);
+    let texts = svg_texts("figure", &svg);
     assert_eq!(count(&texts, "middle"), 1);
     assert!(
         texts

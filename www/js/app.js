@@ -32,7 +32,8 @@ const UINT32 = { min: 0, max: 4294967295, integer: true };
  * &play=1&runs=200&ex=100&tseed=1&dt=0.1&speed=1&custom=x0,y0,x1,y1&filter=pf&particles=1000
  * &filters=ekf,ukf,pf` (the animated filter, the particle count and the Monte Carlo's filters);
  * multi-target: `#mode=mtl`;
- * a shared view ("Copy link"): `roi=x0,x1,y0,y1` (the Plan panel's region of interest, m) and
+ * a shared view ("Copy link"): `view=x0,x1,y0,y1` (the map's zoomed window, m), `roi=x0,x1,y0,y1`
+ * (the Plan panel's region of interest, m) and
  * the scenario as `scenario=<base64url of its JSON>` or `z=<base64url of its raw-deflated JSON>`
  * (share.js; a scenario replaces the preset). Every number is parsed strictly (dom.js
  * `decimal`); a bad option is left at its default and reported in `errors` (naming the option,
@@ -88,6 +89,7 @@ function hashOptions(presets) {
     seed: read('seed', (t) => decimalIn(t, 'seed', UINT32)) ?? 1,
     res: option('res', 'resolution'),
     roi: numbers('roi', 4),
+    view: numbers('view', 4),
     scenario: scenarioKey ? [scenarioKey, h.get(scenarioKey)] : null,
   };
   return { opts, errors };
@@ -234,6 +236,13 @@ export async function start() {
 
   view.resize();
   view.setHome(app.area());
+  if (opts.view) {
+    try {
+      view.setWindow(opts.view);
+    } catch (e) {
+      errors.push(`URL option view: ${errorText(e)}`);
+    }
+  }
   new ResizeObserver(() => {
     view.resize();
     changed({ draw: true });
@@ -265,12 +274,13 @@ export async function start() {
   if (opts.play) tracking.play();
   if (errors.length) showError(errors.join(' · '));
 
-  /** The link to this view: mode, map grid, target, ROI and the scenario (share.js). */
+  /** The link to this view: mode, map grid, zoomed window, target, ROI and the scenario (share.js). */
   const link = () => viewLink({
     mode: st.mode,
     res: $('resolution').value,
     target: st.target,
     roi: plan.roi,
+    window: view.zoomed() ? Array.from(view.area) : null,
     scenario: app.scenario_json(),
   });
   $('share-copy').addEventListener('click', () => copyLink(link));

@@ -101,9 +101,10 @@ export async function decodeScenario(key, value) {
  * `scenario` (JSON text; `z=` or `scenario=`, see encodeScenario). Numbers are written in their
  * shortest round-trip form, which the page's strict parser reads back exactly.
  */
-export async function viewLink({ mode, res, target, roi, scenario }) {
+export async function viewLink({ mode, res, target, roi, window, scenario }) {
   const parts = [`mode=${mode}`];
   if (res) parts.push(`res=${res}`);
+  if (window) parts.push(`view=${window.join(',')}`);
   if (target) parts.push(`target=${target.x},${target.y}`, `seed=${target.seed}`);
   if (roi) parts.push(`roi=${roi.join(',')}`);
   const [key, value] = await encodeScenario(scenario);

@@ -57,6 +57,23 @@ export class View {
     this.fit(e);
   }
 
+  /**
+   * Shows the window `w` = [x0, x1, y0, y1] m (a shared link's): finite, non-empty, its width
+   * within ZOOM_SPAN of the home's; otherwise throws naming what is wrong and changes nothing.
+   */
+  setWindow(w) {
+    const [x0, x1, y0, y1] = w;
+    if (!w.every(Number.isFinite) || !(x1 > x0) || !(y1 > y0)) {
+      throw new Error(`"${w.join(',')}" is not a window x0,x1,y0,y1 with x0 < x1 and y0 < y1`);
+    }
+    const homeW = this.home[1] - this.home[0];
+    const r = (x1 - x0) / homeW;
+    if (!(r >= ZOOM_SPAN.min && r <= ZOOM_SPAN.max)) {
+      throw new Error(`a window ${x1 - x0} m wide is outside ${ZOOM_SPAN.min} … ${ZOOM_SPAN.max} times the area's ${homeW} m`);
+    }
+    this.fit(w);
+  }
+
   /** Back to the home extent. */
   reset() {
     if (this.home) this.fit(this.home);
