@@ -192,17 +192,33 @@ pub(crate) fn map_panel<'a, DB: DrawingBackend + 'a>(
     map: &MapData,
     scale: Option<&LogScale>,
 ) -> Result<Chart<'a, DB>, ChartError> {
-    let area = &map.grid.area;
-    let mut chart = ChartBuilder::on(chart_area)
+    let mut chart = metre_chart(chart_area, lay, &map.grid.area)?;
+    raster::draw_heatmap(&chart.plotting_area().strip_coord_spec(), map, scale)?;
+    draw_metre_axes(&mut chart, lay)?;
+    Ok(chart)
+}
+
+/// A plot of `area` in `chart_area` laid out by `lay`: metres on both axes at equal scale (the
+/// layout sized the plot to `area`'s aspect); nothing drawn yet.
+pub(crate) fn metre_chart<'a, DB: DrawingBackend + 'a>(
+    chart_area: &'a DrawingArea<DB, Shift>,
+    lay: &layout::Layout,
+    area: &Area,
+) -> Result<Chart<'a, DB>, ChartError> {
+    ChartBuilder::on(chart_area)
         .margin_top(lay.plot_margin_top)
         .margin_right(lay.plot_margin_right)
         .x_label_area_size(lay.x_label_area)
         .y_label_area_size(lay.y_label_area)
         .build_cartesian_2d(area.x[0]..area.x[1], area.y[0]..area.y[1])
-        .map_err(chart_err)?;
+        .map_err(chart_err)
+}
 
-    raster::draw_heatmap(&chart.plotting_area().strip_coord_spec(), map, scale)?;
-
+/// The metre axes of a [`metre_chart`]: tick labels, `x (m)`, `y (m)`, no mesh.
+pub(crate) fn draw_metre_axes<'a, DB: DrawingBackend + 'a>(
+    chart: &mut Chart<'a, DB>,
+    lay: &layout::Layout,
+) -> Result<(), ChartError> {
     let tick_font = ("sans-serif", lay.font.ticks).into_font();
     let axis_font = ("sans-serif", lay.font.axis).into_font();
     chart
@@ -218,8 +234,7 @@ pub(crate) fn map_panel<'a, DB: DrawingBackend + 'a>(
         .x_label_formatter(&|v| axis_label(*v))
         .y_label_formatter(&|v| axis_label(*v))
         .draw()
-        .map_err(chart_err)?;
-    Ok(chart)
+        .map_err(chart_err)
 }
 
 /// The nodes (with the legend of every labelled series) and the frame of a [`map_panel`].

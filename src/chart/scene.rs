@@ -14,10 +14,10 @@ use plotters::element::{DashedPathElement, IntoDynElement};
 use plotters::prelude::*;
 
 use super::layout::{self, chart_err, register_fonts, ChartError};
-use super::map::{check_area, finish_panel};
+use super::map::{check_area, draw_metre_axes, finish_panel, metre_chart};
 use super::overlay::clipped_runs;
 use super::raster::Chart;
-use super::{axis_label, ChartNode, NodeKind, CURVE_PALETTE};
+use super::{ChartNode, NodeKind, CURVE_PALETTE};
 use crate::math::Real;
 use crate::measure::Ellipse;
 use crate::mtl::view::output::EllipseView;
@@ -123,27 +123,8 @@ pub fn draw_mtl_scene<DB: DrawingBackend>(
     let lay = layout::Layout::new(root, &window, true);
     layout::draw_titles(root, &lay.font, &lay.band, &title, Some(&subtitle))?;
     let chart_area = root.clone().shrink(lay.chart_origin, lay.chart_size);
-    let mut chart = ChartBuilder::on(&chart_area)
-        .margin_top(lay.plot_margin_top)
-        .margin_right(lay.plot_margin_right)
-        .x_label_area_size(lay.x_label_area)
-        .y_label_area_size(lay.y_label_area)
-        .build_cartesian_2d(window.x[0]..window.x[1], window.y[0]..window.y[1])
-        .map_err(chart_err)?;
-    chart
-        .configure_mesh()
-        .disable_mesh()
-        .x_desc("x (m)")
-        .y_desc("y (m)")
-        .label_style(("sans-serif", lay.font.ticks).into_font())
-        .axis_desc_style(("sans-serif", lay.font.axis).into_font())
-        .x_labels(8)
-        .y_labels(8)
-        .set_all_tick_mark_size(lay.font.ticks as i32 / 3 + 2)
-        .x_label_formatter(&|v| axis_label(*v))
-        .y_label_formatter(&|v| axis_label(*v))
-        .draw()
-        .map_err(chart_err)?;
+    let mut chart = metre_chart(&chart_area, &lay, &window)?;
+    draw_metre_axes(&mut chart, &lay)?;
     draw_layers(&mut chart, scene, view, lay.font.nodes)?;
     finish_panel(&mut chart, &scene_nodes(scene), &lay)
 }

@@ -5,7 +5,7 @@ use js_sys::Float64Array;
 use wasm_bindgen::prelude::*;
 
 use super::json::{to_js, CrlbJs, NodesJs, SnapshotJs};
-use super::{err, point};
+use super::{err, point, window};
 use crate::localize::{crlb_at, crlb_map, Grid};
 use crate::present::simulate_snapshot;
 use crate::present::Session;
@@ -226,22 +226,18 @@ impl App {
         ny: usize,
         out: &Float64Array,
     ) -> Result<f64, JsError> {
-        let window = Area {
-            x: [x_min, x_max],
-            y: [y_min, y_max],
-        };
-        window.validate_as(["window.x", "window.y"]).map_err(err)?;
-        self.map_over(window, nx, ny, out)
+        let w = window([x_min, x_max, y_min, y_max]).map_err(err)?;
+        self.map_over(w, nx, ny, out)
     }
 
     fn map_over(
         &self,
-        window: Area,
+        area: Area,
         nx: usize,
         ny: usize,
         out: &Float64Array,
     ) -> Result<f64, JsError> {
-        let grid = Grid::new(window, nx, ny).map_err(err)?;
+        let grid = Grid::new(area, nx, ny).map_err(err)?;
         let mut buf = vec![0.0; out.length() as usize];
         let t0 = performance_now();
         crlb_map(self.session.model(), &grid, &mut buf).map_err(err)?;

@@ -8,7 +8,8 @@ use alloc::vec::Vec;
 use wasm_bindgen::prelude::*;
 
 use crate::error::{limits, Error};
-use crate::{scenario::presets, Vec2};
+use crate::scenario::{presets, Area};
+use crate::Vec2;
 
 /// Module start: route Rust panics to `console.error` with their message.
 #[wasm_bindgen(start)]
@@ -34,6 +35,17 @@ pub fn preset_json(name: &str) -> Result<String, JsError> {
 /// A core error as a JavaScript exception with its message.
 pub(super) fn err(e: Error) -> JsError {
     JsError::new(&e.to_string())
+}
+
+/// A window `[x_min, x_max, y_min, y_max]` (m) from JavaScript: a finite, non-empty rectangle,
+/// else the named error of `window.x` / `window.y`.
+pub(super) fn window([x0, x1, y0, y1]: [f64; 4]) -> Result<Area, Error> {
+    let a = Area {
+        x: [x0, x1],
+        y: [y0, y1],
+    };
+    a.validate_as(["window.x", "window.y"])?;
+    Ok(a)
 }
 
 /// A point from JavaScript numbers, which must be finite (named `x`, `y`).

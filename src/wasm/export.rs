@@ -12,7 +12,7 @@ use serde::Deserialize;
 use wasm_bindgen::prelude::*;
 
 use super::tracking::Track;
-use super::App;
+use super::{window, App};
 use crate::chart::{
     default_titles, draw_crlb_map_with, draw_mtl_scene, scenario_nodes, scene_window,
     suggested_size, ChartOptions, MapData, MapOverlay, SceneChartOptions,
@@ -112,15 +112,7 @@ fn map_figure(
     (width, height): (u32, u32),
 ) -> Result<String, JsError> {
     let area = match opts.window {
-        Some([x0, x1, y0, y1]) => {
-            let a = Area {
-                x: [x0, x1],
-                y: [y0, y1],
-            };
-            a.validate_as(["window.x", "window.y"])
-                .map_err(|e| fail(func, e))?;
-            a
-        }
+        Some(w) => window(w).map_err(|e| fail(func, e))?,
         None => s.area_m,
     };
     let res = opts.res.unwrap_or(DEFAULT_RES);
@@ -287,24 +279,16 @@ pub fn mtl_scene_svg(
         })?
     };
     let scene = MtlScene::from_json(scene_json).map_err(|e| fail(F, e))?;
-    let window = match opts.window {
-        Some([x0, x1, y0, y1]) => {
-            let a = Area {
-                x: [x0, x1],
-                y: [y0, y1],
-            };
-            a.validate_as(["window.x", "window.y"])
-                .map_err(|e| fail(F, e))?;
-            a
-        }
+    let area = match opts.window {
+        Some(w) => window(w).map_err(|e| fail(F, e))?,
         None => scene_window(&scene),
     };
-    let size = figure_size(Some(&window), width, height).map_err(|e| fail(F, e))?;
+    let size = figure_size(Some(&area), width, height).map_err(|e| fail(F, e))?;
     let view = mtl_view(&scene).map_err(|e| fail(F, e))?;
     let chart_opts = SceneChartOptions {
         title: opts.title,
         subtitle: None,
-        window: Some(window),
+        window: Some(area),
     };
     let mut svg = String::new();
     {

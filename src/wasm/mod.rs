@@ -28,7 +28,7 @@ mod render;
 mod tracking;
 
 pub use app::App;
-use base::{err, point};
+use base::{err, point, window};
 pub use base::{preset_json, preset_names, start};
 pub use chart::draw_tracking_chart;
 pub use export::{mtl_scene_svg, tracking_chart_svg, MAX_FIGURE_PX, MAX_FIGURE_RES};
