@@ -62,8 +62,16 @@ for (const e of document.querySelectorAll('button, input, select, label.button')
   if (r.width === 0 || r.height === 0 || e.classList.contains('visually-hidden')) continue;
   if (r.left < -0.5 || r.right > vw + 0.5) outside.push(`${e.id || e.tagName} [${r.left.toFixed(1)}, ${r.right.toFixed(1)}]`);
 }
+// The status read-outs lengthen while dragging (the map's "… while dragging (… on release) …"):
+// the plot keeps its size whatever they say (else the map jumps under the pointer mid-drag).
+const reads = ['map-ms', 'mc-ms', 'mtl-ms'].map((id) => document.getElementById(id));
+const saved = reads.map((e) => e.textContent);
+for (const e of reads) e.textContent = 'map 1024×1024 while dragging (1024×1024 on release): 1234.5 ms · computing in a worker…';
+const plotLong = R(plotEl);
+reads.forEach((e, i) => { e.textContent = saved[i]; });
 const dpr = window.devicePixelRatio || 1;
 return {
+  plotLong, plotSteady: plotLong.every((v, i) => Math.abs(v - plot[i]) <= 0.5),
   vw, vh, dpr, innerWidth: window.innerWidth,
   scrollWidth: document.documentElement.scrollWidth,
   bodyScrollWidth: document.body.scrollWidth,
@@ -167,7 +175,8 @@ struct Row {
 
 /// At 390, 800, 1024 and 1440 px (and 360 × 740, 844 × 390 landscape, 3840 × 2160), in each view: no horizontal scroll, the plot canvas inside its
 /// card and clear of the panel, every control within the window's width, the canvas' backing
-/// store sharp (CSS size × devicePixelRatio), and the three mode buttons whole inside the top bar,
+/// store sharp (CSS size × devicePixelRatio), the plot's size independent of the status bar's
+/// read-outs (they lengthen while dragging), and the three mode buttons whole inside the top bar,
 /// on top at their centres (elementFromPoint) and switching the view when clicked.
 #[test]
 #[ignore = "needs chromium + chromedriver and www/pkg (wasm-pack build); run with --ignored"]
@@ -261,6 +270,13 @@ fn layout_at_four_widths_in_three_views() {
         let p: Vec<f64> = serde_json::from_value(m["plot"].clone()).unwrap_or_default();
         if p.len() != 4 || p[2] - p[0] < 200.0 || p[3] - p[1] < 200.0 {
             fail(format!("plot canvas too small: {}", rect(&m["plot"])));
+        }
+        if m["plotSteady"] != true {
+            fail(format!(
+                "the plot {} resizes to {} when the status read-outs lengthen",
+                rect(&m["plot"]),
+                rect(&m["plotLong"])
+            ));
         }
         if m["sharp"] != true {
             fail(format!(
