@@ -11,11 +11,11 @@ use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 
 use super::layout::chart_err;
-use super::raster::Chart;
+use super::raster::{in_window, legend_entry, plot_window, Chart};
 use super::ChartError;
 use crate::math::Real;
 use crate::measure::Ellipse;
-use crate::present::SnapshotSimulation;
+use crate::present::{SnapshotSimulation, LINK_RGB};
 use crate::track::TrackRun;
 
 /// Points per drawn covariance ellipse.
@@ -25,17 +25,10 @@ const ELLIPSE_POINTS: usize = 72;
 const TRACK_RGB: RGBColor = RGBColor(255, 127, 14);
 /// Colour of the CRLB ellipse (the page's light blue).
 const CRLB_RGB: RGBColor = RGBColor(92, 200, 255);
-/// The page's link colours (iso-delay ellipses), link `i` takes entry `i mod 8`.
-const LINK_RGB: [RGBColor; 8] = [
-    RGBColor(244, 244, 240),
-    RGBColor(255, 209, 102),
-    RGBColor(155, 229, 100),
-    RGBColor(255, 143, 171),
-    RGBColor(184, 192, 255),
-    RGBColor(126, 232, 250),
-    RGBColor(255, 184, 107),
-    RGBColor(208, 162, 247),
-];
+/// The colour of link `i` ([`LINK_RGB`], as the page's).
+fn link_rgb(i: usize) -> RGBColor {
+    super::raster::rgb(LINK_RGB[i % LINK_RGB.len()])
+}
 
 /// How an [`OverlayPath`] is drawn.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -314,7 +307,7 @@ fn legend_styles(line: OverlayLine, width: u32, thin: u32) -> (ShapeStyle, Shape
         OverlayLine::Track => (halo, TRACK_RGB.stroke_width(width)),
         OverlayLine::IsoDelay(i) => (
             BLACK.mix(0.35).stroke_width(thin + 2),
-            LINK_RGB[i % LINK_RGB.len()].stroke_width(thin),
+            link_rgb(i).stroke_width(thin),
         ),
         OverlayLine::Covariance => (none, TRACK_RGB.stroke_width(thin)),
         OverlayLine::Crlb => (
@@ -335,10 +328,7 @@ pub(crate) fn draw_overlay<'a, DB: DrawingBackend + 'a>(
     let width = (2.0 * s).round().max(1.0) as u32;
     let thin = (1.2 * s).round().max(1.0) as u32;
     let dash = (8.0 * s).round().max(2.0) as i32;
-    let (xr, yr) = (chart.x_range(), chart.y_range());
-    let view = [xr.start, xr.end, yr.start, yr.end];
-    let inside =
-        |p: [Real; 2]| (view[0]..=view[1]).contains(&p[0]) && (view[2]..=view[3]).contains(&p[1]);
+    let view = plot_window(chart);
     let halo = BLACK.mix(0.55).stroke_width(width + 3);
     let mut labelled: Vec<String> = Vec::new();
     for path in &overlay.paths {
@@ -362,7 +352,7 @@ pub(crate) fn draw_overlay<'a, DB: DrawingBackend + 'a>(
                     solid(TRACK_RGB.stroke_width(width))?;
                 }
                 OverlayLine::IsoDelay(i) => {
-                    solid(LINK_RGB[i % LINK_RGB.len()].mix(0.85).stroke_width(thin))?;
+                    solid(link_rgb(i).mix(0.85).stroke_width(thin))?;
                 }
                 OverlayLine::Covariance => solid(TRACK_RGB.mix(0.9).stroke_width(thin))?,
                 OverlayLine::Crlb => dashed(dash / 2, dash / 3, CRLB_RGB.stroke_width(thin + 1))?,
@@ -373,21 +363,17 @@ pub(crate) fn draw_overlay<'a, DB: DrawingBackend + 'a>(
                 labelled.push(label.clone());
                 let (h, l) = legend_styles(path.line, width, thin);
                 let half = (9.0 * s).round().max(4.0) as i32;
-                chart
-                    .draw_series(core::iter::empty::<Circle<(Real, Real), i32>>())
-                    .map_err(chart_err)?
-                    .label(label.as_str())
-                    .legend(move |(x, y)| {
-                        EmptyElement::at((x, y))
-                            + PathElement::new(vec![(-half, 0), (half, 0)], h)
-                            + PathElement::new(vec![(-half, 0), (half, 0)], l)
-                    });
+                legend_entry(chart, label, move |(x, y)| {
+                    EmptyElement::at((x, y))
+                        + PathElement::new(vec![(-half, 0), (half, 0)], h)
+                        + PathElement::new(vec![(-half, 0), (half, 0)], l)
+                })?;
             }
         }
     }
     let size = (6.0 * s).round().max(3.0) as i32;
     for m in &overlay.marks {
-        if !inside(m.position_m) {
+        if !in_window(view, m.position_m) {
             continue;
         }
         let at = (m.position_m[0], m.position_m[1]);
@@ -399,11 +385,7 @@ pub(crate) fn draw_overlay<'a, DB: DrawingBackend + 'a>(
             if !labelled.contains(label) {
                 labelled.push(label.clone());
                 let kind = m.kind;
-                chart
-                    .draw_series(core::iter::empty::<Circle<(Real, Real), i32>>())
-                    .map_err(chart_err)?
-                    .label(label.as_str())
-                    .legend(move |(x, y)| mark!((x, y), kind, size, width));
+                legend_entry(chart, label, move |(x, y)| mark!((x, y), kind, size, width))?;
             }
         }
     }

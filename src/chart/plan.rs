@@ -374,17 +374,13 @@ fn draw_paths<'a, DB: DrawingBackend + 'a>(
     }
     if !paths.is_empty() {
         let half = marker.max(4);
-        chart
-            .draw_series(core::iter::empty::<Circle<(Real, Real), i32>>())
-            .map_err(chart_err)?
-            .label("moved: start □ → end ○")
-            .legend(move |(x, y)| {
-                EmptyElement::at((x, y))
-                    + PathElement::new(
-                        [(-2 * half, 0), (2 * half, 0)],
-                        PATH_RGB.stroke_width(width),
-                    )
-            });
+        raster::legend_entry(chart, "moved: start □ → end ○", move |(x, y)| {
+            EmptyElement::at((x, y))
+                + PathElement::new(
+                    [(-2 * half, 0), (2 * half, 0)],
+                    PATH_RGB.stroke_width(width),
+                )
+        })?;
     }
     Ok(())
 }

@@ -18,7 +18,39 @@ pub(crate) type Chart<'a, DB> = ChartContext<'a, DB, Cartesian2d<RangedCoordf64,
 
 const TX_RGB: RGBColor = RGBColor(228, 26, 28);
 
-fn rgb(c: [u8; 3]) -> RGBColor {
+/// The window `[x0, x1, y0, y1]` (m) a map plot shows.
+pub(crate) fn plot_window<DB: DrawingBackend>(chart: &Chart<'_, DB>) -> [Real; 4] {
+    let (xr, yr) = (chart.x_range(), chart.y_range());
+    [xr.start, xr.end, yr.start, yr.end]
+}
+
+/// Whether the point `p` (m) lies in the window `w` = `[x0, x1, y0, y1]`.
+pub(crate) fn in_window(w: [Real; 4], p: [Real; 2]) -> bool {
+    (w[0]..=w[1]).contains(&p[0]) && (w[2]..=w[3]).contains(&p[1])
+}
+
+/// A legend entry `label`, drawn by `mark` (pixels about the entry's anchor), for the series
+/// legend of `chart` (an empty series carries it).
+pub(crate) fn legend_entry<'a, DB, E, F>(
+    chart: &mut Chart<'a, DB>,
+    label: &str,
+    mark: F,
+) -> Result<(), ChartError>
+where
+    DB: DrawingBackend + 'a,
+    E: plotters::element::IntoDynElement<'a, DB, (i32, i32)>,
+    F: Fn((i32, i32)) -> E + 'a,
+{
+    chart
+        .draw_series(core::iter::empty::<Circle<(Real, Real), i32>>())
+        .map_err(chart_err)?
+        .label(label)
+        .legend(mark);
+    Ok(())
+}
+
+/// A `present` colour (`[r, g, b]`) as plotters'.
+pub(super) fn rgb(c: [u8; 3]) -> RGBColor {
     RGBColor(c[0], c[1], c[2])
 }
 
@@ -81,14 +113,11 @@ pub(crate) fn draw_nodes<'a, DB: DrawingBackend + 'a>(
 ) -> Result<(), ChartError> {
     let s = font_px / 20.0;
     let marker = (7.0 * s).round().max(3.0) as i32;
-    let (xr, yr) = (chart.x_range(), chart.y_range());
+    let w = plot_window(chart);
     let (px_x, px_y) = chart.plotting_area().get_pixel_range();
     let font = ("sans-serif", font_px).into_font();
     let plot = chart.plotting_area().clone();
-    let visible = nodes.iter().filter(|n| {
-        let [x, y] = n.position_m;
-        x >= xr.start && x <= xr.end && y >= yr.start && y <= yr.end
-    });
+    let visible = nodes.iter().filter(|n| in_window(w, n.position_m));
     for n in visible {
         let at = (n.position_m[0], n.position_m[1]);
         match n.kind {
@@ -144,22 +173,16 @@ fn draw_legend<'a, DB: DrawingBackend + 'a>(
 ) -> Result<(), ChartError> {
     let has = |k: NodeKind| nodes.iter().any(|n| n.kind == k);
     if has(NodeKind::Transmitter) {
-        chart
-            .draw_series(core::iter::empty::<Circle<(Real, Real), i32>>())
-            .map_err(chart_err)?
-            .label("transmitter")
-            .legend(move |(x, y)| TriangleMarker::new((x, y), marker, TX_RGB.filled()));
+        legend_entry(chart, "transmitter", move |(x, y)| {
+            TriangleMarker::new((x, y), marker, TX_RGB.filled())
+        })?;
     }
     if has(NodeKind::Receiver) {
-        chart
-            .draw_series(core::iter::empty::<Circle<(Real, Real), i32>>())
-            .map_err(chart_err)?
-            .label("receiver")
-            .legend(move |(x, y)| {
-                EmptyElement::at((x, y))
-                    + Circle::new((0, 0), marker - 1, WHITE.filled())
-                    + Circle::new((0, 0), marker - 1, BLACK.stroke_width(2))
-            });
+        legend_entry(chart, "receiver", move |(x, y)| {
+            EmptyElement::at((x, y))
+                + Circle::new((0, 0), marker - 1, WHITE.filled())
+                + Circle::new((0, 0), marker - 1, BLACK.stroke_width(2))
+        })?;
     }
     if has(NodeKind::Transmitter) || has(NodeKind::Receiver) {
         series_legend(

@@ -10,13 +10,13 @@ use alloc::string::String;
 use alloc::vec::Vec;
 
 use plotters::coord::Shift;
-use plotters::element::{DashedPathElement, IntoDynElement};
+use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 
 use super::layout::{self, chart_err, register_fonts, ChartError};
 use super::map::{check_area, draw_metre_axes, finish_panel, metre_chart};
 use super::overlay::clipped_runs;
-use super::raster::Chart;
+use super::raster::{in_window, legend_entry, plot_window, Chart};
 use super::{ChartNode, NodeKind, CURVE_PALETTE};
 use crate::math::Real;
 use crate::measure::Ellipse;
@@ -129,12 +129,6 @@ pub fn draw_mtl_scene<DB: DrawingBackend>(
     finish_panel(&mut chart, &scene_nodes(scene), &lay)
 }
 
-/// The window `[x0, x1, y0, y1]` of a chart.
-fn view_of<DB: DrawingBackend>(chart: &Chart<'_, DB>) -> [Real; 4] {
-    let (xr, yr) = (chart.x_range(), chart.y_range());
-    [xr.start, xr.end, yr.start, yr.end]
-}
-
 /// The polygon `points` clipped to the rectangle `r` = `[x0, x1, y0, y1]` (Sutherland–Hodgman;
 /// empty when it lies outside).
 fn clip_polygon(points: &[(Real, Real)], r: [Real; 4]) -> Vec<(Real, Real)> {
@@ -195,21 +189,6 @@ fn disc(c: [Real; 2], radius: Real) -> Vec<[Real; 2]> {
     })
 }
 
-/// A legend entry drawn by `mark` (pixel coordinates about the entry's anchor).
-fn legend<'a, DB, E, F>(chart: &mut Chart<'a, DB>, label: &str, mark: F) -> Result<(), ChartError>
-where
-    DB: DrawingBackend + 'a,
-    E: IntoDynElement<'a, DB, (i32, i32)>,
-    F: Fn((i32, i32)) -> E + 'a,
-{
-    chart
-        .draw_series(core::iter::empty::<Circle<(Real, Real), i32>>())
-        .map_err(chart_err)?
-        .label(label)
-        .legend(mark);
-    Ok(())
-}
-
 /// Region, discs, segments, ellipses, seeds, hypotheses, targets and detections, with their
 /// legend entries; line widths and markers scale with `font_px` as the nodes' do.
 fn draw_layers<'a, DB: DrawingBackend + 'a>(
@@ -225,8 +204,8 @@ fn draw_layers<'a, DB: DrawingBackend + 'a>(
     let dot = (2.5 * s).round().max(1.0) as i32;
     let size = (6.0 * s).round().max(3.0) as i32;
     let half = (9.0 * s).round().max(4.0) as i32;
-    let w = view_of(chart);
-    let inside = |p: [Real; 2]| (w[0]..=w[1]).contains(&p[0]) && (w[2]..=w[3]).contains(&p[1]);
+    let w = plot_window(chart);
+    let inside = |p: [Real; 2]| in_window(w, p);
     let plot = chart.plotting_area().clone();
     let line = |points: &[[Real; 2]], closed: bool, style: ShapeStyle| -> Result<(), ChartError> {
         for run in clipped_runs(points, closed, w) {
@@ -257,7 +236,7 @@ fn draw_layers<'a, DB: DrawingBackend + 'a>(
     let region = [[x0, y0], [x1, y0], [x1, y1], [x0, y1]];
     fill(&region, REGION_FILL.filled())?;
     line(&region, true, REGION_EDGE.stroke_width(thin))?;
-    legend(chart, "region R", move |(x, y)| {
+    legend_entry(chart, "region R", move |(x, y)| {
         Rectangle::new(
             [(x - half, y - half / 2), (x + half, y + half / 2)],
             REGION_FILL.filled(),
@@ -272,7 +251,7 @@ fn draw_layers<'a, DB: DrawingBackend + 'a>(
     }
     if !scene.discs.is_empty() {
         let label = alloc::format!("disc, D = {} m", scene.diameter);
-        legend(chart, &label, move |(x, y)| {
+        legend_entry(chart, &label, move |(x, y)| {
             Circle::new((x, y), half / 2 + 1, DISC_RGB.mix(0.45).filled())
         })?;
     }
@@ -295,7 +274,7 @@ fn draw_layers<'a, DB: DrawingBackend + 'a>(
         }
     }
     if any_blocked {
-        legend(chart, "blocked LoS", move |(x, y)| {
+        legend_entry(chart, "blocked LoS", move |(x, y)| {
             PathElement::new(
                 vec![(x - half, y), (x + half, y)],
                 BLOCKED_RGB.stroke_width(thin + 1),
@@ -322,12 +301,12 @@ fn draw_layers<'a, DB: DrawingBackend + 'a>(
     }
     if any_dp {
         let c = CURVE_PALETTE[0];
-        legend(chart, "DP range (colour: TRP)", move |(x, y)| {
+        legend_entry(chart, "DP range (colour: TRP)", move |(x, y)| {
             PathElement::new(vec![(x - half, y), (x + half, y)], c.stroke_width(thin))
         })?;
     }
     if any_clutter {
-        legend(chart, "clutter", move |(x, y)| {
+        legend_entry(chart, "clutter", move |(x, y)| {
             PathElement::new(
                 vec![
                     (x - half, y),
@@ -339,7 +318,7 @@ fn draw_layers<'a, DB: DrawingBackend + 'a>(
             )
         })?;
     }
-    legend(chart, "matched range", move |(x, y)| {
+    legend_entry(chart, "matched range", move |(x, y)| {
         PathElement::new(vec![(x - half, y), (x + half, y)], BLACK.stroke_width(bold))
     })?;
 
@@ -354,7 +333,7 @@ fn draw_layers<'a, DB: DrawingBackend + 'a>(
         .map_err(chart_err)?;
     }
     if !view.seeds.is_empty() {
-        legend(chart, "seed", move |(x, y)| {
+        legend_entry(chart, "seed", move |(x, y)| {
             Circle::new((x, y), dot_r, SEED_RGB.filled())
         })?;
     }
@@ -368,7 +347,7 @@ fn draw_layers<'a, DB: DrawingBackend + 'a>(
         .map_err(chart_err)?;
     }
     if !view.hypotheses.is_empty() {
-        legend(chart, "hypothesis", move |(x, y)| {
+        legend_entry(chart, "hypothesis", move |(x, y)| {
             Rectangle::new(
                 [(x - sq, y - sq), (x + sq, y + sq)],
                 HYPOTHESIS_RGB.stroke_width(thin),
@@ -395,7 +374,7 @@ fn draw_layers<'a, DB: DrawingBackend + 'a>(
         plot.draw(&mark(ink)).map_err(chart_err)?;
     }
     if !view.targets.is_empty() {
-        legend(chart, "target", move |(x, y)| cross((x, y), ink))?;
+        legend_entry(chart, "target", move |(x, y)| cross((x, y), ink))?;
     }
     let ring = size + 3;
     let (mut hits, mut misses) = (false, false);
@@ -411,12 +390,12 @@ fn draw_layers<'a, DB: DrawingBackend + 'a>(
         .map_err(chart_err)?;
     }
     if hits {
-        legend(chart, "detected", move |(x, y)| {
+        legend_entry(chart, "detected", move |(x, y)| {
             Circle::new((x, y), ring, DETECTED_RGB.stroke_width(bold))
         })?;
     }
     if misses {
-        legend(chart, "false alarm", move |(x, y)| {
+        legend_entry(chart, "false alarm", move |(x, y)| {
             Circle::new((x, y), ring, FALSE_ALARM_RGB.stroke_width(bold))
         })?;
     }

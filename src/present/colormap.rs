@@ -10,6 +10,20 @@ use crate::present::{colorbar_ticks, Tick};
 /// Colour of unbounded (∞) or missing cells: neutral grey.
 pub const UNBOUNDED_RGB: [u8; 3] = [72, 72, 80];
 
+/// The colours of the links (their iso-delay ellipses; the multi-target view's TRPs) over the
+/// map: link `i` takes entry `i mod 8`. The page draws with them and the map figure's overlays
+/// ([`crate::chart::MapOverlay`]) too.
+pub const LINK_RGB: [[u8; 3]; 8] = [
+    [244, 244, 240],
+    [255, 209, 102],
+    [155, 229, 100],
+    [255, 143, 171],
+    [184, 192, 255],
+    [126, 232, 250],
+    [255, 184, 107],
+    [208, 162, 247],
+];
+
 /// Control points of the perceptually ordered "viridis" map (dark = small error = good).
 const VIRIDIS: [[u8; 3]; 9] = [
     [68, 1, 84],

@@ -11,7 +11,9 @@ mod snapshot;
 mod ticks;
 mod track_view;
 
-pub use colormap::{colorbar_rgba, fill_rgba, render_rgba, viridis, LogScale, UNBOUNDED_RGB};
+pub use colormap::{
+    colorbar_rgba, fill_rgba, render_rgba, viridis, LogScale, LINK_RGB, UNBOUNDED_RGB,
+};
 pub use plan_view::{
     area_of, run_plan, PlanHistoryJson, PlanImprovementJson, PlanJson, PlanObjectiveJson,
     PlanPathJson, PlanProgressJson, PlanRequest, DEFAULT_PLAN_BUDGET,

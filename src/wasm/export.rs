@@ -7,6 +7,7 @@
 //! error is an exception whose message starts with the function's name; nothing here runs until
 //! the page's Save figure button is pressed.
 
+use plotters::coord::Shift;
 use plotters::prelude::*;
 use serde::Deserialize;
 use wasm_bindgen::prelude::*;
@@ -64,9 +65,14 @@ fn fail(func: &str, e: impl core::fmt::Display) -> JsError {
     JsError::new(&format!("{func}: {e}"))
 }
 
-fn parse_options(func: &str, json: &str) -> Result<MapOptions, JsError> {
+/// A figure's options from JSON (`""`: all defaults); malformed JSON or an unknown field is the
+/// named parse error.
+fn parse_options<T: serde::de::DeserializeOwned + Default>(
+    func: &str,
+    json: &str,
+) -> Result<T, JsError> {
     if json.trim().is_empty() {
-        return Ok(MapOptions::default());
+        return Ok(T::default());
     }
     serde_json::from_str(json).map_err(|e| {
         fail(
@@ -142,10 +148,22 @@ fn map_figure(
         values_m: &values,
     };
     let nodes = scenario_nodes(s);
+    render_svg(func, size, |root| {
+        draw_crlb_map_with(root, &map, &nodes, overlay, &chart_opts).map(|_| ())
+    })
+}
+
+/// The SVG text of `size` px that `draw` writes through plotters' SVG backend; its error (or the
+/// backend's) is the exception `func: …`.
+fn render_svg<E: core::fmt::Display>(
+    func: &str,
+    size: (u32, u32),
+    draw: impl FnOnce(&DrawingArea<SVGBackend<'_>, Shift>) -> Result<(), E>,
+) -> Result<String, JsError> {
     let mut svg = String::new();
     {
         let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
-        draw_crlb_map_with(&root, &map, &nodes, overlay, &chart_opts).map_err(|e| fail(func, e))?;
+        draw(&root).map_err(|e| fail(func, e))?;
         root.present().map_err(|e| fail(func, e))?;
     }
     Ok(svg)
@@ -161,7 +179,7 @@ impl App {
     /// (8 … 1024, default 256), title?: text, target?: {x, y, seed}}`. Throws `map_svg: …`.
     pub fn map_svg(&self, width: u32, height: u32, options_json: &str) -> Result<String, JsError> {
         const F: &str = "map_svg";
-        let opts = parse_options(F, options_json)?;
+        let opts: MapOptions = parse_options(F, options_json)?;
         let (s, model) = (self.session().scenario(), self.session().model());
         let overlay = match &opts.target {
             Some(t) => {
@@ -194,7 +212,7 @@ impl Track {
         options_json: &str,
     ) -> Result<String, JsError> {
         const F: &str = "Track.map_svg";
-        let opts = parse_options(F, options_json)?;
+        let opts: MapOptions = parse_options(F, options_json)?;
         if opts.target.is_some() {
             return Err(fail(
                 F,
@@ -231,13 +249,9 @@ pub fn tracking_chart_svg(
 ) -> Result<String, JsError> {
     const F: &str = "tracking_chart_svg";
     let size = figure_size(None, width, height).map_err(|e| fail(F, e))?;
-    let mut svg = String::new();
-    {
-        let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
-        super::chart::draw_result(&root, result_json, title, subtitle, caption)
-            .map_err(|e| fail(F, e))?;
-    }
-    Ok(svg)
+    render_svg(F, size, |root| {
+        super::chart::draw_result(root, result_json, title, subtitle, caption).map(|_| ())
+    })
 }
 
 /// The options of a scene figure (all optional; `""` is all defaults).
@@ -266,18 +280,7 @@ pub fn mtl_scene_svg(
     options_json: &str,
 ) -> Result<String, JsError> {
     const F: &str = "mtl_scene_svg";
-    let opts: SceneOptions = if options_json.trim().is_empty() {
-        SceneOptions::default()
-    } else {
-        serde_json::from_str(options_json).map_err(|e| {
-            fail(
-                F,
-                Error::Parse {
-                    message: e.to_string(),
-                },
-            )
-        })?
-    };
+    let opts: SceneOptions = parse_options(F, options_json)?;
     let scene = MtlScene::from_json(scene_json).map_err(|e| fail(F, e))?;
     let area = match opts.window {
         Some(w) => window(w).map_err(|e| fail(F, e))?,
@@ -290,11 +293,7 @@ pub fn mtl_scene_svg(
         subtitle: None,
         window: Some(area),
     };
-    let mut svg = String::new();
-    {
-        let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
-        draw_mtl_scene(&root, &scene, &view, &chart_opts).map_err(|e| fail(F, e))?;
-        root.present().map_err(|e| fail(F, e))?;
-    }
-    Ok(svg)
+    render_svg(F, size, |root| {
+        draw_mtl_scene(root, &scene, &view, &chart_opts)
+    })
 }

@@ -36,7 +36,7 @@ pub use montecarlo::MonteCarloJob;
 pub use mtl::{mtl_check_scene, mtl_default_scene, mtl_view_of, MtlSession};
 pub use plan::plan_network;
 pub use render::{
-    axis_ticks, colorbar_rgba, colorbar_ticks, format_length, render_map_rgba, scale_bar,
+    axis_ticks, colorbar_rgba, colorbar_ticks, format_length, link_rgb, render_map_rgba, scale_bar,
     unbounded_rgb, MAX_AXIS_TICKS,
 };
 pub use tracking::{drag_velocity, track_steps, Track, MAX_TRACK_STEPS};

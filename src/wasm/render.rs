@@ -6,7 +6,7 @@ use wasm_bindgen::prelude::*;
 
 use super::err;
 use super::json::{to_js, ColorbarTickJs, ScaleBarJs};
-use crate::present::{self, LogScale, UNBOUNDED_RGB};
+use crate::present::{self, LogScale, LINK_RGB, UNBOUNDED_RGB};
 use crate::present::{format_length_m, linear_ticks};
 
 /// Colours a map (`values`, m) into `rgba` (4 bytes per value, e.g. an `ImageData.data`) on the
@@ -36,6 +36,13 @@ pub fn colorbar_rgba(n: usize) -> Vec<u8> {
 #[wasm_bindgen]
 pub fn unbounded_rgb() -> Vec<u8> {
     UNBOUNDED_RGB.to_vec()
+}
+
+/// The links' colours ([`crate::present::LINK_RGB`]), `[r, g, b]` each, flat: link `i` takes
+/// entry `i mod (len / 3)`.
+#[wasm_bindgen]
+pub fn link_rgb() -> Vec<u8> {
+    LINK_RGB.concat()
 }
 
 /// Ticks of the log colour bar for a scale `[min, max]`, m: `[{frac, value_m, label}]` with

@@ -18,6 +18,7 @@ import { Mtl } from './mtl.js';
 import { Plan } from './plan.js';
 import { FigureExport } from './export.js';
 import { Zoomer } from './zoom.js';
+import { setLinkColors } from './draw.js';
 
 const MODES = ['snapshot', 'tracking', 'mtl'];
 
@@ -101,6 +102,7 @@ export async function start() {
   const wasmUrl = new URL('../pkg/scatterloc_bg.wasm', import.meta.url);
   const module = await WebAssembly.compile(await (await fetch(wasmUrl)).arrayBuffer());
   await init({ module_or_path: module });
+  setLinkColors(wasm.link_rgb());
   const { opts, errors } = hashOptions(wasm.preset_names());
   const preset = opts.preset ?? 'sensors2019';
   const app = wasm.App.from_preset(preset);

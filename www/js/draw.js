@@ -17,7 +17,13 @@ export const C = {
   iso: 'rgba(255,255,255,0.62)',
   baseline: 'rgba(255,255,255,0.28)',
 };
-const LINK_COLORS = ['#f4f4f0', '#ffd166', '#9be564', '#ff8fab', '#b8c0ff', '#7ee8fa', '#ffb86b', '#d0a2f7'];
+/** The links' colours, from the core (present::LINK_RGB, as the figures'): set by setLinkColors. */
+let LINK_COLORS = ['#ffffff'];
+/** Takes the links' colours from the core's flat `[r, g, b, …]` (wasm link_rgb); app.js at start. */
+export function setLinkColors(rgb) {
+  LINK_COLORS = [];
+  for (let i = 0; i + 2 < rgb.length; i += 3) LINK_COLORS.push(`rgb(${rgb[i]},${rgb[i + 1]},${rgb[i + 2]})`);
+}
 /** The plot colour of link (or TRP) `i`. */
 export const linkColor = (i) => LINK_COLORS[i % LINK_COLORS.length];
 export const FONT = '11.5px system-ui, -apple-system, "Segoe UI", Roboto, sans-serif';
@@ -118,7 +124,6 @@ export function drawScaleBar(ctx, view, w) {
   const len = view.len(bar.length_m);
   const x = r.x + 10;
   const y = r.y + r.h - 10;
-  ctx.lineWidth = 2;
   for (const [color, width] of [['rgba(0,0,0,0.7)', 4], ['#fff', 2]]) {
     ctx.strokeStyle = color; ctx.lineWidth = width;
     ctx.beginPath();

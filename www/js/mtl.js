@@ -8,7 +8,7 @@
 
 import { $, decimalIn, errorText, fillKeyValues, fixed, showError, clearError } from './dom.js';
 import { JobWorker } from './workers.js';
-import { View } from './view.js';
+import { MARGIN, View } from './view.js';
 import { hitRadius, pickNearest } from './interact.js';
 import { drawMtl } from './mtl-draw.js';
 
@@ -54,7 +54,7 @@ export class Mtl {
     }
     this.canvas = $('plot');
     // No colour bar here: a narrow right margin.
-    this.view = new View(this.canvas, { left: 58, right: 24, top: 16, bottom: 44 });
+    this.view = new View(this.canvas, { ...MARGIN, right: 24 });
     this.scene = JSON.parse(this.wasm.mtl_default_scene());
     this.result = null; // the last view from the core
     this.resultGen = 0;
