@@ -23,6 +23,8 @@
 //! - [`mtl`]: multi-target localization under correlated blocking (`multi-target.md`).
 //! - [`plan`]: network planning — move nodes to minimise a CRLB objective over a region
 //!   (CMA-ES with restarts, constraints).
+//! - [`study`]: the use cases every front end shares — the Monte Carlo study over any list of
+//!   filters, its part files and their merge, run through a [`study::Driver`].
 //! - [`present`]: view models shared by the page and the figures: ticks, colour map, snapshot and
 //!   track views, the interactive session.
 //!
@@ -46,6 +48,7 @@ pub mod mtl;
 pub mod plan;
 pub mod present;
 pub mod scenario;
+pub mod study;
 pub mod track;
 
 #[cfg(feature = "std")]

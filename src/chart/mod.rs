@@ -3,7 +3,7 @@
 //!
 //! [`draw_crlb_map`] draws the CRLB map figure (the same colours and colour-bar ticks as the page);
 //! [`draw_crlb_map_with`] adds a [`MapOverlay`] (a target's snapshot or a track, as the page shows).
-//! [`draw_tracking_rmse`] draws the tracking figure of \[S\] Fig. 3 (spec §10) in the same style.
+//! [`draw_tracking_filters`] draws the tracking figure of \[S\] Fig. 3 (spec §10) in the same style.
 //! [`draw_plan_maps`] draws a network plan: the maps before and after side by side.
 //! [`draw_curves`] draws the ROC and missed-detection curves of the multi-target experiments.
 //! [`draw_mtl_scene`] draws a multi-target scene and its view (the page's multi-target view).
@@ -32,6 +32,5 @@ pub use roc::{
 };
 pub use scene::{draw_mtl_scene, scene_nodes, scene_titles, scene_window, SceneChartOptions};
 pub use tracking::{
-    draw_tracking_filters, draw_tracking_rmse, tracking_size, FilterCurve, FiltersPanel,
-    TrackingChartOptions, TrackingPanel,
+    draw_tracking_filters, tracking_size, FilterCurve, FiltersPanel, TrackingChartOptions,
 };

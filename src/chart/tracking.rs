@@ -27,22 +27,6 @@ const CURVE_RGB: [RGBColor; 4] = [
     CURVE_PALETTE[3],
 ];
 
-/// The legend label of the EKF curve of [`draw_tracking_rmse`].
-const EKF_LABEL: &str = "EKF RMSE  ε_EKF";
-
-/// One panel: the curves of one scenario.
-#[derive(Debug, Clone, Copy)]
-pub struct TrackingPanel<'a> {
-    /// Panel caption, e.g. `Scenario II`.
-    pub title: &'a str,
-    /// Times `t_n`, s (ascending).
-    pub t_s: &'a [Real],
-    /// `ε_EKF(t_n)`, m, one per time (empty: not drawn; non-finite: a gap).
-    pub rmse_ekf_m: &'a [Real],
-    /// `ε_PCRLB(t_n)`, m, one per time (empty: not drawn; `None`: a gap).
-    pub rmse_pcrlb_m: &'a [Option<Real>],
-}
-
 /// One named RMSE curve of a [`FiltersPanel`].
 #[derive(Debug, Clone, Copy)]
 pub struct FilterCurve<'a> {
@@ -115,52 +99,12 @@ fn y_range(panels: &[FiltersPanel]) -> (Real, Real) {
     }
 }
 
-/// Draws the figure onto `root` (filled white first): the title band, then one panel per entry
-/// of `panels` side by side with a shared y range. Returns that range `(lo, hi)`, m. Does not call
-/// `present()`.
-pub fn draw_tracking_rmse<DB: DrawingBackend>(
-    root: &DrawingArea<DB, Shift>,
-    panels: &[TrackingPanel],
-    opts: &TrackingChartOptions,
-) -> Result<(Real, Real), ChartError> {
-    register_fonts();
-    for p in panels {
-        let lengths = [p.rmse_ekf_m.len(), p.rmse_pcrlb_m.len()];
-        if lengths.iter().any(|&n| n != 0 && n != p.t_s.len()) {
-            return Err(ChartError(alloc::format!(
-                "{}: {} times but {} EKF and {} PCRLB values",
-                p.title,
-                p.t_s.len(),
-                lengths[0],
-                lengths[1]
-            )));
-        }
-    }
-    let curves: Vec<[FilterCurve; 1]> = panels
-        .iter()
-        .map(|p| {
-            [FilterCurve {
-                label: EKF_LABEL,
-                rmse_m: p.rmse_ekf_m,
-            }]
-        })
-        .collect();
-    let panels: Vec<FiltersPanel> = panels
-        .iter()
-        .zip(&curves)
-        .map(|(p, c)| FiltersPanel {
-            title: p.title,
-            t_s: p.t_s,
-            curves: c,
-            rmse_pcrlb_m: p.rmse_pcrlb_m,
-        })
-        .collect();
-    draw_panels(root, &panels, opts)
-}
-
-/// [`draw_tracking_rmse`] with several trackers' RMSE curves per panel (issue 15): each curve
-/// solid in its own colour (the first in the EKF's blue) with its label in the legend, next to
-/// the dashed PCRLB. Returns the shared y range `(lo, hi)`, m. Does not call `present()`.
+/// Draws the tracking figure onto `root` (filled white first): the title band, then one panel
+/// per entry of `panels` side by side with a shared y range, each with one or more trackers'
+/// labelled RMSE curves (labels: [`crate::study::curve_label`]), each solid in its own colour
+/// (the first in the EKF's blue) with its label in the legend, next to the dashed PCRLB — [S]
+/// Fig. 3 with the EKF alone. The one entry point of the CLI's and the page's tracking charts.
+/// Returns the shared y range `(lo, hi)`, m. Does not call `present()`.
 pub fn draw_tracking_filters<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     panels: &[FiltersPanel],

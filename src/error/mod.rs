@@ -193,6 +193,20 @@ pub enum Error {
         /// The name given.
         name: String,
     },
+    /// A part file that does not fit its set (`merge` of a sharded study).
+    InconsistentPart {
+        /// The part's path.
+        path: String,
+        /// What does not fit.
+        what: String,
+    },
+    /// The files given to `merge` are not one study's complete set of parts: not part files,
+    /// foreign parts, shard counts that disagree, duplicate or missing shards (the message
+    /// lists the files).
+    PartSet {
+        /// The whole message.
+        what: String,
+    },
 }
 
 impl fmt::Display for Error {
@@ -330,6 +344,10 @@ impl fmt::Display for Error {
                 "{field}: unknown filter \"{}\" (known: ekf, ukf, pf)",
                 Clip(name)
             ),
+            Error::InconsistentPart { path, what } => {
+                write!(f, "merge: inconsistent part {path}: {what}")
+            }
+            Error::PartSet { what } => write!(f, "{what}"),
         }
     }
 }

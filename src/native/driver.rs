@@ -8,6 +8,7 @@ use std::vec::Vec;
 use rayon::prelude::*;
 
 use crate::error::{Error, Result};
+use crate::study::Driver;
 
 /// Runs `job(0..jobs)` on `threads` workers (0 = all cores), `per_thread` jobs per worker and
 /// wave, and calls `merge` with each result in job order. After each wave `on_progress(done)`
@@ -53,4 +54,32 @@ pub fn thread_pool(threads: usize) -> Result<rayon::ThreadPool> {
             min: 0,
             max: 1024,
         })
+}
+
+/// The study [`Driver`] on threads: [`run_ordered`] on `threads` workers (0 = all cores), with
+/// `cancel` (Ctrl-C) checked between waves. Results equal [`crate::study::Sequential`]'s for
+/// any thread count.
+pub struct Parallel<'a> {
+    threads: usize,
+    cancel: &'a AtomicBool,
+}
+
+impl<'a> Parallel<'a> {
+    /// A driver on `threads` workers (0 = all cores) that stops when `cancel` becomes true.
+    pub fn new(threads: usize, cancel: &'a AtomicBool) -> Parallel<'a> {
+        Parallel { threads, cancel }
+    }
+}
+
+impl Driver for Parallel<'_> {
+    fn run<T: Send>(
+        &mut self,
+        jobs: usize,
+        batch: usize,
+        job: &(dyn Fn(usize) -> Result<T> + Sync),
+        merge: &mut dyn FnMut(T),
+        progress: &mut dyn FnMut(usize),
+    ) -> Result<()> {
+        run_ordered(jobs, self.threads, batch, self.cancel, job, merge, progress)
+    }
 }

@@ -1,7 +1,8 @@
 //! Native (`std`, not wasm32) drivers: the CRLB map over threads ([`crlb_map_parallel`], rows
 //! split over rayon workers), [`run_ordered`], the one ordered parallel driver (rayon waves,
-//! results merged in job order, progress and cancel between waves), and the two studies that
-//! run on it: the tracker's Monte Carlo ([`run_parallel`], [`run_pcrlb_parallel`], and
+//! results merged in job order, progress and cancel between waves), [`Parallel`], the
+//! [`crate::study::Driver`] on it that the studies of [`crate::study`] run through, and the
+//! two studies' convenience entry points: the tracker's Monte Carlo ([`run_parallel`], [`run_pcrlb_parallel`], and
 //! [`run_chunks_parallel`] for a shard, [`run_filter_chunks_parallel`] for
 //! the UKF or the particle filter) and the multi-target experiment sweeps
 //! ([`run_experiment_parallel`], and [`run_experiment_range`] for a shard). Results never
@@ -12,7 +13,7 @@ mod map;
 mod parallel;
 mod sweep;
 
-pub use driver::{run_ordered, thread_pool};
+pub use driver::{run_ordered, thread_pool, Parallel};
 pub use map::{crlb_map_parallel, PARALLEL_MAP_MIN_CELLS};
 pub use parallel::{
     run_chunks_parallel, run_filter_chunks_parallel, run_parallel, run_pcrlb_parallel,

@@ -1,18 +1,20 @@
-//! The Monte Carlo study ([`crate::track`]) on the ordered driver ([`run_ordered`]): chunks of
-//! trajectories run in parallel and their sums are combined exactly ([`StudySums`]), so the
+//! The Monte Carlo study ([`crate::track`]) on the ordered driver: the tracker's study is the
+//! core's [`FilterStudy`] on the [`Parallel`] driver; the PCRLB alone runs truth chunks on
+//! [`run_ordered`]. Chunks of trajectories run in parallel and their sums are combined exactly ([`StudySums`]), so the
 //! result is identical for any thread count, and a shard's sums ([`run_chunks_parallel`])
 //! merge into exactly the sums of the whole study.
 
 use std::ops::Range;
 use std::sync::atomic::AtomicBool;
 
-use super::driver::run_ordered;
-use crate::error::{Error, Result};
+use super::driver::{run_ordered, Parallel};
+use crate::error::Result;
 use crate::math::Real;
 use crate::measure::Model;
+use crate::study::FilterStudy;
 use crate::track::{
-    finish, pcrlb_from_sums, run_filter_chunk, run_truth_chunk, FilterKind, MonteCarloConfig,
-    MonteCarloResult, PartialSums, StudySums,
+    finish, pcrlb_from_sums, run_truth_chunk, FilterKind, MonteCarloConfig, MonteCarloResult,
+    PartialSums, StudySums,
 };
 
 /// Runs the study on `threads` worker threads (0 = all cores). `on_progress(runs_done,
@@ -73,21 +75,17 @@ pub fn run_filter_chunks_parallel(
     chunks: Range<usize>,
     threads: usize,
     cancel: &AtomicBool,
-    on_progress: impl FnMut(usize, usize),
+    mut on_progress: impl FnMut(usize, usize),
 ) -> Result<StudySums> {
     filter.validate()?;
-    cfg.validate()?;
-    check_chunks(cfg, &chunks)?;
-    run_waves(
+    let mut study = FilterStudy::new(*cfg, &[filter])?;
+    study.run_range(
         model,
-        cfg,
         chunks,
-        threads,
-        cancel,
-        on_progress,
-        |m, c, k| run_filter_chunk(m, c, filter, k),
-        cfg.noise_runs,
-    )
+        &mut Parallel::new(threads, cancel),
+        &mut on_progress,
+    )?;
+    Ok(study.sums().swap_remove(0))
 }
 
 /// The Monte Carlo PCRLB alone (spec §8, check 10) in parallel: truth trajectories and
@@ -117,19 +115,6 @@ pub fn run_pcrlb_parallel(
         1,
     )?;
     pcrlb_from_sums(cfg, &sums)
-}
-
-/// `chunks` must end at or before the last chunk.
-fn check_chunks(cfg: &MonteCarloConfig, chunks: &Range<usize>) -> Result<()> {
-    let len = cfg.chunk_count();
-    if chunks.end > len || chunks.start > chunks.end {
-        return Err(Error::IndexOutOfRange {
-            field: "chunks",
-            index: chunks.end.max(chunks.start),
-            len,
-        });
-    }
-    Ok(())
 }
 
 /// Runs `chunk` for every chunk of `chunks` through [`run_ordered`] and adds the sums exactly.

@@ -6,9 +6,10 @@
 use std::ops::Range;
 use std::sync::atomic::AtomicBool;
 
-use super::driver::run_ordered;
-use crate::error::{Error, Result};
-use crate::mtl::experiment::{evaluate, ExperimentConfig, ExperimentResult, Tally};
+use super::driver::Parallel;
+use crate::error::Result;
+use crate::mtl::experiment::{ExperimentConfig, ExperimentResult, Tally};
+use crate::study::RocStudy;
 
 /// Runs `cfg` on `threads` worker threads (0 = all cores). `on_progress(done, total)` is called
 /// after every wave; when `cancel` becomes true the run stops after the current wave with
@@ -35,24 +36,10 @@ pub fn run_experiment_range(
     cancel: &AtomicBool,
     mut on_progress: impl FnMut(usize, usize),
 ) -> Result<Tally> {
-    cfg.validate()?;
-    if realisations.end > cfg.realisations || realisations.start > realisations.end {
-        return Err(Error::IndexOutOfRange {
-            field: "realisations",
-            index: realisations.end.max(realisations.start),
-            len: cfg.realisations,
-        });
-    }
-    let (first, total) = (realisations.start, realisations.len());
-    let mut tally = Tally::new(cfg.curves().len(), cfg.sweep.len());
-    run_ordered(
-        total,
-        threads,
-        8,
-        cancel,
-        |i| evaluate(cfg, (first + i) as u64),
-        |part| tally.add(&part),
-        |done| on_progress(done, total),
-    )?;
-    Ok(tally)
+    RocStudy::run_range(
+        cfg,
+        realisations,
+        &mut Parallel::new(threads, cancel),
+        &mut on_progress,
+    )
 }

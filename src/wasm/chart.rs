@@ -34,10 +34,10 @@ struct Curves {
 
 /// The legend label of filter `name`: `EKF RMSE`, `PF RMSE (192 runs × 1000 particles)`.
 fn label(name: &str, runs: usize, particles: Option<usize>) -> String {
-    let upper = name.to_uppercase();
+    let base = crate::study::curve_label(name, false);
     match (name, particles) {
-        ("pf", Some(n)) => format!("{upper} RMSE ({runs} runs × {n} particles)"),
-        _ => format!("{upper} RMSE"),
+        ("pf", Some(n)) => format!("{base} ({runs} runs × {n} particles)"),
+        _ => base,
     }
 }
 

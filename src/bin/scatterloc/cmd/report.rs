@@ -8,40 +8,15 @@ use plotters::prelude::*;
 use serde::Serialize;
 
 use scatterloc::chart::{
-    draw_tracking_filters, draw_tracking_rmse, tracking_size, ChartError, FilterCurve,
-    FiltersPanel, TrackingChartOptions, TrackingPanel,
+    draw_tracking_filters, tracking_size, ChartError, FilterCurve, FiltersPanel,
+    TrackingChartOptions,
 };
+use scatterloc::study::{CurveDoc, TrackStudy as Study};
 
 use super::io::emit;
 use super::output::{check_writable, write_figure, write_json_file, Figure, Format};
-use super::study::{at_report_times, AtTime, Study};
+use super::study::{at_report_times, AtTime};
 use crate::CliError;
-
-/// The curves of one trajectory and its scalars `M` (flattened after the curves).
-#[derive(Serialize)]
-pub struct CurveDoc<M: Serialize> {
-    /// `t_n`, s.
-    pub t_s: Vec<f64>,
-    /// `ε_EKF(t_n)`, m (EKF studies only).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub rmse_ekf_m: Option<Vec<f64>>,
-    /// `ε_PCRLB(t_n)`, m (`null` where singular).
-    pub rmse_pcrlb_m: Vec<Option<f64>>,
-    /// Average NEES (EKF studies only).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub nees: Option<Vec<f64>>,
-    /// Everything else.
-    #[serde(flatten)]
-    pub meta: M,
-    /// Added to the panel caption of the figure (EKF studies: the failed runs, which
-    /// `ε_EKF` leaves out); not part of the JSON.
-    #[serde(skip)]
-    pub caption_note: Option<String>,
-    /// Several trackers (`montecarlo --filters`): the figure draws these labelled RMSE curves
-    /// instead of `rmse_ekf_m`; not part of the JSON (the meta holds them).
-    #[serde(skip)]
-    pub figure_curves: Option<Vec<(String, Vec<f64>)>>,
-}
 
 /// The scalars and the values at the reporting times.
 #[derive(Serialize)]
@@ -87,19 +62,8 @@ fn encode<T: Serialize>(v: &T) -> Result<String, CliError> {
     serde_json::to_string(v).map_err(|e| CliError::output(format!("encoding JSON: {e}")))
 }
 
-/// The [S] Fig. 3 figure as a [`Figure`].
-struct TrackingFigure<'a> {
-    panels: Vec<TrackingPanel<'a>>,
-    opts: &'a TrackingChartOptions,
-}
-
-impl Figure for TrackingFigure<'_> {
-    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), ChartError> {
-        draw_tracking_rmse(root, &self.panels, self.opts).map(|_| ())
-    }
-}
-
-/// The figure of several trackers' curves as a [`Figure`].
+/// The tracking figure ([S] Fig. 3; one or more trackers' labelled RMSE curves beside the
+/// PCRLB) as a [`Figure`].
 struct FiltersFigure<'a> {
     panels: Vec<FiltersPanel<'a>>,
     opts: &'a TrackingChartOptions,
@@ -109,13 +73,6 @@ impl Figure for FiltersFigure<'_> {
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), ChartError> {
         draw_tracking_filters(root, &self.panels, self.opts).map(|_| ())
     }
-}
-
-/// `{layout}, scenario II` or `{layout}, scenarios I, II, III` (figure titles).
-pub fn which(study: &Study) -> String {
-    let names: Vec<&str> = study.trajectories.iter().map(|t| t.name()).collect();
-    let plural = if names.len() > 1 { "s" } else { "" };
-    format!("{}, scenario{plural} {}", study.layout, names.join(", "))
 }
 
 /// Where results go: a figure (`--out`, SVG or PNG) and the curves (`--json`).
@@ -173,45 +130,30 @@ impl Outputs {
                 })
                 .collect();
             let size = tracking_size(docs.len());
-            if docs.iter().any(|d| d.figure_curves.is_some()) {
-                let curves: Vec<Vec<FilterCurve>> = docs
-                    .iter()
-                    .map(|d| {
-                        d.figure_curves
-                            .iter()
-                            .flatten()
-                            .map(|(label, rmse)| FilterCurve {
-                                label,
-                                rmse_m: rmse,
-                            })
-                            .collect()
-                    })
-                    .collect();
-                let panels = docs
-                    .iter()
-                    .zip(&captions)
-                    .zip(&curves)
-                    .map(|((d, title), curves)| FiltersPanel {
-                        title,
-                        t_s: &d.t_s,
-                        curves,
-                        rmse_pcrlb_m: &d.rmse_pcrlb_m,
-                    })
-                    .collect();
-                write_figure("out", path, *format, size, &FiltersFigure { panels, opts })?;
-            } else {
-                let panels = docs
-                    .iter()
-                    .zip(&captions)
-                    .map(|(d, title)| TrackingPanel {
-                        title,
-                        t_s: &d.t_s,
-                        rmse_ekf_m: d.rmse_ekf_m.as_deref().unwrap_or(&[]),
-                        rmse_pcrlb_m: &d.rmse_pcrlb_m,
-                    })
-                    .collect();
-                write_figure("out", path, *format, size, &TrackingFigure { panels, opts })?;
-            }
+            let curves: Vec<Vec<FilterCurve>> = docs
+                .iter()
+                .map(|d| {
+                    d.figure_curves
+                        .iter()
+                        .map(|(label, rmse)| FilterCurve {
+                            label,
+                            rmse_m: rmse,
+                        })
+                        .collect()
+                })
+                .collect();
+            let panels = docs
+                .iter()
+                .zip(&captions)
+                .zip(&curves)
+                .map(|((d, title), curves)| FiltersPanel {
+                    title,
+                    t_s: &d.t_s,
+                    curves,
+                    rmse_pcrlb_m: &d.rmse_pcrlb_m,
+                })
+                .collect();
+            write_figure("out", path, *format, size, &FiltersFigure { panels, opts })?;
         }
         let summaries: Vec<Summary<M>> = docs
             .iter()

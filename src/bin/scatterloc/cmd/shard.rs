@@ -1,33 +1,17 @@
 //! Running one shard of a study (issue 13 §4): `--shard I/N|env` resolved against the batch
-//! system's variables, and the part file a sharded run writes instead of its result — the
-//! study's full configuration and seed, the shard, its timing and the sufficient statistics
-//! ([`scatterloc::track::StudySums`], [`scatterloc::mtl::experiment::Tally`]), which
-//! `scatterloc merge` (`super::merge`) adds up exactly.
-//!
-//! Part file (JSON, format `scatterloc-part`, version 1):
-//! `{"format": "scatterloc-part", "version": 1, "software": "scatterloc 0.1.0", "study":
-//! "montecarlo" | "mtl-roc", "config": {…}, "shard": {"index": I, "count": N, "unit": "chunks" |
-//! "realisations", "range": [a, b], "total": C}, "timing": {"threads": T, "wall_time_s": [..]},
-//! "sums": …}`. The shard covers the units `[a, b)` = [`Shard::range`] of `C`.
+//! system's variables, and the writing of the part file a sharded run writes instead of its
+//! result ([`scatterloc::study::PartFile`], whose format is documented in the library), which
+//! `scatterloc merge` (`super::merge`) checks and adds up exactly.
 
-use serde::{Deserialize, Serialize};
+use serde::Serialize;
 
 use scatterloc::math::{Shard, MAX_SHARDS};
+use scatterloc::study::{PartFile, ShardDoc};
 
 use super::io::emit;
 use super::output::{check_writable, write_json_file, Format};
 use crate::cli::{ShardArgs, ShardSpec};
 use crate::CliError;
-
-/// The `format` of a part file.
-pub const PART_FORMAT: &str = "scatterloc-part";
-/// The `version` of the part format this build reads and writes.
-pub const PART_VERSION: u64 = 1;
-
-/// The `software` of a part file: parts of one study must come from the same build version.
-pub fn software() -> String {
-    format!("scatterloc {}", env!("CARGO_PKG_VERSION"))
-}
 
 /// The shard of a run from `--shard` and `--shards` (`None`: the whole study). `--shard env`
 /// reads the process environment ([`from_env`]).
@@ -144,81 +128,15 @@ pub fn part_path(json: Option<&str>, out: Option<&str>) -> Result<String, CliErr
     Ok(path.to_string())
 }
 
-/// Where a shard lies in its study.
-#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct ShardDoc {
-    /// `I`, 0-based.
-    pub index: usize,
-    /// `N`.
-    pub count: usize,
-    /// What the study is split into: `chunks` (Monte Carlo) or `realisations` (ROC).
-    pub unit: String,
-    /// The units `[a, b)` of this shard.
-    pub range: [usize; 2],
-    /// The study's units `C`.
-    pub total: usize,
-}
-
-impl ShardDoc {
-    /// Shard `shard` of a study of `total` `unit`s.
-    pub fn new(shard: Shard, unit: &str, total: usize) -> ShardDoc {
-        let r = shard.range(total);
-        ShardDoc {
-            index: shard.index(),
-            count: shard.count(),
-            unit: unit.to_string(),
-            range: [r.start, r.end],
-            total,
-        }
-    }
-}
-
-/// Run time of a part (or of the merged study).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct Timing {
-    /// Worker threads used.
-    pub threads: usize,
-    /// Wall time, s, one per entry of `sums` (Monte Carlo: per trajectory).
-    pub wall_time_s: Vec<f64>,
-}
-
-/// A part file as written.
-#[derive(Serialize)]
-struct PartOut<'a, C: Serialize, S: Serialize> {
-    format: &'static str,
-    version: u64,
-    software: String,
-    study: &'a str,
-    config: &'a C,
-    shard: &'a ShardDoc,
-    timing: &'a Timing,
-    sums: &'a S,
-}
-
-/// Writes the part file `path` (atomically) and prints the one-line summary `{part, study,
-/// shard, …extra}`.
-pub fn write_part<C: Serialize, S: Serialize, E: Serialize>(
+/// Writes the part file `part` to `path` (atomically) and prints the one-line summary
+/// `{part, study, shard, …extra}`.
+pub fn write_part<C: Serialize, S: Serialize + ?Sized, E: Serialize>(
     path: &str,
-    study: &str,
-    config: &C,
-    shard: &ShardDoc,
-    timing: &Timing,
-    sums: &S,
+    part: &PartFile<C, S>,
     extra: &E,
 ) -> Result<(), CliError> {
-    let part = PartOut {
-        format: PART_FORMAT,
-        version: PART_VERSION,
-        software: software(),
-        study,
-        config,
-        shard,
-        timing,
-        sums,
-    };
-    write_json_file("json", path, &part)?;
+    let (study, shard, timing) = (part.study(), part.shard(), part.timing());
+    write_json_file("json", path, part)?;
     #[derive(Serialize)]
     struct Line<'a, E: Serialize> {
         part: &'a str,

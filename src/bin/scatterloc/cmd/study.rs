@@ -9,19 +9,16 @@ use std::time::{Duration, Instant};
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
 
-use scatterloc::native::{
-    run_chunks_parallel, run_filter_chunks_parallel, run_parallel, run_pcrlb_parallel,
-};
+use scatterloc::native::{run_pcrlb_parallel, Parallel};
+use scatterloc::study::{FilterStudy, TrackStudy as Study};
 use scatterloc::track::ConstantVelocity;
-use scatterloc::track::FilterKind;
 use scatterloc::track::{
-    paper_initial_covariance, step_count, TrackScenario, PAPER_DURATION_S, PAPER_INTENSITY,
-    PAPER_STEP_S,
+    step_count, TrackScenario, PAPER_DURATION_S, PAPER_INTENSITY, PAPER_STEP_S,
 };
-use scatterloc::track::{MonteCarloConfig, MonteCarloResult, StudySums, MAX_STEPS};
+use scatterloc::track::{MonteCarloConfig, MAX_STEPS};
 use scatterloc::{scenario::presets, Error, Model, Scenario};
 
-use super::io::{model_of, read_scenario};
+use super::io::read_scenario;
 use crate::cli::{StudyArgs, Trajectory};
 use crate::CliError;
 
@@ -32,22 +29,6 @@ const MAX_THREADS: usize = 256;
 
 /// Set by Ctrl-C; the Monte Carlo driver stops after its current wave.
 static CANCEL: AtomicBool = AtomicBool::new(false);
-
-/// The scenario, trajectories and time grid of a study.
-pub struct Study {
-    /// Name of the node layout (preset or scenario file).
-    pub layout: String,
-    /// The scenario (validated).
-    pub scenario: Scenario,
-    /// The measurement model.
-    pub model: Model,
-    /// Trajectories to evaluate, in order.
-    pub trajectories: Vec<TrackScenario>,
-    /// CV model (E7).
-    pub motion: ConstantVelocity,
-    /// Steps after `t₀`.
-    pub steps: usize,
-}
 
 /// Maps a core error to the flag that caused it.
 pub fn flag_error(e: Error) -> CliError {
@@ -100,7 +81,7 @@ pub fn parse_study(args: &StudyArgs) -> Result<Study, CliError> {
     let motion = ConstantVelocity::validated(dt, q).map_err(flag_error)?;
     let duration = args.duration.unwrap_or(PAPER_DURATION_S);
     let steps = checked_steps(duration, dt)?;
-    Study::new(layout, scenario, trajectories, motion, steps)
+    new_study(layout, scenario, trajectories, motion, steps)
 }
 
 /// The node layout of `--preset NAME` (default `sensors2019`) or `--scenario FILE` (not both):
@@ -125,63 +106,16 @@ pub fn load_layout(
     }
 }
 
-impl Study {
-    /// A study of `scenario` (validated) named `layout`.
-    pub fn new(
-        layout: String,
-        scenario: Scenario,
-        trajectories: Vec<TrackScenario>,
-        motion: ConstantVelocity,
-        steps: usize,
-    ) -> Result<Study, CliError> {
-        Ok(Study {
-            layout,
-            model: model_of(&scenario)?,
-            scenario,
-            trajectories,
-            motion,
-            steps,
-        })
-    }
-
-    /// The Monte Carlo study of spec §9.5 for trajectory `t`: prior mean `x̄₀` of §9.4,
-    /// `P(t₀) = diag(0.1, 0.1, 0.01, 0.01)`, validated (errors name the flags).
-    pub fn config(
-        &self,
-        t: TrackScenario,
-        runs: usize,
-        noise_runs: usize,
-        seed: u64,
-        oracle_noise: bool,
-    ) -> Result<MonteCarloConfig, CliError> {
-        let cfg = MonteCarloConfig {
-            motion: self.motion,
-            steps: self.steps,
-            mean_state: t.mean_state(),
-            initial_covariance: paper_initial_covariance(),
-            trajectories: runs,
-            noise_runs,
-            seed,
-            oracle_noise,
-        };
-        cfg.validate().map_err(flag_error)?;
-        Ok(cfg)
-    }
-
-    /// `T = …` for titles: milliseconds below 0.1 s.
-    pub fn step_label(&self) -> String {
-        let dt = self.motion.dt_s;
-        let (v, unit) = if dt < 0.1 {
-            (dt * 1e3, "ms")
-        } else {
-            (dt, "s")
-        };
-        let text = format!("{v:.6}");
-        format!(
-            "{} {unit}",
-            text.trim_end_matches('0').trim_end_matches('.')
-        )
-    }
+/// A tracking study of `scenario` named `layout` (model errors name `--scenario`).
+pub fn new_study(
+    layout: String,
+    scenario: Scenario,
+    trajectories: Vec<TrackScenario>,
+    motion: ConstantVelocity,
+    steps: usize,
+) -> Result<Study, CliError> {
+    Study::new(layout, scenario, trajectories, motion, steps)
+        .map_err(|e| CliError::usage(format!("--scenario: {e}")))
 }
 
 /// `--threads` (default 0 = all cores) and the number of threads that means.
@@ -222,64 +156,28 @@ pub fn interrupted() -> bool {
     CANCEL.load(Ordering::SeqCst)
 }
 
-/// Runs `cfg` on `threads` threads with a progress bar labelled `label` (drawn only when stderr
-/// is a terminal). Ctrl-C stops it: exit status 130. Returns the result and the wall time, s.
-pub fn run_with_progress(
-    model: &Model,
-    cfg: &MonteCarloConfig,
-    threads: usize,
-    label: &str,
-) -> Result<(MonteCarloResult, f64), CliError> {
-    with_progress(cfg.runs(), "runs", label, |cancel, progress| {
-        run_parallel(model, cfg, threads, cancel, progress)
-    })
-}
-
-/// The sums of the chunks `chunks` of `cfg` (a shard) with the progress bar of
-/// [`run_with_progress`] (counting the runs of these chunks) and its Ctrl-C handling.
-pub fn run_chunks_with_progress(
-    model: &Model,
-    cfg: &MonteCarloConfig,
-    chunks: std::ops::Range<usize>,
-    threads: usize,
-    label: &str,
-) -> Result<(StudySums, f64), CliError> {
-    let total = cfg.trajectories_in(&chunks) * cfg.noise_runs;
-    with_progress(total, "runs", label, |cancel, progress| {
-        run_chunks_parallel(model, cfg, chunks, threads, cancel, progress)
-    })
-}
-
-/// The sums of chunks `chunks` of `cfg` once per filter of `filters` (in order, on the same
-/// truth and measurements) under one progress bar counting the runs of every filter, with the
-/// Ctrl-C handling of [`run_with_progress`]: the sums in the order of `filters` and the wall
-/// time.
+/// Runs the chunks `chunks` of every filter of `study` ([`FilterStudy::run_range`]) on
+/// `threads` threads under one progress bar labelled `label` counting the runs of every
+/// filter (drawn only when stderr is a terminal). Ctrl-C stops it: exit status 130. Returns
+/// the wall time, s.
 pub fn run_filters_with_progress(
     model: &Model,
-    cfg: &MonteCarloConfig,
-    filters: &[FilterKind],
+    study: &mut FilterStudy,
     chunks: std::ops::Range<usize>,
     threads: usize,
     label: &str,
-) -> Result<(Vec<StudySums>, f64), CliError> {
-    let per_filter = cfg.trajectories_in(&chunks) * cfg.noise_runs;
-    let total = per_filter * filters.len();
-    with_progress(total, "runs", label, |cancel, progress| {
-        let mut out = Vec::with_capacity(filters.len());
-        for (k, &filter) in filters.iter().enumerate() {
-            let offset = k * per_filter;
-            out.push(run_filter_chunks_parallel(
-                model,
-                cfg,
-                filter,
-                chunks.clone(),
-                threads,
-                cancel,
-                |done, _| progress(offset + done, total),
-            )?);
-        }
-        Ok(out)
-    })
+) -> Result<f64, CliError> {
+    let cfg = *study.config();
+    let runs = study
+        .filters()
+        .iter()
+        .map(|f| cfg.trajectories_in(&(chunks.start.min(f.chunks)..chunks.end.min(f.chunks))))
+        .sum::<usize>()
+        * cfg.noise_runs;
+    let ((), wall) = with_progress(runs, "runs", label, |cancel, progress| {
+        study.run_range(model, chunks, &mut Parallel::new(threads, cancel), progress)
+    })?;
+    Ok(wall)
 }
 
 /// The Monte Carlo PCRLB alone (truth trajectories only, no EKF) with the same progress bar

@@ -6,7 +6,7 @@
 
 use plotters::coord::Shift;
 use plotters::prelude::*;
-use serde::{Deserialize, Serialize};
+use serde::Serialize;
 
 use scatterloc::chart::{
     curve_chart_size, draw_curves, ChartError, CurveChartOptions, CurveSeries, LineKind, Marker,
@@ -14,25 +14,24 @@ use scatterloc::chart::{
 use scatterloc::mtl::algorithm::{locate, MtlConfig};
 use scatterloc::mtl::empirical::EmpiricalTable;
 use scatterloc::mtl::experiment::{
-    EmpiricalTraining, Experiment, ExperimentConfig, ExperimentResult, Method, Tally,
-    MAX_REALISATIONS,
+    Experiment, ExperimentConfig, ExperimentResult, Method, Tally, MAX_REALISATIONS,
 };
 use scatterloc::mtl::input::{
     from_json, target_reports, ModelSpec, NetworkInput, RangesInput, TargetReport, TrainingSpec,
     DEFAULT_DIAMETER_M, DEFAULT_LAMBDA, DEFAULT_P_D,
 };
 use scatterloc::mtl::sim::table2::{icb_row, table2_buckets, true_row};
-use scatterloc::mtl::sim::{LosModel, NodeLayout, SimSettings, VB_ICB_P_U};
+use scatterloc::mtl::sim::{SimSettings, VB_ICB_P_U};
 use scatterloc::native::run_experiment_range;
 use scatterloc::Error;
 
 use super::io::{emit, read_input};
-use super::merge::{differs, inconsistent, merged_timing, sums_of, Part};
 use super::output::{check_writable, write_figure, write_json_file, Figure, Format};
-use super::shard::{self, ShardDoc, Timing};
+use super::shard;
 use super::study::{cancelled, run_with_bar, threads};
 use crate::cli::{MtlLocateArgs, MtlModel, RocArgs, RocExperiment, Table2Args};
 use crate::CliError;
+use scatterloc::study::{Part, PartFile, RocConfig, RocStudy, ShardDoc, Timing};
 
 mod locate;
 mod roc;

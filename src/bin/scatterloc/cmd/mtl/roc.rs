@@ -19,151 +19,6 @@ fn run_with_progress(
     Ok((res.map_err(|e| core_error(&e, "mtl roc"))?, wall))
 }
 
-/// Every setting of a run (the \[P\] parameters of §7 and §8 included) in the JSON file.
-#[derive(Serialize)]
-struct ConfigDoc {
-    experiment: &'static str,
-    swept: &'static str,
-    sweep: Vec<f64>,
-    realisations: usize,
-    seed: u64,
-    /// `N_u` values (V-A).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    n_u: Option<Vec<usize>>,
-    /// Fixed `T_e` (V-B, V-C).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    t_e: Option<f64>,
-    icb_p_u: f64,
-    ppp_exact: bool,
-    empirical: Option<EmpiricalDoc>,
-    settings: SettingsDoc,
-    algorithm: AlgorithmDoc,
-}
-
-#[derive(Serialize)]
-struct EmpiricalDoc {
-    cells: usize,
-    scenes: usize,
-}
-
-#[derive(Serialize)]
-struct SettingsDoc {
-    region_m: [[f64; 2]; 2],
-    /// `uniform` (`n_tx`, `n_rx`) or `fixed` (`tx`, `rx`).
-    nodes: NodesDoc,
-    /// `discs` or `independent`.
-    los: &'static str,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    p_los: Option<f64>,
-    lambda: f64,
-    diameter_m: f64,
-    range_sigma_m: f64,
-    resolution_m: f64,
-    detection_radius_m: f64,
-    p_d: f64,
-    targets: usize,
-    clutter_mean: f64,
-    r_max_m: f64,
-    geometric_ips: [bool; 2],
-}
-
-#[derive(Serialize)]
-#[serde(tag = "layout", rename_all = "lowercase")]
-enum NodesDoc {
-    Uniform {
-        n_tx: usize,
-        n_rx: usize,
-    },
-    Fixed {
-        tx: Vec<[f64; 2]>,
-        rx: Vec<[f64; 2]>,
-    },
-}
-
-#[derive(Serialize)]
-struct AlgorithmDoc {
-    /// `null` = ∞.
-    b_max: Option<usize>,
-    n_min: usize,
-    order: Option<Vec<usize>>,
-    region_filter: bool,
-    merge_final: bool,
-    merge_shared_pairs: usize,
-    merge_radius_m: Option<f64>,
-    refinement_max_iterations: usize,
-    refinement_step_tol_m: f64,
-    late_seeds: bool,
-    late_seed_catch_up: bool,
-    max_candidates: usize,
-}
-
-fn config_doc(cfg: &ExperimentConfig) -> ConfigDoc {
-    let s = &cfg.settings;
-    let m = &cfg.mtl;
-    let va = cfg.experiment == Experiment::Va;
-    let xy = |v: &scatterloc::Vec2| [v.x, v.y];
-    ConfigDoc {
-        experiment: cfg.experiment.name(),
-        swept: cfg.experiment.swept(),
-        sweep: cfg.sweep.clone(),
-        realisations: cfg.realisations,
-        seed: cfg.seed,
-        n_u: va.then(|| cfg.n_u.clone()),
-        t_e: (!va).then_some(cfg.t_e),
-        icb_p_u: cfg.icb_p_u,
-        ppp_exact: cfg.ppp_exact,
-        empirical: cfg.empirical.map(|e| EmpiricalDoc {
-            cells: e.cells,
-            scenes: e.scenes,
-        }),
-        settings: SettingsDoc {
-            region_m: [xy(&s.region.min), xy(&s.region.max)],
-            nodes: match &s.nodes {
-                NodeLayout::Uniform { n_tx, n_rx } => NodesDoc::Uniform {
-                    n_tx: *n_tx,
-                    n_rx: *n_rx,
-                },
-                NodeLayout::Fixed { tx, rx } => NodesDoc::Fixed {
-                    tx: tx.iter().map(xy).collect(),
-                    rx: rx.iter().map(xy).collect(),
-                },
-            },
-            los: match s.los {
-                LosModel::Discs => "discs",
-                LosModel::Independent { .. } => "independent",
-            },
-            p_los: match s.los {
-                LosModel::Independent { p_los } => Some(p_los),
-                LosModel::Discs => None,
-            },
-            lambda: s.lambda,
-            diameter_m: s.diameter,
-            range_sigma_m: s.range_sigma,
-            resolution_m: s.resolution,
-            detection_radius_m: s.detection_radius,
-            p_d: s.p_d,
-            targets: s.targets,
-            clutter_mean: s.clutter_mean,
-            r_max_m: s.r_max,
-            geometric_ips: [s.geometric_ips.kind1, s.geometric_ips.kind2],
-        },
-        algorithm: AlgorithmDoc {
-            b_max: (m.b_max != usize::MAX).then_some(m.b_max),
-            n_min: m.n_min,
-            order: m.order.clone(),
-            region_filter: m.region.is_some(),
-            merge_final: m.merge_final,
-            merge_shared_pairs: m.merge_shared_pairs,
-            merge_radius_m: m.merge_radius_m.is_finite().then_some(m.merge_radius_m),
-            refinement_max_iterations: m.refinement.max_iterations,
-            refinement_step_tol_m: m.refinement.step_tol_m,
-            late_seeds: m.late_seeds,
-            late_seed_catch_up: m.late_seed_catch_up,
-            max_candidates: m.max_candidates,
-        },
-    }
-}
-
 #[derive(Serialize)]
 struct PointDoc {
     threshold: f64,
@@ -186,7 +41,7 @@ struct CurveDoc {
 /// The `--json` file of `mtl roc`.
 #[derive(Serialize)]
 struct RocDoc {
-    config: ConfigDoc,
+    config: RocConfig,
     realisations: usize,
     targets: u64,
     disagreements: u64,
@@ -329,17 +184,15 @@ struct RocFlags {
 
 /// The validated configuration of `f` (errors name the flags).
 fn roc_config(f: &RocFlags) -> Result<ExperimentConfig, CliError> {
-    let experiment = f.experiment;
-    let mut cfg = ExperimentConfig::new(experiment);
-    let n = f.realisations.unwrap_or(cfg.realisations);
-    if !(1..=MAX_REALISATIONS).contains(&n) {
+    if let Some(n) = f
+        .realisations
+        .filter(|n| !(1..=MAX_REALISATIONS).contains(n))
+    {
         return Err(CliError::usage(format!(
             "--realizations: {n} is outside the allowed range 1..={MAX_REALISATIONS}"
         )));
     }
-    cfg.realisations = n;
-    cfg.seed = f.seed;
-    if experiment == Experiment::Va {
+    if f.experiment == Experiment::Va {
         let only = [("empirical", f.empirical), ("exact", f.exact)];
         if let Some((flag, _)) = only.iter().find(|(_, given)| *given) {
             return Err(CliError::usage(format!(
@@ -347,15 +200,15 @@ fn roc_config(f: &RocFlags) -> Result<ExperimentConfig, CliError> {
             )));
         }
     }
-    cfg.ppp_exact = f.exact;
-    if let Some(n) = f.max_candidates {
-        cfg.mtl.max_candidates = n;
-    }
-    if f.empirical {
-        cfg.empirical = Some(EmpiricalTraining::default());
-    }
-    cfg.validate().map_err(|e| core_error(&e, "mtl roc"))?;
-    Ok(cfg)
+    RocStudy::config(
+        f.experiment,
+        f.realisations,
+        f.seed,
+        f.exact,
+        f.empirical,
+        f.max_candidates,
+    )
+    .map_err(|e| core_error(&e, "mtl roc"))
 }
 
 /// A figure to write: its path and format.
@@ -421,15 +274,9 @@ pub fn mtl_roc(args: &RocArgs) -> Result<(), CliError> {
         let counted = Counted {
             realisations: tally.realisations(),
         };
-        return shard::write_part(
-            &path,
-            "mtl-roc",
-            &config_doc(&cfg),
-            &doc,
-            &timing,
-            &tally,
-            &counted,
-        );
+        let config = RocConfig::of(&cfg);
+        let part = PartFile::new("mtl-roc", &config, &doc, &timing, &tally);
+        return shard::write_part(&path, &part, &counted);
     }
     let (figure, json) = result_outputs(args.out.as_deref(), args.json.as_deref())?;
     let label = format!("experiment {}", experiment.name());
@@ -437,77 +284,13 @@ pub fn mtl_roc(args: &RocArgs) -> Result<(), CliError> {
     write_result(&cfg, &tally.finish(&cfg), wall, used, json, figure)
 }
 
-/// What a part's `config` says about the flags (the rest is checked against
-/// [`config_doc`]).
-#[derive(Deserialize)]
-struct RocKey {
-    experiment: String,
-    realisations: usize,
-    seed: u64,
-    ppp_exact: bool,
-    empirical: Option<serde::de::IgnoredAny>,
-    algorithm: AlgorithmKey,
-}
-
-#[derive(Deserialize)]
-struct AlgorithmKey {
-    max_candidates: usize,
-}
-
 /// `scatterloc merge` of `mtl roc` parts (checked as a set by `merge`): the tallies of every
-/// shard added exactly, then the outputs of the unsharded run.
+/// shard added exactly ([`RocStudy::merge`]), then the outputs of the unsharded run.
 pub fn merge_roc(parts: &[Part], json: &str, out: Option<&str>) -> Result<(), CliError> {
-    let first = &parts[0];
-    let bad = |what: String| inconsistent(&first.path, what);
-    let key = RocKey::deserialize(&first.config).map_err(|e| bad(format!("config: {e}")))?;
-    let experiment = Experiment::parse(&key.experiment)
-        .ok_or_else(|| bad(format!("config.experiment: {:?}", key.experiment)))?;
-    let cfg = roc_config(&RocFlags {
-        experiment,
-        realisations: Some(key.realisations),
-        seed: key.seed,
-        exact: key.ppp_exact,
-        empirical: key.empirical.is_some(),
-        max_candidates: Some(key.algorithm.max_candidates),
-    })
-    .map_err(|e| bad(format!("config: {}", e.message)))?;
-    let again = serde_json::to_value(config_doc(&cfg))
-        .map_err(|e| CliError::output(format!("encoding JSON: {e}")))?;
-    if let Some(d) = differs(&again, &first.config) {
-        return Err(bad(format!(
-            "config is not as this scatterloc writes it ({d})"
-        )));
-    }
-    if first.shard.total != cfg.realisations {
-        return Err(bad(format!(
-            "shard.total {} is not the study's {} realisations",
-            first.shard.total, cfg.realisations
-        )));
-    }
+    let (cfg, r, wall, threads) =
+        RocStudy::merge(parts).map_err(|e| CliError::usage(e.to_string()))?;
     let (figure, json) = result_outputs(out, Some(json))?;
-    let (curves, points) = (cfg.curves().len(), cfg.sweep.len());
-    let mut merged = Tally::new(curves, points);
-    for part in parts {
-        let tally: Tally = sums_of(part)?;
-        let len = part.shard.range[1] - part.shard.range[0];
-        if !tally.has_shape(curves, points) || tally.realisations() != len {
-            return Err(inconsistent(
-                &part.path,
-                format!("sums are not {len} realisations of {curves} curves × {points} thresholds"),
-            ));
-        }
-        merged.merge(&tally);
-    }
-    let (timing, _) = merged_timing(parts, 1)?;
-    let r = merged.finish(&cfg);
-    write_result(
-        &cfg,
-        &r,
-        timing.wall_time_s[0],
-        timing.threads,
-        json,
-        figure,
-    )
+    write_result(&cfg, &r, wall, threads, json, figure)
 }
 
 /// Writes the outputs of a result: the JSON file, the figure and the summary table on stdout.
@@ -522,7 +305,7 @@ fn write_result(
     let experiment = cfg.experiment;
     if let Some(p) = json {
         let doc = RocDoc {
-            config: config_doc(cfg),
+            config: RocConfig::of(cfg),
             realisations: r.realisations,
             targets: r.targets,
             disagreements: r.disagreements,

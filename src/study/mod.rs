@@ -1,0 +1,32 @@
+//! Use cases: the studies every front end runs the same way — the native CLI (whole or one
+//! shard of a cluster run), its `merge`, the page's workers and library users (a Python
+//! binding). A study takes its configuration, runs its units through a [`Driver`] (the core's
+//! [`Sequential`], or `crate::native::Parallel` on threads), and returns sums that add exactly
+//! ([`crate::math::ExactSum`]), so a result depends on its seed only. The part file of a
+//! sharded run and the checks of a set of them ([`PartSet`]) live here too, returning core
+//! [`crate::Error`]s.
+//!
+//! - [`MonteCarloStudy`]: the tracker(s) against the posterior CRLB (spec §8, §9.5), over any
+//!   list of filters ([`FilterStudy`]: lead filter, particle budget), its part-file
+//!   configuration [`McConfig`] and result documents [`CurveDoc`].
+//! - [`RocStudy`]: the multi-target method's ROC experiments (§8 of `multi-target.md`), its
+//!   record [`RocConfig`].
+//! - [`PartSet`], [`PartFile`]: the part file format (`scatterloc-part`, version 1).
+
+mod drive;
+mod filters;
+mod montecarlo;
+mod part;
+mod roc;
+
+pub use drive::{Driver, Sequential};
+pub use filters::{particle_chunks, FilterResults, FilterRun, FilterStudy};
+pub use montecarlo::{
+    curve_label, CurveDoc, FilterCurves, FilterDoc, FiltersConfig, McConfig, McMeta,
+    MonteCarloStudy, RunTime, TrackStudy,
+};
+pub use part::{
+    differs, inconsistent, merged_timing, software, Part, PartFile, PartSet, ShardDoc, Timing,
+    PART_FORMAT, PART_VERSION,
+};
+pub use roc::{RocConfig, RocStudy};
