@@ -209,6 +209,34 @@ pub enum Error {
     },
 }
 
+impl Error {
+    /// The input field the error names, when it names one (`runs`, `receivers[2].position_m`,
+    /// `filters[1]`, …): what a front end maps to its own flag or form control. `Display` starts
+    /// with it for every variant that has one.
+    pub fn field(&self) -> Option<&str> {
+        match self {
+            Error::NonFinite { field }
+            | Error::NotPositive { field, .. }
+            | Error::OutOfRange { field, .. }
+            | Error::UnknownNode { field, .. }
+            | Error::NotPositiveDefinite { field }
+            | Error::WorkLimit { field, .. }
+            | Error::UnknownTrajectory { field, .. }
+            | Error::Degenerate { field }
+            | Error::Infeasible { field, .. }
+            | Error::UnknownPattern { field, .. }
+            | Error::UnknownFilter { field, .. } => Some(field),
+            Error::EmptyNodeList { field }
+            | Error::InvertedArea { field, .. }
+            | Error::LengthMismatch { field, .. }
+            | Error::SizeLimit { field, .. }
+            | Error::IndexOutOfRange { field, .. }
+            | Error::LastNode { field } => Some(field),
+            _ => None,
+        }
+    }
+}
+
 impl fmt::Display for Error {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {

@@ -30,3 +30,6 @@ pub use part::{
     PART_FORMAT, PART_VERSION,
 };
 pub use roc::{RocConfig, RocStudy};
+
+#[cfg(test)]
+mod tests;

@@ -4,27 +4,13 @@
 
 use scatterloc::track::{FilterKind, PfConfig, UkfParams};
 
+use super::flags::with_flag;
 use crate::cli::{FilterName, FilterSettings};
 use crate::CliError;
 
-/// The core's field names of the filter settings and their flags.
-const FLAGS: [(&str, &str); 5] = [
-    ("ukf_alpha", "--ukf-alpha"),
-    ("ukf_beta", "--ukf-beta"),
-    ("ukf_kappa", "--ukf-kappa"),
-    ("particles", "--particles"),
-    ("roughening", "--roughening"),
-];
-
 /// A core error of the filter settings with the flag in place of the field.
 fn settings_error(e: scatterloc::Error) -> CliError {
-    let text = e.to_string();
-    for (field, flag) in FLAGS {
-        if text.starts_with(field) {
-            return CliError::usage(text.replacen(field, flag, 1));
-        }
-    }
-    CliError::usage(text)
+    CliError::usage(with_flag(&e).unwrap_or_else(|| e.to_string()))
 }
 
 /// The trackers `names` with `settings` (`flag` names the filter flag in messages). A UKF

@@ -8,6 +8,7 @@
 
 mod crlb_map;
 mod filters;
+mod flags;
 mod gating;
 mod io;
 mod merge;

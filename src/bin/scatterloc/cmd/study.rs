@@ -18,6 +18,7 @@ use scatterloc::track::{
 use scatterloc::track::{MonteCarloConfig, MAX_STEPS};
 use scatterloc::{scenario::presets, Error, Model, Scenario};
 
+use super::flags::with_flag;
 use super::io::read_scenario;
 use crate::cli::{StudyArgs, Trajectory};
 use crate::CliError;
@@ -30,32 +31,13 @@ const MAX_THREADS: usize = 256;
 /// Set by Ctrl-C; the Monte Carlo driver stops after its current wave.
 static CANCEL: AtomicBool = AtomicBool::new(false);
 
-/// Maps a core error to the flag that caused it.
+/// A core error as a usage error (exit status 2) naming the flag that caused it
+/// ([`super::flags::with_flag`]); Ctrl-C is [`cancelled`].
 pub fn flag_error(e: Error) -> CliError {
-    let flag = |field: &str| {
-        match field {
-            "runs" => "--runs",
-            "noise_runs" => "--noise-runs",
-            "runs*noise_runs" => "--runs × --noise-runs",
-            "steps" => "--duration / --dt (steps)",
-            "dt_s" => "--dt",
-            "process_noise" => "--process-noise",
-            "threads" => "--threads",
-            other => other,
-        }
-        .to_string()
-    };
-    let text = match &e {
-        Error::SizeLimit { field, .. } => e.to_string().replacen(field, &flag(field), 1),
-        Error::NonFinite { field }
-        | Error::NotPositive { field, .. }
-        | Error::OutOfRange { field, .. } => {
-            e.to_string().replacen(field.as_str(), &flag(field), 1)
-        }
-        Error::Cancelled => return cancelled(),
-        _ => e.to_string(),
-    };
-    CliError::usage(text)
+    if matches!(e, Error::Cancelled) {
+        return cancelled();
+    }
+    CliError::usage(with_flag(&e).unwrap_or_else(|| e.to_string()))
 }
 
 /// The Ctrl-C outcome: exit status 130, nothing written.

@@ -25,6 +25,7 @@ use scatterloc::mtl::sim::{SimSettings, VB_ICB_P_U};
 use scatterloc::native::run_experiment_range;
 use scatterloc::Error;
 
+use super::flags::with_flag;
 use super::io::{emit, read_input};
 use super::output::{check_writable, write_figure, write_json_file, Figure, Format};
 use super::shard;
@@ -41,46 +42,15 @@ pub use locate::mtl_locate;
 pub use roc::{merge_roc, mtl_roc};
 pub use table2::mtl_table2;
 
-/// The flag that sets a core field, for messages.
-fn flag_of(field: &str) -> Option<&'static str> {
-    Some(match field {
-        "t_e" => "--te",
-        "t_b" => "--tb",
-        "b_max" => "--b-max",
-        "n_min" => "--n-min",
-        "max_candidates" => "--max-candidates",
-        "order" => "--order",
-        "p_u" => "--p-u",
-        "p_d" => "--p-d",
-        "p_los" => "--p-los",
-        "lambda" => "--lambda",
-        "diameter" => "--diameter",
-        "scenes" => "--scenes",
-        "nx" | "ny" | "nx*ny*patterns" => "--cells",
-        "realisations" => "--realizations",
-        "threads" => "--threads",
-        "draws" => "--draws",
-        _ => return None,
-    })
-}
-
 /// A core error as a CLI error: the field replaced by its flag when a flag sets it, else
 /// prefixed with `context` (the file it came from).
 fn core_error(e: &Error, context: &str) -> CliError {
     if matches!(e, Error::Cancelled) {
         return cancelled();
     }
-    let text = e.to_string();
-    let field = match e {
-        Error::SizeLimit { field, .. } | Error::LengthMismatch { field, .. } => field.to_string(),
-        Error::NonFinite { field }
-        | Error::NotPositive { field, .. }
-        | Error::OutOfRange { field, .. } => field.clone(),
-        _ => String::new(),
-    };
-    match flag_of(&field) {
-        Some(flag) => CliError::usage(text.replacen(&field, flag, 1)),
-        None => CliError::usage(format!("{context}: {text}")),
+    match with_flag(e) {
+        Some(text) => CliError::usage(text),
+        None => CliError::usage(format!("{context}: {e}")),
     }
 }
 

@@ -1,0 +1,60 @@
+//! The one map from the core's field names to the CLI's flags: a core error that names a field
+//! a flag sets ([`scatterloc::Error::field`]) is reported with the flag in its place, so every
+//! command's messages name what the user typed.
+
+use scatterloc::Error;
+
+/// Core field → flag.
+const FLAGS: [(&str, &str); 32] = [
+    // Tracking studies (`montecarlo`, `pcrlb`, `track`).
+    ("runs", "--runs"),
+    ("noise_runs", "--noise-runs"),
+    ("runs*noise_runs", "--runs × --noise-runs"),
+    ("steps", "--duration / --dt (steps)"),
+    ("dt_s", "--dt"),
+    ("process_noise", "--process-noise"),
+    ("threads", "--threads"),
+    // The trackers' settings.
+    ("ukf_alpha", "--ukf-alpha"),
+    ("ukf_beta", "--ukf-beta"),
+    ("ukf_kappa", "--ukf-kappa"),
+    ("particles", "--particles"),
+    ("roughening", "--roughening"),
+    // The multi-target method (`mtl`).
+    ("t_e", "--te"),
+    ("t_b", "--tb"),
+    ("b_max", "--b-max"),
+    ("n_min", "--n-min"),
+    ("max_candidates", "--max-candidates"),
+    ("order", "--order"),
+    ("p_u", "--p-u"),
+    ("p_d", "--p-d"),
+    ("p_los", "--p-los"),
+    ("lambda", "--lambda"),
+    ("diameter", "--diameter"),
+    ("scenes", "--scenes"),
+    ("nx", "--cells"),
+    ("ny", "--cells"),
+    ("nx*ny*patterns", "--cells"),
+    ("realisations", "--realizations"),
+    ("draws", "--draws"),
+    ("empirical", "--empirical"),
+    ("exact", "--exact"),
+    ("filters", "--filters"),
+];
+
+/// The flag that sets core field `field`.
+pub fn flag_of(field: &str) -> Option<&'static str> {
+    FLAGS
+        .iter()
+        .find(|(f, _)| *f == field)
+        .map(|(_, flag)| *flag)
+}
+
+/// `e`'s message with its field replaced by the flag that sets it (`None`: `e` names no field
+/// a flag sets).
+pub fn with_flag(e: &Error) -> Option<String> {
+    let field = e.field()?;
+    let flag = flag_of(field)?;
+    Some(e.to_string().replacen(field, flag, 1))
+}

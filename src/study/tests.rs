@@ -1,0 +1,291 @@
+//! The use cases against their own contract: any driver, any order of work items and any
+//! split into shards give the same sums bit for bit (the sums are exact); the lead and widest
+//! rules; the particle budget's closed form; the part set's named errors.
+
+use alloc::format;
+use alloc::string::{String, ToString};
+use alloc::vec;
+use alloc::vec::Vec;
+
+use super::*;
+use crate::math::Shard;
+use crate::measure::Model;
+use crate::scenario::presets;
+use crate::track::{
+    paper_initial_covariance, ConstantVelocity, FilterKind, MonteCarloConfig, PfConfig,
+    TrackScenario, UkfParams,
+};
+
+fn model() -> Model {
+    Model::new(&presets::preset("sensors2019").unwrap()).unwrap()
+}
+
+fn config(trajectories: usize, noise_runs: usize, steps: usize, seed: u64) -> MonteCarloConfig {
+    MonteCarloConfig {
+        motion: ConstantVelocity::validated(0.1, 1.0).unwrap(),
+        steps,
+        mean_state: TrackScenario::II.mean_state(),
+        initial_covariance: paper_initial_covariance(),
+        trajectories,
+        noise_runs,
+        seed,
+        oracle_noise: false,
+    }
+}
+
+const PF: FilterKind = FilterKind::Pf(PfConfig {
+    particles: 40,
+    roughening: None,
+});
+
+#[test]
+fn work_items_ranges_and_shards_give_the_same_sums() {
+    let m = model();
+    for seed in [1, 2, 3] {
+        let cfg = config(40, 2, 6, seed);
+        let kinds = [FilterKind::Ukf(UkfParams::default()), FilterKind::Ekf, PF];
+        // Page order: chunk by chunk, the filters interleaved, two items per call.
+        let mut items = FilterStudy::new(cfg, &kinds).unwrap();
+        while !items.run_items(&m, 2).unwrap() {}
+        // CLI order: filter by filter, the whole range.
+        let mut whole = FilterStudy::new(cfg, &kinds).unwrap();
+        whole
+            .run_range(
+                &m,
+                0..cfg.chunk_count(),
+                &mut Sequential::new(),
+                &mut |_, _| {},
+            )
+            .unwrap();
+        assert_eq!(items.sums(), whole.sums());
+        // Three shards merged.
+        let mut merged = FilterStudy::new(cfg, &kinds).unwrap();
+        for i in 0..3 {
+            let r = Shard::new(i, 3).unwrap().range(cfg.chunk_count());
+            let mut part = FilterStudy::new(cfg, &kinds).unwrap();
+            part.run_range(&m, r.clone(), &mut Sequential::new(), &mut |_, _| {})
+                .unwrap();
+            for (f, s) in part.sums().iter().enumerate() {
+                merged.add_sums(f, s, r.len());
+            }
+        }
+        assert_eq!(merged.sums(), whole.sums());
+        assert_eq!(merged.results().unwrap(), whole.results().unwrap());
+        // The EKF of the list is the EKF study alone.
+        let mut ekf = FilterStudy::new(cfg, &[FilterKind::Ekf]).unwrap();
+        ekf.run_items(&m, usize::MAX).unwrap();
+        assert_eq!(ekf.sums()[0], whole.sums()[1]);
+    }
+}
+
+#[cfg(all(feature = "std", not(target_arch = "wasm32")))]
+#[test]
+fn parallel_driver_equals_sequential() {
+    use core::sync::atomic::AtomicBool;
+    let m = model();
+    let cfg = config(70, 2, 5, 9);
+    let kinds = [FilterKind::Ekf, FilterKind::Ukf(UkfParams::default())];
+    let cancel = AtomicBool::new(false);
+    let mut seq = FilterStudy::new(cfg, &kinds).unwrap();
+    seq.run_range(&m, 1..5, &mut Sequential::new(), &mut |_, _| {})
+        .unwrap();
+    for threads in [1, 2, 3] {
+        let mut par = FilterStudy::new(cfg, &kinds).unwrap();
+        let mut last = (0, 0);
+        par.run_range(
+            &m,
+            1..5,
+            &mut crate::native::Parallel::new(threads, &cancel),
+            &mut |d, t| last = (d, t),
+        )
+        .unwrap();
+        assert_eq!(par.sums(), seq.sums());
+        // Progress ends at every run of both filters: chunks 1..5 are trajectories 16..70,
+        // 2 filters × 54 trajectories × 2 noise runs.
+        assert_eq!(last, (216, 216));
+    }
+}
+
+#[test]
+fn lead_is_the_ekf_else_the_first_and_the_bound_comes_from_the_widest() {
+    let m = model();
+    let cfg = config(48, 1, 4, 5);
+    let ukf = FilterKind::Ukf(UkfParams::default());
+    let lead = |kinds: &[FilterKind]| {
+        let mut s = FilterStudy::new(cfg, kinds).unwrap();
+        s.run_items(&m, usize::MAX).unwrap();
+        let r = s.results().unwrap();
+        (kinds[r.curves[r.lead].0].name(), r)
+    };
+    assert_eq!(lead(&[ukf, FilterKind::Ekf]).0, "ekf");
+    assert_eq!(lead(&[ukf, PF]).0, "ukf");
+    // The particle filter held to one chunk of three: it leads alone, the widest is the UKF,
+    // whose bound (48 trajectories) the top-level curves carry.
+    let budget = 16 * 4 * 40; // one chunk's runs × steps × particles
+    let mut s = FilterStudy::with_particle_budget(cfg, &[PF, ukf], budget).unwrap();
+    assert_eq!(s.filters()[0].chunks, 1);
+    assert_eq!(s.filters()[0].runs_planned(&cfg), 16);
+    assert_eq!(s.item_count(), 4);
+    s.run_items(&m, usize::MAX).unwrap();
+    let r = s.results().unwrap();
+    assert_eq!((r.lead, r.widest), (0, 1));
+    let top = r.top();
+    assert_eq!(top.rmse_ekf_m, r.curves[0].1.rmse_ekf_m);
+    assert_eq!(top.rmse_pcrlb_m, r.curves[1].1.rmse_pcrlb_m);
+    assert_ne!(r.curves[0].1.rmse_pcrlb_m, r.curves[1].1.rmse_pcrlb_m);
+}
+
+#[test]
+fn particle_chunks_is_the_whole_chunks_that_fit() {
+    // 100 trajectories = 7 chunks; a chunk is 16 × 2 runs of 10 steps × 100 particles.
+    let cfg = config(100, 2, 10, 1);
+    let chunk = 16 * 2 * 10 * 100;
+    for (budget, want) in [
+        (0, 1),
+        (chunk - 1, 1),
+        (chunk, 1),
+        (3 * chunk, 3),
+        (3 * chunk + chunk / 2, 3),
+        (7 * chunk, 7),
+        (usize::MAX, 7),
+    ] {
+        assert_eq!(particle_chunks(&cfg, 100, budget), want, "budget {budget}");
+    }
+}
+
+#[test]
+fn bad_filter_lists_are_named_errors() {
+    let cfg = config(16, 1, 3, 1);
+    let e = FilterStudy::new(cfg, &[]).unwrap_err();
+    assert_eq!(e.field(), Some("filters"));
+    let e = FilterStudy::new(cfg, &[FilterKind::Ekf, FilterKind::Ekf]).unwrap_err();
+    assert_eq!(e.field(), Some("filters[1]"));
+    let bad_pf = FilterKind::Pf(PfConfig {
+        particles: 0,
+        roughening: None,
+    });
+    assert_eq!(
+        FilterStudy::new(cfg, &[bad_pf]).unwrap_err().field(),
+        Some("particles")
+    );
+    let mut s = FilterStudy::new(cfg, &[FilterKind::Ekf]).unwrap();
+    let e = s
+        .run_range(&model(), 0..2, &mut Sequential::new(), &mut |_, _| {})
+        .unwrap_err();
+    assert_eq!(e.field(), Some("chunks"));
+    assert_eq!(s.results().unwrap_err().field(), Some("runs (successful)"));
+}
+
+/// `n` part files of a study of `total` units, as `(path, text)`.
+fn parts(n: usize, total: usize, seed: u64) -> Vec<(String, String)> {
+    (0..n)
+        .map(|i| {
+            let shard = ShardDoc::new(Shard::new(i, n).unwrap(), "chunks", total);
+            let timing = Timing {
+                threads: 2,
+                wall_time_s: vec![1.0 + i as f64],
+            };
+            let config = serde_json::json!({ "seed": seed });
+            let text =
+                serde_json::to_string(&PartFile::new("montecarlo", &config, &shard, &timing, &[i]))
+                    .unwrap();
+            (format!("p{i}.json"), text)
+        })
+        .collect()
+}
+
+#[test]
+fn part_sets_are_checked_as_one_study() {
+    let good = parts(3, 10, 1);
+    let mut shuffled = good.clone();
+    shuffled.reverse();
+    let set = PartSet::check(&shuffled).unwrap();
+    let ranges: Vec<[usize; 2]> = set.parts.iter().map(|p| p.shard.range).collect();
+    assert_eq!(ranges, [[0, 3], [3, 6], [6, 10]]);
+    let (timing, thread_s) = merged_timing(&set.parts, 1).unwrap();
+    assert_eq!(
+        (timing.threads, timing.wall_time_s[0], thread_s[0]),
+        (2, 6.0, 12.0)
+    );
+    assert!(merged_timing(&set.parts, 2).is_err());
+
+    let msg = |files: &[(String, String)]| PartSet::check(files).unwrap_err().to_string();
+    // Missing and duplicate shards.
+    assert_eq!(
+        msg(&good[..2]),
+        "merge: missing parts: shard 2 of 3 (2 of 3 given)"
+    );
+    let mut dup = good.clone();
+    dup.push(("again.json".into(), good[1].1.clone()));
+    assert_eq!(
+        msg(&dup),
+        "merge: duplicate parts (shards of 3): shard 1 in p1.json, again.json"
+    );
+    // A foreign part (another seed) and another shard count.
+    let mut foreign = good.clone();
+    foreign[2] = parts(3, 10, 2).swap_remove(2);
+    assert!(msg(&foreign).starts_with("merge: foreign parts, not of the study of p0.json"));
+    let mut counts = good[..2].to_vec();
+    counts.push(parts(2, 10, 1).swap_remove(1));
+    counts[2].0 = "two.json".into();
+    assert!(msg(&counts).starts_with("merge: the parts disagree on the shard count: 2 shards: two.json; 3 shards: p0.json, p1.json"));
+    // Not part files: another format, another version, not JSON.
+    let other = good[0].1.replace("scatterloc-part", "other");
+    let newer = good[0].1.replace("\"version\":1", "\"version\":2");
+    let bad = [
+        ("a".to_string(), other),
+        ("b".to_string(), newer),
+        ("c".to_string(), "{".to_string()),
+    ];
+    let m = msg(&bad);
+    assert!(m.starts_with("merge: not scatterloc part files (format \"scatterloc-part\", version 1): a (format \"other\""), "{m}");
+    assert!(
+        m.contains("b (version 2, this scatterloc reads version 1)"),
+        "{m}"
+    );
+    assert!(m.contains("c (invalid JSON"), "{m}");
+    // A part whose range is not its index's.
+    let mut wrong = good.clone();
+    wrong[1].1 = wrong[1].1.replace("\"range\":[3,6]", "\"range\":[3,7]");
+    assert!(matches!(
+        PartSet::check(&wrong).unwrap_err(),
+        crate::Error::InconsistentPart { ref path, .. } if path == "p1.json"
+    ));
+    assert_eq!(msg(&[]), "merge: no part files given");
+}
+
+#[test]
+fn monte_carlo_config_rebuilds_the_study_and_refuses_an_edited_one() {
+    let track = TrackStudy::new(
+        "sensors2019".into(),
+        presets::preset("sensors2019").unwrap(),
+        vec![TrackScenario::I, TrackScenario::III],
+        ConstantVelocity::validated(0.1, 1.0).unwrap(),
+        5,
+    )
+    .unwrap();
+    let kinds = [FilterKind::Ekf, PF];
+    let study = MonteCarloStudy::new(track, 20, 2, 11, false, &kinds).unwrap();
+    let doc = serde_json::to_value(study.config_doc().unwrap()).unwrap();
+    assert_eq!(doc["filters"]["names"], serde_json::json!(["ekf", "pf"]));
+    assert_eq!(doc["filters"]["particles"], 40);
+    let again = MonteCarloStudy::from_config(&doc).unwrap();
+    assert_eq!(again.configs, study.configs);
+    assert_eq!(again.filters, study.filters);
+    let mut edited = doc.clone();
+    edited["noise_runs"] = serde_json::json!(3);
+    let ok = MonteCarloStudy::from_config(&edited).unwrap();
+    assert_eq!(ok.noise_runs, 3);
+    edited["filters"]["ukf"] = serde_json::json!([1.0, 2.0, 0.0]);
+    let e = MonteCarloStudy::from_config(&edited)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("config is not as this scatterloc writes it (filters.ukf"),
+        "{e}"
+    );
+    // The EKF alone records no filters.
+    let ekf =
+        MonteCarloStudy::new(study.track.clone(), 20, 2, 11, false, &[FilterKind::Ekf]).unwrap();
+    assert!(ekf.config_doc().unwrap().filters.is_none());
+}
