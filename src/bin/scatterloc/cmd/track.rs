@@ -3,8 +3,9 @@
 //! predict only), `R` fixed from `sigma_s` or from the link budget (E8) at the predicted position.
 //! With `raw_steps` (every link's full list of `[delay, amplitude]` estimates) each step is first
 //! gated against `--calibration` (E4) and associated (spec §4) before the update.
-//! `--filter ukf|pf` runs the UKF or the particle filter instead (plain form only: gating and
-//! association use the EKF's predicted delays and innovation σ).
+//! `--filter ukf|pf` runs the UKF or the particle filter instead, in either form: gating and
+//! association then use that filter's predicted delays and innovation σ (its sigma points, its
+//! weighted particles).
 
 use serde::{Deserialize, Serialize};
 
@@ -16,7 +17,7 @@ use scatterloc::track::gating::{start_from_snapshot, GatedTracker, START_SPEED_S
 use scatterloc::track::gating::{AssociationRule, Choice, DelayEstimate};
 use scatterloc::track::ConstantVelocity;
 use scatterloc::track::MAX_STEPS;
-use scatterloc::track::{Ekf, MeasurementNoise, Tracker, UpdateSummary};
+use scatterloc::track::{Ekf, Filter, MeasurementNoise, Tracker, UpdateSummary};
 use scatterloc::{Error, Model};
 
 use super::filters::filter_kinds;
@@ -151,12 +152,6 @@ pub fn track(args: &TrackArgs) -> Result<(), CliError> {
         // No calibration: nothing is static (every estimate is a candidate).
         links: vec![Default::default(); n],
     });
-    if name != FilterName::Ekf && m.raw_steps.is_some() {
-        return Err(CliError::usage(format!(
-            "--filter {}: the plain form (steps) only; raw_steps gating needs the EKF",
-            name.name()
-        )));
-    }
     let (ekf, start) = initial_filter(&m, &model, &cal, &scenario.area_m, &bad)?;
     let len = match (&m.steps, &m.raw_steps) {
         (Some(s), None) => s.len(),
@@ -184,18 +179,16 @@ pub fn track(args: &TrackArgs) -> Result<(), CliError> {
         static_removed: None,
         start,
     };
+    // The particle filter draws its particles from stream 0 of `--seed`.
+    let own = rng(args.seed.unwrap_or(1), 0);
+    let filter = Tracker::new(kind, ekf.state, ekf.covariance, own).map_err(|e| bad(&e))?;
     match (m.steps, m.raw_steps) {
-        (Some(steps), _) => {
-            // The particle filter draws its particles from stream 0 of `--seed`.
-            let own = rng(args.seed.unwrap_or(1), 0);
-            let filter = Tracker::new(kind, ekf.state, ekf.covariance, own).map_err(|e| bad(&e))?;
-            plain(
-                &model, filter, &motion, noise, &steps, m.dt_s, &mut out, &bad,
-            )?
-        }
+        (Some(steps), _) => plain(
+            &model, filter, &motion, noise, &steps, m.dt_s, &mut out, &bad,
+        )?,
         (_, Some(raw)) => {
-            let tracker =
-                GatedTracker::new(ekf, &model, &cal, motion, noise, rule).map_err(|e| bad(&e))?;
+            let tracker = GatedTracker::new(filter, &model, &cal, motion, noise, rule)
+                .map_err(|e| bad(&e))?;
             gated(tracker, n, &raw, m.dt_s, &mut out, &bad)?
         }
         (None, None) => unreachable!("checked above"),
@@ -316,7 +309,7 @@ fn plain(
 /// The raw form: every step (one list per each of `links` links) gated and associated by
 /// `tracker`, with what it chose.
 fn gated(
-    mut tracker: GatedTracker,
+    mut tracker: GatedTracker<Tracker>,
     links: usize,
     raw: &[RawStep],
     dt_s: f64,
@@ -330,8 +323,8 @@ fn gated(
         let s = tracker
             .step(&estimates(step))
             .map_err(|e| step_error(&field, e, bad))?;
-        let ekf = &tracker.ekf;
-        record(out, &ekf.state, &ekf.covariance, k, dt_s, &s.summary);
+        let f = &tracker.filter;
+        record(out, f.state(), f.covariance(), k, dt_s, &s.summary);
         choices.push(names(&s.selection.choices));
         used.push(s.selection.delays);
         removed.push(s.selection.static_removed);
