@@ -15,3 +15,6 @@ mod truth;
 pub use calibration::{CalibrationResult, CalibrationSnapshots};
 pub use measurements::{one_list_per_link, Measurements, RawStep, Sigma, Start, Steps};
 pub use truth::Truth;
+
+#[cfg(test)]
+mod tests;
