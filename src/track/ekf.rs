@@ -34,7 +34,7 @@ use crate::error::{check_len, limits, Error, Result};
 use crate::math::{sqrt, Mat4, Real, Vec2, Vec4, SPEED_OF_LIGHT};
 use crate::measure::Model;
 use crate::track::shared::{
-    check_covariance, check_state, check_update, link_sigmas, spd_quadratic_form,
+    check_covariance, check_state, check_update, link_sigmas, predict_gaussian, spd_quadratic_form,
 };
 use crate::track::{ConstantVelocity, Filter, MeasurementNoise, PredictedDelay, UpdateSummary};
 
@@ -81,8 +81,7 @@ impl Ekf {
     /// Predict: `x̂⁻ = A x̂`, `P⁻ = A P Aᵀ + Q` (S16, E7).
     #[inline]
     pub fn predict(&mut self, motion: &ConstantVelocity) {
-        self.state = motion.propagate(&self.state);
-        self.covariance = motion.propagate_covariance(&self.covariance);
+        predict_gaussian(&mut self.state, &mut self.covariance, motion);
     }
 
     /// Update with delays `z` (s, one per link in scenario link order, `None` = missing; no link

@@ -13,6 +13,7 @@ use nalgebra::Cholesky;
 use crate::error::{check_len, limits, Error, Result};
 use crate::math::{Mat4, Real, Vec2, Vec4, PI, SPEED_OF_LIGHT};
 use crate::measure::Model;
+use crate::track::ConstantVelocity;
 
 mod geometry;
 mod nees;
@@ -189,6 +190,14 @@ pub(crate) fn link_sigmas(
             }
         })
         .collect()
+}
+
+/// The Gaussian filters' predict (the EKF's S16 and the UKF's exact unscented transform of the
+/// linear CV model): `x̂⁻ = A x̂`, `P⁻ = A P Aᵀ + Q` (E7).
+#[inline(always)]
+pub(crate) fn predict_gaussian(state: &mut Vec4, covariance: &mut Mat4, motion: &ConstantVelocity) {
+    *state = motion.propagate(state);
+    *covariance = motion.propagate_covariance(covariance);
 }
 
 /// Runs `op` on `filter`; on error `filter` is put back as it was (the rollback of a step).

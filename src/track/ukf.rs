@@ -42,7 +42,7 @@ use crate::math::{sqrt, Mat4, Real, Vec2, Vec4, SPEED_OF_LIGHT};
 use crate::measure::Model;
 use crate::track::ekf::link_information;
 use crate::track::shared::{
-    check_covariance, check_state, check_update, first_input_error, link_sigmas,
+    check_covariance, check_state, check_update, first_input_error, link_sigmas, predict_gaussian,
     spd_quadratic_form, Ldl4, NO_UPDATE,
 };
 use crate::track::{ConstantVelocity, Filter, MeasurementNoise, PredictedDelay, UpdateSummary};
@@ -144,8 +144,7 @@ impl Ukf {
 
     /// Predict: the unscented transform of the linear CV model, `A x̂`, `A P Aᵀ + Q` (E7).
     pub fn predict(&mut self, motion: &ConstantVelocity) {
-        self.state = motion.propagate(&self.state);
-        self.covariance = motion.propagate_covariance(&self.covariance);
+        predict_gaussian(&mut self.state, &mut self.covariance, motion);
     }
 
     /// Update with delays `z` (s, one per link, `None` = missing) by the unscented transform of
