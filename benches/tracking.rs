@@ -328,7 +328,7 @@ fn gated_step(c: &mut Criterion) {
             for s in &snaps {
                 black_box(t.step(black_box(s)).unwrap());
             }
-            t.ekf
+            t.filter
         })
     });
     let preds = ekf.predicted_delays(&model, noise).unwrap();

@@ -20,6 +20,8 @@
 //!   the Monte Carlo study (§8, §9.5).
 //! - [`track::gating`], a stage of tracking: calibration, 3σ gating (E4), association (§4), the
 //!   gated tracker and the §9.6 stand-in.
+//! - [`formats`]: one serde type per file the tracker reads or writes (measurements with
+//!   `steps` or `raw_steps`, calibration snapshots, calibration result, truth), with checks.
 //! - [`mtl`]: multi-target localization under correlated blocking (`multi-target.md`).
 //! - [`plan`]: network planning — move nodes to minimise a CRLB objective over a region
 //!   (CMA-ES with restarts, constraints).
@@ -41,6 +43,7 @@
 extern crate alloc;
 
 pub mod error;
+pub mod formats;
 pub mod localize;
 pub mod math;
 pub mod measure;

@@ -139,24 +139,24 @@ fn track_rejects_bad_filter_flags_naming_them() {
     for (extra, needles) in cases {
         fails(&[&base[..], extra].concat(), needles);
     }
-    // raw_steps: the gated mode needs the EKF.
+    // raw_steps: gated with any filter (issue 23; tests/gating.rs tracks the §9.6 stand-in).
     let mut raw = measurements();
     let o = raw.as_object_mut().unwrap();
     o.remove("steps");
     o.insert("raw_steps".into(), json!([[[[1e-8, 1.0]], [], [], []]]));
     let r = dir.write("raw.json", &raw);
-    fails(
-        &[
+    for filter in ["ukf", "pf"] {
+        let v = ok_json(&[
             "track",
             "--scenario",
             &s,
             "--measurements",
             &r,
             "--filter",
-            "ukf",
-        ],
-        &["--filter ukf", "raw_steps"],
-    );
+            filter,
+        ]);
+        assert_eq!(v["links_used"], json!([1]), "{filter}: {v}");
+    }
 }
 
 /// A tiny study: scenario I, 16 trajectories × 2 noise runs, 20 steps.

@@ -14,8 +14,8 @@ use scatterloc::track::gating::{select, AssociationRule, Choice};
 use scatterloc::track::gating::{start_from_snapshot, GatedTracker, START_SPEED_SIGMA_MPS};
 use scatterloc::track::gating::{Calibration, ClusterConfig, LinkCalibration, StaticCluster};
 use scatterloc::track::paper_initial_covariance;
-use scatterloc::track::ConstantVelocity;
-use scatterloc::track::{Ekf, MeasurementNoise};
+use scatterloc::track::{ConstantVelocity, Filter, FilterKind, Tracker};
+use scatterloc::track::{Ekf, MeasurementNoise, PfConfig, UkfParams};
 use scatterloc::{measure, scenario::presets};
 
 mod common;
@@ -130,6 +130,8 @@ struct LoopStats {
     consistent: usize,
     /// Largest position error after the first second, m.
     worst_after_1s_m: Real,
+    /// RMS position error after the first second, m.
+    rms_after_1s_m: Real,
 }
 
 const LOOP_STEPS: usize = 600;
@@ -180,6 +182,18 @@ fn run_loop_from(
     seed: u64,
     lm_start: bool,
 ) -> LoopStats {
+    run_loop_with(FilterKind::Ekf, false_alarms, rule, seed, lm_start)
+}
+
+/// [`run_loop_from`] with any filter of the seam behind the gating (a [`Tracker`] of `kind`
+/// started where the EKF would be; the particle filter's own stream is stream 7 of `seed`).
+fn run_loop_with(
+    kind: FilterKind,
+    false_alarms: Real,
+    rule: AssociationRule,
+    seed: u64,
+    lm_start: bool,
+) -> LoopStats {
     let model = model();
     let cfg = ClusterConfig::for_bandwidth(bandwidth()).unwrap();
     let mut rng = measure::rng(seed, 0);
@@ -210,7 +224,8 @@ fn run_loop_from(
         Ekf::new(circle(0.0), paper_initial_covariance()).unwrap()
     };
     let noise = MeasurementNoise::AtPrediction;
-    let mut tracker = GatedTracker::new(ekf, &model, &cal, motion, noise, rule).unwrap();
+    let filter = Tracker::new(kind, ekf.state, ekf.covariance, measure::rng(seed, 7)).unwrap();
+    let mut tracker = GatedTracker::new(filter, &model, &cal, motion, noise, rule).unwrap();
     let mut st = LoopStats {
         resolved: 0,
         echo_taken: 0,
@@ -219,7 +234,9 @@ fn run_loop_from(
         unresolved_static_paths: 0,
         consistent: 0,
         worst_after_1s_m: 0.0,
+        rms_after_1s_m: 0.0,
     };
+    let mut sum_sq = (0.0, 0usize);
     for k in 1..=LOOP_STEPS {
         let truth = circle(k as Real * dt);
         let r = Vec2::new(truth[0], truth[1]);
@@ -241,17 +258,24 @@ fn run_loop_from(
                 }
             }
         }
-        let e = tracker.ekf.position() - r;
-        let p_rr = tracker.ekf.covariance.fixed_view::<2, 2>(0, 0).into_owned();
+        let e = tracker.filter.position() - r;
+        let p_rr = tracker
+            .filter
+            .covariance()
+            .fixed_view::<2, 2>(0, 0)
+            .into_owned();
         if (e.transpose() * p_rr.try_inverse().unwrap() * e)[0] <= 13.8 {
             st.consistent += 1;
         }
         if k as Real * dt > 1.0 {
             st.worst_after_1s_m = st.worst_after_1s_m.max(e.norm());
+            sum_sq = (sum_sq.0 + e.norm_squared(), sum_sq.1 + 1);
         }
     }
+    st.rms_after_1s_m = (sum_sq.0 / sum_sq.1 as Real).sqrt();
     println!(
-        "{rule:?}, {false_alarms} false alarms per link and snapshot, LM start {lm_start}: {st:?}"
+        "{} {rule:?}, {false_alarms} false alarms per link and snapshot, LM start {lm_start}: {st:?}",
+        kind.name()
     );
     st
 }
@@ -366,4 +390,96 @@ fn predicted_delay_and_innovation_sigma_match_a_single_link_update() {
             value: 0.0
         }
     );
+}
+
+/// The filters of the seam behind the same gating (issue 23): the §9.6 stand-in with 0.5
+/// false alarms per link and snapshot under the gated rule, tracked by the EKF, the UKF and the
+/// particle filter (1000 particles), each gating and associating on its own predicted delays
+/// and innovation σ, seeds 1–4 (fixed in advance), truth and LM starts. Each meets the EKF's
+/// bounds ([`LoopStats::assert_tracked`]), and the UKF's and PF's RMS position error after the
+/// first second is at most 1.25 × the EKF's. Why 1.25: the measurement model is nearly linear
+/// over the filter's spread (σ of a few cm against ranges of metres), so the UKF's and the
+/// EKF's estimates differ to second order; the PF adds its Monte Carlo variance `P/N_eff`,
+/// with `N_eff ≥ N/2 = 500` a factor `√(1 + 1/500)` on the RMS. What remains is a different
+/// association in a few steps; measured (seeds 1–4, both starts): EKF 0.026–0.032 m, UKF within
+/// 0.5 % of it, PF within 2 % (0.98–1.02×); 1.25 is 12 times that spread.
+#[test]
+fn every_filter_keeps_the_gated_track() {
+    let kinds = [
+        FilterKind::Ekf,
+        FilterKind::Ukf(UkfParams::default()),
+        FilterKind::Pf(PfConfig::default()),
+    ];
+    for seed in 1..=4 {
+        for lm_start in [false, true] {
+            let [ekf, ukf, pf] =
+                kinds.map(|k| run_loop_with(k, 0.5, AssociationRule::Gated, seed, lm_start));
+            println!(
+                "seed {seed}, LM start {lm_start}: RMS after 1 s ekf {:.4} ukf {:.4} pf {:.4} m",
+                ekf.rms_after_1s_m, ukf.rms_after_1s_m, pf.rms_after_1s_m
+            );
+            for st in [&ekf, &ukf, &pf] {
+                st.assert_tracked();
+            }
+            for st in [&ukf, &pf] {
+                assert!(
+                    st.rms_after_1s_m <= 1.25 * ekf.rms_after_1s_m,
+                    "seed {seed}: {st:?} vs the EKF's {ekf:?}"
+                );
+            }
+        }
+    }
+}
+
+/// The predicted delays the gating reads, filter against filter, at states along the loop with
+/// P(t₀) = diag(0.1 m², 0.1 m², …) of §9.5 (position σ 0.32 m): the UKF's sigma-point `ẑ_p`,
+/// `√S_pp` and the PF's weighted-particle ones (N = 100 000) against the EKF's Jacobian values
+/// (E3). Tolerances, in units of the EKF's `√S_pp`:
+/// - UKF − EKF mean ≤ 0.1: the range is convex, and the UT's mean carries the curvature term
+///   `½ tr(∇²h P)` the linearisation drops (measured 0.006–0.070); UKF and PF σ within 2 % of
+///   the EKF's (measured ≤ 0.96 % and ≤ 0.26 %: third-order terms);
+/// - PF − UKF mean ≤ 4 standard errors of a weighted mean of N particles, `4/√N` = 0.013 (the
+///   PF sees the same curvature; measured ≤ 0.006).
+#[test]
+fn every_filter_predicts_the_delays_the_ekf_does() {
+    let model = model();
+    let noise = MeasurementNoise::AtPrediction;
+    let n = 100_000;
+    for t in [0.0, 7.0, 21.0, 33.0] {
+        let (x, p) = (circle(t), paper_initial_covariance());
+        let ekf = Ekf::new(x, p)
+            .unwrap()
+            .predicted_delays(&model, noise)
+            .unwrap();
+        let ukf = Tracker::new(
+            FilterKind::Ukf(UkfParams::default()),
+            x,
+            p,
+            measure::rng(1, 0),
+        )
+        .unwrap()
+        .predicted_delays(&model, noise)
+        .unwrap();
+        let pf_kind = FilterKind::Pf(PfConfig {
+            particles: n,
+            roughening: None,
+        });
+        let pf = Tracker::new(pf_kind, x, p, measure::rng(2, 0))
+            .unwrap()
+            .predicted_delays(&model, noise)
+            .unwrap();
+        for link in 0..model.link_count() {
+            let (e, u, q) = (ekf[link], ukf[link], pf[link]);
+            let sigma = e.innovation_sigma_s;
+            let what = format!("t {t} link {link}: ekf {e:?} ukf {u:?} pf {q:?}");
+            assert!((u.delay_s - e.delay_s).abs() <= 0.1 * sigma, "{what}");
+            assert!(
+                (q.delay_s - u.delay_s).abs() <= 4.0 / (n as Real).sqrt() * sigma,
+                "{what}"
+            );
+            for s in [u.innovation_sigma_s, q.innovation_sigma_s] {
+                assert!((s / sigma - 1.0).abs() <= 0.02, "{what}");
+            }
+        }
+    }
 }

@@ -17,6 +17,14 @@ pub enum Error {
         /// serde_json's message (it names the field and the line/column).
         message: String,
     },
+    /// A file parsed but its content does not fit (a missing alternative, a count or a length
+    /// per link that is wrong): see [`crate::formats`].
+    InvalidFile {
+        /// Path of the field, e.g. `steps[3]`.
+        field: String,
+        /// What is wrong, in words.
+        reason: String,
+    },
     /// A number that must be finite is NaN or infinite.
     NonFinite {
         /// Path of the field, e.g. `receivers[2].position_m`.
@@ -241,6 +249,7 @@ impl fmt::Display for Error {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             Error::Parse { message } => write!(f, "invalid JSON: {}", Clip(message)),
+            Error::InvalidFile { field, reason } => write!(f, "{field}: {reason}"),
             Error::NonFinite { field } => write!(f, "{field}: not a finite number"),
             Error::NotPositive { field, value } => {
                 write!(f, "{field}: must be > 0 (got {})", Num(*value))

@@ -28,80 +28,21 @@
 //! their transmitter gains, the longest dependency chain of an update, side by side. The sums
 //! of pass 1 are added in link order, so the results are bitwise those of a link-by-link loop.
 
-use nalgebra::Cholesky;
+use alloc::vec::Vec;
 
 use crate::error::{check_len, limits, Error, Result};
-use crate::math::{sqrt, Mat4, Real, Vec2, Vec4, PI, SPEED_OF_LIGHT};
+use crate::math::{sqrt, Mat4, Real, Vec2, Vec4, SPEED_OF_LIGHT};
 use crate::measure::Model;
-use crate::track::ConstantVelocity;
+use crate::track::shared::{
+    check_covariance, check_state, check_update, link_sigmas, predict_gaussian, spd_quadratic_form,
+};
+use crate::track::{ConstantVelocity, Filter, MeasurementNoise, PredictedDelay, UpdateSummary};
 
 mod batch;
 mod links;
-mod nees;
 
-pub(crate) use batch::{first_input_error, update_lanes};
+pub(crate) use batch::update_lanes;
 pub(crate) use links::link_information;
-pub(crate) use nees::{spd_quadratic_form, Ldl4};
-
-/// Where the measurement noise `R = diag(σ_p²)` comes from (spec §6 \[choice\]).
-#[derive(Debug, Clone, Copy)]
-pub enum MeasurementNoise<'a> {
-    /// Fixed `σ_p` per link, s (e.g. the parameter estimator's variances).
-    Fixed(&'a [Real]),
-    /// `σ_p` from the link budget (E8) at the predicted position — the simulation default.
-    AtPrediction,
-    /// `σ_p` from the link budget at a given position (the "oracle" option: the truth).
-    At(Vec2),
-}
-
-impl MeasurementNoise<'_> {
-    /// `Fixed` noise must give one σ per link (`LengthMismatch` of `sigma_s` otherwise).
-    pub fn check_links(&self, n: usize) -> Result<()> {
-        match self {
-            MeasurementNoise::Fixed(s) if s.len() != n => Err(Error::LengthMismatch {
-                field: "sigma_s",
-                expected: n,
-                found: s.len(),
-            }),
-            _ => Ok(()),
-        }
-    }
-
-    /// `σ_p` of link `link`, s, for a filter whose predicted position is `r_pred`.
-    pub fn sigma(&self, model: &Model, link: usize, r_pred: Vec2) -> Real {
-        match *self {
-            MeasurementNoise::Fixed(s) => s[link],
-            MeasurementNoise::AtPrediction => model.sigma_delay(link, r_pred),
-            MeasurementNoise::At(r) => model.sigma_delay(link, r),
-        }
-    }
-}
-
-/// The filter's predicted measurement of one link: `h_p(r̂⁻)` (E1) and the innovation standard
-/// deviation `√S_pp`, `S_pp = J_p P_rr J_pᵀ + σ_p²` (E3, spec §6), both in seconds.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct PredictedDelay {
-    /// `h_p(r̂⁻)`, s.
-    pub delay_s: Real,
-    /// `√S_pp`, s.
-    pub innovation_sigma_s: Real,
-}
-
-impl PredictedDelay {
-    /// `|τ − h_p(r̂⁻)| / √S_pp`: the normalised innovation of a candidate delay.
-    pub fn normalized_innovation(&self, delay_s: Real) -> Real {
-        (delay_s - self.delay_s).abs() / self.innovation_sigma_s
-    }
-}
-
-/// Outcome of one update.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct UpdateSummary {
-    /// Normalised innovation squared `νᵀ S⁻¹ ν` (0 when no link was used).
-    pub nis: Real,
-    /// Links whose measurement was used.
-    pub links_used: usize,
-}
 
 /// The filter: state estimate `x̂ = [x, y, vx, vy]ᵀ` and its covariance `P`.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -110,83 +51,6 @@ pub struct Ekf {
     pub state: Vec4,
     /// `P`, m², m²/s, m²/s².
     pub covariance: Mat4,
-}
-
-/// Geometry of one node as seen from a point `r`: the unit vector node → `r` (zero when they
-/// nearly coincide, as [`crate::measure::unit_from`]), the distance and `1/max(d, 1 m)²` (the
-/// floored distance factor of the SNR, E8). One division and one square root; lane 0 of the
-/// EKF's `links::NodeViews`.
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct NodeView {
-    pub(crate) unit: Vec2,
-    pub(crate) distance: Real,
-    pub(crate) inv_floored_sq: Real,
-}
-
-impl NodeView {
-    #[inline(always)]
-    pub(crate) fn new(node: Vec2, r: Vec2) -> NodeView {
-        let v = links::NodeViews::<1>::new(&[node.x], &[node.y], &[r.x], &[r.y]);
-        NodeView {
-            unit: Vec2::new(v.ux[0], v.uy[0]),
-            distance: v.distance[0],
-            inv_floored_sq: v.inv_floored_sq[0],
-        }
-    }
-}
-
-/// `8π²β²/c²`: turns an SNR into the range-domain information `1/(cσ_p)²`, 1/m² (E8).
-#[inline(always)]
-pub(crate) fn range_information_per_snr(model: &Model) -> Real {
-    8.0 * PI * PI * model.beta2 / (SPEED_OF_LIGHT * SPEED_OF_LIGHT)
-}
-
-/// `1/(cσ)²` for a delay standard deviation `σ`, 1/m² (checked by the caller).
-#[inline(always)]
-fn information_from_sigma(sigma: Real) -> Real {
-    let r = SPEED_OF_LIGHT * sigma;
-    1.0 / (r * r)
-}
-
-/// Checks a user-supplied state: finite, position within [`limits::COORDINATE_M`], velocity
-/// within [`limits::VELOCITY_M_S`] (errors name `initial_state[i]`).
-pub(crate) fn check_state(state: &Vec4) -> Result<()> {
-    if state.iter().any(|v| !v.is_finite()) {
-        return Err(Error::NonFinite {
-            field: "initial_state".into(),
-        });
-    }
-    for (i, range) in [
-        limits::COORDINATE_M,
-        limits::COORDINATE_M,
-        limits::VELOCITY_M_S,
-        limits::VELOCITY_M_S,
-    ]
-    .iter()
-    .enumerate()
-    {
-        range.check(&alloc::format!("initial_state[{i}]"), state[i])?;
-    }
-    Ok(())
-}
-
-/// Relative asymmetry tolerated in a user-supplied covariance.
-const SYMMETRY_TOLERANCE: Real = 1e-9;
-
-/// Checks that `p` is finite, symmetric (to 1e-9 relative) and positive definite.
-pub fn check_covariance(field: &str, p: &Mat4) -> Result<()> {
-    if p.iter().any(|v| !v.is_finite()) {
-        return Err(Error::NonFinite {
-            field: field.into(),
-        });
-    }
-    let scale = p.abs().max();
-    if (p - p.transpose()).abs().max() > SYMMETRY_TOLERANCE * scale || Cholesky::new(*p).is_none() {
-        return Err(Error::NotPositiveDefinite {
-            field: field.into(),
-        });
-    }
-    Ok(())
 }
 
 impl Ekf {
@@ -217,13 +81,12 @@ impl Ekf {
     /// Predict: `x̂⁻ = A x̂`, `P⁻ = A P Aᵀ + Q` (S16, E7).
     #[inline]
     pub fn predict(&mut self, motion: &ConstantVelocity) {
-        self.state = motion.propagate(&self.state);
-        self.covariance = motion.propagate_covariance(&self.covariance);
+        predict_gaussian(&mut self.state, &mut self.covariance, motion);
     }
 
     /// Update with delays `z` (s, one per link in scenario link order, `None` = missing; no link
-    /// = nothing to do). On error the filter is left unchanged. `P` is taken as symmetric (its
-    /// upper triangle is read).
+    /// = nothing to do) by the batch Joseph-form update (S17, module docs). On error the filter
+    /// is left unchanged. `P` is taken as symmetric (its upper triangle is read).
     ///
     /// `innovations`, if given, receives `z_p − h_p(r̂⁻)` in seconds for the used links and `None`
     /// for the others.
@@ -234,11 +97,9 @@ impl Ekf {
         noise: MeasurementNoise,
         mut innovations: Option<&mut [Option<Real>]>,
     ) -> Result<UpdateSummary> {
-        let n = model.link_count();
-        check_len("measurement", n, z.len())?;
-        noise.check_links(n)?;
+        check_update(model, z, noise)?;
         if let Some(out) = innovations.as_deref_mut() {
-            check_len("innovations", n, out.len())?;
+            check_len("innovations", model.link_count(), out.len())?;
             out.fill(None);
         }
         let innovation = |_lane: usize, link: usize, nu: Real| {
@@ -257,7 +118,8 @@ impl Ekf {
         summary
     }
 
-    /// Predict then update (one filter step).
+    /// Predict then update (one filter step, [`Filter::step`]); on error the filter is left as
+    /// before the step.
     pub fn step(
         &mut self,
         motion: &ConstantVelocity,
@@ -265,39 +127,33 @@ impl Ekf {
         z: &[Option<Real>],
         noise: MeasurementNoise,
     ) -> Result<UpdateSummary> {
-        let before = *self;
-        self.predict(motion);
-        self.update(model, z, noise, None)
-            .inspect_err(|_| *self = before)
+        Filter::step(self, motion, model, z, noise)
     }
 
     /// The predicted measurement of every link at the current state (call after
-    /// [`Ekf::predict`]): `h_p(r̂⁻)` and `√S_pp` with `σ_p` from `noise`. A `σ_p` that is not
-    /// finite and `> 0` is [`Error::InvalidSigma`]; `Fixed` noise of the wrong length is
-    /// [`Error::LengthMismatch`].
+    /// [`Ekf::predict`]): `h_p(r̂⁻)` (E1) and `√S_pp`, `S_pp = J_p P_rr J_pᵀ + σ_p²` from the
+    /// Jacobian (E3), with `σ_p` from `noise`. A `σ_p` that is not finite and `> 0` is
+    /// [`Error::InvalidSigma`]; `Fixed` noise of the wrong length is [`Error::LengthMismatch`].
     pub fn predicted_delays(
         &self,
         model: &Model,
         noise: MeasurementNoise,
-    ) -> Result<alloc::vec::Vec<PredictedDelay>> {
-        let n = model.link_count();
-        noise.check_links(n)?;
+    ) -> Result<Vec<PredictedDelay>> {
         let r = self.position();
+        let sigmas = link_sigmas(model, noise, r)?;
         let p_rr = self.covariance.fixed_view::<2, 2>(0, 0).into_owned();
-        (0..n)
-            .map(|link| {
-                let sigma = noise.sigma(model, link, r);
-                if !positive_finite(sigma) {
-                    return Err(Error::InvalidSigma { link, value: sigma });
-                }
+        Ok(sigmas
+            .iter()
+            .enumerate()
+            .map(|(link, sigma)| {
                 let j = model.network.jacobian_row(link, r);
                 let s = (j.transpose() * p_rr * j)[0] + sigma * sigma;
-                Ok(PredictedDelay {
+                PredictedDelay {
                     delay_s: model.network.delay(link, r),
                     innovation_sigma_s: sqrt(s),
-                })
+                }
             })
-            .collect()
+            .collect())
     }
 
     /// Normalised estimation error squared `(x̂ − x)ᵀ P⁻¹ (x̂ − x)` against a true state;
@@ -308,16 +164,39 @@ impl Ekf {
     }
 }
 
-/// `x > 0` and finite, as two float compares (`is_finite` becomes an integer classification
-/// sequence in the hot loop).
-#[inline(always)]
-fn positive_finite(x: Real) -> bool {
-    x > 0.0 && finite_probe(x) == 0.0
-}
+/// The EKF behind the filter seam: its own predict (S16, E7), predicted delays from the
+/// Jacobian (E3) and update (S17).
+impl Filter for Ekf {
+    fn name(&self) -> &'static str {
+        "ekf"
+    }
 
-/// `x − x`: `0` for a finite `x`, NaN otherwise (a sum of probes is `0` iff all are finite).
-#[inline(always)]
-#[allow(clippy::eq_op)]
-fn finite_probe(x: Real) -> Real {
-    x - x
+    fn predict(&mut self, motion: &ConstantVelocity) {
+        Ekf::predict(self, motion)
+    }
+
+    fn predicted_delays(
+        &self,
+        model: &Model,
+        noise: MeasurementNoise,
+    ) -> Result<Vec<PredictedDelay>> {
+        Ekf::predicted_delays(self, model, noise)
+    }
+
+    fn update(
+        &mut self,
+        model: &Model,
+        z: &[Option<Real>],
+        noise: MeasurementNoise,
+    ) -> Result<UpdateSummary> {
+        Ekf::update(self, model, z, noise, None)
+    }
+
+    fn state(&self) -> &Vec4 {
+        &self.state
+    }
+
+    fn covariance(&self) -> &Mat4 {
+        &self.covariance
+    }
 }

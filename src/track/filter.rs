@@ -1,19 +1,120 @@
-//! The trackers side by side (issue 15): which one a study or a track runs ([`FilterKind`]) and
-//! one value that is any of them ([`Tracker`]), so a driver — a Monte Carlo chunk, the CLI's
-//! `track --filter`, the page's animated track — predicts, updates and reads the estimate the
-//! same way whichever filter it holds. The EKF (spec §6), the UKF and the bootstrap particle
-//! filter (`filters-and-planning.md` §1–2) share the CV motion model (E7) and the delay
-//! measurement model (E1, E8).
+//! The trackers side by side (issues 15, 23): the one filter seam ([`Filter`]), which filter a
+//! study or a track runs ([`FilterKind`]) and one value that is any of them ([`Tracker`]), so a
+//! driver — a Monte Carlo chunk, the CLI's `track --filter`, the gated tracker of spec §4, the
+//! page's animated track — predicts, updates and reads the estimate the same way whichever
+//! filter it holds. The EKF (spec §6), the UKF and the bootstrap particle filter
+//! (`filters-and-planning.md` §1–2) share the CV motion model (E7) and the delay measurement
+//! model (E1, E8).
 
 use alloc::boxed::Box;
-
 use alloc::string::ToString;
+use alloc::vec::Vec;
 
 use crate::error::{Error, Result};
 use crate::math::{Mat4, Real, Vec2, Vec4};
 use crate::measure::{Model, Rng};
-use crate::track::{ConstantVelocity, Ekf, MeasurementNoise, UpdateSummary};
+use crate::track::shared::{rolled_back, spd_quadratic_form};
+use crate::track::{ConstantVelocity, Ekf, MeasurementNoise, PredictedDelay, UpdateSummary};
 use crate::track::{ParticleFilter, PfConfig, Ukf, UkfParams};
+
+/// The filter seam: what every tracker of the delay model does, on the CV motion model (E7) and
+/// the delay measurement model (E1, `σ_p` from E8 or given).
+///
+/// - [`Filter::predict`]: the time update (E7; S16 for the EKF).
+/// - [`Filter::predicted_delays`]: after a predict, each link's predicted delay `ẑ_p` and its
+///   innovation σ `√S_pp` — the EKF's from its Jacobian (E3, `S = J P Jᵀ + σ²`), the UKF's from
+///   its sigma points (§1, `S = Σ Wᶜ (𝒵 − ẑ)² + σ²`), the particle filter's from its weighted
+///   particles (§2, `S = Σ w (h − ẑ)² + σ²`). Gating (E4) and association (spec §4) read them.
+/// - [`Filter::update`]: the measurement update with delays `z` (one per link, `None` =
+///   missing); on error the filter is unchanged.
+/// - [`Filter::state`], [`Filter::covariance`], [`Filter::nees`]: the estimate, its covariance
+///   and the NEES against a true state.
+/// - [`Filter::step`]: predict then update, rolled back on error.
+///
+/// # Example
+///
+/// ```
+/// use scatterloc::math::{Mat4, Vec4};
+/// use scatterloc::measure::rng;
+/// use scatterloc::scenario::presets;
+/// use scatterloc::track::{ConstantVelocity, Filter, FilterKind, MeasurementNoise, Tracker};
+/// use scatterloc::Model;
+///
+/// let model = Model::new(&presets::sensors2019()).unwrap();
+/// let motion = ConstantVelocity::new(0.1, 0.1);
+/// let x0 = Vec4::new(8.0, 3.0, 0.5, 0.0);
+/// let p0 = Mat4::from_diagonal(&Vec4::new(0.01, 0.01, 0.1, 0.1));
+/// let mut f = Tracker::new(FilterKind::Ekf, x0, p0, rng(1, 0)).unwrap();
+/// f.predict(&motion);
+/// let predicted = f.predicted_delays(&model, MeasurementNoise::AtPrediction).unwrap();
+/// let z: Vec<_> = predicted.iter().map(|p| Some(p.delay_s)).collect();
+/// let summary = f.update(&model, &z, MeasurementNoise::AtPrediction).unwrap();
+/// assert_eq!(summary.links_used, model.link_count());
+/// // A bad measurement leaves the filter as it was.
+/// let before = *f.state();
+/// let bad = vec![Some(-1.0); model.link_count()];
+/// assert!(f.step(&motion, &model, &bad, MeasurementNoise::AtPrediction).is_err());
+/// assert_eq!(*f.state(), before);
+/// ```
+pub trait Filter: Clone {
+    /// `ekf`, `ukf` or `pf`.
+    fn name(&self) -> &'static str;
+
+    /// Predict by the CV model (E7).
+    fn predict(&mut self, motion: &ConstantVelocity);
+
+    /// Each link's predicted delay `ẑ_p` and innovation σ `√S_pp` at the current (predicted)
+    /// state, both s, with `σ_p` from `noise` at the filter's position. `Fixed` noise of the
+    /// wrong length is [`Error::LengthMismatch`]; a `σ_p` not finite and `> 0` is
+    /// [`Error::InvalidSigma`]; a covariance that gives no spread is
+    /// [`Error::NotPositiveDefinite`].
+    fn predicted_delays(
+        &self,
+        model: &Model,
+        noise: MeasurementNoise,
+    ) -> Result<Vec<PredictedDelay>>;
+
+    /// Update with delays `z` (s, one per link, `None` = missing; no link = nothing to do). On
+    /// error the filter is unchanged.
+    fn update(
+        &mut self,
+        model: &Model,
+        z: &[Option<Real>],
+        noise: MeasurementNoise,
+    ) -> Result<UpdateSummary>;
+
+    /// The estimate `x̂ = [x, y, vx, vy]`, m and m/s.
+    fn state(&self) -> &Vec4;
+
+    /// Its covariance `P`.
+    fn covariance(&self) -> &Mat4;
+
+    /// Position part of the estimate, m.
+    fn position(&self) -> Vec2 {
+        let x = self.state();
+        Vec2::new(x[0], x[1])
+    }
+
+    /// Normalised estimation error squared `(x̂ − x)ᵀ P⁻¹ (x̂ − x)` against a true state;
+    /// `None` if `P` is not positive definite.
+    fn nees(&self, truth: &Vec4) -> Option<Real> {
+        spd_quadratic_form(self.covariance(), &(self.state() - truth))
+    }
+
+    /// Predict then update (one filter step); on error the filter is left as before the step.
+    fn step(
+        &mut self,
+        motion: &ConstantVelocity,
+        model: &Model,
+        z: &[Option<Real>],
+        noise: MeasurementNoise,
+    ) -> Result<UpdateSummary> {
+        rolled_back(self, |f| {
+            f.predict(motion);
+            f.update(model, z, noise)
+        })
+    }
+}
 
 /// The tracker a study or a track runs: the EKF (spec §6), the UKF or the bootstrap particle
 /// filter (`filters-and-planning.md` §1–2), all on the same motion and measurement models.
@@ -91,43 +192,70 @@ impl Tracker {
             }
         })
     }
+}
 
-    /// `ekf`, `ukf` or `pf`.
-    pub fn name(&self) -> &'static str {
+/// Every filter behind one value: each method delegates to the filter held (the EKF's own
+/// `step` is a copy and the particle filter's a clone, as the default).
+impl Filter for Tracker {
+    fn name(&self) -> &'static str {
         match self {
-            Tracker::Ekf(_) => "ekf",
-            Tracker::Ukf(_) => "ukf",
-            Tracker::Pf(_) => "pf",
+            Tracker::Ekf(f) => f.name(),
+            Tracker::Ukf(f) => f.name(),
+            Tracker::Pf(f) => f.name(),
         }
     }
 
-    /// Predict by the CV model (E7).
-    pub fn predict(&mut self, motion: &ConstantVelocity) {
+    fn predict(&mut self, motion: &ConstantVelocity) {
         match self {
-            Tracker::Ekf(f) => f.predict(motion),
-            Tracker::Ukf(f) => f.predict(motion),
-            Tracker::Pf(f) => f.predict(motion),
+            Tracker::Ekf(f) => Filter::predict(f, motion),
+            Tracker::Ukf(f) => Filter::predict(f, motion),
+            Tracker::Pf(f) => Filter::predict(f.as_mut(), motion),
         }
     }
 
-    /// Update with delays `z` (s, one per link, `None` = missing): the filter's own update
-    /// (the EKF without innovations, the particle filter's summary). On error the filter is
-    /// unchanged.
-    pub fn update(
+    fn predicted_delays(
+        &self,
+        model: &Model,
+        noise: MeasurementNoise,
+    ) -> Result<Vec<PredictedDelay>> {
+        match self {
+            Tracker::Ekf(f) => Filter::predicted_delays(f, model, noise),
+            Tracker::Ukf(f) => Filter::predicted_delays(f, model, noise),
+            Tracker::Pf(f) => Filter::predicted_delays(f.as_ref(), model, noise),
+        }
+    }
+
+    fn update(
         &mut self,
         model: &Model,
         z: &[Option<Real>],
         noise: MeasurementNoise,
     ) -> Result<UpdateSummary> {
         match self {
-            Tracker::Ekf(f) => f.update(model, z, noise, None),
-            Tracker::Ukf(f) => f.update(model, z, noise),
-            Tracker::Pf(f) => f.update(model, z, noise).map(|u| u.summary),
+            Tracker::Ekf(f) => Filter::update(f, model, z, noise),
+            Tracker::Ukf(f) => Filter::update(f, model, z, noise),
+            Tracker::Pf(f) => Filter::update(f.as_mut(), model, z, noise),
         }
     }
 
-    /// Predict then update (one filter step); on error the filter is left as before the step.
-    pub fn step(
+    fn state(&self) -> &Vec4 {
+        match self {
+            Tracker::Ekf(f) => Filter::state(f),
+            Tracker::Ukf(f) => Filter::state(f),
+            Tracker::Pf(f) => Filter::state(f.as_ref()),
+        }
+    }
+
+    fn covariance(&self) -> &Mat4 {
+        match self {
+            Tracker::Ekf(f) => Filter::covariance(f),
+            Tracker::Ukf(f) => Filter::covariance(f),
+            Tracker::Pf(f) => Filter::covariance(f.as_ref()),
+        }
+    }
+
+    /// The held filter's step, so that the rollback copies only that filter.
+    fn step(
         &mut self,
         motion: &ConstantVelocity,
         model: &Model,
@@ -135,33 +263,9 @@ impl Tracker {
         noise: MeasurementNoise,
     ) -> Result<UpdateSummary> {
         match self {
-            Tracker::Ekf(f) => f.step(motion, model, z, noise),
-            Tracker::Ukf(f) => f.step(motion, model, z, noise),
-            Tracker::Pf(f) => f.step(motion, model, z, noise).map(|u| u.summary),
+            Tracker::Ekf(f) => Filter::step(f, motion, model, z, noise),
+            Tracker::Ukf(f) => Filter::step(f, motion, model, z, noise),
+            Tracker::Pf(f) => Filter::step(f.as_mut(), motion, model, z, noise),
         }
-    }
-
-    /// The estimate `x̂`, m and m/s (the particle filter's weighted mean).
-    pub fn state(&self) -> &Vec4 {
-        match self {
-            Tracker::Ekf(f) => &f.state,
-            Tracker::Ukf(f) => &f.state,
-            Tracker::Pf(f) => &f.state,
-        }
-    }
-
-    /// Its covariance `P` (the particle filter's weighted covariance).
-    pub fn covariance(&self) -> &Mat4 {
-        match self {
-            Tracker::Ekf(f) => &f.covariance,
-            Tracker::Ukf(f) => &f.covariance,
-            Tracker::Pf(f) => &f.covariance,
-        }
-    }
-
-    /// Position part of the estimate, m.
-    pub fn position(&self) -> Vec2 {
-        let x = self.state();
-        Vec2::new(x[0], x[1])
     }
 }

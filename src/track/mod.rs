@@ -1,6 +1,7 @@
 //! Tracking a moving scatterer: the white-noise-acceleration motion model (E7), the EKF with the
 //! Joseph-form update (spec §6, S16–S17), the UKF and the bootstrap particle filter
-//! (`filters-and-planning.md` §1–2), the posterior CRLB recursion (E9, §8), the trajectories
+//! (`filters-and-planning.md` §1–2) behind one seam ([`Filter`], driven through [`Tracker`]) with
+//! their shared helpers in one private module (`shared`), the posterior CRLB recursion (E9, §8), the trajectories
 //! of \[S\] Fig. 2b and the Monte Carlo prior (§9.4–9.5), one simulated run for display, and the
 //! Monte Carlo study of the tracker against its bound, chunked so that any driver (sequential,
 //! `native`, the page's worker) gives the same result.
@@ -12,13 +13,14 @@ mod montecarlo;
 mod motion;
 mod pcrlb;
 mod pf;
+mod shared;
 mod track_sim;
 mod trajectory;
 mod ukf;
 
-pub use ekf::{check_covariance, Ekf, MeasurementNoise, PredictedDelay, UpdateSummary};
-pub(crate) use ekf::{range_information_per_snr, spd_quadratic_form, update_lanes, NodeView};
-pub use filter::{FilterKind, Tracker};
+pub(crate) use ekf::update_lanes;
+pub use ekf::Ekf;
+pub use filter::{Filter, FilterKind, Tracker};
 pub use montecarlo::{
     finish, pcrlb_from_sums, run_chunk, run_filter_chunk, run_pcrlb_sequential, run_sequential,
     run_truth_chunk, MonteCarloConfig, MonteCarloResult, PartialSums, StudySums,
@@ -27,6 +29,8 @@ pub use montecarlo::{
 pub use motion::ConstantVelocity;
 pub use pcrlb::{nominal_pcrlb_rmse, pcrlb_rmse, PosteriorInformation};
 pub use pf::{ParticleFilter, PfConfig, PfUpdate, MAX_PARTICLES};
+pub use shared::{check_covariance, MeasurementNoise, PredictedDelay, UpdateSummary};
+pub(crate) use shared::{range_information_per_snr, spd_quadratic_form, NodeView};
 pub use track_sim::{simulate_track, TrackRun};
 pub use trajectory::{
     paper_initial_covariance, step_count, TrackScenario, TruthSampler, PAPER_DURATION_S,

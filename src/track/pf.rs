@@ -20,13 +20,16 @@ use alloc::vec::Vec;
 
 use rand::Rng as _;
 
-use crate::error::{check_len, Error, Result};
+use crate::error::{Error, Result};
 use crate::math::portable::{exp, ln};
 use crate::math::{sqrt, Mat4, Real, Vec2, Vec4, SPEED_OF_LIGHT};
 use crate::measure::{Model, Rng};
-use crate::track::ekf::{check_covariance, check_state, first_input_error};
+use crate::track::shared::{
+    check_covariance, check_state, check_update, first_input_error, link_sigmas, rolled_back,
+    spd_quadratic_form, NO_UPDATE,
+};
 use crate::track::trajectory::normal4;
-use crate::track::{spd_quadratic_form, ConstantVelocity, MeasurementNoise, UpdateSummary};
+use crate::track::{ConstantVelocity, Filter, MeasurementNoise, PredictedDelay, UpdateSummary};
 
 /// Most particles of a filter.
 pub const MAX_PARTICLES: usize = 1_000_000;
@@ -179,22 +182,16 @@ impl ParticleFilter {
         z: &[Option<Real>],
         noise: MeasurementNoise,
     ) -> Result<PfUpdate> {
-        let links = model.link_count();
-        check_len("measurement", links, z.len())?;
-        noise.check_links(links)?;
+        let m = check_update(model, z, noise)?;
         let n = self.particles.len();
-        let used: Vec<usize> = (0..links).filter(|&p| z[p].is_some()).collect();
-        let m = used.len();
         if m == 0 {
             return Ok(PfUpdate {
-                summary: UpdateSummary {
-                    nis: 0.0,
-                    links_used: 0,
-                },
+                summary: NO_UPDATE,
                 ess: ess(&self.weights),
                 resampled: false,
             });
         }
+        let used: Vec<usize> = (0..z.len()).filter(|&p| z[p].is_some()).collect();
         let r_pred = self.position();
         if let Some(e) = first_input_error(model, z, noise, r_pred) {
             return Err(e);
@@ -265,7 +262,8 @@ impl ParticleFilter {
         })
     }
 
-    /// Predict then update (one filter step); on error the filter is left as before the step.
+    /// Predict then update (one filter step, as [`Filter::step`] with the particle filter's
+    /// own outcome); on error the filter is left as before the step.
     pub fn step(
         &mut self,
         motion: &ConstantVelocity,
@@ -273,15 +271,75 @@ impl ParticleFilter {
         z: &[Option<Real>],
         noise: MeasurementNoise,
     ) -> Result<PfUpdate> {
-        let before = self.clone();
-        self.predict(motion);
-        self.update(model, z, noise).inspect_err(|_| *self = before)
+        rolled_back(self, |f| {
+            f.predict(motion);
+            f.update(model, z, noise)
+        })
     }
 
     /// Normalised estimation error squared of the estimate against a true state (`None` if the
     /// covariance is not positive definite, e.g. after collapsing onto one particle).
     pub fn nees(&self, truth: &Vec4) -> Option<Real> {
         spd_quadratic_form(&self.covariance, &(self.state - truth))
+    }
+
+    /// The predicted measurement of every link from the weighted particles (spec §2):
+    /// `ẑ_p = Σ w_j h_p(x_j)` and `√S_pp`, `S_pp = Σ w_j (h_p(x_j) − ẑ_p)² + σ_p²` (weights
+    /// normalised), both s, with `σ_p` from `noise` at the weighted mean (as the update's). Two
+    /// passes over the particles (mean, then spread); no state change.
+    pub fn predicted_delays(
+        &self,
+        model: &Model,
+        noise: MeasurementNoise,
+    ) -> Result<Vec<PredictedDelay>> {
+        let sigmas = link_sigmas(model, noise, self.position())?;
+        let net = &model.network;
+        let links = sigmas.len();
+        let ntx = net.transmitters.len();
+        let mut d = vec![0.0; ntx + net.receivers.len()];
+        // The particle's range on every link (E1: the sum of its two node distances), m.
+        let mut ranges = |x: &Vec4, out: &mut [Real]| {
+            for (k, node) in net.transmitters.iter().chain(&net.receivers).enumerate() {
+                let (dx, dy) = (x[0] - node.x, x[1] - node.y);
+                d[k] = sqrt(dx * dx + dy * dy);
+            }
+            for (o, l) in out.iter_mut().zip(&net.links) {
+                *o = d[l.tx] + d[ntx + l.rx];
+            }
+        };
+        let total: Real = self.weights.iter().sum();
+        let mut h = vec![0.0; links];
+        let mut mean = vec![0.0; links];
+        for (x, w) in self.particles.iter().zip(&self.weights) {
+            ranges(x, &mut h);
+            for (m, hk) in mean.iter_mut().zip(&h) {
+                *m += w * hk;
+            }
+        }
+        mean.iter_mut().for_each(|m| *m /= total);
+        let mut var = vec![0.0; links];
+        for (x, w) in self.particles.iter().zip(&self.weights) {
+            ranges(x, &mut h);
+            for ((v, hk), m) in var.iter_mut().zip(&h).zip(&mean) {
+                *v += w * (hk - m) * (hk - m);
+            }
+        }
+        mean.iter()
+            .zip(&var)
+            .zip(&sigmas)
+            .map(|((m, v), sigma)| {
+                let s = v / (total * SPEED_OF_LIGHT * SPEED_OF_LIGHT) + sigma * sigma;
+                if !(s > 0.0 && s.is_finite() && m.is_finite()) {
+                    return Err(Error::Degenerate {
+                        field: "pf.predicted_delays".into(),
+                    });
+                }
+                Ok(PredictedDelay {
+                    delay_s: m / SPEED_OF_LIGHT,
+                    innovation_sigma_s: sqrt(s),
+                })
+            })
+            .collect()
     }
 
     /// NIS of the weighted predicted measurement, from the ranges just computed and the
@@ -405,4 +463,41 @@ impl ParticleFilter {
 /// `1/Σ w_j²` of normalised weights.
 fn ess(weights: &[Real]) -> Real {
     1.0 / weights.iter().map(|w| w * w).sum::<Real>()
+}
+
+/// The particle filter behind the filter seam: predict (E7), predicted delays from its weighted
+/// particles and the SIR update (spec §2).
+impl Filter for ParticleFilter {
+    fn name(&self) -> &'static str {
+        "pf"
+    }
+
+    fn predict(&mut self, motion: &ConstantVelocity) {
+        ParticleFilter::predict(self, motion)
+    }
+
+    fn predicted_delays(
+        &self,
+        model: &Model,
+        noise: MeasurementNoise,
+    ) -> Result<Vec<PredictedDelay>> {
+        ParticleFilter::predicted_delays(self, model, noise)
+    }
+
+    fn update(
+        &mut self,
+        model: &Model,
+        z: &[Option<Real>],
+        noise: MeasurementNoise,
+    ) -> Result<UpdateSummary> {
+        ParticleFilter::update(self, model, z, noise).map(|u| u.summary)
+    }
+
+    fn state(&self) -> &Vec4 {
+        &self.state
+    }
+
+    fn covariance(&self) -> &Mat4 {
+        &self.covariance
+    }
 }

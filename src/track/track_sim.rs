@@ -11,7 +11,7 @@ use crate::measure::Model;
 use crate::measure::{rng, standard_normal};
 use crate::track::ConstantVelocity;
 use crate::track::TruthSampler;
-use crate::track::{FilterKind, MeasurementNoise, Tracker};
+use crate::track::{Filter, FilterKind, MeasurementNoise, Tracker};
 
 /// A simulated run, `steps + 1` entries per series (`t₀ … t_steps`; no measurement at `t₀`).
 #[derive(Debug, Clone, PartialEq)]

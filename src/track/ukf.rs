@@ -35,12 +35,17 @@
 //! [`Error::NotPositiveDefinite`] and leaves the filter unchanged.
 
 use alloc::vec;
+use alloc::vec::Vec;
 
-use crate::error::{check_len, Error, Result};
+use crate::error::{Error, Result};
 use crate::math::{sqrt, Mat4, Real, Vec2, Vec4, SPEED_OF_LIGHT};
 use crate::measure::Model;
-use crate::track::ekf::{check_covariance, check_state, first_input_error, link_information, Ldl4};
-use crate::track::{ConstantVelocity, MeasurementNoise, UpdateSummary};
+use crate::track::ekf::link_information;
+use crate::track::shared::{
+    check_covariance, check_state, check_update, first_input_error, link_sigmas, predict_gaussian,
+    spd_quadratic_form, Ldl4, NO_UPDATE,
+};
+use crate::track::{ConstantVelocity, Filter, MeasurementNoise, PredictedDelay, UpdateSummary};
 
 /// State dimension `n`.
 const N: usize = 4;
@@ -139,8 +144,7 @@ impl Ukf {
 
     /// Predict: the unscented transform of the linear CV model, `A x̂`, `A P Aᵀ + Q` (E7).
     pub fn predict(&mut self, motion: &ConstantVelocity) {
-        self.state = motion.propagate(&self.state);
-        self.covariance = motion.propagate_covariance(&self.covariance);
+        predict_gaussian(&mut self.state, &mut self.covariance, motion);
     }
 
     /// Update with delays `z` (s, one per link, `None` = missing) by the unscented transform of
@@ -152,15 +156,9 @@ impl Ukf {
         z: &[Option<Real>],
         noise: MeasurementNoise,
     ) -> Result<UpdateSummary> {
-        let links = model.link_count();
-        check_len("measurement", links, z.len())?;
-        noise.check_links(links)?;
-        let m = z.iter().filter(|v| v.is_some()).count();
+        let m = check_update(model, z, noise)?;
         if m == 0 {
-            return Ok(UpdateSummary {
-                nis: 0.0,
-                links_used: 0,
-            });
+            return Ok(NO_UPDATE);
         }
         // Up to 8 links on the stack (no allocation), more on the heap; the same code.
         let (x, p) = if m <= 4 {
@@ -276,7 +274,8 @@ impl Ukf {
         Ok(((state, nis), covariance))
     }
 
-    /// Predict then update (one filter step); on error the filter is left as before the step.
+    /// Predict then update (one filter step, [`Filter::step`]); on error the filter is left as
+    /// before the step.
     pub fn step(
         &mut self,
         motion: &ConstantVelocity,
@@ -284,15 +283,97 @@ impl Ukf {
         z: &[Option<Real>],
         noise: MeasurementNoise,
     ) -> Result<UpdateSummary> {
-        let before = *self;
-        self.predict(motion);
-        self.update(model, z, noise).inspect_err(|_| *self = before)
+        Filter::step(self, motion, model, z, noise)
+    }
+
+    /// The predicted measurement of every link from the sigma points of `(x̂⁻, P⁻)` (spec §1):
+    /// `ẑ_p = Σ Wᵐ_i h_p(χ_i)` and `√S_pp`, `S_pp = Σ Wᶜ_i (h_p(χ_i) − ẑ_p)² + σ_p²`, both s,
+    /// with `σ_p` from `noise` at `r̂⁻`. As in the update (module docs) only the four sigma
+    /// points off `χ₀`'s position are evaluated: with `d_k = h_p(χ_k) − h_p(χ₀)`,
+    /// `δ = ẑ_p − h_p(χ₀) = Wᵢ Σ d_k` and `S_pp = Wᵢ Σ d_k² + (β − α²) δ² + σ_p²`. A `P⁻` or an
+    /// `S_pp` that is not positive is [`Error::NotPositiveDefinite`].
+    pub fn predicted_delays(
+        &self,
+        model: &Model,
+        noise: MeasurementNoise,
+    ) -> Result<Vec<PredictedDelay>> {
+        let not_pd = |field: &str| Error::NotPositiveDefinite {
+            field: field.into(),
+        };
+        let center = self.position();
+        let sigmas = link_sigmas(model, noise, center)?;
+        let f = Ldl4::new(&self.covariance).ok_or_else(|| not_pd("ukf.covariance"))?;
+        let spread = N as Real + self.params.lambda();
+        let (s0, s1) = (sqrt(spread * f.d[0]), sqrt(spread * f.d[1]));
+        let points = [
+            center + Vec2::new(s0, f.l10 * s0),
+            center + Vec2::new(0.0, s1),
+            center - Vec2::new(s0, f.l10 * s0),
+            center - Vec2::new(0.0, s1),
+        ];
+        let (_, _, wi) = self.params.weights();
+        let c_delta = self.params.beta - self.params.alpha * self.params.alpha;
+        sigmas
+            .iter()
+            .enumerate()
+            .map(|(link, sigma)| {
+                let h0 = model.network.delay(link, center);
+                let d = points.map(|r| model.network.delay(link, r) - h0);
+                let delta = wi * (((d[0] + d[1]) + d[2]) + d[3]);
+                let spread = wi * (((d[0] * d[0] + d[1] * d[1]) + d[2] * d[2]) + d[3] * d[3]);
+                let s = spread + c_delta * delta * delta + sigma * sigma;
+                if !(s > 0.0 && s.is_finite()) {
+                    return Err(not_pd("ukf.innovation_covariance"));
+                }
+                Ok(PredictedDelay {
+                    delay_s: h0 + delta,
+                    innovation_sigma_s: sqrt(s),
+                })
+            })
+            .collect()
     }
 
     /// Normalised estimation error squared against a true state (`None` if `P` is not positive
     /// definite).
     pub fn nees(&self, truth: &Vec4) -> Option<Real> {
-        crate::track::spd_quadratic_form(&self.covariance, &(self.state - truth))
+        spd_quadratic_form(&self.covariance, &(self.state - truth))
+    }
+}
+
+/// The UKF behind the filter seam: predict (E7), predicted delays from its sigma points and the
+/// unscented update (spec §1).
+impl Filter for Ukf {
+    fn name(&self) -> &'static str {
+        "ukf"
+    }
+
+    fn predict(&mut self, motion: &ConstantVelocity) {
+        Ukf::predict(self, motion)
+    }
+
+    fn predicted_delays(
+        &self,
+        model: &Model,
+        noise: MeasurementNoise,
+    ) -> Result<Vec<PredictedDelay>> {
+        Ukf::predicted_delays(self, model, noise)
+    }
+
+    fn update(
+        &mut self,
+        model: &Model,
+        z: &[Option<Real>],
+        noise: MeasurementNoise,
+    ) -> Result<UpdateSummary> {
+        Ukf::update(self, model, z, noise)
+    }
+
+    fn state(&self) -> &Vec4 {
+        &self.state
+    }
+
+    fn covariance(&self) -> &Mat4 {
+        &self.covariance
     }
 }
 

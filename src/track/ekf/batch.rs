@@ -3,11 +3,11 @@
 //! derivation in the [`ekf`](super) module docs).
 
 use super::links::{link_information, Information};
-use super::{finite_probe, information_from_sigma, positive_finite};
 use super::{Ekf, MeasurementNoise, UpdateSummary};
-use crate::error::{limits, Error, Result};
+use crate::error::{Error, Result};
 use crate::math::{Mat4, Real, Vec2, Vec4};
 use crate::measure::Model;
+use crate::track::shared::{finite_probe, first_input_error, positive_finite, NO_UPDATE};
 
 /// The EKF update of `L` independent filters against the same model and noise option, each
 /// with its own delays `z[j]` (lengths checked by the caller); `active[j] = false` skips filter
@@ -29,7 +29,7 @@ pub(crate) fn update_lanes<const L: usize>(
     let info = link_information(model, &r_pred, &z, &active, noise, |j, p, nu, _| {
         innovation(j, p, nu)
     });
-    let mut out = [NO_UPDATE; L];
+    let mut out = [NO_LINKS; L];
     for (j, out) in out.iter_mut().enumerate() {
         let a = &info[j];
         if !active[j] {
@@ -49,11 +49,8 @@ pub(crate) fn update_lanes<const L: usize>(
     out
 }
 
-/// The summary of an update without links.
-const NO_UPDATE: Result<UpdateSummary> = Ok(UpdateSummary {
-    nis: 0.0,
-    links_used: 0,
-});
+/// The result of an update without links.
+const NO_LINKS: Result<UpdateSummary> = Ok(NO_UPDATE);
 
 impl Ekf {
     /// Pass 2 of an update: the batch update in the position space (module docs) from the
@@ -185,31 +182,3 @@ impl Ekf {
 /// ([`Ekf::apply_information_wide`]): the covariance form's relative rounding error grows like
 /// `ε·tr(M P_rr)`, here ≈ 2·10⁻¹⁰.
 const WIDE_PRIOR: Real = 1e6;
-
-/// The first bad input of an update in link order (slow path, after the accumulated checks
-/// failed): a delay outside [`limits::DELAY_S`], a given (`Fixed`) `σ_p` outside
-/// [`limits::DELAY_SIGMA_S`], or a `σ_p` that is not finite and positive (or so small that
-/// `1/(cσ_p)²` overflows). `None` if all are fine.
-#[cold]
-pub(crate) fn first_input_error(
-    model: &Model,
-    z: &[Option<Real>],
-    noise: MeasurementNoise,
-    r_pred: Vec2,
-) -> Option<Error> {
-    for (link, zi) in z.iter().enumerate() {
-        let Some(zi) = *zi else { continue };
-        if !limits::DELAY_S.contains(zi) {
-            return Some(Error::InvalidDelay { link, value: zi });
-        }
-        let sigma = noise.sigma(model, link, r_pred);
-        let given = matches!(noise, MeasurementNoise::Fixed(_));
-        if given && !limits::DELAY_SIGMA_S.contains(sigma) {
-            return Some(Error::InvalidSigma { link, value: sigma });
-        }
-        if !(positive_finite(sigma) && information_from_sigma(sigma).is_finite()) {
-            return Some(Error::InvalidSigma { link, value: sigma });
-        }
-    }
-    None
-}

@@ -13,12 +13,14 @@
 //! bitwise those of a link-by-link loop: a lane without a measurement has `w = 0` and `ν = 0`,
 //! so its terms are `±0`, which leave a sum unchanged (a sum that starts at `+0` never is `−0`).
 
-use super::{finite_probe, information_from_sigma, range_information_per_snr, MeasurementNoise};
 use crate::error::limits;
-use crate::math::{sqrt, Real, Vec2, SPEED_OF_LIGHT};
+use crate::math::{Real, Vec2, SPEED_OF_LIGHT};
 use crate::measure::Model;
-use crate::measure::{SNR_DISTANCE_FLOOR_M, UNIT_VECTOR_MIN_DISTANCE_M};
 use crate::scenario::LinkIndex;
+use crate::track::shared::{
+    finite_probe, information_from_sigma, range_information_per_snr, NodeViews,
+};
+use crate::track::MeasurementNoise;
 
 /// Links evaluated together; a network's last block is padded with unused lanes.
 const BLOCK: usize = 4;
@@ -54,53 +56,6 @@ const NO_INFORMATION: Information = Information {
     links_used: 0,
     valid: true,
 };
-
-/// Geometry of `B` nodes as seen from `B` points (lane `i`: node `i` from point `i`): distance,
-/// unit vector node → point
-/// (zero closer than [`UNIT_VECTOR_MIN_DISTANCE_M`], as [`crate::measure::unit_from`]) and
-/// `1/max(d, 1 m)²` (the floored distance factor of the SNR, E8). One square root and one
-/// division per node.
-#[derive(Debug, Clone, Copy)]
-pub(super) struct NodeViews<const B: usize> {
-    pub(super) distance: [Real; B],
-    pub(super) ux: [Real; B],
-    pub(super) uy: [Real; B],
-    pub(super) inv_floored_sq: [Real; B],
-}
-
-impl<const B: usize> NodeViews<B> {
-    /// Nodes `(x[i], y[i])` seen from the points `(px[i], py[i])`.
-    #[inline(always)]
-    pub(super) fn new(
-        x: &[Real; B],
-        y: &[Real; B],
-        px: &[Real; B],
-        py: &[Real; B],
-    ) -> NodeViews<B> {
-        let mut v = NodeViews {
-            distance: [0.0; B],
-            ux: [0.0; B],
-            uy: [0.0; B],
-            inv_floored_sq: [0.0; B],
-        };
-        for i in 0..B {
-            let (dx, dy) = (px[i] - x[i], py[i] - y[i]);
-            let distance = sqrt(dx * dx + dy * dy);
-            let inv = 1.0 / distance;
-            let near = distance < UNIT_VECTOR_MIN_DISTANCE_M;
-            v.ux[i] = if near { 0.0 } else { dx * inv };
-            v.uy[i] = if near { 0.0 } else { dy * inv };
-            let inv_floored = if distance >= SNR_DISTANCE_FLOOR_M {
-                inv
-            } else {
-                1.0 / SNR_DISTANCE_FLOOR_M
-            };
-            v.distance[i] = distance;
-            v.inv_floored_sq[i] = inv_floored * inv_floored;
-        }
-        v
-    }
-}
 
 /// A transmitter as seen from `r̂⁻`: distance, unit vector, floored `1/d²` and, for `R` at the
 /// prediction, its gain toward `r̂⁻` (E8; 0 otherwise).

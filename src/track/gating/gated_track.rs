@@ -1,6 +1,9 @@
-//! The EKF of spec §6 fed by the estimation stage of spec §4: per snapshot predict, gate every
-//! link's estimates against the calibration (E4), associate the rest using the prediction
-//! (`h_p(r̂⁻)`, `√S_pp`), then update with the links that kept a measurement (an absent link
+//! Any filter of the seam ([`Filter`]: the EKF of spec §6, the UKF or the particle filter of
+//! `filters-and-planning.md` §1–2, or a [`crate::track::Tracker`] holding one) fed by the
+//! estimation stage of spec §4: per snapshot predict, gate every link's estimates against the
+//! calibration (E4), associate the rest using the filter's own prediction (`ẑ_p`, `√S_pp`:
+//! the EKF's from its Jacobian, the UKF's from its sigma points, the particle filter's from its
+//! weighted particles), then update with the links that kept a measurement (an absent link
 //! skips its row; none = predict only).
 //!
 //! Without a track yet (the measurement case of spec §9.6 starts with "LM at t₀ = 0"),
@@ -17,7 +20,7 @@ use crate::measure::Model;
 use crate::scenario::Area;
 use crate::track::gating::Calibration;
 use crate::track::gating::{select, AssociationRule, DelayEstimate, Selection};
-use crate::track::ConstantVelocity;
+use crate::track::{ConstantVelocity, Filter};
 use crate::track::{Ekf, MeasurementNoise, UpdateSummary};
 
 /// One step of [`GatedTracker::step`].
@@ -29,11 +32,11 @@ pub struct GatedStep {
     pub selection: Selection,
 }
 
-/// An EKF whose measurements pass through gating and association.
+/// A filter (by default the EKF) whose measurements pass through gating and association.
 #[derive(Debug, Clone)]
-pub struct GatedTracker<'a> {
+pub struct GatedTracker<'a, F: Filter = Ekf> {
     /// The filter (state after the last step).
-    pub ekf: Ekf,
+    pub filter: F,
     model: &'a Model,
     calibration: &'a Calibration,
     motion: ConstantVelocity,
@@ -41,20 +44,20 @@ pub struct GatedTracker<'a> {
     rule: AssociationRule,
 }
 
-impl<'a> GatedTracker<'a> {
-    /// A tracker on `model` with one calibration entry per link (else `LengthMismatch`),
-    /// associating under `rule`.
+impl<'a, F: Filter> GatedTracker<'a, F> {
+    /// A tracker of `filter` on `model` with one calibration entry per link (else
+    /// `LengthMismatch`), associating under `rule`.
     pub fn new(
-        ekf: Ekf,
+        filter: F,
         model: &'a Model,
         calibration: &'a Calibration,
         motion: ConstantVelocity,
         noise: MeasurementNoise<'a>,
         rule: AssociationRule,
-    ) -> Result<GatedTracker<'a>> {
+    ) -> Result<GatedTracker<'a, F>> {
         calibration.check_links(model.link_count())?;
         Ok(GatedTracker {
-            ekf,
+            filter,
             model,
             calibration,
             motion,
@@ -66,12 +69,12 @@ impl<'a> GatedTracker<'a> {
     /// Predict, gate and associate `snapshot` (`[p]` = link `p`'s estimates), update. On error
     /// the filter is left unchanged.
     pub fn step(&mut self, snapshot: &[Vec<DelayEstimate>]) -> Result<GatedStep> {
-        let mut next = self.ekf;
+        let mut next = self.filter.clone();
         next.predict(&self.motion);
         let predictions = next.predicted_delays(self.model, self.noise)?;
         let selection = select(self.calibration, snapshot, Some(&predictions), self.rule)?;
-        let summary = next.update(self.model, &selection.delays, self.noise, None)?;
-        self.ekf = next;
+        let summary = next.update(self.model, &selection.delays, self.noise)?;
+        self.filter = next;
         Ok(GatedStep { summary, selection })
     }
 }

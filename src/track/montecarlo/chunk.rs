@@ -14,7 +14,7 @@ use crate::track::TruthSampler;
 use crate::track::{
     range_information_per_snr, spd_quadratic_form, update_lanes, Ekf, MeasurementNoise, NodeView,
 };
-use crate::track::{FilterKind, Tracker};
+use crate::track::{Filter, FilterKind, Tracker};
 
 /// Salt of the particle filters' own streams (particles, resampling), apart from the
 /// measurement-noise streams, so every filter of a study sees the same measurements.

@@ -4,12 +4,9 @@
 
 use std::path::Path;
 
-use serde::{Deserialize, Serialize};
-
-use scatterloc::track::gating::{default_channel, LoopPath, LOOP_DURATION_S};
-use scatterloc::track::gating::{
-    Calibration, ClusterConfig, LinkCalibration, MAX_CALIBRATION_SNAPSHOTS,
-};
+use scatterloc::formats::{CalibrationResult, CalibrationSnapshots, Measurements, RawStep, Truth};
+use scatterloc::track::gating::{default_channel, Calibration, ClusterConfig};
+use scatterloc::track::gating::{LoopPath, LOOP_DURATION_S};
 use scatterloc::track::paper_initial_covariance;
 use scatterloc::track::ConstantVelocity;
 use scatterloc::{measure, Model};
@@ -20,52 +17,9 @@ use super::study::{checked_steps, flag_error};
 use crate::cli::{CalibrateArgs, SimulateWalkArgs, WalkStart};
 use crate::CliError;
 
-/// The `--snapshots` file of `calibrate`: per snapshot, per link, the delay estimates, s.
-#[derive(Debug, Deserialize, Serialize)]
-#[serde(deny_unknown_fields)]
-pub struct SnapshotsFile {
-    /// `snapshots[k][p]` = link `p`'s delays in snapshot `k`.
-    pub snapshots: Vec<Vec<Vec<f64>>>,
-}
-
-/// The calibration file (`calibrate`'s output, `track --calibration`'s input).
-#[derive(Debug, Deserialize, Serialize)]
-pub struct CalibrationFile {
-    /// Clusterer gap `g`, s (informative on input).
-    #[serde(default)]
-    pub gap_s: Option<f64>,
-    /// The 50 % rule's fraction (informative on input).
-    #[serde(default)]
-    pub min_fraction: Option<f64>,
-    /// `σ_min`, s (informative on input).
-    #[serde(default)]
-    pub sigma_floor_s: Option<f64>,
-    /// Calibration snapshots used (informative on input).
-    #[serde(default)]
-    pub snapshot_count: Option<usize>,
-    /// Per link in scenario link order: `{"clusters": [{"mean_s", "sigma_s", ..}]}`.
-    pub links: Vec<LinkCalibration>,
-}
-
-impl CalibrationFile {
-    /// The validated calibration for a model with `links` links.
-    pub fn into_calibration(self, links: usize) -> Result<Calibration, scatterloc::Error> {
-        let cal = Calibration {
-            links: self
-                .links
-                .into_iter()
-                .enumerate()
-                .map(|(p, l)| LinkCalibration::from_clusters(p, l.clusters))
-                .collect::<Result<Vec<_>, _>>()?,
-        };
-        cal.check_links(links)?;
-        Ok(cal)
-    }
-}
-
 /// Reads `--calibration` for a model.
 pub fn read_calibration(path: &str, model: &Model) -> Result<Calibration, CliError> {
-    let f: CalibrationFile = read_json_file("calibration", path)?;
+    let f: CalibrationResult = read_json_file("calibration", path)?;
     f.into_calibration(model.link_count())
         .map_err(|e| CliError::usage(format!("--calibration {path}: {e}")))
 }
@@ -99,39 +53,13 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<(), CliError> {
         CliError::usage(format!("{flag}: {e}"))
     })?;
     let path = args.snapshots.as_str();
-    let f: SnapshotsFile = read_json_file("snapshots", path)?;
+    let f: CalibrationSnapshots = read_json_file("snapshots", path)?;
     let bad = |e: &dyn std::fmt::Display| CliError::usage(format!("--snapshots {path}: {e}"));
-    if f.snapshots.is_empty() || f.snapshots.len() > MAX_CALIBRATION_SNAPSHOTS {
-        return Err(bad(&format!(
-            "snapshots: {} given, 1 … {MAX_CALIBRATION_SNAPSHOTS} are allowed",
-            f.snapshots.len()
-        )));
-    }
-    for (k, snap) in f.snapshots.iter().enumerate() {
-        one_list_per_link(&format!("snapshots[{k}]"), snap.len(), n).map_err(|e| bad(&e))?;
-    }
-    let cal = Calibration::from_snapshots(&f.snapshots, n, &cfg).map_err(|e| bad(&e))?;
-    let out = CalibrationFile {
-        gap_s: Some(cfg.gap_s),
-        min_fraction: Some(cfg.min_fraction),
-        sigma_floor_s: Some(cfg.sigma_floor_s),
-        snapshot_count: Some(f.snapshots.len()),
-        links: cal.links,
-    };
+    let cal = f.calibrate(n, &cfg).map_err(|e| bad(&e))?;
+    let out = CalibrationResult::of(cal, &cfg, f.snapshots.len());
     match args.out.as_deref() {
         Some(p) => write_json_file("out", p, &out),
         None => emit_json(&out),
-    }
-}
-
-/// `Err` naming `field` unless it holds one list per link (`len == n`).
-pub fn one_list_per_link(field: &str, len: usize, n: usize) -> Result<(), String> {
-    if len == n {
-        Ok(())
-    } else {
-        Err(format!(
-            "{field}: expected {n} lists (one per link), found {len}"
-        ))
     }
 }
 
@@ -139,32 +67,6 @@ pub fn one_list_per_link(field: &str, len: usize, n: usize) -> Result<(), String
 /// `[delay, amplitude]` pair with a comma), so every file it writes stays below the input cap
 /// of 256 MiB ([`scatterloc::error::limits::MAX_INPUT_BYTES`]) and `track` can read it.
 const MAX_WALK_ESTIMATES: f64 = 5e6;
-
-/// One raw step of a measurements file: per link, `[delay_s, amplitude]` estimates.
-pub type RawStep = Vec<Vec<[f64; 2]>>;
-
-/// The measurements file `simulate-walk` writes (the `raw_steps` form of `track`).
-#[derive(Serialize)]
-struct WalkMeasurements {
-    dt_s: f64,
-    process_noise: f64,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    initial_state: Option<[f64; 4]>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    initial_covariance: Option<[[f64; 4]; 4]>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    initial_snapshot: Option<RawStep>,
-    raw_steps: Vec<RawStep>,
-}
-
-/// The truth file of `simulate-walk`.
-#[derive(Serialize)]
-struct WalkTruth {
-    t_s: Vec<f64>,
-    states: Vec<[f64; 4]>,
-    /// Per step, per link: whether the echo was resolved from every static path.
-    resolved: Vec<Vec<bool>>,
-}
 
 /// `--out-dir` must name a directory or a new path: not empty, not an existing file.
 fn check_out_dir(dir: &str) -> Result<(), CliError> {
@@ -220,9 +122,7 @@ pub fn simulate_walk(args: &SimulateWalkArgs) -> Result<(), CliError> {
     let cal_snaps = clean.calibration_snapshots(&model, ncal, &mut rng);
     let states = path.states(dt, steps);
     let raw = |snap: Vec<Vec<scatterloc::track::gating::DelayEstimate>>| -> RawStep {
-        snap.iter()
-            .map(|l| l.iter().map(|e| [e.delay_s, e.amplitude]).collect())
-            .collect()
+        Measurements::raw_step(&snap)
     };
     // The snapshot at t₀ (drawn either way, so the later ones do not depend on --start).
     let s0 = path.state_at(0.0);
@@ -239,16 +139,18 @@ pub fn simulate_walk(args: &SimulateWalkArgs) -> Result<(), CliError> {
         );
     }
     let p0 = paper_initial_covariance();
-    let measurements = WalkMeasurements {
+    let measurements = Measurements {
         dt_s: dt,
         process_noise: q,
         initial_state: from_truth.then(|| s0.into()),
         initial_covariance: from_truth
             .then(|| std::array::from_fn(|i| std::array::from_fn(|j| p0[(i, j)]))),
         initial_snapshot: (!from_truth).then_some(first),
-        raw_steps,
+        sigma_s: None,
+        steps: None,
+        raw_steps: Some(raw_steps),
     };
-    let truth = WalkTruth {
+    let truth = Truth {
         t_s: (1..=steps).map(|k| k as f64 * dt).collect(),
         states: states.iter().map(|s| (*s).into()).collect(),
         resolved,
@@ -259,7 +161,7 @@ pub fn simulate_walk(args: &SimulateWalkArgs) -> Result<(), CliError> {
     write_json_file(
         "out-dir",
         &file("calibration_snapshots.json"),
-        &SnapshotsFile {
+        &CalibrationSnapshots {
             snapshots: cal_snaps,
         },
     )?;

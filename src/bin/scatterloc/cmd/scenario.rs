@@ -2,9 +2,10 @@
 
 use serde::{Deserialize, Serialize};
 
+use scatterloc::formats::Sigma;
 use scatterloc::localize::crlb_at;
 use scatterloc::localize::{locate as lm_locate, DelayMeasurements, LmConfig};
-use scatterloc::{scenario::presets, Error, Mat2, Vec2};
+use scatterloc::{scenario::presets, Mat2, Vec2};
 
 use super::io::{emit, emit_json, model_of, read_json_file, read_scenario};
 use crate::cli::{CrlbArgs, LocateArgs, PresetArgs};
@@ -102,48 +103,6 @@ struct DelaysFile {
     /// Start of the iteration, m (default: grid search over the area).
     #[serde(default)]
     initial_m: Option<[f64; 2]>,
-}
-
-/// `sigma_s` of a measurements file: one delay standard deviation for all links or one per link, s.
-#[derive(Debug, Deserialize)]
-#[serde(untagged)]
-pub enum Sigma {
-    /// The same σ for every link.
-    One(f64),
-    /// One σ per link in scenario link order.
-    PerLink(Vec<f64>),
-}
-
-impl Sigma {
-    /// One σ per link for `n` links, each a finite number > 0 (errors name `sigma_s[k]`).
-    pub fn per_link(self, n: usize) -> Result<Vec<f64>, Error> {
-        let v = match self {
-            Sigma::One(v) => {
-                if !(v.is_finite() && v > 0.0) {
-                    return Err(Error::NotPositive {
-                        field: "sigma_s".into(),
-                        value: v,
-                    });
-                }
-                vec![v; n]
-            }
-            Sigma::PerLink(v) if v.len() != n => {
-                return Err(Error::LengthMismatch {
-                    field: "sigma_s",
-                    expected: n,
-                    found: v.len(),
-                })
-            }
-            Sigma::PerLink(v) => v,
-        };
-        match v.iter().position(|s| !(s.is_finite() && *s > 0.0)) {
-            Some(link) => Err(Error::InvalidSigma {
-                link,
-                value: v[link],
-            }),
-            None => Ok(v),
-        }
-    }
 }
 
 /// `scatterloc locate --scenario S --delays D`.

@@ -3,59 +3,30 @@
 //! predict only), `R` fixed from `sigma_s` or from the link budget (E8) at the predicted position.
 //! With `raw_steps` (every link's full list of `[delay, amplitude]` estimates) each step is first
 //! gated against `--calibration` (E4) and associated (spec §4) before the update.
-//! `--filter ukf|pf` runs the UKF or the particle filter instead (plain form only: gating and
-//! association use the EKF's predicted delays and innovation σ).
+//! `--filter ukf|pf` runs the UKF or the particle filter instead, in either form: gating and
+//! association then use that filter's predicted delays and innovation σ (its sigma points, its
+//! weighted particles).
 
-use serde::{Deserialize, Serialize};
+use serde::Serialize;
 
+use scatterloc::formats::{Measurements, RawStep, Start, Steps};
 use scatterloc::math::{Mat4, Vec4};
 use scatterloc::measure::rng;
 use scatterloc::scenario::Area;
 use scatterloc::track::gating::Calibration;
 use scatterloc::track::gating::{start_from_snapshot, GatedTracker, START_SPEED_SIGMA_MPS};
-use scatterloc::track::gating::{AssociationRule, Choice, DelayEstimate};
+use scatterloc::track::gating::{AssociationRule, Choice};
 use scatterloc::track::ConstantVelocity;
-use scatterloc::track::MAX_STEPS;
-use scatterloc::track::{Ekf, MeasurementNoise, Tracker, UpdateSummary};
+use scatterloc::track::{Ekf, Filter, MeasurementNoise, Tracker, UpdateSummary};
 use scatterloc::{Error, Model};
 
 use super::filters::filter_kinds;
-use super::gating::{one_list_per_link, read_calibration, RawStep};
+use super::gating::read_calibration;
 use super::io::{emit, model_of, read_json_file, read_scenario};
 use super::output::{check_writable, Format};
-use super::scenario::Sigma;
 use super::track_fig::{read_truth, write_track_figure, TrackSeries};
 use crate::cli::{Association, FilterName, TrackArgs};
 use crate::CliError;
-
-/// The `--measurements` file.
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct MeasurementsFile {
-    /// Step `T`, s.
-    dt_s: f64,
-    /// Process-noise intensity `q̃`, m²/s³.
-    process_noise: f64,
-    /// `x̂(t₀) = [x, y, vx, vy]`, m and m/s.
-    #[serde(default)]
-    initial_state: Option<[f64; 4]>,
-    /// `P(t₀)`, row-major.
-    #[serde(default)]
-    initial_covariance: Option<[[f64; 4]; 4]>,
-    /// No track yet (raw form only): the snapshot at t₀, `[[delay_s, amplitude], ..]` per link;
-    /// the filter starts from its LM fix.
-    #[serde(default)]
-    initial_snapshot: Option<RawStep>,
-    /// Fixed delay σ (one or per link), s; absent: the link budget at the prediction.
-    #[serde(default)]
-    sigma_s: Option<Sigma>,
-    /// Per step, one delay per link in scenario link order (`null` = missing), s.
-    #[serde(default)]
-    steps: Option<Vec<Vec<Option<f64>>>>,
-    /// Per step, per link, every `[delay_s, amplitude]` estimate (gated and associated).
-    #[serde(default)]
-    raw_steps: Option<Vec<RawStep>>,
-}
 
 /// Output of `track`: one entry per step (after its update).
 #[derive(Serialize)]
@@ -91,17 +62,6 @@ struct StartOut {
     choices: Vec<&'static str>,
 }
 
-/// One raw step as the core's estimates.
-fn estimates(step: &[Vec<[f64; 2]>]) -> Vec<Vec<DelayEstimate>> {
-    step.iter()
-        .map(|l| {
-            l.iter()
-                .map(|&[delay_s, amplitude]| DelayEstimate { delay_s, amplitude })
-                .collect()
-        })
-        .collect()
-}
-
 /// `scatterloc track --scenario S --measurements M [--calibration C] [--association R]`.
 pub fn track(args: &TrackArgs) -> Result<(), CliError> {
     let mpath = args.measurements.as_str();
@@ -126,15 +86,12 @@ pub fn track(args: &TrackArgs) -> Result<(), CliError> {
         ));
     }
     let scenario = read_scenario(&args.scenario)?;
-    let mut m: MeasurementsFile = read_json_file("measurements", mpath)?;
+    let m: Measurements = read_json_file("measurements", mpath)?;
     let bad = |e: &dyn std::fmt::Display| CliError::usage(format!("--measurements {mpath}: {e}"));
     let model = model_of(&scenario)?;
     let n = model.link_count();
-    let motion = ConstantVelocity::validated(m.dt_s, m.process_noise).map_err(|e| bad(&e))?;
-    let sigmas = match m.sigma_s.take() {
-        Some(s) => Some(s.per_link(n).map_err(|e| bad(&e))?),
-        None => None,
-    };
+    let motion = m.motion().map_err(|e| bad(&e))?;
+    let sigmas = m.sigmas(n).map_err(|e| bad(&e))?;
     let noise = match &sigmas {
         Some(s) => MeasurementNoise::Fixed(s),
         None => MeasurementNoise::AtPrediction,
@@ -151,24 +108,12 @@ pub fn track(args: &TrackArgs) -> Result<(), CliError> {
         // No calibration: nothing is static (every estimate is a candidate).
         links: vec![Default::default(); n],
     });
-    if name != FilterName::Ekf && m.raw_steps.is_some() {
-        return Err(CliError::usage(format!(
-            "--filter {}: the plain form (steps) only; raw_steps gating needs the EKF",
-            name.name()
-        )));
-    }
     let (ekf, start) = initial_filter(&m, &model, &cal, &scenario.area_m, &bad)?;
-    let len = match (&m.steps, &m.raw_steps) {
-        (Some(s), None) => s.len(),
-        (None, Some(r)) => r.len(),
-        _ => return Err(bad(&"give exactly one of steps and raw_steps")),
-    };
-    if len > MAX_STEPS {
-        return Err(bad(&format!(
-            "steps: {len} steps, at most {MAX_STEPS} are allowed"
-        )));
-    }
-    if m.raw_steps.is_none() && (args.calibration.is_some() || args.association.is_some()) {
+    let steps = m.steps().map_err(|e| bad(&e))?;
+    let len = steps.len();
+    if matches!(steps, Steps::Plain(_))
+        && (args.calibration.is_some() || args.association.is_some())
+    {
         return Err(CliError::usage(
             "--calibration/--association: apply to raw_steps only (this file has steps)",
         ));
@@ -184,21 +129,18 @@ pub fn track(args: &TrackArgs) -> Result<(), CliError> {
         static_removed: None,
         start,
     };
-    match (m.steps, m.raw_steps) {
-        (Some(steps), _) => {
-            // The particle filter draws its particles from stream 0 of `--seed`.
-            let own = rng(args.seed.unwrap_or(1), 0);
-            let filter = Tracker::new(kind, ekf.state, ekf.covariance, own).map_err(|e| bad(&e))?;
-            plain(
-                &model, filter, &motion, noise, &steps, m.dt_s, &mut out, &bad,
-            )?
+    // The particle filter draws its particles from stream 0 of `--seed`.
+    let own = rng(args.seed.unwrap_or(1), 0);
+    let filter = Tracker::new(kind, ekf.state, ekf.covariance, own).map_err(|e| bad(&e))?;
+    match steps {
+        Steps::Plain(steps) => plain(
+            &model, filter, &motion, noise, steps, m.dt_s, &mut out, &bad,
+        )?,
+        Steps::Raw(raw) => {
+            let tracker = GatedTracker::new(filter, &model, &cal, motion, noise, rule)
+                .map_err(|e| bad(&e))?;
+            gated(tracker, n, raw, m.dt_s, &mut out, &bad)?
         }
-        (_, Some(raw)) => {
-            let tracker =
-                GatedTracker::new(ekf, &model, &cal, motion, noise, rule).map_err(|e| bad(&e))?;
-            gated(tracker, n, &raw, m.dt_s, &mut out, &bad)?
-        }
-        (None, None) => unreachable!("checked above"),
     }
     if let Some((path, format)) = figure {
         let truth = match args.truth.as_deref() {
@@ -236,21 +178,18 @@ pub fn track(args: &TrackArgs) -> Result<(), CliError> {
 /// The filter at `t₀`: from `initial_state` and `initial_covariance`, or (raw steps only) from
 /// the LM fix of `initial_snapshot`, reported as `start`.
 fn initial_filter(
-    m: &MeasurementsFile,
+    m: &Measurements,
     model: &Model,
     cal: &Calibration,
     area: &Area,
     bad: &dyn Fn(&dyn std::fmt::Display) -> CliError,
 ) -> Result<(Ekf, Option<StartOut>), CliError> {
-    match (m.initial_state, m.initial_covariance, &m.initial_snapshot) {
-        (Some(x0), Some(p0), None) => {
-            let p0 = Mat4::from_fn(|i, j| p0[i][j]);
-            Ok((Ekf::new(Vec4::from(x0), p0).map_err(|e| bad(&e))?, None))
-        }
-        (None, None, Some(snap)) if m.raw_steps.is_some() => {
-            one_list_per_link("initial_snapshot", snap.len(), model.link_count())
+    match m.start().map_err(|e| bad(&e))? {
+        Start::Given(x0, p0) => Ok((Ekf::new(x0, p0).map_err(|e| bad(&e))?, None)),
+        Start::Snapshot(snap) => {
+            let snap = Measurements::estimates("initial_snapshot", snap, model.link_count())
                 .map_err(|e| bad(&e))?;
-            let f = start_from_snapshot(model, cal, &estimates(snap), area, START_SPEED_SIGMA_MPS)
+            let f = start_from_snapshot(model, cal, &snap, area, START_SPEED_SIGMA_MPS)
                 .map_err(|e| bad(&format!("initial_snapshot: {e}")))?;
             let c = &f.ekf.covariance;
             let start = StartOut {
@@ -263,9 +202,6 @@ fn initial_filter(
             };
             Ok((f.ekf, Some(start)))
         }
-        _ => Err(bad(
-            &"give initial_state and initial_covariance, or (with raw_steps) initial_snapshot",
-        )),
     }
 }
 
@@ -298,12 +234,7 @@ fn plain(
     let n = model.link_count();
     for (k, z) in steps.iter().enumerate() {
         let field = format!("steps[{k}]");
-        if z.len() != n {
-            return Err(bad(&format!(
-                "{field}: expected {n} delays (one per link, null = missing), found {}",
-                z.len()
-            )));
-        }
+        Measurements::check_plain_step(k, z, n).map_err(|e| bad(&e))?;
         filter.predict(motion);
         let summary = filter
             .update(model, z, noise)
@@ -316,7 +247,7 @@ fn plain(
 /// The raw form: every step (one list per each of `links` links) gated and associated by
 /// `tracker`, with what it chose.
 fn gated(
-    mut tracker: GatedTracker,
+    mut tracker: GatedTracker<Tracker>,
     links: usize,
     raw: &[RawStep],
     dt_s: f64,
@@ -326,12 +257,12 @@ fn gated(
     let (mut used, mut choices, mut removed) = (vec![], vec![], vec![]);
     for (k, step) in raw.iter().enumerate() {
         let field = format!("raw_steps[{k}]");
-        one_list_per_link(&field, step.len(), links).map_err(|e| bad(&e))?;
+        let estimates = Measurements::estimates(&field, step, links).map_err(|e| bad(&e))?;
         let s = tracker
-            .step(&estimates(step))
+            .step(&estimates)
             .map_err(|e| step_error(&field, e, bad))?;
-        let ekf = &tracker.ekf;
-        record(out, &ekf.state, &ekf.covariance, k, dt_s, &s.summary);
+        let f = &tracker.filter;
+        record(out, f.state(), f.covariance(), k, dt_s, &s.summary);
         choices.push(names(&s.selection.choices));
         used.push(s.selection.delays);
         removed.push(s.selection.static_removed);

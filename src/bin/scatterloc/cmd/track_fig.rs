@@ -5,24 +5,14 @@
 
 use plotters::coord::Shift;
 use plotters::prelude::*;
-use serde::Deserialize;
-
 use scatterloc::chart::{
     draw_curves, ChartError, CurveChartOptions, CurveSeries, LineKind, Marker,
 };
+use scatterloc::formats::Truth;
 
 use super::io::read_json_file;
 use super::output::{write_figure, Figure, Format};
 use crate::CliError;
-
-/// The `--truth` file: the true states at the track's times.
-#[derive(Debug, Deserialize)]
-pub struct TruthFile {
-    /// Times, s (must equal the track's).
-    pub t_s: Vec<f64>,
-    /// `[x, y, vx, vy]` per time.
-    pub states: Vec<[f64; 4]>,
-}
 
 /// What the figure is drawn from.
 pub struct TrackSeries<'a> {
@@ -49,33 +39,12 @@ impl Figure for TrackFigure<'_> {
     }
 }
 
-/// Reads `--truth` and checks that its times are the track's.
-pub fn read_truth(path: &str, t_s: &[f64]) -> Result<TruthFile, CliError> {
-    let truth: TruthFile = read_json_file("truth", path)?;
-    let bad = |m: String| CliError::usage(format!("--truth {path}: {m}"));
-    if truth.t_s.len() != t_s.len() || truth.states.len() != t_s.len() {
-        return Err(bad(format!(
-            "{} times and {} states, the track has {} steps",
-            truth.t_s.len(),
-            truth.states.len(),
-            t_s.len()
-        )));
-    }
-    if let Some(k) =
-        (0..t_s.len()).find(|&k| (truth.t_s[k] - t_s[k]).abs() > 1e-9 * t_s[k].abs().max(1.0))
-    {
-        return Err(bad(format!(
-            "t_s[{k}] = {} but the track's step is at {} s",
-            truth.t_s[k], t_s[k]
-        )));
-    }
-    if let Some(k) = truth
-        .states
-        .iter()
-        .position(|s| s.iter().any(|v| !v.is_finite()))
-    {
-        return Err(bad(format!("states[{k}]: not a finite number")));
-    }
+/// Reads `--truth` ([`Truth`]) and checks that its times are the track's.
+pub fn read_truth(path: &str, t_s: &[f64]) -> Result<Truth, CliError> {
+    let truth: Truth = read_json_file("truth", path)?;
+    truth
+        .check_times(t_s)
+        .map_err(|e| CliError::usage(format!("--truth {path}: {e}")))?;
     Ok(truth)
 }
 
@@ -84,7 +53,7 @@ pub fn write_track_figure(
     path: &str,
     format: Format,
     track: &TrackSeries,
-    truth: Option<&TruthFile>,
+    truth: Option<&Truth>,
     subtitle: String,
 ) -> Result<(), CliError> {
     let cm = |v: f64| 100.0 * v;

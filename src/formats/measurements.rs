@@ -1,0 +1,265 @@
+//! The measurements file of `track` (spec §6, §4): the CV model's step and intensity (E7), the
+//! start, an optional fixed delay σ and per step either one delay per link (`steps`, E1) or
+//! every link's `[delay, amplitude]` estimates (`raw_steps`, gated by E4 and associated by
+//! spec §4).
+
+use alloc::format;
+use alloc::string::String;
+use alloc::vec;
+use alloc::vec::Vec;
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::{Error, Result};
+use crate::math::{Mat4, Real, Vec4};
+use crate::scenario::parse_json;
+use crate::track::gating::DelayEstimate;
+use crate::track::{ConstantVelocity, MAX_STEPS};
+
+/// One raw step: per link, every `[delay_s, amplitude]` estimate.
+pub type RawStep = Vec<Vec<[f64; 2]>>;
+
+/// `sigma_s` of a measurements file: one delay standard deviation for all links or one per
+/// link, s.
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[serde(untagged)]
+pub enum Sigma {
+    /// The same σ for every link.
+    One(f64),
+    /// One σ per link in scenario link order.
+    PerLink(Vec<f64>),
+}
+
+impl Sigma {
+    /// One σ per link for `n` links, each a finite number > 0 (errors name `sigma_s`, or the
+    /// link of a bad per-link σ).
+    pub fn per_link(self, n: usize) -> Result<Vec<f64>> {
+        let v = match self {
+            Sigma::One(v) => {
+                if !(v.is_finite() && v > 0.0) {
+                    return Err(Error::NotPositive {
+                        field: "sigma_s".into(),
+                        value: v,
+                    });
+                }
+                vec![v; n]
+            }
+            Sigma::PerLink(v) if v.len() != n => {
+                return Err(Error::LengthMismatch {
+                    field: "sigma_s",
+                    expected: n,
+                    found: v.len(),
+                })
+            }
+            Sigma::PerLink(v) => v,
+        };
+        match v.iter().position(|s| !(s.is_finite() && *s > 0.0)) {
+            Some(link) => Err(Error::InvalidSigma {
+                link,
+                value: v[link],
+            }),
+            None => Ok(v),
+        }
+    }
+}
+
+/// The measurements file (`track --measurements`; `simulate-walk` writes the `raw_steps`
+/// form). Absent optional fields are not written.
+///
+/// # Example
+///
+/// ```
+/// use scatterloc::formats::{Measurements, Start, Steps};
+///
+/// let m = Measurements::from_json(
+///     r#"{"dt_s": 0.1, "process_noise": 0.1,
+///         "initial_state": [1, 2, 0, 0],
+///         "initial_covariance": [[0.1,0,0,0],[0,0.1,0,0],[0,0,0.01,0],[0,0,0,0.01]],
+///         "steps": [[3.0e-8, null]]}"#,
+/// )
+/// .unwrap();
+/// assert!(matches!(m.start().unwrap(), Start::Given(..)));
+/// let Steps::Plain(steps) = m.steps().unwrap() else { panic!("plain form") };
+/// Measurements::check_plain_step(0, &steps[0], 2).unwrap();
+/// // A step with the wrong number of delays is named.
+/// let e = Measurements::check_plain_step(0, &steps[0], 3).unwrap_err();
+/// assert_eq!(e.to_string(), "steps[0]: expected 3 delays (one per link, null = missing), found 2");
+/// ```
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct Measurements {
+    /// Step `T`, s.
+    pub dt_s: f64,
+    /// Process-noise intensity `q̃`, m²/s³.
+    pub process_noise: f64,
+    /// `x̂(t₀) = [x, y, vx, vy]`, m and m/s.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub initial_state: Option<[f64; 4]>,
+    /// `P(t₀)`, row-major.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub initial_covariance: Option<[[f64; 4]; 4]>,
+    /// No track yet (raw form only): the snapshot at t₀, `[[delay_s, amplitude], ..]` per link;
+    /// the filter starts from its LM fix.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub initial_snapshot: Option<RawStep>,
+    /// Fixed delay σ (one or per link), s; absent: the link budget at the prediction (E8).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sigma_s: Option<Sigma>,
+    /// Per step, one delay per link in scenario link order (`null` = missing), s.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub steps: Option<Vec<Vec<Option<f64>>>>,
+    /// Per step, per link, every `[delay_s, amplitude]` estimate (gated and associated).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub raw_steps: Option<Vec<RawStep>>,
+}
+
+/// The steps of a [`Measurements`] file, in one of its two forms.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Steps<'a> {
+    /// One delay (or `None`) per link and step.
+    Plain(&'a [Vec<Option<f64>>]),
+    /// Every estimate per link and step.
+    Raw(&'a [RawStep]),
+}
+
+impl Steps<'_> {
+    /// The number of steps.
+    pub fn len(&self) -> usize {
+        match self {
+            Steps::Plain(s) => s.len(),
+            Steps::Raw(s) => s.len(),
+        }
+    }
+
+    /// Whether there is no step.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+}
+
+/// How a [`Measurements`] file starts the filter.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Start<'a> {
+    /// `x̂(t₀)` and `P(t₀)` as given (validated by the filter).
+    Given(Vec4, Mat4),
+    /// The LM fix of this snapshot (raw form only).
+    Snapshot(&'a RawStep),
+}
+
+/// An [`Error::InvalidFile`] of `field`.
+fn invalid(field: impl Into<String>, reason: String) -> Error {
+    Error::InvalidFile {
+        field: field.into(),
+        reason,
+    }
+}
+
+/// `Err` naming `field` unless it holds one list per link (`len == n`): [`Error::InvalidFile`].
+pub fn one_list_per_link(field: &str, len: usize, n: usize) -> Result<()> {
+    if len == n {
+        Ok(())
+    } else {
+        Err(invalid(
+            field,
+            format!("expected {n} lists (one per link), found {len}"),
+        ))
+    }
+}
+
+impl Measurements {
+    /// Parses a measurements file (errors name the field: [`Error::Parse`]).
+    pub fn from_json(text: &str) -> Result<Measurements> {
+        parse_json(text)
+    }
+
+    /// The CV motion model (E7) of `dt_s` and `process_noise`, validated.
+    pub fn motion(&self) -> Result<ConstantVelocity> {
+        ConstantVelocity::validated(self.dt_s, self.process_noise)
+    }
+
+    /// The fixed σ per link of `links` links (`None`: from the link budget), validated as
+    /// [`Sigma::per_link`].
+    pub fn sigmas(&self, links: usize) -> Result<Option<Vec<Real>>> {
+        self.sigma_s.clone().map(|s| s.per_link(links)).transpose()
+    }
+
+    /// The steps: exactly one of `steps` and `raw_steps`, at most [`MAX_STEPS`] of them
+    /// ([`Error::InvalidFile`] of `steps` otherwise).
+    pub fn steps(&self) -> Result<Steps<'_>> {
+        let steps = match (&self.steps, &self.raw_steps) {
+            (Some(s), None) => Steps::Plain(s),
+            (None, Some(r)) => Steps::Raw(r),
+            _ => {
+                return Err(invalid(
+                    "steps",
+                    "give exactly one of steps and raw_steps".into(),
+                ))
+            }
+        };
+        let len = steps.len();
+        if len > MAX_STEPS {
+            return Err(invalid(
+                "steps",
+                format!("{len} steps, at most {MAX_STEPS} are allowed"),
+            ));
+        }
+        Ok(steps)
+    }
+
+    /// The start: `initial_state` with `initial_covariance`, or (with `raw_steps`) an
+    /// `initial_snapshot` ([`Error::InvalidFile`] of `initial_state` otherwise).
+    pub fn start(&self) -> Result<Start<'_>> {
+        match (
+            self.initial_state,
+            self.initial_covariance,
+            &self.initial_snapshot,
+        ) {
+            (Some(x0), Some(p0), None) => {
+                Ok(Start::Given(Vec4::from(x0), Mat4::from_fn(|i, j| p0[i][j])))
+            }
+            (None, None, Some(snap)) if self.raw_steps.is_some() => Ok(Start::Snapshot(snap)),
+            _ => Err(invalid(
+                "initial_state",
+                "give initial_state and initial_covariance, or (with raw_steps) initial_snapshot"
+                    .into(),
+            )),
+        }
+    }
+
+    /// Checks plain step `k`: one delay (or `null`) per each of `links` links.
+    pub fn check_plain_step(k: usize, z: &[Option<f64>], links: usize) -> Result<()> {
+        if z.len() == links {
+            Ok(())
+        } else {
+            Err(invalid(
+                format!("steps[{k}]"),
+                format!(
+                    "expected {links} delays (one per link, null = missing), found {}",
+                    z.len()
+                ),
+            ))
+        }
+    }
+
+    /// One raw step (or the initial snapshot) as the core's estimates, after checking it holds
+    /// one list per each of `links` links (errors name `field`).
+    pub fn estimates(field: &str, step: &RawStep, links: usize) -> Result<Vec<Vec<DelayEstimate>>> {
+        one_list_per_link(field, step.len(), links)?;
+        Ok(step
+            .iter()
+            .map(|l| {
+                l.iter()
+                    .map(|&[delay_s, amplitude]| DelayEstimate { delay_s, amplitude })
+                    .collect()
+            })
+            .collect())
+    }
+
+    /// The raw form of estimates (the inverse of [`Measurements::estimates`]).
+    pub fn raw_step(estimates: &[Vec<DelayEstimate>]) -> RawStep {
+        estimates
+            .iter()
+            .map(|l| l.iter().map(|e| [e.delay_s, e.amplitude]).collect())
+            .collect()
+    }
+}
