@@ -100,7 +100,8 @@ def roc(name, label, at):
     d = load(name)
     if d is None:
         return
-    print(f"\n{label} ({d['realisations']} realisations, {d['disagreements']} size-rule/i.c.b disagreements)")
+    extra = f", {d['disagreements']} size-rule/i.c.b disagreements (check 6)" if name == "va.json" else ""
+    print(f"\n{label} ({d['realisations']} realisations{extra})")
     for c in d["curves"]:
         pts = c["points"]
         best = max(pts, key=lambda p: p["p_d"])
