@@ -270,7 +270,7 @@ fn check10_monte_carlo_pcrlb_fast_profile_iii() {
 
 /// Spec check 10 at the paper step 2.048 ms (4883 steps), scenario I, with the seeds and
 /// standard errors of the fast profile ([`check10_seeds`]: each seed within 5 % of the table
-/// + 4 jackknife SE, and the seeds pooled), over seeds 1–3 ([`CHECK10_PAPER_SEEDS`]). Each seed
+/// plus 4 jackknife SE, and the seeds pooled), over seeds 1–3 ([`CHECK10_PAPER_SEEDS`]). Each seed
 /// is 5000 trajectories, 2.4·10⁷ truth steps and Fisher matrices per scenario: seconds in
 /// release, minutes in a debug build, so ignored by default. The former one-seed test asserted
 /// "within 5 %" on seed 1 alone. Seeds 1–3 are within 1 % of the table except III at 5 s
