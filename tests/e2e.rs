@@ -28,45 +28,58 @@ use scatterloc::{Model, Scenario, Vec2};
 mod tracking;
 
 /// Multi-target mode: drag a target, the detection follows (issue 4).
+#[cfg(test)]
 #[path = "e2e/mtl.rs"]
 mod mtl;
 
 /// Issue 12: hostile input bounded, named and harmless (stale recomputes, bad numbers, huge
 /// areas, large networks, URL options).
+#[cfg(test)]
 #[path = "e2e/hardening.rs"]
 mod hardening;
 
 /// Issue 13: the page's own map-kernel timing (SIMD) while a receiver is dragged.
+#[cfg(test)]
 #[path = "e2e/speed.rs"]
 mod speed;
 
 /// Issue 14: the Plan panel (planner in a Web Worker, Stop/Undo) and shared links.
+#[cfg(test)]
 #[path = "e2e/plan.rs"]
 mod plan;
 
 /// Issue 16: keyboard (Tab, arrows, Delete on the plot) and axe-core in the three views.
+#[cfg(test)]
 #[path = "e2e/a11y.rs"]
 mod a11y;
 
 /// Issue 16: responsive layout at four widths in the three views, and a touch drag (CDP).
+#[cfg(test)]
 #[path = "e2e/layout.rs"]
 mod layout;
 
 /// SVG text checks shared with the other figure-export tests.
+#[cfg(test)]
 #[path = "common/svg.rs"]
 mod svg;
 
 /// Issue 16 §6: "Save figure" (SVG through the CLI's chart code, PNG of the canvas).
+#[cfg(test)]
 #[path = "e2e/export.rs"]
 mod export;
 
 /// Issue 16 §3: zoom and pan (wheel, pinch, drag, double-click, buttons) in the three views.
+#[cfg(test)]
 #[path = "e2e/zoom.rs"]
 mod zoom;
 
-/// `SCATTERLOC_SCREENSHOT=1`: writes docs/screenshot-tracking.png.
+/// The docs screenshots: not a test, the example `screenshot` (`examples/screenshot.rs`) runs
+/// it through this harness. The example includes this file as a module, so the test modules
+/// above are `cfg(test)` and only the harness, the tracking helpers and this module compile
+/// there; in the test binary it is unused.
+#[cfg_attr(test, allow(dead_code))]
 #[path = "e2e/screenshot.rs"]
-mod screenshot;
+pub(crate) mod screenshot;
 
 /// One browser at a time (2-core machines).
 static SERIAL: Mutex<()> = Mutex::new(());

@@ -400,11 +400,11 @@ fn run_mtl_scene(text: &str) -> Verdict {
     Ok(Pass::Ok)
 }
 
-/// Each case runs in a child process (`fuzz_mtl_scene_child`): a run-away view (e.g. a huge
-/// `t_e`) cannot be stopped from inside.
+/// Each case runs in a child process (this test re-run by [`run_child`]; [`check::child_main`]
+/// runs the case there): a run-away view (e.g. a huge `t_e`) cannot be stopped from inside.
 #[test]
 fn fuzz_mtl_scene() {
-    if std::env::var("SCATTERLOC_FUZZ_CHILD").is_ok() {
+    if check::child_main("mtl_scene", run_mtl_scene) {
         return;
     }
     let dir = CaseDir::new("mtl_scene");
@@ -416,16 +416,10 @@ fn fuzz_mtl_scene() {
         mtl_docs(docs::mtl_scenes(), 4),
         |c| {
             let m = mutated(c);
-            let v = run_child("mtl_scene", "fuzz_mtl_scene_child", &dir, &m.text);
+            let v = run_child("mtl_scene", "fuzz_mtl_scene", &dir, &m.text);
             case(&m, v)
         },
     );
-}
-
-/// The child side of [`fuzz_mtl_scene`] (does nothing in a normal run).
-#[test]
-fn fuzz_mtl_scene_child() {
-    check::child_main("mtl_scene", run_mtl_scene);
 }
 
 // ------------------------------------------------------------------------------- network + ranges
@@ -448,11 +442,12 @@ fn run_mtl_request(text: &str) -> Verdict {
     Ok(Pass::Ok)
 }
 
-/// Each case runs in a child process (this binary's `fuzz_network_ranges_child`): Algorithm 1
-/// cannot be stopped from inside when it runs away, a child can be killed.
+/// Each case runs in a child process (this test re-run by [`run_child`]; [`check::child_main`]
+/// runs the case there): Algorithm 1 cannot be stopped from inside when it runs away, a child
+/// can be killed.
 #[test]
 fn fuzz_network_ranges() {
-    if std::env::var("SCATTERLOC_FUZZ_CHILD").is_ok() {
+    if check::child_main("network_ranges", run_mtl_request) {
         return;
     }
     let dir = CaseDir::new("network_ranges");
@@ -464,16 +459,10 @@ fn fuzz_network_ranges() {
         mtl_docs(docs::mtl_requests(), 4),
         |c| {
             let m = mutated(c);
-            let v = run_child("network_ranges", "fuzz_network_ranges_child", &dir, &m.text);
+            let v = run_child("network_ranges", "fuzz_network_ranges", &dir, &m.text);
             case(&m, v)
         },
     );
-}
-
-/// The child side of [`fuzz_network_ranges`] (does nothing in a normal run).
-#[test]
-fn fuzz_network_ranges_child() {
-    check::child_main("network_ranges", run_mtl_request);
 }
 
 // ------------------------------------------------------------------------------- empirical table

@@ -1,7 +1,8 @@
 //! The §8 experiments of spec `multi-target.md` as ROC sweeps: check 6 on the Fig. 3 data
 //! (size rule ≡ Bayesian i.c.b), the expected shapes of Fig. 4 (i.c.b false alarms before
-//! detections, PPP the other way round) and Fig. 5 (Bayesian MTL ≈ genie), thread-count
-//! independence, and named errors for bad configurations.
+//! detections, as [A] says; PPP the other way round, the spec's expectation, not a claim of
+//! [A]), Fig. 5 as docs/reproduction.md reports it (the genie misses more at low T_b, the two
+//! close at high T_b), thread-count independence, and named errors for bad configurations.
 
 #![cfg(not(target_arch = "wasm32"))]
 
@@ -54,7 +55,8 @@ fn fig3_size_rule_and_icb_are_identical() {
 
 /// Fig. 4: sweeping T_b, the i.c.b model (p_u = 0.5329 > 0.5) picks up false alarms before
 /// detections — its first non-empty threshold has P_FA > P_D — while the PPP model detects
-/// before it false-alarms. Also: P_D and the number of estimates never decrease with T_b at the
+/// before it false-alarms (spec §8's expectation; [A] says nothing about the PPP curve's
+/// order). Also: P_D and the number of estimates never decrease with T_b at the
 /// end of the sweep (all thresholds pass).
 #[test]
 fn fig4_icb_false_alarms_before_detections_ppp_not() {
@@ -71,28 +73,58 @@ fn fig4_icb_false_alarms_before_detections_ppp_not() {
     assert!(r.curves.iter().all(|c| c.points[0].estimates == 0));
 }
 
-/// Fig. 5: the genie-aided method (Algorithm 1 on the true matchings) and Bayesian MTL have
-/// nearly the same missed-detection probability 1 − P_D; the genie has no false alarms.
+/// Fig. 5, as docs/reproduction.md reports it (verdict "differs"): at low T_b the genie
+/// (Algorithm 1 on the true matchings) misses **more** than Bayesian MTL — 1 − P_D 0.86 vs 0.75
+/// at T_b = 2, a P_D gap MTL − genie of +0.11 — and at high T_b the two end close (0.160 vs
+/// 0.150 for T_b ≥ 11: a gap of −0.01); the genie has no false alarms. Those numbers are from
+/// the CLI run of 100 realisations, seed 1 (`mtl roc --experiment vc`).
+///
+/// Here: 8 seeds × 2 realisations (the 16 realisations of the former one-seed test, so the same
+/// run time), each seed a group of 2·K = 4 targets. The gap `d` is the mean of the groups'
+/// gaps and its standard error is `sd(d_g)/√8` over the groups (the realisations are
+/// independent; the two methods see the same scenes, so the gap is a paired difference). With
+/// the SE floored at one target in all (1/32), asserted:
+/// - at T_b = 2 and 20 the gap is within 3 SE of the docs' value (+0.11 and −0.01);
+/// - at T_b = 2 the gap is positive: the genie is not a benchmark there, the docs' verdict.
+///
+/// Seeds 1–8 give +0.188 (SE 0.062) at T_b = 2 and +0.000 (SE 0.047) at T_b = 20; the first
+/// realisation of each of seeds 1–48 gives +0.104 (SE 0.030) and +0.021 (SE 0.033).
 #[test]
-fn fig5_bayesian_mtl_close_to_genie() {
-    let mut cfg = ExperimentConfig::new(Experiment::Vc);
-    cfg.realisations = 16;
-    cfg.sweep = vec![4.0, 8.0, 12.0, 20.0];
-    let r = run(&cfg, 0);
-    let (mtl, genie) = (
-        curve(&r.curves, Method::Ppp),
-        curve(&r.curves, Method::Genie),
-    );
-    for (a, g) in mtl.points.iter().zip(&genie.points) {
-        assert_eq!(g.false_alarms, 0);
+fn fig5_genie_misses_more_at_low_threshold_as_documented() {
+    const SEEDS: std::ops::RangeInclusive<u64> = 1..=8;
+    // (T_b, the gap P_D(MTL) − P_D(genie) that docs/reproduction.md reports at it)
+    const DOCS: [(f64, f64); 2] = [(2.0, 0.86 - 0.75), (20.0, 0.150 - 0.160)];
+    let mut gaps = vec![Vec::new(); DOCS.len()];
+    let mut targets = 0;
+    for seed in SEEDS {
+        let mut cfg = ExperimentConfig::new(Experiment::Vc);
+        cfg.realisations = 2;
+        cfg.seed = seed;
+        cfg.sweep = DOCS.iter().map(|d| d.0).collect();
+        let r = run(&cfg, 0);
+        let (mtl, genie) = (
+            curve(&r.curves, Method::Ppp),
+            curve(&r.curves, Method::Genie),
+        );
+        targets += r.targets;
+        for (j, (a, g)) in mtl.points.iter().zip(&genie.points).enumerate() {
+            assert_eq!(g.false_alarms, 0, "seed {seed}: genie false alarms");
+            gaps[j].push((a.detections as f64 - g.detections as f64) / r.targets as f64);
+        }
+    }
+    for ((t_b, want), d) in DOCS.iter().zip(&gaps) {
+        let n = d.len() as f64;
+        let mean = d.iter().sum::<f64>() / n;
+        let sd = (d.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
+        let se = (sd / n.sqrt()).max(1.0 / targets as f64);
+        println!("T_b {t_b}: P_D gap MTL − genie {mean:+.3} (SE {se:.3}), docs {want:+.3}");
         assert!(
-            (a.p_d - g.p_d).abs() <= 0.15,
-            "T_b {}: MTL {} genie {}",
-            a.threshold,
-            a.p_d,
-            g.p_d
+            (mean - want).abs() <= 3.0 * se,
+            "T_b {t_b}: gap {mean:+.3} vs the docs' {want:+.3} ± 3 SE ({se:.3})"
         );
     }
+    let low = gaps[0].iter().sum::<f64>();
+    assert!(low > 0.0, "T_b 2: the genie does not miss more ({low})");
 }
 
 /// Results depend on the seed only: 1 thread, 2 threads and the sequential driver agree

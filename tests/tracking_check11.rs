@@ -11,7 +11,8 @@ mod common;
 use common::sensors_model as model;
 use common::tracking::{at, study, FAST_STEP_S};
 use scatterloc::math::Real;
-use scatterloc::track::{run_sequential, MonteCarloConfig, MonteCarloResult, TrackScenario};
+use scatterloc::track::{finish, run_chunk, run_sequential, MonteCarloConfig, PartialSums};
+use scatterloc::track::{MonteCarloResult, StudySums, TrackScenario};
 
 /// Runs the three scenarios and checks spec check 11:
 /// - ε_EKF ≥ ε_PCRLB up to Monte Carlo error at every step: the sample RMSE of N independent
@@ -20,17 +21,31 @@ use scatterloc::track::{run_sequential, MonteCarloConfig, MonteCarloResult, Trac
 /// - scenario I: ε_EKF/ε_PCRLB ≤ 1.05 for 1 ≤ t ≤ 5 s;
 /// - at 10 s the ratio exceeds 1.2 in II and III.
 ///
-/// Returns the ratios at 10 s.
-fn check11(trajectories: usize, noise_runs: usize) -> [Real; 3] {
+/// Returns the ratios at 10 s and their delete-a-group jackknife standard errors: the study is
+/// run chunk by chunk (as `run_sequential` runs it, so the curves are the same), each chunk of
+/// [`scatterloc::track::CHUNK_TRAJECTORIES`] trajectories a group; with chunk g left out the
+/// ratio is `q₋g`, and `SE² = (G − 1)/G · Σ_g (q₋g − mean q₋·)²`. The SE covers both the EKF's
+/// and the bound's Monte Carlo error (the same truths enter both) and needs no Gaussian
+/// assumption (near the nodes the squared errors are heavy-tailed).
+fn check11(trajectories: usize, noise_runs: usize) -> ([Real; 3], [Real; 3]) {
     let model = model();
     let slack = 1.0 - 3.0 * (1.0 / (2.0 * trajectories as Real)).sqrt();
-    TrackScenario::ALL.map(|s| {
-        let r: MonteCarloResult = run_sequential(
-            &model,
-            &study(s, FAST_STEP_S, trajectories, noise_runs),
-            |_, _| true,
-        )
-        .unwrap();
+    let mut se = [0.0; 3];
+    let at10 = TrackScenario::ALL.map(|s| {
+        let cfg = study(s, FAST_STEP_S, trajectories, noise_runs);
+        let parts: Vec<PartialSums> = (0..cfg.chunk_count())
+            .map(|c| run_chunk(&model, &cfg, c).unwrap())
+            .collect();
+        let result = |skip: Option<usize>| -> MonteCarloResult {
+            let mut sums = StudySums::new(cfg.steps);
+            for (g, p) in parts.iter().enumerate() {
+                if Some(g) != skip {
+                    sums.add(p);
+                }
+            }
+            finish(&cfg, &sums).unwrap()
+        };
+        let r = result(None);
         assert_eq!(r.failed_runs, 0);
         let ratio: Vec<Real> = r
             .rmse_ekf_m
@@ -57,21 +72,66 @@ fn check11(trajectories: usize, noise_runs: usize) -> [Real; 3] {
                 ratio[100]
             );
         }
+        let loo: Vec<Real> = (0..parts.len())
+            .map(|g| {
+                let r = result(Some(g));
+                r.rmse_ekf_m[100] / r.rmse_pcrlb_m[100].unwrap()
+            })
+            .collect();
+        let g = loo.len() as Real;
+        let mean = loo.iter().sum::<Real>() / g;
+        let row = TrackScenario::ALL.iter().position(|x| *x == s).unwrap();
+        se[row] = ((g - 1.0) / g * loo.iter().map(|q| (q - mean).powi(2)).sum::<Real>()).sqrt();
+        println!(
+            "check 11 {}: ratio at 10 s {:.4}, jackknife SE {:.4}",
+            s.name(),
+            ratio[100],
+            se[row]
+        );
         ratio[100]
-    })
+    });
+    (at10, se)
 }
 
+/// The spec's three reference seeds at the fast profile, ε_EKF/ε_PCRLB at 10 s (spec check 11:
+/// I 1.17–1.20, II 1.60–2.05, III 1.35–1.36).
+const SPEC_REFERENCE_AT_10S: [(Real, Real); 3] = [(1.17, 1.20), (1.60, 2.05), (1.35, 1.36)];
+
 /// Spec check 11 at the spec's size, 1000 × 10 runs (3·10⁶ EKF steps: ≈ 0.5 s in release, about
-/// a minute in a debug build). Seed 1 ratios at 10 s: I 1.19, II 1.79, III 1.29; seeds 1–5 give
-/// I ≤ 1.018 on [1, 5] s, II 1.51–1.81 and III 1.27–1.35 at 10 s.
+/// a minute in a debug build), seed 1. Besides check 11 itself ([`check11`]):
+/// - in II and III the 10 s ratio exceeds 1.2 by more than 2 of its jackknife SEs (one-sided
+///   97.7 %: the spec's threshold holds beyond the Monte Carlo error of this run, not by luck);
+/// - each 10 s ratio lies within 4 SE of the range of the spec's reference seeds (a run of the
+///   same study with another seed scatters by its SE; the spec does not say which seeds or
+///   implementation gave its ranges, so this checks consistency, not identity).
+///
+/// Seed 1 gives I 1.187 (SE 0.013), II 1.787 (SE 0.112), III 1.288 (SE 0.027) at 10 s. II's SE is
+/// 6 %, 2.8× the Gaussian √(1/(2N)) = 2.2 %: near the nodes the errors are heavy-tailed, as the
+/// spread over seeds 1–5 (II 1.51–1.81, III 1.27–1.35; I ≤ 1.018 on [1, 5] s) shows. (The former
+/// test pinned seed 1's own ratios, II 1.79 and III 1.29, to an unsourced ±0.01.)
 #[test]
 #[ignore = "3e6 EKF steps: run with --release -- --ignored"]
 fn check11_ekf_vs_pcrlb_fast_profile() {
-    let at10 = check11(1000, 10);
-    assert!(
-        (at10[1] - 1.79).abs() < 0.01 && (at10[2] - 1.29).abs() < 0.01,
-        "{at10:?}"
-    );
+    let (at10, se) = check11(1000, 10);
+    for (j, s) in TrackScenario::ALL.iter().enumerate() {
+        if *s != TrackScenario::I {
+            assert!(
+                at10[j] - 2.0 * se[j] > 1.2,
+                "check 11 {}: ratio {} − 2 SE ({}) ≤ 1.2",
+                s.name(),
+                at10[j],
+                se[j]
+            );
+        }
+        let (lo, hi) = SPEC_REFERENCE_AT_10S[j];
+        assert!(
+            at10[j] >= lo - 4.0 * se[j] && at10[j] <= hi + 4.0 * se[j],
+            "check 11 {}: ratio {} outside the spec's reference [{lo}, {hi}] ± 4 SE ({})",
+            s.name(),
+            at10[j],
+            se[j]
+        );
+    }
 }
 
 /// Spec check 11 at 200 × 5 runs (always run). Over seeds 1–8 at this size the scenario I ratio

@@ -1,20 +1,16 @@
 //! The docs screenshots (docs/screenshot-tracking.png by default; any mode through
 //! `SCATTERLOC_SCREENSHOT_HASH`), taken through the same browser harness as the end-to-end tests.
+//! Not a test (it asserts nothing): `cargo run --example screenshot` (examples/screenshot.rs).
 
 use super::tracking::{mc_done, wait_state};
 use super::{connect, js, open_hash, runtime, settle, start_server, Driver, SERIAL};
 
 /// Writes docs/screenshot-tracking.png (tracking mode, scenario II at 4.5 s, the particle
-/// filter animated, EKF, UKF and PF in the Monte Carlo, after a warm
-/// Monte Carlo re-run) when `SCATTERLOC_SCREENSHOT=1`; otherwise does nothing.
+/// filter animated, EKF, UKF and PF in the Monte Carlo, after a warm Monte Carlo re-run).
 /// `SCATTERLOC_SCREENSHOT_HASH` (page options), `SCATTERLOC_SCREENSHOT_OUT` (a path) and
 /// `SCATTERLOC_SCREENSHOT_SIZE` (the viewport, `WIDTHxHEIGHT` CSS px; 1400x900 by default) override.
-#[test]
-#[ignore = "needs chromium + chromedriver and www/pkg; set SCATTERLOC_SCREENSHOT=1"]
-fn tracking_screenshot() {
-    if std::env::var("SCATTERLOC_SCREENSHOT").map_or(true, |v| v != "1") {
-        return;
-    }
+/// Needs chromium + chromedriver (`CHROMEDRIVER`) and the page's wasm in www/pkg.
+pub(crate) fn tracking_screenshot() {
     let hash = std::env::var("SCATTERLOC_SCREENSHOT_HASH")
         .unwrap_or_else(|_| "#mode=tracking&track=II&step=45&filter=pf&filters=ekf,ukf,pf".into());
     let out = std::env::var("SCATTERLOC_SCREENSHOT_OUT").unwrap_or_else(|_| {

@@ -530,11 +530,19 @@ impl Drop for CaseDir {
 /// Marker of the verdict line a child case prints.
 const VERDICT: &str = "@@fuzz-verdict@@";
 
-/// In a child process (`SCATTERLOC_FUZZ_CHILD` = kind, `SCATTERLOC_FUZZ_CHILD_FILE` = case):
-/// runs `run` on the case text if `kind` is the one asked for and prints the verdict line.
-pub fn child_main(kind: &str, run: impl FnOnce(&str) -> Verdict) {
-    if std::env::var("SCATTERLOC_FUZZ_CHILD").ok().as_deref() != Some(kind) {
-        return;
+/// The child side of an in-process kind that runs its cases in child processes
+/// ([`run_child`]). The child is this test binary re-run with the kind's own (parent) test as
+/// the exact filter and `SCATTERLOC_FUZZ_CHILD` = kind, `SCATTERLOC_FUZZ_CHILD_FILE` = case: that
+/// test calls this first. In a child (`SCATTERLOC_FUZZ_CHILD` set) it runs `run` on the case
+/// text if `kind` is the one asked for, prints the verdict line and returns `true`: the test
+/// returns without fuzzing. In a normal run it returns `false`. (There is no separate child
+/// `#[test]`, which would pass in every normal run without testing anything.)
+pub fn child_main(kind: &str, run: impl FnOnce(&str) -> Verdict) -> bool {
+    let Ok(asked) = std::env::var("SCATTERLOC_FUZZ_CHILD") else {
+        return false;
+    };
+    if asked != kind {
+        return true;
     }
     let path = std::env::var("SCATTERLOC_FUZZ_CHILD_FILE").expect("case file");
     let text = std::fs::read_to_string(path).expect("read case");
@@ -544,9 +552,11 @@ pub fn child_main(kind: &str, run: impl FnOnce(&str) -> Verdict) {
         Err(f) => format!("fail {:?} {}", f.class, f.detail.replace('\n', " ")),
     };
     println!("{VERDICT} {line}");
+    true
 }
 
-/// Runs an in-process case in a child process of this test binary (its test `test_name`), so
+/// Runs an in-process case in a child process of this test binary (its test `test_name`, the
+/// kind's parent test, which hands it to [`child_main`]), so
 /// that a run-away case is killed at the CLI time limit and bounded by the CLI memory limit.
 pub fn run_child(kind: &str, test_name: &str, dir: &CaseDir, text: &str) -> Verdict {
     let file = dir.write("case.json", text);
