@@ -17,8 +17,8 @@ step "no_std build (wasm32v1-none has no std in its sysroot)"
 cargo build --lib --no-default-features --target wasm32v1-none
 
 step "wasm-pack test --headless --chrome"
-# Only the targets that hold wasm tests (the library's and tests/wasm.rs): building the 30 other
-# integration tests for wasm, all empty there, took about two minutes.
+# Only the targets that hold wasm tests (the library's and tests/wasm.rs): building the other
+# integration tests for wasm, all empty there, took about two minutes (when there were 30).
 wasm-pack test --headless --chrome --mode no-install -- --lib --test wasm 2>&1 | tee -a "$log"
 
 step "build the page's wasm (release, as served) for the end-to-end test"
@@ -28,7 +28,7 @@ step "native cargo test (unit, spec checks, properties, CLI)"
 cargo test 2>&1 | tee -a "$log"
 
 step "full-size spec checks: check 10 at the paper step, check 11 at full size (the cheap part of scripts/reproduce.sh)"
-cargo test --test tracking_pcrlb --test tracking_check11 --test mtl_sim -- --ignored 2>&1 | tee -a "$log"
+cargo test --test tracking --test mtl -- --ignored pcrlb:: check11:: sim:: 2>&1 | tee -a "$log"
 
 step "browser end-to-end (Debian chromium + chromedriver; prints the page's own map timing)"
 cargo test --test e2e -- --ignored --nocapture --test-threads=1 2>&1 | tee -a "$log"

@@ -501,7 +501,7 @@ fn gating_in_wasm() {
 }
 
 /// The planner in the browser (issue 14, check 4): the short plan of the native test
-/// `plans_depend_on_the_seed_only` (tests/planning.rs) through the page's binding gives the same
+/// `plans_depend_on_the_seed_only` (tests/library/planning.rs) through the page's binding gives the same
 /// bits; progress is reported per generation, a `false` from the callback cancels, and bad
 /// requests are named errors.
 #[wasm_bindgen_test]
@@ -518,7 +518,7 @@ fn plan_in_wasm_equals_native_and_cancels() {
     let rx2 = get(&get(&get(&plan, "scenario"), "receivers"), "1");
     let pos = get(&rx2, "position_m");
     let bits = [num(&pos, "0").to_bits(), num(&pos, "1").to_bits()];
-    // tests/planning.rs DETERMINISM_RX2_BITS.
+    // tests/library/planning.rs DETERMINISM_RX2_BITS.
     assert_eq!(bits, [0x4021_e4d3_ec16_58ec, 0x4037_c8ac_686a_6934]);
     assert_eq!(num(&plan, "evaluations"), 300.0);
     let calls_made = num(&js_sys::global().into(), "__planCalls");

@@ -10,7 +10,7 @@ use scatterloc::scenario::Area;
 use scatterloc::{scenario::presets, Model, Scenario, Vec2};
 use serde_json::{json, Value};
 
-mod common;
+use crate::common;
 
 use common::cli::{fails, ok_json, run, TempDir, BIN};
 use common::within_rel;

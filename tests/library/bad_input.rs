@@ -10,7 +10,7 @@ use scatterloc::scenario::presets::{self, preset};
 use scatterloc::scenario::{Area, LinkSpec, Pattern, Scenario};
 use scatterloc::{Error, Model};
 
-mod common;
+use crate::common;
 
 use common::noise_free;
 

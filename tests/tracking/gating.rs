@@ -18,7 +18,7 @@ use scatterloc::track::ConstantVelocity;
 use scatterloc::track::{Ekf, MeasurementNoise};
 use scatterloc::{measure, scenario::presets};
 
-mod common;
+use crate::common;
 
 use common::sensors_model as model;
 

@@ -1,0 +1,35 @@
+//! End-to-end tests of the `scatterloc` binary, one module per command family: presets, CRLB,
+//! maps, locate, help and completions (`basics`), tracking studies (`tracking`, `montecarlo`,
+//! `filters`), the gating pipeline (`gating`), the planner (`plan`), the multi-target commands
+//! (`mtl`), sharded studies and `merge` (`scale_out`), and bounded, named bad input
+//! (`hardening`). Every module checks the "exit 2 + one stderr line naming the field" contract.
+#![cfg(not(target_arch = "wasm32"))]
+
+mod common;
+
+#[path = "cli/basics.rs"]
+mod basics;
+
+#[path = "cli/filters.rs"]
+mod filters;
+
+#[path = "cli/gating.rs"]
+mod gating;
+
+#[path = "cli/hardening.rs"]
+mod hardening;
+
+#[path = "cli/montecarlo.rs"]
+mod montecarlo;
+
+#[path = "cli/mtl.rs"]
+mod mtl;
+
+#[path = "cli/plan.rs"]
+mod plan;
+
+#[path = "cli/scale_out.rs"]
+mod scale_out;
+
+#[path = "cli/tracking.rs"]
+mod tracking;
