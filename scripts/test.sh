@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Sets up (idempotently) and runs every test: native cargo test, the no_std build,
-# wasm-pack test in headless Chromium, and the browser end-to-end test.
+# Sets up (idempotently) and runs every test: rustfmt and clippy (native and wasm32), native
+# cargo test, the no_std build, wasm-pack test in headless Chromium, and the browser end-to-end
+# test.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 export PATH="$HOME/.cargo/bin:$PATH"
@@ -12,6 +13,15 @@ export CARGO_INCREMENTAL="${CARGO_INCREMENTAL:-0}"
 
 step() { printf '\n==== [%dm%02ds] %s\n' $(((SECONDS - start) / 60)) $(((SECONDS - start) % 60)) "$*"; }
 log=$(mktemp); trap 'rm -f "$log"' EXIT
+
+step "cargo fmt --check"
+cargo fmt --check
+
+step "cargo clippy --all-targets -- -D warnings (native: library, CLI, tests, benches)"
+cargo clippy --all-targets -- -D warnings
+
+step "cargo clippy for wasm32 (the page's bindings and tests/wasm.rs)"
+cargo clippy --target wasm32-unknown-unknown --lib --test wasm -- -D warnings
 
 step "no_std build (wasm32v1-none has no std in its sysroot)"
 cargo build --lib --no-default-features --target wasm32v1-none
