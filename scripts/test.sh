@@ -26,6 +26,13 @@ cargo clippy --target wasm32-unknown-unknown --lib --test wasm -- -D warnings
 step "no_std build (wasm32v1-none has no std in its sysroot)"
 cargo build --lib --no-default-features --target wasm32v1-none
 
+step "core + parallel driver alone (features: parallel; no plotters, no wasm-bindgen)"
+cargo build --no-default-features --features parallel
+if cargo tree --no-default-features --features parallel -e normal | grep -E 'plotters|wasm-bindgen'; then
+  echo "the parallel feature pulls in plotters or wasm-bindgen" >&2
+  exit 1
+fi
+
 step "wasm-pack test --headless --chrome"
 # Only the targets that hold wasm tests (the library's and tests/wasm.rs): building the other
 # integration tests for wasm, all empty there, took about two minutes (when there were 30).
