@@ -644,7 +644,8 @@ fn unknown_preset() {
     assert_eq!(
         e,
         Error::UnknownPreset {
-            name: "sensors2020".into()
+            name: "sensors2020".into(),
+            known: &presets::PRESET_NAMES
         }
     );
     names(&e, "sensors2020");

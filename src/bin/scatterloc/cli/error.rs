@@ -7,7 +7,7 @@ use std::ffi::OsString;
 use clap::error::{ContextKind, ContextValue, ErrorKind};
 
 use super::Parsed;
-use crate::CliError;
+use crate::failure::CliError;
 
 /// Prints help or the version (status 0), or turns any other error into a usage error.
 /// `argv` (without the program name) tells which subcommand the error belongs to.

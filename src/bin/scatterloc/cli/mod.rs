@@ -27,7 +27,7 @@ pub use study::{MontecarloArgs, PcrlbArgs, StudyArgs};
 pub use track::{CalibrateArgs, SimulateWalkArgs, TrackArgs};
 pub use values::{Association, MtlModel, RocExperiment, ShardSpec, Trajectory, WalkStart};
 
-use crate::CliError;
+use crate::failure::CliError;
 
 /// The top-level help's list of commands with their main flags, and the conventions.
 const AFTER_HELP: &str = "\

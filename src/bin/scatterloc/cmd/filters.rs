@@ -5,7 +5,7 @@
 use scatterloc::track::{FilterKind, PfConfig, UkfParams};
 
 use crate::cli::{FilterName, FilterSettings};
-use crate::CliError;
+use crate::failure::CliError;
 
 /// The core's field names of the filter settings and their flags.
 const FLAGS: [(&str, &str); 5] = [

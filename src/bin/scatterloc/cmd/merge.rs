@@ -16,7 +16,7 @@ use scatterloc::math::Shard;
 use super::io::read_input_named;
 use super::shard::{ShardDoc, Timing, PART_FORMAT, PART_VERSION};
 use crate::cli::MergeArgs;
-use crate::CliError;
+use crate::failure::CliError;
 
 /// Study kinds and the unit their shards split.
 const STUDIES: [(&str, &str); 2] = [("montecarlo", "chunks"), ("mtl-roc", "realisations")];

@@ -23,7 +23,7 @@ use super::study::{
     run_pcrlb_with_progress, run_with_progress, threads, Study,
 };
 use crate::cli::{FilterName, FilterSettings, MontecarloArgs, PcrlbArgs};
-use crate::CliError;
+use crate::failure::CliError;
 use clap::ValueEnum;
 
 /// Scalars of one Monte Carlo study, after the curves in the JSON file and in the summary.

@@ -15,7 +15,7 @@ use scatterloc::chart::{
 use super::io::emit;
 use super::output::{check_writable, write_figure, write_json_file, Figure, Format};
 use super::study::{at_report_times, AtTime, Study};
-use crate::CliError;
+use crate::failure::CliError;
 
 /// The curves of one trajectory and its scalars `M` (flattened after the curves).
 #[derive(Serialize)]

@@ -17,7 +17,7 @@ use scatterloc::math::{Shard, MAX_SHARDS};
 use super::io::emit;
 use super::output::{check_writable, write_json_file, Format};
 use crate::cli::{ShardArgs, ShardSpec};
-use crate::CliError;
+use crate::failure::CliError;
 
 /// The `format` of a part file.
 pub const PART_FORMAT: &str = "scatterloc-part";

@@ -26,7 +26,7 @@ use super::output::{check_writable, Format};
 use super::scenario::Sigma;
 use super::track_fig::{read_truth, write_track_figure, TrackSeries};
 use crate::cli::{Association, FilterName, TrackArgs};
-use crate::CliError;
+use crate::failure::CliError;
 
 /// The `--measurements` file.
 #[derive(Debug, Deserialize)]

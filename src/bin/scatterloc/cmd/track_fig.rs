@@ -13,7 +13,7 @@ use scatterloc::chart::{
 
 use super::io::read_json_file;
 use super::output::{write_figure, Figure, Format};
-use crate::CliError;
+use crate::failure::CliError;
 
 /// The `--truth` file: the true states at the track's times.
 #[derive(Debug, Deserialize)]

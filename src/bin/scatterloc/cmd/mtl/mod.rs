@@ -32,7 +32,7 @@ use super::output::{check_writable, write_figure, write_json_file, Figure, Forma
 use super::shard::{self, ShardDoc, Timing};
 use super::study::{cancelled, run_with_bar, threads};
 use crate::cli::{MtlLocateArgs, MtlModel, RocArgs, RocExperiment, Table2Args};
-use crate::CliError;
+use crate::failure::CliError;
 
 mod locate;
 mod roc;
