@@ -547,3 +547,22 @@ fn plan_in_wasm_equals_native_and_cancels() {
         assert!(m.contains(field), "{bad}: {m}");
     }
 }
+
+/// The limits the page range-checks its own inputs against are the core's (one definition): the
+/// URL's track step and the Plan panel's budget and default budget.
+#[wasm_bindgen_test]
+fn page_field_ranges_are_the_cores() {
+    let track: serde_json::Value = serde_json::from_str(&wasm::track_field_ranges()).unwrap();
+    assert_eq!(
+        track,
+        serde_json::json!({ "step": [0, wasm::MAX_TRACK_STEPS] })
+    );
+    let plan: serde_json::Value = serde_json::from_str(&wasm::plan_field_ranges()).unwrap();
+    assert_eq!(
+        plan,
+        serde_json::json!({
+            "budget": [1, scatterloc::plan::MAX_PLAN_BUDGET],
+            "default_budget": scatterloc::present::DEFAULT_PLAN_BUDGET,
+        })
+    );
+}
