@@ -292,7 +292,7 @@ pub fn parse(argv: Vec<OsString>) -> Result<Parsed, CliError> {
     let args = std::iter::once(OsString::from("scatterloc")).chain(argv.iter().cloned());
     let matches = match cmd.try_get_matches_from_mut(args) {
         Ok(m) => m,
-        Err(e) => return error::handle(e, &cmd, &argv),
+        Err(e) => return error::handle(e, &cmd, &argv).map(|()| Parsed::Printed),
     };
     Cli::from_arg_matches(&matches)
         .map(Parsed::Run)
