@@ -10,6 +10,8 @@ WASM_PACK_VERSION=0.15.1
 WB_VERSION=$(awk '$0=="name = \"wasm-bindgen\""{getline; gsub(/version = |"/,""); print; exit}' Cargo.lock)
 
 rustup target add wasm32-unknown-unknown wasm32v1-none >/dev/null 2>&1 || rustup target add wasm32-unknown-unknown wasm32v1-none
+# The fmt and clippy stages of scripts/test.sh.
+rustup component add rustfmt clippy >/dev/null 2>&1 || rustup component add rustfmt clippy
 
 if ! command -v chromium >/dev/null || ! command -v chromedriver >/dev/null; then
   apt-get update -qq

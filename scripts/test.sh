@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Sets up (idempotently) and runs every test: native cargo test, the no_std build,
-# wasm-pack test in headless Chromium, and the browser end-to-end test.
+# Sets up (idempotently) and runs every test: rustfmt and clippy (native and wasm32), native
+# cargo test, the no_std build, wasm-pack test in headless Chromium, and the browser end-to-end
+# test.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 export PATH="$HOME/.cargo/bin:$PATH"
@@ -13,12 +14,28 @@ export CARGO_INCREMENTAL="${CARGO_INCREMENTAL:-0}"
 step() { printf '\n==== [%dm%02ds] %s\n' $(((SECONDS - start) / 60)) $(((SECONDS - start) % 60)) "$*"; }
 log=$(mktemp); trap 'rm -f "$log"' EXIT
 
+step "cargo fmt --check"
+cargo fmt --check
+
+step "cargo clippy --all-targets -- -D warnings (native: library, CLI, tests, benches)"
+cargo clippy --all-targets -- -D warnings
+
+step "cargo clippy for wasm32 (the page's bindings and tests/wasm.rs)"
+cargo clippy --target wasm32-unknown-unknown --lib --test wasm -- -D warnings
+
 step "no_std build (wasm32v1-none has no std in its sysroot)"
 cargo build --lib --no-default-features --target wasm32v1-none
 
+step "core + parallel driver alone (features: parallel; no plotters, no wasm-bindgen)"
+cargo build --no-default-features --features parallel
+if cargo tree --no-default-features --features parallel -e normal | grep -E 'plotters|wasm-bindgen'; then
+  echo "the parallel feature pulls in plotters or wasm-bindgen" >&2
+  exit 1
+fi
+
 step "wasm-pack test --headless --chrome"
-# Only the targets that hold wasm tests (the library's and tests/wasm.rs): building the 30 other
-# integration tests for wasm, all empty there, took about two minutes.
+# Only the targets that hold wasm tests (the library's and tests/wasm.rs): building the other
+# integration tests for wasm, all empty there, took about two minutes (when there were 30).
 wasm-pack test --headless --chrome --mode no-install -- --lib --test wasm 2>&1 | tee -a "$log"
 
 step "build the page's wasm (release, as served) for the end-to-end test"
@@ -28,7 +45,7 @@ step "native cargo test (unit, spec checks, properties, CLI)"
 cargo test 2>&1 | tee -a "$log"
 
 step "full-size spec checks: check 10 at the paper step, check 11 at full size (the cheap part of scripts/reproduce.sh)"
-cargo test --test tracking_pcrlb --test tracking_check11 --test mtl_sim -- --ignored 2>&1 | tee -a "$log"
+cargo test --test tracking --test mtl -- --ignored pcrlb:: check11:: sim:: 2>&1 | tee -a "$log"
 
 step "browser end-to-end (Debian chromium + chromedriver; prints the page's own map timing)"
 cargo test --test e2e -- --ignored --nocapture --test-threads=1 2>&1 | tee -a "$log"

@@ -30,14 +30,17 @@
 //! - [`present`]: view models shared by the page and the figures: ticks, colour map, snapshot and
 //!   track views, the interactive session.
 //!
-//! Platform edges (`std`):
-//! - `native` (native `std` only): the one ordered parallel driver (rayon) of Monte Carlo studies
-//!   and multi-target sweeps.
-//! - `chart` (`std`): plotters figures on any drawing backend (SVG/PNG natively, a canvas in the
-//!   page).
-//! - `wasm` (`std` on wasm32 only): the page's bindings; they only wrap the core.
+//! Platform edges, one cargo feature each (all in `default`; each implies `std`):
+//! - `native` (feature `parallel`, not on wasm32): the one ordered parallel driver (rayon) of
+//!   Monte Carlo studies and multi-target sweeps.
+//! - `chart` (feature `chart`): plotters figures on any drawing backend (SVG/PNG natively, a
+//!   canvas in the page).
+//! - `wasm` (feature `wasm`, wasm32 only; implies `chart`): the page's bindings; they only wrap
+//!   the core.
 //!
-//! The CLI lives in `src/bin/scatterloc` and uses only the public API.
+//! The CLI lives in `src/bin/scatterloc` (feature `cli`, which implies `parallel` and `chart`) and
+//! uses only the public API. `--no-default-features --features parallel` is the core with the
+//! parallel driver and neither plotters nor wasm-bindgen.
 #![cfg_attr(not(feature = "std"), no_std)]
 
 extern crate alloc;
@@ -54,11 +57,11 @@ pub mod scenario;
 pub mod study;
 pub mod track;
 
-#[cfg(feature = "std")]
+#[cfg(feature = "chart")]
 pub mod chart;
-#[cfg(all(feature = "std", not(target_arch = "wasm32")))]
+#[cfg(all(feature = "parallel", not(target_arch = "wasm32")))]
 pub mod native;
-#[cfg(all(feature = "std", target_arch = "wasm32"))]
+#[cfg(all(feature = "wasm", target_arch = "wasm32"))]
 pub mod wasm;
 
 pub use error::{Error, Result};

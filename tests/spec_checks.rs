@@ -1,7 +1,7 @@
 #![cfg(not(target_arch = "wasm32"))]
 //! Spec §0 checks 1, 2, 3, 6, 7 and 8 (`shared/spec/delay-localization.md`), plus the §2 ellipse
-//! geometry and the CRLB map kernel (checks 4, 5, 9–11: `tracking_*.rs` and the unit tests; check
-//! 12: `gating.rs`). Every expected number is quoted from the spec (its check
+//! geometry and the CRLB map kernel (checks 4, 5, 9–11: `tracking/*.rs` and the unit tests; check
+//! 12: `tracking/gating.rs`). Every expected number is quoted from the spec (its check
 //! number is cited next to it) or derived from a closed form / finite difference stated in a comment.
 //! Tolerances for printed values are half a unit of the last printed digit.
 

@@ -501,7 +501,7 @@ fn gating_in_wasm() {
 }
 
 /// The planner in the browser (issue 14, check 4): the short plan of the native test
-/// `plans_depend_on_the_seed_only` (tests/planning.rs) through the page's binding gives the same
+/// `plans_depend_on_the_seed_only` (tests/library/planning.rs) through the page's binding gives the same
 /// bits; progress is reported per generation, a `false` from the callback cancels, and bad
 /// requests are named errors.
 #[wasm_bindgen_test]
@@ -518,7 +518,7 @@ fn plan_in_wasm_equals_native_and_cancels() {
     let rx2 = get(&get(&get(&plan, "scenario"), "receivers"), "1");
     let pos = get(&rx2, "position_m");
     let bits = [num(&pos, "0").to_bits(), num(&pos, "1").to_bits()];
-    // tests/planning.rs DETERMINISM_RX2_BITS.
+    // tests/library/planning.rs DETERMINISM_RX2_BITS.
     assert_eq!(bits, [0x4021_e4d3_ec16_58ec, 0x4037_c8ac_686a_6934]);
     assert_eq!(num(&plan, "evaluations"), 300.0);
     let calls_made = num(&js_sys::global().into(), "__planCalls");
@@ -546,4 +546,23 @@ fn plan_in_wasm_equals_native_and_cancels() {
         let m = err(wasm::plan_network(&scenario, bad, &calls));
         assert!(m.contains(field), "{bad}: {m}");
     }
+}
+
+/// The limits the page range-checks its own inputs against are the core's (one definition): the
+/// URL's track step and the Plan panel's budget and default budget.
+#[wasm_bindgen_test]
+fn page_field_ranges_are_the_cores() {
+    let track: serde_json::Value = serde_json::from_str(&wasm::track_field_ranges()).unwrap();
+    assert_eq!(
+        track,
+        serde_json::json!({ "step": [0, wasm::MAX_TRACK_STEPS] })
+    );
+    let plan: serde_json::Value = serde_json::from_str(&wasm::plan_field_ranges()).unwrap();
+    assert_eq!(
+        plan,
+        serde_json::json!({
+            "budget": [1, scatterloc::plan::MAX_PLAN_BUDGET],
+            "default_budget": scatterloc::present::DEFAULT_PLAN_BUDGET,
+        })
+    );
 }

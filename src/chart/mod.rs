@@ -8,11 +8,12 @@
 //! [`draw_curves`] draws the ROC and missed-detection curves of the multi-target experiments.
 //! [`draw_mtl_scene`] draws a multi-target scene and its view (the page's multi-target view).
 
+mod clip;
 mod layout;
 mod map;
 mod overlay;
+mod panel;
 mod plan;
-mod raster;
 mod roc;
 mod scene;
 mod tracking;
@@ -20,10 +21,10 @@ mod tracking;
 pub(crate) use layout::{axis_label, chart_err};
 pub use layout::{register_fonts, suggested_size, ChartError};
 pub use map::{
-    check_area, default_titles, draw_crlb_map, draw_crlb_map_with, scenario_nodes, ChartNode,
-    ChartOptions, ChartSummary, MapData, NodeKind,
+    default_titles, draw_crlb_map, draw_crlb_map_with, scenario_nodes, ChartOptions, ChartSummary,
 };
 pub use overlay::{MapOverlay, OverlayLine, OverlayMark, OverlayMarkKind, OverlayPath};
+pub use panel::{check_area, ChartNode, MapData, NodeKind};
 pub use plan::{
     draw_plan_maps, plan_caption, plan_chart_size, PlanChartOptions, PlanPanel, PlanPath,
 };

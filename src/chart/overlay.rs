@@ -10,8 +10,9 @@ use alloc::vec::Vec;
 use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 
+use super::clip::clipped_runs;
 use super::layout::chart_err;
-use super::raster::{in_window, legend_entry, plot_window, Chart};
+use super::panel::{in_window, legend_entry, plot_window, Chart};
 use super::ChartError;
 use crate::math::Real;
 use crate::measure::Ellipse;
@@ -27,7 +28,7 @@ const TRACK_RGB: RGBColor = RGBColor(255, 127, 14);
 const CRLB_RGB: RGBColor = RGBColor(92, 200, 255);
 /// The colour of link `i` ([`LINK_RGB`], as the page's).
 fn link_rgb(i: usize) -> RGBColor {
-    super::raster::rgb(LINK_RGB[i % LINK_RGB.len()])
+    super::panel::rgb(LINK_RGB[i % LINK_RGB.len()])
 }
 
 /// How an [`OverlayPath`] is drawn.
@@ -226,49 +227,6 @@ impl MapOverlay {
     }
 }
 
-/// The runs of the polyline `points` (closed back to its start when `closed`) inside the view
-/// `[x0, x1, y0, y1]`: each segment is clipped, and a run breaks where the line leaves the view.
-pub(super) fn clipped_runs(
-    points: &[[Real; 2]],
-    closed: bool,
-    view: [Real; 4],
-) -> Vec<Vec<(Real, Real)>> {
-    let mut pts: Vec<(Real, Real)> = points
-        .iter()
-        .filter(|p| p[0].is_finite() && p[1].is_finite())
-        .map(|p| (p[0], p[1]))
-        .collect();
-    if closed && pts.len() > 2 {
-        pts.push(pts[0]);
-    }
-    let mut runs: Vec<Vec<(Real, Real)>> = Vec::new();
-    let mut run: Vec<(Real, Real)> = Vec::new();
-    for w in pts.windows(2) {
-        match super::plan::clip_segment(w[0], w[1], view) {
-            Some([a, b]) => {
-                if run.last() != Some(&a) {
-                    if run.len() > 1 {
-                        runs.push(core::mem::take(&mut run));
-                    }
-                    run.clear();
-                    run.push(a);
-                }
-                run.push(b);
-            }
-            None => {
-                if run.len() > 1 {
-                    runs.push(core::mem::take(&mut run));
-                }
-                run.clear();
-            }
-        }
-    }
-    if run.len() > 1 {
-        runs.push(run);
-    }
-    runs
-}
-
 /// A marker of `kind` at `at` (metres on a chart, pixels in a legend), `$size` px across its
 /// arms, lines `$width` px: one element type for every kind (unused parts are transparent, which
 /// the backends skip).
@@ -394,7 +352,8 @@ pub(crate) fn draw_overlay<'a, DB: DrawingBackend + 'a>(
 
 #[cfg(test)]
 mod tests {
-    use super::{clipped_runs, MapOverlay};
+    use super::MapOverlay;
+    use crate::chart::clip::clipped_runs;
     use crate::chart::{draw_crlb_map_with, scenario_nodes, ChartOptions, MapData};
     use crate::localize::{crlb_map, Grid};
     use crate::present::simulate_snapshot;

@@ -11,10 +11,9 @@ use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
+use super::clip::clip_segment;
 use super::layout::{self, chart_err, register_fonts, ChartError, Fonts, TitleBand};
-use super::map::{check_area, finish_panel, map_panel};
-use super::raster::{self, Chart};
-use super::{ChartNode, MapData};
+use super::panel::{self, check_area, finish_panel, map_panel, Chart, ChartNode, MapData};
 use crate::math::Real;
 use crate::plan::Objective;
 use crate::present::{format_length_m, LogScale, PlanObjectiveJson};
@@ -258,7 +257,7 @@ pub fn draw_plan_maps<DB: DrawingBackend>(
         finish_panel(&mut chart, panel.nodes, l)?;
     }
     let bar_area = root.clone().shrink(first.bar_origin, first.bar_size);
-    raster::draw_colorbar(
+    panel::draw_colorbar(
         &bar_area,
         scale.as_ref(),
         unbounded_cells > 0,
@@ -374,7 +373,7 @@ fn draw_paths<'a, DB: DrawingBackend + 'a>(
     }
     if !paths.is_empty() {
         let half = marker.max(4);
-        raster::legend_entry(chart, "moved: start □ → end ○", move |(x, y)| {
+        panel::legend_entry(chart, "moved: start □ → end ○", move |(x, y)| {
             EmptyElement::at((x, y))
                 + PathElement::new(
                     [(-2 * half, 0), (2 * half, 0)],
@@ -383,67 +382,4 @@ fn draw_paths<'a, DB: DrawingBackend + 'a>(
         })?;
     }
     Ok(())
-}
-
-/// The part of the segment `a`–`b` inside the rectangle `[x0, x1, y0, y1]` (Liang–Barsky), or
-/// `None` when it misses it.
-pub(super) fn clip_segment(
-    a: (Real, Real),
-    b: (Real, Real),
-    r: [Real; 4],
-) -> Option<[(Real, Real); 2]> {
-    let (dx, dy) = (b.0 - a.0, b.1 - a.1);
-    let (mut t0, mut t1): (Real, Real) = (0.0, 1.0);
-    for (p, q) in [
-        (-dx, a.0 - r[0]),
-        (dx, r[1] - a.0),
-        (-dy, a.1 - r[2]),
-        (dy, r[3] - a.1),
-    ] {
-        if p == 0.0 {
-            if q < 0.0 {
-                return None;
-            }
-        } else {
-            let t = q / p;
-            if p < 0.0 {
-                t0 = t0.max(t);
-            } else {
-                t1 = t1.min(t);
-            }
-        }
-    }
-    (t0 <= t1).then_some([
-        (a.0 + t0 * dx, a.1 + t0 * dy),
-        (a.0 + t1 * dx, a.1 + t1 * dy),
-    ])
-}
-
-#[cfg(test)]
-mod tests {
-    use super::clip_segment;
-
-    #[test]
-    fn segments_are_clipped_to_the_view() {
-        let r = [0.0, 10.0, 0.0, 10.0];
-        assert_eq!(
-            clip_segment((1.0, 1.0), (2.0, 3.0), r),
-            Some([(1.0, 1.0), (2.0, 3.0)])
-        );
-        assert_eq!(
-            clip_segment((5.0, 5.0), (15.0, 5.0), r),
-            Some([(5.0, 5.0), (10.0, 5.0)])
-        );
-        assert_eq!(
-            clip_segment((-5.0, -5.0), (15.0, 15.0), r),
-            Some([(0.0, 0.0), (10.0, 10.0)])
-        );
-        // Touching a corner only.
-        assert_eq!(
-            clip_segment((-10.0, 0.0), (20.0, 30.0), r),
-            Some([(0.0, 10.0), (0.0, 10.0)])
-        );
-        assert_eq!(clip_segment((20.0, 20.0), (30.0, 25.0), r), None);
-        assert_eq!(clip_segment((-1.0, 5.0), (-1.0, 6.0), r), None);
-    }
 }

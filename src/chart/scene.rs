@@ -13,11 +13,11 @@ use plotters::coord::Shift;
 use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 
+use super::clip::{clip_polygon, clipped_runs};
 use super::layout::{self, chart_err, register_fonts, ChartError};
-use super::map::{check_area, draw_metre_axes, finish_panel, metre_chart};
-use super::overlay::clipped_runs;
-use super::raster::{in_window, legend_entry, plot_window, Chart};
-use super::{ChartNode, NodeKind, CURVE_PALETTE};
+use super::panel::{check_area, draw_metre_axes, finish_panel, metre_chart};
+use super::panel::{in_window, legend_entry, plot_window, Chart, ChartNode, NodeKind};
+use super::roc::CURVE_PALETTE;
 use crate::math::Real;
 use crate::measure::Ellipse;
 use crate::mtl::view::output::EllipseView;
@@ -127,43 +127,6 @@ pub fn draw_mtl_scene<DB: DrawingBackend>(
     draw_metre_axes(&mut chart, &lay)?;
     draw_layers(&mut chart, scene, view, lay.font.nodes)?;
     finish_panel(&mut chart, &scene_nodes(scene), &lay)
-}
-
-/// The polygon `points` clipped to the rectangle `r` = `[x0, x1, y0, y1]` (Sutherland–Hodgman;
-/// empty when it lies outside).
-fn clip_polygon(points: &[(Real, Real)], r: [Real; 4]) -> Vec<(Real, Real)> {
-    let mut out = points.to_vec();
-    for edge in 0..4 {
-        let inside = |p: (Real, Real)| match edge {
-            0 => p.0 >= r[0],
-            1 => p.0 <= r[1],
-            2 => p.1 >= r[2],
-            _ => p.1 <= r[3],
-        };
-        let cut = |a: (Real, Real), b: (Real, Real)| {
-            let t = match edge {
-                0 => (r[0] - a.0) / (b.0 - a.0),
-                1 => (r[1] - a.0) / (b.0 - a.0),
-                2 => (r[2] - a.1) / (b.1 - a.1),
-                _ => (r[3] - a.1) / (b.1 - a.1),
-            };
-            (a.0 + t * (b.0 - a.0), a.1 + t * (b.1 - a.1))
-        };
-        let input = core::mem::take(&mut out);
-        for (i, &b) in input.iter().enumerate() {
-            let a = input[(i + input.len() - 1) % input.len()];
-            match (inside(a), inside(b)) {
-                (true, true) => out.push(b),
-                (true, false) => out.push(cut(a, b)),
-                (false, true) => {
-                    out.push(cut(a, b));
-                    out.push(b);
-                }
-                (false, false) => {}
-            }
-        }
-    }
-    out
 }
 
 fn outline(e: &EllipseView) -> Vec<[Real; 2]> {
@@ -404,7 +367,8 @@ fn draw_layers<'a, DB: DrawingBackend + 'a>(
 
 #[cfg(test)]
 mod tests {
-    use super::{clip_polygon, draw_mtl_scene, scene_window, SceneChartOptions};
+    use super::{draw_mtl_scene, scene_window, SceneChartOptions};
+    use crate::chart::clip::clip_polygon;
     use crate::mtl::view::{mtl_view, MtlScene};
     use crate::scenario::Area;
     use plotters::prelude::*;

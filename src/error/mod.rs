@@ -147,6 +147,8 @@ pub enum Error {
     UnknownPreset {
         /// The name asked for.
         name: String,
+        /// The names there are (`scenario::presets::PRESET_NAMES`), listed by the message.
+        known: &'static [&'static str],
     },
     /// An index past the end of a list (a node, a grid column or row).
     IndexOutOfRange {
@@ -351,11 +353,11 @@ impl fmt::Display for Error {
                 "{field}: degenerate (every particle's likelihood is zero or not a number)"
             ),
             Error::Infeasible { field, reason } => write!(f, "{field}: {}", Clip(reason)),
-            Error::UnknownPreset { name } => write!(
+            Error::UnknownPreset { name, known } => write!(
                 f,
                 "unknown preset \"{}\" (known: {})",
                 Clip(name),
-                crate::scenario::presets::PRESET_NAMES.join(", ")
+                known.join(", ")
             ),
             Error::IndexOutOfRange { field, index, len } => {
                 write!(f, "{field}[{index}]: no such entry (there are {len})")

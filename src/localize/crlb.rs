@@ -7,10 +7,12 @@ use crate::measure::unit_from;
 use crate::measure::Ellipse;
 use crate::measure::{Model, SNR_DISTANCE_FLOOR_M};
 
+mod grid;
 mod map;
 mod simd;
 
-pub use map::{crlb_map, crlb_map_rows, crlb_map_scalar, Grid, MAX_GRID_CELLS, MAX_GRID_SIDE};
+pub use grid::{Grid, MAX_GRID_CELLS, MAX_GRID_SIDE};
+pub use map::{crlb_map, crlb_map_rows, crlb_map_scalar};
 
 /// A Fisher matrix whose reciprocal condition number `λ_min/λ_max` is below this is treated as
 /// singular: the position is unbounded along some direction (collinear or too few informative

@@ -411,7 +411,7 @@ pub const MAX_CACHED_TABLES: usize = 1 << 16;
 /// Algorithm 1 reaches the same least-squares location along several paths (a matching grown in
 /// another order, a late seed's catch-up) and Gauss–Newton lands within ≈ 1e-10 m of it each
 /// time, so tables memoised on this grid are reused. Moving `x` by ≤ 0.71 µm changes `L_b` by
-/// ≤ 1.1e-6 nats on random V-B queries (tested in `tests/mtl_blocking.rs`), far below the
+/// ≤ 1.1e-6 nats on random V-B queries (tested in `tests/mtl/blocking.rs`), far below the
 /// `T_b` steps of 0.25 nats. Outcomes are not bitwise those at exact locations: near-ties in `J`
 /// between candidates that reach the same matching along different paths can resolve the other
 /// way. The measurements behind this choice are in `docs/benchmarks.md` (table grid).

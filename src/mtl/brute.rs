@@ -15,7 +15,7 @@
 //! Accepted matchings are reported as targets after the same final merge as the staged algorithm
 //! (ascending `J` (M2), a matching sharing ≥ `merge_shared_pairs` pairs with a kept one is
 //! dropped; always applied here). "Staged = brute force" means: the same number of targets and a
-//! one-to-one pairing of their positions within a tolerance (see `tests/mtl_algorithm.rs`).
+//! one-to-one pairing of their positions within a tolerance (see `tests/mtl/algorithm.rs`).
 //!
 //! Speed-up (documented, \[P\] of this reference): from a start `x₀` an MPC is only tried when
 //! its normalized error at `x₀` against the two seed pairs is at most [`SCREEN_FACTOR`]`·T_e`.

@@ -17,6 +17,7 @@ pub fn preset(name: &str) -> Result<Scenario> {
         "iclgnss2019" => Ok(iclgnss2019()),
         _ => Err(Error::UnknownPreset {
             name: name.to_string(),
+            known: &PRESET_NAMES,
         }),
     }
 }

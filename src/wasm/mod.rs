@@ -34,9 +34,9 @@ pub use chart::draw_tracking_chart;
 pub use export::{mtl_scene_svg, tracking_chart_svg, MAX_FIGURE_PX, MAX_FIGURE_RES};
 pub use montecarlo::MonteCarloJob;
 pub use mtl::{mtl_check_scene, mtl_default_scene, mtl_view_of, MtlSession};
-pub use plan::plan_network;
+pub use plan::{plan_field_ranges, plan_network};
 pub use render::{
     axis_ticks, colorbar_rgba, colorbar_ticks, format_length, link_rgb, render_map_rgba, scale_bar,
     unbounded_rgb, MAX_AXIS_TICKS,
 };
-pub use tracking::{drag_velocity, track_steps, Track, MAX_TRACK_STEPS};
+pub use tracking::{drag_velocity, track_field_ranges, track_steps, Track, MAX_TRACK_STEPS};

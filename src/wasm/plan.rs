@@ -7,8 +7,21 @@ use wasm_bindgen::prelude::*;
 use super::err;
 use super::json::to_js;
 use crate::error::Error;
-use crate::present::{run_plan, PlanRequest};
+use crate::plan::MAX_PLAN_BUDGET;
+use crate::present::{run_plan, PlanRequest, DEFAULT_PLAN_BUDGET};
 use crate::Scenario;
+
+/// The core's range of the Plan panel's budget, which the page range-checks before the core
+/// does: `{"budget": [1, MAX_PLAN_BUDGET], "default_budget": DEFAULT_PLAN_BUDGET}`
+/// ([`MAX_PLAN_BUDGET`], [`DEFAULT_PLAN_BUDGET`]), so the page and the core share one definition.
+#[wasm_bindgen]
+pub fn plan_field_ranges() -> String {
+    serde_json::json!({
+        "budget": [1, MAX_PLAN_BUDGET],
+        "default_budget": DEFAULT_PLAN_BUDGET,
+    })
+    .to_string()
+}
 
 /// Plans a network on scenario JSON `scenario_json` (schema v1) for `request_json`:
 /// `{move, objective, roi: [x0, x1, y0, y1], bounds?, allowed?, min_spacing_m?, grid?, budget?,

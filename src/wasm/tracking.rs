@@ -19,6 +19,14 @@ use crate::{Model, Scenario};
 /// worker's memory bounded; 10 s at 1 ms).
 pub const MAX_TRACK_STEPS: usize = 10_000;
 
+/// The core's range of a track's step index (the URL's `step`), which the page range-checks
+/// before the core does: `{"step": [0, MAX_TRACK_STEPS]}` ([`MAX_TRACK_STEPS`]), so the page and
+/// the core share one definition.
+#[wasm_bindgen]
+pub fn track_field_ranges() -> String {
+    serde_json::json!({ "step": [0, MAX_TRACK_STEPS] }).to_string()
+}
+
 /// Most particle-steps (`steps × particles`) of one animated particle-filter track: it runs on
 /// the page's main thread (about 1 s in Chromium on a 2020s laptop core).
 pub const MAX_TRACK_PARTICLE_STEPS: usize = 10_000_000;

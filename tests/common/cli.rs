@@ -1,4 +1,4 @@
-//! Helpers of the CLI tests (`cli*.rs`): a temporary
+//! Helpers of the CLI tests (`cli.rs`, `cli/`): a temporary
 //! directory, running the binary, and the "exit 2 + one stderr line naming the field" contract
 //! for bad input.
 

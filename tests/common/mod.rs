@@ -7,10 +7,11 @@
 //! - [`sensors_model`]: the L4 model of the tracking paper's preset; [`noise_free`]: the inputs
 //!   of a noise-free fix;
 //! - [`cli`]: running the binary, temporary directories and the bad-input contract;
-//! - [`tracking`]: the §9.5 Monte Carlo studies and covariance comparisons of the `tracking_*`
+//! - [`tracking`]: the §9.5 Monte Carlo studies and covariance comparisons of the `tracking`
 //!   tests.
 //!
-//! Each test crate includes this module with `mod common;` and uses what it needs.
+//! Each test crate root includes this module with `mod common;` (its modules `use crate::common;`)
+//! and uses what it needs.
 #![allow(dead_code)]
 
 pub mod cli;

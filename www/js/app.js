@@ -22,8 +22,6 @@ import { setLinkColors } from './draw.js';
 
 const MODES = ['snapshot', 'tracking', 'mtl'];
 
-/** Most steps of a track (the core's MAX_TRACK_STEPS), for the URL's `step`. */
-const MAX_STEP = 10000;
 /** Most Monte Carlo runs the page offers (its largest choice). */
 const MAX_RUNS = 10000;
 const UINT32 = { min: 0, max: 4294967295, integer: true };
@@ -63,13 +61,15 @@ function hashOptions(presets) {
     if (parts.length !== n) throw new Error(`${k}: "${t}" is not ${n} comma-separated numbers`);
     return parts.map((p, i) => decimal(p, `${k}[${i}]`));
   });
+  // The step index's range is the core's (MAX_TRACK_STEPS, one definition).
+  const stepRange = JSON.parse(wasm.track_field_ranges()).step;
   const target = numbers('target', 2);
   const custom = numbers('custom', 4);
   const scenarioKey = ['z', 'scenario'].find((k) => h.has(k));
   const opts = {
     mode: oneOf('mode', MODES) ?? 'snapshot',
     track: oneOf('track', ['I', 'II', 'III', 'custom']),
-    step: read('step', (t) => decimalIn(t, 'step', { min: 0, max: MAX_STEP, integer: true })),
+    step: read('step', (t) => decimalIn(t, 'step', { min: stepRange[0], max: stepRange[1], integer: true })),
     play: h.get('play') === '1',
     runs: read('runs', (t) => decimalIn(t, 'runs', { min: 1, max: MAX_RUNS, integer: true })),
     ex: option('ex', 'track-ex'),

@@ -13,10 +13,6 @@
 import { $, clearError, decimalIn, errorText, fitCanvas, fixed, showError } from './dom.js';
 import { C, FONT } from './draw.js';
 
-/** The core's largest plan budget (MAX_PLAN_BUDGET). */
-const MAX_BUDGET = 1000000;
-/** The core's default budget (DEFAULT_PLAN_BUDGET). */
-const DEFAULT_BUDGET = 10000;
 /** Duration of a node glide to an improved layout, ms. */
 const GLIDE_MS = 200;
 /** A drag shorter than this (CSS px, either side) draws no ROI. */
@@ -25,7 +21,8 @@ const ROI_COLOR = '#ffd166';
 
 /** Inputs of the panel: the name in messages and the allowed range (dom.js decimalIn). */
 const FIELDS = {
-  'plan-budget': { name: 'plan budget', min: 1, max: MAX_BUDGET, integer: true, unit: 'evaluations' },
+  // min, max: the core's (MAX_PLAN_BUDGET), from plan_field_ranges in the constructor.
+  'plan-budget': { name: 'plan budget', integer: true, unit: 'evaluations' },
   'plan-seed': { name: 'plan seed', min: 0, max: Number.MAX_SAFE_INTEGER, integer: true },
   'plan-t': { name: 'plan coverage threshold T', min: 0.000001, max: 100000000, unit: 'm' },
 };
@@ -61,6 +58,10 @@ export class Plan {
   /** @param {object} ctx - {app, wasm, module, st, view, changed, showHint}. */
   constructor(ctx) {
     this.ctx = ctx;
+    // The budget's range and default come from the core (one definition).
+    const ranges = JSON.parse(ctx.wasm.plan_field_ranges());
+    [FIELDS['plan-budget'].min, FIELDS['plan-budget'].max] = ranges.budget;
+    this.defaultBudget = ranges.default_budget; // DEFAULT_PLAN_BUDGET
     this.status = 'idle'; // 'idle' | 'running' | 'done' | 'error'
     this.worker = null;
     this.runId = 0;
@@ -310,7 +311,7 @@ export class Plan {
     this.error = null;
     this.run = {
       id: ++this.runId, request, t0: performance.now(), evaluations: 0,
-      budget: request.budget ?? DEFAULT_BUDGET, best: null, messages: 0, improvements: 0,
+      budget: request.budget ?? this.defaultBudget, best: null, messages: 0, improvements: 0,
       wallMs: null, workerMs: null, stopped: null,
     };
     this.status = 'running';
@@ -561,7 +562,7 @@ export class Plan {
     g.setTransform(dpr, 0, 0, dpr, 0, 0);
     const box = { x: 52, y: 10, w: Math.max(10, width - 80), h: Math.max(10, height - 34) };
     const r = this.run;
-    const budget = Math.max(1, r ? r.budget : DEFAULT_BUDGET);
+    const budget = Math.max(1, r ? r.budget : this.defaultBudget);
     const now = r ? r.evaluations : 0;
     const pts = this.points.filter(([, b]) => typeof b === 'number' && Number.isFinite(b));
     this.chartPoints = pts.length;

@@ -4,7 +4,8 @@
 //! network planning (`plan`), the multi-target method (`mtl`), and the merge of sharded studies
 //! (`merge`).
 //!
-//! `cli` declares the command line (clap), `cmd` runs the commands. Results are JSON on stdout.
+//! `cli` declares the command line (clap), `cmd` runs the commands, `failure` holds their one
+//! error type ([`CliError`](failure::CliError)). Results are JSON on stdout.
 //! Bad input exits with status 2 and one line on stderr that names the offending flag or field;
 //! nothing panics on bad input. Native only: for wasm32 targets (which `wasm-pack test` also
 //! builds bins for) `main` is empty.
@@ -16,35 +17,11 @@ fn main() {}
 mod cli;
 #[cfg(not(target_arch = "wasm32"))]
 mod cmd;
-
-/// A failure to report: one line on stderr and an exit status.
 #[cfg(not(target_arch = "wasm32"))]
-#[derive(Debug)]
-pub struct CliError {
-    /// The message (a single line).
-    pub message: String,
-    /// Process exit status.
-    pub code: i32,
-}
+mod failure;
 
 #[cfg(not(target_arch = "wasm32"))]
-impl CliError {
-    /// Bad input: exit status 2.
-    pub fn usage(message: impl Into<String>) -> CliError {
-        CliError {
-            message: message.into(),
-            code: 2,
-        }
-    }
-
-    /// Failure to write results: exit status 1.
-    pub fn output(message: impl Into<String>) -> CliError {
-        CliError {
-            message: message.into(),
-            code: 1,
-        }
-    }
-}
+use failure::CliError;
 
 #[cfg(not(target_arch = "wasm32"))]
 fn main() {

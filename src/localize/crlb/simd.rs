@@ -15,7 +15,7 @@ use alloc::vec::Vec;
 
 use wide::{f64x4, CmpEq, CmpGt, CmpLt};
 
-use super::map::Grid;
+use super::grid::Grid;
 use super::{link_weights, SINGULAR_RCOND};
 use crate::math::{Real, Vec2};
 use crate::measure::{Model, TxPattern, SNR_DISTANCE_FLOOR_M, UNIT_VECTOR_MIN_DISTANCE_M};

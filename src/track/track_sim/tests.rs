@@ -42,7 +42,7 @@ fn scenario_i_track_converges_and_is_deterministic() {
 /// Every filter of one seed sees the same truth and the same delays, and the UKF and the
 /// particle filter (2000 particles) track scenario I as the EKF does: over steps 10 … 100 their
 /// RMS position error is within 1.5× the EKF's on each of three seeds (the filters agree within
-/// their Monte Carlo error on the near-linear case, `tests/tracking_filters_mc.rs`; one run's
+/// their Monte Carlo error on the near-linear case, `tests/tracking/filters_mc.rs`; one run's
 /// error is one draw, so the margin is loose).
 #[test]
 fn every_filter_sees_the_same_data_and_tracks() {

@@ -6,17 +6,16 @@ use std::ffi::OsString;
 
 use clap::error::{ContextKind, ContextValue, ErrorKind};
 
-use super::Parsed;
-use crate::CliError;
+use crate::failure::CliError;
 
-/// Prints help or the version (status 0), or turns any other error into a usage error.
-/// `argv` (without the program name) tells which subcommand the error belongs to.
-pub fn handle(e: clap::Error, cmd: &clap::Command, argv: &[OsString]) -> Result<Parsed, CliError> {
+/// Prints help or the version (`Ok`: status 0, nothing to run), or turns any other error into a
+/// usage error. `argv` (without the program name) tells which subcommand the error belongs to.
+pub fn handle(e: clap::Error, cmd: &clap::Command, argv: &[OsString]) -> Result<(), CliError> {
     match e.kind() {
         ErrorKind::DisplayHelp | ErrorKind::DisplayVersion => {
             e.print()
                 .map_err(|io| CliError::output(format!("stdout: {io}")))?;
-            Ok(Parsed::Printed)
+            Ok(())
         }
         _ => Err(CliError::usage(one_line(&e, cmd, argv))),
     }

@@ -27,7 +27,7 @@ pub use study::{MontecarloArgs, PcrlbArgs, StudyArgs};
 pub use track::{CalibrateArgs, SimulateWalkArgs, TrackArgs};
 pub use values::{Association, MtlModel, RocExperiment, ShardSpec, Trajectory, WalkStart};
 
-use crate::CliError;
+use crate::failure::CliError;
 
 /// The top-level help's list of commands with their main flags, and the conventions.
 const AFTER_HELP: &str = "\
@@ -292,7 +292,7 @@ pub fn parse(argv: Vec<OsString>) -> Result<Parsed, CliError> {
     let args = std::iter::once(OsString::from("scatterloc")).chain(argv.iter().cloned());
     let matches = match cmd.try_get_matches_from_mut(args) {
         Ok(m) => m,
-        Err(e) => return error::handle(e, &cmd, &argv),
+        Err(e) => return error::handle(e, &cmd, &argv).map(|()| Parsed::Printed),
     };
     Cli::from_arg_matches(&matches)
         .map(Parsed::Run)

@@ -19,7 +19,7 @@ use scatterloc::{Error, Model, Scenario};
 use super::io::{emit, read_scenario};
 use super::output::{write_figure, write_json_file, Figure, Format};
 use crate::cli::CrlbMapArgs;
-use crate::CliError;
+use crate::failure::CliError;
 
 /// Default grid side.
 const DEFAULT_N: usize = 256;

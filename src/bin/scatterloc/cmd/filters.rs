@@ -6,7 +6,7 @@ use scatterloc::track::{FilterKind, PfConfig, UkfParams};
 
 use super::flags::with_flag;
 use crate::cli::{FilterName, FilterSettings};
-use crate::CliError;
+use crate::failure::CliError;
 
 /// A core error of the filter settings with the flag in place of the field.
 fn settings_error(e: scatterloc::Error) -> CliError {

@@ -15,7 +15,7 @@ use super::io::{emit_json, model_of, read_json_file, read_scenario};
 use super::output::write_json_file;
 use super::study::{checked_steps, flag_error};
 use crate::cli::{CalibrateArgs, SimulateWalkArgs, WalkStart};
-use crate::CliError;
+use crate::failure::CliError;
 
 /// Reads `--calibration` for a model.
 pub fn read_calibration(path: &str, model: &Model) -> Result<Calibration, CliError> {

@@ -10,7 +10,7 @@ use scatterloc::error::limits;
 use scatterloc::scenario::parse_json;
 use scatterloc::{Model, Scenario};
 
-use crate::CliError;
+use crate::failure::CliError;
 
 /// Writes `text` and a newline to stdout.
 pub fn emit(text: &str) -> Result<(), CliError> {

@@ -9,7 +9,7 @@ use scatterloc::study::PartSet;
 
 use super::io::read_input_named;
 use crate::cli::MergeArgs;
-use crate::CliError;
+use crate::failure::CliError;
 
 /// `scatterloc merge`.
 pub fn merge(args: &MergeArgs) -> Result<(), CliError> {

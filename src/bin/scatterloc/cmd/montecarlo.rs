@@ -21,7 +21,7 @@ use super::study::{
     flag_error, parse_study, run_filters_with_progress, run_pcrlb_with_progress, threads,
 };
 use crate::cli::{FilterName, MontecarloArgs, PcrlbArgs};
-use crate::CliError;
+use crate::failure::CliError;
 
 /// The figure's title and subtitle.
 fn chart_options(study: &MonteCarloStudy) -> TrackingChartOptions {

@@ -11,7 +11,7 @@ use serde::Serialize;
 
 use scatterloc::chart::ChartError;
 
-use crate::CliError;
+use crate::failure::CliError;
 
 /// File format, from the extension of the path.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

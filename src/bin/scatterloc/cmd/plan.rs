@@ -21,7 +21,7 @@ use super::io::{emit, read_json_file};
 use super::output::{check_writable, write_figure, write_json_file, Figure, Format};
 use super::study::{cancelled, interrupted, load_layout, run_with_bar};
 use crate::cli::PlanArgs;
-use crate::CliError;
+use crate::failure::CliError;
 
 /// Grid side of the figure's maps (as `crlb-map`'s default).
 const FIGURE_GRID: usize = 256;

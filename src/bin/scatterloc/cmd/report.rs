@@ -16,7 +16,7 @@ use scatterloc::study::{CurveDoc, TrackStudy as Study};
 use super::io::emit;
 use super::output::{check_writable, write_figure, write_json_file, Figure, Format};
 use super::study::{at_report_times, AtTime};
-use crate::CliError;
+use crate::failure::CliError;
 
 /// The scalars and the values at the reporting times.
 #[derive(Serialize)]

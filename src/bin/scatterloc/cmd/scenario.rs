@@ -9,7 +9,7 @@ use scatterloc::{scenario::presets, Mat2, Vec2};
 
 use super::io::{emit, emit_json, model_of, read_json_file, read_scenario};
 use crate::cli::{CrlbArgs, LocateArgs, PresetArgs};
-use crate::CliError;
+use crate::failure::CliError;
 
 /// A symmetric 2×2 matrix as `[[a, b], [b, c]]` (upper triangle).
 fn sym(m: &Mat2) -> [[f64; 2]; 2] {

@@ -11,7 +11,7 @@ use scatterloc::study::{PartFile, ShardDoc};
 use super::io::emit;
 use super::output::{check_writable, write_json_file, Format};
 use crate::cli::{ShardArgs, ShardSpec};
-use crate::CliError;
+use crate::failure::CliError;
 
 /// The shard of a run from `--shard` and `--shards` (`None`: the whole study). `--shard env`
 /// reads the process environment ([`from_env`]).

@@ -21,7 +21,7 @@ use scatterloc::{scenario::presets, Error, Model, Scenario};
 use super::flags::with_flag;
 use super::io::read_scenario;
 use crate::cli::{StudyArgs, Trajectory};
-use crate::CliError;
+use crate::failure::CliError;
 
 /// Times at which the summaries report the curves, s (check 9, 10).
 pub const REPORT_TIMES_S: [f64; 4] = [1.0, 2.0, 5.0, 10.0];

@@ -26,7 +26,7 @@ use super::io::{emit, model_of, read_json_file, read_scenario};
 use super::output::{check_writable, Format};
 use super::track_fig::{read_truth, write_track_figure, TrackSeries};
 use crate::cli::{Association, FilterName, TrackArgs};
-use crate::CliError;
+use crate::failure::CliError;
 
 /// Output of `track`: one entry per step (after its update).
 #[derive(Serialize)]

@@ -12,7 +12,7 @@ use scatterloc::formats::Truth;
 
 use super::io::read_json_file;
 use super::output::{write_figure, Figure, Format};
-use crate::CliError;
+use crate::failure::CliError;
 
 /// What the figure is drawn from.
 pub struct TrackSeries<'a> {

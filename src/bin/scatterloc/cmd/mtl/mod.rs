@@ -31,7 +31,7 @@ use super::output::{check_writable, write_figure, write_json_file, Figure, Forma
 use super::shard;
 use super::study::{cancelled, run_with_bar, threads};
 use crate::cli::{MtlLocateArgs, MtlModel, RocArgs, RocExperiment, Table2Args};
-use crate::CliError;
+use crate::failure::CliError;
 use scatterloc::study::{Part, PartFile, RocConfig, RocStudy, ShardDoc, Timing};
 
 mod locate;

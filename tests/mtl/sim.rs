@@ -6,7 +6,7 @@ use scatterloc::mtl::sim::*;
 use scatterloc::mtl::trp::TrpMap;
 use scatterloc::{Error, Vec2};
 
-mod common;
+use crate::common;
 
 use common::within_abs;
 

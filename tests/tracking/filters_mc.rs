@@ -3,7 +3,7 @@
 //! same measurements as the EKF study, paired results close to the EKF's where the problem is
 //! near-linear, and seed-only results whatever the chunk order.
 
-mod common;
+use crate::common;
 
 use common::sensors_model as model;
 use common::tracking::{at, study};

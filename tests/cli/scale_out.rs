@@ -5,7 +5,7 @@
 //! writes nothing.
 #![cfg(not(target_arch = "wasm32"))]
 
-mod common;
+use crate::common;
 
 use std::process::{Child, Command, Output, Stdio};
 

@@ -2,11 +2,11 @@
 //! Tracking, spec check 11 (the EKF against the PCRLB) and NEES consistency of the EKF, fast
 //! profile. Monte Carlo tolerances are derived from the Monte Carlo standard error and stated
 //! where used. Runs too slow for a debug build are `#[ignore]` (run them with
-//! `cargo test --release --test tracking_check11 -- --ignored`); a smaller variant of each always
+//! `cargo test --release --test tracking -- --ignored check11::`); a smaller variant of each always
 //! runs.
 //! (Split from the former `tracking.rs`.)
 
-mod common;
+use crate::common;
 
 use common::sensors_model as model;
 use common::tracking::{at, study, FAST_STEP_S};

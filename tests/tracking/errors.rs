@@ -3,7 +3,7 @@
 //! validated by every driver before any work) and cancellation of the Monte Carlo drivers.
 //! (Split from the former `tracking.rs`.)
 
-mod common;
+use crate::common;
 
 use std::sync::atomic::{AtomicBool, Ordering};
 

@@ -3,7 +3,7 @@
 //! that a run computes what its documentation says, rebuilt from the public API.
 //! (Split from the former `tracking.rs`.)
 
-mod common;
+use crate::common;
 
 use std::sync::atomic::AtomicBool;
 

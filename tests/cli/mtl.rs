@@ -3,7 +3,7 @@
 //! (check 4) and small `roc` runs writing JSON and figures. Few realisations: fast in debug.
 #![cfg(not(target_arch = "wasm32"))]
 
-mod common;
+use crate::common;
 
 use serde_json::{json, Value};
 

@@ -3,7 +3,7 @@
 //! of white-noise acceleration and the EKF predict is `A P Aᵀ + Q`. Check 4 (the Q entries at
 //! 2.048 ms) is the unit test `motion::check4`. (Split from the former `tracking.rs`.)
 
-mod common;
+use crate::common;
 
 use common::rel_close;
 use common::tracking::covariance_close;

@@ -4,7 +4,7 @@
 //! expected number is the output of the reference filter below or a closed form stated next to
 //! it. (Split from the former `tracking.rs`.)
 
-mod common;
+use crate::common;
 
 use nalgebra::{DMatrix, DVector};
 

@@ -15,7 +15,7 @@ use scatterloc::scenario::{
 };
 use scatterloc::Model;
 
-mod common;
+use crate::common;
 
 use common::noise_free;
 

@@ -1,9 +1,9 @@
 //! End-to-end tests of the `track` and `pcrlb` subcommands of the `scatterloc` binary (issue 3
 //! §3): the EKF over a measurement file (spec §6) with gaps and bad input, the nominal PCRLB
-//! (§8, check 9) and the Monte Carlo bound, and bad study flags. `montecarlo`: cli_montecarlo.rs.
+//! (§8, check 9) and the Monte Carlo bound, and bad study flags. `montecarlo`: cli/montecarlo.rs.
 #![cfg(not(target_arch = "wasm32"))]
 
-mod common;
+use crate::common;
 
 use scatterloc::{scenario::presets, Model, Vec2};
 use serde_json::{json, Value};

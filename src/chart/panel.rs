@@ -1,5 +1,9 @@
-//! The heatmap raster, the colour bar and the node markers of the map figure.
+//! The panel toolkit of the metre-axis figures (the map, the plan and the multi-target scene):
+//! what a map panel shows ([`MapData`], [`ChartNode`]), the plot with metre axes at equal scale,
+//! the heatmap raster, the colour bar, the node markers, the legend entries and the frame. It
+//! imports only `layout` of the chart module; every figure imports it.
 
+use alloc::string::String;
 use alloc::vec::Vec;
 
 use plotters::coord::types::RangedCoordf64;
@@ -7,14 +11,125 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
-use super::layout::{series_legend, Fonts};
-use super::{chart_err, ChartError, ChartNode, MapData, NodeKind};
+use super::layout::{self, axis_label, chart_err, series_legend, ChartError, Fonts};
+use crate::localize::Grid;
 use crate::math::Real;
 use crate::present::colorbar_ticks;
 use crate::present::{viridis, LogScale, UNBOUNDED_RGB};
+use crate::scenario::Area;
 
 /// A map plot: metre axes in both directions.
 pub(crate) type Chart<'a, DB> = ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
+
+/// A computed map: the grid and its values, row-major with row `j` at `y_j` (ascending y), m;
+/// `+∞` (or any non-finite value) marks an unbounded cell. This is what [`crate::localize::crlb_map`]
+/// writes.
+#[derive(Debug, Clone, Copy)]
+pub struct MapData<'a> {
+    /// The grid of cell centres.
+    pub grid: Grid,
+    /// `grid.len()` values, m.
+    pub values_m: &'a [Real],
+}
+
+/// What a node is, which sets its marker.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum NodeKind {
+    /// Drawn as a red triangle.
+    Transmitter,
+    /// Drawn as a white circle.
+    Receiver,
+}
+
+/// A named node to mark on the map.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ChartNode {
+    /// Label drawn next to the marker.
+    pub name: String,
+    /// Position, m.
+    pub position_m: [Real; 2],
+    /// Marker kind.
+    pub kind: NodeKind,
+}
+
+/// Fails unless both ranges of `area` can be drawn: finite, increasing, a span that does not
+/// overflow and is not too thin for axis ticks (relative to the coordinates' magnitude).
+pub fn check_area(area: &Area) -> Result<(), ChartError> {
+    area.validate().map_err(chart_err)?;
+    for (axis, [lo, hi]) in [("x", area.x), ("y", area.y)] {
+        let span = hi - lo;
+        if !(span.is_finite() && span > 1e-9 * lo.abs().max(hi.abs())) {
+            return Err(ChartError(alloc::format!(
+                "the {axis} range [{lo:?}, {hi:?}] cannot be drawn (span overflows or is too thin)"
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// The plot of one map in `chart_area` (laid out by `lay`): the coloured cells on `scale` (grey
+/// where unbounded or without a scale) and metre axes at equal scale. Overlays go on the returned
+/// chart, then [`finish_panel`] draws the nodes and the frame.
+pub(crate) fn map_panel<'a, DB: DrawingBackend + 'a>(
+    chart_area: &'a DrawingArea<DB, Shift>,
+    lay: &layout::Layout,
+    map: &MapData,
+    scale: Option<&LogScale>,
+) -> Result<Chart<'a, DB>, ChartError> {
+    let mut chart = metre_chart(chart_area, lay, &map.grid.area)?;
+    draw_heatmap(&chart.plotting_area().strip_coord_spec(), map, scale)?;
+    draw_metre_axes(&mut chart, lay)?;
+    Ok(chart)
+}
+
+/// A plot of `area` in `chart_area` laid out by `lay`: metres on both axes at equal scale (the
+/// layout sized the plot to `area`'s aspect); nothing drawn yet.
+pub(crate) fn metre_chart<'a, DB: DrawingBackend + 'a>(
+    chart_area: &'a DrawingArea<DB, Shift>,
+    lay: &layout::Layout,
+    area: &Area,
+) -> Result<Chart<'a, DB>, ChartError> {
+    ChartBuilder::on(chart_area)
+        .margin_top(lay.plot_margin_top)
+        .margin_right(lay.plot_margin_right)
+        .x_label_area_size(lay.x_label_area)
+        .y_label_area_size(lay.y_label_area)
+        .build_cartesian_2d(area.x[0]..area.x[1], area.y[0]..area.y[1])
+        .map_err(chart_err)
+}
+
+/// The metre axes of a [`metre_chart`]: tick labels, `x (m)`, `y (m)`, no mesh.
+pub(crate) fn draw_metre_axes<'a, DB: DrawingBackend + 'a>(
+    chart: &mut Chart<'a, DB>,
+    lay: &layout::Layout,
+) -> Result<(), ChartError> {
+    let tick_font = ("sans-serif", lay.font.ticks).into_font();
+    let axis_font = ("sans-serif", lay.font.axis).into_font();
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .x_desc("x (m)")
+        .y_desc("y (m)")
+        .label_style(tick_font)
+        .axis_desc_style(axis_font)
+        .x_labels(8)
+        .y_labels(8)
+        .set_all_tick_mark_size(lay.font.ticks as i32 / 3 + 2)
+        .x_label_formatter(&|v| axis_label(*v))
+        .y_label_formatter(&|v| axis_label(*v))
+        .draw()
+        .map_err(chart_err)
+}
+
+/// The nodes (with the legend of every labelled series) and the frame of a [`map_panel`].
+pub(crate) fn finish_panel<'a, DB: DrawingBackend + 'a>(
+    chart: &mut Chart<'a, DB>,
+    nodes: &[ChartNode],
+    lay: &layout::Layout,
+) -> Result<(), ChartError> {
+    draw_nodes(chart, nodes, lay.font.nodes)?;
+    layout::frame_plot(chart)
+}
 
 const TX_RGB: RGBColor = RGBColor(228, 26, 28);
 

@@ -3,7 +3,7 @@
 //! trajectories, and Ctrl-C leaving no files behind.
 #![cfg(not(target_arch = "wasm32"))]
 
-mod common;
+use crate::common;
 
 use std::process::Command;
 

@@ -9,15 +9,14 @@
 //! required to be present. SVG figures must be identical.
 //!
 //! To regenerate the reference with another binary (only when an output is meant to change):
-//! `SCATTERLOC_PIN_WRITE=/path/to/scatterloc cargo test --test cli_pinned`.
+//! `SCATTERLOC_PIN_WRITE=/path/to/scatterloc cargo test --test cli pinned::`.
 
 use std::collections::BTreeMap;
 use std::process::Command;
 
 use serde_json::Value;
 
-mod common;
-use common::cli::{TempDir, BIN};
+use crate::common::cli::{TempDir, BIN};
 
 /// Keys whose values are run times: present, not compared.
 const TIMING_KEYS: [&str; 5] = [

@@ -10,7 +10,7 @@ use scatterloc::scenario::presets::{self, preset};
 use scatterloc::scenario::{Area, LinkSpec, Pattern, Scenario};
 use scatterloc::{Error, Model};
 
-mod common;
+use crate::common;
 
 use common::noise_free;
 
@@ -644,7 +644,8 @@ fn unknown_preset() {
     assert_eq!(
         e,
         Error::UnknownPreset {
-            name: "sensors2020".into()
+            name: "sensors2020".into(),
+            known: &presets::PRESET_NAMES
         }
     );
     names(&e, "sensors2020");

@@ -18,7 +18,7 @@ use scatterloc::track::{ConstantVelocity, Filter, FilterKind, Tracker};
 use scatterloc::track::{Ekf, MeasurementNoise, PfConfig, UkfParams};
 use scatterloc::{measure, scenario::presets};
 
-mod common;
+use crate::common;
 
 use common::sensors_model as model;
 

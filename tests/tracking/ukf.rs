@@ -5,7 +5,7 @@
 //! EKF's (exact for the linear CV model); the near-linear limit (a tight prior) against the EKF's
 //! update; and the named errors.
 
-mod common;
+use crate::common;
 
 use nalgebra::{Cholesky, DMatrix, DVector};
 

@@ -2,7 +2,7 @@
 //! §9.6): the three commands chained as the README shows, and named errors for bad input.
 #![cfg(not(target_arch = "wasm32"))]
 
-mod common;
+use crate::common;
 
 use scatterloc::math::SPEED_OF_LIGHT;
 use scatterloc::{scenario::presets, Model, Vec2};
@@ -57,7 +57,7 @@ fn pipeline(dir: &TempDir, association: &str) -> (Value, Value, Value) {
 /// each link, to 5 standard errors of a 500-snapshot mean of 0.3 ns jitter), and the gated
 /// track follows the truth file: every blind-zone pair is absent or a gated false alarm (≥ 90 %
 /// absent), the RMSE after the first second is below 5 cm and the largest error below 20 cm
-/// (the §9.6 loop test in `gating.rs` derives these bounds).
+/// (the §9.6 loop test in `tracking/gating.rs` derives these bounds).
 #[test]
 fn simulate_calibrate_track_chain() {
     let dir = TempDir::new();

@@ -2,11 +2,11 @@
 //! Tracking, the posterior CRLB (spec §8, E9): spec checks 5, 9 (against the Monte Carlo bound)
 //! and 10. Monte Carlo tolerances are derived from the Monte Carlo standard error and stated
 //! where used. Runs too slow for a debug build are `#[ignore]` (run them with
-//! `cargo test --release --test tracking_pcrlb -- --ignored`); a smaller variant of each always
+//! `cargo test --release --test tracking -- --ignored pcrlb::`); a smaller variant of each always
 //! runs.
 //! (Split from the former `tracking.rs`.)
 
-mod common;
+use crate::common;
 
 use common::rel_close;
 use common::sensors_model as model;

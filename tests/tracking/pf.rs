@@ -4,7 +4,7 @@
 //! log-space weights of an extreme step, named errors, and the near-linear case where the EKF,
 //! the UKF and the PF must agree within their Monte Carlo error.
 
-mod common;
+use crate::common;
 
 use common::sensors_model as model;
 use common::tracking::fast_motion;

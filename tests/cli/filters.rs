@@ -4,7 +4,7 @@
 //! determinism, bad flags named, two shards merged equal to the unsharded run, Ctrl-C).
 #![cfg(not(target_arch = "wasm32"))]
 
-mod common;
+use crate::common;
 
 use scatterloc::{scenario::presets, Model, Vec2};
 use serde_json::{json, Value};

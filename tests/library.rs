@@ -1,0 +1,19 @@
+//! The library's API across layers, one module per topic: one test per bad-input class
+//! (`bad_input`), the SIMD CRLB map kernel against its scalar reference (`map_kernel`), the
+//! planner's evidence (`planning`, `filters-and-planning.md` §3) and property tests of the core
+//! (`properties`, proptest; shrunk failures in `library/properties.proptest-regressions`).
+#![cfg(not(target_arch = "wasm32"))]
+
+mod common;
+
+#[path = "library/bad_input.rs"]
+mod bad_input;
+
+#[path = "library/map_kernel.rs"]
+mod map_kernel;
+
+#[path = "library/planning.rs"]
+mod planning;
+
+#[path = "library/properties.rs"]
+mod properties;
