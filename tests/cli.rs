@@ -1,8 +1,9 @@
 //! End-to-end tests of the `scatterloc` binary, one module per command family: presets, CRLB,
 //! maps, locate, help and completions (`basics`), tracking studies (`tracking`, `montecarlo`,
 //! `filters`), the gating pipeline (`gating`), the planner (`plan`), the multi-target commands
-//! (`mtl`), sharded studies and `merge` (`scale_out`), and bounded, named bad input
-//! (`hardening`). Every module checks the "exit 2 + one stderr line naming the field" contract.
+//! (`mtl`), sharded studies and `merge` (`scale_out`), bounded, named bad input (`hardening`),
+//! and the outputs of a fixed set of commands pinned to those of the binary before issue 23
+//! (`pinned`). Every module checks the "exit 2 + one stderr line naming the field" contract.
 #![cfg(not(target_arch = "wasm32"))]
 
 mod common;

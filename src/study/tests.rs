@@ -78,7 +78,7 @@ fn work_items_ranges_and_shards_give_the_same_sums() {
     }
 }
 
-#[cfg(all(feature = "std", not(target_arch = "wasm32")))]
+#[cfg(all(feature = "parallel", not(target_arch = "wasm32")))]
 #[test]
 fn parallel_driver_equals_sequential() {
     use core::sync::atomic::AtomicBool;
