@@ -22,7 +22,7 @@ use scatterloc::math::{Mat4, Vec2, Vec4};
 use scatterloc::mtl::algorithm::{locate as mtl_locate, MtlConfig};
 use scatterloc::mtl::empirical::EmpiricalTable;
 use scatterloc::mtl::input::{from_json, target_reports, LocateRequest, ModelSpec, NetworkInput};
-use scatterloc::mtl::view::{mtl_view, MtlScene};
+use scatterloc::present::{mtl_view, MtlScene};
 use scatterloc::present::{simulate_snapshot, Session};
 use scatterloc::scenario::{parse_json, presets, Area, Scenario};
 use scatterloc::track::gating::{Calibration, ClusterConfig};

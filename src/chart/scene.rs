@@ -20,8 +20,8 @@ use super::panel::{in_window, legend_entry, plot_window, Chart, ChartNode, NodeK
 use super::roc::CURVE_PALETTE;
 use crate::math::Real;
 use crate::measure::Ellipse;
-use crate::mtl::view::output::EllipseView;
-use crate::mtl::view::{MtlScene, MtlView};
+use crate::present::EllipseView;
+use crate::present::{MtlScene, MtlView};
 use crate::scenario::Area;
 use crate::Vec2;
 
@@ -104,7 +104,7 @@ pub fn scene_nodes(scene: &MtlScene) -> Vec<ChartNode> {
     nodes
 }
 
-/// Draws the scene figure of `scene` and its `view` ([`crate::mtl::view::mtl_view`]) onto `root`
+/// Draws the scene figure of `scene` and its `view` ([`crate::present::mtl_view`]) onto `root`
 /// (filled white first). Does not call `present()`.
 pub fn draw_mtl_scene<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
@@ -369,7 +369,7 @@ fn draw_layers<'a, DB: DrawingBackend + 'a>(
 mod tests {
     use super::{draw_mtl_scene, scene_window, SceneChartOptions};
     use crate::chart::clip::clip_polygon;
-    use crate::mtl::view::{mtl_view, MtlScene};
+    use crate::present::{mtl_view, MtlScene};
     use crate::scenario::Area;
     use plotters::prelude::*;
 

@@ -102,7 +102,7 @@ fn y_range(panels: &[FiltersPanel]) -> (Real, Real) {
 /// Draws the tracking figure onto `root` (filled white first): the title band, then one panel
 /// per entry of `panels` side by side with a shared y range, each with one or more trackers'
 /// labelled RMSE curves (labels: [`crate::study::curve_label`]), each solid in its own colour
-/// (the first in the EKF's blue) with its label in the legend, next to the dashed PCRLB — [S]
+/// (the first in the EKF's blue) with its label in the legend, next to the dashed PCRLB — \[S\]
 /// Fig. 3 with the EKF alone. The one entry point of the CLI's and the page's tracking charts.
 /// Returns the shared y range `(lo, hi)`, m. Does not call `present()`.
 pub fn draw_tracking_filters<DB: DrawingBackend>(

@@ -17,7 +17,6 @@
 //! - [`algorithm`]: Algorithm 1 (§4), staged matching with the vector likelihood (M6) and
 //!   the final selection by `J` (M2).
 //! - [`brute`]: the brute-force reference over all matchings (small instances, tests).
-//! - [`view`]: one user-placed scene (nodes, targets, discs) turned into what the page draws.
 
 pub mod algorithm;
 pub mod blocking;
@@ -31,4 +30,3 @@ pub mod polygon;
 pub mod ppp;
 pub mod sim;
 pub mod trp;
-pub mod view;

@@ -42,7 +42,7 @@ pub fn run_parallel(
 /// [`MonteCarloConfig::shard_chunks`]) on `threads` worker threads (0 = all cores); progress
 /// and cancel as in [`run_parallel`], counting the runs of these chunks. Sums of disjoint
 /// ranges merged with [`StudySums::merge`] equal those of their union exactly. An empty range
-/// gives zero sums. [`Error::IndexOutOfRange`] (`chunks`) past the last chunk.
+/// gives zero sums. [`crate::Error::IndexOutOfRange`] (`chunks`) past the last chunk.
 pub fn run_chunks_parallel(
     model: &Model,
     cfg: &MonteCarloConfig,
@@ -63,7 +63,7 @@ pub fn run_chunks_parallel(
 }
 
 /// [`run_chunks_parallel`] with any tracker (issue 15): the sums of the chunks `chunks` of the
-/// study run by `filter` ([`run_filter_chunk`]: the EKF study's truth and measurements), on
+/// study run by `filter` ([`crate::track::run_filter_chunk`]: the EKF study's truth and measurements), on
 /// `threads` worker threads (0 = all cores), with progress and cancel as in [`run_parallel`].
 /// [`FilterKind::Ekf`] gives exactly [`run_chunks_parallel`]'s sums. The filter's settings are
 /// validated first (errors name `ukf_alpha`, `ukf_beta`, `ukf_kappa`, `particles`,

@@ -28,7 +28,7 @@ pub fn run_experiment_parallel(
 /// of `cfg.realisations`) on `threads` worker threads; progress (counting these realisations)
 /// and cancel as in [`run_experiment_parallel`]. Tallies of disjoint ranges merged with
 /// [`Tally::merge`] equal the tally of their union exactly; an empty range gives an empty
-/// tally. [`Error::IndexOutOfRange`] (`realisations`) past the last realisation.
+/// tally. [`crate::Error::IndexOutOfRange`] (`realisations`) past the last realisation.
 pub fn run_experiment_range(
     cfg: &ExperimentConfig,
     realisations: Range<usize>,

@@ -1,11 +1,14 @@
 //! View models shared by every front end (the page through `wasm`, the figures through `chart`):
 //! axis ticks and length labels, the log colour scale of CRLB maps, one simulated snapshot as the
-//! page draws it, a simulated track's frames, the planner's request and report (`plan.json`), and the interactive [`Session`] (a validated
-//! scenario and its compiled model, kept in step). Pure `no_std` functions of the core's results:
+//! page draws it, a simulated track's frames, the planner's request and report (`plan.json`), a
+//! multi-target scene turned into what the page draws ([`mtl_view`]: nodes, targets, discs,
+//! measurements, Algorithm 1's trace), and the interactive [`Session`] (a validated scenario and
+//! its compiled model, kept in step). Pure `no_std` functions of the core's results:
 //! no maths of their own beyond layout.
 
 mod colormap;
 mod plan_view;
+mod scene;
 mod session;
 mod snapshot;
 mod ticks;
@@ -17,6 +20,14 @@ pub use colormap::{
 pub use plan_view::{
     area_of, run_plan, PlanHistoryJson, PlanImprovementJson, PlanJson, PlanObjectiveJson,
     PlanPathJson, PlanProgressJson, PlanRequest, DEFAULT_PLAN_BUDGET,
+};
+pub use scene::output::{
+    DetectedView, EllipseView, HypothesisView, MetricsView, ModelView, MtlView, RangeView,
+    SeedView, SegmentView, StageCounts, TargetView, TrpView,
+};
+pub use scene::{
+    mtl_view, mtl_view_cached, BlockingChoice, MtlScene, ViewCache, MAX_CACHED_TABLES,
+    MAX_VIEW_CLUTTER, MAX_VIEW_DISCS, MAX_VIEW_NODES, MAX_VIEW_TARGETS,
 };
 pub use session::Session;
 pub(crate) use snapshot::{link_sim, view_radius};

@@ -257,7 +257,7 @@ pub struct CurveDoc<M: Serialize> {
 }
 
 /// The legend label of a filter's RMSE curve in the tracking figures (the one home of these
-/// labels): `EKF RMSE  ε_EKF` for the EKF alone ([S] Fig. 3), else `EKF RMSE`, `UKF RMSE`,
+/// labels): `EKF RMSE  ε_EKF` for the EKF alone (\[S\] Fig. 3), else `EKF RMSE`, `UKF RMSE`,
 /// `PF RMSE`.
 pub fn curve_label(filter: &str, alone: bool) -> String {
     match (filter, alone) {

@@ -20,8 +20,8 @@ use crate::chart::{
 };
 use crate::error::{limits, Error};
 use crate::localize::{crlb_map, Grid};
-use crate::mtl::view::{mtl_view, MtlScene};
 use crate::present::simulate_snapshot;
+use crate::present::{mtl_view, MtlScene};
 use crate::scenario::Area;
 use crate::{Model, Scenario, Vec2};
 

@@ -13,7 +13,7 @@
 //! `json.rs` (the page's object shapes and `to_js`), `tracking.rs` (`App.simulate_track` and the
 //! `Track` it returns), `montecarlo.rs` (`MonteCarloJob`, run chunk by chunk in a Web Worker),
 //! `chart.rs` (the plotters ε_EKF / ε_PCRLB chart on a canvas), `mtl.rs` (the multi-target view
-//! of a scene, [`crate::mtl::view`]), `plan.rs` (the planner, run in a Web Worker), `export.rs`
+//! of a scene, [`crate::present::scene`]), `plan.rs` (the planner, run in a Web Worker), `export.rs`
 //! (the page's "Save figure": the map and tracking figures as SVG through the CLI's chart code).
 
 mod app;

@@ -1,5 +1,5 @@
 //! The multi-target ("MTL") view for the page: a scene as JSON in, its view
-//! ([`crate::mtl::view::MtlView`]) as a JavaScript object out, either one-off
+//! ([`crate::present::MtlView`]) as a JavaScript object out, either one-off
 //! ([`mtl_view_of`]) or from an [`MtlSession`] that keeps the core's [`ViewCache`] between
 //! recomputes (the page's worker). Bad input throws the core's named message; no math here.
 
@@ -7,7 +7,7 @@ use wasm_bindgen::prelude::*;
 
 use super::err;
 use super::json::{to_js, MtlViewJs};
-use crate::mtl::view::{mtl_view_cached, MtlScene, ViewCache};
+use crate::present::{mtl_view_cached, MtlScene, ViewCache};
 
 #[wasm_bindgen]
 extern "C" {
@@ -30,7 +30,7 @@ pub fn mtl_field_ranges() -> String {
     let cs = crate::error::limits::C_SIGMA_M;
     serde_json::json!({
         "range_sigma": [cs.min, cs.max],
-        "clutter_mean": [0.0, crate::mtl::view::MAX_VIEW_CLUTTER],
+        "clutter_mean": [0.0, crate::present::MAX_VIEW_CLUTTER],
     })
     .to_string()
 }
@@ -44,7 +44,7 @@ pub fn mtl_check_scene(scene_json: &str) -> Result<String, JsError> {
 
 /// The view of a scene (JSON, schema [`MtlScene`]): `{trps, seeds, hypotheses, detected,
 /// targets, segments, metrics, stages, model, mpcs, compute_ms}` (see
-/// [`crate::mtl::view::MtlView`]); `compute_ms` is the core's own time for parse, data and
+/// [`crate::present::MtlView`]); `compute_ms` is the core's own time for parse, data and
 /// Algorithm 1. Throws the core's named error on bad input.
 #[wasm_bindgen]
 pub fn mtl_view_of(scene_json: &str) -> Result<JsValue, JsError> {

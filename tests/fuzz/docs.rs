@@ -8,7 +8,7 @@ use serde_json::{json, Value};
 use scatterloc::math::Vec2;
 use scatterloc::mtl::empirical::EmpiricalTable;
 use scatterloc::mtl::polygon::Rect;
-use scatterloc::mtl::view::MtlScene;
+use scatterloc::present::MtlScene;
 use scatterloc::scenario::presets;
 use scatterloc::{measure, Model};
 

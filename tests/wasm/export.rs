@@ -198,7 +198,7 @@ fn map_svg_rejects_bad_input_with_named_messages() {
 /// window leaves out what lies outside it; bad input names the function and the field.
 #[wasm_bindgen_test]
 fn mtl_scene_svg_draws_the_scene_and_its_detections() {
-    use scatterloc::mtl::view::{mtl_view, MtlScene};
+    use scatterloc::present::{mtl_view, MtlScene};
     let scene = MtlScene::vb();
     let json = scene.to_json();
     let view = mtl_view(&scene).unwrap();

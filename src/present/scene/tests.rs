@@ -3,6 +3,7 @@
 use alloc::string::ToString;
 use alloc::vec::Vec;
 
+use super::output::MtlView;
 use super::*;
 use crate::mtl::algorithm::{locate, Measurements, MtlConfig, MtlOutput};
 use crate::mtl::blocking::{NodeBlockingModel, NodeTableCache, TableCached, TABLE_GRID_M};

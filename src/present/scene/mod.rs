@@ -19,10 +19,10 @@
 //! [`trp_peaks`]: crate::mtl::sim::generator::trp_peaks
 //! [`resolution_merge`]: crate::mtl::sim::generator::resolution_merge
 
-pub mod compute;
-pub mod data;
-pub mod model;
-pub mod output;
+mod compute;
+mod data;
+mod model;
+pub(super) mod output;
 
 #[cfg(test)]
 mod tests;
@@ -40,8 +40,7 @@ use crate::mtl::polygon::Rect;
 use crate::mtl::trp::TrpMap;
 
 pub use compute::{mtl_view, mtl_view_cached};
-pub use model::ViewCache;
-pub use output::MtlView;
+pub use model::{ViewCache, MAX_CACHED_TABLES};
 
 /// Most transmitters (and, separately, receivers) of a page scene (keeps a recompute interactive:
 /// the PPP model enumerates `2^{N_t+N_r}` node patterns per candidate).
