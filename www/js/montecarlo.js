@@ -1,15 +1,19 @@
-// The page side of the browser Monte Carlo: one module Web Worker (mc-worker.js) runs the study; a
-// generation number cancels a run when a newer one starts (every drag restarts it). Shows the
-// progress bar, the status line and the plotters chart (drawn by the wasm core on #track-chart).
+// The page side of the browser Monte Carlo: a job worker (workers.js; mc-worker.js) runs the
+// study in slices; a newer generation supersedes a running study (every drag restarts it), which
+// the worker drops at its next slice. Shows the progress bar, the status line and the plotters
+// chart (drawn by the wasm core on #track-chart).
 
 import { $, errorText, fitCanvas, fixed } from './dom.js';
+import { JobWorker } from './workers.js';
 
 export class MonteCarlo {
-  /** @param {object} wasm - the wasm module; @param {function} onError - shows a message. */
-  constructor(wasm, onError) {
+  /**
+   * @param {object} wasm - the wasm module; @param {WebAssembly.Module} module - its compiled
+   * module (handed to the worker); @param {function} onError - shows a message.
+   */
+  constructor(wasm, module, onError) {
     this.wasm = wasm;
     this.onError = onError;
-    this.gen = 0;
     this.state = 'idle'; // 'running' | 'done' | 'error' | 'idle'
     this.params = null;
     this.result = null; // last result JSON text (partial while running)
@@ -18,14 +22,24 @@ export class MonteCarlo {
     this.ms = null; // wall time of the last finished run, ms (post to result)
     this.computeMs = null; // the worker's own time for it
     this.superseded = 0; // running jobs cancelled by a newer one
-    this.workerReady = false;
     this.coldStart = false;
     this.series = 0;
     this.caption = '';
-    this.worker = new Worker(new URL('./mc-worker.js', import.meta.url), { type: 'module' });
-    this.worker.onmessage = (e) => this.receive(e.data);
-    this.worker.onerror = (e) => this.fail(`Monte Carlo worker: ${e.message || 'failed to start'}`);
+    this.worker = new JobWorker(new URL('./mc-worker.js', import.meta.url), module, {
+      staleMs: Infinity, // never terminated: the worker drops a stale study at its next slice
+      onProgress: (m) => this.receive(m),
+      onResult: (m) => this.receive(m),
+      onError: (message, gen) => {
+        if (gen === undefined) this.fail(`Monte Carlo worker: ${message}`);
+        else if (gen === this.gen) this.fail(`Monte Carlo: ${message}`);
+      },
+    });
     new ResizeObserver(() => this.drawChart()).observe($('track-chart').parentElement);
+  }
+
+  /** The generation of the newest study (or cancel). */
+  get gen() {
+    return this.worker.gen;
   }
 
   /**
@@ -34,42 +48,33 @@ export class MonteCarlo {
    */
   start(params, caption) {
     if (this.state === 'running') this.superseded += 1;
-    this.gen += 1;
     this.params = params;
     this.caption = caption;
     this.state = 'running';
-    this.coldStart = !this.workerReady; // the time then includes compiling the worker's wasm
+    this.coldStart = !this.worker.ready; // the time then includes starting the worker's wasm
     this.result = null;
     this.done = 0;
     this.total = 0; // known from the worker's first report
     this.t0 = performance.now();
-    this.worker.postMessage({ type: 'run', gen: this.gen, ...params });
+    this.worker.post(params);
     this.show();
   }
 
   /** Stops the current study (the worker drops it at its next slice). */
   cancel() {
     if (this.state === 'running') this.superseded += 1;
-    this.gen += 1;
-    this.worker.postMessage({ type: 'cancel', gen: this.gen });
+    this.worker.cancel();
     this.state = 'idle';
     this.show();
   }
 
+  /** A progress or result message of the worker. */
   receive(m) {
-    if (m.type === 'ready') {
-      this.workerReady = true;
-      return;
-    }
-    if (m.gen !== this.gen) return; // a cancelled run
-    if (m.type === 'error') {
-      this.fail(`Monte Carlo: ${m.message}`);
-      return;
-    }
+    if (m.gen !== this.gen) return; // a superseded or cancelled run
     this.done = m.done;
     this.total = m.total;
     this.result = m.result;
-    if (m.type === 'done') {
+    if (m.type === 'result') {
       this.state = 'done';
       this.ms = performance.now() - this.t0;
       this.computeMs = m.ms;

@@ -1,8 +1,8 @@
 // The Plan panel of the snapshot view: moves nodes so that the CRLB over a region of interest
 // (ROI) improves, with the core's planner (plan_network: CMA-ES on a coarse ROI grid, re-scored
-// on the requested grid) in a Web Worker (plan-worker.js). While it runs, every improvement is
-// applied to the page's App and the nodes glide to it (GLIDE_MS, one map per frame at a drag's
-// cost); a small chart shows the objective against evaluations. At the end the objective before
+// on the requested grid) in a job worker (workers.js, plan-worker.js). While it runs, every
+// improvement is applied to the page's App and the nodes glide to it (GLIDE_MS, one map per
+// frame at a drag's cost); a small chart shows the objective against evaluations. At the end the objective before
 // → after (plan.json, requested grid) is shown and its scenario applied. Stop, a node drag, any
 // scenario edit (preset, import, inputs) or leaving the snapshot view cancels the plan (the
 // worker is terminated); Undo restores the whole scenario saved at Optimize.
@@ -12,6 +12,7 @@
 
 import { $, clearError, decimalIn, errorText, fitCanvas, fixed, showError } from './dom.js';
 import { C, FONT } from './draw.js';
+import { JobWorker } from './workers.js';
 
 /** Duration of a node glide to an improved layout, ms. */
 const GLIDE_MS = 200;
@@ -63,9 +64,18 @@ export class Plan {
     [FIELDS['plan-budget'].min, FIELDS['plan-budget'].max] = ranges.budget;
     this.defaultBudget = ranges.default_budget; // DEFAULT_PLAN_BUDGET
     this.status = 'idle'; // 'idle' | 'running' | 'done' | 'error'
-    this.worker = null;
-    this.runId = 0;
-    this.run = null; // the current or last plan: {id, request, t0, evaluations, budget, …}
+    // Started at the first plan; staleMs 0: a cancelled plan's worker is terminated at once (its
+    // wasm call is synchronous) and the next plan starts a fresh one.
+    this.worker = new JobWorker(new URL('./plan-worker.js', import.meta.url), ctx.module, {
+      staleMs: 0,
+      lazy: true,
+      onProgress: (m) => this.progress(m),
+      onResult: (m) => this.finish(m),
+      onError: (message, gen) => {
+        if (gen === undefined || this.current({ gen })) this.fail(message); // undefined: the worker's own
+      },
+    });
+    this.run = null; // the current or last plan: {id (its job's gen), request, t0, evaluations, …}
     this.points = []; // the chart's [evaluations, best]
     this.chartPoints = 0; // finite points in the last chart drawn
     this.result = null; // the last plan.json
@@ -310,14 +320,14 @@ export class Plan {
     this.result = null;
     this.error = null;
     this.run = {
-      id: ++this.runId, request, t0: performance.now(), evaluations: 0,
+      id: null, request, t0: performance.now(), evaluations: 0,
       budget: request.budget ?? this.defaultBudget, best: null, messages: 0, improvements: 0,
       wallMs: null, workerMs: null, stopped: null,
     };
     this.status = 'running';
     this.arm(false);
     if (!this.open) this.setOpen(true);
-    this.spawn().postMessage({ type: 'run', id: this.run.id, scenario: this.undoJson, request: JSON.stringify(request) });
+    this.run.id = this.worker.post({ scenario: this.undoJson, request: JSON.stringify(request) });
     this.sync();
     this.drawChart();
     this.ctx.changed({ draw: true });
@@ -335,7 +345,7 @@ export class Plan {
    */
   cancel(reason) {
     if (this.status !== 'running') return false;
-    this.kill();
+    this.worker.cancel();
     this.finishGlide(); // may complete a plan whose result already arrived
     if (this.status === 'running') {
       this.status = 'idle';
@@ -366,61 +376,47 @@ export class Plan {
     return true;
   }
 
-  spawn() {
-    if (!this.worker) {
-      const w = new Worker(new URL('./plan-worker.js', import.meta.url), { type: 'module' });
-      w.onmessage = (e) => this.receive(e.data);
-      w.onerror = (e) => {
-        e.preventDefault();
-        this.fail(`worker: ${e.message || 'failed to start'}`);
-      };
-      w.postMessage({ type: 'init', module: this.ctx.module });
-      this.worker = w;
-    }
-    return this.worker;
+  /** True if `m` (a worker message) belongs to the running plan. */
+  current(m) {
+    return this.run && m.gen === this.run.id && this.status === 'running';
   }
 
-  kill() {
-    if (!this.worker) return;
-    this.worker.onmessage = null;
-    this.worker.onerror = null;
-    this.worker.terminate();
-    this.worker = null;
-  }
-
-  receive(m) {
+  /** A progress message of the plan: evaluations, history points, the newest improvement. */
+  progress(m) {
+    if (!this.current(m)) return;
     const r = this.run;
-    if (m.type === 'ready' || !r || m.id !== r.id || this.status !== 'running') return;
-    if (m.type === 'progress') {
-      r.messages += 1;
-      r.evaluations = m.evaluations;
-      r.budget = m.budget;
-      for (const p of m.points) this.points.push(p);
-      if (m.improvement) {
-        r.improvements += 1;
-        r.best = m.improvement.best;
-        this.glideTo(m.improvement.scenario);
-      }
-    } else if (m.type === 'done') {
-      r.wallMs = performance.now() - r.t0;
-      r.workerMs = m.ms;
-      r.evaluations = m.result.evaluations;
-      this.result = m.result;
-      this.points = m.result.history.map((h) => [h.evaluations, h.best]);
-      this.glideTo(JSON.stringify(m.result.scenario), () => {
-        this.status = 'done';
-        this.sync();
-      });
-    } else if (m.type === 'error') {
-      this.fail(m.message);
-      return;
+    r.messages += 1;
+    r.evaluations = m.evaluations;
+    r.budget = m.budget;
+    for (const p of m.points) this.points.push(p);
+    if (m.improvement) {
+      r.improvements += 1;
+      r.best = m.improvement.best;
+      this.glideTo(m.improvement.scenario);
     }
     this.sync();
     this.drawChart();
   }
 
+  /** The plan's result (plan.json): the nodes glide to its layout, then the plan is done. */
+  finish(m) {
+    if (!this.current(m)) return;
+    const r = this.run;
+    r.wallMs = performance.now() - r.t0;
+    r.workerMs = m.ms;
+    r.evaluations = m.result.evaluations;
+    this.result = m.result;
+    this.points = m.result.history.map((h) => [h.evaluations, h.best]);
+    this.glideTo(JSON.stringify(m.result.scenario), () => {
+      this.status = 'done';
+      this.sync();
+    });
+    this.sync();
+    this.drawChart();
+  }
+
   fail(message) {
-    this.kill();
+    this.worker.cancel();
     this.finishGlide();
     this.status = 'error';
     this.error = message;

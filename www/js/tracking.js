@@ -27,7 +27,7 @@ export class Tracking {
     this.data = null;
     this.frame = null;
     this.dragging = false;
-    this.mc = new MonteCarlo(ctx.wasm, showError);
+    this.mc = new MonteCarlo(ctx.wasm, ctx.module, showError);
     // URL options arrive checked (app.js); a run count between the offered ones gets its own entry.
     const runs = opts.runs === undefined ? undefined : String(opts.runs);
     if (runs && ![...$('mc-runs').options].some((o) => o.value === runs)) $('mc-runs').add(new Option(`${runs} runs`, runs));

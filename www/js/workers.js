@@ -1,31 +1,45 @@
-// The page side of a replaceable job worker (worker-loop.js is the other side), the one home of
-// "a new edit replaces running work" for the multi-target view and the CRLB map: jobs carry a
-// generation; only the newest one matters. When the worker is still busy with an older job
-// `staleMs` after that job started, the worker is terminated and a fresh one is started (the
-// compiled wasm module is handed over, so that takes milliseconds) and the newest job is posted
-// to it. A job's own time is unbounded here: the core bounds its work (named errors).
+// The page side of the page's one job-worker protocol (worker-loop.js is the other side and
+// lists the messages), the one home of "a new edit replaces running work" for the CRLB map, the
+// multi-target view, the Monte Carlo study and the planner: jobs carry a generation; only the
+// newest one matters. A running job becomes stale when a newer job is posted or the jobs are
+// cancelled; when the worker is still busy with it `staleMs` after it started, the worker is
+// terminated and a fresh one is started (the compiled wasm module is handed over, so that takes
+// milliseconds) and the newest job, if any, is posted to it. staleMs: 0 terminates at once (the
+// map; the planner, whose wasm call is synchronous); Infinity never does (the Monte Carlo, which
+// pauses between slices and drops a stale job itself). A job's own time is unbounded here: the
+// core bounds its work (named errors).
 
 export class JobWorker {
   /**
    * @param {URL} url - the module worker (built on serveLatest).
    * @param {WebAssembly.Module} module - the page's compiled wasm module.
-   * @param {object} o - {onResult(message), onError(message), staleMs}.
+   * @param {object} o - {onResult(message), onProgress?(message), onError(message, gen?),
+   *   staleMs, lazy?}: onResult gets every result not older than the last answered job (the
+   *   caller may skip those older than `gen`), onProgress the newest job's progress; `lazy`
+   *   starts the worker at the first job (and after a termination, at the next one).
    */
-  constructor(url, module, { onResult, onError, staleMs }) {
-    Object.assign(this, { url, module, onResult, onError, staleMs });
-    this.gen = 0; // newest job posted
+  constructor(url, module, { onResult, onProgress = () => {}, onError, staleMs, lazy = false }) {
+    Object.assign(this, { url, module, onResult, onProgress, onError, staleMs, lazy });
+    this.gen = 0; // newest job posted (or cancel)
     this.doneGen = 0; // newest job answered (result or error)
     this.job = null; // the newest job's message
     this.running = null; // {gen, t0}: the job the worker is on
     this.restarts = 0; // workers terminated because they were busy with stale work
+    this.ready = false; // the current worker has instantiated the module
     this.timer = null;
-    this.spawn();
+    this.worker = null;
+    if (!lazy) this.spawn();
   }
 
   spawn() {
+    this.ready = false;
     this.worker = new Worker(this.url, { type: 'module' });
     this.worker.onmessage = (e) => this.receive(e.data);
-    this.worker.onerror = (e) => this.onError(`worker: ${e.message || 'failed to start'}`);
+    this.worker.onerror = (e) => {
+      e.preventDefault(); // reported here; the next job starts a fresh worker
+      this.drop();
+      this.onError(`worker: ${e.message || 'failed to start'}`);
+    };
     this.worker.postMessage({ type: 'init', module: this.module });
   }
 
@@ -33,17 +47,24 @@ export class JobWorker {
   post(job) {
     this.gen += 1;
     this.job = { type: 'job', gen: this.gen, ...job };
+    if (!this.worker) this.spawn();
     this.worker.postMessage(this.job);
     this.watch();
     return this.gen;
   }
 
-  /** Drops every job: results of older generations are ignored; a running one is terminated. */
+  /**
+   * Drops every job: results of older generations are ignored; a running one is stale (see the
+   * file comment: terminated, or dropped by the worker at its next pause).
+   */
   cancel() {
     this.gen += 1;
     this.doneGen = this.gen;
     this.job = null;
-    if (this.running) this.restart();
+    if (this.worker) this.worker.postMessage({ type: 'cancel', gen: this.gen });
+    if (!this.running) return;
+    if (Number.isFinite(this.staleMs)) this.watch();
+    else this.running = null; // it ends at its next pause, without a message
   }
 
   /** True while the newest job has no answer. */
@@ -57,10 +78,17 @@ export class JobWorker {
   }
 
   receive(m) {
-    if (m.type === 'ready') return;
+    if (m.type === 'ready') {
+      this.ready = true;
+      return;
+    }
     if (m.type === 'start') {
       this.running = { gen: m.gen, t0: performance.now() };
       this.watch();
+      return;
+    }
+    if (m.type === 'progress') {
+      if (m.gen === this.gen) this.onProgress(m);
       return;
     }
     this.running = null;
@@ -73,18 +101,26 @@ export class JobWorker {
   /** Restarts the worker once its current job is stale and older than staleMs. */
   watch() {
     clearTimeout(this.timer);
-    if (!this.running || this.running.gen >= this.gen) return;
+    if (!this.running || this.running.gen >= this.gen || !Number.isFinite(this.staleMs)) return;
     const wait = this.staleMs - this.busyMs();
     if (wait <= 0) this.restart();
     else this.timer = setTimeout(() => this.watch(), wait);
   }
 
-  restart() {
+  /** Terminates the worker (the next job starts a fresh one). */
+  drop() {
     clearTimeout(this.timer);
+    this.worker.onmessage = null;
+    this.worker.onerror = null;
     this.worker.terminate();
-    this.restarts += 1;
+    this.worker = null;
     this.running = null;
-    this.spawn();
+  }
+
+  restart() {
+    this.drop();
+    this.restarts += 1;
+    if (this.job || !this.lazy) this.spawn();
     if (this.job) this.worker.postMessage(this.job);
   }
 }
