@@ -235,7 +235,8 @@ impl Error {
             | Error::Degenerate { field }
             | Error::Infeasible { field, .. }
             | Error::UnknownPattern { field, .. }
-            | Error::UnknownFilter { field, .. } => Some(field),
+            | Error::UnknownFilter { field, .. }
+            | Error::InvalidFile { field, .. } => Some(field),
             Error::EmptyNodeList { field }
             | Error::InvertedArea { field, .. }
             | Error::LengthMismatch { field, .. }

@@ -11,6 +11,8 @@
 //!   configuration [`McConfig`] and result documents [`CurveDoc`].
 //! - [`RocStudy`]: the multi-target method's ROC experiments (§8 of `multi-target.md`), its
 //!   record [`RocConfig`].
+//! - [`track_measurements`]: a measurement file (`steps` or gated `raw_steps`) tracked by any
+//!   filter ([`TrackOutput`], the document of `scatterloc track`).
 //! - [`PartSet`], [`PartFile`]: the part file format (`scatterloc-part`, version 1).
 
 mod drive;
@@ -18,6 +20,7 @@ mod filters;
 mod montecarlo;
 mod part;
 mod roc;
+mod track;
 
 pub use drive::{Driver, Sequential};
 pub use filters::{particle_chunks, FilterResults, FilterRun, FilterStudy};
@@ -30,6 +33,7 @@ pub use part::{
     PART_FORMAT, PART_VERSION,
 };
 pub use roc::{RocConfig, RocStudy};
+pub use track::{track_measurements, TrackOutput, TrackRequest, TrackStart};
 
 #[cfg(test)]
 mod tests;

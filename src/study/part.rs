@@ -21,14 +21,15 @@
 //!     .map(|i| {
 //!         let shard = ShardDoc::new(Shard::new(i, 2).unwrap(), "chunks", 5);
 //!         let timing = Timing { threads: 1, wall_time_s: vec![0.5] };
-//!         let part = PartFile::new("montecarlo", &serde_json::json!({"seed": 1}), &shard, &timing, &[i]);
+//!         let (config, sums) = (serde_json::json!({"seed": 1}), [i]);
+//!         let part = PartFile::new("montecarlo", &config, &shard, &timing, &sums);
 //!         (format!("part{i}.json"), serde_json::to_string(&part).unwrap())
 //!     })
 //!     .collect();
 //! // … read back as one set, in shard order.
 //! let set = PartSet::check(&texts).unwrap();
 //! assert_eq!(set.study, "montecarlo");
-//! assert_eq!(set.parts[1].shard.range, [3, 5]);
+//! assert_eq!(set.parts[1].shard.range, [2, 5]);
 //! let sums: Vec<usize> = set.parts[1].sums().unwrap();
 //! assert_eq!(sums, [1]);
 //! // A set with a shard missing is refused, naming it.

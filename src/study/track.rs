@@ -1,0 +1,289 @@
+//! Tracking from a measurement file as one use case (spec §4, §6): the file's delays — one per
+//! link and step (`steps`), or every link's full list of estimates (`raw_steps`), gated against
+//! a calibration (E4) and associated (§4) before each update — run through any tracker (the
+//! EKF, the UKF or the particle filter; [`crate::track::Filter`]), started from the file's
+//! `initial_state` or from the Levenberg–Marquardt fix of its `initial_snapshot`. The result
+//! ([`TrackOutput`]) is the document `scatterloc track` prints.
+//!
+//! ```
+//! use scatterloc::formats::Measurements;
+//! use scatterloc::scenario::presets;
+//! use scatterloc::study::{track_measurements, TrackRequest};
+//! use scatterloc::track::gating::AssociationRule;
+//! use scatterloc::track::FilterKind;
+//! use scatterloc::Model;
+//!
+//! let scenario = presets::preset("sensors2019").unwrap();
+//! let model = Model::new(&scenario).unwrap();
+//! // The delays of a scatterer standing at (10, 10) m, three steps.
+//! let truth = scatterloc::Vec2::new(10.0, 10.0);
+//! let delays: Vec<Option<f64>> = model.network.delays(truth).into_iter().map(Some).collect();
+//! let file = serde_json::json!({
+//!     "dt_s": 0.1,
+//!     "process_noise": 0.1,
+//!     "initial_state": [9.5, 10.5, 0.0, 0.0],
+//!     "initial_covariance": [[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 0.1, 0.0], [0.0, 0.0, 0.0, 0.1]],
+//!     "steps": [delays.clone(), delays.clone(), delays],
+//! });
+//! let m = Measurements::from_json(&file.to_string()).unwrap();
+//! let out = track_measurements(&TrackRequest {
+//!     model: &model,
+//!     area: &scenario.area_m,
+//!     measurements: &m,
+//!     calibration: None,
+//!     rule: AssociationRule::Spec,
+//!     filter: FilterKind::Ekf,
+//!     seed: 1,
+//! })
+//! .unwrap();
+//! assert_eq!(out.t_s.len(), 3);
+//! assert!((out.states[2][0] - 10.0).abs() < 0.05 && (out.states[2][1] - 10.0).abs() < 0.05);
+//! ```
+
+use alloc::format;
+use alloc::string::ToString;
+use alloc::vec;
+use alloc::vec::Vec;
+
+use serde::Serialize;
+
+use crate::error::{Error, Result};
+use crate::formats::{Measurements, RawStep, Start, Steps};
+use crate::math::{Mat4, Vec4};
+use crate::measure::{rng, Model};
+use crate::scenario::Area;
+use crate::track::gating::{
+    start_from_snapshot, AssociationRule, Calibration, Choice, GatedTracker, START_SPEED_SIGMA_MPS,
+};
+use crate::track::UpdateSummary;
+use crate::track::{ConstantVelocity, Ekf, Filter, FilterKind, MeasurementNoise, Tracker};
+
+/// What a track runs on.
+#[derive(Debug, Clone, Copy)]
+pub struct TrackRequest<'a> {
+    /// The measurement model of the scenario.
+    pub model: &'a Model,
+    /// The scenario's area (the LM fix of `initial_snapshot` searches it).
+    pub area: &'a Area,
+    /// The measurement file.
+    pub measurements: &'a Measurements,
+    /// The calibration of the empty area (`raw_steps` only; `None`: nothing is static).
+    pub calibration: Option<&'a Calibration>,
+    /// How a link's estimates are associated (`raw_steps` only).
+    pub rule: AssociationRule,
+    /// The tracker.
+    pub filter: FilterKind,
+    /// The particle filter's seed (it draws its particles from stream 0 of it).
+    pub seed: u64,
+}
+
+/// A track: one entry per step (after its update).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct TrackOutput {
+    /// `t_k = (k + 1) T`, s.
+    pub t_s: Vec<f64>,
+    /// The estimates `[x, y, vx, vy]`.
+    pub states: Vec<[f64; 4]>,
+    /// Their covariances.
+    pub covariances: Vec<[[f64; 4]; 4]>,
+    /// NIS `νᵀS⁻¹ν` of the step; `null` when no link was used.
+    pub nis: Vec<Option<f64>>,
+    /// Links used per step.
+    pub links_used: Vec<usize>,
+    /// `raw_steps` only: per step the delay taken per link (`null` = absent), s.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub delays_used_s: Option<Vec<Vec<Option<f64>>>>,
+    /// `raw_steps` only: per step how each link was chosen (absent/single/nearest/strongest).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub choices: Option<Vec<Vec<&'static str>>>,
+    /// `raw_steps` only: per step per link the estimates discarded as static (E4).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub static_removed: Option<Vec<Vec<usize>>>,
+    /// `initial_snapshot` only: the LM fix that started the filter.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub start: Option<TrackStart>,
+}
+
+/// The start of a track from `initial_snapshot`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct TrackStart {
+    /// The fix, m.
+    pub position_m: [f64; 2],
+    /// Its position covariance, m².
+    pub covariance_m2: [[f64; 2]; 2],
+    /// Why LM stopped.
+    pub termination: &'static str,
+    /// Links the fix used.
+    pub links_used: usize,
+    /// The delay taken per link (`null` = none), s.
+    pub delays_used_s: Vec<Option<f64>>,
+    /// How each link's delay was chosen.
+    pub choices: Vec<&'static str>,
+}
+
+/// Runs the track of `req`. Errors name the field of the file (`steps[k]`, `raw_steps[k][p]`,
+/// `initial_snapshot`, …).
+pub fn track_measurements(req: &TrackRequest) -> Result<TrackOutput> {
+    let (model, m) = (req.model, req.measurements);
+    let n = model.link_count();
+    let motion = m.motion()?;
+    let sigmas = m.sigmas(n)?;
+    let noise = match &sigmas {
+        Some(s) => MeasurementNoise::Fixed(s),
+        None => MeasurementNoise::AtPrediction,
+    };
+    let empty;
+    let cal = match req.calibration {
+        Some(c) => c,
+        None => {
+            // No calibration: nothing is static (every estimate is a candidate).
+            empty = Calibration {
+                links: vec![Default::default(); n],
+            };
+            &empty
+        }
+    };
+    let (ekf, start) = initial_filter(m, model, cal, req.area)?;
+    let steps = m.steps()?;
+    let len = steps.len();
+    let mut out = TrackOutput {
+        t_s: Vec::with_capacity(len),
+        states: Vec::with_capacity(len),
+        covariances: Vec::with_capacity(len),
+        nis: Vec::with_capacity(len),
+        links_used: Vec::with_capacity(len),
+        delays_used_s: None,
+        choices: None,
+        static_removed: None,
+        start,
+    };
+    let own = rng(req.seed, 0);
+    let filter = Tracker::new(req.filter, ekf.state, ekf.covariance, own)?;
+    match steps {
+        Steps::Plain(steps) => plain(model, filter, &motion, noise, steps, m.dt_s, &mut out)?,
+        Steps::Raw(raw) => {
+            let tracker = GatedTracker::new(filter, model, cal, motion, noise, req.rule)?;
+            gated(tracker, n, raw, m.dt_s, &mut out)?
+        }
+    }
+    Ok(out)
+}
+
+/// The filter at `t₀`: from `initial_state` and `initial_covariance`, or (raw steps only) from
+/// the LM fix of `initial_snapshot`, reported as `start`.
+fn initial_filter(
+    m: &Measurements,
+    model: &Model,
+    cal: &Calibration,
+    area: &Area,
+) -> Result<(Ekf, Option<TrackStart>)> {
+    match m.start()? {
+        Start::Given(x0, p0) => Ok((Ekf::new(x0, p0)?, None)),
+        Start::Snapshot(snap) => {
+            let snap = Measurements::estimates("initial_snapshot", snap, model.link_count())?;
+            let f = start_from_snapshot(model, cal, &snap, area, START_SPEED_SIGMA_MPS).map_err(
+                |e| Error::InvalidFile {
+                    field: "initial_snapshot".into(),
+                    reason: e.to_string(),
+                },
+            )?;
+            let c = &f.ekf.covariance;
+            let start = TrackStart {
+                position_m: [f.report.position.x, f.report.position.y],
+                covariance_m2: [[c[(0, 0)], c[(0, 1)]], [c[(1, 0)], c[(1, 1)]]],
+                termination: f.report.termination.as_str(),
+                links_used: f.report.links_used,
+                choices: names(&f.selection.choices),
+                delays_used_s: f.selection.delays,
+            };
+            Ok((f.ekf, Some(start)))
+        }
+    }
+}
+
+/// The names of `choices`.
+fn names(choices: &[Choice]) -> Vec<&'static str> {
+    choices.iter().map(|c| c.name()).collect()
+}
+
+/// A core error of step `field`: `steps[k]: …`, and an invalid delay `delays_s[p]: …` of the
+/// core as `steps[k][p]: …`.
+fn step_error(field: &str, e: Error) -> Error {
+    match e {
+        Error::InvalidDelay { link, .. } => {
+            let text = e.to_string();
+            let reason = text.split_once(": ").map_or(text.as_str(), |(_, r)| r);
+            Error::InvalidFile {
+                field: format!("{field}[{link}]"),
+                reason: reason.to_string(),
+            }
+        }
+        other => Error::InvalidFile {
+            field: field.to_string(),
+            reason: other.to_string(),
+        },
+    }
+}
+
+/// The plain form: one delay (or null) per link and step.
+fn plain(
+    model: &Model,
+    mut filter: Tracker,
+    motion: &ConstantVelocity,
+    noise: MeasurementNoise,
+    steps: &[Vec<Option<f64>>],
+    dt_s: f64,
+    out: &mut TrackOutput,
+) -> Result<()> {
+    let n = model.link_count();
+    for (k, z) in steps.iter().enumerate() {
+        let field = format!("steps[{k}]");
+        Measurements::check_plain_step(k, z, n)?;
+        filter.predict(motion);
+        let summary = filter
+            .update(model, z, noise)
+            .map_err(|e| step_error(&field, e))?;
+        record(out, filter.state(), filter.covariance(), k, dt_s, &summary);
+    }
+    Ok(())
+}
+
+/// The raw form: every step (one list per each of `links` links) gated and associated by
+/// `tracker`, with what it chose.
+fn gated(
+    mut tracker: GatedTracker<Tracker>,
+    links: usize,
+    raw: &[RawStep],
+    dt_s: f64,
+    out: &mut TrackOutput,
+) -> Result<()> {
+    let (mut used, mut choices, mut removed) = (vec![], vec![], vec![]);
+    for (k, step) in raw.iter().enumerate() {
+        let field = format!("raw_steps[{k}]");
+        let estimates = Measurements::estimates(&field, step, links)?;
+        let s = tracker
+            .step(&estimates)
+            .map_err(|e| step_error(&field, e))?;
+        let f = &tracker.filter;
+        record(out, f.state(), f.covariance(), k, dt_s, &s.summary);
+        choices.push(names(&s.selection.choices));
+        used.push(s.selection.delays);
+        removed.push(s.selection.static_removed);
+    }
+    out.delays_used_s = Some(used);
+    out.choices = Some(choices);
+    out.static_removed = Some(removed);
+    Ok(())
+}
+
+/// Appends step `k`'s filter state `x` and covariance `p` to the output.
+fn record(out: &mut TrackOutput, x: &Vec4, p: &Mat4, k: usize, dt_s: f64, summary: &UpdateSummary) {
+    out.t_s.push((k + 1) as f64 * dt_s);
+    out.states.push((*x).into());
+    out.covariances.push(core::array::from_fn(|i| {
+        core::array::from_fn(|j| p[(i, j)])
+    }));
+    out.nis
+        .push((summary.links_used > 0).then_some(summary.nis));
+    out.links_used.push(summary.links_used);
+}
