@@ -490,7 +490,7 @@ impl MonteCarloStudy {
         };
         let mut doc = CurveDoc {
             t_s: top.t_s.clone(),
-            rmse_ekf_m: Some(top.rmse_ekf_m.clone()),
+            rmse_ekf_m: Some(top.rmse_m.clone()),
             rmse_pcrlb_m: top.rmse_pcrlb_m.clone(),
             nees: Some(top.nees.clone()),
             caption_note: Some(format!(
@@ -503,7 +503,7 @@ impl MonteCarloStudy {
                 .iter()
                 .map(|(i, r)| {
                     let label = curve_label(name(*i), self.ekf_only());
-                    (label, r.rmse_ekf_m.clone())
+                    (label, r.rmse_m.clone())
                 })
                 .collect(),
             meta: McMeta {
@@ -546,7 +546,7 @@ impl MonteCarloStudy {
                     (
                         name(*i),
                         FilterDoc {
-                            rmse_m: r.rmse_ekf_m.clone(),
+                            rmse_m: r.rmse_m.clone(),
                             nees: r.nees.clone(),
                             runs: r.runs,
                             failed_runs: r.failed_runs,

@@ -130,7 +130,7 @@ fn lead_is_the_ekf_else_the_first_and_the_bound_comes_from_the_widest() {
     let r = s.results().unwrap();
     assert_eq!((r.lead, r.widest), (0, 1));
     let top = r.top();
-    assert_eq!(top.rmse_ekf_m, r.curves[0].1.rmse_ekf_m);
+    assert_eq!(top.rmse_m, r.curves[0].1.rmse_m);
     assert_eq!(top.rmse_pcrlb_m, r.curves[1].1.rmse_pcrlb_m);
     assert_ne!(r.curves[0].1.rmse_pcrlb_m, r.curves[1].1.rmse_pcrlb_m);
 }

@@ -120,8 +120,10 @@ impl MonteCarloConfig {
 pub struct MonteCarloResult {
     /// `t_n = n T`, s, `n = 0 … steps`.
     pub t_s: Vec<Real>,
-    /// `ε_EKF(t_n)`, m.
-    pub rmse_ekf_m: Vec<Real>,
+    /// The filter's RMSE `ε(t_n)`, m (any filter's; the JSON key keeps the name of the EKF's
+    /// curve, `rmse_ekf_m`, of \[S\] Fig. 3).
+    #[serde(rename = "rmse_ekf_m")]
+    pub rmse_m: Vec<Real>,
     /// `ε_PCRLB(t_n)`, m (`None` if the information became singular).
     pub rmse_pcrlb_m: Vec<Option<Real>>,
     /// Average NEES per step (4 degrees of freedom for a consistent filter).
@@ -151,7 +153,7 @@ pub fn finish(cfg: &MonteCarloConfig, sums: &StudySums) -> Result<MonteCarloResu
         t_s: (0..=cfg.steps)
             .map(|n| n as Real * cfg.motion.dt_s)
             .collect(),
-        rmse_ekf_m: sums
+        rmse_m: sums
             .squared_error
             .iter()
             .map(|v| sqrt(v.value() / runs))

@@ -146,7 +146,7 @@ impl MonteCarloJob {
                 let f = &filters[*i];
                 FilterCurvesJs {
                     name: f.kind.name(),
-                    rmse_m: &r.rmse_ekf_m,
+                    rmse_m: &r.rmse_m,
                     nees: &r.nees,
                     runs: r.runs,
                     failed_runs: r.failed_runs,

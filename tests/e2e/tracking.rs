@@ -246,7 +246,7 @@ fn native_difference(params: &Value, result: &Value) -> f64 {
     let mut worst: f64 = 0.0;
     for (key, n) in [
         ("t_s", &native.t_s),
-        ("rmse_ekf_m", &native.rmse_ekf_m),
+        ("rmse_ekf_m", &native.rmse_m),
         ("rmse_pcrlb_m", &pcrlb),
         ("nees", &native.nees),
     ] {
@@ -483,7 +483,7 @@ fn native_filters_difference(params: &Value, result: &Value) -> f64 {
         }
         let native = finish(&cfg, &sums).unwrap();
         assert_eq!(b["runs"].as_u64(), Some(native.runs as u64), "{name}");
-        for (key, n) in [("rmse_m", &native.rmse_ekf_m), ("nees", &native.nees)] {
+        for (key, n) in [("rmse_m", &native.rmse_m), ("nees", &native.nees)] {
             let v = floats(&b[key]);
             assert_eq!(v.len(), n.len(), "{name} {key}");
             for (x, y) in v.iter().zip(n) {

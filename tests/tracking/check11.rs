@@ -48,7 +48,7 @@ fn check11(trajectories: usize, noise_runs: usize) -> ([Real; 3], [Real; 3]) {
         let r = result(None);
         assert_eq!(r.failed_runs, 0);
         let ratio: Vec<Real> = r
-            .rmse_ekf_m
+            .rmse_m
             .iter()
             .zip(&r.rmse_pcrlb_m)
             .map(|(e, p)| e / p.unwrap())
@@ -75,7 +75,7 @@ fn check11(trajectories: usize, noise_runs: usize) -> ([Real; 3], [Real; 3]) {
         let loo: Vec<Real> = (0..parts.len())
             .map(|g| {
                 let r = result(Some(g));
-                r.rmse_ekf_m[100] / r.rmse_pcrlb_m[100].unwrap()
+                r.rmse_m[100] / r.rmse_pcrlb_m[100].unwrap()
             })
             .collect();
         let g = loo.len() as Real;

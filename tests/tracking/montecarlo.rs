@@ -43,7 +43,7 @@ fn identical_results_for_one_and_two_threads_and_sequential() {
     );
     // Another seed changes the curves (the seed is used).
     let other = run_sequential(&model, &MonteCarloConfig { seed: 2, ..cfg }, |_, _| true).unwrap();
-    assert_ne!(other.rmse_ekf_m, seq.rmse_ekf_m);
+    assert_ne!(other.rmse_m, seq.rmse_m);
 }
 
 /// The harness computes what its documentation says: trajectory `i` from stream
@@ -93,7 +93,7 @@ fn monte_carlo_reproduces_independent_filter_runs() {
     }
     let pcrlb = pcrlb_rmse(&cfg.motion, &cfg.initial_covariance, &fisher).unwrap();
     for n in 0..=30 {
-        rel_close("ε_EKF", got.rmse_ekf_m[n], (se[n] / 10.0).sqrt(), 1e-12);
+        rel_close("ε_EKF", got.rmse_m[n], (se[n] / 10.0).sqrt(), 1e-12);
         rel_close("NEES", got.nees[n], nees[n] / 10.0, 1e-12);
         rel_close(
             "ε_PCRLB",

@@ -57,7 +57,7 @@ fn check5_initial_bound_and_error() {
     );
     rel_close(
         "ε_EKF(t0) sample",
-        mc.rmse_ekf_m[0],
+        mc.rmse_m[0],
         0.2f64.sqrt(),
         4.0 / (2000f64).sqrt() / 2.0,
     );

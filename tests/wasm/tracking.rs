@@ -212,7 +212,7 @@ fn monte_carlo_job_chunked_equals_one_go_and_core() {
     };
     let some = |v: &[f64]| v.iter().map(|x| Some(*x)).collect::<Vec<_>>();
     assert_eq!(floats(&r["t_s"]), some(&native.t_s));
-    assert_eq!(floats(&r["rmse_ekf_m"]), some(&native.rmse_ekf_m));
+    assert_eq!(floats(&r["rmse_ekf_m"]), some(&native.rmse_m));
     assert_eq!(floats(&r["rmse_pcrlb_m"]), native.rmse_pcrlb_m);
     assert_eq!(floats(&r["nees"]), some(&native.nees));
     let p0 = r["rmse_pcrlb_m"][0].as_f64().unwrap();
@@ -422,7 +422,7 @@ fn monte_carlo_job_runs_several_filters() {
             .iter()
             .map(|x| x.as_f64().unwrap())
             .collect();
-        assert_eq!(v, native.rmse_ekf_m, "{name}");
+        assert_eq!(v, native.rmse_m, "{name}");
         let v: Vec<f64> = f["nees"]
             .as_array()
             .unwrap()

@@ -289,7 +289,7 @@ fn monte_carlo_progress_and_result() {
         r.nees[1] = f64::NAN;
         let ekf = FilterCurvesJs {
             name: "ekf",
-            rmse_m: &r.rmse_ekf_m,
+            rmse_m: &r.rmse_m,
             nees: &r.nees,
             runs: r.runs,
             failed_runs: r.failed_runs,
