@@ -236,13 +236,9 @@ impl FilterStudy {
             });
         }
         let cfg = self.config;
-        let ranges: Vec<Range<usize>> = self
-            .filters
-            .iter()
-            .map(|f| chunks.start.min(f.chunks)..chunks.end.min(f.chunks))
-            .collect();
+        let ranges = self.ranges_of(&chunks);
         let runs_in = |r: &Range<usize>| cfg.trajectories_in(r) * cfg.noise_runs;
-        let total: usize = ranges.iter().map(runs_in).sum();
+        let total = self.runs_in(&chunks);
         let mut offset = 0;
         for (f, range) in self.filters.iter_mut().zip(&ranges) {
             let (kind, first) = (f.kind, range.start);
@@ -259,6 +255,23 @@ impl FilterStudy {
             offset += runs_in(range);
         }
         Ok(())
+    }
+
+    /// Each filter's part of `chunks` (a filter runs only its own leading chunks).
+    fn ranges_of(&self, chunks: &Range<usize>) -> Vec<Range<usize>> {
+        self.filters
+            .iter()
+            .map(|f| chunks.start.min(f.chunks)..chunks.end.min(f.chunks))
+            .collect()
+    }
+
+    /// Runs of every filter in `chunks`: what [`FilterStudy::run_range`]'s progress counts to.
+    pub fn runs_in(&self, chunks: &Range<usize>) -> usize {
+        let cfg = &self.config;
+        self.ranges_of(chunks)
+            .iter()
+            .map(|r| cfg.trajectories_in(r) * cfg.noise_runs)
+            .sum()
     }
 
     /// Adds filter `filter`'s sums of `chunks` chunks (a part of a sharded run).

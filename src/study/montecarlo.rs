@@ -37,7 +37,7 @@ use serde_json::Value;
 use crate::error::{Error, Result};
 use crate::measure::Model;
 use crate::scenario::Scenario;
-use crate::study::part::{differs, merged_timing, Part, Timing};
+use crate::study::part::{differs, merged_timing, Part};
 use crate::study::{inconsistent, FilterResults, FilterStudy};
 use crate::track::{
     paper_initial_covariance, ConstantVelocity, FilterKind, MonteCarloConfig, MonteCarloResult,
@@ -636,13 +636,5 @@ impl MonteCarloStudy {
             })
             .collect();
         Ok((study, runs, times))
-    }
-
-    /// The timing record of a part: `threads` and one wall time per trajectory.
-    pub fn timing(threads: usize, walls: Vec<f64>) -> Timing {
-        Timing {
-            threads,
-            wall_time_s: walls,
-        }
     }
 }

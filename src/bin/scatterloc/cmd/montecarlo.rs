@@ -10,7 +10,7 @@ use serde::Serialize;
 use scatterloc::chart::TrackingChartOptions;
 use scatterloc::math::Shard;
 use scatterloc::study::{
-    CurveDoc, FilterStudy, MonteCarloStudy, Part, PartFile, RunTime, ShardDoc, TrackStudy,
+    CurveDoc, FilterStudy, MonteCarloStudy, Part, PartFile, RunTime, ShardDoc, Timing, TrackStudy,
 };
 use scatterloc::track::{nominal_pcrlb_rmse, paper_initial_covariance};
 
@@ -118,7 +118,10 @@ fn run_shard(
         runs: sums.iter().map(|s| s.runs).sum(),
         failed_runs: sums.iter().map(|s| s.failed_runs).sum(),
     };
-    let timing = MonteCarloStudy::timing(used, walls);
+    let timing = Timing {
+        threads: used,
+        wall_time_s: walls,
+    };
     let doc = ShardDoc::new(shard, "chunks", total);
     let config = study
         .config_doc()

@@ -149,13 +149,7 @@ pub fn run_filters_with_progress(
     threads: usize,
     label: &str,
 ) -> Result<f64, CliError> {
-    let cfg = *study.config();
-    let runs = study
-        .filters()
-        .iter()
-        .map(|f| cfg.trajectories_in(&(chunks.start.min(f.chunks)..chunks.end.min(f.chunks))))
-        .sum::<usize>()
-        * cfg.noise_runs;
+    let runs = study.runs_in(&chunks);
     let ((), wall) = with_progress(runs, "runs", label, |cancel, progress| {
         study.run_range(model, chunks, &mut Parallel::new(threads, cancel), progress)
     })?;
