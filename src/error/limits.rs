@@ -153,6 +153,26 @@ pub const MAX_LINKS: usize = 4096;
 /// nothing but cost; a full mesh already reaches [`MAX_LINKS`] at 64 × 64).
 pub const MAX_NODES: usize = 4096;
 
+/// Longest name, bytes of UTF-8: the scenario's, each node's, and the node names a link or a
+/// plan's movable list refers to. 256 bytes holds any label a figure, a legend or a table shows
+/// legibly (the presets use 2–12); names are copied into every figure, legend, JSON output and
+/// error message, and a 100 MB name made a PNG figure take minutes and froze the page for
+/// seconds (issue 24).
+pub const MAX_NAME_BYTES: usize = 256;
+
+/// `Ok` when `name` has at most [`MAX_NAME_BYTES`] bytes; else [`Error::NameTooLong`] naming
+/// `field` (checked before any copy of the name is made).
+pub fn check_name(field: &str, name: &str) -> Result<()> {
+    if name.len() > MAX_NAME_BYTES {
+        return Err(Error::NameTooLong {
+            field: field.into(),
+            bytes: name.len(),
+            max: MAX_NAME_BYTES,
+        });
+    }
+    Ok(())
+}
+
 /// Largest input file the CLI reads, bytes (`--scenario`, `--delays`, `--measurements`, …):
 /// 256 MiB. The largest legitimate input, a `simulate-walk` raw-steps file, is capped at the
 /// same size when written.

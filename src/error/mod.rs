@@ -126,6 +126,16 @@ pub enum Error {
         /// Largest allowed value.
         max: usize,
     },
+    /// A name (a node's, the scenario's) longer than [`limits::MAX_NAME_BYTES`] (issue 24: a
+    /// 100 MB name made every figure take minutes).
+    NameTooLong {
+        /// Path of the field, e.g. `transmitters[3].name`.
+        field: String,
+        /// Its length, bytes of UTF-8.
+        bytes: usize,
+        /// The cap, bytes.
+        max: usize,
+    },
     /// A covariance or information matrix that must be symmetric positive definite is not (or
     /// stopped being so during a filter update).
     NotPositiveDefinite {
@@ -236,6 +246,7 @@ impl Error {
             | Error::Infeasible { field, .. }
             | Error::UnknownPattern { field, .. }
             | Error::UnknownFilter { field, .. }
+            | Error::NameTooLong { field, .. }
             | Error::InvalidFile { field, .. } => Some(field),
             Error::EmptyNodeList { field }
             | Error::InvertedArea { field, .. }
@@ -339,6 +350,9 @@ impl fmt::Display for Error {
                     f,
                     "{field}: {value} is outside the allowed range {min}..={max}"
                 )
+            }
+            Error::NameTooLong { field, bytes, max } => {
+                write!(f, "{field}: {bytes} bytes long, at most {max} are allowed")
             }
             Error::NotPositiveDefinite { field } => {
                 write!(f, "{field}: not a symmetric positive-definite matrix")

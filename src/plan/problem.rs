@@ -168,6 +168,7 @@ impl PlanSpace {
             MoveSpec::Names(names) => {
                 let mut v = Vec::new();
                 for name in names {
+                    crate::error::limits::check_name("move", name)?;
                     let node = base
                         .transmitters
                         .iter()

@@ -19,14 +19,23 @@ mod cli;
 mod cmd;
 #[cfg(not(target_arch = "wasm32"))]
 mod failure;
+#[cfg(not(target_arch = "wasm32"))]
+mod stdout;
 
 #[cfg(not(target_arch = "wasm32"))]
 use failure::CliError;
 
 #[cfg(not(target_arch = "wasm32"))]
 fn main() {
+    // A write past the file-size limit (`ulimit -f`) then fails with EFBIG, which the output
+    // writer reports (removing its temporaries), instead of SIGXFSZ killing the process and
+    // leaving them behind (issue 24). A handler that does nothing, installed without unsafe code.
+    let _ = signal_hook::flag::register(
+        signal_hook::consts::SIGXFSZ,
+        std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false)),
+    );
     let argv: Vec<std::ffi::OsString> = std::env::args_os().skip(1).collect();
-    let result = cli::parse(argv).and_then(|parsed| match parsed {
+    let result = stdout::check().and_then(|()| cli::parse(argv)).and_then(|parsed| match parsed {
         cli::Parsed::Run(args) => run(args.command),
         cli::Parsed::Printed => Ok(()),
     });

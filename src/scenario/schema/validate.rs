@@ -4,7 +4,7 @@
 use alloc::collections::BTreeSet;
 use alloc::format;
 
-use super::{Area, Pattern, Scenario};
+use super::{Area, LinkSpec, Pattern, Scenario};
 use crate::error::{check_finite, limits, Error, Result};
 
 impl Scenario {
@@ -27,10 +27,12 @@ impl Scenario {
         if let Some(g) = r.processing_gain_db {
             limits::PROCESSING_GAIN_DB.check("radio.processing_gain_db", g)?;
         }
+        limits::check_name("name", &self.name)?;
         node_count("transmitters", self.transmitters.len())?;
         node_count("receivers", self.receivers.len())?;
         let mut names: BTreeSet<&str> = BTreeSet::new();
         for (i, t) in self.transmitters.iter().enumerate() {
+            limits::check_name(&format!("transmitters[{i}].name"), &t.name)?;
             unique_name(&mut names, &t.name)?;
             position(&format!("transmitters[{i}].position_m"), t.position_m)?;
             limits::POWER_DBM.check(&format!("transmitters[{i}].power_dbm"), t.power_dbm)?;
@@ -59,12 +61,19 @@ impl Scenario {
             }
         }
         for (i, rx) in self.receivers.iter().enumerate() {
+            limits::check_name(&format!("receivers[{i}].name"), &rx.name)?;
             unique_name(&mut names, &rx.name)?;
             position(&format!("receivers[{i}].position_m"), rx.position_m)?;
             limits::GAIN_DBI.check(&format!("receivers[{i}].gain_dbi"), rx.gain_dbi)?;
         }
         limits::RCS_M2.check("target.rcs_m2", self.target.rcs_m2)?;
         self.area_m.validate()?;
+        if let LinkSpec::List(pairs) = &self.links {
+            for (i, [t, r]) in pairs.iter().enumerate() {
+                limits::check_name(&format!("links[{i}][0]"), t)?;
+                limits::check_name(&format!("links[{i}][1]"), r)?;
+            }
+        }
         let links = self.link_indices()?.len();
         if links > limits::MAX_LINKS {
             return Err(Error::SizeLimit {

@@ -13,9 +13,13 @@ use crate::failure::CliError;
 pub fn handle(e: clap::Error, cmd: &clap::Command, argv: &[OsString]) -> Result<(), CliError> {
     match e.kind() {
         ErrorKind::DisplayHelp | ErrorKind::DisplayVersion => {
-            e.print()
-                .map_err(|io| CliError::output(format!("stdout: {io}")))?;
-            Ok(())
+            if std::io::IsTerminal::is_terminal(&std::io::stdout()) {
+                // clap's own print keeps the colours of a terminal.
+                e.print()
+                    .map_err(|io| CliError::output(format!("stdout: {io}")))
+            } else {
+                crate::stdout::write(e.render().to_string().as_bytes())
+            }
         }
         _ => Err(CliError::usage(one_line(&e, cmd, argv))),
     }

@@ -301,7 +301,6 @@ pub fn parse(argv: Vec<OsString>) -> Result<Parsed, CliError> {
 
 /// Writes the completion script for `shell` to stdout.
 pub fn completions(shell: Shell) -> Result<(), CliError> {
-    use std::io::Write;
     let shell = match shell {
         Shell::Bash => clap_complete::Shell::Bash,
         Shell::Zsh => clap_complete::Shell::Zsh,
@@ -309,8 +308,5 @@ pub fn completions(shell: Shell) -> Result<(), CliError> {
     };
     let mut buf = Vec::new();
     clap_complete::generate(shell, &mut command(), "scatterloc", &mut buf);
-    let mut out = std::io::stdout().lock();
-    out.write_all(&buf)
-        .and_then(|_| out.flush())
-        .map_err(|e| CliError::output(format!("stdout: {e}")))
+    crate::stdout::write(&buf)
 }

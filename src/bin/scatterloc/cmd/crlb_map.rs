@@ -17,7 +17,7 @@ use scatterloc::scenario::Area;
 use scatterloc::{Error, Model, Scenario};
 
 use super::io::{emit, read_scenario};
-use super::output::{write_figure, write_json_file, Figure, Format};
+use super::output::{check_writable, write_figure, write_json_file, Figure, Format};
 use crate::cli::CrlbMapArgs;
 use crate::failure::CliError;
 
@@ -73,6 +73,8 @@ pub fn crlb_map(args: &CrlbMapArgs) -> Result<(), CliError> {
     }
     let size = figure_size(args, &area)?;
     let model = Model::new(&s).map_err(|e| CliError::usage(format!("--scenario: {e}")))?;
+    // Before the work: a FIFO, link or device at --out is refused now (issue 24).
+    check_writable("out", out)?;
 
     let t0 = Instant::now();
     let mut values = vec![0.0; grid.len()];

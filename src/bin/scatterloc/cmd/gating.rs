@@ -5,14 +5,14 @@
 use std::path::Path;
 
 use scatterloc::formats::{CalibrationResult, CalibrationSnapshots, Measurements, RawStep, Truth};
-use scatterloc::track::gating::{default_channel, Calibration, ClusterConfig};
+use scatterloc::track::gating::{default_channel, Calibration, ClusterConfig, StaticChannel};
 use scatterloc::track::gating::{LoopPath, LOOP_DURATION_S};
 use scatterloc::track::paper_initial_covariance;
 use scatterloc::track::ConstantVelocity;
 use scatterloc::{measure, Model};
 
 use super::io::{emit_json, model_of, read_json_file, read_scenario};
-use super::output::write_json_file;
+use super::output::{check_writable, write_json_file, Format, OutputSet};
 use super::study::{checked_steps, flag_error};
 use crate::cli::{CalibrateArgs, SimulateWalkArgs, WalkStart};
 use crate::failure::CliError;
@@ -27,6 +27,11 @@ pub fn read_calibration(path: &str, model: &Model) -> Result<Calibration, CliErr
 /// `scatterloc calibrate --scenario S --snapshots C [--gap-s G] [--min-fraction F]
 /// [--sigma-floor-s S] [--out OUT.json]`.
 pub fn calibrate(args: &CalibrateArgs) -> Result<(), CliError> {
+    // The extension rule of every other output flag (issue 24: `--out cal.txt` wrote JSON).
+    if let Some(p) = args.out.as_deref() {
+        Format::of("out", p, &[Format::Json])?;
+        check_writable("out", p)?;
+    }
     let scenario = read_scenario(&args.scenario)?;
     let model = model_of(&scenario)?;
     let n = model.link_count();
@@ -68,17 +73,42 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<(), CliError> {
 /// of 256 MiB ([`scatterloc::error::limits::MAX_INPUT_BYTES`]) and `track` can read it.
 const MAX_WALK_ESTIMATES: f64 = 5e6;
 
-/// `--out-dir` must name a directory or a new path: not empty, not an existing file.
-fn check_out_dir(dir: &str) -> Result<(), CliError> {
+/// The files `simulate-walk` writes into `--out-dir`, in order.
+const WALK_FILES: [&str; 3] = [
+    "calibration_snapshots.json",
+    "measurements.json",
+    "truth.json",
+];
+
+/// `--out-dir` must name a directory or a new path: not empty, not an existing file. A missing
+/// directory is created here, before the work (bad input, exit status 2, when it cannot be);
+/// then every file's target is checked (a link or a FIFO planted at `truth.json` is refused
+/// before anything is written; issue 24). Returns whether the directory was created.
+fn prepare_out_dir(dir: &str) -> Result<bool, CliError> {
     if dir.is_empty() {
         return Err(CliError::usage("--out-dir: the path is empty".to_string()));
     }
     match std::fs::metadata(dir) {
-        Ok(meta) if !meta.is_dir() => Err(CliError::usage(format!(
-            "--out-dir: '{dir}' exists and is not a directory"
-        ))),
-        _ => Ok(()),
+        Ok(meta) if !meta.is_dir() => {
+            return Err(CliError::usage(format!(
+                "--out-dir: '{dir}' exists and is not a directory"
+            )))
+        }
+        Ok(_) => {
+            for name in WALK_FILES {
+                check_writable("out-dir", &walk_file(dir, name))?;
+            }
+            Ok(false)
+        }
+        Err(_) => std::fs::create_dir_all(dir)
+            .map(|()| true)
+            .map_err(|e| CliError::usage(format!("--out-dir: cannot create '{dir}': {e}"))),
     }
+}
+
+/// The path of `name` in `--out-dir`.
+fn walk_file(dir: &str, name: &str) -> String {
+    Path::new(dir).join(name).to_string_lossy().into_owned()
 }
 
 /// `scatterloc simulate-walk --scenario S --out-dir DIR [--duration S] [--dt T]
@@ -87,7 +117,9 @@ pub fn simulate_walk(args: &SimulateWalkArgs) -> Result<(), CliError> {
     let scenario = read_scenario(&args.scenario)?;
     let model = model_of(&scenario)?;
     let dir = args.out_dir.as_str();
-    check_out_dir(dir)?;
+    if dir.is_empty() {
+        return Err(CliError::usage("--out-dir: the path is empty".to_string()));
+    }
     let dt = args.dt.unwrap_or(0.1);
     let q = args.process_noise.unwrap_or(0.1);
     ConstantVelocity::validated(dt, q).map_err(flag_error)?;
@@ -115,26 +147,70 @@ pub fn simulate_walk(args: &SimulateWalkArgs) -> Result<(), CliError> {
              estimates would be written, at most {MAX_WALK_ESTIMATES:.0} are allowed"
         )));
     }
+    let created = prepare_out_dir(dir)?;
+    let walk = Walk {
+        model: &model,
+        channel: &channel,
+        clean: &default_channel(scenario.radio.bandwidth_hz, 0.0),
+        ncal,
+        seed,
+        dt,
+        q,
+        steps,
+        from_truth,
+    };
+    let written = walk.write(dir);
+    if written.is_err() && created {
+        // Nothing new is left: the directory made above is removed again (only if empty).
+        let _ = std::fs::remove_dir(dir);
+    }
+    let truth = written?;
+    emit_json(&serde_json::json!({
+        "steps": steps,
+        "calibration_snapshots": ncal,
+        "false_alarms": fa,
+        "blind_zone_pairs": truth.resolved.iter().flatten().filter(|r| !**r).count(),
+        "files": WALK_FILES,
+    }))
+}
+
+/// The validated settings of one `simulate-walk`.
+struct Walk<'a> {
+    model: &'a Model,
+    /// The channel of the walk (with false alarms).
+    channel: &'a StaticChannel,
+    /// Calibration of the empty area without false alarms (see the calibration module).
+    clean: &'a StaticChannel,
+    ncal: usize,
+    seed: u64,
+    dt: f64,
+    q: f64,
+    steps: usize,
+    from_truth: bool,
+}
+
+impl Walk<'_> {
+    /// Draws the walk and writes its three files into `dir`, all or none; returns the truth.
+    fn write(&self, dir: &str) -> Result<Truth, CliError> {
+    let Walk { model, channel, clean, ncal, seed, dt, q, steps, from_truth } = *self;
     let path = LoopPath::default();
-    // Calibration of the empty area without false alarms (see the calibration module).
-    let clean = default_channel(scenario.radio.bandwidth_hz, 0.0);
     let mut rng = measure::rng(seed, 0);
-    let cal_snaps = clean.calibration_snapshots(&model, ncal, &mut rng);
+    let cal_snaps = clean.calibration_snapshots(model, ncal, &mut rng);
     let states = path.states(dt, steps);
     let raw = |snap: Vec<Vec<scatterloc::track::gating::DelayEstimate>>| -> RawStep {
         Measurements::raw_step(&snap)
     };
     // The snapshot at t₀ (drawn either way, so the later ones do not depend on --start).
     let s0 = path.state_at(0.0);
-    let first = raw(channel.snapshot(&model, Some(scatterloc::Vec2::new(s0[0], s0[1])), &mut rng));
+    let first = raw(channel.snapshot(model, Some(scatterloc::Vec2::new(s0[0], s0[1])), &mut rng));
     let mut raw_steps = Vec::with_capacity(steps);
     let mut resolved = Vec::with_capacity(steps);
     for s in &states {
         let r = scatterloc::Vec2::new(s[0], s[1]);
-        raw_steps.push(raw(channel.snapshot(&model, Some(r), &mut rng)));
+        raw_steps.push(raw(channel.snapshot(model, Some(r), &mut rng)));
         resolved.push(
             (0..model.link_count())
-                .map(|p| channel.resolved(&model, p, model.network.delay(p, r)))
+                .map(|p| channel.resolved(model, p, model.network.delay(p, r)))
                 .collect(),
         );
     }
@@ -155,23 +231,19 @@ pub fn simulate_walk(args: &SimulateWalkArgs) -> Result<(), CliError> {
         states: states.iter().map(|s| (*s).into()).collect(),
         resolved,
     };
-    std::fs::create_dir_all(dir)
-        .map_err(|e| CliError::output(format!("--out-dir: cannot create '{dir}': {e}")))?;
-    let file = |name: &str| Path::new(dir).join(name).to_string_lossy().into_owned();
-    write_json_file(
+    // All three files or none (issue 24).
+    let [cal_file, meas_file, truth_file] = WALK_FILES.map(|name| walk_file(dir, name));
+    let mut files = OutputSet::new();
+    files.json(
         "out-dir",
-        &file("calibration_snapshots.json"),
+        &cal_file,
         &CalibrationSnapshots {
             snapshots: cal_snaps,
         },
     )?;
-    write_json_file("out-dir", &file("measurements.json"), &measurements)?;
-    write_json_file("out-dir", &file("truth.json"), &truth)?;
-    emit_json(&serde_json::json!({
-        "steps": steps,
-        "calibration_snapshots": ncal,
-        "false_alarms": fa,
-        "blind_zone_pairs": truth.resolved.iter().flatten().filter(|r| !**r).count(),
-        "files": ["calibration_snapshots.json", "measurements.json", "truth.json"],
-    }))
+    files.json("out-dir", &meas_file, &measurements)?;
+    files.json("out-dir", &truth_file, &truth)?;
+    files.commit()?;
+    Ok(truth)
+    }
 }

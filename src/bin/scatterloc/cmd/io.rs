@@ -1,7 +1,7 @@
 //! Reading the inputs (files or standard input, JSON with errors naming the field) and writing
 //! results to stdout.
 
-use std::io::{Read, Write};
+use std::io::Read;
 
 use serde::de::DeserializeOwned;
 use serde::Serialize;
@@ -12,12 +12,12 @@ use scatterloc::{Model, Scenario};
 
 use crate::failure::CliError;
 
-/// Writes `text` and a newline to stdout.
+/// Writes `text` and a newline to stdout, checked ([`crate::stdout`]).
 pub fn emit(text: &str) -> Result<(), CliError> {
-    let mut out = std::io::stdout().lock();
-    writeln!(out, "{text}")
-        .and_then(|_| out.flush())
-        .map_err(|e| CliError::output(format!("stdout: {e}")))
+    let mut bytes = Vec::with_capacity(text.len() + 1);
+    bytes.extend_from_slice(text.as_bytes());
+    bytes.push(b'\n');
+    crate::stdout::write(&bytes)
 }
 
 /// Pretty JSON on stdout (serde_json writes non-finite numbers as `null`).

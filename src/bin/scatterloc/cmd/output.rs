@@ -1,13 +1,27 @@
-//! Output files of the CLI: the format from the extension, atomic writes (a temporary file in the
-//! same directory, renamed into place, so an interrupted or failed run leaves nothing
-//! half-written) and SVG/PNG figures drawn by any [`Figure`].
+//! Output files of the CLI: the format from the extension, and the one writer every output file
+//! goes through (issue 24, docs/cli.md "Output safety"):
+//!
+//! - the target is checked up front: an empty path, a symbolic link, a directory, a FIFO, a
+//!   socket or a device is refused with an error naming the flag, before any work;
+//! - each file is written into a temporary file with a random hidden name in the target's
+//!   directory, created exclusively (`O_CREAT | O_EXCL`, by `tempfile`): nothing planted at a
+//!   predictable name can be followed, and concurrent runs never share a temporary;
+//! - the temporary is flushed and `fsync`ed, then renamed over the target (a new target is
+//!   created without replacing anything that appeared in the meantime), so a reader sees the
+//!   old file or the whole new one, never a torn one;
+//! - a command with several outputs stages all of them in an [`OutputSet`] set and renames them
+//!   only when every one was written; on any failure the temporaries are removed and nothing new
+//!   is left.
 
+use std::fs::{File, Permissions};
 use std::io::{BufWriter, Write};
+use std::os::unix::fs::{FileTypeExt, PermissionsExt};
 use std::path::{Path, PathBuf};
 
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use serde::Serialize;
+use tempfile::NamedTempFile;
 
 use scatterloc::chart::ChartError;
 
@@ -73,88 +87,239 @@ pub fn cannot_write(flag: &str, path: &str, e: impl std::fmt::Display) -> CliErr
     CliError::usage(format!("--{flag}: cannot write '{path}': {e}"))
 }
 
-/// `dir/stem.tmp.ext` beside `path` (the extension is kept: the PNG encoder picks the format
-/// from it).
-fn temporary_path(path: &Path) -> PathBuf {
-    let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned());
-    let name = match (stem, path.extension()) {
-        (Some(stem), Some(ext)) => format!("{stem}.tmp.{}", ext.to_string_lossy()),
-        (Some(stem), None) => format!("{stem}.tmp"),
-        _ => ".scatterloc.tmp".to_string(),
-    };
-    path.with_file_name(name)
+/// What is at an output path now.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Existing {
+    /// Nothing: the file will be created.
+    Nothing,
+    /// A regular file: it will be replaced.
+    File,
 }
 
 /// Refuses, naming `--flag`, an empty path and anything at `path` that an atomic write would
-/// destroy instead of writing: a symbolic link (its target would never be written), a device,
-/// a FIFO, a socket or a directory. A regular file (replaced) or a new path is fine.
-pub fn check_target(flag: &str, path: &str) -> Result<(), CliError> {
+/// destroy instead of writing, or that would block or discard the data: a symbolic link (its
+/// target would never be written), a directory, a FIFO (opening it waits for a reader), a
+/// socket or a device (`/dev/null` would lose the data). A regular file (replaced) or a new path
+/// is fine. Nothing is opened.
+fn target_kind(flag: &str, path: &str) -> Result<Existing, CliError> {
     if path.is_empty() {
         return Err(CliError::usage(format!("--{flag}: the path is empty")));
     }
     let meta = match std::fs::symlink_metadata(path) {
         Ok(meta) => meta,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(()),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Existing::Nothing),
         Err(e) => return Err(cannot_write(flag, path, e)),
     };
     let kind = meta.file_type();
     if kind.is_file() {
-        return Ok(());
+        return Ok(Existing::File);
     }
     let what = if kind.is_symlink() {
         "a symbolic link"
     } else if kind.is_dir() {
         "a directory"
+    } else if kind.is_fifo() {
+        "a FIFO"
+    } else if kind.is_socket() {
+        "a socket"
+    } else if kind.is_char_device() || kind.is_block_device() {
+        "a device"
     } else {
-        "a device, FIFO or socket"
+        "not a regular file"
     };
     Err(CliError::usage(format!(
         "--{flag}: '{path}' is {what}, not a regular file; refusing to replace it (write to a new path or a regular file)"
     )))
 }
 
-/// Fails now, naming `--flag`, if `path` could not be written later (see [`check_target`];
-/// missing directory, no permission): creates and removes its temporary file. For long runs,
-/// before they start.
-pub fn check_writable(flag: &str, path: &str) -> Result<(), CliError> {
-    check_target(flag, path)?;
-    let tmp = temporary_path(Path::new(path));
-    std::fs::File::create(&tmp).map_err(|e| cannot_write(flag, path, e))?;
-    let _ = std::fs::remove_file(&tmp);
-    Ok(())
-}
-
-/// Writes `path` atomically: `write` fills the temporary file beside it, which is then renamed
-/// over `path`; on any failure the temporary file is removed and `path` is untouched.
-pub fn write_atomic(
-    flag: &str,
-    path: &str,
-    write: impl FnOnce(&Path) -> Result<(), CliError>,
-) -> Result<(), CliError> {
-    check_target(flag, path)?;
-    let tmp = temporary_path(Path::new(path));
-    // Fail early, with the target's name, when the directory is missing or not writable.
-    std::fs::File::create(&tmp).map_err(|e| cannot_write(flag, path, e))?;
-    let done = write(&tmp).and_then(|()| {
-        std::fs::rename(&tmp, path).map_err(|e| CliError::output(format!("--{flag}: {e}")))
-    });
-    if done.is_err() {
-        let _ = std::fs::remove_file(&tmp);
+/// The directory an output file is written in (`.` for a bare file name).
+fn directory_of(path: &str) -> PathBuf {
+    match Path::new(path).parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => PathBuf::from("."),
     }
-    done
 }
 
-/// Writes `value` as compact JSON (and a newline) to `path`, atomically.
+/// A new temporary file for `path`: random hidden name in its directory, created exclusively;
+/// permissions as a plain `File::create` (0666 less the umask), so the renamed output has the
+/// same mode as before issue 24. Removed when dropped.
+fn temporary_for(flag: &str, path: &str) -> Result<NamedTempFile, CliError> {
+    tempfile::Builder::new()
+        .prefix(".scatterloc-")
+        .suffix(".tmp")
+        .rand_bytes(12)
+        .permissions(Permissions::from_mode(0o666))
+        .tempfile_in(directory_of(path))
+        .map_err(|e| cannot_write(flag, path, e))
+}
+
+/// Fails now, naming `--flag`, if `path` could not be written later: a refused kind of target
+/// (see the module doc), a missing directory, no permission (a temporary file is created in
+/// its directory and removed). Every command calls it for each output before its work starts.
+pub fn check_writable(flag: &str, path: &str) -> Result<(), CliError> {
+    target_kind(flag, path)?;
+    temporary_for(flag, path).map(drop)
+}
+
+/// One staged output: its temporary, and where it goes.
+struct Staged {
+    flag: String,
+    path: String,
+    tmp: NamedTempFile,
+}
+
+/// The outputs of one command, staged as temporaries and renamed into place together by
+/// [`OutputSet::commit`] once all were written. Dropping the set without committing removes every
+/// temporary: a failed command leaves nothing new.
+#[derive(Default)]
+pub struct OutputSet {
+    staged: Vec<Staged>,
+}
+
+impl OutputSet {
+    /// An empty set.
+    pub fn new() -> OutputSet {
+        OutputSet::default()
+    }
+
+    /// A new temporary for `path` (checked), filled by `write`, flushed and synced to disk.
+    fn stage(
+        &mut self,
+        flag: &str,
+        path: &str,
+        write: impl FnOnce(&mut BufWriter<&File>) -> Result<(), CliError>,
+    ) -> Result<(), CliError> {
+        target_kind(flag, path)?;
+        let tmp = temporary_for(flag, path)?;
+        {
+            let mut w = BufWriter::new(tmp.as_file());
+            write(&mut w)?;
+            w.flush().map_err(|e| cannot_write(flag, path, e))?;
+        }
+        tmp.as_file()
+            .sync_all()
+            .map_err(|e| cannot_write(flag, path, e))?;
+        self.staged.push(Staged {
+            flag: flag.to_string(),
+            path: path.to_string(),
+            tmp,
+        });
+        Ok(())
+    }
+
+    /// Stages `value` as compact JSON (and a newline) for `path`.
+    pub fn json<T: Serialize>(&mut self, flag: &str, path: &str, value: &T) -> Result<(), CliError> {
+        self.stage(flag, path, |w| {
+            serde_json::to_writer(&mut *w, value).map_err(|e| cannot_write(flag, path, e))?;
+            w.write_all(b"\n").map_err(|e| cannot_write(flag, path, e))
+        })
+    }
+
+    /// Stages `figure` drawn as an SVG or PNG of `size` pixels for `path`. A PNG is drawn into
+    /// memory and encoded into the temporary (the encoder plotters' own PNG files use, so the
+    /// bytes are the same), never through a path.
+    pub fn figure(
+        &mut self,
+        flag: &str,
+        path: &str,
+        format: Format,
+        size: (u32, u32),
+        figure: &impl Figure,
+    ) -> Result<(), CliError> {
+        let fail = |e: String| CliError::output(format!("--{flag}: drawing the figure: {e}"));
+        match format {
+            Format::Svg => {
+                let mut svg = String::new();
+                {
+                    let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
+                    figure.draw(&root).map_err(|e| fail(e.to_string()))?;
+                    root.present().map_err(|e| fail(e.to_string()))?;
+                }
+                self.stage(flag, path, |w| {
+                    w.write_all(svg.as_bytes())
+                        .map_err(|e| cannot_write(flag, path, e))
+                })
+            }
+            Format::Png => {
+                let (width, height) = size;
+                let mut rgb = vec![0u8; width as usize * height as usize * 3];
+                {
+                    let root = BitMapBackend::with_buffer(&mut rgb, size).into_drawing_area();
+                    figure.draw(&root).map_err(|e| fail(e.to_string()))?;
+                    root.present().map_err(|e| fail(e.to_string()))?;
+                }
+                self.stage(flag, path, |w| {
+                    image::write_buffer_with_format(
+                        w,
+                        &rgb,
+                        width,
+                        height,
+                        image::ColorType::Rgb8,
+                        image::ImageOutputFormat::Png,
+                    )
+                    .map_err(|e| cannot_write(flag, path, e))
+                })
+            }
+            Format::Json => Err(fail("JSON is not a figure format".into())),
+        }
+    }
+
+    /// Renames every staged temporary over its target. All targets are checked again first
+    /// (a link, FIFO or directory that appeared meanwhile is refused before anything is
+    /// renamed). A new target is created without replacing anything (`persist_noclobber`), an
+    /// existing regular file is replaced atomically (`rename`, which never follows a link). If a
+    /// rename still fails, the files this commit created are removed again.
+    pub fn commit(self) -> Result<(), CliError> {
+        for s in &self.staged {
+            target_kind(&s.flag, &s.path)?;
+        }
+        let mut created: Vec<String> = Vec::new();
+        for s in self.staged {
+            match persist(s.tmp, &s.flag, &s.path) {
+                Ok(Existing::Nothing) => created.push(s.path),
+                Ok(Existing::File) => {}
+                Err(e) => {
+                    for p in &created {
+                        let _ = std::fs::remove_file(p);
+                    }
+                    return Err(e);
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Renames `tmp` to `path`: see [`OutputSet::commit`]. Returns what was there before.
+fn persist(mut tmp: NamedTempFile, flag: &str, path: &str) -> Result<Existing, CliError> {
+    let fail = |e: std::io::Error| CliError::output(format!("--{flag}: cannot write '{path}': {e}"));
+    // A concurrent writer may create the target between the check and the rename: then it is
+    // a regular file and is replaced (the last writer wins, whole).
+    for _ in 0..4 {
+        match target_kind(flag, path)? {
+            Existing::Nothing => match tmp.persist_noclobber(path) {
+                Ok(_) => return Ok(Existing::Nothing),
+                Err(e) if e.error.kind() == std::io::ErrorKind::AlreadyExists => tmp = e.file,
+                Err(e) => return Err(fail(e.error)),
+            },
+            Existing::File => {
+                return tmp
+                    .persist(path)
+                    .map(|_| Existing::File)
+                    .map_err(|e| fail(e.error))
+            }
+        }
+    }
+    Err(fail(std::io::Error::other(
+        "the target kept changing during the write",
+    )))
+}
+
+/// Writes `value` as compact JSON (and a newline) to `path`, atomically (one-file [`OutputSet`]).
 pub fn write_json_file<T: Serialize>(flag: &str, path: &str, value: &T) -> Result<(), CliError> {
-    write_atomic(flag, path, |tmp| {
-        let fail = |e: &dyn std::fmt::Display| cannot_write(flag, path, e);
-        let file = std::fs::File::create(tmp).map_err(|e| fail(&e))?;
-        let mut w = BufWriter::new(file);
-        serde_json::to_writer(&mut w, value).map_err(|e| fail(&e))?;
-        w.write_all(b"\n")
-            .and_then(|()| w.flush())
-            .map_err(|e| fail(&e))
-    })
+    let mut out = OutputSet::new();
+    out.json(flag, path, value)?;
+    out.commit()
 }
 
 /// Something drawable on any plotters backend (the CLI's SVG and PNG files).
@@ -163,7 +328,8 @@ pub trait Figure {
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), ChartError>;
 }
 
-/// Draws `figure` into an SVG or PNG file of `size` pixels at `path`, atomically.
+/// Draws `figure` into an SVG or PNG file of `size` pixels at `path`, atomically (one-file
+/// [`OutputSet`]).
 pub fn write_figure(
     flag: &str,
     path: &str,
@@ -171,22 +337,7 @@ pub fn write_figure(
     size: (u32, u32),
     figure: &impl Figure,
 ) -> Result<(), CliError> {
-    let fail = |e: String| CliError::output(format!("--{flag}: drawing the figure: {e}"));
-    write_atomic(flag, path, |tmp| match format {
-        Format::Svg => {
-            let mut svg = String::new();
-            {
-                let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
-                figure.draw(&root).map_err(|e| fail(e.to_string()))?;
-                root.present().map_err(|e| fail(e.to_string()))?;
-            }
-            std::fs::write(tmp, svg).map_err(|e| cannot_write(flag, path, e))
-        }
-        Format::Png => {
-            let root = BitMapBackend::new(tmp, size).into_drawing_area();
-            figure.draw(&root).map_err(|e| fail(e.to_string()))?;
-            root.present().map_err(|e| cannot_write(flag, path, e))
-        }
-        Format::Json => Err(fail("JSON is not a figure format".into())),
-    })
+    let mut out = OutputSet::new();
+    out.figure(flag, path, format, size, figure)?;
+    out.commit()
 }

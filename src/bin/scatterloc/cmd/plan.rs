@@ -18,7 +18,7 @@ use scatterloc::present::{run_plan, PlanJson, PlanRequest, DEFAULT_PLAN_BUDGET};
 use scatterloc::{Error, Model, Scenario};
 
 use super::io::{emit, read_json_file};
-use super::output::{check_writable, write_figure, write_json_file, Figure, Format};
+use super::output::{check_writable, Figure, Format, OutputSet};
 use super::study::{cancelled, interrupted, load_layout, run_with_bar};
 use crate::cli::PlanArgs;
 use crate::failure::CliError;
@@ -79,6 +79,8 @@ pub fn plan(args: &PlanArgs) -> Result<(), CliError> {
     })?;
     let plan = result.map_err(errors)?;
 
+    // The figure and the plan are renamed into place together, or neither (issue 24).
+    let mut files = OutputSet::new();
     if let Some((path, format)) = figure {
         let maps = PlanMaps::compute(&scenario, &plan.scenario)?;
         if interrupted() {
@@ -92,12 +94,13 @@ pub fn plan(args: &PlanArgs) -> Result<(), CliError> {
             opts: chart_options(&scenario, &plan, &args.movable),
         };
         let size = plan_chart_size(&scenario.area_m, FIGURE_WIDTH);
-        write_figure("figure", path, format, size, &figure)?;
+        files.figure("figure", path, format, size, &figure)?;
     }
     if interrupted() {
         return Err(cancelled());
     }
-    write_json_file("out", out, &plan)?;
+    files.json("out", out, &plan)?;
+    files.commit()?;
 
     let summary = json!({
         "out": out,

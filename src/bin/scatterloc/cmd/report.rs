@@ -14,7 +14,7 @@ use scatterloc::chart::{
 use scatterloc::study::{CurveDoc, TrackStudy as Study};
 
 use super::io::emit;
-use super::output::{check_writable, write_figure, write_json_file, Figure, Format};
+use super::output::{check_writable, Figure, Format, OutputSet};
 use super::study::{at_report_times, AtTime};
 use crate::failure::CliError;
 
@@ -116,8 +116,10 @@ impl Outputs {
         if self.json.is_none() && self.figure.is_none() {
             return emit(&encode(&Body::of(docs))?);
         }
+        // The JSON and the figure are renamed into place together, or neither (issue 24).
+        let mut files = OutputSet::new();
         if let Some(path) = &self.json {
-            write_json_file("json", path, &Body::of(docs))?;
+            files.json("json", path, &Body::of(docs))?;
         }
         if let Some((path, format)) = &self.figure {
             let captions: Vec<String> = study
@@ -153,8 +155,9 @@ impl Outputs {
                     rmse_pcrlb_m: &d.rmse_pcrlb_m,
                 })
                 .collect();
-            write_figure("out", path, *format, size, &FiltersFigure { panels, opts })?;
+            files.figure("out", path, *format, size, &FiltersFigure { panels, opts })?;
         }
+        files.commit()?;
         let summaries: Vec<Summary<M>> = docs
             .iter()
             .map(|d| Summary {

@@ -303,6 +303,8 @@ fn write_result(
     figure: FigureOut,
 ) -> Result<(), CliError> {
     let experiment = cfg.experiment;
+    // The JSON and the figure are renamed into place together, or neither (issue 24).
+    let mut files = OutputSet::new();
     if let Some(p) = json {
         let doc = RocDoc {
             config: RocConfig::of(cfg),
@@ -333,7 +335,7 @@ fn write_result(
                 })
                 .collect(),
         };
-        write_json_file("json", p, &doc)?;
+        files.json("json", p, &doc)?;
     }
     if let Some((p, format)) = figure {
         let xy: Vec<Vec<(f64, f64)>> = r
@@ -350,7 +352,8 @@ fn write_result(
             })
             .collect();
         let fig = figure_of(r, cfg, &xy);
-        write_figure("out", p, format, curve_chart_size(), &fig)?;
+        files.figure("out", p, format, curve_chart_size(), &fig)?;
     }
+    files.commit()?;
     emit(&summary_table(r, cfg, wall, used))
 }
