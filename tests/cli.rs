@@ -3,7 +3,8 @@
 //! `filters`), the gating pipeline (`gating`), the planner (`plan`), the multi-target commands
 //! (`mtl`), sharded studies and `merge` (`scale_out`), bounded, named bad input (`hardening`),
 //! and the outputs of a fixed set of commands pinned to those of the binary before issue 23
-//! (`pinned`). Every module checks the "exit 2 + one stderr line naming the field" contract.
+//! (`pinned`), and the output writer's guarantees: atomic, never through a link, a FIFO or a
+//! device, all-or-nothing, checked stdout (`outputs`, issue 24). Every module checks the "exit 2 + one stderr line naming the field" contract.
 #![cfg(not(target_arch = "wasm32"))]
 
 mod common;
@@ -25,6 +26,9 @@ mod montecarlo;
 
 #[path = "cli/mtl.rs"]
 mod mtl;
+
+#[path = "cli/outputs.rs"]
+mod outputs;
 
 #[path = "cli/pinned.rs"]
 mod pinned;

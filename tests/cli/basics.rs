@@ -796,7 +796,7 @@ fn output_paths_that_are_not_regular_files_are_refused_and_kept() {
             "--out",
             "/dev/null",
         ],
-        &["--out", "/dev/null", "not a regular file"],
+        &["--out", "/dev/null", "a device, not a regular file"],
     );
     assert!(!std::fs::metadata("/dev/null").unwrap().is_file());
 

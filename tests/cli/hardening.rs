@@ -394,9 +394,10 @@ fn long_strings_and_numbers_are_clipped_in_messages() {
     s["receivers"][0]["name"] = json!("R".repeat(100_000));
     s["receivers"][1]["name"] = json!("R".repeat(100_000));
     let f = dir.write("s.json", &s);
+    // Names are capped at 256 bytes since issue 24: named by their field, not echoed.
     let line = fails(
         &["crlb", "--scenario", &f, "--at", "1,1"],
-        &["duplicate node name"],
+        &["receivers[0].name", "100000 bytes long, at most 256"],
     );
     assert!(line.len() < 400, "{} bytes", line.len());
     let out = run(&["crlb", "--scenario", &f, "--at", "1e300,1"]);

@@ -29,8 +29,8 @@ pub fn read_calibration(path: &str, model: &Model) -> Result<Calibration, CliErr
 pub fn calibrate(args: &CalibrateArgs) -> Result<(), CliError> {
     // The extension rule of every other output flag (issue 24: `--out cal.txt` wrote JSON).
     if let Some(p) = args.out.as_deref() {
-        Format::of("out", p, &[Format::Json])?;
         check_writable("out", p)?;
+        Format::of("out", p, &[Format::Json])?;
     }
     let scenario = read_scenario(&args.scenario)?;
     let model = model_of(&scenario)?;

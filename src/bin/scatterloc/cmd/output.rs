@@ -87,6 +87,12 @@ pub fn cannot_write(flag: &str, path: &str, e: impl std::fmt::Display) -> CliErr
     CliError::usage(format!("--{flag}: cannot write '{path}': {e}"))
 }
 
+/// "cannot write" for `--flag` once the file was opened: a failed write (a full disk, a
+/// file-size limit), exit status 1.
+fn write_failed(flag: &str, path: &str, e: impl std::fmt::Display) -> CliError {
+    CliError::output(format!("--{flag}: cannot write '{path}': {e}"))
+}
+
 /// What is at an output path now.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Existing {
@@ -194,11 +200,11 @@ impl OutputSet {
         {
             let mut w = BufWriter::new(tmp.as_file());
             write(&mut w)?;
-            w.flush().map_err(|e| cannot_write(flag, path, e))?;
+            w.flush().map_err(|e| write_failed(flag, path, e))?;
         }
         tmp.as_file()
             .sync_all()
-            .map_err(|e| cannot_write(flag, path, e))?;
+            .map_err(|e| write_failed(flag, path, e))?;
         self.staged.push(Staged {
             flag: flag.to_string(),
             path: path.to_string(),
@@ -210,8 +216,8 @@ impl OutputSet {
     /// Stages `value` as compact JSON (and a newline) for `path`.
     pub fn json<T: Serialize>(&mut self, flag: &str, path: &str, value: &T) -> Result<(), CliError> {
         self.stage(flag, path, |w| {
-            serde_json::to_writer(&mut *w, value).map_err(|e| cannot_write(flag, path, e))?;
-            w.write_all(b"\n").map_err(|e| cannot_write(flag, path, e))
+            serde_json::to_writer(&mut *w, value).map_err(|e| write_failed(flag, path, e))?;
+            w.write_all(b"\n").map_err(|e| write_failed(flag, path, e))
         })
     }
 
@@ -237,7 +243,7 @@ impl OutputSet {
                 }
                 self.stage(flag, path, |w| {
                     w.write_all(svg.as_bytes())
-                        .map_err(|e| cannot_write(flag, path, e))
+                        .map_err(|e| write_failed(flag, path, e))
                 })
             }
             Format::Png => {
@@ -257,7 +263,7 @@ impl OutputSet {
                         image::ColorType::Rgb8,
                         image::ImageOutputFormat::Png,
                     )
-                    .map_err(|e| cannot_write(flag, path, e))
+                    .map_err(|e| write_failed(flag, path, e))
                 })
             }
             Format::Json => Err(fail("JSON is not a figure format".into())),
@@ -292,7 +298,7 @@ impl OutputSet {
 
 /// Renames `tmp` to `path`: see [`OutputSet::commit`]. Returns what was there before.
 fn persist(mut tmp: NamedTempFile, flag: &str, path: &str) -> Result<Existing, CliError> {
-    let fail = |e: std::io::Error| CliError::output(format!("--{flag}: cannot write '{path}': {e}"));
+    let fail = |e: std::io::Error| write_failed(flag, path, e);
     // A concurrent writer may create the target between the check and the rename: then it is
     // a regular file and is replaced (the last writer wins, whole).
     for _ in 0..4 {
