@@ -16,6 +16,7 @@
 use proptest::prelude::*;
 use serde::Deserialize;
 use serde_json::Value;
+use std::process::Command;
 
 use scatterloc::localize::{crlb_at, crlb_map, locate, DelayMeasurements, Grid, LmConfig};
 use scatterloc::math::{Mat4, Vec2, Vec4};
@@ -896,4 +897,169 @@ fn cut(text: &str, k: &str) -> String {
     };
     let end = rest.find(other).unwrap_or(rest.len().saturating_sub(1));
     rest[..end].to_string()
+}
+
+// ------------------------------------------------------------------------------- output targets
+
+/// What a case plants in the output directory before the run (issue 24).
+#[derive(Clone, Copy, Debug)]
+enum Plant {
+    /// Nothing: a new file.
+    Nothing,
+    /// A regular file at the target (replaced).
+    File,
+    /// A symbolic link at the target to a victim file (refused; the victim unchanged).
+    LinkToVictim,
+    /// A symbolic link at the target to `/dev/null` (refused: the data would be lost).
+    LinkToNull,
+    /// A FIFO at the target (refused, not blocking).
+    Fifo,
+    /// A directory at the target (refused).
+    Directory,
+    /// Links to the victim at the old predictable temporary names (never followed).
+    LinksAtTemporaryNames,
+}
+
+const PLANTS: [Plant; 7] = [
+    Plant::Nothing,
+    Plant::File,
+    Plant::LinkToVictim,
+    Plant::LinkToNull,
+    Plant::Fifo,
+    Plant::Directory,
+    Plant::LinksAtTemporaryNames,
+];
+
+/// The output-writing commands of a case: the arguments (`{out}` is the planted target, `{dir}`
+/// its directory, `{s}` the scenario) and the target's file name.
+const WRITERS: &[(&[&str], &str)] = &[
+    (&["crlb-map", "--scenario", "{s}", "--out", "{out}", "--nx", "16", "--ny", "16"], "m.json"),
+    (&["crlb-map", "--scenario", "{s}", "--out", "{out}", "--nx", "16", "--ny", "16"], "m.png"),
+    (
+        &["plan", "--scenario", "{s}", "--out", "{dir}/p.json", "--figure", "{out}", "--grid", "8",
+          "--move", "rx", "--objective", "p90", "--roi", "-7.5,30,-10,26", "--budget", "40"],
+        "p.svg",
+    ),
+    (&["simulate-walk", "--scenario", "{s}", "--out-dir", "{dir}", "--duration", "1",
+       "--calibration-snapshots", "5"], "truth.json"),
+    (&["montecarlo", "--trajectory", "I", "--runs", "4", "--noise-runs", "1", "--dt", "0.1",
+       "--json", "{out}"], "mc.json"),
+];
+
+/// One output-target case: `writers` processes at once run a command whose target holds
+/// `plant`. The invariant (docs/cli.md, "Output safety"): a refused target is exit 2 naming the
+/// flag and writes nothing; otherwise exit 0 and the target is a regular file holding one whole
+/// output; the victim is never changed, nothing blocks (the time limit), no temporary is left.
+fn run_output_target(cmd: usize, plant: Plant, writers: usize, dir: &CaseDir) -> Verdict {
+    use std::os::unix::fs::symlink;
+    let (args, name) = WRITERS[cmd];
+    let out_dir = dir.0.join("out");
+    let _ = std::fs::remove_dir_all(&out_dir);
+    std::fs::create_dir_all(&out_dir).expect("out dir");
+    let d = out_dir.to_string_lossy().into_owned();
+    let target = out_dir.join(name);
+    let scenario = dir.write("s.json", &docs::sensors_text());
+    let victim = dir.write("victim.txt", "precious");
+    let planted = match plant {
+        Plant::Nothing => false,
+        Plant::File => {
+            std::fs::write(&target, "old").expect("plant");
+            false
+        }
+        Plant::LinkToVictim => {
+            symlink(&victim, &target).expect("plant");
+            true
+        }
+        Plant::LinkToNull => {
+            symlink("/dev/null", &target).expect("plant");
+            true
+        }
+        Plant::Fifo => {
+            let ok = Command::new("mkfifo").arg(&target).status().expect("mkfifo");
+            assert!(ok.success());
+            true
+        }
+        Plant::Directory => {
+            std::fs::create_dir(&target).expect("plant");
+            true
+        }
+        Plant::LinksAtTemporaryNames => {
+            let stem = name.split('.').next().unwrap_or(name);
+            let ext = name.rsplit('.').next().unwrap_or("");
+            for tmp in [format!("{stem}.tmp.{ext}"), format!("{name}.tmp"), format!("{stem}.tmp")] {
+                symlink(&victim, out_dir.join(tmp)).expect("plant");
+            }
+            false
+        }
+    };
+    let args: Vec<String> = args
+        .iter()
+        .map(|a| {
+            a.replace("{out}", &target.to_string_lossy())
+                .replace("{dir}", &d)
+                .replace("{s}", &scenario)
+        })
+        .collect();
+    let runs: Vec<check::CliRun> = std::thread::scope(|s| {
+        let hs: Vec<_> = (0..writers).map(|_| s.spawn(|| run_cli(&args))).collect();
+        hs.into_iter().map(|h| h.join().expect("run")).collect()
+    });
+    for run in &runs {
+        // Summaries name the outputs not asked for as null (`out` of montecarlo without --out).
+        let v = check_cli(run, &|p, _| p == "out" || p == "figure")?;
+        if planted != (v == Pass::Err) {
+            return Err(fail(
+                Class::BadOutput,
+                format!("{plant:?}: exit {:?}: {}", run.code, clip(&run.stderr, 300)),
+            ));
+        }
+    }
+    if std::fs::read_to_string(&victim).ok().as_deref() != Some("precious") {
+        return Err(fail(Class::BadOutput, format!("{plant:?}: the link's target was written")));
+    }
+    let left: Vec<String> = std::fs::read_dir(&out_dir)
+        .expect("list")
+        .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
+        .filter(|f| f.starts_with(".scatterloc-"))
+        .collect();
+    if !left.is_empty() {
+        return Err(fail(Class::BadOutput, format!("temporaries left: {left:?}")));
+    }
+    if planted {
+        // Nothing new beside the planted target.
+        let n = std::fs::read_dir(&out_dir).expect("list").count();
+        if n != 1 {
+            return Err(fail(Class::BadOutput, format!("{plant:?}: {n} entries after a refusal")));
+        }
+        return Ok(Pass::Err);
+    }
+    let bytes = std::fs::read(&target).unwrap_or_default();
+    let whole = match name.rsplit('.').next() {
+        Some("json") => serde_json::from_slice::<Value>(&bytes).is_ok(),
+        Some("png") => bytes.starts_with(b"\x89PNG") && bytes.ends_with(b"IEND\xaeB`\x82"),
+        _ => bytes.ends_with(b"</svg>\n") || bytes.ends_with(b"</svg>"),
+    };
+    if !whole || !std::fs::symlink_metadata(&target).is_ok_and(|m| m.is_file()) {
+        return Err(fail(Class::BadOutput, format!("{plant:?}: {name} is not one whole output")));
+    }
+    Ok(Pass::Ok)
+}
+
+/// Issue 24: output targets with planted links, FIFOs, directories and files, and concurrent
+/// writers, for each kind of output (JSON, PNG, SVG with its JSON, simulate-walk's three files,
+/// a study's --json).
+#[test]
+fn fuzz_cli_output_targets() {
+    let strategy = (
+        0..WRITERS.len(),
+        prop::sample::select(PLANTS.to_vec()),
+        1usize..=2,
+    );
+    let dir = CaseDir::new("output_targets");
+    fuzz(file!(), "cli_output_targets", 24, KNOWN, strategy, |&(cmd, plant, writers)| {
+        Case {
+            verdict: run_output_target(cmd, plant, writers, &dir),
+            what: format!("{:?} with {plant:?}, {writers} writer(s)", WRITERS[cmd].0),
+        }
+    });
 }
