@@ -15,9 +15,9 @@
 //! "montecarlo" | "mtl-roc", "config": {…}, "shard": {"index": I, "count": N, "unit": "chunks" |
 //! "realisations", "range": [a, b], "total": C}, "timing": {"threads": T, "wall_time_s": [..]},
 //! "digest": "sha256:…", "sums": …}`. The shard covers the units `[a, b)` = [`Shard::range`] of
-//! `C`. `digest` is the SHA-256 of the sums serialized as compact JSON by this build
-//! ([`sums_digest`]): the same sums give the same bytes, so it does not depend on the thread
-//! count, and a part reformatted (e.g. by `jq`) keeps it. Version 1 (without a digest) is
+//! `C`. `digest` is the SHA-256 of the sums' JSON as a canonical token stream
+//! ([`sums_digest`]): the same sums give the same digest, so it does not depend on the thread
+//! count, and a part reformatted (e.g. by `jq -S .`) keeps it. Version 1 (without a digest) is
 //! refused with a named error.
 //!
 //! # What is checked (issue 24)
@@ -35,7 +35,8 @@
 //!
 //! Every part's sums, when merged (the study rebuilt from `config` gives the bounds):
 //! - no array longer than the study implies (checked while parsing, before anything is
-//!   allocated for it: [`Part::read_sums`]); the types exact (counts are whole numbers ≥ 0);
+//!   allocated for it: [`Part::read_sums`]); the digest matches the sums (corruption,
+//!   truncation, an edit); the types exact (counts are whole numbers ≥ 0);
 //! - the digest matches the sums (corruption, truncation, an edit);
 //! - Monte Carlo, per entry `sums[k·F + f]` (trajectory `k`, filter `f` of `F`): `steps + 1`
 //!   entries per list; `trajectories` = the trajectories of the shard's chunks; `runs +
@@ -119,11 +120,13 @@ pub fn software() -> String {
     format!("scatterloc {}", env!("CARGO_PKG_VERSION"))
 }
 
-/// `sha256:` and the hex SHA-256 of `sums` serialized as compact JSON: the `digest` of a part
-/// file. Errors are serde_json's (sums that do not serialize).
+/// The `digest` of a part file with sums `sums`: `sha256:` and the hex SHA-256 of their JSON
+/// as a canonical token stream (structure, strings, numbers by type and bits; not the layout
+/// or the key order, so a reformatted part keeps its digest). Errors are serde_json's (sums
+/// that do not serialize).
 pub fn sums_digest<S: Serialize + ?Sized>(sums: &S) -> core::result::Result<String, String> {
-    let bytes = serde_json::to_vec(sums).map_err(|e| format!("encoding the sums: {e}"))?;
-    Ok(format!("sha256:{:x}", Sha256::digest(&bytes)))
+    let text = serde_json::to_string(sums).map_err(|e| format!("encoding the sums: {e}"))?;
+    walk("sums", &text, usize::MAX).map(|d| hex(&d))
 }
 
 /// Where a shard lies in its study.
@@ -345,14 +348,18 @@ fn clip(text: &str) -> String {
     }
 }
 
-/// Checks that `raw` has no array of more than `max` entries (nested at any depth) without
-/// allocating for it; the error names the path under `what` (`sums[0].squared_error: more
-/// than 11 entries …`).
-fn check_shape(what: &str, raw: &str, max: usize) -> core::result::Result<(), String> {
-    struct Shape {
+/// Walks the JSON text `raw` once without allocating for its values: checks that no array
+/// (nested at any depth) has more than `max` entries, and returns the SHA-256 of its values
+/// as a canonical token stream (the value's structure, strings, numbers by type and bits;
+/// an object's entries in any order — whitespace, layout and key order do not count; an
+/// object of more than `max` keys is refused too). The error
+/// names the path under `what` (`sums[0].squared_error: more than 11 entries …`).
+fn walk(what: &str, raw: &str, max: usize) -> core::result::Result<[u8; 32], String> {
+    struct Shape<'h> {
         max: usize,
+        h: &'h mut Sha256,
     }
-    impl<'de> DeserializeSeed<'de> for Shape {
+    impl<'de> DeserializeSeed<'de> for Shape<'_> {
         type Value = ();
         fn deserialize<D: serde::Deserializer<'de>>(
             self,
@@ -361,54 +368,98 @@ fn check_shape(what: &str, raw: &str, max: usize) -> core::result::Result<(), St
             d.deserialize_any(self)
         }
     }
-    impl<'de> Visitor<'de> for Shape {
+    impl<'de> Visitor<'de> for Shape<'_> {
         type Value = ();
         fn expecting(&self, f: &mut core::fmt::Formatter) -> core::fmt::Result {
             f.write_str("any JSON value")
         }
-        fn visit_bool<E>(self, _: bool) -> core::result::Result<(), E> {
+        fn visit_bool<E>(self, v: bool) -> core::result::Result<(), E> {
+            self.h.update([b'b', v as u8]);
             Ok(())
         }
-        fn visit_i64<E>(self, _: i64) -> core::result::Result<(), E> {
+        fn visit_i64<E>(self, v: i64) -> core::result::Result<(), E> {
+            self.h.update([b'i']);
+            self.h.update(v.to_le_bytes());
             Ok(())
         }
-        fn visit_u64<E>(self, _: u64) -> core::result::Result<(), E> {
+        fn visit_u64<E>(self, v: u64) -> core::result::Result<(), E> {
+            self.h.update([b'u']);
+            self.h.update(v.to_le_bytes());
             Ok(())
         }
-        fn visit_f64<E>(self, _: f64) -> core::result::Result<(), E> {
+        fn visit_f64<E>(self, v: f64) -> core::result::Result<(), E> {
+            self.h.update([b'f']);
+            self.h.update(v.to_bits().to_le_bytes());
             Ok(())
         }
-        fn visit_str<E>(self, _: &str) -> core::result::Result<(), E> {
+        fn visit_str<E>(self, v: &str) -> core::result::Result<(), E> {
+            self.h.update([b's']);
+            self.h.update((v.len() as u64).to_le_bytes());
+            self.h.update(v.as_bytes());
             Ok(())
         }
         fn visit_unit<E>(self) -> core::result::Result<(), E> {
+            self.h.update([b'n']);
             Ok(())
         }
         fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> core::result::Result<(), A::Error> {
+            let Shape { max, h } = self;
+            h.update([b'[']);
             let mut n = 0usize;
-            while seq.next_element_seed(Shape { max: self.max })?.is_some() {
+            while seq.next_element_seed(Shape { max, h: &mut *h })?.is_some() {
                 n += 1;
-                if n > self.max {
+                if n > max {
                     return Err(serde::de::Error::custom(format!(
-                        "more than {} entries (the most the study's configuration implies)",
-                        self.max
+                        "more than {max} entries (the most the study's configuration implies)"
                     )));
                 }
             }
+            h.update([b']']);
             Ok(())
         }
         fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> core::result::Result<(), A::Error> {
-            while map.next_key::<IgnoredAny>()?.is_some() {
-                map.next_value_seed(Shape { max: self.max })?;
+            // Each entry hashed on its own, the entries' hashes sorted: key order does not
+            // count (a tool that sorts keys keeps the digest).
+            let Shape { max, h } = self;
+            let mut entries: Vec<[u8; 32]> = Vec::new();
+            loop {
+                let mut e = Sha256::new();
+                if map.next_key_seed(Shape { max, h: &mut e })?.is_none() {
+                    break;
+                }
+                map.next_value_seed(Shape { max, h: &mut e })?;
+                entries.push(e.finalize().into());
+                if entries.len() > max {
+                    return Err(serde::de::Error::custom(format!(
+                        "more than {max} keys (the most the study's configuration implies)"
+                    )));
+                }
             }
+            entries.sort_unstable();
+            h.update([b'{']);
+            for e in &entries {
+                h.update(e);
+            }
+            h.update([b'}']);
             Ok(())
         }
     }
+    let mut h = Sha256::new();
     let mut de = serde_json::Deserializer::from_str(raw);
     let mut track = serde_path_to_error::Track::new();
-    Shape { max }
+    Shape { max, h: &mut h }
         .deserialize(serde_path_to_error::Deserializer::new(&mut de, &mut track))
-        .map_err(|e| at_path(what, &track.path().to_string(), e))
+        .map_err(|e| at_path(what, &track.path().to_string(), e))?;
+    Ok(h.finalize().into())
+}
+
+/// `sha256:` and 64 hex digits.
+fn hex(d: &[u8; 32]) -> String {
+    let mut s = String::from("sha256:");
+    for b in d {
+        s.push_str(&format!("{b:02x}"));
+    }
+    s
 }
 
 /// Reads one part file's text: the format and version first, then the fields, each checked
@@ -465,7 +516,7 @@ fn read_part(text: &str) -> core::result::Result<Header<'_>, NotPart> {
     }
     let config: Value =
         serde_json::from_str(config).map_err(|e| other(format!("config: {e}")))?;
-    check_shape("timing", part.timing.get(), MAX_TIMING_ENTRIES).map_err(other)?;
+    walk("timing", part.timing.get(), MAX_TIMING_ENTRIES).map_err(other)?;
     let timing: Timing = parse_at("timing", part.timing.get()).map_err(other)?;
     if timing.threads == 0 {
         return Err(other("timing.threads: 0, not a thread count ≥ 1".into()));
@@ -501,8 +552,8 @@ fn read_part(text: &str) -> core::result::Result<Header<'_>, NotPart> {
 impl Part {
     /// The sums of this part as `T`, from `text`, the part file read again: the header must be
     /// the one checked ([`PartSet::read`]), no array of the sums longer than `max_len` (checked
-    /// while parsing, before anything is allocated for it), the sums must parse as `T` (errors
-    /// name the field) and match the part's digest. Each problem is [`Error::InconsistentPart`].
+    /// in a first pass that allocates nothing for the sums, which also computes their digest),
+    /// the digest the part's, and the sums must parse as `T` (errors name the field). Each problem is [`Error::InconsistentPart`].
     pub fn read_sums<T: serde::de::DeserializeOwned + Serialize>(
         &self,
         text: &str,
@@ -523,9 +574,8 @@ impl Part {
             ));
         }
         let raw = header.sums.get();
-        check_shape("sums", raw, max_len).map_err(|e| inconsistent(&self.path, e))?;
-        let sums: T = parse_at("sums", raw).map_err(|e| inconsistent(&self.path, e))?;
-        let digest = sums_digest(&sums).map_err(|e| inconsistent(&self.path, e))?;
+        let digest = walk("sums", raw, max_len).map_err(|e| inconsistent(&self.path, e))?;
+        let digest = hex(&digest);
         if digest != self.digest {
             return Err(inconsistent(
                 &self.path,
@@ -537,6 +587,7 @@ impl Part {
                 ),
             ));
         }
+        let sums: T = parse_at("sums", raw).map_err(|e| inconsistent(&self.path, e))?;
         Ok(sums)
     }
 }
