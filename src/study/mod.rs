@@ -13,13 +13,14 @@
 //!   record [`RocConfig`].
 //! - [`track_measurements`]: a measurement file (`steps` or gated `raw_steps`) tracked by any
 //!   filter ([`TrackOutput`], the document of `scatterloc track`).
-//! - [`PartSet`], [`PartFile`]: the part file format (`scatterloc-part`, version 1).
+//! - [`PartSet`], [`PartFile`]: the part file format (`scatterloc-part`, version 2, with a digest of its sums) and what `merge` checks.
 
 mod drive;
 mod filters;
 mod montecarlo;
 mod part;
 mod roc;
+mod sums;
 mod track;
 
 pub use drive::{Driver, Sequential};
@@ -29,8 +30,9 @@ pub use montecarlo::{
     MonteCarloStudy, RunTime, TrackStudy,
 };
 pub use part::{
-    differs, inconsistent, merged_timing, software, Part, PartFile, PartSet, ShardDoc, Timing,
-    PART_FORMAT, PART_VERSION,
+    differs, inconsistent, load_sums, merged_timing, software, sums_digest, Part, PartFile,
+    PartSet, ShardDoc, Timing, MAX_PART_CONFIG_BYTES, MAX_TIMING_ENTRIES, PART_FORMAT,
+    PART_VERSION,
 };
 pub use roc::{RocConfig, RocStudy};
 pub use track::{track_measurements, TrackOutput, TrackRequest, TrackStart};

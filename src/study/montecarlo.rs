@@ -37,7 +37,8 @@ use serde_json::Value;
 use crate::error::{Error, Result};
 use crate::measure::Model;
 use crate::scenario::Scenario;
-use crate::study::part::{differs, merged_timing, Part};
+use crate::study::part::{differs, load_sums, merged_timing, PartSet};
+use crate::study::sums::check_sums;
 use crate::study::{inconsistent, FilterResults, FilterStudy};
 use crate::track::{
     paper_initial_covariance, ConstantVelocity, FilterKind, MonteCarloConfig, MonteCarloResult,
@@ -563,17 +564,23 @@ impl MonteCarloStudy {
         runs.iter().flat_map(FilterStudy::sums).collect()
     }
 
-    /// The merge of a checked set of part files ([`crate::study::PartSet::check`]): the study
-    /// of the first part's configuration ([`MonteCarloStudy::from_config`]), every
-    /// trajectory's runs with the sums of every shard added exactly, and each trajectory's run
-    /// time (the wall times added, the most threads of any part, the thread time
-    /// `Σ wall · threads`). A part whose sums or timing do not fit the study is
-    /// [`Error::InconsistentPart`].
-    pub fn merge(parts: &[Part]) -> Result<(MonteCarloStudy, Vec<FilterStudy>, Vec<RunTime>)> {
+    /// The merge of a checked set of part files ([`PartSet::read`]): the study of its
+    /// configuration ([`MonteCarloStudy::from_config`]), every trajectory's runs with the sums
+    /// of every shard added exactly, and each trajectory's run time (the wall times added, the
+    /// most threads of any part, the thread time `Σ wall · threads`). Each part's sums are
+    /// read again through `load`, one part at a time, and checked against their digest and the
+    /// study ([`crate::study::Part::read_sums`], `check_sums`; the invariants are listed in
+    /// [`crate::study::PartSet`]'s module). A part whose sums or timing do not fit the study
+    /// is [`Error::InconsistentPart`], naming the part and the field.
+    pub fn merge(
+        set: &PartSet,
+        load: &mut dyn FnMut(&str) -> Result<String>,
+    ) -> Result<(MonteCarloStudy, Vec<FilterStudy>, Vec<RunTime>)> {
+        let parts = &set.parts;
         let first = parts.first().ok_or(Error::PartSet {
             what: "merge: no part files given".into(),
         })?;
-        let study = MonteCarloStudy::from_config(&first.config).map_err(|e| match e {
+        let study = MonteCarloStudy::from_config(&set.config).map_err(|e| match e {
             Error::Parse { message } => inconsistent(&first.path, message),
             e => inconsistent(&first.path, e),
         })?;
@@ -587,44 +594,39 @@ impl MonteCarloStudy {
                 ),
             ));
         }
+        // Timing first (no sums read for a part whose header does not fit).
+        let (timing, thread_s) = merged_timing(parts, study.configs.len())?;
         let per = study.filters.len();
+        let entries = study.configs.len() * per;
+        let steps = study.track.steps;
+        // The longest array of a part's sums: the per-step lists, the entries, the partials of
+        // an exact sum (at most ~40).
+        let max_len = (steps + 1).max(entries).max(64);
         let mut runs = (0..study.configs.len())
             .map(|k| study.filter_study(k))
             .collect::<Result<Vec<_>>>()?;
         for part in parts {
-            let sums: Vec<StudySums> = part.sums()?;
+            let sums: Vec<StudySums> = load_sums(part, max_len, load)?;
             let chunks = part.shard.range[0]..part.shard.range[1];
-            if sums.len() != study.configs.len() * per {
+            if sums.len() != entries {
                 return Err(inconsistent(
                     &part.path,
                     format!(
-                        "{} sums for {} trajectories × {per} filters",
+                        "sums: {} entries, not {} trajectories × {per} filters",
                         sums.len(),
                         study.configs.len()
                     ),
                 ));
             }
             for (k, (cfg, run)) in study.configs.iter().zip(runs.iter_mut()).enumerate() {
-                for f in 0..per {
-                    let s = &sums[k * per + f];
-                    let trajectories = cfg.trajectories_in(&chunks);
-                    if !s.has_steps(cfg.steps)
-                        || s.trajectories != trajectories
-                        || s.runs + s.failed_runs != trajectories * cfg.noise_runs
-                    {
-                        return Err(inconsistent(
-                            &part.path,
-                            format!(
-                                "sums do not match chunks [{}, {}) of the study ({} steps, {trajectories} trajectories × {} noise runs)",
-                                chunks.start, chunks.end, cfg.steps, cfg.noise_runs
-                            ),
-                        ));
-                    }
+                let of_trajectory = &sums[k * per..(k + 1) * per];
+                check_sums(cfg, &chunks, k * per, of_trajectory)
+                    .map_err(|what| inconsistent(&part.path, what))?;
+                for (f, s) in of_trajectory.iter().enumerate() {
                     run.add_sums(f, s, chunks.len());
                 }
             }
         }
-        let (timing, thread_s) = merged_timing(parts, study.configs.len())?;
         let times = timing
             .wall_time_s
             .iter()

@@ -1,16 +1,60 @@
-//! The part file of a sharded study (issue 13 §4) and the checks that make a set of them one
-//! study: a sharded run writes its configuration, seed, shard, timing and sufficient statistics
-//! ([`crate::track::StudySums`], [`crate::mtl::experiment::Tally`]) instead of its result, and
-//! [`PartSet::check`] reads the parts back as one set before anything is merged — every one a
-//! part file of this format version, all of one study (same software version, study kind and
-//! configuration, seed included), every shard of one count present exactly once, each
-//! consistent with its index. Each problem is one named error that lists the offending files.
+//! The part file of a sharded study (issue 13 §4, issue 24) and the checks that make a set of
+//! them one study: a sharded run writes its configuration, seed, shard, timing and sufficient
+//! statistics ([`crate::track::StudySums`], [`crate::mtl::experiment::Tally`]) instead of its
+//! result, with a digest of those sums; [`PartSet::read`] reads the parts back as one set
+//! before anything is merged — every one a part file of this format version, all of one study
+//! (same software version, study kind and configuration, seed included), every shard of one
+//! count present exactly once, each consistent with its index — and the study's `merge`
+//! ([`crate::study::MonteCarloStudy::merge`], [`crate::study::RocStudy::merge`]) reads each
+//! part's sums again, one file at a time, and checks them against their digest and against
+//! the study before adding them. Each problem is one named error that names the file and the
+//! field ([`Error::PartSet`] for the set, [`Error::InconsistentPart`] for one part).
 //!
-//! Part file (JSON, format `scatterloc-part`, version 1):
-//! `{"format": "scatterloc-part", "version": 1, "software": "scatterloc 0.1.0", "study":
+//! Part file (JSON, format `scatterloc-part`, version 2):
+//! `{"format": "scatterloc-part", "version": 2, "software": "scatterloc 0.1.0", "study":
 //! "montecarlo" | "mtl-roc", "config": {…}, "shard": {"index": I, "count": N, "unit": "chunks" |
 //! "realisations", "range": [a, b], "total": C}, "timing": {"threads": T, "wall_time_s": [..]},
-//! "sums": …}`. The shard covers the units `[a, b)` = [`Shard::range`] of `C`.
+//! "digest": "sha256:…", "sums": …}`. The shard covers the units `[a, b)` = [`Shard::range`] of
+//! `C`. `digest` is the SHA-256 of the sums' JSON as a canonical token stream
+//! ([`sums_digest`]): the same sums give the same digest, so it does not depend on the thread
+//! count, and a part reformatted (e.g. by `jq -S .`) keeps it. Version 1 (without a digest) is
+//! refused with a named error.
+//!
+//! # What is checked (issue 24)
+//!
+//! Every part, when the set is read:
+//! - `format` is `scatterloc-part` and `version` is [`PART_VERSION`] (a set all of one other
+//!   version gets one error naming that version); the fields are exactly those above;
+//! - `study` is `montecarlo` or `mtl-roc`, `shard.unit` its unit; `shard` is the shard
+//!   `index` of `count` of `total` units ([`Shard::range`]), `total` the same in every part;
+//! - `config` at most [`MAX_PART_CONFIG_BYTES`] of JSON, `timing` at most
+//!   [`MAX_TIMING_ENTRIES`] entries; `timing.threads` ≥ 1; every `timing.wall_time_s[i]`
+//!   finite and ≥ 0; `digest` is `sha256:` and 64 lowercase hex digits.
+//!
+//! The set: one study (software, study, config), one shard count, every shard exactly once.
+//!
+//! Every part's sums, when merged (the study rebuilt from `config` gives the bounds):
+//! - no array longer than the study implies (checked while parsing, before anything is
+//!   allocated for it: [`Part::read_sums`]); the digest matches the sums (corruption,
+//!   truncation, an edit); the types exact (counts are whole numbers ≥ 0);
+//! - the digest matches the sums (corruption, truncation, an edit);
+//! - Monte Carlo, per entry `sums[k·F + f]` (trajectory `k`, filter `f` of `F`): `steps + 1`
+//!   entries per list; `trajectories` = the trajectories of the shard's chunks; `runs +
+//!   failed_runs` = trajectories × noise runs; every `squared_error[n]` and `nees[n]` finite
+//!   and ≥ 0, zero when no run counted and non-zero when one did; `fisher[n]` finite,
+//!   symmetric (`F₂₁ = F₁₂` exactly: every addend is), with a diagonal ≥ 0 and positive
+//!   semi-definite (`F₁₂² ≤ F₁₁ F₂₂`, relative 10⁻⁹ for rounding), `fisher[0]` zero, all zero
+//!   when no trajectory counted and not all zero when one did; the Fisher sums and trajectory
+//!   count are the same for every filter of a trajectory (they come from the truth alone);
+//! - ROC ([`crate::mtl::experiment::Tally::check`]): `realisations` = the shard's; `curves ×
+//!   points` as the experiment's; per point `detections ≤ targets`, `false_alarms ≤
+//!   estimates`, the ratio sums finite, in `[0, realisations]`, zero when their count is;
+//!   `disagreements ≤ realisations × curves × points`.
+//!
+//! Memory: [`PartSet::read`] and the merges hold one part file's text at a time (the CLI
+//! caps each at 256 MiB, [`crate::error::limits::MAX_INPUT_BYTES`]), the reference
+//! configuration, and per part a few hundred bytes; the sums of one part are at most what
+//! its configuration implies (the merged sums' size).
 //!
 //! ```
 //! use scatterloc::math::Shard;
@@ -26,15 +70,20 @@
 //!         (format!("part{i}.json"), serde_json::to_string(&part).unwrap())
 //!     })
 //!     .collect();
-//! // … read back as one set, in shard order.
+//! // … read back as one set, in shard order …
 //! let set = PartSet::check(&texts).unwrap();
 //! assert_eq!(set.study, "montecarlo");
 //! assert_eq!(set.parts[1].shard.range, [2, 5]);
-//! let sums: Vec<usize> = set.parts[1].sums().unwrap();
+//! // … and the sums of one part, checked against its digest (arrays of at most 8 entries).
+//! let sums: Vec<usize> = set.parts[1].read_sums(&texts[1].1, 8).unwrap();
 //! assert_eq!(sums, [1]);
 //! // A set with a shard missing is refused, naming it.
 //! let err = PartSet::check(&texts[..1]).unwrap_err();
 //! assert!(err.to_string().contains("missing parts: shard 1 of 2"));
+//! // An edited sum no longer matches its digest.
+//! let edited = texts[1].1.replace("\"sums\":[1]", "\"sums\":[2]");
+//! let err = set.parts[1].read_sums::<Vec<usize>>(&edited, 8).unwrap_err();
+//! assert!(err.to_string().contains("part1.json: sums do not match their digest"));
 //! ```
 
 use alloc::collections::BTreeMap;
@@ -43,16 +92,25 @@ use alloc::string::{String, ToString};
 use alloc::vec;
 use alloc::vec::Vec;
 
+use serde::de::{DeserializeSeed, IgnoredAny, MapAccess, SeqAccess, Visitor};
 use serde::{Deserialize, Serialize};
+use serde_json::value::RawValue;
 use serde_json::Value;
+use sha2::{Digest, Sha256};
 
 use crate::error::{Error, Result};
 use crate::math::Shard;
 
 /// The `format` of a part file.
 pub const PART_FORMAT: &str = "scatterloc-part";
-/// The `version` of the part format this build reads and writes.
-pub const PART_VERSION: u64 = 1;
+/// The `version` of the part format this build reads and writes (2: with `digest`, issue 24).
+pub const PART_VERSION: u64 = 2;
+/// Largest `config` of a part file, bytes of JSON: 4 MiB. The largest legitimate one, a
+/// scenario of 4096 + 4096 nodes ([`crate::error::limits::MAX_NODES`]) with its links, is
+/// below 2 MiB; the configuration is parsed into a JSON tree (up to ~16× its text).
+pub const MAX_PART_CONFIG_BYTES: usize = 4 << 20;
+/// Most entries of a part's `timing.wall_time_s` (one per trajectory: at most 3).
+pub const MAX_TIMING_ENTRIES: usize = 16;
 
 /// Study kinds and the unit their shards split.
 const STUDIES: [(&str, &str); 2] = [("montecarlo", "chunks"), ("mtl-roc", "realisations")];
@@ -60,6 +118,15 @@ const STUDIES: [(&str, &str); 2] = [("montecarlo", "chunks"), ("mtl-roc", "reali
 /// The `software` of a part file: parts of one study must come from the same build version.
 pub fn software() -> String {
     format!("scatterloc {}", env!("CARGO_PKG_VERSION"))
+}
+
+/// The `digest` of a part file with sums `sums`: `sha256:` and the hex SHA-256 of their JSON
+/// as a canonical token stream (structure, strings, numbers by type and bits; not the layout
+/// or the key order, so a reformatted part keeps its digest). Errors are serde_json's (sums
+/// that do not serialize).
+pub fn sums_digest<S: Serialize + ?Sized>(sums: &S) -> core::result::Result<String, String> {
+    let text = serde_json::to_string(sums).map_err(|e| format!("encoding the sums: {e}"))?;
+    walk("sums", &text, usize::MAX).map(|d| hex(&d))
 }
 
 /// Where a shard lies in its study.
@@ -102,12 +169,10 @@ pub struct Timing {
     pub wall_time_s: Vec<f64>,
 }
 
-/// A part file as written (serialize it, e.g. with `serde_json::to_string`).
-#[derive(Debug, Serialize)]
+/// A part file as written (serialize it, e.g. with `serde_json::to_string`; serializing
+/// computes its `digest`, [`sums_digest`]).
+#[derive(Debug)]
 pub struct PartFile<'a, C: Serialize, S: Serialize + ?Sized> {
-    format: &'static str,
-    version: u64,
-    software: String,
     study: &'a str,
     config: &'a C,
     shard: &'a ShardDoc,
@@ -126,9 +191,6 @@ impl<'a, C: Serialize, S: Serialize + ?Sized> PartFile<'a, C, S> {
         sums: &'a S,
     ) -> PartFile<'a, C, S> {
         PartFile {
-            format: PART_FORMAT,
-            version: PART_VERSION,
-            software: software(),
             study,
             config,
             shard,
@@ -153,44 +215,102 @@ impl<'a, C: Serialize, S: Serialize + ?Sized> PartFile<'a, C, S> {
     }
 }
 
-/// A part file as read (its configuration and sums still JSON values).
-#[derive(Debug, Deserialize)]
+impl<C: Serialize, S: Serialize + ?Sized> Serialize for PartFile<'_, C, S> {
+    fn serialize<Z: serde::Serializer>(&self, z: Z) -> core::result::Result<Z::Ok, Z::Error> {
+        #[derive(Serialize)]
+        struct Out<'b, C: Serialize, S: Serialize + ?Sized> {
+            format: &'static str,
+            version: u64,
+            software: String,
+            study: &'b str,
+            config: &'b C,
+            shard: &'b ShardDoc,
+            timing: &'b Timing,
+            digest: String,
+            sums: &'b S,
+        }
+        let digest = sums_digest(self.sums).map_err(serde::ser::Error::custom)?;
+        Out {
+            format: PART_FORMAT,
+            version: PART_VERSION,
+            software: software(),
+            study: self.study,
+            config: self.config,
+            shard: self.shard,
+            timing: self.timing,
+            digest,
+            sums: self.sums,
+        }
+        .serialize(z)
+    }
+}
+
+/// The first two fields every version has (the rest is not parsed: nothing is allocated).
+#[derive(Deserialize)]
+struct Probe<'a> {
+    #[serde(borrow, default)]
+    format: Option<&'a RawValue>,
+    #[serde(borrow, default)]
+    version: Option<&'a RawValue>,
+}
+
+/// A part file as read: the large fields still text of the file.
+#[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
-struct PartIn {
-    /// `format` and `version`, checked before the fields are read.
+struct PartIn<'a> {
     #[serde(rename = "format")]
-    _format: serde::de::IgnoredAny,
+    _format: IgnoredAny,
     #[serde(rename = "version")]
-    _version: serde::de::IgnoredAny,
+    _version: IgnoredAny,
+    software: String,
+    study: String,
+    #[serde(borrow)]
+    config: &'a RawValue,
+    shard: ShardDoc,
+    #[serde(borrow)]
+    timing: &'a RawValue,
+    digest: String,
+    #[serde(borrow)]
+    sums: &'a RawValue,
+}
+
+/// A part's header, checked on its own.
+struct Header<'a> {
     software: String,
     study: String,
     config: Value,
     shard: ShardDoc,
     timing: Timing,
-    sums: Value,
+    digest: String,
+    sums: &'a RawValue,
 }
 
-/// One checked part of a [`PartSet`].
+impl Header<'_> {
+    /// What makes parts one study: software, study kind and configuration.
+    fn identity(&self) -> Value {
+        serde_json::json!({"software": self.software, "study": self.study, "config": self.config})
+    }
+}
+
+/// The SHA-256 of a canonical JSON value (object keys sorted).
+fn key_of(v: &Value) -> [u8; 32] {
+    Sha256::digest(v.to_string().as_bytes()).into()
+}
+
+/// One checked part of a [`PartSet`]: its header (the sums are read again when merged,
+/// [`Part::read_sums`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Part {
     /// The name the part was given under (its path).
     pub path: String,
-    /// The study's configuration (the same in every part of a set).
-    pub config: Value,
     /// Which shard.
     pub shard: ShardDoc,
     /// Its run time.
     pub timing: Timing,
-    /// Its sums (the study's type, as JSON).
-    pub sums: Value,
-}
-
-impl Part {
-    /// The sums as `T`; sums that do not parse make the part inconsistent
-    /// ([`Error::InconsistentPart`]).
-    pub fn sums<T: serde::de::DeserializeOwned>(&self) -> Result<T> {
-        T::deserialize(&self.sums).map_err(|e| inconsistent(&self.path, format!("sums: {e}")))
-    }
+    /// Its `digest`.
+    pub digest: String,
+    /// SHA-256 of its identity (software, study, configuration).
+    identity: [u8; 32],
 }
 
 /// The parts of one study, checked as a set, in shard order.
@@ -198,8 +318,506 @@ impl Part {
 pub struct PartSet {
     /// The study kind: `montecarlo` or `mtl-roc`.
     pub study: String,
+    /// The study's configuration (the same in every part).
+    pub config: Value,
     /// The parts, one per shard, in shard order.
     pub parts: Vec<Part>,
+}
+
+/// Why a file is not a part file of this build.
+enum NotPart {
+    /// A part file of another format version.
+    Version(String),
+    /// Anything else.
+    Other(String),
+}
+
+/// Raw JSON text for a message: at most 60 characters.
+fn shown_raw(v: Option<&RawValue>) -> String {
+    match v {
+        Some(v) => clip(v.get().trim()),
+        None => "absent".to_string(),
+    }
+}
+
+/// At most 60 characters of `text`, then `…`.
+fn clip(text: &str) -> String {
+    match text.char_indices().nth(60) {
+        Some((i, _)) => format!("{}…", &text[..i]),
+        None => text.to_string(),
+    }
+}
+
+/// Walks the JSON text `raw` once without allocating for its values: checks that no array
+/// (nested at any depth) has more than `max` entries, and returns the SHA-256 of its values
+/// as a canonical token stream (the value's structure, strings, numbers by type and bits;
+/// an object's entries in any order — whitespace, layout and key order do not count; an
+/// object of more than `max` keys is refused too). The error
+/// names the path under `what` (`sums[0].squared_error: more than 11 entries …`).
+fn walk(what: &str, raw: &str, max: usize) -> core::result::Result<[u8; 32], String> {
+    struct Shape<'h> {
+        max: usize,
+        h: &'h mut Sha256,
+    }
+    impl<'de> DeserializeSeed<'de> for Shape<'_> {
+        type Value = ();
+        fn deserialize<D: serde::Deserializer<'de>>(
+            self,
+            d: D,
+        ) -> core::result::Result<(), D::Error> {
+            d.deserialize_any(self)
+        }
+    }
+    impl<'de> Visitor<'de> for Shape<'_> {
+        type Value = ();
+        fn expecting(&self, f: &mut core::fmt::Formatter) -> core::fmt::Result {
+            f.write_str("any JSON value")
+        }
+        fn visit_bool<E>(self, v: bool) -> core::result::Result<(), E> {
+            self.h.update([b'b', v as u8]);
+            Ok(())
+        }
+        fn visit_i64<E>(self, v: i64) -> core::result::Result<(), E> {
+            self.h.update([b'i']);
+            self.h.update(v.to_le_bytes());
+            Ok(())
+        }
+        fn visit_u64<E>(self, v: u64) -> core::result::Result<(), E> {
+            self.h.update([b'u']);
+            self.h.update(v.to_le_bytes());
+            Ok(())
+        }
+        fn visit_f64<E>(self, v: f64) -> core::result::Result<(), E> {
+            self.h.update([b'f']);
+            self.h.update(v.to_bits().to_le_bytes());
+            Ok(())
+        }
+        fn visit_str<E>(self, v: &str) -> core::result::Result<(), E> {
+            self.h.update([b's']);
+            self.h.update((v.len() as u64).to_le_bytes());
+            self.h.update(v.as_bytes());
+            Ok(())
+        }
+        fn visit_unit<E>(self) -> core::result::Result<(), E> {
+            self.h.update([b'n']);
+            Ok(())
+        }
+        fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> core::result::Result<(), A::Error> {
+            let Shape { max, h } = self;
+            h.update([b'[']);
+            let mut n = 0usize;
+            while seq.next_element_seed(Shape { max, h: &mut *h })?.is_some() {
+                n += 1;
+                if n > max {
+                    return Err(serde::de::Error::custom(format!(
+                        "more than {max} entries (the most the study's configuration implies)"
+                    )));
+                }
+            }
+            h.update([b']']);
+            Ok(())
+        }
+        fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> core::result::Result<(), A::Error> {
+            // Each entry hashed on its own, the entries' hashes sorted: key order does not
+            // count (a tool that sorts keys keeps the digest).
+            let Shape { max, h } = self;
+            let mut entries: Vec<[u8; 32]> = Vec::new();
+            loop {
+                let mut e = Sha256::new();
+                if map.next_key_seed(Shape { max, h: &mut e })?.is_none() {
+                    break;
+                }
+                map.next_value_seed(Shape { max, h: &mut e })?;
+                entries.push(e.finalize().into());
+                if entries.len() > max {
+                    return Err(serde::de::Error::custom(format!(
+                        "more than {max} keys (the most the study's configuration implies)"
+                    )));
+                }
+            }
+            entries.sort_unstable();
+            h.update([b'{']);
+            for e in &entries {
+                h.update(e);
+            }
+            h.update([b'}']);
+            Ok(())
+        }
+    }
+    let mut h = Sha256::new();
+    let mut de = serde_json::Deserializer::from_str(raw);
+    let mut track = serde_path_to_error::Track::new();
+    Shape { max, h: &mut h }
+        .deserialize(serde_path_to_error::Deserializer::new(&mut de, &mut track))
+        .map_err(|e| at_path(what, &track.path().to_string(), e))?;
+    Ok(h.finalize().into())
+}
+
+/// `sha256:` and 64 hex digits.
+fn hex(d: &[u8; 32]) -> String {
+    let mut s = String::from("sha256:");
+    for b in d {
+        s.push_str(&format!("{b:02x}"));
+    }
+    s
+}
+
+/// Reads one part file's text: the format and version first, then the fields, each checked
+/// on its own.
+fn read_part(text: &str) -> core::result::Result<Header<'_>, NotPart> {
+    let other = NotPart::Other;
+    let probe: Probe = serde_json::from_str(text).map_err(|e| {
+        other(match e.classify() {
+            serde_json::error::Category::Data => format!("not a part file: {e}"),
+            _ => format!("invalid JSON: {e}"),
+        })
+    })?;
+    let format = probe.format.map(|f| f.get().trim());
+    if format != Some(&format!("\"{PART_FORMAT}\"")[..]) {
+        return Err(other(format!(
+            "format {}, not \"{PART_FORMAT}\"",
+            shown_raw(probe.format)
+        )));
+    }
+    let version = probe.version.map(|v| serde_json::from_str::<u64>(v.get()));
+    match version {
+        Some(Ok(PART_VERSION)) => {}
+        Some(Ok(v)) => return Err(NotPart::Version(v.to_string())),
+        _ => {
+            return Err(other(format!(
+                "version {}, this scatterloc reads version {PART_VERSION}",
+                shown_raw(probe.version)
+            )))
+        }
+    }
+    let part: PartIn = serde_json::from_str(text).map_err(|e| other(e.to_string()))?;
+    let (study, unit) = match STUDIES.iter().find(|(s, _)| *s == part.study) {
+        Some(&(s, u)) => (s, u),
+        None => {
+            return Err(other(format!(
+                "study \"{}\" is not montecarlo or mtl-roc",
+                clip(&part.study.escape_debug().to_string())
+            )))
+        }
+    };
+    if part.shard.unit != unit {
+        return Err(other(format!(
+            "shard.unit \"{}\" is not \"{unit}\" (study {study})",
+            clip(&part.shard.unit.escape_debug().to_string())
+        )));
+    }
+    let config = part.config.get();
+    if config.len() > MAX_PART_CONFIG_BYTES {
+        return Err(other(format!(
+            "config: {} bytes, more than the {} MiB a study's configuration takes",
+            config.len(),
+            MAX_PART_CONFIG_BYTES >> 20
+        )));
+    }
+    let config: Value =
+        serde_json::from_str(config).map_err(|e| other(format!("config: {e}")))?;
+    walk("timing", part.timing.get(), MAX_TIMING_ENTRIES).map_err(other)?;
+    let timing: Timing = parse_at("timing", part.timing.get()).map_err(other)?;
+    if timing.threads == 0 {
+        return Err(other("timing.threads: 0, not a thread count ≥ 1".into()));
+    }
+    if let Some((i, w)) = timing
+        .wall_time_s
+        .iter()
+        .enumerate()
+        .find(|(_, w)| !(w.is_finite() && **w >= 0.0))
+    {
+        return Err(other(format!(
+            "timing.wall_time_s[{i}]: {w} is not a wall time (finite, ≥ 0 s)"
+        )));
+    }
+    let hex = part.digest.strip_prefix("sha256:").unwrap_or("");
+    if hex.len() != 64 || !hex.bytes().all(|b| b.is_ascii_digit() || (b'a'..=b'f').contains(&b)) {
+        return Err(other(format!(
+            "digest \"{}\" is not sha256: and 64 lowercase hex digits",
+            clip(&part.digest.escape_debug().to_string())
+        )));
+    }
+    Ok(Header {
+        software: part.software,
+        study: part.study,
+        config,
+        shard: part.shard,
+        timing,
+        digest: part.digest,
+        sums: part.sums,
+    })
+}
+
+impl Part {
+    /// The sums of this part as `T`, from `text`, the part file read again: the header must be
+    /// the one checked ([`PartSet::read`]), no array of the sums longer than `max_len` (checked
+    /// in a first pass that allocates nothing for the sums, which also computes their digest),
+    /// the digest the part's, and the sums must parse as `T` (errors name the field). Each problem is [`Error::InconsistentPart`].
+    pub fn read_sums<T: serde::de::DeserializeOwned + Serialize>(
+        &self,
+        text: &str,
+        max_len: usize,
+    ) -> Result<T> {
+        let header = read_part(text).map_err(|e| match e {
+            NotPart::Version(v) => inconsistent(&self.path, format!("version {v}")),
+            NotPart::Other(why) => inconsistent(&self.path, why),
+        })?;
+        if header.shard != self.shard
+            || header.timing != self.timing
+            || header.digest != self.digest
+            || key_of(&header.identity()) != self.identity
+        {
+            return Err(inconsistent(
+                &self.path,
+                "the file changed while it was merged (read again for its sums)",
+            ));
+        }
+        let raw = header.sums.get();
+        let digest = walk("sums", raw, max_len).map_err(|e| inconsistent(&self.path, e))?;
+        let digest = hex(&digest);
+        if digest != self.digest {
+            return Err(inconsistent(
+                &self.path,
+                format!(
+                    "sums do not match their digest (the file was corrupted, truncated or \
+                     edited after it was written): digest {}, the sums hash to {}",
+                    clip(&self.digest),
+                    clip(&digest)
+                ),
+            ));
+        }
+        let sums: T = parse_at("sums", raw).map_err(|e| inconsistent(&self.path, e))?;
+        Ok(sums)
+    }
+}
+
+/// Reads `part`'s text for the merge: `load` (errors as they are), then [`Part::read_sums`].
+pub fn load_sums<T: serde::de::DeserializeOwned + Serialize>(
+    part: &Part,
+    max_len: usize,
+    load: &mut dyn FnMut(&str) -> Result<String>,
+) -> Result<T> {
+    let text = load(&part.path)?;
+    part.read_sums(&text, max_len)
+}
+
+/// Distinct studies whose configuration [`PartSet::read`] keeps to name the difference.
+const KEPT: usize = 10;
+
+/// `sums` or `timing` followed by a serde path (`[0].runs`, `.threads`) and the message.
+fn at_path(what: &str, path: &str, inner: impl core::fmt::Display) -> String {
+    match path {
+        "" | "." => format!("{what}: {inner}"),
+        p if p.starts_with('[') => format!("{what}{p}: {inner}"),
+        p => format!("{what}.{p}: {inner}"),
+    }
+}
+
+/// `raw` as `T`, errors naming the field under `what` (`sums[0].runs: invalid value: …`).
+fn parse_at<T: serde::de::DeserializeOwned>(
+    what: &str,
+    raw: &str,
+) -> core::result::Result<T, String> {
+    let mut de = serde_json::Deserializer::from_str(raw);
+    serde_path_to_error::deserialize(&mut de)
+        .map_err(|e| at_path(what, &e.path().to_string(), e.into_inner()))
+}
+
+impl PartSet {
+    /// Reads and checks the part files `paths` as one set, one file at a time through `load`
+    /// (the file's text; its errors are returned as they are): the study kind, its
+    /// configuration and the parts' headers in shard order (the sums are read again by the
+    /// study's merge, [`Part::read_sums`]). Errors: [`Error::PartSet`] (not part files of this
+    /// version, foreign parts, shard counts that disagree, duplicate or missing shards; each
+    /// lists the files) or [`Error::InconsistentPart`] (a part that is not the shard it says it
+    /// is).
+    pub fn read(
+        paths: &[String],
+        load: &mut dyn FnMut(&str) -> Result<String>,
+    ) -> Result<PartSet> {
+        // Every file is a part of this format; one identity Value is kept per study seen.
+        let mut read: Vec<Part> = Vec::new();
+        let mut studies: BTreeMap<[u8; 32], (usize, usize, String, Value)> = BTreeMap::new();
+        let mut bad = Vec::new();
+        let mut versions: BTreeMap<String, usize> = BTreeMap::new();
+        for path in paths {
+            let text = load(path)?;
+            match read_part(&text) {
+                Ok(h) => {
+                    let identity = h.identity();
+                    let key = key_of(&identity);
+                    // At most KEPT configurations are held (the rest: compared by digest only).
+                    let keep = studies.len() < KEPT;
+                    let e = studies.entry(key).or_insert_with(|| {
+                        let identity = if keep { identity } else { Value::Null };
+                        (0, read.len(), h.study.clone(), identity)
+                    });
+                    e.0 += 1;
+                    read.push(Part {
+                        path: path.clone(),
+                        shard: h.shard,
+                        timing: h.timing,
+                        digest: h.digest,
+                        identity: key,
+                    });
+                }
+                Err(NotPart::Version(v)) => {
+                    *versions.entry(v.clone()).or_default() += 1;
+                    bad.push(format!(
+                        "{path} (version {v}, this scatterloc reads version {PART_VERSION})"
+                    ));
+                }
+                Err(NotPart::Other(why)) => bad.push(format!("{path} ({why})")),
+            }
+        }
+        if !bad.is_empty() {
+            if let (true, Some((v, _))) = (read.is_empty() && versions.len() == 1, versions.iter().next()) {
+                if versions[v] == paths.len() {
+                    return Err(set_error(format!(
+                        "merge: the parts are of part format version {v}; this scatterloc ({}) \
+                         reads version {PART_VERSION}: merge them with the build that wrote \
+                         them, or run the shards again with this one",
+                        software()
+                    )));
+                }
+            }
+            return Err(set_error(format!(
+                "merge: not scatterloc part files (format \"{PART_FORMAT}\", version {PART_VERSION}): {}",
+                listed(&bad)
+            )));
+        }
+        // One study: the identity shared by the most parts (the first such part's on a tie).
+        let (&reference, _) = studies
+            .iter()
+            .max_by_key(|(_, (n, first, ..))| (*n, core::cmp::Reverse(*first)))
+            .ok_or_else(|| set_error("merge: no part files given".into()))?;
+        if studies.len() > 1 {
+            let (_, first, study, want) = &studies[&reference];
+            let foreign: Vec<String> = read
+                .iter()
+                .filter(|p| p.identity != reference)
+                .map(|p| {
+                    let got = &studies[&p.identity].3;
+                    let d = first_difference(want, got, "").unwrap_or_default();
+                    format!("{} ({d})", p.path)
+                })
+                .collect();
+            return Err(set_error(format!(
+                "merge: foreign parts, not of the study of {} ({study}, {}): {}",
+                read[*first].path,
+                want["software"].as_str().unwrap_or(""),
+                listed(&foreign)
+            )));
+        }
+        let (_, _, study, identity) = studies
+            .remove(&reference)
+            .ok_or_else(|| set_error("merge: no part files given".into()))?;
+        let config = match identity {
+            Value::Object(mut m) => m.remove("config").unwrap_or(Value::Null),
+            _ => Value::Null,
+        };
+        check_set(&read)?;
+        read.sort_by_key(|p| p.shard.index);
+        Ok(PartSet {
+            study,
+            config,
+            parts: read,
+        })
+    }
+
+    /// [`PartSet::read`] of part files held in memory: `(path, text)` of each.
+    pub fn check(files: &[(String, String)]) -> Result<PartSet> {
+        let paths: Vec<String> = files.iter().map(|(p, _)| p.clone()).collect();
+        let mut next = 0;
+        PartSet::read(&paths, &mut |_| {
+            let text = files[next].1.clone();
+            next += 1;
+            Ok(text)
+        })
+    }
+}
+
+/// The shards of parts of one study: one count, each the shard it says, each exactly once.
+fn check_set(read: &[Part]) -> Result<()> {
+    let Some(first) = read.first() else {
+        return Err(set_error("merge: no part files given".into()));
+    };
+    // One shard count.
+    let mut counts: BTreeMap<usize, Vec<&str>> = BTreeMap::new();
+    for p in read {
+        counts.entry(p.shard.count).or_default().push(&p.path);
+    }
+    if counts.len() > 1 {
+        let items: Vec<String> = counts
+            .iter()
+            .map(|(n, files)| format!("{n} shards: {}", files.join(", ")))
+            .collect();
+        return Err(set_error(format!(
+            "merge: the parts disagree on the shard count: {}",
+            listed(&items)
+        )));
+    }
+    let count = first.shard.count;
+    // Each part is the shard it says it is.
+    for p in read {
+        let s = &p.shard;
+        let Some(shard) = Shard::new(s.index, s.count) else {
+            return Err(inconsistent(
+                &p.path,
+                format!("shard {} of {} does not exist", s.index, s.count),
+            ));
+        };
+        let r = shard.range(s.total);
+        if s.range != [r.start, r.end] || s.total != first.shard.total {
+            return Err(inconsistent(
+                &p.path,
+                format!(
+                    "shard.range [{}, {}] of {} {} is not shard {} of {} ([{}, {}] of {})",
+                    s.range[0],
+                    s.range[1],
+                    s.total,
+                    s.unit,
+                    s.index,
+                    s.count,
+                    r.start,
+                    r.end,
+                    first.shard.total
+                ),
+            ));
+        }
+    }
+    // Every shard exactly once.
+    let mut by_index: BTreeMap<usize, Vec<&str>> = BTreeMap::new();
+    for p in read {
+        by_index.entry(p.shard.index).or_default().push(&p.path);
+    }
+    let duplicates: Vec<String> = by_index
+        .iter()
+        .filter(|(_, files)| files.len() > 1)
+        .map(|(i, files)| format!("shard {i} in {}", files.join(", ")))
+        .collect();
+    let missing: Vec<usize> = (0..count).filter(|i| !by_index.contains_key(i)).collect();
+    let mut problems = Vec::new();
+    if !duplicates.is_empty() {
+        problems.push(format!(
+            "merge: duplicate parts (shards of {count}): {}",
+            listed(&duplicates)
+        ));
+    }
+    if !missing.is_empty() {
+        problems.push(format!(
+            "merge: missing parts: shard{} {} of {count} ({} of {count} given)",
+            if missing.len() == 1 { "" } else { "s" },
+            ranges(&missing),
+            by_index.len()
+        ));
+    }
+    if problems.is_empty() {
+        Ok(())
+    } else {
+        Err(set_error(problems.join("; ")))
+    }
 }
 
 /// A part that does not fit its set: `merge: inconsistent part PATH: what`.
@@ -254,13 +872,9 @@ fn ranges(indices: &[usize]) -> String {
 
 /// A JSON value for a message: compact, at most 60 characters.
 fn shown(v: Option<&Value>) -> String {
-    let text = match v {
-        Some(v) => v.to_string(),
+    match v {
+        Some(v) => clip(&v.to_string()),
         None => "absent".to_string(),
-    };
-    match text.char_indices().nth(60) {
-        Some((i, _)) => format!("{}…", &text[..i]),
-        None => text,
     }
 }
 
@@ -298,175 +912,6 @@ fn first_difference(want: &Value, got: &Value, path: &str) -> Option<String> {
             shown(Some(got)),
             shown(Some(want))
         )),
-    }
-}
-
-/// Reads one part file's text: the format and version first, then the fields.
-fn read_part(text: &str) -> core::result::Result<PartIn, String> {
-    let value: Value = serde_json::from_str(text).map_err(|e| format!("invalid JSON: {e}"))?;
-    let format = value.get("format").and_then(Value::as_str);
-    let version = value.get("version").and_then(Value::as_u64);
-    if format != Some(PART_FORMAT) {
-        return Err(format!(
-            "format {}, not \"{PART_FORMAT}\"",
-            shown(value.get("format"))
-        ));
-    }
-    if version != Some(PART_VERSION) {
-        return Err(format!(
-            "version {}, this scatterloc reads version {PART_VERSION}",
-            shown(value.get("version"))
-        ));
-    }
-    let part: PartIn = serde_json::from_value(value).map_err(|e| e.to_string())?;
-    match STUDIES.iter().find(|(s, _)| *s == part.study) {
-        None => Err(format!(
-            "study \"{}\" is not montecarlo or mtl-roc",
-            part.study.escape_debug()
-        )),
-        Some((_, unit)) if part.shard.unit != *unit => Err(format!(
-            "shard.unit \"{}\" is not \"{unit}\" (study {})",
-            part.shard.unit.escape_debug(),
-            part.study
-        )),
-        Some(_) => Ok(part),
-    }
-}
-
-impl PartSet {
-    /// Reads and checks `files` (`(path, text)` of each part file) as one set: the study kind
-    /// and the parts in shard order. Errors: [`Error::PartSet`] (not part files, foreign
-    /// parts, shard counts that disagree, duplicate or missing shards; each lists the files)
-    /// or [`Error::InconsistentPart`] (a part that is not the shard it says it is).
-    pub fn check(files: &[(String, String)]) -> Result<PartSet> {
-        // Every file is a part of this format.
-        let mut read = Vec::new();
-        let mut bad = Vec::new();
-        for (path, text) in files {
-            match read_part(text) {
-                Ok(p) => read.push((path.clone(), p)),
-                Err(why) => bad.push(format!("{path} ({why})")),
-            }
-        }
-        if !bad.is_empty() {
-            return Err(set_error(format!(
-                "merge: not scatterloc part files (format \"{PART_FORMAT}\", version {PART_VERSION}): {}",
-                listed(&bad)
-            )));
-        }
-        // One study: the identity shared by the most parts (the first such part's on a tie).
-        let identity = |p: &PartIn| serde_json::json!({"software": p.software, "study": p.study, "config": p.config});
-        let mut votes: BTreeMap<String, (usize, usize)> = BTreeMap::new();
-        for (i, (_, p)) in read.iter().enumerate() {
-            let e = votes.entry(identity(p).to_string()).or_insert((0, i));
-            e.0 += 1;
-        }
-        let (_, &(_, first)) = votes
-            .iter()
-            .max_by_key(|(_, &(n, first))| (n, core::cmp::Reverse(first)))
-            .ok_or_else(|| set_error("merge: no part files given".into()))?;
-        let reference = identity(&read[first].1);
-        let foreign: Vec<String> = read
-            .iter()
-            .filter_map(|(path, p)| {
-                first_difference(&reference, &identity(p), "").map(|d| format!("{path} ({d})"))
-            })
-            .collect();
-        if !foreign.is_empty() {
-            return Err(set_error(format!(
-                "merge: foreign parts, not of the study of {} ({}, {}): {}",
-                read[first].0,
-                read[first].1.study,
-                read[first].1.software,
-                listed(&foreign)
-            )));
-        }
-        // One shard count.
-        let mut counts: BTreeMap<usize, Vec<&str>> = BTreeMap::new();
-        for (path, p) in &read {
-            counts.entry(p.shard.count).or_default().push(path);
-        }
-        if counts.len() > 1 {
-            let items: Vec<String> = counts
-                .iter()
-                .map(|(n, files)| format!("{n} shards: {}", files.join(", ")))
-                .collect();
-            return Err(set_error(format!(
-                "merge: the parts disagree on the shard count: {}",
-                listed(&items)
-            )));
-        }
-        let count = read[0].1.shard.count;
-        // Each part is the shard it says it is.
-        for (path, p) in &read {
-            let s = &p.shard;
-            let Some(shard) = Shard::new(s.index, s.count) else {
-                return Err(inconsistent(
-                    path,
-                    format!("shard {} of {} does not exist", s.index, s.count),
-                ));
-            };
-            let r = shard.range(s.total);
-            if s.range != [r.start, r.end] || s.total != read[0].1.shard.total {
-                return Err(inconsistent(
-                    path,
-                    format!(
-                        "shard.range [{}, {}] of {} {} is not shard {} of {} ([{}, {}] of {})",
-                        s.range[0],
-                        s.range[1],
-                        s.total,
-                        s.unit,
-                        s.index,
-                        s.count,
-                        r.start,
-                        r.end,
-                        read[0].1.shard.total
-                    ),
-                ));
-            }
-        }
-        // Every shard exactly once.
-        let mut by_index: BTreeMap<usize, Vec<&str>> = BTreeMap::new();
-        for (path, p) in &read {
-            by_index.entry(p.shard.index).or_default().push(path);
-        }
-        let duplicates: Vec<String> = by_index
-            .iter()
-            .filter(|(_, files)| files.len() > 1)
-            .map(|(i, files)| format!("shard {i} in {}", files.join(", ")))
-            .collect();
-        let missing: Vec<usize> = (0..count).filter(|i| !by_index.contains_key(i)).collect();
-        let mut problems = Vec::new();
-        if !duplicates.is_empty() {
-            problems.push(format!(
-                "merge: duplicate parts (shards of {count}): {}",
-                listed(&duplicates)
-            ));
-        }
-        if !missing.is_empty() {
-            problems.push(format!(
-                "merge: missing parts: shard{} {} of {count} ({} of {count} given)",
-                if missing.len() == 1 { "" } else { "s" },
-                ranges(&missing),
-                by_index.len()
-            ));
-        }
-        if !problems.is_empty() {
-            return Err(set_error(problems.join("; ")));
-        }
-        let study = read[0].1.study.clone();
-        let mut parts: Vec<Part> = read
-            .into_iter()
-            .map(|(path, p)| Part {
-                path,
-                config: p.config,
-                shard: p.shard,
-                timing: p.timing,
-                sums: p.sums,
-            })
-            .collect();
-        parts.sort_by_key(|p| p.shard.index);
-        Ok(PartSet { study, parts })
     }
 }
 

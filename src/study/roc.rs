@@ -29,7 +29,7 @@ use crate::mtl::experiment::{
     MAX_REALISATIONS,
 };
 use crate::mtl::sim::{LosModel, NodeLayout};
-use crate::study::part::{differs, inconsistent, merged_timing, Part};
+use crate::study::part::{differs, inconsistent, load_sums, merged_timing, PartSet};
 use crate::study::Driver;
 
 /// Every setting of a ROC run (the \[P\] parameters of §7 and §8 included): the `config` of its
@@ -302,15 +302,21 @@ impl RocStudy {
         Ok(tally)
     }
 
-    /// The merge of a checked set of part files ([`crate::study::PartSet::check`]): the
-    /// configuration, the result of every shard's tally added exactly, the wall time added
-    /// and the most threads of any part. A part that does not fit is
-    /// [`Error::InconsistentPart`].
-    pub fn merge(parts: &[Part]) -> Result<(ExperimentConfig, ExperimentResult, f64, usize)> {
+    /// The merge of a checked set of part files ([`PartSet::read`]): the configuration, the
+    /// result of every shard's tally added exactly, the wall time added and the most threads of
+    /// any part. Each part's tally is read again through `load`, one part at a time, and
+    /// checked against its digest ([`crate::study::Part::read_sums`]) and the experiment
+    /// ([`Tally::check`]). A part that does not fit is [`Error::InconsistentPart`], naming the
+    /// part and the field.
+    pub fn merge(
+        set: &PartSet,
+        load: &mut dyn FnMut(&str) -> Result<String>,
+    ) -> Result<(ExperimentConfig, ExperimentResult, f64, usize)> {
+        let parts = &set.parts;
         let first = parts.first().ok_or(Error::PartSet {
             what: "merge: no part files given".into(),
         })?;
-        let cfg = RocStudy::from_config(&first.config).map_err(|e| match e {
+        let cfg = RocStudy::from_config(&set.config).map_err(|e| match e {
             Error::Parse { message } => inconsistent(&first.path, message),
             e => inconsistent(&first.path, e),
         })?;
@@ -323,22 +329,19 @@ impl RocStudy {
                 ),
             ));
         }
+        let (timing, _) = merged_timing(parts, 1)?;
         let (curves, points) = (cfg.curves().len(), cfg.sweep.len());
+        // The longest array of a tally: curves, points, the partials of an exact sum (~40).
+        let max_len = curves.max(points).max(64);
         let mut merged = Tally::new(curves, points);
         for part in parts {
-            let tally: Tally = part.sums()?;
+            let tally: Tally = load_sums(part, max_len, load)?;
             let len = part.shard.range[1] - part.shard.range[0];
-            if !tally.has_shape(curves, points) || tally.realisations() != len {
-                return Err(inconsistent(
-                    &part.path,
-                    format!(
-                        "sums are not {len} realisations of {curves} curves × {points} thresholds"
-                    ),
-                ));
-            }
+            tally
+                .check(len, curves, points)
+                .map_err(|what| inconsistent(&part.path, format!("sums.{what}")))?;
             merged.merge(&tally);
         }
-        let (timing, _) = merged_timing(parts, 1)?;
         let r = merged.finish(&cfg);
         Ok((cfg, r, timing.wall_time_s[0], timing.threads))
     }

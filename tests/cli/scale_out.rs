@@ -157,7 +157,7 @@ fn montecarlo_four_shard_processes_merge_to_the_unsharded_run() {
         (&p["format"], &p["version"], &p["study"]),
         (
             &Value::from("scatterloc-part"),
-            &Value::from(1),
+            &Value::from(2),
             &Value::from("montecarlo")
         )
     );
@@ -278,7 +278,7 @@ fn bad_part_sets_are_named_errors_that_write_nothing() {
     let of_two = part(&dir.path("of2.json"), &["--shard", "1/2"]);
     let whole = part(&dir.path("whole.json"), &[]);
     let mut v = read_json(&parts[1]);
-    v["version"] = Value::from(2);
+    v["version"] = Value::from(3);
     let v2 = dir.write("v2.json", &v);
     let mut v = read_json(&parts[1]);
     v["shard"]["range"] = serde_json::json!([0, 2]);
@@ -342,7 +342,7 @@ fn bad_part_sets_are_named_errors_that_write_nothing() {
         &[p0, &v2, &garbage, p2],
         &[
             "merge: not scatterloc part files",
-            "v2.json (version 2",
+            "v2.json (version 3",
             "garbage.json (invalid JSON",
         ],
     );
@@ -534,4 +534,145 @@ fn ctrl_c_stops_a_sharded_run_without_writing_its_part() {
     assert!(out.stdout.is_empty());
     assert!(err.contains("cancelled"), "{err}");
     assert!(dir.files().is_empty(), "{:?}", dir.files());
+}
+
+/// Sets the digest of part `v` to that of its sums: an edit that keeps the part
+/// self-consistent, so only the range checks refuse it.
+fn redigest(v: &mut Value) {
+    v["digest"] = Value::from(scatterloc::study::sums_digest(&v["sums"]).unwrap());
+}
+
+/// Issue 24: parts whose sums are impossible, corrupted, truncated or of another version are
+/// named errors (exit status 2) naming the part and the field, and write nothing.
+#[test]
+fn tampered_parts_are_named_errors_that_write_nothing() {
+    let dir = TempDir::new();
+    let parts = run_shards(&dir, &SMALL, "ok", 2, &[0, 1]);
+    let roc = run_shards(&dir, &ROC, "roc", 2, &[0, 1]);
+    let good = read_json(&parts[1]);
+    let edit = |name: &str, f: &dyn Fn(&mut Value), redo: bool| {
+        let mut v = good.clone();
+        f(&mut v);
+        if redo {
+            redigest(&mut v);
+        }
+        dir.write(name, &v)
+    };
+    let negative = edit(
+        "neg.json",
+        &|v| v["sums"][0]["squared_error"][3] = serde_json::json!([-3.2]),
+        true,
+    );
+    let nan_nees = edit(
+        "nan.json",
+        &|v| v["sums"][0]["nees"][2] = serde_json::json!("nan"),
+        true,
+    );
+    let failed = edit(
+        "failed.json",
+        &|v| v["sums"][0]["failed_runs"] = serde_json::json!(5),
+        true,
+    );
+    let asym = edit(
+        "asym.json",
+        &|v| v["sums"][0]["fisher"][1][1] = serde_json::json!([-7.0]),
+        true,
+    );
+    let corrupt = edit(
+        "corrupt.json",
+        &|v| v["sums"][0]["squared_error"][3] = serde_json::json!([1.0]),
+        false,
+    );
+    let wall = edit(
+        "wall.json",
+        &|v| v["timing"]["wall_time_s"][0] = serde_json::json!(-1.0),
+        false,
+    );
+    let text = std::fs::read_to_string(&parts[1]).unwrap();
+    let truncated = dir.write_text("trunc.json", &text[..text.len() * 2 / 3]);
+    let mut old = Vec::new();
+    for (i, p) in parts.iter().enumerate() {
+        let mut v = read_json(p);
+        v["version"] = Value::from(1);
+        v.as_object_mut().unwrap().remove("digest");
+        old.push(dir.write(&format!("old{i}.json"), &v));
+    }
+    let mut r = read_json(&roc[1]);
+    r["sums"]["sums"][0][0]["detection_ratio"] = serde_json::json!([-0.83]);
+    redigest(&mut r);
+    let pd = dir.write("pd.json", &r);
+    let before = dir.files();
+    let (out, fig) = (dir.path("out.json"), dir.path("fig.svg"));
+    let merge_fails = |given: &[&String], needles: &[&str]| {
+        let mut args = vec!["merge", "--json", &out, "--out", &fig];
+        args.extend(given.iter().map(|s| s.as_str()));
+        let err = fails(&args, needles);
+        assert_eq!(dir.files(), before, "nothing written: {err}");
+    };
+    let p0 = &parts[0];
+    let bad = "merge: inconsistent part";
+    merge_fails(
+        &[p0, &negative],
+        &[bad, "neg.json: sums[0].squared_error[3]: -3.2 is negative"],
+    );
+    merge_fails(
+        &[p0, &nan_nees],
+        &[bad, "nan.json: sums[0].nees[2]: NaN is not finite"],
+    );
+    merge_fails(
+        &[p0, &failed],
+        &[bad, "failed.json: sums[0].failed_runs: 5 failed + 16 counted"],
+    );
+    merge_fails(
+        &[p0, &asym],
+        &[bad, "asym.json: sums[0].fisher[1]: not symmetric"],
+    );
+    merge_fails(
+        &[p0, &corrupt],
+        &[bad, "corrupt.json: sums do not match their digest"],
+    );
+    merge_fails(
+        &[p0, &wall],
+        &["wall.json (timing.wall_time_s[0]: -1 is not a wall time"],
+    );
+    merge_fails(&[p0, &truncated], &["trunc.json (invalid JSON: EOF"]);
+    merge_fails(
+        &[&old[0], &old[1]],
+        &["merge: the parts are of part format version 1", "reads version 2"],
+    );
+    merge_fails(
+        &[&roc[0], &pd],
+        &[bad, "pd.json: sums.sums[0][0].detection_ratio: -0.83"],
+    );
+    // The untouched sets still merge.
+    merge(&out, None, &[parts[1].clone(), parts[0].clone()]);
+    merge(&dir.path("roc.json"), None, &roc);
+}
+
+/// Issue 24: a 229 MiB part (under the 256 MiB input cap) padded with a long array of sums
+/// is refused with a named error under a 4 GB address-space limit (it took 7.7 GB and aborted
+/// before). `merge` holds one part's text at a time and checks array lengths before
+/// allocating them.
+#[test]
+fn a_padded_part_is_a_named_error_within_the_memory_cap() {
+    let dir = TempDir::new();
+    let parts = run_shards(&dir, &SMALL, "ok", 2, &[0, 1]);
+    let text = std::fs::read_to_string(&parts[1]).unwrap();
+    // 229 MiB of empty exact sums in the first squared-error list.
+    let at = text.find("\"squared_error\":[").unwrap() + "\"squared_error\":[".len();
+    let pad = "[],".repeat((229 << 20) / 3);
+    let padded = format!("{}{pad}{}", &text[..at], &text[at..]);
+    let big = dir.write_text("big.json", &padded);
+    drop((padded, pad, text));
+    let out = dir.path("out.json");
+    let script = format!("ulimit -v 4000000; exec {BIN} merge --json {out} {} {big}", parts[0]);
+    let o = Command::new("sh").args(["-c", &script]).output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("merge: inconsistent part")
+            && err.contains("big.json: sums[0].squared_error: more than 64 entries"),
+        "{err}"
+    );
+    assert!(!std::path::Path::new(&out).exists());
 }

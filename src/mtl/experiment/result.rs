@@ -116,6 +116,88 @@ impl Tally {
         self.sums.len() == curves && self.sums.iter().all(|c| c.len() == points)
     }
 
+    /// Checks that these sums can be the tally of `realisations` realisations of `curves ×
+    /// points` (issue 24: a part file's sums, before [`Tally::merge`]): the counts per point
+    /// `detections ≤ targets` and `false_alarms ≤ estimates`; the ratio sums finite, in
+    /// `[0, realisations]` (each addend is in `[0, 1]`) and zero when their count is;
+    /// `disagreements ≤ realisations × curves × points`. The error names the field under the
+    /// tally (`sums[1][4].detections: 120 is more than the 100 targets`).
+    pub fn check(
+        &self,
+        realisations: usize,
+        curves: usize,
+        points: usize,
+    ) -> core::result::Result<(), String> {
+        use alloc::format;
+        if self.realisations != realisations {
+            return Err(format!(
+                "realisations: {}, not the shard's {realisations}",
+                self.realisations
+            ));
+        }
+        if self.sums.len() != curves {
+            return Err(format!(
+                "sums: {} curves, not the experiment's {curves}",
+                self.sums.len()
+            ));
+        }
+        let n = realisations as Real;
+        for (c, curve) in self.sums.iter().enumerate() {
+            if curve.len() != points {
+                return Err(format!(
+                    "sums[{c}]: {} points, not the experiment's {points} thresholds",
+                    curve.len()
+                ));
+            }
+            for (p, s) in curve.iter().enumerate() {
+                let at = |f: &str| format!("sums[{c}][{p}].{f}");
+                if s.detections > self.targets {
+                    return Err(format!(
+                        "{}: {} is more than the {} targets",
+                        at("detections"),
+                        s.detections,
+                        self.targets
+                    ));
+                }
+                if s.false_alarms > s.estimates {
+                    return Err(format!(
+                        "{}: {} is more than the {} estimates",
+                        at("false_alarms"),
+                        s.false_alarms,
+                        s.estimates
+                    ));
+                }
+                for (name, sum, count) in [
+                    ("detection_ratio", &s.detection_ratio, s.detections),
+                    ("false_alarm_ratio", &s.false_alarm_ratio, s.false_alarms),
+                ] {
+                    let v = sum.value();
+                    if !(0.0..=n).contains(&v) {
+                        return Err(format!(
+                            "{}: {v} is not a sum of {realisations} ratios (0 to {realisations})",
+                            at(name)
+                        ));
+                    }
+                    if (count == 0) != (v == 0.0) {
+                        return Err(format!(
+                            "{}: {v}, but the count is {count}",
+                            at(name)
+                        ));
+                    }
+                }
+            }
+        }
+        let most = (realisations as u128) * (curves as u128) * (points as u128);
+        if u128::from(self.disagreements) > most {
+            return Err(format!(
+                "disagreements: {} is more than {realisations} realisations × {curves} curves × \
+                 {points} thresholds",
+                self.disagreements
+            ));
+        }
+        Ok(())
+    }
+
     /// Realisations added.
     pub fn realisations(&self) -> usize {
         self.realisations

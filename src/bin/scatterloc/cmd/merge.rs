@@ -1,26 +1,30 @@
 //! `scatterloc merge`: the part files of a sharded study into the result of the unsharded run.
-//! The files are read here; the library checks them as one set
-//! ([`scatterloc::study::PartSet::check`]: format version, one study, every shard exactly once)
-//! before anything is written, each problem one named error (exit status 2) that lists the
-//! offending files or shards; the study's command (`montecarlo`, `mtl roc`) then adds the sums
-//! exactly and writes its usual outputs.
+//! The files are read here, one at a time (each at most 256 MiB); the library checks them as
+//! one set ([`scatterloc::study::PartSet::read`]: format version, one study, every shard
+//! exactly once) before anything is written, then the study's merge reads each part's sums
+//! again and checks them against their digest and the study (issue 24; the list is in
+//! docs/scale-out.md, "What merge checks"). Each problem is one named error (exit status 2)
+//! naming the part and the field, or the offending files or shards; the study's command
+//! (`montecarlo`, `mtl roc`) then writes its usual outputs.
 
 use scatterloc::study::PartSet;
+use scatterloc::Error;
 
 use super::io::read_input_named;
 use crate::cli::MergeArgs;
 use crate::failure::CliError;
 
+/// Reads part file `path` for `merge` (its errors as the library's, exit status 2).
+pub fn load_part(path: &str) -> Result<String, Error> {
+    read_input_named("merge: PART", path).map_err(|e| Error::PartSet { what: e.message })
+}
+
 /// `scatterloc merge`.
 pub fn merge(args: &MergeArgs) -> Result<(), CliError> {
-    let files = args
-        .parts
-        .iter()
-        .map(|path| Ok((path.clone(), read_input_named("merge: PART", path)?)))
-        .collect::<Result<Vec<_>, CliError>>()?;
-    let set = PartSet::check(&files).map_err(|e| CliError::usage(e.to_string()))?;
+    let set = PartSet::read(&args.parts, &mut |p| load_part(p))
+        .map_err(|e| CliError::usage(e.to_string()))?;
     match set.study.as_str() {
-        "montecarlo" => super::montecarlo::merge_parts(&set.parts, &args.json, args.out.as_deref()),
-        _ => super::mtl::merge_roc(&set.parts, &args.json, args.out.as_deref()),
+        "montecarlo" => super::montecarlo::merge_parts(&set, &args.json, args.out.as_deref()),
+        _ => super::mtl::merge_roc(&set, &args.json, args.out.as_deref()),
     }
 }

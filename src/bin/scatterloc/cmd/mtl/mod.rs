@@ -32,7 +32,7 @@ use super::shard;
 use super::study::{cancelled, run_with_bar, threads};
 use crate::cli::{MtlLocateArgs, MtlModel, RocArgs, RocExperiment, Table2Args};
 use crate::failure::CliError;
-use scatterloc::study::{Part, PartFile, RocConfig, RocStudy, ShardDoc, Timing};
+use scatterloc::study::{PartFile, PartSet, RocConfig, RocStudy, ShardDoc, Timing};
 
 mod locate;
 mod roc;
