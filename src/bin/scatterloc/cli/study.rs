@@ -69,6 +69,10 @@ pub struct MontecarloArgs {
     pub settings: FilterSettings,
     #[command(flatten)]
     pub shard: ShardArgs,
+    /// Run even when the work is predicted to take more than 24 CPU-hours (the cap; the
+    /// prediction and its calibration: docs/benchmarks.md "Cost model").
+    #[arg(long)]
+    pub allow_long: bool,
 }
 
 /// `scatterloc pcrlb`.

@@ -43,6 +43,10 @@ pub struct TrackArgs {
     pub seed: Option<u64>,
     #[command(flatten)]
     pub settings: FilterSettings,
+    /// Run even when the track is predicted to take more than 24 CPU-hours (the cap; the
+    /// prediction and its calibration: docs/benchmarks.md "Cost model").
+    #[arg(long)]
+    pub allow_long: bool,
 }
 
 /// `scatterloc calibrate`.
