@@ -382,7 +382,10 @@ impl fmt::Display for Error {
                 cause,
             } => {
                 let name = filter.to_uppercase();
-                write!(f, "{field}: every run of the {name} failed ({runs} of {runs})")?;
+                write!(
+                    f,
+                    "{field}: every run of the {name} failed ({runs} of {runs})"
+                )?;
                 match cause {
                     Some(c) => write!(f, "; the first: {}", Clip(c)),
                     None => Ok(()),

@@ -18,7 +18,7 @@ use crate::track::{step_ns, FilterKind};
 
 /// The CLI's default cap on predicted work: one CPU-day (24 CPU-hours), s. The paper-scale
 /// studies of docs/reproduction.md (EKF + UKF ≈ 1 CPU-hour) fit; a full-mesh 64 × 64-node UKF
-/// study, or a particle filter of 10⁶ particles at paper scale, do not. `--allow-long` lifts it.
+/// study, or a particle filter of 10⁶ particles at paper scale, do not. `--max-cpu-hours` changes it.
 pub const MAX_CPU_S: Real = 86_400.0;
 
 /// The page's cap on a track computed on its main thread, s (a tab must not freeze).

@@ -15,8 +15,8 @@ use crate::error::{Error, Result};
 use crate::measure::Model;
 use crate::study::Driver;
 use crate::track::{
-    finish, run_filter_chunk, run_filter_chunk_in, FilterKind, MonteCarloConfig, MonteCarloResult, StudySums,
-    CHUNK_TRAJECTORIES, MAX_PARTICLES, MAX_RUNS,
+    finish, run_filter_chunk, run_filter_chunk_in, FilterKind, MonteCarloConfig, MonteCarloResult,
+    StudySums, CHUNK_TRAJECTORIES, MAX_PARTICLES, MAX_RUNS,
 };
 
 /// One tracker of a [`FilterStudy`]: its kind, the leading chunks it runs, its sums so far.

@@ -9,7 +9,10 @@
 //! - UKF (`filters-and-planning.md` §1): the `L × L` innovation covariance `S` is built
 //!   (`L²/2` entries of 4 products) and factorised (`L³/6` multiply-adds, [`crate::track::Ukf`]),
 //!   so `a + b·L + c·L² + d·L³`;
-//! - particle filter (§2): every particle evaluates every link, `N·(a + b·L)`.
+//! - particle filter (§2): every particle evaluates every link, and the NIS of the update
+//!   (`S = Σ w (h − ẑ)(h − ẑ)ᵀ + R`, `src/track/pf.rs`) accumulates an `L × L` matrix per
+//!   particle (`L²/2` products) and factorises it (`L³/3`): `N·(a + b·L + c·L²/2) + d·L³/3`.
+//!   Above a few hundred links the `N·L²` term dominates.
 //!
 //! The constants are nanoseconds per unit on this project's 2-core development machine, release
 //! build, one thread: the fixed and per-link terms from the criterion benches of
@@ -35,9 +38,14 @@ pub const UKF_NS_PER_LINK2: Real = 2.0;
 /// UKF step, per multiply-add of its Cholesky factorisation (`L³/6`), ns.
 pub const UKF_NS_PER_LINK3: Real = 1.4;
 /// Particle filter step, per particle, ns.
-pub const PF_NS_PER_PARTICLE: Real = 30.0;
+pub const PF_NS_PER_PARTICLE: Real = 40.0;
 /// Particle filter step, per particle and link, ns.
-pub const PF_NS_PER_PARTICLE_LINK: Real = 6.0;
+pub const PF_NS_PER_PARTICLE_LINK: Real = 3.0;
+/// Particle filter step, per particle and product of its NIS matrix (`L²/2`), ns.
+pub const PF_NS_PER_PARTICLE_LINK2: Real = 1.1;
+/// Particle filter step, per multiply-add of the NIS matrix's Cholesky factorisation
+/// (`L³/3`), ns.
+pub const PF_NS_PER_LINK3: Real = 0.16;
 
 /// The predicted CPU time of one step (predict, measurements, update, error and NEES) of
 /// `filter` with `links` links, ns (module docs).
@@ -46,10 +54,16 @@ pub fn step_ns(filter: FilterKind, links: usize) -> Real {
     match filter {
         FilterKind::Ekf => EKF_NS + EKF_NS_PER_LINK * l,
         FilterKind::Ukf(_) => {
-            UKF_NS + UKF_NS_PER_LINK * l + UKF_NS_PER_LINK2 * l * l + UKF_NS_PER_LINK3 * l * l * l / 6.0
+            UKF_NS
+                + UKF_NS_PER_LINK * l
+                + UKF_NS_PER_LINK2 * l * l
+                + UKF_NS_PER_LINK3 * l * l * l / 6.0
         }
         FilterKind::Pf(c) => {
-            c.particles as Real * (PF_NS_PER_PARTICLE + PF_NS_PER_PARTICLE_LINK * l)
+            let per_particle = PF_NS_PER_PARTICLE
+                + PF_NS_PER_PARTICLE_LINK * l
+                + PF_NS_PER_PARTICLE_LINK2 * l * l / 2.0;
+            c.particles as Real * per_particle + PF_NS_PER_LINK3 * l * l * l / 3.0
         }
     }
 }

@@ -69,10 +69,10 @@ pub struct MontecarloArgs {
     pub settings: FilterSettings,
     #[command(flatten)]
     pub shard: ShardArgs,
-    /// Run even when the work is predicted to take more than 24 CPU-hours (the cap; the
-    /// prediction and its calibration: docs/benchmarks.md "Cost model").
-    #[arg(long)]
-    pub allow_long: bool,
+    /// Refuse work predicted to take more than H CPU-hours [default: 24] (issue 24; the
+    /// prediction and its calibration: docs/benchmarks.md "Cost model"); > 0.
+    #[arg(long, value_name = "H", value_parser = finite)]
+    pub max_cpu_hours: Option<f64>,
 }
 
 /// `scatterloc pcrlb`.

@@ -63,7 +63,7 @@ pub fn montecarlo(args: &MontecarloArgs) -> Result<(), CliError> {
         Some(s) => s.range(study.chunk_count()),
         None => 0..study.chunk_count(),
     };
-    let predicted = check_study_cost(&study, &chunks, used, args.allow_long)?;
+    let predicted = check_study_cost(&study, &chunks, used, args.max_cpu_hours)?;
     if let Some(shard) = shard {
         let path = shard::part_path(args.json.as_deref(), args.out.as_deref())?;
         return run_shard(&study, shard, (threads, used), &path);

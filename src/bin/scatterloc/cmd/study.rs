@@ -11,8 +11,8 @@ use serde::Serialize;
 
 use scatterloc::native::{run_pcrlb_parallel, Parallel};
 use scatterloc::study::{
-    check_cost, CurveDoc, FilterResults, FilterStudy, McMeta, MonteCarloStudy,
-    TrackStudy as Study, MAX_CPU_S,
+    check_cost, CurveDoc, FilterResults, FilterStudy, McMeta, MonteCarloStudy, TrackStudy as Study,
+    MAX_CPU_S,
 };
 use scatterloc::track::ConstantVelocity;
 use scatterloc::track::{
@@ -144,7 +144,7 @@ pub fn check_study_cost(
     study: &MonteCarloStudy,
     chunks: &std::ops::Range<usize>,
     threads: usize,
-    allow_long: bool,
+    max_cpu_hours: Option<f64>,
 ) -> Result<String, CliError> {
     let links = study.track.model.link_count();
     let mut cpu_s = 0.0;
@@ -159,33 +159,44 @@ pub fn check_study_cost(
         "montecarlo",
         cpu_s,
         threads,
-        allow_long,
+        max_cpu_hours,
         "--runs, --noise-runs, --duration (or a larger --dt), --particles, fewer --filters or a \
          scenario with fewer links, or split it with --shard",
     )?;
-    Ok(format!(" · predicted ≈ {} on {threads} threads", duration_text(wall)))
+    Ok(format!(
+        " · predicted ≈ {} on {threads} threads",
+        duration_text(wall)
+    ))
 }
 
-/// [`check_cost`] of `cpu_s` against [`MAX_CPU_S`] unless `allow_long`, as a usage error of
-/// command `what` naming the flags `change` and `--allow-long`.
+/// [`check_cost`] of `cpu_s` against `--max-cpu-hours` (default [`MAX_CPU_S`]), as a usage
+/// error of command `what` with the predicted time, naming the flags `change` and
+/// `--max-cpu-hours`.
 pub fn cost_refused(
     what: &str,
     cpu_s: f64,
     threads: usize,
-    allow_long: bool,
+    max_cpu_hours: Option<f64>,
     change: &str,
 ) -> Result<(), CliError> {
-    if allow_long {
-        return Ok(());
-    }
-    check_cost(what, cpu_s, MAX_CPU_S).map_err(|_| {
+    let cap = match max_cpu_hours {
+        None => MAX_CPU_S,
+        Some(h) if h > 0.0 && h <= 1e6 => h * 3600.0,
+        Some(h) => {
+            return Err(CliError::usage(format!(
+                "--max-cpu-hours: {h} is outside the allowed range 0 < H <= 1e6"
+            )))
+        }
+    };
+    check_cost(what, cpu_s, cap).map_err(|_| {
         CliError::usage(format!(
             "{what}: the work is predicted to take {} of CPU time (≈ {} on {threads} threads), \
-             over the cap of {} (24 CPU-hours); lower {change}, or pass --allow-long to run it \
-             anyway (the cost model: docs/benchmarks.md \"Cost model\")",
+             over the cap of {} (--max-cpu-hours {}); lower {change}, or raise --max-cpu-hours \
+             to run it anyway (the cost model: docs/benchmarks.md \"Cost model\")",
             duration_text(cpu_s),
             duration_text(cpu_s / threads.max(1) as f64),
-            duration_text(MAX_CPU_S),
+            duration_text(cap),
+            cap / 3600.0,
         ))
     })
 }

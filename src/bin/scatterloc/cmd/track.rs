@@ -8,8 +8,8 @@
 //! association then use that filter's predicted delays and innovation σ (its sigma points, its
 //! weighted particles).
 
-use scatterloc::formats::{Measurements, Steps};
 use scatterloc::error::Cancel;
+use scatterloc::formats::{Measurements, Steps};
 use scatterloc::study::{track_cpu_s, track_measurements_in, TrackRequest};
 use scatterloc::track::gating::AssociationRule;
 
@@ -74,7 +74,7 @@ pub fn track(args: &TrackArgs) -> Result<(), CliError> {
         "track",
         track_cpu_s(kind, n, steps),
         1,
-        args.allow_long,
+        args.max_cpu_hours,
         "the steps of --measurements, --particles, or use --filter ekf or a scenario with fewer \
          links",
     )?;
