@@ -80,7 +80,7 @@ impl Default for UkfParams {
 pub const ALPHA_RANGE: crate::error::limits::Range = crate::error::limits::Range {
     min: 1e-4,
     max: 1.0,
-    allowed: "1e-4 to 1 (Wan & van der Merwe)",
+    allowed: "1e-4 to 1, Wan & van der Merwe",
 };
 
 impl UkfParams {
