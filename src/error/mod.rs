@@ -397,10 +397,9 @@ impl fmt::Display for Error {
                 limit_s,
             } => write!(
                 f,
-                "{field}: the work is predicted to take {} CPU-s ({} h), over the cap of {} CPU-s; \
+                "{field}: the work is predicted to take {} s of CPU time, over the cap of {} s; \
                  make it smaller",
-                Num(predicted_s.round()),
-                Num((predicted_s / 360.0).round() / 10.0),
+                Num(crate::math::round(*predicted_s)),
                 Num(*limit_s)
             ),
             Error::Degenerate { field } => write!(
