@@ -4,9 +4,11 @@
 use alloc::string::String;
 use core::fmt;
 
+mod cancel;
 pub mod limits;
 mod show;
 
+pub use cancel::{check_every, Cancel, CHECK_NS};
 pub use show::{Clip, Num};
 
 /// A named error. `Display` gives one line that names the offending field.
@@ -153,6 +155,28 @@ pub enum Error {
     },
     /// A long computation was cancelled by its caller (Ctrl-C, a new drag in the page).
     Cancelled,
+    /// Every run of one filter of a study failed (issue 24): the study keeps the other
+    /// filters' results; this is the error when no filter has one.
+    AllRunsFailed {
+        /// The setting to change, e.g. `particles` (the particle filter), `ukf_alpha`.
+        field: String,
+        /// `ekf`, `ukf` or `pf`.
+        filter: &'static str,
+        /// Runs that failed (all of them).
+        runs: usize,
+        /// The first failed run's error, when this process ran it.
+        cause: Option<String>,
+    },
+    /// Work predicted to take longer than the front end's cap (issue 24): a Monte Carlo study or
+    /// a track refused before it starts (`crate::track::step_ns`, `crate::study::cost`).
+    TooLong {
+        /// The inputs that drive the work, e.g. `runs, noise_runs, steps, particles`.
+        field: String,
+        /// The predicted CPU time, s.
+        predicted_s: f64,
+        /// The cap, s.
+        limit_s: f64,
+    },
     /// A name that is not one of the known presets.
     UnknownPreset {
         /// The name asked for.
@@ -241,6 +265,8 @@ impl Error {
             | Error::UnknownNode { field, .. }
             | Error::NotPositiveDefinite { field }
             | Error::WorkLimit { field, .. }
+            | Error::AllRunsFailed { field, .. }
+            | Error::TooLong { field, .. }
             | Error::UnknownTrajectory { field, .. }
             | Error::Degenerate { field }
             | Error::Infeasible { field, .. }
@@ -363,6 +389,33 @@ impl fmt::Display for Error {
                  multi-target localization); give fewer ranges per TRP, or lower T_e or c_sigma_m"
             ),
             Error::Cancelled => write!(f, "cancelled"),
+            Error::AllRunsFailed {
+                field,
+                filter,
+                runs,
+                cause,
+            } => {
+                let name = filter.to_uppercase();
+                write!(
+                    f,
+                    "{field}: every run of the {name} failed ({runs} of {runs})"
+                )?;
+                match cause {
+                    Some(c) => write!(f, "; the first: {}", Clip(c)),
+                    None => Ok(()),
+                }
+            }
+            Error::TooLong {
+                field,
+                predicted_s,
+                limit_s,
+            } => write!(
+                f,
+                "{field}: the work is predicted to take {} s of CPU time, over the cap of {} s; \
+                 make it smaller",
+                Num(crate::math::round(*predicted_s)),
+                Num(*limit_s)
+            ),
             Error::Degenerate { field } => write!(
                 f,
                 "{field}: degenerate (every particle's likelihood is zero or not a number)"

@@ -7,7 +7,7 @@ use std::vec::Vec;
 
 use rayon::prelude::*;
 
-use crate::error::{Error, Result};
+use crate::error::{Cancel, Error, Result};
 use crate::study::Driver;
 
 /// Runs `job(0..jobs)` on `threads` workers (0 = all cores), `per_thread` jobs per worker and
@@ -57,7 +57,7 @@ pub fn thread_pool(threads: usize) -> Result<rayon::ThreadPool> {
 }
 
 /// The study [`Driver`] on threads: [`run_ordered`] on `threads` workers (0 = all cores), with
-/// `cancel` (Ctrl-C) checked between waves. Results equal [`crate::study::Sequential`]'s for
+/// `cancel` (Ctrl-C) checked between waves and, through the jobs' [`Cancel`], inside them. Results equal [`crate::study::Sequential`]'s for
 /// any thread count.
 pub struct Parallel<'a> {
     threads: usize,
@@ -76,10 +76,21 @@ impl Driver for Parallel<'_> {
         &mut self,
         jobs: usize,
         batch: usize,
-        job: &(dyn Fn(usize) -> Result<T> + Sync),
+        job: &(dyn Fn(usize, Cancel) -> Result<T> + Sync),
         merge: &mut dyn FnMut(T),
         progress: &mut dyn FnMut(usize),
     ) -> Result<()> {
-        run_ordered(jobs, self.threads, batch, self.cancel, job, merge, progress)
+        let flag = self.cancel;
+        let stop = move || flag.load(Ordering::Relaxed);
+        let cancel = Cancel::when(&stop);
+        run_ordered(
+            jobs,
+            self.threads,
+            batch,
+            flag,
+            |i| job(i, cancel),
+            merge,
+            progress,
+        )
     }
 }

@@ -7,6 +7,7 @@
 //! the most trajectories counted. The CLI (whole or one shard), its `merge` and the page's
 //! worker all run a study through this type.
 
+use alloc::string::ToString;
 use alloc::vec::Vec;
 use core::ops::Range;
 
@@ -14,8 +15,8 @@ use crate::error::{Error, Result};
 use crate::measure::Model;
 use crate::study::Driver;
 use crate::track::{
-    finish, run_filter_chunk, FilterKind, MonteCarloConfig, MonteCarloResult, StudySums,
-    CHUNK_TRAJECTORIES, MAX_PARTICLES, MAX_RUNS,
+    finish, run_filter_chunk, run_filter_chunk_in, FilterKind, MonteCarloConfig, MonteCarloResult,
+    StudySums, CHUNK_TRAJECTORIES, MAX_PARTICLES, MAX_RUNS,
 };
 
 /// One tracker of a [`FilterStudy`]: its kind, the leading chunks it runs, its sums so far.
@@ -29,9 +30,34 @@ pub struct FilterRun {
     pub sums: StudySums,
     /// Chunks counted so far.
     pub chunks_done: usize,
+    /// The error of its first failed run in the chunks this process ran (not kept in part
+    /// files: `None` after a merge).
+    pub first_failure: Option<Error>,
 }
 
 impl FilterRun {
+    /// The setting of this filter a user changes when all its runs fail: `particles` (too few
+    /// particles degenerate), `ukf_alpha` (the sigma-point spread), `initial_covariance` (the
+    /// EKF's prior).
+    pub fn setting(&self) -> &'static str {
+        match self.kind {
+            FilterKind::Ekf => "initial_covariance",
+            FilterKind::Ukf(_) => "ukf_alpha",
+            FilterKind::Pf(_) => "particles",
+        }
+    }
+
+    /// [`Error::AllRunsFailed`] for this filter: its setting, its failed runs, its first
+    /// failure.
+    pub fn all_failed(&self) -> Error {
+        Error::AllRunsFailed {
+            field: self.setting().into(),
+            filter: self.kind.name(),
+            runs: self.sums.failed_runs,
+            cause: self.first_failure.as_ref().map(|e| e.to_string()),
+        }
+    }
+
     /// Runs the filter will have made when all its chunks are counted.
     pub fn runs_planned(&self, cfg: &MonteCarloConfig) -> usize {
         (self.chunks * CHUNK_TRAJECTORIES).min(cfg.trajectories) * cfg.noise_runs
@@ -60,6 +86,10 @@ pub struct FilterResults {
     /// The entry of `curves` with the most trajectories counted (the first on a tie): its
     /// `ε_PCRLB` is the study's.
     pub widest: usize,
+    /// The filters that counted chunks but whose every run failed (issue 24), in list order:
+    /// `(index in the filter list, the error naming the setting to change and the cause)`,
+    /// an [`Error::AllRunsFailed`].
+    pub failed: Vec<(usize, Error)>,
 }
 
 impl FilterResults {
@@ -135,6 +165,7 @@ impl FilterStudy {
                 chunks,
                 sums: StudySums::new(config.steps),
                 chunks_done: 0,
+                first_failure: None,
             });
         }
         let has_pf = filters.iter().any(|k| matches!(k, FilterKind::Pf(_)));
@@ -210,6 +241,9 @@ impl FilterStudy {
             let f = &mut self.filters[i];
             let part = run_filter_chunk(model, &self.config, f.kind, chunk)?;
             f.sums.add(&part);
+            if f.first_failure.is_none() {
+                f.first_failure = part.first_failure;
+            }
             f.chunks_done += 1;
             self.items_done += 1;
         }
@@ -243,11 +277,17 @@ impl FilterStudy {
         for (f, range) in self.filters.iter_mut().zip(&ranges) {
             let (kind, first) = (f.kind, range.start);
             let mut sums = StudySums::new(cfg.steps);
+            let failure = &mut f.first_failure;
             driver.run(
                 range.len(),
                 4,
-                &|c| run_filter_chunk(model, &cfg, kind, first + c),
-                &mut |part| sums.add(&part),
+                &|c, cancel| run_filter_chunk_in(model, &cfg, kind, first + c, cancel),
+                &mut |part| {
+                    sums.add(&part);
+                    if failure.is_none() {
+                        *failure = part.first_failure;
+                    }
+                },
                 &mut |done| progress(offset + runs_in(&(first..first + done)), total),
             )?;
             f.sums.merge(&sums);
@@ -287,17 +327,25 @@ impl FilterStudy {
         self.filters.iter().map(|f| f.sums.clone()).collect()
     }
 
-    /// The curves of every filter that has counted a chunk ([`finish`]), the lead and the
-    /// widest. [`Error::SizeLimit`] (`runs (successful)`) before any run is counted, or when a
-    /// filter that has counted chunks has no successful run.
+    /// The curves of every filter that has counted a successful run ([`finish`]), the lead,
+    /// the widest, and the filters whose every run failed (issue 24: reported on their own, the
+    /// other filters' curves kept). [`Error::SizeLimit`] (`runs (successful)`) before any run
+    /// is counted; when every filter that counted runs failed in all of them, the first one's
+    /// [`Error::AllRunsFailed`] (naming the setting to change and the first failure).
     pub fn results(&self) -> Result<FilterResults> {
         let mut curves = Vec::new();
+        let mut failed = Vec::new();
         for (i, f) in self.filters.iter().enumerate() {
-            if f.chunks_done > 0 {
+            if f.sums.runs > 0 {
                 curves.push((i, finish(&self.config, &f.sums)?));
+            } else if f.sums.failed_runs > 0 {
+                failed.push((i, f.all_failed()));
             }
         }
         if curves.is_empty() {
+            if let Some((_, e)) = failed.into_iter().next() {
+                return Err(e);
+            }
             return Err(Error::SizeLimit {
                 field: "runs (successful)",
                 value: 0,
@@ -318,6 +366,7 @@ impl FilterStudy {
             curves,
             lead,
             widest,
+            failed,
         })
     }
 }

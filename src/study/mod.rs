@@ -13,8 +13,11 @@
 //!   record [`RocConfig`].
 //! - [`track_measurements`]: a measurement file (`steps` or gated `raw_steps`) tracked by any
 //!   filter ([`TrackOutput`], the document of `scatterloc track`).
+//! - [`check_cost`], [`track_cpu_s`], [`FilterStudy::predicted_cpu_s`]: the predicted work
+//!   of a study or a track and the caps front ends refuse work over (issue 24).
 //! - [`PartSet`], [`PartFile`]: the part file format (`scatterloc-part`, version 2, with a digest of its sums) and what `merge` checks.
 
+mod cost;
 mod drive;
 mod filters;
 mod montecarlo;
@@ -23,6 +26,7 @@ mod roc;
 mod sums;
 mod track;
 
+pub use cost::{check_cost, track_cpu_s, MAX_CPU_S, PAGE_STUDY_CPU_S, PAGE_TRACK_CPU_S};
 pub use drive::{Driver, Sequential};
 pub use filters::{particle_chunks, FilterResults, FilterRun, FilterStudy};
 pub use montecarlo::{
@@ -35,7 +39,7 @@ pub use part::{
     PART_VERSION,
 };
 pub use roc::{RocConfig, RocStudy};
-pub use track::{track_measurements, TrackOutput, TrackRequest, TrackStart};
+pub use track::{track_measurements, track_measurements_in, TrackOutput, TrackRequest, TrackStart};
 
 #[cfg(test)]
 mod tests;

@@ -309,14 +309,20 @@ pub struct McMeta {
 /// The curves of one filter of a study of several.
 #[derive(Debug, Clone, Serialize)]
 pub struct FilterDoc {
-    /// The filter's RMSE, m.
+    /// The filter's RMSE, m (absent when every run failed).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
     pub rmse_m: Vec<f64>,
-    /// Its average NEES.
+    /// Its average NEES (absent when every run failed).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
     pub nees: Vec<f64>,
     /// Its runs counted.
     pub runs: usize,
     /// Its runs that failed numerically (left out of `rmse_m`).
     pub failed_runs: usize,
+    /// Only when every run failed (issue 24): the error naming the setting to change and the
+    /// first failure ([`crate::Error::AllRunsFailed`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub error: Option<String>,
 }
 
 /// `{"ekf": {..}, "ukf": {..}, ..}` in the order of the filter list.
@@ -529,32 +535,51 @@ impl MonteCarloStudy {
         if self.ekf_only() {
             return doc;
         }
-        if !self.filters.contains(&FilterKind::Ekf) {
+        let ekf_counted = results
+            .curves
+            .iter()
+            .any(|(i, _)| self.filters[*i] == FilterKind::Ekf);
+        if !ekf_counted {
             doc.rmse_ekf_m = None;
             doc.nees = None;
         }
-        let notes: Vec<String> = results
+        // Every filter in list order: its curves, or its failure (issue 24).
+        let mut entries: Vec<(usize, String, FilterDoc)> = results
             .curves
             .iter()
-            .map(|(i, r)| format!("{}: {}", name(*i), note(r)))
+            .map(|(i, r)| {
+                let doc = FilterDoc {
+                    rmse_m: r.rmse_m.clone(),
+                    nees: r.nees.clone(),
+                    runs: r.runs,
+                    failed_runs: r.failed_runs,
+                    error: None,
+                };
+                (*i, note(r), doc)
+            })
+            .collect();
+        for (i, e) in &results.failed {
+            let runs = match e {
+                crate::Error::AllRunsFailed { runs, .. } => *runs,
+                _ => 0,
+            };
+            let doc = FilterDoc {
+                rmse_m: Vec::new(),
+                nees: Vec::new(),
+                runs: 0,
+                failed_runs: runs,
+                error: Some(e.to_string()),
+            };
+            (entries).push((*i, format!("all {runs} runs failed"), doc));
+        }
+        entries.sort_by_key(|(i, _, _)| *i);
+        let notes: Vec<String> = entries
+            .iter()
+            .map(|(i, n, _)| format!("{}: {n}", name(*i)))
             .collect();
         doc.caption_note = Some(notes.join(", "));
         doc.meta.filters = Some(FilterCurves(
-            results
-                .curves
-                .iter()
-                .map(|(i, r)| {
-                    (
-                        name(*i),
-                        FilterDoc {
-                            rmse_m: r.rmse_m.clone(),
-                            nees: r.nees.clone(),
-                            runs: r.runs,
-                            failed_runs: r.failed_runs,
-                        },
-                    )
-                })
-                .collect(),
+            entries.into_iter().map(|(i, _, d)| (name(i), d)).collect(),
         ));
         doc
     }

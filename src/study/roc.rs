@@ -295,7 +295,7 @@ impl RocStudy {
         driver.run(
             total,
             8,
-            &|i| evaluate(cfg, (first + i) as u64),
+            &|i, _| evaluate(cfg, (first + i) as u64),
             &mut |part| tally.add(&part),
             &mut |done| progress(done, total),
         )?;

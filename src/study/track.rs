@@ -47,7 +47,7 @@ use alloc::vec::Vec;
 
 use serde::Serialize;
 
-use crate::error::{Error, Result};
+use crate::error::{check_every, Cancel, Error, Result};
 use crate::formats::{Measurements, RawStep, Start, Steps};
 use crate::math::{Mat4, Vec4};
 use crate::measure::{rng, Model};
@@ -55,7 +55,7 @@ use crate::scenario::Area;
 use crate::track::gating::{
     start_from_snapshot, AssociationRule, Calibration, Choice, GatedTracker, START_SPEED_SIGMA_MPS,
 };
-use crate::track::UpdateSummary;
+use crate::track::{step_ns, UpdateSummary};
 use crate::track::{ConstantVelocity, Ekf, Filter, FilterKind, MeasurementNoise, Tracker};
 
 /// What a track runs on.
@@ -124,6 +124,14 @@ pub struct TrackStart {
 /// Runs the track of `req`. Errors name the field of the file (`steps[k]`, `raw_steps[k][p]`,
 /// `initial_snapshot`, …).
 pub fn track_measurements(req: &TrackRequest) -> Result<TrackOutput> {
+    track_measurements_in(req, Cancel::NEVER)
+}
+
+/// [`track_measurements`] that asks `cancel` every millisecond or so of work
+/// ([`check_every`] steps of [`step_ns`]) and stops with [`Error::Cancelled`] (issue 24: a
+/// 4096-link UKF step takes seconds, and a file may hold 10⁶ steps).
+pub fn track_measurements_in(req: &TrackRequest, cancel: Cancel) -> Result<TrackOutput> {
+    let every = check_every(step_ns(req.filter, req.model.link_count()));
     let (model, m) = (req.model, req.measurements);
     let n = model.link_count();
     let motion = m.motion()?;
@@ -160,10 +168,13 @@ pub fn track_measurements(req: &TrackRequest) -> Result<TrackOutput> {
     let own = rng(req.seed, 0);
     let filter = Tracker::new(req.filter, ekf.state, ekf.covariance, own)?;
     match steps {
-        Steps::Plain(steps) => plain(model, filter, &motion, noise, steps, m.dt_s, &mut out)?,
+        Steps::Plain(steps) => {
+            let at = Every { cancel, every };
+            plain(model, filter, &motion, noise, steps, m.dt_s, at, &mut out)?
+        }
         Steps::Raw(raw) => {
             let tracker = GatedTracker::new(filter, model, cal, motion, noise, req.rule)?;
-            gated(tracker, n, raw, m.dt_s, &mut out)?
+            gated(tracker, n, raw, m.dt_s, Every { cancel, every }, &mut out)?
         }
     }
     Ok(out)
@@ -225,7 +236,26 @@ fn step_error(field: &str, e: Error) -> Error {
     }
 }
 
+/// A [`Cancel`] asked every `every` steps.
+#[derive(Debug, Clone, Copy)]
+struct Every<'a> {
+    cancel: Cancel<'a>,
+    every: usize,
+}
+
+impl Every<'_> {
+    /// [`Error::Cancelled`] at step `k` when it is a checking step and the caller asks.
+    fn check(&self, k: usize) -> Result<()> {
+        if k % self.every.max(1) == 0 {
+            self.cancel.check()
+        } else {
+            Ok(())
+        }
+    }
+}
+
 /// The plain form: one delay (or null) per link and step.
+#[allow(clippy::too_many_arguments)]
 fn plain(
     model: &Model,
     mut filter: Tracker,
@@ -233,10 +263,12 @@ fn plain(
     noise: MeasurementNoise,
     steps: &[Vec<Option<f64>>],
     dt_s: f64,
+    at: Every,
     out: &mut TrackOutput,
 ) -> Result<()> {
     let n = model.link_count();
     for (k, z) in steps.iter().enumerate() {
+        at.check(k)?;
         let field = format!("steps[{k}]");
         Measurements::check_plain_step(k, z, n)?;
         filter.predict(motion);
@@ -255,10 +287,12 @@ fn gated(
     links: usize,
     raw: &[RawStep],
     dt_s: f64,
+    at: Every,
     out: &mut TrackOutput,
 ) -> Result<()> {
     let (mut used, mut choices, mut removed) = (vec![], vec![], vec![]);
     for (k, step) in raw.iter().enumerate() {
+        at.check(k)?;
         let field = format!("raw_steps[{k}]");
         let estimates = Measurements::estimates(&field, step, links)?;
         let s = tracker

@@ -6,6 +6,7 @@
 //! Monte Carlo study of the tracker against its bound, chunked so that any driver (sequential,
 //! `native`, the page's worker) gives the same result.
 
+mod cost;
 mod ekf;
 mod filter;
 pub mod gating;
@@ -18,13 +19,17 @@ mod track_sim;
 mod trajectory;
 mod ukf;
 
+pub use cost::{
+    step_ns, EKF_NS, EKF_NS_PER_LINK, PF_NS_PER_LINK3, PF_NS_PER_PARTICLE, PF_NS_PER_PARTICLE_LINK,
+    PF_NS_PER_PARTICLE_LINK2, UKF_NS, UKF_NS_PER_LINK, UKF_NS_PER_LINK2, UKF_NS_PER_LINK3,
+};
 pub(crate) use ekf::update_lanes;
 pub use ekf::Ekf;
 pub use filter::{Filter, FilterKind, Tracker};
 pub use montecarlo::{
-    finish, pcrlb_from_sums, run_chunk, run_filter_chunk, run_pcrlb_sequential, run_sequential,
-    run_truth_chunk, MonteCarloConfig, MonteCarloResult, PartialSums, StudySums,
-    CHUNK_TRAJECTORIES, MAX_RUNS, MAX_STEPS,
+    finish, pcrlb_from_sums, run_chunk, run_chunk_in, run_filter_chunk, run_filter_chunk_in,
+    run_pcrlb_sequential, run_sequential, run_truth_chunk, MonteCarloConfig, MonteCarloResult,
+    PartialSums, StudySums, CHUNK_TRAJECTORIES, MAX_RUNS, MAX_STEPS,
 };
 pub use motion::ConstantVelocity;
 pub use pcrlb::{nominal_pcrlb_rmse, pcrlb_rmse, PosteriorInformation};
@@ -36,4 +41,4 @@ pub use trajectory::{
     paper_initial_covariance, step_count, TrackScenario, TruthSampler, PAPER_DURATION_S,
     PAPER_INTENSITY, PAPER_STEP_S,
 };
-pub use ukf::{Ukf, UkfParams};
+pub use ukf::{Ukf, UkfParams, ALPHA_RANGE as UKF_ALPHA_RANGE};

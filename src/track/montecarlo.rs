@@ -23,7 +23,7 @@ use crate::track::ConstantVelocity;
 mod chunk;
 mod sums;
 
-pub use chunk::{run_chunk, run_filter_chunk, run_truth_chunk};
+pub use chunk::{run_chunk, run_chunk_in, run_filter_chunk, run_filter_chunk_in, run_truth_chunk};
 pub use sums::{PartialSums, StudySums};
 
 /// Trajectories per chunk (the unit of parallel work, of the fixed-order sums inside a chunk and

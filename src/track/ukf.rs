@@ -53,7 +53,7 @@ const N: usize = 4;
 /// The scaled unscented transform's parameters (spec §1 \[choice\]: α = 1, β = 2, κ = 0).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct UkfParams {
-    /// Spread of the sigma points, `0 < α ≤ 10`.
+    /// Spread of the sigma points, `10⁻⁴ ≤ α ≤ 1` ([`ALPHA_RANGE`]).
     pub alpha: Real,
     /// Prior knowledge of the distribution (2 is optimal for a Gaussian), `0 ≤ β ≤ 10`.
     pub beta: Real,
@@ -71,6 +71,18 @@ impl Default for UkfParams {
     }
 }
 
+/// The range of the UKF's `α` (issue 24): `10⁻⁴ ≤ α ≤ 1`, the range E. A. Wan and R. van der
+/// Merwe give for the scaled unscented transform ("The Unscented Kalman Filter", ch. 7 of S.
+/// Haykin (ed.), *Kalman Filtering and Neural Networks*, Wiley 2001, §7.3). Below it the sigma
+/// points collapse onto the mean (`n + λ = α²(n + κ)`; at `α = 10⁻³⁰⁰` it underflows to 0 and
+/// every update failed with a not-positive-definite covariance); above 1 they spread wider than
+/// the prior.
+pub const ALPHA_RANGE: crate::error::limits::Range = crate::error::limits::Range {
+    min: 1e-4,
+    max: 1.0,
+    allowed: "1e-4 to 1, Wan & van der Merwe",
+};
+
 impl UkfParams {
     /// Checks the ranges (errors name `ukf_alpha`, `ukf_beta`, `ukf_kappa`).
     pub fn validate(&self) -> Result<()> {
@@ -79,9 +91,7 @@ impl UkfParams {
             value,
             allowed,
         };
-        if !(self.alpha.is_finite() && self.alpha > 0.0 && self.alpha <= 10.0) {
-            return Err(out("ukf_alpha", self.alpha, "0 < alpha <= 10"));
-        }
+        ALPHA_RANGE.check("ukf_alpha", self.alpha)?;
         if !(self.beta.is_finite() && (0.0..=10.0).contains(&self.beta)) {
             return Err(out("ukf_beta", self.beta, "0 <= beta <= 10"));
         }

@@ -13,9 +13,21 @@ use alloc::vec::Vec;
 
 use super::json::{to_json, FilterCurvesJs, MonteCarloJs};
 use super::tracking::{checked_steps, page_filter, prior_and_motion};
-use crate::study::FilterStudy;
+use crate::study::{check_cost, FilterStudy, PAGE_STUDY_CPU_S};
 use crate::track::{paper_initial_covariance, FilterKind, MonteCarloConfig};
 use crate::{Model, Scenario};
+
+/// [`crate::Error::TooLong`] when `study` is predicted to take more than
+/// [`PAGE_STUDY_CPU_S`] (issue 24: a shared link on a 64 × 64 mesh must not start hours of work).
+fn check_page_cost(model: &Model, study: &FilterStudy) -> Result<(), JsError> {
+    let all = 0..study.config().chunk_count();
+    check_cost(
+        "runs, steps, filters (on this network's links)",
+        study.predicted_cpu_s(model.link_count(), &all),
+        PAGE_STUDY_CPU_S,
+    )
+    .map_err(err)
+}
 
 /// A Monte Carlo study of ε(t) of one or more trackers and ε_PCRLB(t) in progress: the core's
 /// [`FilterStudy`] run a few work items per call.
@@ -61,7 +73,15 @@ impl MonteCarloJob {
         checked_steps(steps).map_err(err)?;
         cfg.validate().map_err(err)?;
         let study = FilterStudy::new(cfg, &[FilterKind::Ekf]).map_err(err)?;
+        check_page_cost(&model, &study)?;
         Ok(MonteCarloJob { model, study })
+    }
+
+    /// The study's predicted CPU time, s (issue 24, `FilterStudy::predicted_cpu_s`, calibrated
+    /// natively; the page's wasm is slower).
+    pub fn predicted_cpu_s(&self) -> f64 {
+        let all = 0..self.study.config().chunk_count();
+        self.study.predicted_cpu_s(self.model.link_count(), &all)
     }
 
     /// Runs the trackers `names` (comma-separated `ekf`, `ukf`, `pf`, each at most once, in
@@ -92,9 +112,11 @@ impl MonteCarloJob {
             }
             kinds.push(kind);
         }
-        self.study =
+        let study =
             FilterStudy::with_particle_budget(*self.study.config(), &kinds, particle_budget)
                 .map_err(err)?;
+        check_page_cost(&self.model, &study)?;
+        self.study = study;
         Ok(())
     }
 

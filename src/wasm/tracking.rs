@@ -113,6 +113,15 @@ impl App {
             }));
         }
         let session = self.session();
+        // Issue 24: the track runs on the page's main thread; refuse one predicted to freeze it
+        // (a UKF or PF on a 64 × 64 mesh took over 90 s) with the predicted time.
+        let links = session.model().link_count();
+        crate::study::check_cost(
+            "filter, particles, steps (on this network's links)",
+            crate::study::track_cpu_s(tracker, links, steps),
+            crate::study::PAGE_TRACK_CPU_S,
+        )
+        .map_err(err)?;
         let p0 = paper_initial_covariance();
         let run = simulate_track(
             session.model(),

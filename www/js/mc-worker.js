@@ -4,7 +4,8 @@
 // particles, particle_budget}. The study runs in SLICE_MS slices; after each slice it posts
 // progress {gen, done, total (chunks), result (MonteCarloJob.result_json text, partial)} and
 // pauses, so a newer job or a cancel gets in: then this job is dropped (the page never terminates
-// this worker: workers.js staleMs Infinity). The result: {gen, ms, done, total, result}.
+// this worker for that, but does when one slice outlasts its 250 ms grace: workers.js graceMs).
+// The result: {gen, ms, done, total, result}.
 
 import { MonteCarloJob } from '../pkg/scatterloc.js';
 import { serveLatest } from './worker-loop.js';

@@ -26,7 +26,8 @@ export class MonteCarlo {
     this.series = 0;
     this.caption = '';
     this.worker = new JobWorker(new URL('./mc-worker.js', import.meta.url), module, {
-      staleMs: Infinity, // never terminated: the worker drops a stale study at its next slice
+      staleMs: Infinity, // the worker drops a stale study at its next slice …
+      graceMs: 250, // … or is terminated when that takes longer (one long chunk; issue 24)
       onProgress: (m) => this.receive(m),
       onResult: (m) => this.receive(m),
       onError: (message, gen) => {
@@ -60,7 +61,7 @@ export class MonteCarlo {
     this.show();
   }
 
-  /** Stops the current study (the worker drops it at its next slice). */
+  /** Stops the current study (the worker drops it at its next slice, or is terminated after 250 ms). */
   cancel() {
     if (this.state === 'running') this.superseded += 1;
     this.worker.cancel();

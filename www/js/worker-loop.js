@@ -11,8 +11,10 @@
 //                                          when, and may terminate the worker when it went stale);
 //   {type: 'progress', gen, ...}           what the job reports while it runs (`progress` below);
 //   {type: 'result', gen, ms, ...}         the job's result (ms: its time in the worker);
-//   {type: 'error', gen, message}          the job failed (also when the module did not load).
-// A job dropped at a pause (superseded or cancelled) sends nothing more.
+//   {type: 'error', gen, message}          the job failed (also when the module did not load);
+//   {type: 'dropped', gen}                 the job was dropped at a pause (superseded or
+//                                          cancelled): the worker is free (issue 24: the page
+//                                          terminates a worker whose stale job does not pause).
 
 import init from '../pkg/scatterloc.js';
 import { errorText } from './dom.js';
@@ -51,7 +53,8 @@ export function serveLatest(compute) {
       const { value, transfer = [] } = await compute(m, { progress, pause });
       self.postMessage({ type: 'result', gen, ms: performance.now() - t0, ...value }, transfer);
     } catch (err) {
-      if (err !== SUPERSEDED) self.postMessage({ type: 'error', gen, message: errorText(err) });
+      if (err === SUPERSEDED) self.postMessage({ type: 'dropped', gen });
+      else self.postMessage({ type: 'error', gen, message: errorText(err) });
     }
   }
 

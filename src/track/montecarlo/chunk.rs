@@ -6,7 +6,7 @@ use alloc::vec;
 use alloc::vec::Vec;
 
 use super::{MonteCarloConfig, PartialSums, CHUNK_TRAJECTORIES};
-use crate::error::Result;
+use crate::error::{check_every, Cancel, Error, Result};
 use crate::math::{Mat2, Real, Vec2, Vec4, SPEED_OF_LIGHT};
 use crate::measure::{rng, standard_normal, Rng};
 use crate::measure::{sigma_delay_from_snr, Model};
@@ -14,7 +14,7 @@ use crate::track::TruthSampler;
 use crate::track::{
     range_information_per_snr, spd_quadratic_form, update_lanes, Ekf, MeasurementNoise, NodeView,
 };
-use crate::track::{Filter, FilterKind, Tracker};
+use crate::track::{step_ns, Filter, FilterKind, Tracker};
 
 /// Salt of the particle filters' own streams (particles, resampling), apart from the
 /// measurement-noise streams, so every filter of a study sees the same measurements.
@@ -128,6 +128,18 @@ const LANES: usize = 4;
 /// Runs chunk `chunk` (trajectories `chunk·16 …`) of the study and returns its sums.
 /// Trajectory `i` uses stream `rng(seed, 2i)`; its noise run `j` uses `rng(seed, 2(i·N_noise + j) + 1)`.
 pub fn run_chunk(model: &Model, cfg: &MonteCarloConfig, chunk: usize) -> Result<PartialSums> {
+    run_chunk_in(model, cfg, chunk, Cancel::NEVER)
+}
+
+/// [`run_chunk`] that asks `cancel` every millisecond or so of work, inside a run too
+/// ([`check_every`] steps of [`step_ns`]), and stops with [`Error::Cancelled`] (issue 24).
+pub fn run_chunk_in(
+    model: &Model,
+    cfg: &MonteCarloConfig,
+    chunk: usize,
+    cancel: Cancel,
+) -> Result<PartialSums> {
+    let every = check_every(LANES as Real * step_ns(FilterKind::Ekf, model.link_count()));
     let steps = cfg.steps;
     let sampler = TruthSampler::new(cfg.motion, cfg.mean_state, &cfg.initial_covariance)?;
     // Validated once here; every run starts from a copy.
@@ -142,13 +154,15 @@ pub fn run_chunk(model: &Model, cfg: &MonteCarloConfig, chunk: usize) -> Result<
             let streams: [u64; LANES] = core::array::from_fn(|j| {
                 2 * (traj as u64 * cfg.noise_runs as u64 + (first + j) as u64) + 1
             });
-            let ok = match start {
-                Ok(ekf) => run_filters(model, cfg, ekf, &mut s, &streams[..count]),
-                Err(_) => [false; LANES],
+            let ok = match &start {
+                Ok(ekf) => run_filters(model, cfg, *ekf, &mut s, &streams[..count], cancel, every)?,
+                Err(e) => core::array::from_fn(|_| Err(e.clone())),
             };
             // Add the runs in run order (the reduction order does not depend on LANES).
-            for (j, &ok) in ok.iter().enumerate().take(count) {
-                if ok {
+            for (j, ok) in ok.into_iter().enumerate().take(count) {
+                if let Err(e) = ok {
+                    sums.fail(e);
+                } else {
                     let lane = j * (steps + 1)..(j + 1) * (steps + 1);
                     for ((a, e), (b, v)) in sums
                         .squared_error
@@ -160,8 +174,6 @@ pub fn run_chunk(model: &Model, cfg: &MonteCarloConfig, chunk: usize) -> Result<
                         *b += v;
                     }
                     sums.runs += 1;
-                } else {
-                    sums.failed_runs += 1;
                 }
             }
             first += count;
@@ -181,9 +193,23 @@ pub fn run_filter_chunk(
     filter: FilterKind,
     chunk: usize,
 ) -> Result<PartialSums> {
+    run_filter_chunk_in(model, cfg, filter, chunk, Cancel::NEVER)
+}
+
+/// [`run_filter_chunk`] that asks `cancel` every millisecond or so of work, inside a run too
+/// ([`check_every`] steps of [`step_ns`]: every step of a particle filter with 10⁶ particles),
+/// and stops with [`Error::Cancelled`] (issue 24). Results equal [`run_filter_chunk`]'s.
+pub fn run_filter_chunk_in(
+    model: &Model,
+    cfg: &MonteCarloConfig,
+    filter: FilterKind,
+    chunk: usize,
+    cancel: Cancel,
+) -> Result<PartialSums> {
     if filter == FilterKind::Ekf {
-        return run_chunk(model, cfg, chunk);
+        return run_chunk_in(model, cfg, chunk, cancel);
     }
+    let every = check_every(step_ns(filter, model.link_count()));
     let steps = cfg.steps;
     let sampler = TruthSampler::new(cfg.motion, cfg.mean_state, &cfg.initial_covariance)?;
     // Validated once (bad settings fail the study; a bad prior fails every run, as for the EKF).
@@ -194,7 +220,9 @@ pub fn run_filter_chunk(
         prepare_trajectory(model, cfg, &sampler, traj, &mut s, &mut sums);
         for j in 0..cfg.noise_runs {
             let stream = 2 * (traj as u64 * cfg.noise_runs as u64 + j as u64) + 1;
-            if run_other_filter(model, cfg, filter, &mut s, stream) {
+            if let Err(e) = run_other_filter(model, cfg, filter, &mut s, stream, cancel, every)? {
+                sums.fail(e);
+            } else {
                 for ((a, e), (b, v)) in sums
                     .squared_error
                     .iter_mut()
@@ -205,33 +233,41 @@ pub fn run_filter_chunk(
                     *b += v;
                 }
                 sums.runs += 1;
-            } else {
-                sums.failed_runs += 1;
             }
         }
     }
     Ok(sums)
 }
 
+/// A filter's outcome on one run: `Ok` counted, `Err` its failure (the run is excluded).
+type RunOutcome = core::result::Result<(), Error>;
+
 /// A filter (the UKF or the particle filter; the EKF's studies take [`run_chunk`]'s lanes) over the prepared truth with the measurements of noise stream
-/// `stream`; fills lane 0 of `s.squared_error` and `s.nees`; `false` if the filter failed.
+/// `stream`; fills lane 0 of `s.squared_error` and `s.nees`; the inner error if the filter
+/// failed; [`Error::Cancelled`] when `cancel` asks (checked every `every` steps).
 fn run_other_filter(
     model: &Model,
     cfg: &MonteCarloConfig,
     filter: FilterKind,
     s: &mut Scratch,
     stream: u64,
-) -> bool {
+    cancel: Cancel,
+    every: usize,
+) -> Result<RunOutcome> {
     let links = model.link_count();
     let steps = s.truth.len();
     let mut noise_rng = rng(cfg.seed, stream);
     let own = rng(cfg.seed ^ PF_STREAM_SALT, stream);
-    let Ok(mut f) = Tracker::new(filter, cfg.mean_state, cfg.initial_covariance, own) else {
-        return false;
+    let mut f = match Tracker::new(filter, cfg.mean_state, cfg.initial_covariance, own) {
+        Ok(f) => f,
+        Err(e) => return Ok(Err(e)),
     };
     let (truth, table) = (&s.truth[..steps], &s.table[..links * steps]);
     let z = &mut s.measurement[..links];
     for n in 0..steps {
+        if n % every == 0 {
+            cancel.check()?;
+        }
         let x = &truth[n];
         if n > 0 {
             let row = &table[n * links..(n + 1) * links];
@@ -243,18 +279,25 @@ fn run_other_filter(
             } else {
                 MeasurementNoise::AtPrediction
             };
-            if f.step(&cfg.motion, model, z, noise).is_err() {
-                return false;
+            if let Err(e) = f.step(&cfg.motion, model, z, noise) {
+                return Ok(Err(e));
             }
         }
         let e = f.state() - x;
         s.squared_error[n] = e[0] * e[0] + e[1] * e[1];
         match spd_quadratic_form(f.covariance(), &e) {
             Some(v) => s.nees[n] = v,
-            None => return false,
+            None => return Ok(Err(not_pd_nees(f.name()))),
         }
     }
-    true
+    Ok(Ok(()))
+}
+
+/// The failure of a run whose covariance stopped being positive definite (its NEES).
+fn not_pd_nees(filter: &str) -> Error {
+    Error::NotPositiveDefinite {
+        field: alloc::format!("{filter}.covariance"),
+    }
 }
 
 /// The truth half of [`run_chunk`] alone: the same trajectories (same streams) and their Fisher
@@ -272,15 +315,17 @@ pub fn run_truth_chunk(model: &Model, cfg: &MonteCarloConfig, chunk: usize) -> R
 
 /// EKF runs from `start` over the prepared truth, one per stream in `streams` (at most
 /// [`LANES`]), advanced together step by step (one [`update_lanes`] call updates all of them).
-/// Fills lane `j`'s `s.squared_error` and `s.nees`; `false` for a run whose filter failed
-/// numerically.
+/// Fills lane `j`'s `s.squared_error` and `s.nees`; lane `j`'s error for a run whose filter
+/// failed numerically; [`Error::Cancelled`] when `cancel` asks (checked every `every` steps).
 fn run_filters(
     model: &Model,
     cfg: &MonteCarloConfig,
     start: Ekf,
     s: &mut Scratch,
     streams: &[u64],
-) -> [bool; LANES] {
+    cancel: Cancel,
+    every: usize,
+) -> Result<[RunOutcome; LANES]> {
     let links = model.link_count();
     let steps = s.truth.len();
     let count = streams.len().min(LANES);
@@ -288,9 +333,13 @@ fn run_filters(
     let mut rngs: [Rng; LANES] =
         core::array::from_fn(|j| rng(cfg.seed, streams.get(j).copied().unwrap_or(0)));
     let mut alive: [bool; LANES] = core::array::from_fn(|j| j < count);
+    let mut outcome: [RunOutcome; LANES] = core::array::from_fn(|_| Ok(()));
     let (truth, table) = (&s.truth[..steps], &s.table[..links * steps]);
     let measurement = &mut s.measurement[..LANES * links];
     for n in 0..steps {
+        if n % every == 0 {
+            cancel.check()?;
+        }
         let x = &truth[n];
         if n > 0 {
             let row = &table[n * links..(n + 1) * links];
@@ -310,8 +359,11 @@ fn run_filters(
             let zs: [&[Option<Real>]; LANES] =
                 core::array::from_fn(|j| &measurement[j * links..(j + 1) * links]);
             let done = update_lanes(&mut ekf, model, zs, alive, noise, |_, _, _| {});
-            for (a, d) in alive.iter_mut().zip(&done) {
-                *a &= d.is_ok();
+            for ((a, d), o) in alive.iter_mut().zip(done).zip(&mut outcome) {
+                if let (true, Err(e)) = (*a, d) {
+                    *a = false;
+                    *o = Err(e);
+                }
             }
         }
         for j in 0..LANES {
@@ -321,10 +373,13 @@ fn run_filters(
                 s.squared_error[k] = e[0] * e[0] + e[1] * e[1];
                 match spd_quadratic_form(&ekf[j].covariance, &e) {
                     Some(v) => s.nees[k] = v,
-                    None => alive[j] = false,
+                    None => {
+                        alive[j] = false;
+                        outcome[j] = Err(not_pd_nees("ekf"));
+                    }
                 }
             }
         }
     }
-    alive
+    Ok(outcome)
 }

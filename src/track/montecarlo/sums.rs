@@ -6,6 +6,7 @@ use alloc::vec::Vec;
 
 use serde::{Deserialize, Serialize};
 
+use crate::error::Error;
 use crate::math::{ExactSum, Mat2, Real};
 
 /// Per-step sums of the runs of one chunk, added in run order (plain `f64`: the order inside a
@@ -25,6 +26,9 @@ pub struct PartialSums {
     pub failed_runs: usize,
     /// Trajectories counted.
     pub trajectories: usize,
+    /// The error of the chunk's first failed run (issue 24: the cause a study reports when
+    /// every run of a filter fails); not part of the sums.
+    pub first_failure: Option<Error>,
 }
 
 impl PartialSums {
@@ -37,6 +41,15 @@ impl PartialSums {
             runs: 0,
             failed_runs: 0,
             trajectories: 0,
+            first_failure: None,
+        }
+    }
+
+    /// Counts a failed run with its error (the first one is kept).
+    pub fn fail(&mut self, e: Error) {
+        self.failed_runs += 1;
+        if self.first_failure.is_none() {
+            self.first_failure = Some(e);
         }
     }
 }

@@ -61,7 +61,7 @@ pub struct FilterSettings {
     /// Roughening constant c of the particle filter, 0..=10 [default: off].
     #[arg(long, value_name = "C", value_parser = finite)]
     pub roughening: Option<f64>,
-    /// UKF sigma-point spread alpha, 0 < alpha <= 10 [default: 1].
+    /// UKF sigma-point spread alpha, 1e-4 <= alpha <= 1 (Wan & van der Merwe) [default: 1].
     #[arg(long, value_name = "A", value_parser = finite)]
     pub ukf_alpha: Option<f64>,
     /// UKF beta, 0..=10 [default: 2].

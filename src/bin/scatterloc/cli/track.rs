@@ -43,6 +43,10 @@ pub struct TrackArgs {
     pub seed: Option<u64>,
     #[command(flatten)]
     pub settings: FilterSettings,
+    /// Refuse work predicted to take more than H CPU-hours [default: 24] (issue 24; the
+    /// prediction and its calibration: docs/benchmarks.md "Cost model"); > 0.
+    #[arg(long, value_name = "H", value_parser = finite)]
+    pub max_cpu_hours: Option<f64>,
 }
 
 /// `scatterloc calibrate`.

@@ -18,7 +18,8 @@ use super::filters::filter_kinds;
 use super::report::Outputs;
 use super::shard;
 use super::study::{
-    flag_error, parse_study, run_filters_with_progress, run_pcrlb_with_progress, threads,
+    check_study_cost, flag_error, parse_study, report_failures, run_filters_with_progress,
+    run_pcrlb_with_progress, threads,
 };
 use crate::cli::{FilterName, MontecarloArgs, PcrlbArgs};
 use crate::failure::CliError;
@@ -57,7 +58,13 @@ pub fn montecarlo(args: &MontecarloArgs) -> Result<(), CliError> {
     let kinds = filter_kinds(&names, &args.settings, "--filters")?;
     let study = MonteCarloStudy::new(track, runs, noise_runs, seed, args.oracle_noise, &kinds)
         .map_err(flag_error)?;
-    if let Some(shard) = shard::resolve(&args.shard)? {
+    let shard = shard::resolve(&args.shard)?;
+    let chunks = match shard {
+        Some(s) => s.range(study.chunk_count()),
+        None => 0..study.chunk_count(),
+    };
+    let predicted = check_study_cost(&study, &chunks, used, args.max_cpu_hours)?;
+    if let Some(shard) = shard {
         let path = shard::part_path(args.json.as_deref(), args.out.as_deref())?;
         return run_shard(&study, shard, (threads, used), &path);
     }
@@ -65,7 +72,7 @@ pub fn montecarlo(args: &MontecarloArgs) -> Result<(), CliError> {
 
     let mut docs = Vec::new();
     for (k, t) in study.track.trajectories.iter().enumerate() {
-        let label = format!("scenario {:>3}", t.name());
+        let label = format!("scenario {:>3}{}", t.name(), predicted);
         let mut runs = study.filter_study(k).map_err(flag_error)?;
         let all = 0..study.chunk_count();
         let wall = run_filters_with_progress(&study.track.model, &mut runs, all, threads, &label)?;
@@ -74,7 +81,10 @@ pub fn montecarlo(args: &MontecarloArgs) -> Result<(), CliError> {
             thread_s: wall * used as f64,
             threads: used,
         };
-        docs.push(study.doc(k, &runs.results().map_err(flag_error)?, time));
+        let results = runs.results().map_err(flag_error)?;
+        let mut doc = study.doc(k, &results, time);
+        report_failures(&format!("scenario {}", t.name()), &results, &mut doc);
+        docs.push(doc);
     }
     outputs.finish(&study.track, &docs, &chart_options(&study))
 }
@@ -138,7 +148,11 @@ pub fn merge_parts(set: &PartSet, json: &str, out: Option<&str>) -> Result<(), C
     let outputs = Outputs::parse(out, Some(json))?;
     let mut docs = Vec::new();
     for (k, (run, time)) in runs.iter().zip(times).enumerate() {
-        docs.push(study.doc(k, &run.results().map_err(flag_error)?, time));
+        let results = run.results().map_err(flag_error)?;
+        let mut doc = study.doc(k, &results, time);
+        let name = study.track.trajectories[k].name();
+        report_failures(&format!("scenario {name}"), &results, &mut doc);
+        docs.push(doc);
     }
     outputs.finish(&study.track, &docs, &chart_options(&study))
 }

@@ -10,7 +10,10 @@ use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
 
 use scatterloc::native::{run_pcrlb_parallel, Parallel};
-use scatterloc::study::{FilterStudy, TrackStudy as Study};
+use scatterloc::study::{
+    check_cost, CurveDoc, FilterResults, FilterStudy, McMeta, MonteCarloStudy, TrackStudy as Study,
+    MAX_CPU_S,
+};
 use scatterloc::track::ConstantVelocity;
 use scatterloc::track::{
     step_count, TrackScenario, PAPER_DURATION_S, PAPER_INTENSITY, PAPER_STEP_S,
@@ -131,6 +134,101 @@ pub fn checked_steps(duration: f64, dt: f64) -> Result<usize, CliError> {
         )));
     }
     Ok(steps)
+}
+
+/// The predicted CPU time of `chunks` of every trajectory of `study` (issue 24,
+/// [`FilterStudy::predicted_cpu_s`]) checked against [`MAX_CPU_S`] unless `allow_long`: over it
+/// is a usage error (exit status 2) with the predicted time and the flags to change. Returns a
+/// note for the progress bar (` · predicted ≈ … on N threads`).
+pub fn check_study_cost(
+    study: &MonteCarloStudy,
+    chunks: &std::ops::Range<usize>,
+    threads: usize,
+    max_cpu_hours: Option<f64>,
+) -> Result<String, CliError> {
+    let links = study.track.model.link_count();
+    let mut cpu_s = 0.0;
+    for k in 0..study.track.trajectories.len() {
+        cpu_s += study
+            .filter_study(k)
+            .map_err(flag_error)?
+            .predicted_cpu_s(links, chunks);
+    }
+    let wall = cpu_s / threads.max(1) as f64;
+    cost_refused(
+        "montecarlo",
+        cpu_s,
+        threads,
+        max_cpu_hours,
+        "--runs, --noise-runs, --duration (or a larger --dt), --particles, fewer --filters or a \
+         scenario with fewer links, or split it with --shard",
+    )?;
+    Ok(format!(
+        " · predicted ≈ {} on {threads} threads",
+        duration_text(wall)
+    ))
+}
+
+/// [`check_cost`] of `cpu_s` against `--max-cpu-hours` (default [`MAX_CPU_S`]), as a usage
+/// error of command `what` with the predicted time, naming the flags `change` and
+/// `--max-cpu-hours`.
+pub fn cost_refused(
+    what: &str,
+    cpu_s: f64,
+    threads: usize,
+    max_cpu_hours: Option<f64>,
+    change: &str,
+) -> Result<(), CliError> {
+    let cap = match max_cpu_hours {
+        None => MAX_CPU_S,
+        Some(h) if h > 0.0 && h <= 1e6 => h * 3600.0,
+        Some(h) => {
+            return Err(CliError::usage(format!(
+                "--max-cpu-hours: {h} is outside the allowed range 0 < H <= 1e6"
+            )))
+        }
+    };
+    check_cost(what, cpu_s, cap).map_err(|_| {
+        CliError::usage(format!(
+            "{what}: the work is predicted to take {} of CPU time (≈ {} on {threads} threads), \
+             over the cap of {} (--max-cpu-hours {}); lower {change}, or raise --max-cpu-hours \
+             to run it anyway (the cost model: docs/benchmarks.md \"Cost model\")",
+            duration_text(cpu_s),
+            duration_text(cpu_s / threads.max(1) as f64),
+            duration_text(cap),
+            cap / 3600.0,
+        ))
+    })
+}
+
+/// A duration in words: `12 s`, `3.4 min`, `5.6 h`, `7.8 days`.
+pub fn duration_text(s: f64) -> String {
+    if s < 60.0 {
+        format!("{s:.0} s")
+    } else if s < 3600.0 {
+        format!("{:.1} min", s / 60.0)
+    } else if s < 86_400.0 * 2.0 {
+        format!("{:.1} h", s / 3600.0)
+    } else {
+        format!("{:.1} days", s / 86_400.0)
+    }
+}
+
+/// Issue 24: a filter whose every run failed is reported on its own — a warning on stderr
+/// naming its flag and first failure (the study's other filters keep their results and the exit
+/// status stays 0), and the flag in place of the core field in the document's `error`.
+pub fn report_failures(label: &str, results: &FilterResults, doc: &mut CurveDoc<McMeta>) {
+    for (_, e) in &results.failed {
+        let text = with_flag(e).unwrap_or_else(|| e.to_string());
+        eprintln!("warning: {label}: {text}; its curve is left out");
+        if let (Some(field), Some(filters)) = (e.field(), doc.meta.filters.as_mut()) {
+            for (_, f) in filters.0.iter_mut() {
+                if let (Some(msg), Some(flag)) = (f.error.as_mut(), super::flags::flag_of(field)) {
+                    *msg = msg.replacen(field, flag, 1);
+                }
+            }
+        }
+    }
 }
 
 /// Whether Ctrl-C was pressed (after a run of [`run_with_bar`], e.g. while a figure is drawn).

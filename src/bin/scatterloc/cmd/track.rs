@@ -8,14 +8,16 @@
 //! association then use that filter's predicted delays and innovation σ (its sigma points, its
 //! weighted particles).
 
+use scatterloc::error::Cancel;
 use scatterloc::formats::{Measurements, Steps};
-use scatterloc::study::{track_measurements, TrackRequest};
+use scatterloc::study::{track_cpu_s, track_measurements_in, TrackRequest};
 use scatterloc::track::gating::AssociationRule;
 
 use super::filters::filter_kinds;
 use super::gating::read_calibration;
 use super::io::{emit, model_of, read_json_file, read_scenario};
 use super::output::{check_writable, Format};
+use super::study::{cost_refused, run_with_bar};
 use super::track_fig::{read_truth, write_track_figure, TrackSeries};
 use crate::cli::{Association, FilterName, TrackArgs};
 use crate::failure::CliError;
@@ -63,7 +65,20 @@ pub fn track(args: &TrackArgs) -> Result<(), CliError> {
             "--calibration/--association: apply to raw_steps only (this file has steps)",
         ));
     }
-    let out = track_measurements(&TrackRequest {
+    let steps = match m.steps() {
+        Ok(Steps::Plain(s)) => s.len(),
+        Ok(Steps::Raw(r)) => r.len(),
+        Err(_) => 0, // reported by the track itself
+    };
+    cost_refused(
+        "track",
+        track_cpu_s(kind, n, steps),
+        1,
+        args.max_cpu_hours,
+        "the steps of --measurements, --particles, or use --filter ekf or a scenario with fewer \
+         links",
+    )?;
+    let req = TrackRequest {
         model: &model,
         area: &scenario.area_m,
         measurements: &m,
@@ -72,8 +87,13 @@ pub fn track(args: &TrackArgs) -> Result<(), CliError> {
         filter: kind,
         // The particle filter draws its particles from stream 0 of `--seed`.
         seed: args.seed.unwrap_or(1),
-    })
-    .map_err(|e| bad(&e))?;
+    };
+    // Ctrl-C stops the track within milliseconds (issue 24): exit status 130, nothing written.
+    let (res, _) = run_with_bar(steps, "steps", "track", |cancel, _| {
+        let stop = || cancel.load(std::sync::atomic::Ordering::Relaxed);
+        track_measurements_in(&req, Cancel::when(&stop))
+    })?;
+    let out = res.map_err(|e| bad(&e))?;
     if let Some((path, format)) = figure {
         let truth = match args.truth.as_deref() {
             Some(t) => Some(read_truth(t, &out.t_s)?),
