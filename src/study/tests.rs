@@ -422,6 +422,15 @@ fn predicted_cost_is_runs_times_steps_times_the_step_cost() {
     let ukf = FilterKind::Ukf(UkfParams::default());
     assert!((15.0e9..17.5e9).contains(&step_ns(ukf, 4096)));
     assert!((0.2e9..0.3e9).contains(&step_ns(ukf, 1024)));
+    // The page (issue 24): a UKF or PF track on a 64 × 64 mesh is refused on its main thread
+    // from the first step; its default tracks on sensors2019 (100 steps; the PF 1000
+    // particles) are not.
+    let pf1000 = FilterKind::Pf(pf);
+    assert!(track_cpu_s(ukf, 4096, 1) > PAGE_TRACK_CPU_S);
+    assert!(track_cpu_s(pf1000, 4096, 1) > PAGE_TRACK_CPU_S);
+    for kind in [FilterKind::Ekf, ukf, pf1000] {
+        assert!(track_cpu_s(kind, links, 100) < 0.01 * PAGE_TRACK_CPU_S);
+    }
     // The cap: a named error with both times.
     let e = check_cost("runs", 90_000.0, MAX_CPU_S).unwrap_err();
     assert_eq!(e.field(), Some("runs"));
