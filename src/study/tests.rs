@@ -663,3 +663,155 @@ fn impossible_roc_tallies_are_named_errors() {
         assert!(got.contains(&want), "want {want:?} in\n{got}");
     }
 }
+
+// Issue 24, "Long work".
+
+/// A driver whose jobs' [`crate::error::Cancel`] asks to stop after `after` questions: the
+/// in-run check of the chunk loop (not only the driver's between jobs) ends the study.
+struct StopAfter {
+    after: usize,
+    asked: core::sync::atomic::AtomicUsize,
+}
+
+impl Driver for StopAfter {
+    fn run<T: Send>(
+        &mut self,
+        jobs: usize,
+        _batch: usize,
+        job: &(dyn Fn(usize, crate::error::Cancel) -> crate::Result<T> + Sync),
+        merge: &mut dyn FnMut(T),
+        progress: &mut dyn FnMut(usize),
+    ) -> crate::Result<()> {
+        use core::sync::atomic::Ordering;
+        let stop = || self.asked.fetch_add(1, Ordering::Relaxed) >= self.after;
+        for i in 0..jobs {
+            merge(job(i, crate::error::Cancel::when(&stop))?);
+            progress(i + 1);
+        }
+        Ok(())
+    }
+}
+
+#[test]
+fn a_run_is_cancelled_inside_its_steps() {
+    use core::sync::atomic::{AtomicUsize, Ordering};
+    // One chunk of one run of a particle filter: 200 steps of 20 000 particles, ≈ 1.2 ms per
+    // step predicted (step_ns), so every step asks (check_every = 1).
+    let pf = FilterKind::Pf(PfConfig {
+        particles: 20_000,
+        roughening: None,
+    });
+    let links = model().link_count();
+    assert_eq!(
+        crate::error::check_every(crate::track::step_ns(pf, links)),
+        1
+    );
+    let cfg = config(1, 1, 200, 3);
+    let mut s = FilterStudy::new(cfg, &[pf]).unwrap();
+    let mut driver = StopAfter {
+        after: 3,
+        asked: AtomicUsize::new(0),
+    };
+    let e = s
+        .run_range(&model(), 0..1, &mut driver, &mut |_, _| {})
+        .unwrap_err();
+    assert_eq!(e, crate::Error::Cancelled);
+    // Asked at steps 0, 1, 2 (go on) and 3 (stop): inside the one run, 196 steps before its end.
+    assert_eq!(driver.asked.load(Ordering::Relaxed), 4);
+    // The EKF's lanes ask every check_every(4 × step_ns) steps: 1 ms / (4 × 140 ns) = 1785.
+    let ekf_ns = 4.0 * crate::track::step_ns(FilterKind::Ekf, links);
+    assert_eq!(crate::error::check_every(ekf_ns), (1e6 / ekf_ns) as usize);
+    // Never asked to stop: the sums are those of the plain driver, bit for bit.
+    let mut never = StopAfter {
+        after: usize::MAX,
+        asked: AtomicUsize::new(0),
+    };
+    let cfg = config(16, 2, 20, 3);
+    let kinds = [FilterKind::Ekf, FilterKind::Ukf(UkfParams::default())];
+    let (mut a, mut b) = (
+        FilterStudy::new(cfg, &kinds).unwrap(),
+        FilterStudy::new(cfg, &kinds).unwrap(),
+    );
+    a.run_range(&model(), 0..1, &mut never, &mut |_, _| {})
+        .unwrap();
+    b.run_range(&model(), 0..1, &mut Sequential::new(), &mut |_, _| {})
+        .unwrap();
+    assert_eq!(a.sums(), b.sums());
+}
+
+#[test]
+fn a_filter_failing_every_run_keeps_the_others_results() {
+    // One particle: its covariance is zero, so no run has a NEES (every run fails).
+    let pf = FilterKind::Pf(PfConfig {
+        particles: 1,
+        roughening: None,
+    });
+    let cfg = config(16, 1, 5, 1);
+    let mut s = FilterStudy::new(cfg, &[FilterKind::Ekf, pf]).unwrap();
+    s.run_range(&model(), 0..1, &mut Sequential::new(), &mut |_, _| {})
+        .unwrap();
+    let r = s.results().unwrap();
+    assert_eq!(r.curves.len(), 1);
+    assert_eq!(r.curves[0].0, 0, "the EKF's curves are kept");
+    assert_eq!(r.curves[0].1.runs, 16);
+    assert_eq!(r.failed.len(), 1);
+    let (i, e) = &r.failed[0];
+    assert_eq!(*i, 1);
+    assert_eq!(e.field(), Some("particles"));
+    let text = e.to_string();
+    assert!(
+        text.starts_with("particles: every run of the PF failed (16 of 16); the first: "),
+        "{text}"
+    );
+    // The PF alone: no result, the same named error.
+    let mut alone = FilterStudy::new(cfg, &[pf]).unwrap();
+    alone
+        .run_range(&model(), 0..1, &mut Sequential::new(), &mut |_, _| {})
+        .unwrap();
+    assert_eq!(alone.results().unwrap_err().to_string(), text);
+}
+
+#[test]
+fn predicted_cost_is_runs_times_steps_times_the_step_cost() {
+    use crate::track::step_ns;
+    let links = model().link_count();
+    let pf = PfConfig {
+        particles: 1000,
+        roughening: None,
+    };
+    let cfg = config(40, 3, 50, 1);
+    // The particle filter held to 1 chunk of the 3 (16 × 3 runs × 50 steps × 1000 ≤ 2.4e6).
+    let s =
+        FilterStudy::with_particle_budget(cfg, &[FilterKind::Ekf, FilterKind::Pf(pf)], 2_400_000)
+            .unwrap();
+    let ekf = 120.0 * 50.0 * step_ns(FilterKind::Ekf, links) * 1e-9;
+    let pf_s = 48.0 * 50.0 * step_ns(FilterKind::Pf(pf), links) * 1e-9;
+    let got = s.predicted_cpu_s(links, &(0..3));
+    assert!((got - (ekf + pf_s)).abs() <= 1e-12 * got, "{got}");
+    // A shard's chunks only: chunk 2 holds 8 trajectories, and no PF chunk.
+    let shard = s.predicted_cpu_s(links, &(2..3));
+    assert!((shard - 24.0 * 50.0 * step_ns(FilterKind::Ekf, links) * 1e-9).abs() <= 1e-15);
+    // The model's large-link terms (docs/benchmarks.md "Cost model"): a 4096-link UKF step
+    // ≈ 16 s (16 s measured in issue 24), a 1024-link one ≈ 0.25 s (measured 0.25 s).
+    let ukf = FilterKind::Ukf(UkfParams::default());
+    assert!((15.0e9..17.5e9).contains(&step_ns(ukf, 4096)));
+    assert!((0.2e9..0.3e9).contains(&step_ns(ukf, 1024)));
+    // The page (issue 24): a UKF or PF track on a 64 × 64 mesh is refused on its main thread
+    // from the first step; its default tracks on sensors2019 (100 steps; the PF 1000
+    // particles) are not.
+    let pf1000 = FilterKind::Pf(pf);
+    assert!(track_cpu_s(ukf, 4096, 1) > PAGE_TRACK_CPU_S);
+    assert!(track_cpu_s(pf1000, 4096, 1) > PAGE_TRACK_CPU_S);
+    for kind in [FilterKind::Ekf, ukf, pf1000] {
+        assert!(track_cpu_s(kind, links, 100) < 0.01 * PAGE_TRACK_CPU_S);
+    }
+    // The cap: a named error with both times.
+    let e = check_cost("runs", 90_000.0, MAX_CPU_S).unwrap_err();
+    assert_eq!(e.field(), Some("runs"));
+    assert!(
+        e.to_string()
+            .contains("90000 s of CPU time, over the cap of 86400 s"),
+        "{e}"
+    );
+    assert!(check_cost("runs", MAX_CPU_S, MAX_CPU_S).is_ok());
+}

@@ -41,4 +41,6 @@ pub use trajectory::{
     paper_initial_covariance, step_count, TrackScenario, TruthSampler, PAPER_DURATION_S,
     PAPER_INTENSITY, PAPER_STEP_S,
 };
-pub use ukf::{Ukf, UkfParams, ALPHA_RANGE as UKF_ALPHA_RANGE};
+pub use ukf::{
+    Ukf, UkfParams, ALPHA_RANGE as UKF_ALPHA_RANGE, MAX_PRIOR_VARIANCE as UKF_MAX_PRIOR_VARIANCE,
+};

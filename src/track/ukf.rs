@@ -83,6 +83,16 @@ pub const ALPHA_RANGE: crate::error::limits::Range = crate::error::limits::Range
     allowed: "1e-4 to 1, Wan & van der Merwe",
 };
 
+/// The largest prior variance (any diagonal entry of `initial_covariance`) the UKF starts from
+/// (issue 24), m² or m²/s²: σ = 100 m, ten times the areas of this project's scenarios. The
+/// sigma points lie `√((n + λ) P)` off the mean, and from a wider prior the unscented transform
+/// samples the delays far outside the network: on the sensors2019 track of `tests/cli/filters.rs`
+/// (20 steps, cσ ≈ 1 cm) the UKF came within 1 cm of the EKF after 10 steps from diag(10⁴), but
+/// was 1 km off after 2 steps and still 0.5 m off after 20 from diag(10⁶), and from diag(10¹¹)
+/// its innovation covariance lost `R` to rounding (`ukf.innovation_covariance` in every step).
+/// The EKF, whose update switches to the information form for wide priors, takes up to 10¹².
+pub const MAX_PRIOR_VARIANCE: Real = 1e4;
+
 impl UkfParams {
     /// Checks the ranges (errors name `ukf_alpha`, `ukf_beta`, `ukf_kappa`).
     pub fn validate(&self) -> Result<()> {
@@ -135,10 +145,22 @@ pub struct Ukf {
 }
 
 impl Ukf {
-    /// A filter at `state` with covariance `covariance` (validated as for the EKF) and `params`.
+    /// A filter at `state` with covariance `covariance` (validated as for the EKF, and each
+    /// variance at most [`MAX_PRIOR_VARIANCE`]: [`Error::OutOfRange`]
+    /// `initial_covariance[i][i]`) and `params`.
     pub fn new(state: Vec4, covariance: Mat4, params: UkfParams) -> Result<Ukf> {
         check_state(&state)?;
         check_covariance("initial_covariance", &covariance)?;
+        for i in 0..N {
+            let v = covariance[(i, i)];
+            if v > MAX_PRIOR_VARIANCE {
+                return Err(Error::OutOfRange {
+                    field: alloc::format!("initial_covariance[{i}][{i}]"),
+                    value: v,
+                    allowed: "at most 1e4 for the UKF; the EKF takes up to 1e12",
+                });
+            }
+        }
         params.validate()?;
         Ok(Ukf {
             state,

@@ -434,6 +434,18 @@ pub(super) struct MonteCarloJs<'a> {
     filters: Vec<FilterCurvesJs<'a>>,
     particles: Option<usize>,
     particle_budget: Option<usize>,
+    /// Only when a filter failed in every run (issue 24): `[{name, failed_runs, error}]`.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    failed_filters: Vec<FailedFilterJs>,
+}
+
+/// A filter of a [`MonteCarloJs`] whose every run failed: its name, failed runs and the error
+/// naming the setting to change and the first failure.
+#[derive(Serialize)]
+pub(super) struct FailedFilterJs {
+    pub(super) name: &'static str,
+    pub(super) failed_runs: usize,
+    pub(super) error: alloc::string::String,
 }
 
 /// One tracker's curves in a [`MonteCarloJs`]: `{rmse_m, nees, runs, failed_runs, chunks_done,
@@ -488,7 +500,14 @@ impl<'a> MonteCarloJs<'a> {
             filters,
             particles,
             particle_budget,
+            failed_filters: Vec::new(),
         }
+    }
+
+    /// With the filters whose every run failed.
+    pub(super) fn with_failed(mut self, failed: Vec<FailedFilterJs>) -> MonteCarloJs<'a> {
+        self.failed_filters = failed;
+        self
     }
 }
 

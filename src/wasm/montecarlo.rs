@@ -11,7 +11,7 @@ use wasm_bindgen::prelude::*;
 use super::err;
 use alloc::vec::Vec;
 
-use super::json::{to_json, FilterCurvesJs, MonteCarloJs};
+use super::json::{to_json, FailedFilterJs, FilterCurvesJs, MonteCarloJs};
 use super::tracking::{checked_steps, page_filter, prior_and_motion};
 use crate::study::{check_cost, FilterStudy, PAGE_STUDY_CPU_S};
 use crate::track::{paper_initial_covariance, FilterKind, MonteCarloConfig};
@@ -178,15 +178,27 @@ impl MonteCarloJob {
                 }
             })
             .collect();
-        to_json(&MonteCarloJs::new(
-            &top,
-            cfg,
-            lead.sums.trajectories,
-            self.study.items_done(),
-            self.study.item_count(),
-            per_filter,
-            self.study.particles(),
-            self.study.particle_budget(),
-        ))
+        let failed = results
+            .failed
+            .iter()
+            .map(|(i, e)| FailedFilterJs {
+                name: filters[*i].kind.name(),
+                failed_runs: filters[*i].sums.failed_runs,
+                error: alloc::string::ToString::to_string(e),
+            })
+            .collect();
+        to_json(
+            &MonteCarloJs::new(
+                &top,
+                cfg,
+                lead.sums.trajectories,
+                self.study.items_done(),
+                self.study.item_count(),
+                per_filter,
+                self.study.particles(),
+                self.study.particle_budget(),
+            )
+            .with_failed(failed),
+        )
     }
 }

@@ -155,11 +155,13 @@ export class MonteCarlo {
 
 /**
  * The failed-run counts of a result, shown wherever the RMSE is (even when 0): "0 failed runs",
- * "EKF 0, PF 3 failed runs (excluded from the RMSE)".
+ * "EKF 0, PF 3 failed runs (excluded from the RMSE)"; a filter that failed in every run
+ * (`failed_filters`, issue 24) adds its error, e.g. " · PF: particles: every run of the PF failed …".
  */
 function failedRuns(r) {
   const f = Object.entries(r.filters || { ekf: r });
   const total = f.reduce((a, [, c]) => a + c.failed_runs, 0);
   const counts = f.length === 1 ? String(total) : f.map(([name, c]) => `${name.toUpperCase()} ${c.failed_runs}`).join(', ');
-  return `${counts} failed run${total === 1 && f.length === 1 ? '' : 's'}${total ? ' (excluded from the RMSE)' : ''}`;
+  const all = (r.failed_filters || []).map((x) => ` · ${x.name.toUpperCase()}: ${x.error}`).join('');
+  return `${counts} failed run${total === 1 && f.length === 1 ? '' : 's'}${total ? ' (excluded from the RMSE)' : ''}${all}`;
 }
