@@ -722,7 +722,10 @@ fn url_options_bad_ones_are_named_and_the_rest_applies() {
         if want.is_empty() {
             assert_eq!(b, "", "{hash}: no banner");
         } else {
-            assert!(b.starts_with(want.as_str()), "{hash}: banner {b:?}, want {want:?}");
+            assert!(
+                b.starts_with(want.as_str()),
+                "{hash}: banner {b:?}, want {want:?}"
+            );
         }
         assert!(!b.contains("Internal error"), "{hash}: {b:?}");
         assert_eq!(&r[1], applied, "{hash}: the rest of the link applies");
@@ -815,7 +818,10 @@ fn copy_link_reads_back_or_offers_the_scenario_file() {
     let per = compact_len(&wide_scenario(2, "x")) - compact_len(&wide_scenario(1, "x"));
     let base = compact_len(&wide_scenario(1, "x")) - per;
     let (n_under, n_over) = ((CAP * 9 / 10 - base) / per, (CAP * 11 / 10 - base) / per);
-    assert!(n_over <= 4096, "{n_over} transmitters (the link cap is 4096)");
+    assert!(
+        n_over <= 4096,
+        "{n_over} transmitters (the link cap is 4096)"
+    );
     let under = wide_scenario(n_under, "under-cap");
     let over = wide_scenario(n_over, "over-cap");
     assert!(compact_len(&under) < CAP && compact_len(&over) > CAP);
@@ -895,9 +901,16 @@ fn copy_link_reads_back_or_offers_the_scenario_file() {
     // Under the cap: a link, shown; it reopens the same scenario with no banner.
     assert_eq!(small[2], false, "the link field is shown: {}", small[0]);
     assert_eq!(small[3], true, "no file offered: {}", small[0]);
-    assert!(small[1].as_str().unwrap_or_default().contains("#mode=snapshot&res=128&"));
+    assert!(small[1]
+        .as_str()
+        .unwrap_or_default()
+        .contains("#mode=snapshot&res=128&"));
     let json = |v: &Value| serde_json::from_str::<Value>(v.as_str().unwrap_or_default()).unwrap();
-    assert_eq!(json(&reopened[0]), json(&small[5]), "the link reopens the scenario");
+    assert_eq!(
+        json(&reopened[0]),
+        json(&small[5]),
+        "the link reopens the scenario"
+    );
     assert_eq!(json(&reopened[0])["name"], "under-cap");
     assert_eq!(reopened[1], "", "no banner");
     assert_eq!(reopened[2], json!([]), "console errors");
@@ -914,7 +927,11 @@ fn copy_link_reads_back_or_offers_the_scenario_file() {
     assert_eq!(large[2], true, "the link field is hidden");
     assert_eq!(large[3], false, "the scenario file is offered");
     assert_eq!(large[4], false, "the bar is shown");
-    assert_eq!(saved, json!(["over-cap.json"]), "the button saves the scenario file");
+    assert_eq!(
+        saved,
+        json!(["over-cap.json"]),
+        "the button saves the scenario file"
+    );
 }
 
 /// Issue 24: a 10 MB node name froze every interaction for 3.5–6 s. The core caps name lengths
