@@ -2,6 +2,7 @@
 //! and the two conversions at the JavaScript edge (a core error to an exception, two numbers
 //! to a checked point).
 
+use alloc::format;
 use alloc::string::{String, ToString};
 use alloc::vec::Vec;
 
@@ -46,6 +47,46 @@ pub(super) fn window([x0, x1, y0, y1]: [f64; 4]) -> Result<Area, Error> {
     };
     a.validate_as(["window.x", "window.y"])?;
     Ok(a)
+}
+
+/// Checks a rectangle `[x_min, x_max, y_min, y_max]` (m) that the page reads from its URL option
+/// `name` (`view`, the map's window, or `roi`, the Plan panel's region) with the core's rule for
+/// areas ([`Area::validate_as`]: finite, within [`limits::COORDINATE_M`], min < max and a span of
+/// at least [`limits::MIN_AREA_SPAN_M`] on both axes), so the page and the core share one
+/// definition (issue 24). Throws the named error (`view.x`, `view.y`, `roi.x`, `roi.y`; another
+/// name is checked as `window.x` / `window.y`).
+#[wasm_bindgen]
+pub fn check_rect(
+    name: &str,
+    x_min: f64,
+    x_max: f64,
+    y_min: f64,
+    y_max: f64,
+) -> Result<(), JsError> {
+    let fields = match name {
+        "view" => ["view.x", "view.y"],
+        "roi" => ["roi.x", "roi.y"],
+        _ => ["window.x", "window.y"],
+    };
+    Area {
+        x: [x_min, x_max],
+        y: [y_min, y_max],
+    }
+    .validate_as(fields)
+    .map_err(err)
+}
+
+/// Checks a point `(x, y)` (m) that the page reads from its URL option `name` (e.g. `target`)
+/// with the core's coordinate range ([`limits::COORDINATE_M`]); throws the named error
+/// (`target.x`, `target.y`) (issue 24).
+#[wasm_bindgen]
+pub fn check_point(name: &str, x: f64, y: f64) -> Result<(), JsError> {
+    limits::COORDINATE_M
+        .check(&format!("{name}.x"), x)
+        .map_err(err)?;
+    limits::COORDINATE_M
+        .check(&format!("{name}.y"), y)
+        .map_err(err)
 }
 
 /// A point from JavaScript numbers, which must be finite (named `x`, `y`).

@@ -46,7 +46,7 @@ fn finished(s: &Value) -> bool {
 
 /// Opens `url` as a fresh page (through about:blank, so a hash-only change reloads too) and
 /// waits for `data-ready` (or fails on `data-error`).
-async fn open_url(c: &Client, url: &str) -> Result<(), String> {
+pub(super) async fn open_url(c: &Client, url: &str) -> Result<(), String> {
     c.goto("about:blank").await.map_err(|e| e.to_string())?;
     c.goto(url).await.map_err(|e| e.to_string())?;
     let body = c
@@ -570,7 +570,7 @@ fn tampered_links_are_named_and_the_default_scenario_stays() {
         ),
         (
             "#roi=5,1,2,3".into(),
-            "URL option roi: [5, 1, 2, 3] is empty",
+            "URL option roi.x: the minimum 5 must be below the maximum 1",
         ),
         (
             "#roi=0,0x1,2,3".into(),

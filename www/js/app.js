@@ -5,7 +5,7 @@
 // from the core; JavaScript routes events and draws. Loaded by main.js.
 
 import init, * as wasm from '../pkg/scatterloc.js';
-import { $, decimal, decimalIn, errorText, showError } from './dom.js';
+import { $, clip, decimal, decimalIn, errorText, showError } from './dom.js';
 import { decodeScenario, viewLink } from './share.js';
 import { registerHooks } from './hooks.js';
 import { View } from './view.js';
@@ -13,7 +13,7 @@ import { MapView } from './map.js';
 import { Panel } from './panel.js';
 import { attachPointer, hitNode } from './interact.js';
 import { attachKeyboard } from './keyboard.js';
-import { Tracking } from './tracking.js';
+import { FILTERS, SEED_RANGE, Tracking } from './tracking.js';
 import { Mtl } from './mtl.js';
 import { Plan } from './plan.js';
 import { FigureExport } from './export.js';
@@ -22,76 +22,110 @@ import { setLinkColors } from './draw.js';
 
 const MODES = ['snapshot', 'tracking', 'mtl'];
 
-/** Most Monte Carlo runs the page offers (its largest choice). */
-const MAX_RUNS = 10000;
-const UINT32 = { min: 0, max: 4294967295, integer: true };
+/**
+ * Every option the page reads from the URL hash (anything else is named in the banner as unknown):
+ * `#preset=iclgnss2019&target=6,4&seed=3&res=256` (snapshot); tracking: `#mode=tracking&track=II
+ * &step=45&play=1&runs=200&ex=100&tseed=1&dt=0.1&speed=1&custom=x0,y0,x1,y1&filter=pf
+ * &particles=1000&filters=ekf,ukf,pf` (the animated filter, the particle count and the Monte
+ * Carlo's filters); multi-target: `#mode=mtl`; a shared view ("Copy link"): `view=x0,x1,y0,y1`
+ * (the map's zoomed window, m), `roi=x0,x1,y0,y1` (the Plan panel's region of interest, m) and
+ * the scenario as `scenario=<base64url of its JSON>` or `z=<base64url of its raw-deflated JSON>`
+ * (share.js; a scenario replaces the preset).
+ */
+const KNOWN = ['mode', 'preset', 'res', 'target', 'seed', 'view', 'roi', 'scenario', 'z', 'track', 'step',
+  'play', 'runs', 'ex', 'tseed', 'dt', 'speed', 'filter', 'particles', 'filters', 'custom'];
 
 /**
- * `#preset=iclgnss2019&target=6,4&seed=3&res=256` -> options; tracking: `#mode=tracking&track=II&step=45
- * &play=1&runs=200&ex=100&tseed=1&dt=0.1&speed=1&custom=x0,y0,x1,y1&filter=pf&particles=1000
- * &filters=ekf,ukf,pf` (the animated filter, the particle count and the Monte Carlo's filters);
- * multi-target: `#mode=mtl`;
- * a shared view ("Copy link"): `view=x0,x1,y0,y1` (the map's zoomed window, m), `roi=x0,x1,y0,y1`
- * (the Plan panel's region of interest, m) and
- * the scenario as `scenario=<base64url of its JSON>` or `z=<base64url of its raw-deflated JSON>`
- * (share.js; a scenario replaces the preset). Every number is parsed strictly (dom.js
- * `decimal`); a bad option is left at its default and reported in `errors` (naming the option,
- * the value given and what is allowed); the scenario and the ROI are judged in start().
+ * The URL hash -> {opts, errors}. Every option is parsed strictly with the panel's own ranges
+ * (issue 24): a choice must be one of the panel's choices (its <select>'s values: `res`, `runs`,
+ * `ex`, `dt`, `speed`, `filter`, `particles`), a number a strict decimal (dom.js `decimal`) in
+ * the range the panel or the core uses (`step`: the core's track_field_ranges; `seed`, `tseed`:
+ * the seed inputs' range; `target`, `custom`: the core's coordinate range, check_point; `view`,
+ * `roi`: the core's rule for areas, check_rect), `play` 0 or 1, `filters` a list of distinct ekf, ukf, pf. A bad, repeated or
+ * unknown option is left at its default and reported in `errors` (naming the option, the value
+ * given and what is allowed); the rest of the link still applies. The scenario, the window
+ * (within the zoom and pan limits of the scenario's area, View.setWindow) and the ROI (inside
+ * the area) are judged in start().
  */
 function hashOptions(presets) {
   const h = new URLSearchParams(location.hash.slice(1));
   const errors = [];
+  const bad = new Set(); // options already reported
+  const report = (k, message) => {
+    bad.add(k);
+    errors.push(`URL option ${message}`);
+  };
+  for (const k of new Set(h.keys())) {
+    if (!KNOWN.includes(k)) report(k, `${clip(k)}: unknown (known options: ${KNOWN.join(', ')})`);
+    else if (h.getAll(k).length > 1) report(k, `${k}: given ${h.getAll(k).length} times (at most once)`);
+  }
   const read = (k, parse) => {
     const t = h.get(k);
-    if (t === null) return undefined;
+    if (t === null || bad.has(k)) return undefined;
     try {
       return parse(t);
     } catch (e) {
-      errors.push(`URL option ${errorText(e)}`);
+      report(k, errorText(e));
       return undefined;
     }
   };
   const oneOf = (k, values) => read(k, (t) => {
-    if (!values.includes(t)) throw new Error(`${k}: "${t}" is not one of ${values.join(', ')}`);
+    if (!values.includes(t)) throw new Error(`${k}: "${clip(t)}" is not one of ${values.join(', ')}`);
     return t;
   });
+  // A choice of the panel: one of its <select>'s values, written exactly as there.
   const option = (k, id) => oneOf(k, [...$(id).options].map((o) => o.value));
   const numbers = (k, n) => read(k, (t) => {
     const parts = t.split(',');
-    if (parts.length !== n) throw new Error(`${k}: "${t}" is not ${n} comma-separated numbers`);
+    if (parts.length !== n) throw new Error(`${k}: "${clip(t)}" is not ${n} comma-separated numbers`);
     return parts.map((p, i) => decimal(p, `${k}[${i}]`));
   });
+  // n numbers that the core then checks (one definition; its errors name `${k}.x` and so on).
+  const checked = (k, n, check) => {
+    const v = numbers(k, n);
+    return v === undefined ? undefined : read(k, () => {
+      check(v);
+      return v;
+    });
+  };
   // The step index's range is the core's (MAX_TRACK_STEPS, one definition).
   const stepRange = JSON.parse(wasm.track_field_ranges()).step;
-  const target = numbers('target', 2);
-  const custom = numbers('custom', 4);
-  const scenarioKey = ['z', 'scenario'].find((k) => h.has(k));
+  const target = checked('target', 2, ([x, y]) => wasm.check_point('target', x, y));
+  const custom = checked('custom', 4, ([x0, y0, x1, y1]) => {
+    wasm.check_point('custom.start', x0, y0);
+    wasm.check_point('custom.end', x1, y1);
+  });
+  const rect = (k) => checked(k, 4, (r) => wasm.check_rect(k, ...r));
+  const scenarioKeys = ['z', 'scenario'].filter((k) => h.has(k) && !bad.has(k));
+  if (scenarioKeys.length > 1) report('scenario', 'z and scenario: both given (one scenario at most)');
   const opts = {
     mode: oneOf('mode', MODES) ?? 'snapshot',
-    track: oneOf('track', ['I', 'II', 'III', 'custom']),
+    track: oneOf('track', [...$('track-kind').options].map((o) => o.value)),
     step: read('step', (t) => decimalIn(t, 'step', { min: stepRange[0], max: stepRange[1], integer: true })),
-    play: h.get('play') === '1',
-    runs: read('runs', (t) => decimalIn(t, 'runs', { min: 1, max: MAX_RUNS, integer: true })),
+    play: oneOf('play', ['0', '1']) === '1',
+    runs: option('runs', 'mc-runs'),
     ex: option('ex', 'track-ex'),
-    tseed: read('tseed', (t) => decimalIn(t, 'tseed', UINT32)),
+    tseed: read('tseed', (t) => decimalIn(t, 'tseed', SEED_RANGE)),
     dt: option('dt', 'track-dt'),
     speed: option('speed', 'track-speed'),
     filter: option('filter', 'track-filter'),
     particles: option('particles', 'track-particles'),
     filters: read('filters', (t) => {
       const names = t.split(',');
-      const bad = names.find((n) => !['ekf', 'ukf', 'pf'].includes(n));
-      if (bad !== undefined) throw new Error(`filters: "${bad}" is not one of ekf, ukf, pf`);
+      const wrong = names.find((n) => !FILTERS.includes(n));
+      if (wrong !== undefined) throw new Error(`filters: "${clip(wrong)}" is not one of ${FILTERS.join(', ')}`);
+      const twice = names.find((n, i) => names.indexOf(n) !== i);
+      if (twice !== undefined) throw new Error(`filters: "${twice}" is given twice (distinct filters of ${FILTERS.join(', ')})`);
       return names;
     }),
     custom: custom ? { x0: custom[0], y0: custom[1], x1: custom[2], y1: custom[3] } : null,
     preset: oneOf('preset', presets),
     target: target ? { x: target[0], y: target[1] } : null,
-    seed: read('seed', (t) => decimalIn(t, 'seed', UINT32)) ?? 1,
+    seed: read('seed', (t) => decimalIn(t, 'seed', SEED_RANGE)) ?? 1,
     res: option('res', 'resolution'),
-    roi: numbers('roi', 4),
-    view: numbers('view', 4),
-    scenario: scenarioKey ? [scenarioKey, h.get(scenarioKey)] : null,
+    roi: rect('roi'),
+    view: rect('view'),
+    scenario: scenarioKeys.length === 1 ? [scenarioKeys[0], h.get(scenarioKeys[0])] : null,
   };
   return { opts, errors };
 }
@@ -285,7 +319,7 @@ export async function start() {
     window: view.zoomed() ? Array.from(view.area) : null,
     scenario: app.scenario_json(),
   });
-  $('share-copy').addEventListener('click', () => copyLink(link));
+  $('share-copy').addEventListener('click', () => copyLink(link, () => panel.exportJson()));
   $('share-close').addEventListener('click', () => { $('share').hidden = true; });
 
   registerHooks({
@@ -297,17 +331,32 @@ export async function start() {
 
 /**
  * "Copy link": shows the link in the read-only field (selected, for copying by hand) and writes
- * it to the clipboard where the browser allows it.
+ * it to the clipboard where the browser allows it. A scenario too large for a link (share.js
+ * viewLink's `tooLarge`) is said so in the bar, with a button saving the scenario file
+ * (`save`, the panel's Export) instead.
  */
-async function copyLink(link) {
+async function copyLink(link, save) {
+  const field = $('share-url');
+  const saveButton = $('share-save');
   let url;
   try {
     url = await link();
   } catch (e) {
-    showError(`Copy link: ${errorText(e)}`);
+    if (!e || !e.tooLarge) {
+      showError(`Copy link: ${errorText(e)}`);
+      return;
+    }
+    field.value = '';
+    field.hidden = true;
+    saveButton.hidden = false;
+    saveButton.onclick = save;
+    $('share').hidden = false;
+    $('share-note').textContent = `No link: ${errorText(e)}.`;
+    saveButton.focus();
     return;
   }
-  const field = $('share-url');
+  field.hidden = false;
+  saveButton.hidden = true;
   field.value = url;
   $('share').hidden = false;
   $('share-note').textContent = '';

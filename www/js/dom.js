@@ -8,6 +8,12 @@ export const $ = (id) => document.getElementById(id);
 /** A plain decimal number: optional sign (`-`, `+` or `−`), digits with an optional point, optional exponent. */
 const DECIMAL = /^[+\-\u2212]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?$/;
 
+/** Text for a message: at most 64 characters (longer text ends in "…"), so a huge input cannot flood the banner. */
+export function clip(text) {
+  const t = String(text);
+  return t.length > 64 ? `${t.slice(0, 63)}…` : t;
+}
+
 /**
  * Text -> number by strict decimal parsing (the one parser of every number the page reads from
  * an input or the URL): hex (`0x10`), `Infinity`, empty text and trailing junk are rejected with
@@ -16,9 +22,9 @@ const DECIMAL = /^[+\-\u2212]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?$/;
 export function decimal(text, field) {
   const t = String(text ?? '').trim();
   if (t === '') throw new Error(`${field}: empty (a decimal number is required)`);
-  if (!DECIMAL.test(t)) throw new Error(`${field}: "${t}" is not a decimal number`);
+  if (!DECIMAL.test(t)) throw new Error(`${field}: "${clip(t)}" is not a decimal number`);
   const v = Number(t.replace('\u2212', '-'));
-  if (!Number.isFinite(v)) throw new Error(`${field}: "${t}" is out of range (not a finite number)`);
+  if (!Number.isFinite(v)) throw new Error(`${field}: "${clip(t)}" is out of range (not a finite number)`);
   return v;
 }
 
@@ -29,8 +35,8 @@ export function decimal(text, field) {
 export function decimalIn(text, field, { min, max, integer = false, unit = '' }) {
   const v = decimal(text, field);
   const allowed = `allowed ${integer ? 'an integer ' : ''}${fmtBound(min)} … ${fmtBound(max)}${unit ? ` ${unit}` : ''}`;
-  if (integer && !Number.isInteger(v)) throw new Error(`${field}: ${String(text).trim()} is not an integer (${allowed})`);
-  if (!(v >= min && v <= max)) throw new Error(`${field}: ${String(text).trim()} is out of range (${allowed})`);
+  if (integer && !Number.isInteger(v)) throw new Error(`${field}: ${clip(String(text).trim())} is not an integer (${allowed})`);
+  if (!(v >= min && v <= max)) throw new Error(`${field}: ${clip(String(text).trim())} is out of range (${allowed})`);
   return v;
 }
 

@@ -161,12 +161,16 @@ export class Plan {
     return this.roi ? [...this.roi] : Array.from(this.ctx.app.area());
   }
 
-  /** Throws unless `r` is a non-empty rectangle inside the scenario area. */
+  /**
+   * Throws unless `r` is a rectangle the planner accepts (the core's rule for areas: a span of at
+   * least its minimum, check_rect) inside the scenario area.
+   */
   checkRoi(r) {
     const [ax0, ax1, ay0, ay1] = Array.from(this.ctx.app.area());
     const text = `[${r.join(', ')}]`;
     if (!(r.length === 4 && r.every(Number.isFinite))) throw new Error(`${text} is not 4 finite numbers x0, x1, y0, y1`);
     if (!(r[0] < r[1] && r[2] < r[3])) throw new Error(`${text} is empty (x0 < x1 and y0 < y1 are needed)`);
+    this.ctx.wasm.check_rect('roi', ...r); // the core's rule for areas (the planner's too): its smallest span
     if (r[0] < ax0 || r[1] > ax1 || r[2] < ay0 || r[3] > ay1) {
       throw new Error(`${text} m must lie inside the scenario area [${ax0}, ${ax1}, ${ay0}, ${ay1}] m`);
     }

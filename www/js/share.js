@@ -96,10 +96,23 @@ export async function decodeScenario(key, value) {
 }
 
 /**
+ * The error of a scenario too large for a link: `tooLarge` is set (app.js then offers the
+ * scenario file instead) and the message gives the size and the cap.
+ */
+function tooLarge(what) {
+  const e = new Error(`${what}; a link carries at most ${MAX_BYTES} bytes (1 MiB): save the scenario as a file and share that (Import opens it)`);
+  e.tooLarge = true;
+  return e;
+}
+
+/**
  * The page's URL with a hash reopening this view: `mode`, the map grid `res`, the snapshot
  * `target` ({x, y, seed}: `target=x,y&seed=s`), the `roi` ([x0, x1, y0, y1] m, or null) and the
  * `scenario` (JSON text; `z=` or `scenario=`, see encodeScenario). Numbers are written in their
- * shortest round-trip form, which the page's strict parser reads back exactly.
+ * shortest round-trip form, which the page's strict parser reads back exactly. What the page
+ * writes it reads (issue 24): a scenario over MAX_BYTES of compact JSON, or whose link the
+ * reader would refuse (decodeScenario, run here on the link's own text), throws `tooLarge`
+ * instead of giving a link.
  */
 export async function viewLink({ mode, res, target, roi, window, scenario }) {
   const parts = [`mode=${mode}`];
@@ -107,7 +120,17 @@ export async function viewLink({ mode, res, target, roi, window, scenario }) {
   if (window) parts.push(`view=${window.join(',')}`);
   if (target) parts.push(`target=${target.x},${target.y}`, `seed=${target.seed}`);
   if (roi) parts.push(`roi=${roi.join(',')}`);
-  const [key, value] = await encodeScenario(scenario);
+  const compact = JSON.stringify(JSON.parse(scenario));
+  const size = new TextEncoder().encode(compact).length;
+  if (size > MAX_BYTES) throw tooLarge(`the scenario is ${size} bytes of JSON`);
+  const [key, value] = await encodeScenario(compact);
+  let back;
+  try {
+    back = await decodeScenario(key, value);
+  } catch (e) {
+    throw tooLarge(`the scenario's ${key}= text would be refused (${e && e.message ? e.message : e})`);
+  }
+  if (back !== compact) throw new Error(`the ${key}= text does not read back as the scenario`);
   parts.push(`${key}=${value}`);
   return `${location.origin}${location.pathname}#${parts.join('&')}`;
 }

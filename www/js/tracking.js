@@ -8,11 +8,15 @@ import { $, decimalIn, errorText, fillKeyValues, fixed, showError, clearError } 
 import { MonteCarlo } from './montecarlo.js';
 import { drawTrack } from './track-draw.js';
 
-const DURATION_S = 10; // the scenarios of spec §9.4 last 10 s
+/** The run's duration, s: the scenarios of spec §9.4 last 10 s (a drawn trajectory too). */
+export const DURATION_S = 10;
 // The particle filter's share of a browser Monte Carlo study: runs × steps × particles at most this
 // (the job runs the leading chunks of 16 runs that fit, at least one); about 3 s in the worker.
 export const PARTICLE_BUDGET = 20_000_000;
-const FILTERS = ['ekf', 'ukf', 'pf'];
+/** The filters of the panel (the Monte Carlo's check boxes mc-ekf, mc-ukf, mc-pf). */
+export const FILTERS = ['ekf', 'ukf', 'pf'];
+/** The range of the seed inputs (a u32 of the core; also the URL's `seed` and `tseed`). */
+export const SEED_RANGE = { min: 0, max: 4294967295, integer: true };
 
 export class Tracking {
   /** @param {object} ctx - {app, wasm, st, view, changed}; @param {object} opts - hash options. */
@@ -28,11 +32,9 @@ export class Tracking {
     this.frame = null;
     this.dragging = false;
     this.mc = new MonteCarlo(ctx.wasm, ctx.module, showError);
-    // URL options arrive checked (app.js); a run count between the offered ones gets its own entry.
-    const runs = opts.runs === undefined ? undefined : String(opts.runs);
-    if (runs && ![...$('mc-runs').options].some((o) => o.value === runs)) $('mc-runs').add(new Option(`${runs} runs`, runs));
+    // URL options arrive checked (app.js): each choice one of its <select>'s values.
     for (const [id, v] of [['track-kind', this.kind], ['track-dt', opts.dt], ['track-seed', opts.tseed],
-      ['track-ex', opts.ex], ['mc-runs', runs], ['track-speed', opts.speed], ['track-filter', opts.filter],
+      ['track-ex', opts.ex], ['mc-runs', opts.runs], ['track-speed', opts.speed], ['track-filter', opts.filter],
       ['track-particles', opts.particles]]) {
       if (v !== null && v !== undefined && v !== '') $(id).value = String(v);
     }
@@ -63,7 +65,7 @@ export class Tracking {
     let v = [0, 0];
     const d = this.drawn;
     if (this.kind === 'custom') v = w.drag_velocity(d.x0, d.y0, d.x1, d.y1, DURATION_S);
-    const seed = decimalIn($('track-seed').value, 'seed', { min: 0, max: 4294967295, integer: true });
+    const seed = decimalIn($('track-seed').value, 'seed', SEED_RANGE);
     const filter = $('track-filter').value;
     const particles = Number($('track-particles').value);
     return { kind: this.kind, x0: d.x0, y0: d.y0, vx: v[0], vy: v[1], dt_s: dt, steps, seed, filter, particles };

@@ -11,6 +11,8 @@ export const MARGIN_NARROW = { left: 50, right: 84, top: 16, bottom: 44 };
 const NARROW_PX = 480;
 /** Zoom limits: the window's width between these multiples of the home extent's width. */
 export const ZOOM_SPAN = { min: 1e-4, max: 8 };
+/** Rounding allowed on a shared window's limits, a fraction of the home extent's side. */
+const SLACK = 1e-9;
 
 export class View {
   /** @param {object} [margin] - the plot's margins, CSS px (default MARGIN: room for the colour bar). */
@@ -58,18 +60,40 @@ export class View {
   }
 
   /**
-   * Shows the window `w` = [x0, x1, y0, y1] m (a shared link's): finite, non-empty, its width
-   * within ZOOM_SPAN of the home's; otherwise throws naming what is wrong and changes nothing.
+   * Where a window's centre may be: the home extent grown by its own size on each side
+   * ([x_lo, x_hi, y_lo, y_hi] m), the limit of a pan (panBy) and of a shared window (setWindow).
+   */
+  reach() {
+    const [hx0, hx1, hy0, hy1] = this.home;
+    return [hx0 - (hx1 - hx0), hx1 + (hx1 - hx0), hy0 - (hy1 - hy0), hy1 + (hy1 - hy0)];
+  }
+
+  /**
+   * Shows the window `w` = [x0, x1, y0, y1] m (a shared link's, already checked by the core's
+   * rule for areas, check_rect) if a zoom and pan could show it: each side within ZOOM_SPAN of
+   * the home's and its centre within reach(); otherwise throws naming what is wrong and the
+   * allowed range, and changes nothing.
    */
   setWindow(w) {
     const [x0, x1, y0, y1] = w;
     if (!w.every(Number.isFinite) || !(x1 > x0) || !(y1 > y0)) {
       throw new Error(`"${w.join(',')}" is not a window x0,x1,y0,y1 with x0 < x1 and y0 < y1`);
     }
-    const homeW = this.home[1] - this.home[0];
-    const r = (x1 - x0) / homeW;
-    if (!(r >= ZOOM_SPAN.min && r <= ZOOM_SPAN.max)) {
-      throw new Error(`a window ${x1 - x0} m wide is outside ${ZOOM_SPAN.min} … ${ZOOM_SPAN.max} times the area's ${homeW} m`);
+    const [hx0, hx1, hy0, hy1] = this.home;
+    const [rx0, rx1, ry0, ry1] = this.reach();
+    for (const [axis, lo, hi, hlo, hhi, clo, chi] of [['x', x0, x1, hx0, hx1, rx0, rx1], ['y', y0, y1, hy0, hy1, ry0, ry1]]) {
+      const span = hi - lo;
+      const home = hhi - hlo;
+      // SLACK: a window the gestures made (clamped to a limit, then rounded) is always accepted.
+      const slack = SLACK * home;
+      if (!(span >= ZOOM_SPAN.min * home - slack && span <= ZOOM_SPAN.max * home + slack)) {
+        throw new Error(`the window's ${axis} side of ${span} m is outside ${ZOOM_SPAN.min} … ${ZOOM_SPAN.max} times `
+          + `the area's ${home} m (allowed ${ZOOM_SPAN.min * home} … ${ZOOM_SPAN.max * home} m)`);
+      }
+      const c = (lo + hi) / 2;
+      if (!(c >= clo - slack && c <= chi + slack)) {
+        throw new Error(`the window's ${axis} centre ${c} m is outside ${clo} … ${chi} m (the area grown by its size on each side)`);
+      }
     }
     this.fit(w);
   }
@@ -114,14 +138,13 @@ export class View {
   panBy(dx, dy) {
     if (!this.home) return;
     const [x0, x1, y0, y1] = this.area;
-    const [hx0, hx1, hy0, hy1] = this.home;
-    const clampShift = (shift, lo, hi, hlo, hhi) => {
+    const [rx0, rx1, ry0, ry1] = this.reach();
+    const clampShift = (shift, lo, hi, clo, chi) => {
       const c = (lo + hi) / 2 + shift;
-      const span = hhi - hlo;
-      return Math.min(Math.max(c, hlo - span), hhi + span) - (lo + hi) / 2;
+      return Math.min(Math.max(c, clo), chi) - (lo + hi) / 2;
     };
-    const sx = clampShift(-dx / this.scale, x0, x1, hx0, hx1);
-    const sy = clampShift(dy / this.scale, y0, y1, hy0, hy1);
+    const sx = clampShift(-dx / this.scale, x0, x1, rx0, rx1);
+    const sy = clampShift(dy / this.scale, y0, y1, ry0, ry1);
     if (sx === 0 && sy === 0) return;
     this.fit([x0 + sx, x1 + sx, y0 + sy, y1 + sy]);
   }
