@@ -574,8 +574,7 @@ fn read_part<'a>(text: &'a str) -> core::result::Result<Header<'a>, NotPart> {
             MAX_PART_CONFIG_BYTES >> 20
         )));
     }
-    let config: Value =
-        serde_json::from_str(config).map_err(|e| other(format!("config: {e}")))?;
+    let config: Value = serde_json::from_str(config).map_err(|e| other(format!("config: {e}")))?;
     walk("timing", part.timing.get(), MAX_TIMING_ENTRIES).map_err(other)?;
     let timing: Timing = parse_at("timing", part.timing.get()).map_err(other)?;
     if timing.threads == 0 {
@@ -592,7 +591,11 @@ fn read_part<'a>(text: &'a str) -> core::result::Result<Header<'a>, NotPart> {
         )));
     }
     let hex = part.digest.strip_prefix("sha256:").unwrap_or("");
-    if hex.len() != 64 || !hex.bytes().all(|b| b.is_ascii_digit() || (b'a'..=b'f').contains(&b)) {
+    if hex.len() != 64
+        || !hex
+            .bytes()
+            .all(|b| b.is_ascii_digit() || (b'a'..=b'f').contains(&b))
+    {
         return Err(other(format!(
             "digest \"{}\" is not sha256: and 64 lowercase hex digits",
             clip(&part.digest.escape_debug().to_string())
@@ -692,10 +695,7 @@ impl PartSet {
     /// version, foreign parts, shard counts that disagree, duplicate or missing shards; each
     /// lists the files) or [`Error::InconsistentPart`] (a part that is not the shard it says it
     /// is).
-    pub fn read(
-        paths: &[String],
-        load: &mut dyn FnMut(&str) -> Result<String>,
-    ) -> Result<PartSet> {
+    pub fn read(paths: &[String], load: &mut dyn FnMut(&str) -> Result<String>) -> Result<PartSet> {
         // Every file is a part of this format; one identity Value is kept per study seen.
         let mut read: Vec<Part> = Vec::new();
         let mut studies: BTreeMap<[u8; 32], (usize, usize, String, Value)> = BTreeMap::new();
@@ -732,7 +732,10 @@ impl PartSet {
             }
         }
         if !bad.is_empty() {
-            if let (true, Some((v, _))) = (read.is_empty() && versions.len() == 1, versions.iter().next()) {
+            if let (true, Some((v, _))) = (
+                read.is_empty() && versions.len() == 1,
+                versions.iter().next(),
+            ) {
                 if versions[v] == paths.len() {
                     return Err(set_error(format!(
                         "merge: the parts are of part format version {v}; this scatterloc ({}) \
@@ -946,9 +949,10 @@ pub fn differs(want: &Value, got: &Value) -> Option<String> {
 
 /// [`differs`] below `path`.
 fn first_difference(want: &Value, got: &Value, path: &str) -> Option<String> {
+    // Keys and paths shown at most 60 characters (a part's keys are the user's text).
     let at = |key: &str| match path {
-        "" => key.to_string(),
-        p => format!("{p}.{key}"),
+        "" => clip(key),
+        p => clip(&format!("{p}.{}", clip(key))),
     };
     match (want, got) {
         (Value::Object(a), Value::Object(b)) => {
@@ -968,7 +972,8 @@ fn first_difference(want: &Value, got: &Value, path: &str) -> Option<String> {
             .find_map(|(i, (x, y))| first_difference(x, y, &format!("{path}[{i}]"))),
         _ if want == got => None,
         _ => Some(format!(
-            "{path}: {}, not {}",
+            "{}: {}, not {}",
+            clip(path),
             shown(Some(got)),
             shown(Some(want))
         )),

@@ -621,7 +621,10 @@ fn tampered_parts_are_named_errors_that_write_nothing() {
     );
     merge_fails(
         &[p0, &failed],
-        &[bad, "failed.json: sums[0].failed_runs: 5 failed + 16 counted"],
+        &[
+            bad,
+            "failed.json: sums[0].failed_runs: 5 failed + 16 counted",
+        ],
     );
     merge_fails(
         &[p0, &asym],
@@ -638,7 +641,10 @@ fn tampered_parts_are_named_errors_that_write_nothing() {
     merge_fails(&[p0, &truncated], &["trunc.json (invalid JSON: EOF"]);
     merge_fails(
         &[&old[0], &old[1]],
-        &["merge: the parts are of part format version 1", "reads version 2"],
+        &[
+            "merge: the parts are of part format version 1",
+            "reads version 2",
+        ],
     );
     merge_fails(
         &[&roc[0], &pd],
@@ -665,7 +671,10 @@ fn a_padded_part_is_a_named_error_within_the_memory_cap() {
     let big = dir.write_text("big.json", &padded);
     drop((padded, pad, text));
     let out = dir.path("out.json");
-    let script = format!("ulimit -v 4000000; exec {BIN} merge --json {out} {} {big}", parts[0]);
+    let script = format!(
+        "ulimit -v 4000000; exec {BIN} merge --json {out} {} {big}",
+        parts[0]
+    );
     let o = Command::new("sh").args(["-c", &script]).output().unwrap();
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{err}");

@@ -10,7 +10,8 @@ use serde::Serialize;
 use scatterloc::chart::TrackingChartOptions;
 use scatterloc::math::Shard;
 use scatterloc::study::{
-    CurveDoc, FilterStudy, MonteCarloStudy, PartFile, PartSet, RunTime, ShardDoc, Timing, TrackStudy,
+    CurveDoc, FilterStudy, MonteCarloStudy, PartFile, PartSet, RunTime, ShardDoc, Timing,
+    TrackStudy,
 };
 use scatterloc::track::{nominal_pcrlb_rmse, paper_initial_covariance};
 
