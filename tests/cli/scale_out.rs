@@ -650,9 +650,20 @@ fn tampered_parts_are_named_errors_that_write_nothing() {
         &[&roc[0], &pd],
         &[bad, "pd.json: sums.sums[0][0].detection_ratio: -0.83"],
     );
-    // The untouched sets still merge.
+    // The untouched sets still merge, a part from stdin too (read once: merge reads a part
+    // twice, for the set and for its sums).
     merge(&out, None, &[parts[1].clone(), parts[0].clone()]);
     merge(&dir.path("roc.json"), None, &roc);
+    let piped = dir.path("piped.json");
+    let o = command(&["merge", "--json", &piped, &parts[0], "-"], &[])
+        .stdin(std::fs::File::open(&parts[1]).unwrap())
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(
+        without_timing(&read_json(&piped)),
+        without_timing(&read_json(&out))
+    );
 }
 
 /// Issue 24: a 229 MiB part (under the 256 MiB input cap) padded with a long array of sums
