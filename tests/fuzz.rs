@@ -36,6 +36,8 @@ mod check;
 mod docs;
 #[path = "fuzz/mutate.rs"]
 mod mutate;
+#[path = "fuzz/parts.rs"]
+mod parts;
 #[path = "fuzz/runner.rs"]
 mod runner;
 

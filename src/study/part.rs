@@ -92,7 +92,7 @@ use alloc::string::{String, ToString};
 use alloc::vec;
 use alloc::vec::Vec;
 
-use serde::de::{DeserializeSeed, IgnoredAny, MapAccess, SeqAccess, Visitor};
+use serde::de::{DeserializeSeed, MapAccess, SeqAccess, Visitor};
 use serde::{Deserialize, Serialize};
 use serde_json::value::RawValue;
 use serde_json::Value;
@@ -245,32 +245,68 @@ impl<C: Serialize, S: Serialize + ?Sized> Serialize for PartFile<'_, C, S> {
     }
 }
 
-/// The first two fields every version has (the rest is not parsed: nothing is allocated).
-#[derive(Deserialize)]
-struct Probe<'a> {
-    #[serde(borrow, default)]
-    format: Option<&'a RawValue>,
-    #[serde(borrow, default)]
-    version: Option<&'a RawValue>,
+/// The top-level fields of a part file, in order.
+const FIELDS: [&str; 9] = [
+    "format", "version", "software", "study", "config", "shard", "timing", "digest", "sums",
+];
+
+/// A part file's top level as read in one pass: each field's JSON text (nothing parsed or
+/// allocated for the values), and the first unknown or repeated key.
+struct RawPart<'a> {
+    fields: [Option<&'a RawValue>; 9],
+    problem: Option<String>,
 }
 
-/// A part file as read: the large fields still text of the file.
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
+impl<'de> Deserialize<'de> for RawPart<'de> {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> core::result::Result<Self, D::Error> {
+        struct V;
+        impl<'de> Visitor<'de> for V {
+            type Value = RawPart<'de>;
+            fn expecting(&self, f: &mut core::fmt::Formatter) -> core::fmt::Result {
+                f.write_str("a part file (a JSON object)")
+            }
+            fn visit_map<A: MapAccess<'de>>(
+                self,
+                mut map: A,
+            ) -> core::result::Result<RawPart<'de>, A::Error> {
+                let mut part = RawPart {
+                    fields: [None; 9],
+                    problem: None,
+                };
+                while let Some(key) = map.next_key::<alloc::borrow::Cow<'de, str>>()? {
+                    let value: &'de RawValue = map.next_value()?;
+                    match FIELDS.iter().position(|f| *f == key) {
+                        Some(i) if part.fields[i].is_none() => part.fields[i] = Some(value),
+                        Some(_) => {
+                            part.problem
+                                .get_or_insert_with(|| format!("duplicate field `{key}`"));
+                        }
+                        None => {
+                            part.problem.get_or_insert_with(|| {
+                                format!(
+                                    "unknown field `{}`, expected one of {}",
+                                    clip(&key.escape_debug().to_string()),
+                                    FIELDS.join(", ")
+                                )
+                            });
+                        }
+                    }
+                }
+                Ok(part)
+            }
+        }
+        d.deserialize_map(V)
+    }
+}
+
+/// A part file's fields, the large ones still text of the file.
 struct PartIn<'a> {
-    #[serde(rename = "format")]
-    _format: IgnoredAny,
-    #[serde(rename = "version")]
-    _version: IgnoredAny,
     software: String,
     study: String,
-    #[serde(borrow)]
     config: &'a RawValue,
     shard: ShardDoc,
-    #[serde(borrow)]
     timing: &'a RawValue,
     digest: String,
-    #[serde(borrow)]
     sums: &'a RawValue,
 }
 
@@ -464,33 +500,57 @@ fn hex(d: &[u8; 32]) -> String {
 
 /// Reads one part file's text: the format and version first, then the fields, each checked
 /// on its own.
-fn read_part(text: &str) -> core::result::Result<Header<'_>, NotPart> {
+fn read_part<'a>(text: &'a str) -> core::result::Result<Header<'a>, NotPart> {
     let other = NotPart::Other;
-    let probe: Probe = serde_json::from_str(text).map_err(|e| {
+    let raw: RawPart = serde_json::from_str(text).map_err(|e| {
         other(match e.classify() {
             serde_json::error::Category::Data => format!("not a part file: {e}"),
             _ => format!("invalid JSON: {e}"),
         })
     })?;
-    let format = probe.format.map(|f| f.get().trim());
-    if format != Some(&format!("\"{PART_FORMAT}\"")[..]) {
+    let [format, version, software, study, config, shard, timing, digest, sums] = raw.fields;
+    if format.map(|f| f.get().trim()) != Some(&format!("\"{PART_FORMAT}\"")[..]) {
         return Err(other(format!(
             "format {}, not \"{PART_FORMAT}\"",
-            shown_raw(probe.format)
+            shown_raw(format)
         )));
     }
-    let version = probe.version.map(|v| serde_json::from_str::<u64>(v.get()));
-    match version {
+    match version.map(|v| serde_json::from_str::<u64>(v.get())) {
         Some(Ok(PART_VERSION)) => {}
         Some(Ok(v)) => return Err(NotPart::Version(v.to_string())),
         _ => {
             return Err(other(format!(
                 "version {}, this scatterloc reads version {PART_VERSION}",
-                shown_raw(probe.version)
+                shown_raw(version)
             )))
         }
     }
-    let part: PartIn = serde_json::from_str(text).map_err(|e| other(e.to_string()))?;
+    if let Some(problem) = raw.problem {
+        return Err(other(problem));
+    }
+    let field = |i: usize, v: Option<&'a RawValue>| {
+        v.ok_or_else(|| NotPart::Other(format!("missing field `{}`", FIELDS[i])))
+    };
+    let (software, study, config) = (field(2, software)?, field(3, study)?, field(4, config)?);
+    let (shard, timing, digest, sums) = (
+        field(5, shard)?,
+        field(6, timing)?,
+        field(7, digest)?,
+        field(8, sums)?,
+    );
+    let software: String = parse_at("software", software.get()).map_err(other)?;
+    let study: String = parse_at("study", study.get()).map_err(other)?;
+    let shard: ShardDoc = parse_at("shard", shard.get()).map_err(other)?;
+    let digest: String = parse_at("digest", digest.get()).map_err(other)?;
+    let part = PartIn {
+        software,
+        study,
+        config,
+        shard,
+        timing,
+        digest,
+        sums,
+    };
     let (study, unit) = match STUDIES.iter().find(|(s, _)| *s == part.study) {
         Some(&(s, u)) => (s, u),
         None => {
@@ -514,8 +574,7 @@ fn read_part(text: &str) -> core::result::Result<Header<'_>, NotPart> {
             MAX_PART_CONFIG_BYTES >> 20
         )));
     }
-    let config: Value =
-        serde_json::from_str(config).map_err(|e| other(format!("config: {e}")))?;
+    let config: Value = serde_json::from_str(config).map_err(|e| other(format!("config: {e}")))?;
     walk("timing", part.timing.get(), MAX_TIMING_ENTRIES).map_err(other)?;
     let timing: Timing = parse_at("timing", part.timing.get()).map_err(other)?;
     if timing.threads == 0 {
@@ -532,7 +591,11 @@ fn read_part(text: &str) -> core::result::Result<Header<'_>, NotPart> {
         )));
     }
     let hex = part.digest.strip_prefix("sha256:").unwrap_or("");
-    if hex.len() != 64 || !hex.bytes().all(|b| b.is_ascii_digit() || (b'a'..=b'f').contains(&b)) {
+    if hex.len() != 64
+        || !hex
+            .bytes()
+            .all(|b| b.is_ascii_digit() || (b'a'..=b'f').contains(&b))
+    {
         return Err(other(format!(
             "digest \"{}\" is not sha256: and 64 lowercase hex digits",
             clip(&part.digest.escape_debug().to_string())
@@ -632,10 +695,7 @@ impl PartSet {
     /// version, foreign parts, shard counts that disagree, duplicate or missing shards; each
     /// lists the files) or [`Error::InconsistentPart`] (a part that is not the shard it says it
     /// is).
-    pub fn read(
-        paths: &[String],
-        load: &mut dyn FnMut(&str) -> Result<String>,
-    ) -> Result<PartSet> {
+    pub fn read(paths: &[String], load: &mut dyn FnMut(&str) -> Result<String>) -> Result<PartSet> {
         // Every file is a part of this format; one identity Value is kept per study seen.
         let mut read: Vec<Part> = Vec::new();
         let mut studies: BTreeMap<[u8; 32], (usize, usize, String, Value)> = BTreeMap::new();
@@ -672,7 +732,10 @@ impl PartSet {
             }
         }
         if !bad.is_empty() {
-            if let (true, Some((v, _))) = (read.is_empty() && versions.len() == 1, versions.iter().next()) {
+            if let (true, Some((v, _))) = (
+                read.is_empty() && versions.len() == 1,
+                versions.iter().next(),
+            ) {
                 if versions[v] == paths.len() {
                     return Err(set_error(format!(
                         "merge: the parts are of part format version {v}; this scatterloc ({}) \
@@ -886,9 +949,10 @@ pub fn differs(want: &Value, got: &Value) -> Option<String> {
 
 /// [`differs`] below `path`.
 fn first_difference(want: &Value, got: &Value, path: &str) -> Option<String> {
+    // Keys and paths shown at most 60 characters (a part's keys are the user's text).
     let at = |key: &str| match path {
-        "" => key.to_string(),
-        p => format!("{p}.{key}"),
+        "" => clip(key),
+        p => clip(&format!("{p}.{}", clip(key))),
     };
     match (want, got) {
         (Value::Object(a), Value::Object(b)) => {
@@ -908,7 +972,8 @@ fn first_difference(want: &Value, got: &Value, path: &str) -> Option<String> {
             .find_map(|(i, (x, y))| first_difference(x, y, &format!("{path}[{i}]"))),
         _ if want == got => None,
         _ => Some(format!(
-            "{path}: {}, not {}",
+            "{}: {}, not {}",
+            clip(path),
             shown(Some(got)),
             shown(Some(want))
         )),

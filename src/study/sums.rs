@@ -80,9 +80,7 @@ pub fn check_sums(
                 ));
             }
             if f21 != f12 {
-                return Err(format!(
-                    "{field}: not symmetric (F21 = {f21}, F12 = {f12})"
-                ));
+                return Err(format!("{field}: not symmetric (F21 = {f21}, F12 = {f12})"));
             }
             let scale = f11.max(f22);
             if scale > 0.0 {
@@ -101,9 +99,7 @@ pub fn check_sums(
             }
             let zero = f11 == 0.0 && f22 == 0.0;
             if n == 0 && !zero {
-                return Err(format!(
-                    "{field}: not zero (step 0 has no measurement)"
-                ));
+                return Err(format!("{field}: not zero (step 0 has no measurement)"));
             }
             if s.trajectories == 0 && !zero {
                 return Err(format!("{field}: not zero, but no trajectory was counted"));

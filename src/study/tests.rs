@@ -331,7 +331,10 @@ fn mc_parts(n: usize) -> (Vec<(String, Value)>, Vec<crate::track::StudySums>) {
             };
             let sums = run(shard.range(total));
             let part = PartFile::new("montecarlo", &config, &doc, &timing, &sums);
-            (format!("part{i}.json"), serde_json::to_value(&part).unwrap())
+            (
+                format!("part{i}.json"),
+                serde_json::to_value(&part).unwrap(),
+            )
         })
         .collect();
     (parts, run(0..total))
@@ -533,7 +536,8 @@ fn bad_part_headers_are_named_errors() {
     };
     for (edit, want) in [
         (
-            &(|v: &mut Value| v["timing"]["wall_time_s"][1] = serde_json::json!(-1.0)) as &dyn Fn(&mut Value),
+            &(|v: &mut Value| v["timing"]["wall_time_s"][1] = serde_json::json!(-1.0))
+                as &dyn Fn(&mut Value),
             "part1.json (timing.wall_time_s[1]: -1 is not a wall time (finite, ≥ 0 s))",
         ),
         (
@@ -545,7 +549,9 @@ fn bad_part_headers_are_named_errors() {
             "part1.json (timing.threads: 0, not a thread count ≥ 1)",
         ),
         (
-            &|v: &mut Value| v["timing"]["wall_time_s"] = Value::Array(vec![serde_json::json!(1.0); 17]),
+            &|v: &mut Value| {
+                v["timing"]["wall_time_s"] = Value::Array(vec![serde_json::json!(1.0); 17])
+            },
             "part1.json (timing.wall_time_s: more than 16 entries",
         ),
         (
@@ -573,8 +579,9 @@ fn bad_part_headers_are_named_errors() {
     }
     let got = PartSet::check(&texts(&old)).unwrap_err().to_string();
     assert!(
-        got.starts_with("merge: the parts are of part format version 1; this scatterloc (scatterloc ")
-            && got.contains("reads version 2"),
+        got.starts_with(
+            "merge: the parts are of part format version 1; this scatterloc (scatterloc "
+        ) && got.contains("reads version 2"),
         "{got}"
     );
     // A filter list with a duplicate (digest and all consistent) is refused by the study.
@@ -597,13 +604,9 @@ fn impossible_roc_tallies_are_named_errors() {
     let parts: Vec<(String, Value)> = (0..2)
         .map(|i| {
             let shard = Shard::new(i, 2).unwrap();
-            let tally = RocStudy::run_range(
-                &cfg,
-                shard.range(2),
-                &mut Sequential::new(),
-                &mut |_, _| {},
-            )
-            .unwrap();
+            let tally =
+                RocStudy::run_range(&cfg, shard.range(2), &mut Sequential::new(), &mut |_, _| {})
+                    .unwrap();
             let doc = ShardDoc::new(shard, "realisations", 2);
             let timing = Timing {
                 threads: 1,
@@ -616,9 +619,7 @@ fn impossible_roc_tallies_are_named_errors() {
     let merge = |parts: &[(String, Value)]| {
         let files = texts(parts);
         let set = PartSet::check(&files).map_err(|e| e.to_string())?;
-        let mut load = |path: &str| {
-            Ok(files.iter().find(|(p, _)| p == path).unwrap().1.clone())
-        };
+        let mut load = |path: &str| Ok(files.iter().find(|(p, _)| p == path).unwrap().1.clone());
         RocStudy::merge(&set, &mut load)
             .map(|r| r.1)
             .map_err(|e| e.to_string())
@@ -636,15 +637,27 @@ fn impossible_roc_tallies_are_named_errors() {
     };
     for (got, want) in [
         (
-            edit(&|s| s["sums"][0][3]["detections"] = serde_json::json!(targets + 1), true),
-            format!("roc1.json: sums.sums[0][3].detections: {} is more than the {targets} targets", targets + 1),
+            edit(
+                &|s| s["sums"][0][3]["detections"] = serde_json::json!(targets + 1),
+                true,
+            ),
+            format!(
+                "roc1.json: sums.sums[0][3].detections: {} is more than the {targets} targets",
+                targets + 1
+            ),
         ),
         (
-            edit(&|s| s["sums"][1][2]["detection_ratio"] = serde_json::json!([-0.83]), true),
+            edit(
+                &|s| s["sums"][1][2]["detection_ratio"] = serde_json::json!([-0.83]),
+                true,
+            ),
             "roc1.json: sums.sums[1][2].detection_ratio: -0.83 is not a sum of 1 ratios".into(),
         ),
         (
-            edit(&|s| s["sums"][0][0]["false_alarm_ratio"] = serde_json::json!("nan"), true),
+            edit(
+                &|s| s["sums"][0][0]["false_alarm_ratio"] = serde_json::json!("nan"),
+                true,
+            ),
             "roc1.json: sums.sums[0][0].false_alarm_ratio: NaN is not a sum".into(),
         ),
         (
@@ -652,7 +665,10 @@ fn impossible_roc_tallies_are_named_errors() {
             "roc1.json: sums.realisations: 2, not the shard's 1".into(),
         ),
         (
-            edit(&|s| s["sums"][0][0]["false_alarms"] = serde_json::json!(-1), true),
+            edit(
+                &|s| s["sums"][0][0]["false_alarms"] = serde_json::json!(-1),
+                true,
+            ),
             "roc1.json: sums.sums[0][0].false_alarms: invalid value: integer `-1`".into(),
         ),
         (

@@ -621,7 +621,10 @@ fn tampered_parts_are_named_errors_that_write_nothing() {
     );
     merge_fails(
         &[p0, &failed],
-        &[bad, "failed.json: sums[0].failed_runs: 5 failed + 16 counted"],
+        &[
+            bad,
+            "failed.json: sums[0].failed_runs: 5 failed + 16 counted",
+        ],
     );
     merge_fails(
         &[p0, &asym],
@@ -638,15 +641,29 @@ fn tampered_parts_are_named_errors_that_write_nothing() {
     merge_fails(&[p0, &truncated], &["trunc.json (invalid JSON: EOF"]);
     merge_fails(
         &[&old[0], &old[1]],
-        &["merge: the parts are of part format version 1", "reads version 2"],
+        &[
+            "merge: the parts are of part format version 1",
+            "reads version 2",
+        ],
     );
     merge_fails(
         &[&roc[0], &pd],
         &[bad, "pd.json: sums.sums[0][0].detection_ratio: -0.83"],
     );
-    // The untouched sets still merge.
+    // The untouched sets still merge, a part from stdin too (read once: merge reads a part
+    // twice, for the set and for its sums).
     merge(&out, None, &[parts[1].clone(), parts[0].clone()]);
     merge(&dir.path("roc.json"), None, &roc);
+    let piped = dir.path("piped.json");
+    let o = command(&["merge", "--json", &piped, &parts[0], "-"], &[])
+        .stdin(std::fs::File::open(&parts[1]).unwrap())
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(
+        without_timing(&read_json(&piped)),
+        without_timing(&read_json(&out))
+    );
 }
 
 /// Issue 24: a 229 MiB part (under the 256 MiB input cap) padded with a long array of sums
@@ -665,7 +682,10 @@ fn a_padded_part_is_a_named_error_within_the_memory_cap() {
     let big = dir.write_text("big.json", &padded);
     drop((padded, pad, text));
     let out = dir.path("out.json");
-    let script = format!("ulimit -v 4000000; exec {BIN} merge --json {out} {} {big}", parts[0]);
+    let script = format!(
+        "ulimit -v 4000000; exec {BIN} merge --json {out} {} {big}",
+        parts[0]
+    );
     let o = Command::new("sh").args(["-c", &script]).output().unwrap();
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{err}");

@@ -179,10 +179,7 @@ impl Tally {
                         ));
                     }
                     if (count == 0) != (v == 0.0) {
-                        return Err(format!(
-                            "{}: {v}, but the count is {count}",
-                            at(name)
-                        ));
+                        return Err(format!("{}: {v}, but the count is {count}", at(name)));
                     }
                 }
             }

@@ -14,17 +14,38 @@ use super::io::read_input_named;
 use crate::cli::MergeArgs;
 use crate::failure::CliError;
 
-/// Reads part file `path` for `merge` (its errors as the library's, exit status 2).
-pub fn load_part(path: &str) -> Result<String, Error> {
-    read_input_named("merge: PART", path).map_err(|e| Error::PartSet { what: e.message })
+/// Reads the part files of `merge`, one at a time (its errors as the library's, exit status
+/// 2); stdin (`-`) is read once and kept, as it cannot be read again.
+#[derive(Default)]
+pub struct PartReader {
+    stdin: Option<String>,
+}
+
+impl PartReader {
+    /// The text of part file `path`.
+    pub fn load(&mut self, path: &str) -> Result<String, Error> {
+        let read = |p: &str| {
+            read_input_named("merge: PART", p).map_err(|e| Error::PartSet { what: e.message })
+        };
+        if path != "-" {
+            return read(path);
+        }
+        if self.stdin.is_none() {
+            self.stdin = Some(read(path)?);
+        }
+        Ok(self.stdin.clone().unwrap_or_default())
+    }
 }
 
 /// `scatterloc merge`.
 pub fn merge(args: &MergeArgs) -> Result<(), CliError> {
-    let set = PartSet::read(&args.parts, &mut |p| load_part(p))
+    let mut reader = PartReader::default();
+    let set = PartSet::read(&args.parts, &mut |p| reader.load(p))
         .map_err(|e| CliError::usage(e.to_string()))?;
     match set.study.as_str() {
-        "montecarlo" => super::montecarlo::merge_parts(&set, &args.json, args.out.as_deref()),
-        _ => super::mtl::merge_roc(&set, &args.json, args.out.as_deref()),
+        "montecarlo" => {
+            super::montecarlo::merge_parts(&set, reader, &args.json, args.out.as_deref())
+        }
+        _ => super::mtl::merge_roc(&set, reader, &args.json, args.out.as_deref()),
     }
 }

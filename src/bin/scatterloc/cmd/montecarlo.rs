@@ -10,7 +10,8 @@ use serde::Serialize;
 use scatterloc::chart::TrackingChartOptions;
 use scatterloc::math::Shard;
 use scatterloc::study::{
-    CurveDoc, FilterStudy, MonteCarloStudy, PartFile, PartSet, RunTime, ShardDoc, Timing, TrackStudy,
+    CurveDoc, FilterStudy, MonteCarloStudy, PartFile, PartSet, RunTime, ShardDoc, Timing,
+    TrackStudy,
 };
 use scatterloc::track::{nominal_pcrlb_rmse, paper_initial_covariance};
 
@@ -142,9 +143,14 @@ fn run_shard(
 
 /// `scatterloc merge` of Monte Carlo parts (checked as a set by `merge`): the sums of every
 /// shard added exactly ([`MonteCarloStudy::merge`]), then the outputs of the unsharded run.
-pub fn merge_parts(set: &PartSet, json: &str, out: Option<&str>) -> Result<(), CliError> {
+pub fn merge_parts(
+    set: &PartSet,
+    mut reader: super::merge::PartReader,
+    json: &str,
+    out: Option<&str>,
+) -> Result<(), CliError> {
     let (study, runs, times) =
-        MonteCarloStudy::merge(set, &mut |p| super::merge::load_part(p)).map_err(flag_error)?;
+        MonteCarloStudy::merge(set, &mut |p| reader.load(p)).map_err(flag_error)?;
     let outputs = Outputs::parse(out, Some(json))?;
     let mut docs = Vec::new();
     for (k, (run, time)) in runs.iter().zip(times).enumerate() {

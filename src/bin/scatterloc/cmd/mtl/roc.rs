@@ -286,8 +286,13 @@ pub fn mtl_roc(args: &RocArgs) -> Result<(), CliError> {
 
 /// `scatterloc merge` of `mtl roc` parts (checked as a set by `merge`): the tallies of every
 /// shard added exactly ([`RocStudy::merge`]), then the outputs of the unsharded run.
-pub fn merge_roc(set: &PartSet, json: &str, out: Option<&str>) -> Result<(), CliError> {
-    let (cfg, r, wall, threads) = RocStudy::merge(set, &mut |p| super::super::merge::load_part(p))
+pub fn merge_roc(
+    set: &PartSet,
+    mut reader: super::super::merge::PartReader,
+    json: &str,
+    out: Option<&str>,
+) -> Result<(), CliError> {
+    let (cfg, r, wall, threads) = RocStudy::merge(set, &mut |p| reader.load(p))
         .map_err(|e| CliError::usage(e.to_string()))?;
     let (figure, json) = result_outputs(out, Some(json))?;
     write_result(&cfg, &r, wall, threads, json, figure)
