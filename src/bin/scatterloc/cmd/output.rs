@@ -214,7 +214,12 @@ impl OutputSet {
     }
 
     /// Stages `value` as compact JSON (and a newline) for `path`.
-    pub fn json<T: Serialize>(&mut self, flag: &str, path: &str, value: &T) -> Result<(), CliError> {
+    pub fn json<T: Serialize>(
+        &mut self,
+        flag: &str,
+        path: &str,
+        value: &T,
+    ) -> Result<(), CliError> {
         self.stage(flag, path, |w| {
             serde_json::to_writer(&mut *w, value).map_err(|e| write_failed(flag, path, e))?;
             w.write_all(b"\n").map_err(|e| write_failed(flag, path, e))
