@@ -935,17 +935,86 @@ const PLANTS: [Plant; 7] = [
 /// The output-writing commands of a case: the arguments (`{out}` is the planted target, `{dir}`
 /// its directory, `{s}` the scenario) and the target's file name.
 const WRITERS: &[(&[&str], &str)] = &[
-    (&["crlb-map", "--scenario", "{s}", "--out", "{out}", "--nx", "16", "--ny", "16"], "m.json"),
-    (&["crlb-map", "--scenario", "{s}", "--out", "{out}", "--nx", "16", "--ny", "16"], "m.png"),
     (
-        &["plan", "--scenario", "{s}", "--out", "{dir}/p.json", "--figure", "{out}", "--grid", "8",
-          "--move", "rx", "--objective", "p90", "--roi", "-7.5,30,-10,26", "--budget", "40"],
+        &[
+            "crlb-map",
+            "--scenario",
+            "{s}",
+            "--out",
+            "{out}",
+            "--nx",
+            "16",
+            "--ny",
+            "16",
+        ],
+        "m.json",
+    ),
+    (
+        &[
+            "crlb-map",
+            "--scenario",
+            "{s}",
+            "--out",
+            "{out}",
+            "--nx",
+            "16",
+            "--ny",
+            "16",
+        ],
+        "m.png",
+    ),
+    (
+        &[
+            "plan",
+            "--scenario",
+            "{s}",
+            "--out",
+            "{dir}/p.json",
+            "--figure",
+            "{out}",
+            "--grid",
+            "8",
+            "--move",
+            "rx",
+            "--objective",
+            "p90",
+            "--roi",
+            "-7.5,30,-10,26",
+            "--budget",
+            "40",
+        ],
         "p.svg",
     ),
-    (&["simulate-walk", "--scenario", "{s}", "--out-dir", "{dir}", "--duration", "1",
-       "--calibration-snapshots", "5"], "truth.json"),
-    (&["montecarlo", "--trajectory", "I", "--runs", "4", "--noise-runs", "1", "--dt", "0.1",
-       "--json", "{out}"], "mc.json"),
+    (
+        &[
+            "simulate-walk",
+            "--scenario",
+            "{s}",
+            "--out-dir",
+            "{dir}",
+            "--duration",
+            "1",
+            "--calibration-snapshots",
+            "5",
+        ],
+        "truth.json",
+    ),
+    (
+        &[
+            "montecarlo",
+            "--trajectory",
+            "I",
+            "--runs",
+            "4",
+            "--noise-runs",
+            "1",
+            "--dt",
+            "0.1",
+            "--json",
+            "{out}",
+        ],
+        "mc.json",
+    ),
 ];
 
 /// One output-target case: `writers` processes at once run a command whose target holds
@@ -977,7 +1046,10 @@ fn run_output_target(cmd: usize, plant: Plant, writers: usize, dir: &CaseDir) ->
             true
         }
         Plant::Fifo => {
-            let ok = Command::new("mkfifo").arg(&target).status().expect("mkfifo");
+            let ok = Command::new("mkfifo")
+                .arg(&target)
+                .status()
+                .expect("mkfifo");
             assert!(ok.success());
             true
         }
@@ -988,7 +1060,11 @@ fn run_output_target(cmd: usize, plant: Plant, writers: usize, dir: &CaseDir) ->
         Plant::LinksAtTemporaryNames => {
             let stem = name.split('.').next().unwrap_or(name);
             let ext = name.rsplit('.').next().unwrap_or("");
-            for tmp in [format!("{stem}.tmp.{ext}"), format!("{name}.tmp"), format!("{stem}.tmp")] {
+            for tmp in [
+                format!("{stem}.tmp.{ext}"),
+                format!("{name}.tmp"),
+                format!("{stem}.tmp"),
+            ] {
                 symlink(&victim, out_dir.join(tmp)).expect("plant");
             }
             false
@@ -1017,7 +1093,10 @@ fn run_output_target(cmd: usize, plant: Plant, writers: usize, dir: &CaseDir) ->
         }
     }
     if std::fs::read_to_string(&victim).ok().as_deref() != Some("precious") {
-        return Err(fail(Class::BadOutput, format!("{plant:?}: the link's target was written")));
+        return Err(fail(
+            Class::BadOutput,
+            format!("{plant:?}: the link's target was written"),
+        ));
     }
     let left: Vec<String> = std::fs::read_dir(&out_dir)
         .expect("list")
@@ -1025,13 +1104,19 @@ fn run_output_target(cmd: usize, plant: Plant, writers: usize, dir: &CaseDir) ->
         .filter(|f| f.starts_with(".scatterloc-"))
         .collect();
     if !left.is_empty() {
-        return Err(fail(Class::BadOutput, format!("temporaries left: {left:?}")));
+        return Err(fail(
+            Class::BadOutput,
+            format!("temporaries left: {left:?}"),
+        ));
     }
     if planted {
         // Nothing new beside the planted target.
         let n = std::fs::read_dir(&out_dir).expect("list").count();
         if n != 1 {
-            return Err(fail(Class::BadOutput, format!("{plant:?}: {n} entries after a refusal")));
+            return Err(fail(
+                Class::BadOutput,
+                format!("{plant:?}: {n} entries after a refusal"),
+            ));
         }
         return Ok(Pass::Err);
     }
@@ -1042,7 +1127,10 @@ fn run_output_target(cmd: usize, plant: Plant, writers: usize, dir: &CaseDir) ->
         _ => bytes.ends_with(b"</svg>\n") || bytes.ends_with(b"</svg>"),
     };
     if !whole || !std::fs::symlink_metadata(&target).is_ok_and(|m| m.is_file()) {
-        return Err(fail(Class::BadOutput, format!("{plant:?}: {name} is not one whole output")));
+        return Err(fail(
+            Class::BadOutput,
+            format!("{plant:?}: {name} is not one whole output"),
+        ));
     }
     Ok(Pass::Ok)
 }
@@ -1058,10 +1146,15 @@ fn fuzz_cli_output_targets() {
         1usize..=2,
     );
     let dir = CaseDir::new("output_targets");
-    fuzz(file!(), "cli_output_targets", 24, KNOWN, strategy, |&(cmd, plant, writers)| {
-        Case {
+    fuzz(
+        file!(),
+        "cli_output_targets",
+        24,
+        KNOWN,
+        strategy,
+        |&(cmd, plant, writers)| Case {
             verdict: run_output_target(cmd, plant, writers, &dir),
             what: format!("{:?} with {plant:?}, {writers} writer(s)", WRITERS[cmd].0),
-        }
-    });
+        },
+    );
 }

@@ -17,7 +17,16 @@ use scatterloc::scenario::presets;
 
 /// The flags of a small, fast plan (tests/cli/plan.rs): move the receivers, p90 over the area.
 const PLAN: [&str; 10] = [
-    "--grid", "16", "--move", "rx", "--objective", "p90", "--roi", "-7.5,30,-10,26", "--budget", "100",
+    "--grid",
+    "16",
+    "--move",
+    "rx",
+    "--objective",
+    "p90",
+    "--roi",
+    "-7.5,30,-10,26",
+    "--budget",
+    "100",
 ];
 
 fn preset_file(dir: &TempDir) -> String {
@@ -31,7 +40,10 @@ fn without_timing(v: &Value) -> Value {
         Value::Object(m) => Value::Object(
             m.iter()
                 .filter(|(k, _)| {
-                    !(k.contains("wall") || k.contains("_ms") || k.contains("ns_per") || *k == "threads")
+                    !(k.contains("wall")
+                        || k.contains("_ms")
+                        || k.contains("ns_per")
+                        || *k == "threads")
                 })
                 .map(|(k, v)| (k.clone(), without_timing(v)))
                 .collect(),
@@ -142,7 +154,10 @@ fn concurrent_writers_never_tear_the_output() {
             let got: Value = serde_json::from_str(&text)
                 .unwrap_or_else(|e| panic!("{name} trial {trial}: torn JSON: {e}"));
             assert_eq!(without_timing(&got), want, "{name} trial {trial}");
-            assert_eq!(new_files(&dir, &["s.json", "out.json"]), Vec::<String>::new());
+            assert_eq!(
+                new_files(&dir, &["s.json", "out.json"]),
+                Vec::<String>::new()
+            );
         }
     }
 }
@@ -160,27 +175,68 @@ fn planted_links_are_never_followed() {
         std::os::unix::fs::symlink(&victim, dir.path(planted)).unwrap();
     }
     let out = dir.path("m.json");
-    ok_json(&["crlb-map", "--scenario", &scenario, "--out", &out, "--nx", "8", "--ny", "8"]);
+    ok_json(&[
+        "crlb-map",
+        "--scenario",
+        &scenario,
+        "--out",
+        &out,
+        "--nx",
+        "8",
+        "--ny",
+        "8",
+    ]);
     assert_eq!(std::fs::read_to_string(&victim).unwrap(), "precious");
     let meta = std::fs::symlink_metadata(&out).unwrap();
     assert!(meta.file_type().is_file(), "m.json is not a regular file");
-    assert_eq!(common::cli::read_json(&out)["x_m"].as_array().unwrap().len(), 8);
+    assert_eq!(
+        common::cli::read_json(&out)["x_m"]
+            .as_array()
+            .unwrap()
+            .len(),
+        8
+    );
 
     // A link at the target: to the victim, and to /dev/null (the data would be lost).
     for (link, to) in [("l.png", victim.as_str()), ("null.png", "/dev/null")] {
         let p = dir.path(link);
         std::os::unix::fs::symlink(to, &p).unwrap();
         fails(
-            &["crlb-map", "--scenario", &scenario, "--out", &p, "--nx", "8", "--ny", "8"],
+            &[
+                "crlb-map",
+                "--scenario",
+                &scenario,
+                "--out",
+                &p,
+                "--nx",
+                "8",
+                "--ny",
+                "8",
+            ],
             &["--out", link, "symbolic link", "refusing"],
         );
         let plan = dir.path("plan.json");
         fails(
-            &[&["plan", "--scenario", &scenario, "--out", &plan, "--figure", &p][..], &PLAN].concat(),
+            &[
+                &[
+                    "plan",
+                    "--scenario",
+                    &scenario,
+                    "--out",
+                    &plan,
+                    "--figure",
+                    &p,
+                ][..],
+                &PLAN,
+            ]
+            .concat(),
             &["--figure", link, "symbolic link"],
         );
         assert!(!std::path::Path::new(&plan).exists(), "plan.json written");
-        assert!(std::fs::symlink_metadata(&p).unwrap().file_type().is_symlink());
+        assert!(std::fs::symlink_metadata(&p)
+            .unwrap()
+            .file_type()
+            .is_symlink());
     }
     assert_eq!(std::fs::read_to_string(&victim).unwrap(), "precious");
     let left: Vec<String> = new_files(&dir, &[])
@@ -207,10 +263,30 @@ fn fifo_and_device_targets_are_refused_without_blocking() {
     {
         let (target, what) = (fifo.as_str(), "a FIFO");
         let cases: Vec<(Vec<&str>, &str)> = vec![
-            (vec!["crlb-map", "--scenario", &scenario, "--out", target], "--out"),
-            ([&["plan", "--scenario", &scenario, "--out", target][..], &PLAN].concat(), "--out"),
             (
-                vec!["montecarlo", "--trajectory", "I", "--json", target, "--runs", "4", "--dt", "0.1"],
+                vec!["crlb-map", "--scenario", &scenario, "--out", target],
+                "--out",
+            ),
+            (
+                [
+                    &["plan", "--scenario", &scenario, "--out", target][..],
+                    &PLAN,
+                ]
+                .concat(),
+                "--out",
+            ),
+            (
+                vec![
+                    "montecarlo",
+                    "--trajectory",
+                    "I",
+                    "--json",
+                    target,
+                    "--runs",
+                    "4",
+                    "--dt",
+                    "0.1",
+                ],
                 "--json",
             ),
         ];
@@ -220,8 +296,24 @@ fn fifo_and_device_targets_are_refused_without_blocking() {
         }
     }
     // calibrate --out and simulate-walk's files.
-    ok_json(&["simulate-walk", "--scenario", &scenario, "--out-dir", &walk, "--duration", "2"]);
-    let args = ["calibrate", "--scenario", &scenario, "--snapshots", &snaps, "--out", &fifo];
+    ok_json(&[
+        "simulate-walk",
+        "--scenario",
+        &scenario,
+        "--out-dir",
+        &walk,
+        "--duration",
+        "2",
+    ]);
+    let args = [
+        "calibrate",
+        "--scenario",
+        &scenario,
+        "--snapshots",
+        &snaps,
+        "--out",
+        &fifo,
+    ];
     let o = run_bounded(&args, limit, "calibrate");
     common::cli::fails_output(&args, &o, &["--out", "a FIFO"]);
     let fifo_dir = TempDir::new();
@@ -231,7 +323,15 @@ fn fifo_and_device_targets_are_refused_without_blocking() {
         .unwrap();
     assert!(made.success());
     let d = fifo_dir.0.to_string_lossy().into_owned();
-    let args = ["simulate-walk", "--scenario", &scenario, "--out-dir", &d, "--duration", "2"];
+    let args = [
+        "simulate-walk",
+        "--scenario",
+        &scenario,
+        "--out-dir",
+        &d,
+        "--duration",
+        "2",
+    ];
     let o = run_bounded(&args, limit, "simulate-walk");
     common::cli::fails_output(&args, &o, &["--out-dir", "truth.json", "a FIFO"]);
     assert_eq!(fifo_dir.files(), vec!["truth.json".to_string()]);
@@ -249,7 +349,15 @@ fn simulate_walk_with_a_planted_truth_link_writes_nothing() {
     std::os::unix::fs::symlink(&target, out.path("truth.json")).unwrap();
     let d = out.0.to_string_lossy().into_owned();
     fails(
-        &["simulate-walk", "--scenario", &scenario, "--out-dir", &d, "--duration", "2"],
+        &[
+            "simulate-walk",
+            "--scenario",
+            &scenario,
+            "--out-dir",
+            &d,
+            "--duration",
+            "2",
+        ],
         &["--out-dir", "truth.json", "symbolic link"],
     );
     assert_eq!(out.files(), vec!["truth.json".to_string()]);
@@ -281,11 +389,22 @@ fn a_full_disk_leaves_nothing() {
     // 64 KiB: the measurements are larger, the calibration snapshots (500 × 4 links) smaller.
     let o = run_with_file_limit(
         128,
-        &["simulate-walk", "--scenario", &scenario, "--out-dir", &d, "--duration", "20"],
+        &[
+            "simulate-walk",
+            "--scenario",
+            &scenario,
+            "--out-dir",
+            &d,
+            "--duration",
+            "20",
+        ],
     );
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(1), "{err}");
-    assert!(err.contains("--out-dir") && err.contains("File too large"), "{err}");
+    assert!(
+        err.contains("--out-dir") && err.contains("File too large"),
+        "{err}"
+    );
     assert_eq!(out.files(), Vec::<String>::new());
 
     // plan: the PNG figure (tens of KiB) fails; plan.json (a few KiB) would fit.
@@ -293,11 +412,26 @@ fn a_full_disk_leaves_nothing() {
     let fig = dir.path("plan.png");
     let o = run_with_file_limit(
         16,
-        &[&["plan", "--scenario", &scenario, "--out", &plan, "--figure", &fig][..], &PLAN].concat(),
+        &[
+            &[
+                "plan",
+                "--scenario",
+                &scenario,
+                "--out",
+                &plan,
+                "--figure",
+                &fig,
+            ][..],
+            &PLAN,
+        ]
+        .concat(),
     );
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(1), "{err}");
-    assert!(err.contains("--figure") && err.contains("File too large"), "{err}");
+    assert!(
+        err.contains("--figure") && err.contains("File too large"),
+        "{err}"
+    );
     assert_eq!(new_files(&dir, &["s.json"]), Vec::<String>::new());
 }
 
@@ -321,16 +455,33 @@ fn long_names_are_a_named_error_fast() {
     );
     let plan = dir.path("plan.json");
     fails(
-        &[&["plan", "--scenario", &big, "--out", &plan, "--figure", &png][..], &PLAN].concat(),
+        &[
+            &["plan", "--scenario", &big, "--out", &plan, "--figure", &png][..],
+            &PLAN,
+        ]
+        .concat(),
         &["name: 104857600 bytes long, at most 256"],
     );
     assert!(t.elapsed() < Duration::from_secs(60), "{:?}", t.elapsed());
-    assert_eq!(new_files(&dir, &["node.json", "name.json"]), Vec::<String>::new());
+    assert_eq!(
+        new_files(&dir, &["node.json", "name.json"]),
+        Vec::<String>::new()
+    );
     // 256 bytes is still fine.
     let mut s: Value = serde_json::from_str(&presets::sensors2019().to_json()).unwrap();
     s["receivers"][1]["name"] = Value::String("R".repeat(256));
     let ok = dir.write("ok.json", &s);
-    ok_json(&["crlb-map", "--scenario", &ok, "--out", &dir.path("ok-map.json"), "--nx", "4", "--ny", "4"]);
+    ok_json(&[
+        "crlb-map",
+        "--scenario",
+        &ok,
+        "--out",
+        &dir.path("ok-map.json"),
+        "--nx",
+        "4",
+        "--ny",
+        "4",
+    ]);
     s["receivers"][1]["name"] = Value::String("R".repeat(257));
     let bad = dir.write("bad.json", &s);
     fails(
@@ -346,17 +497,41 @@ fn calibrate_extension_and_walk_directory_exit_codes() {
     let dir = TempDir::new();
     let scenario = preset_file(&dir);
     let walk = dir.path("walk");
-    ok_json(&["simulate-walk", "--scenario", &scenario, "--out-dir", &walk, "--duration", "2"]);
+    ok_json(&[
+        "simulate-walk",
+        "--scenario",
+        &scenario,
+        "--out-dir",
+        &walk,
+        "--duration",
+        "2",
+    ]);
     let snaps = format!("{walk}/calibration_snapshots.json");
     let txt = dir.path("cal.txt");
     fails(
-        &["calibrate", "--scenario", &scenario, "--snapshots", &snaps, "--out", &txt],
+        &[
+            "calibrate",
+            "--scenario",
+            &scenario,
+            "--snapshots",
+            &snaps,
+            "--out",
+            &txt,
+        ],
         &["--out", "unknown extension '.txt'", ".json"],
     );
     assert!(!std::path::Path::new(&txt).exists());
     let file = dir.write_text("plain", "x");
     fails(
-        &["simulate-walk", "--scenario", &scenario, "--out-dir", &format!("{file}/sub"), "--duration", "2"],
+        &[
+            "simulate-walk",
+            "--scenario",
+            &scenario,
+            "--out-dir",
+            &format!("{file}/sub"),
+            "--duration",
+            "2",
+        ],
         &["--out-dir", "cannot create"],
     );
 }
@@ -379,7 +554,13 @@ fn stdout_errors_are_not_exit_0() {
     let dir = TempDir::new();
     let scenario = preset_file(&dir);
     let mut child = Command::new(BIN)
-        .args(["crlb-map", "--scenario", &scenario, "--out", &dir.path("m.json")])
+        .args([
+            "crlb-map",
+            "--scenario",
+            &scenario,
+            "--out",
+            &dir.path("m.json"),
+        ])
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
@@ -388,7 +569,10 @@ fn stdout_errors_are_not_exit_0() {
     let o = child.wait_with_output().unwrap();
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(1), "{err}");
-    assert!(err.contains("stdout:") && err.contains("Broken pipe"), "{err}");
+    assert!(
+        err.contains("stdout:") && err.contains("Broken pipe"),
+        "{err}"
+    );
     let o = Command::new(BIN)
         .args(["preset", "sensors2019"])
         .stdout(Stdio::null())

@@ -42,3 +42,47 @@ fn trailing_characters_are_rejected() {
         Err(Error::Parse { .. })
     ));
 }
+
+/// Issue 24: names are capped at `limits::MAX_NAME_BYTES` (256) bytes in validation, the
+/// scenario's, each node's and those a link list refers to, each error naming its field; 256
+/// bytes pass. (A 100 MB name made figures take minutes.)
+#[test]
+fn names_longer_than_the_cap_are_named_errors() {
+    use crate::error::limits::MAX_NAME_BYTES;
+    use crate::scenario::presets;
+    use crate::scenario::LinkSpec;
+    assert_eq!(MAX_NAME_BYTES, 256);
+    let long = "é".repeat(129); // 258 bytes, 129 characters: the cap counts bytes.
+    let check = |s: &Scenario, field: &str| {
+        let e = s.validate().unwrap_err();
+        assert_eq!(
+            e,
+            Error::NameTooLong {
+                field: field.into(),
+                bytes: 258,
+                max: 256
+            }
+        );
+        assert_eq!(e.field(), Some(field));
+        assert_eq!(
+            e.to_string(),
+            format!("{field}: 258 bytes long, at most 256 are allowed")
+        );
+    };
+    let mut s = presets::sensors2019();
+    s.name = long.clone();
+    check(&s, "name");
+    let mut s = presets::sensors2019();
+    s.transmitters[0].name = long.clone();
+    check(&s, "transmitters[0].name");
+    let mut s = presets::sensors2019();
+    s.receivers[3].name = long.clone();
+    check(&s, "receivers[3].name");
+    let mut s = presets::sensors2019();
+    let rx = s.receivers[0].name.clone();
+    s.links = LinkSpec::List(vec![[long.clone(), rx]]);
+    check(&s, "links[0][0]");
+    let mut s = presets::sensors2019();
+    s.receivers[3].name = "R".repeat(256);
+    assert!(s.validate().is_ok());
+}

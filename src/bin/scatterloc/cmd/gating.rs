@@ -89,11 +89,9 @@ fn prepare_out_dir(dir: &str) -> Result<bool, CliError> {
         return Err(CliError::usage("--out-dir: the path is empty".to_string()));
     }
     match std::fs::metadata(dir) {
-        Ok(meta) if !meta.is_dir() => {
-            return Err(CliError::usage(format!(
-                "--out-dir: '{dir}' exists and is not a directory"
-            )))
-        }
+        Ok(meta) if !meta.is_dir() => Err(CliError::usage(format!(
+            "--out-dir: '{dir}' exists and is not a directory"
+        ))),
         Ok(_) => {
             for name in WALK_FILES {
                 check_writable("out-dir", &walk_file(dir, name))?;
@@ -192,58 +190,69 @@ struct Walk<'a> {
 impl Walk<'_> {
     /// Draws the walk and writes its three files into `dir`, all or none; returns the truth.
     fn write(&self, dir: &str) -> Result<Truth, CliError> {
-    let Walk { model, channel, clean, ncal, seed, dt, q, steps, from_truth } = *self;
-    let path = LoopPath::default();
-    let mut rng = measure::rng(seed, 0);
-    let cal_snaps = clean.calibration_snapshots(model, ncal, &mut rng);
-    let states = path.states(dt, steps);
-    let raw = |snap: Vec<Vec<scatterloc::track::gating::DelayEstimate>>| -> RawStep {
-        Measurements::raw_step(&snap)
-    };
-    // The snapshot at t₀ (drawn either way, so the later ones do not depend on --start).
-    let s0 = path.state_at(0.0);
-    let first = raw(channel.snapshot(model, Some(scatterloc::Vec2::new(s0[0], s0[1])), &mut rng));
-    let mut raw_steps = Vec::with_capacity(steps);
-    let mut resolved = Vec::with_capacity(steps);
-    for s in &states {
-        let r = scatterloc::Vec2::new(s[0], s[1]);
-        raw_steps.push(raw(channel.snapshot(model, Some(r), &mut rng)));
-        resolved.push(
-            (0..model.link_count())
-                .map(|p| channel.resolved(model, p, model.network.delay(p, r)))
-                .collect(),
-        );
-    }
-    let p0 = paper_initial_covariance();
-    let measurements = Measurements {
-        dt_s: dt,
-        process_noise: q,
-        initial_state: from_truth.then(|| s0.into()),
-        initial_covariance: from_truth
-            .then(|| std::array::from_fn(|i| std::array::from_fn(|j| p0[(i, j)]))),
-        initial_snapshot: (!from_truth).then_some(first),
-        sigma_s: None,
-        steps: None,
-        raw_steps: Some(raw_steps),
-    };
-    let truth = Truth {
-        t_s: (1..=steps).map(|k| k as f64 * dt).collect(),
-        states: states.iter().map(|s| (*s).into()).collect(),
-        resolved,
-    };
-    // All three files or none (issue 24).
-    let [cal_file, meas_file, truth_file] = WALK_FILES.map(|name| walk_file(dir, name));
-    let mut files = OutputSet::new();
-    files.json(
-        "out-dir",
-        &cal_file,
-        &CalibrationSnapshots {
-            snapshots: cal_snaps,
-        },
-    )?;
-    files.json("out-dir", &meas_file, &measurements)?;
-    files.json("out-dir", &truth_file, &truth)?;
-    files.commit()?;
-    Ok(truth)
+        let Walk {
+            model,
+            channel,
+            clean,
+            ncal,
+            seed,
+            dt,
+            q,
+            steps,
+            from_truth,
+        } = *self;
+        let path = LoopPath::default();
+        let mut rng = measure::rng(seed, 0);
+        let cal_snaps = clean.calibration_snapshots(model, ncal, &mut rng);
+        let states = path.states(dt, steps);
+        let raw = |snap: Vec<Vec<scatterloc::track::gating::DelayEstimate>>| -> RawStep {
+            Measurements::raw_step(&snap)
+        };
+        // The snapshot at t₀ (drawn either way, so the later ones do not depend on --start).
+        let s0 = path.state_at(0.0);
+        let first =
+            raw(channel.snapshot(model, Some(scatterloc::Vec2::new(s0[0], s0[1])), &mut rng));
+        let mut raw_steps = Vec::with_capacity(steps);
+        let mut resolved = Vec::with_capacity(steps);
+        for s in &states {
+            let r = scatterloc::Vec2::new(s[0], s[1]);
+            raw_steps.push(raw(channel.snapshot(model, Some(r), &mut rng)));
+            resolved.push(
+                (0..model.link_count())
+                    .map(|p| channel.resolved(model, p, model.network.delay(p, r)))
+                    .collect(),
+            );
+        }
+        let p0 = paper_initial_covariance();
+        let measurements = Measurements {
+            dt_s: dt,
+            process_noise: q,
+            initial_state: from_truth.then(|| s0.into()),
+            initial_covariance: from_truth
+                .then(|| std::array::from_fn(|i| std::array::from_fn(|j| p0[(i, j)]))),
+            initial_snapshot: (!from_truth).then_some(first),
+            sigma_s: None,
+            steps: None,
+            raw_steps: Some(raw_steps),
+        };
+        let truth = Truth {
+            t_s: (1..=steps).map(|k| k as f64 * dt).collect(),
+            states: states.iter().map(|s| (*s).into()).collect(),
+            resolved,
+        };
+        // All three files or none (issue 24).
+        let [cal_file, meas_file, truth_file] = WALK_FILES.map(|name| walk_file(dir, name));
+        let mut files = OutputSet::new();
+        files.json(
+            "out-dir",
+            &cal_file,
+            &CalibrationSnapshots {
+                snapshots: cal_snaps,
+            },
+        )?;
+        files.json("out-dir", &meas_file, &measurements)?;
+        files.json("out-dir", &truth_file, &truth)?;
+        files.commit()?;
+        Ok(truth)
     }
 }

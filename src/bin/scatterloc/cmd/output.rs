@@ -214,7 +214,12 @@ impl OutputSet {
     }
 
     /// Stages `value` as compact JSON (and a newline) for `path`.
-    pub fn json<T: Serialize>(&mut self, flag: &str, path: &str, value: &T) -> Result<(), CliError> {
+    pub fn json<T: Serialize>(
+        &mut self,
+        flag: &str,
+        path: &str,
+        value: &T,
+    ) -> Result<(), CliError> {
         self.stage(flag, path, |w| {
             serde_json::to_writer(&mut *w, value).map_err(|e| write_failed(flag, path, e))?;
             w.write_all(b"\n").map_err(|e| write_failed(flag, path, e))
@@ -306,7 +311,15 @@ fn persist(mut tmp: NamedTempFile, flag: &str, path: &str) -> Result<Existing, C
             Existing::Nothing => match tmp.persist_noclobber(path) {
                 Ok(_) => return Ok(Existing::Nothing),
                 Err(e) if e.error.kind() == std::io::ErrorKind::AlreadyExists => tmp = e.file,
-                Err(e) => return Err(fail(e.error)),
+                // A file system without a no-replace rename or hard links (e.g. FAT on an old
+                // kernel): the target was just checked to be absent, a plain rename then.
+                Err(e) => {
+                    return e
+                        .file
+                        .persist(path)
+                        .map(|_| Existing::Nothing)
+                        .map_err(|e| fail(e.error))
+                }
             },
             Existing::File => {
                 return tmp
