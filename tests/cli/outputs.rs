@@ -579,4 +579,32 @@ fn stdout_errors_are_not_exit_0() {
         .output()
         .unwrap();
     assert!(o.status.success());
+    // `/dev/null` read-write (a daemon's descriptors, Python's `subprocess.DEVNULL`) is the
+    // runtime's stand-in for a closed stdout: refused for a result, accepted for the summary
+    // line of a run whose result went to a file.
+    let o = Command::new("sh")
+        .args([
+            "-c",
+            &format!("exec '{BIN}' preset sensors2019 1<>/dev/null"),
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(
+        o.status.code(),
+        Some(1),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let out = dir.path("rw.json");
+    let o = Command::new("sh")
+        .args([
+            "-c",
+            &format!("exec '{BIN}' crlb-map --scenario '{scenario}' --out '{out}' 1<>/dev/null"),
+        ])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let map: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
+    assert!(map.is_object());
 }

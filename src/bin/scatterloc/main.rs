@@ -35,12 +35,10 @@ fn main() {
         std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false)),
     );
     let argv: Vec<std::ffi::OsString> = std::env::args_os().skip(1).collect();
-    let result = stdout::check()
-        .and_then(|()| cli::parse(argv))
-        .and_then(|parsed| match parsed {
-            cli::Parsed::Run(args) => run(args.command),
-            cli::Parsed::Printed => Ok(()),
-        });
+    let result = cli::parse(argv).and_then(|parsed| match parsed {
+        cli::Parsed::Run(args) => run(args.command),
+        cli::Parsed::Printed => Ok(()),
+    });
     let code = match result {
         Ok(()) => 0,
         Err(e) => {

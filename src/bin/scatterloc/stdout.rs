@@ -6,7 +6,10 @@
 //! on `/dev/null` before `main`, read-write. Here stdout is written through a duplicate of
 //! descriptor 1 as a plain [`File`], so every error (`EBADF`, `EPIPE`, `ENOSPC`) is reported,
 //! and the runtime's stand-in for a closed stdout (`/dev/null` open for reading and writing) is
-//! refused. An explicit `>/dev/null` (write-only) is honoured.
+//! refused where stdout carries a command's result ([`write`]); a summary line beside output
+//! files ([`write_summary`]) is written to it like to any `/dev/null`, so a daemon's or
+//! Python's `subprocess.DEVNULL` stdout (also `/dev/null` read-write) does not fail a run whose
+//! results went to files. An explicit `>/dev/null` (write-only) is honoured.
 
 use std::fs::File;
 use std::io::{Read, Write};
@@ -37,14 +40,14 @@ fn is_closed_stand_in(f: &File) -> bool {
     reader.read(&mut byte).is_ok()
 }
 
-/// Descriptor 1 as a file, refused when it is closed (see the module doc).
-fn open() -> Result<File, CliError> {
+/// Descriptor 1 as a file; with `result`, refused when it is closed (see the module doc).
+fn open(result: bool) -> Result<File, CliError> {
     let fd = std::io::stdout()
         .as_fd()
         .try_clone_to_owned()
         .map_err(failed)?;
     let f = File::from(fd);
-    if is_closed_stand_in(&f) {
+    if result && is_closed_stand_in(&f) {
         return Err(failed(
             "standard output is closed (results are written there; redirect it to a file or /dev/null)",
         ));
@@ -52,14 +55,17 @@ fn open() -> Result<File, CliError> {
     Ok(f)
 }
 
-/// Fails when stdout is closed: `main` checks before any work, so a run whose results would be
-/// lost does not start (exit status 1).
-pub fn check() -> Result<(), CliError> {
-    open().map(drop)
+/// Writes a command's result `bytes` to stdout and flushes; any failure, a closed stdout
+/// included, is an error naming stdout.
+pub fn write(bytes: &[u8]) -> Result<(), CliError> {
+    let mut f = open(true)?;
+    f.write_all(bytes).and_then(|()| f.flush()).map_err(failed)
 }
 
-/// Writes `bytes` to stdout and flushes; any failure is an error naming stdout.
-pub fn write(bytes: &[u8]) -> Result<(), CliError> {
-    let mut f = open()?;
+/// Writes a summary line (the results went to files) to stdout and flushes; a write error
+/// (`EBADF`, `EPIPE`, `ENOSPC`) is an error naming stdout, the runtime's `/dev/null` stand-in
+/// for a closed stdout is not.
+pub fn write_summary(bytes: &[u8]) -> Result<(), CliError> {
+    let mut f = open(false)?;
     f.write_all(bytes).and_then(|()| f.flush()).map_err(failed)
 }

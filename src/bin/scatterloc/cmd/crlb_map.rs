@@ -16,7 +16,7 @@ use scatterloc::native::crlb_map_parallel;
 use scatterloc::scenario::Area;
 use scatterloc::{Error, Model, Scenario};
 
-use super::io::{emit, read_scenario};
+use super::io::{emit_summary, read_scenario};
 use super::output::{check_writable, write_figure, write_json_file, Figure, Format};
 use crate::cli::CrlbMapArgs;
 use crate::failure::CliError;
@@ -121,7 +121,7 @@ pub fn crlb_map(args: &CrlbMapArgs) -> Result<(), CliError> {
         "max_m": max,
         "unbounded_cells": values.iter().filter(|v| !v.is_finite()).count(),
     });
-    emit(&summary.to_string())
+    emit_summary(&summary.to_string())
 }
 
 fn round3(v: f64) -> f64 {

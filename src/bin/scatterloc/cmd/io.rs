@@ -12,12 +12,24 @@ use scatterloc::{Model, Scenario};
 
 use crate::failure::CliError;
 
-/// Writes `text` and a newline to stdout, checked ([`crate::stdout`]).
-pub fn emit(text: &str) -> Result<(), CliError> {
+/// `text` and a newline.
+fn line(text: &str) -> Vec<u8> {
     let mut bytes = Vec::with_capacity(text.len() + 1);
     bytes.extend_from_slice(text.as_bytes());
     bytes.push(b'\n');
-    crate::stdout::write(&bytes)
+    bytes
+}
+
+/// Writes a command's result `text` and a newline to stdout, checked ([`crate::stdout::write`]:
+/// a closed stdout is an error).
+pub fn emit(text: &str) -> Result<(), CliError> {
+    crate::stdout::write(&line(text))
+}
+
+/// Writes the summary line of a command whose results went to files
+/// ([`crate::stdout::write_summary`]).
+pub fn emit_summary(text: &str) -> Result<(), CliError> {
+    crate::stdout::write_summary(&line(text))
 }
 
 /// Pretty JSON on stdout (serde_json writes non-finite numbers as `null`).

@@ -188,6 +188,11 @@ impl OutputSet {
         OutputSet::default()
     }
 
+    /// Whether no file is staged.
+    pub fn is_empty(&self) -> bool {
+        self.staged.is_empty()
+    }
+
     /// A new temporary for `path` (checked), filled by `write`, flushed and synced to disk.
     fn stage(
         &mut self,

@@ -17,7 +17,7 @@ use scatterloc::plan::{Polygon, MAX_PLAN_GRID, MIN_PLAN_GRID};
 use scatterloc::present::{run_plan, PlanJson, PlanRequest, DEFAULT_PLAN_BUDGET};
 use scatterloc::{Error, Model, Scenario};
 
-use super::io::{emit, read_json_file};
+use super::io::{emit_summary, read_json_file};
 use super::output::{check_writable, Figure, Format, OutputSet};
 use super::study::{cancelled, interrupted, load_layout, run_with_bar};
 use crate::cli::PlanArgs;
@@ -115,7 +115,7 @@ pub fn plan(args: &PlanArgs) -> Result<(), CliError> {
         "seed": config.seed,
         "wall_time_s": (wall * 1e3).round() / 1e3,
     });
-    emit(&summary.to_string())
+    emit_summary(&summary.to_string())
 }
 
 /// A core error of the plan as the flag that caused it: `--roi: …`, `--move: …`,

@@ -13,7 +13,7 @@ use scatterloc::chart::{
 };
 use scatterloc::study::{CurveDoc, TrackStudy as Study};
 
-use super::io::emit;
+use super::io::{emit, emit_summary};
 use super::output::{check_writable, Figure, Format, OutputSet};
 use super::study::{at_report_times, AtTime};
 use crate::failure::CliError;
@@ -169,7 +169,7 @@ impl Outputs {
                 ),
             })
             .collect();
-        emit(&encode(&Line {
+        emit_summary(&encode(&Line {
             body: Body::of(&summaries),
             json: self.json.as_deref(),
             out: self.figure.as_ref().map(|f| f.0.as_str()),

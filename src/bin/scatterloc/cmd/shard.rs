@@ -8,7 +8,7 @@ use serde::Serialize;
 use scatterloc::math::{Shard, MAX_SHARDS};
 use scatterloc::study::{PartFile, ShardDoc};
 
-use super::io::emit;
+use super::io::emit_summary;
 use super::output::{check_writable, write_json_file, Format};
 use crate::cli::{ShardArgs, ShardSpec};
 use crate::failure::CliError;
@@ -157,5 +157,5 @@ pub fn write_part<C: Serialize, S: Serialize + ?Sized, E: Serialize>(
     };
     let text = serde_json::to_string(&line)
         .map_err(|e| CliError::output(format!("encoding JSON: {e}")))?;
-    emit(&text)
+    emit_summary(&text)
 }

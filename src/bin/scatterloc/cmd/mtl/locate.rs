@@ -124,7 +124,7 @@ pub fn mtl_locate(args: &MtlLocateArgs) -> Result<(), CliError> {
         ),
         Some(p) => {
             write_json_file("out", p, &doc)?;
-            emit(&format!(
+            emit_summary(&format!(
                 "{{\"count\":{},\"out\":{}}}",
                 doc.count,
                 serde_json::to_string(p).unwrap_or_default()

@@ -26,7 +26,7 @@ use scatterloc::native::run_experiment_range;
 use scatterloc::Error;
 
 use super::flags::with_flag;
-use super::io::{emit, read_input};
+use super::io::{emit, emit_summary, read_input};
 use super::output::{check_writable, write_json_file, Figure, Format, OutputSet};
 use super::shard;
 use super::study::{cancelled, run_with_bar, threads};

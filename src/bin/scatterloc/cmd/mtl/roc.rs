@@ -359,6 +359,12 @@ fn write_result(
         let fig = figure_of(r, cfg, &xy);
         files.figure("out", p, format, curve_chart_size(), &fig)?;
     }
+    let files_written = !files.is_empty();
     files.commit()?;
-    emit(&summary_table(r, cfg, wall, used))
+    let table = summary_table(r, cfg, wall, used);
+    if files_written {
+        emit_summary(&table)
+    } else {
+        emit(&table)
+    }
 }

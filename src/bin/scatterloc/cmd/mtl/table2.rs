@@ -125,6 +125,7 @@ pub fn mtl_table2(args: &Table2Args) -> Result<(), CliError> {
             p_d: s.p_d,
         };
         write_json_file("json", p, &doc)?;
+        return emit_summary(&text);
     }
     emit(&text)
 }
