@@ -58,14 +58,18 @@ fn open(result: bool) -> Result<File, CliError> {
 /// Writes a command's result `bytes` to stdout and flushes; any failure, a closed stdout
 /// included, is an error naming stdout.
 pub fn write(bytes: &[u8]) -> Result<(), CliError> {
-    let mut f = open(true)?;
-    f.write_all(bytes).and_then(|()| f.flush()).map_err(failed)
+    put(bytes, true)
 }
 
 /// Writes a summary line (the results went to files) to stdout and flushes; a write error
 /// (`EBADF`, `EPIPE`, `ENOSPC`) is an error naming stdout, the runtime's `/dev/null` stand-in
 /// for a closed stdout is not.
 pub fn write_summary(bytes: &[u8]) -> Result<(), CliError> {
-    let mut f = open(false)?;
+    put(bytes, false)
+}
+
+/// Writes `bytes` to descriptor 1 ([`open`] with `result`) and flushes.
+fn put(bytes: &[u8], result: bool) -> Result<(), CliError> {
+    let mut f = open(result)?;
     f.write_all(bytes).and_then(|()| f.flush()).map_err(failed)
 }
