@@ -45,6 +45,7 @@
 
 extern crate alloc;
 
+pub mod channel;
 pub mod error;
 pub mod formats;
 pub mod localize;

@@ -249,7 +249,11 @@ impl Measurements {
             .iter()
             .map(|l| {
                 l.iter()
-                    .map(|&[delay_s, amplitude]| DelayEstimate { delay_s, amplitude })
+                    .map(|&[delay_s, amplitude]| DelayEstimate {
+                        delay_s,
+                        amplitude,
+                        sigma_s: None,
+                    })
                     .collect()
             })
             .collect())

@@ -12,6 +12,8 @@ pub type Mat2 = nalgebra::Matrix2<Real>;
 pub type Vec4 = nalgebra::Vector4<Real>;
 /// A 4×4 matrix over the tracking state (transition, covariance, information).
 pub type Mat4 = nalgebra::Matrix4<Real>;
+/// A complex number of [`Real`]s (channel responses and path amplitudes, spec C1).
+pub type Complex = nalgebra::Complex<Real>;
 
 /// Speed of light in vacuum `c`, m/s.
 pub const SPEED_OF_LIGHT: Real = 299_792_458.0;

@@ -13,6 +13,7 @@
 use alloc::format;
 use alloc::vec::Vec;
 
+pub use crate::channel::DelayEstimate;
 use crate::error::{check_len, limits, Error, Result};
 use crate::math::Real;
 use crate::track::gating::Calibration;
@@ -23,15 +24,6 @@ pub const INNOVATION_GATE: Real = 3.0;
 
 /// Largest number of delay estimates accepted for one link in one snapshot.
 pub const MAX_ESTIMATES_PER_LINK: usize = 10_000;
-
-/// One entry of a parameter estimator's per-snapshot list: a delay and its amplitude.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct DelayEstimate {
-    /// `τ̂`, s.
-    pub delay_s: Real,
-    /// Amplitude `|α̂|` (any linear unit; only compared within a link).
-    pub amplitude: Real,
-}
 
 /// How a link's measurement was chosen in one snapshot.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

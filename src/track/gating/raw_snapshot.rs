@@ -108,6 +108,7 @@ impl StaticChannel {
                     .map(|&s| DelayEstimate {
                         delay_s: s + self.static_sigma_s * standard_normal(rng),
                         amplitude: self.static_amplitude,
+                        sigma_s: None,
                     })
                     .collect();
                 if let Some(r) = target {
@@ -117,6 +118,7 @@ impl StaticChannel {
                         list.push(DelayEstimate {
                             delay_s: noisy,
                             amplitude: sqrt(model.snr(p, r)),
+                            sigma_s: None,
                         });
                     }
                 }
@@ -126,6 +128,7 @@ impl StaticChannel {
                     list.push(DelayEstimate {
                         delay_s: statics[0] + u * self.false_alarm_span_s,
                         amplitude: 1.0,
+                        sigma_s: None,
                     });
                 }
                 list.sort_by(|a, b| a.delay_s.total_cmp(&b.delay_s));

@@ -7,6 +7,7 @@ fn est(delay_ns: Real, amplitude: Real) -> DelayEstimate {
     DelayEstimate {
         delay_s: delay_ns * 1e-9,
         amplitude,
+        sigma_s: None,
     }
 }
 
