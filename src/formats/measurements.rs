@@ -13,11 +13,23 @@ use serde::{Deserialize, Serialize};
 use crate::error::{Error, Result};
 use crate::math::{Mat4, Real, Vec4};
 use crate::scenario::parse_json;
-use crate::track::gating::DelayEstimate;
+use crate::channel::{DelayEstimate, Snapshot};
 use crate::track::{ConstantVelocity, MAX_STEPS};
 
-/// One raw step: per link, every `[delay_s, amplitude]` estimate.
-pub type RawStep = Vec<Vec<[f64; 2]>>;
+/// One raw estimate of a measurements file: `[delay_s, amplitude]`, or `[delay_s, amplitude,
+/// sigma_s]` when the estimator gives the delay's standard deviation (`cir estimate` does, C5);
+/// the tracker then weights that delay with it unless the file fixes `sigma_s`.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize, Serialize)]
+#[serde(untagged)]
+pub enum RawEstimate {
+    /// `[delay_s, amplitude]`.
+    Pair([f64; 2]),
+    /// `[delay_s, amplitude, sigma_s]`.
+    WithSigma([f64; 3]),
+}
+
+/// One raw step: per link, every estimate.
+pub type RawStep = Vec<Vec<RawEstimate>>;
 
 /// `sigma_s` of a measurements file: one delay standard deviation for all links or one per
 /// link, s.
@@ -242,28 +254,53 @@ impl Measurements {
     }
 
     /// One raw step (or the initial snapshot) as the core's estimates, after checking it holds
-    /// one list per each of `links` links (errors name `field`).
-    pub fn estimates(field: &str, step: &RawStep, links: usize) -> Result<Vec<Vec<DelayEstimate>>> {
+    /// one list per each of `links` links and every given σ is finite and `> 0` (errors name
+    /// `field`, and `field[p][i]` for a bad σ).
+    pub fn estimates(field: &str, step: &RawStep, links: usize) -> Result<Snapshot> {
         one_list_per_link(field, step.len(), links)?;
-        Ok(step
-            .iter()
-            .map(|l| {
+        step.iter()
+            .enumerate()
+            .map(|(p, l)| {
                 l.iter()
-                    .map(|&[delay_s, amplitude]| DelayEstimate {
-                        delay_s,
-                        amplitude,
-                        sigma_s: None,
+                    .enumerate()
+                    .map(|(i, e)| match *e {
+                        RawEstimate::Pair([delay_s, amplitude]) => Ok(DelayEstimate {
+                            delay_s,
+                            amplitude,
+                            sigma_s: None,
+                        }),
+                        RawEstimate::WithSigma([delay_s, amplitude, sigma_s]) => {
+                            if !(sigma_s.is_finite() && sigma_s > 0.0) {
+                                return Err(Error::NotPositive {
+                                    field: format!("{field}[{p}][{i}] sigma_s"),
+                                    value: sigma_s,
+                                });
+                            }
+                            Ok(DelayEstimate {
+                                delay_s,
+                                amplitude,
+                                sigma_s: Some(sigma_s),
+                            })
+                        }
                     })
                     .collect()
             })
-            .collect())
+            .collect()
     }
 
-    /// The raw form of estimates (the inverse of [`Measurements::estimates`]).
+    /// The raw form of estimates (the inverse of [`Measurements::estimates`]): pairs, or
+    /// triples where an estimate has a σ.
     pub fn raw_step(estimates: &[Vec<DelayEstimate>]) -> RawStep {
         estimates
             .iter()
-            .map(|l| l.iter().map(|e| [e.delay_s, e.amplitude]).collect())
+            .map(|l| {
+                l.iter()
+                    .map(|e| match e.sigma_s {
+                        None => RawEstimate::Pair([e.delay_s, e.amplitude]),
+                        Some(s) => RawEstimate::WithSigma([e.delay_s, e.amplitude, s]),
+                    })
+                    .collect()
+            })
             .collect()
     }
 }

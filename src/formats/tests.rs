@@ -17,10 +17,10 @@ fn written_files_keep_their_keys_and_order() {
         process_noise: 0.1,
         initial_state: None,
         initial_covariance: None,
-        initial_snapshot: Some(vec![vec![[1e-7, 2.0]], vec![]]),
+        initial_snapshot: Some(vec![vec![RawEstimate::Pair([1e-7, 2.0])], vec![]]),
         sigma_s: None,
         steps: None,
-        raw_steps: Some(vec![vec![vec![], vec![[9e-8, 1.5]]]]),
+        raw_steps: Some(vec![vec![vec![], vec![RawEstimate::Pair([9e-8, 1.5])]]]),
     };
     let text = serde_json::to_string(&m).unwrap();
     assert_eq!(

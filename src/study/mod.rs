@@ -13,10 +13,13 @@
 //!   record [`RocConfig`].
 //! - [`track_measurements`]: a measurement file (`steps` or gated `raw_steps`) tracked by any
 //!   filter ([`TrackOutput`], the document of `scatterloc track`).
+//! - [`estimate_recording`], [`calibrate_estimates`], [`cir_track`]: a channel recording
+//!   through the front end (C5–C7) to a track (issue 25).
 //! - [`check_cost`], [`track_cpu_s`], [`FilterStudy::predicted_cpu_s`]: the predicted work
 //!   of a study or a track and the caps front ends refuse work over (issue 24).
 //! - [`PartSet`], [`PartFile`]: the part file format (`scatterloc-part`, version 2, with a digest of its sums) and what `merge` checks.
 
+mod cir;
 mod cost;
 mod drive;
 mod filters;
@@ -26,6 +29,10 @@ mod roc;
 mod sums;
 mod track;
 
+pub use cir::{
+    calibrate_estimates, cir_track, delays_only, estimate_recording, CirStart, CirTrackOutput,
+    CirTrackRequest, DelaySigma, FrontEndConfig, RecordingEstimates,
+};
 pub use cost::{check_cost, track_cpu_s, MAX_CPU_S, PAGE_STUDY_CPU_S, PAGE_TRACK_CPU_S};
 pub use drive::{Driver, Sequential};
 pub use filters::{particle_chunks, FilterResults, FilterRun, FilterStudy};

@@ -115,6 +115,8 @@ pub struct Selection {
     pub choices: Vec<Choice>,
     /// Per link the number of estimates discarded as static (E4).
     pub static_removed: Vec<usize>,
+    /// Per link the estimator's σ of the associated delay (C5), s, when it gave one.
+    pub sigmas: Vec<Option<Real>>,
 }
 
 /// Gates one snapshot (`estimates[p]` = link `p`'s list) against `calibration` and associates
@@ -136,6 +138,7 @@ pub fn select(
         delays: Vec::with_capacity(n),
         choices: Vec::with_capacity(n),
         static_removed: Vec::with_capacity(n),
+        sigmas: Vec::with_capacity(n),
     };
     let mut kept = Vec::new();
     for (link, list) in estimates.iter().enumerate() {
@@ -166,6 +169,7 @@ pub fn select(
         }
         let (index, choice) = associate(&kept, predictions.map(|p| &p[link]), rule);
         out.delays.push(index.map(|i| kept[i].delay_s));
+        out.sigmas.push(index.and_then(|i| kept[i].sigma_s));
         out.choices.push(choice);
         out.static_removed.push(list.len() - kept.len());
     }

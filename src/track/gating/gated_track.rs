@@ -30,6 +30,9 @@ pub struct GatedStep {
     pub summary: UpdateSummary,
     /// What gating and association made of the snapshot.
     pub selection: Selection,
+    /// Per link the delay σ of the update, s (the estimator's where it was used, else the
+    /// tracker's noise at the predicted position).
+    pub sigmas_s: Vec<Real>,
 }
 
 /// A filter (by default the EKF) whose measurements pass through gating and association.
@@ -42,6 +45,7 @@ pub struct GatedTracker<'a, F: Filter = Ekf> {
     motion: ConstantVelocity,
     noise: MeasurementNoise<'a>,
     rule: AssociationRule,
+    estimate_sigmas: bool,
 }
 
 impl<'a, F: Filter> GatedTracker<'a, F> {
@@ -63,7 +67,22 @@ impl<'a, F: Filter> GatedTracker<'a, F> {
             motion,
             noise,
             rule,
+            estimate_sigmas: true,
         })
+    }
+
+    /// Whether an associated delay that carries the estimator's own σ (C5) is weighted with it
+    /// (the default; `false`: always the tracker's `noise`). A fixed `noise`
+    /// ([`MeasurementNoise::Fixed`]) always wins: a file that fixes `sigma_s` means it.
+    pub fn with_estimate_sigmas(mut self, on: bool) -> Self {
+        self.estimate_sigmas = on;
+        self
+    }
+
+    /// The motion model of the next [`GatedTracker::step`] (a recording's snapshots need not be
+    /// uniform in time).
+    pub fn set_motion(&mut self, motion: ConstantVelocity) {
+        self.motion = motion;
     }
 
     /// Predict, gate and associate `snapshot` (`[p]` = link `p`'s estimates), update. On error
@@ -73,9 +92,27 @@ impl<'a, F: Filter> GatedTracker<'a, F> {
         next.predict(&self.motion);
         let predictions = next.predicted_delays(self.model, self.noise)?;
         let selection = select(self.calibration, snapshot, Some(&predictions), self.rule)?;
-        let summary = next.update(self.model, &selection.delays, self.noise)?;
+        let own = self.estimate_sigmas && !matches!(self.noise, MeasurementNoise::Fixed(_));
+        // The estimator's σ where it gave one (and `own`), else the tracker's noise at the
+        // prediction.
+        let r = next.position();
+        let sigmas_s: Vec<Real> = (0..self.model.link_count())
+            .map(|p| match selection.sigmas[p] {
+                Some(s) if own => s,
+                _ => self.noise.sigma(self.model, p, r),
+            })
+            .collect();
+        let summary = if own && selection.sigmas.iter().any(Option::is_some) {
+            next.update(self.model, &selection.delays, MeasurementNoise::Fixed(&sigmas_s))?
+        } else {
+            next.update(self.model, &selection.delays, self.noise)?
+        };
         self.filter = next;
-        Ok(GatedStep { summary, selection })
+        Ok(GatedStep {
+            summary,
+            selection,
+            sigmas_s,
+        })
     }
 }
 

@@ -1,0 +1,379 @@
+//! From a channel recording to a track, as one use case (issue 25; spec C1–C7, §4, §6): every
+//! recorded link's responses go through the snapshot estimator (C5) and that link's path
+//! tracker (C6) ([`estimate_recording`], one driver job per link: the links are independent,
+//! the snapshots of a link are not); the estimates of a recording of the empty area become the
+//! static clusters in (delay, amplitude) (C7), against which every snapshot of the walk is gated
+//! (E4) and associated (§4); the track starts from the first snapshot whose links give a
+//! Levenberg–Marquardt fix (§5) and runs through any filter ([`cir_track`]). The CLI's
+//! `cir estimate` and `cir track`, the page's channel view and library users call these.
+//!
+//! Delays are weighted with the estimator's own σ̂_τ (C4 at the fitted SNR) by default: it
+//! comes from the data, where the link budget's σ (E8) needs the target's RCS and the radio's
+//! losses, which a user of a recording rarely knows.
+
+use alloc::format;
+use alloc::string::ToString;
+use alloc::vec;
+use alloc::vec::Vec;
+
+use serde::Serialize;
+
+use crate::channel::{
+    Band, DelayEstimate, Estimator, EstimatorConfig, PathTracker, PathTrackerConfig, Recording,
+    Snapshot, TrackedPath,
+};
+use crate::error::{check_every, Cancel, Error, Result};
+use crate::math::{Complex, Mat4, Real, Vec4};
+use crate::measure::{rng, Model};
+use crate::scenario::Area;
+use crate::study::{Driver, TrackStart};
+use crate::track::gating::{
+    start_from_snapshot, AmplitudeClusterConfig, AssociationRule, Calibration, GatedTracker,
+    START_SPEED_SIGMA_MPS,
+};
+use crate::track::{step_ns, ConstantVelocity, Filter, FilterKind, MeasurementNoise, Tracker};
+
+/// The front end's settings: the snapshot estimator (C5) and the path tracker (C6).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct FrontEndConfig {
+    /// The snapshot estimator.
+    pub estimator: EstimatorConfig,
+    /// The per-link path tracker.
+    pub paths: PathTrackerConfig,
+}
+
+/// The estimates of a recording: per snapshot and per link of the model (scenario link order)
+/// the tracked paths; a link the recording does not hold has none.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RecordingEstimates {
+    /// Snapshot times, s.
+    pub t_s: Vec<Real>,
+    /// Per model link whether the recording holds it.
+    pub recorded: Vec<bool>,
+    /// `paths[s][p]`: link `p`'s paths in snapshot `s`, ascending in delay.
+    pub paths: Vec<Vec<Vec<TrackedPath>>>,
+    /// `noise_var[s][p]`: the noise variance the estimator used, W (0 for a link not recorded).
+    pub noise_var: Vec<Vec<Real>>,
+}
+
+impl RecordingEstimates {
+    /// Number of snapshots.
+    pub fn len(&self) -> usize {
+        self.t_s.len()
+    }
+
+    /// Whether there is no snapshot.
+    pub fn is_empty(&self) -> bool {
+        self.t_s.is_empty()
+    }
+
+    /// Snapshot `s` as gating reads it: every path (confirmed or not) with its delay, amplitude
+    /// and σ̂_τ.
+    pub fn snapshot(&self, s: usize) -> Snapshot {
+        self.paths[s]
+            .iter()
+            .map(|l| l.iter().map(|t| t.estimate.delay_estimate()).collect())
+            .collect()
+    }
+
+    /// Every snapshot ([`RecordingEstimates::snapshot`]).
+    pub fn snapshots(&self) -> Vec<Snapshot> {
+        (0..self.len()).map(|s| self.snapshot(s)).collect()
+    }
+}
+
+/// The frequency-domain responses of one recorded link, snapshot after snapshot (C1; a CIR
+/// recording mapped by C2).
+fn link_paths(
+    rec: &Recording,
+    band: &Band,
+    link: usize,
+    cfg: &FrontEndConfig,
+    cancel: Cancel,
+    progress: &(dyn Fn(usize) + Sync),
+) -> Result<(Vec<Vec<TrackedPath>>, Vec<Real>)> {
+    let mut estimator = Estimator::new(band.clone(), cfg.estimator)?;
+    let mut tracker = PathTracker::new(cfg.paths)?;
+    let given = rec.noise_var.as_ref().map(|v| v[link]);
+    let mut h: Vec<Complex> = Vec::new();
+    let (mut paths, mut noise) = (Vec::with_capacity(rec.t_s.len()), Vec::new());
+    let every = 64;
+    for (s, &t) in rec.t_s.iter().enumerate() {
+        if s % every == 0 {
+            cancel.check()?;
+            if s > 0 {
+                progress(every);
+            }
+        }
+        let estimated = band.response(rec, s, link, &mut h)?;
+        let nv = given.or(estimated);
+        let mut used = 0.0;
+        let tracked = tracker.step(t, |seeds| {
+            let e = estimator.estimate(&h, nv, seeds)?;
+            used = e.noise_var;
+            Ok(e)
+        })?;
+        paths.push(tracked);
+        noise.push(used);
+    }
+    progress(rec.t_s.len() % every);
+    Ok((paths, noise))
+}
+
+/// The estimates of every snapshot of `rec` on `model`'s links (C5, C6), one `driver` job per
+/// recorded link; `progress` is called with the number of snapshots done since its last call
+/// (from any thread). Errors: the recording's ([`Recording::validate`], a link the scenario
+/// does not have), the estimator's settings, [`Error::Cancelled`].
+pub fn estimate_recording(
+    model: &Model,
+    bandwidth_hz: Real,
+    rec: &Recording,
+    cfg: &FrontEndConfig,
+    driver: &mut impl Driver,
+    progress: &(dyn Fn(usize) + Sync),
+) -> Result<RecordingEstimates> {
+    rec.validate()?;
+    let map = rec.link_map(model)?;
+    let band = Band::of_recording(rec, bandwidth_hz)?;
+    let n = model.link_count();
+    let snapshots = rec.t_s.len();
+    let mut out = RecordingEstimates {
+        t_s: rec.t_s.clone(),
+        recorded: vec![false; n],
+        paths: vec![vec![Vec::new(); n]; snapshots],
+        noise_var: vec![vec![0.0; n]; snapshots],
+    };
+    let mut results = Vec::with_capacity(map.len());
+    driver.run(
+        map.len(),
+        1,
+        &|link, cancel| link_paths(rec, &band, link, cfg, cancel, progress),
+        &mut |r| results.push(r),
+        &mut |_| {},
+    )?;
+    for (link, (paths, noise)) in results.into_iter().enumerate() {
+        let p = map[link];
+        out.recorded[p] = true;
+        for (s, (l, v)) in paths.into_iter().zip(noise).enumerate() {
+            out.paths[s][p] = l;
+            out.noise_var[s][p] = v;
+        }
+    }
+    Ok(out)
+}
+
+/// How `cir track` weights each delay.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum DelaySigma {
+    /// The estimator's own σ̂_τ (C4 at the fitted SNR): the default for recordings.
+    #[default]
+    Estimator,
+    /// The link budget's σ at the prediction (E8: needs the scenario's RCS and radio).
+    LinkBudget,
+}
+
+/// What [`cir_track`] runs on.
+#[derive(Debug, Clone, Copy)]
+pub struct CirTrackRequest<'a> {
+    /// The measurement model of the scenario.
+    pub model: &'a Model,
+    /// The scenario's area (the start fix searches it).
+    pub area: &'a Area,
+    /// The static clusters of the empty area (e.g. [`calibrate_estimates`]).
+    pub calibration: &'a Calibration,
+    /// The estimates of the walk.
+    pub estimates: &'a RecordingEstimates,
+    /// The tracker.
+    pub filter: FilterKind,
+    /// Process-noise intensity `q̃` of the CV model (E7), m²/s³.
+    pub process_noise: Real,
+    /// How a link's candidates are associated.
+    pub rule: AssociationRule,
+    /// How each delay is weighted.
+    pub sigma: DelaySigma,
+    /// The particle filter's seed.
+    pub seed: u64,
+}
+
+/// The track of a recording: one entry per snapshot; `null` before the track starts.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct CirTrackOutput {
+    /// Snapshot times, s.
+    pub t_s: Vec<Real>,
+    /// The estimates `[x, y, vx, vy]` after each snapshot's update (`null` before the start).
+    pub states: Vec<Option<[Real; 4]>>,
+    /// Their covariances (`null` before the start).
+    pub covariances: Vec<Option<[[Real; 4]; 4]>>,
+    /// Links used per snapshot.
+    pub links_used: Vec<usize>,
+    /// Per snapshot the delay taken per link (`null` = absent), s.
+    pub delays_used_s: Vec<Vec<Option<Real>>>,
+    /// Per snapshot the σ each used delay was weighted with, s (`null` = link absent; at the
+    /// start snapshot the link budget's σ at the fix, which the LM fix weights with, §5).
+    pub sigmas_used_s: Vec<Vec<Option<Real>>>,
+    /// Per snapshot how each link was chosen (absent/single/nearest/strongest).
+    pub choices: Vec<Vec<&'static str>>,
+    /// Per snapshot per link the estimates discarded as static (E4).
+    pub static_removed: Vec<Vec<usize>>,
+    /// The snapshot the track started at and its LM fix (`null`: no snapshot gave one).
+    pub start: Option<CirStart>,
+}
+
+/// Where a recording's track started.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct CirStart {
+    /// The snapshot index.
+    pub snapshot: usize,
+    /// Its time, s.
+    pub t_s: Real,
+    /// The fix.
+    #[serde(flatten)]
+    pub fix: TrackStart,
+}
+
+/// The static clusters of a recording of the empty area (C7): each link's estimates clustered
+/// in (delay, amplitude in dB) by `cfg`.
+pub fn calibrate_estimates(
+    model: &Model,
+    empty: &RecordingEstimates,
+    cfg: &AmplitudeClusterConfig,
+) -> Result<Calibration> {
+    Calibration::from_estimates(&empty.snapshots(), model.link_count(), cfg)
+}
+
+/// Tracks a recording's estimates: gate and associate each snapshot, start from the first LM
+/// fix, then filter with the CV model over each snapshot's time step. Asks `cancel` about every
+/// millisecond of work.
+pub fn cir_track(req: &CirTrackRequest, cancel: Cancel) -> Result<CirTrackOutput> {
+    let (model, est) = (req.model, req.estimates);
+    let n = model.link_count();
+    req.calibration.check_links(n)?;
+    let len = est.len();
+    let mut out = CirTrackOutput {
+        t_s: est.t_s.clone(),
+        states: Vec::with_capacity(len),
+        covariances: Vec::with_capacity(len),
+        links_used: Vec::with_capacity(len),
+        delays_used_s: Vec::with_capacity(len),
+        sigmas_used_s: Vec::with_capacity(len),
+        choices: Vec::with_capacity(len),
+        static_removed: Vec::with_capacity(len),
+        start: None,
+    };
+    let every = check_every(step_ns(req.filter, n));
+    // Before the start: one fix attempt per snapshot.
+    let mut k = 0;
+    let mut tracker = None;
+    while k < len {
+        if k % every == 0 {
+            cancel.check()?;
+        }
+        let snap = est.snapshot(k);
+        match start_from_snapshot(model, req.calibration, &snap, req.area, START_SPEED_SIGMA_MPS)
+        {
+            Ok(f) => {
+                let c = &f.ekf.covariance;
+                out.start = Some(CirStart {
+                    snapshot: k,
+                    t_s: est.t_s[k],
+                    fix: TrackStart {
+                        position_m: [f.report.position.x, f.report.position.y],
+                        covariance_m2: [[c[(0, 0)], c[(0, 1)]], [c[(1, 0)], c[(1, 1)]]],
+                        termination: f.report.termination.as_str(),
+                        links_used: f.report.links_used,
+                        choices: f.selection.choices.iter().map(|c| c.name()).collect(),
+                        delays_used_s: f.selection.delays.clone(),
+                    },
+                });
+                record_step(&mut out, Some((&f.ekf.state, &f.ekf.covariance)));
+                out.links_used.push(f.report.links_used);
+                let at = f.report.position;
+                let sig = (0..n)
+                    .map(|p| f.selection.delays[p].map(|_| model.sigma_delay(p, at)))
+                    .collect();
+                out.sigmas_used_s.push(sig);
+                out.choices
+                    .push(f.selection.choices.iter().map(|c| c.name()).collect());
+                out.delays_used_s.push(f.selection.delays);
+                out.static_removed.push(f.selection.static_removed);
+                let filter = Tracker::new(
+                    req.filter,
+                    f.ekf.state,
+                    f.ekf.covariance,
+                    rng(req.seed, 0),
+                )?;
+                tracker = Some(filter);
+                k += 1;
+                break;
+            }
+            Err(_) => {
+                record_step(&mut out, None);
+                out.links_used.push(0);
+                out.delays_used_s.push(vec![None; n]);
+                out.sigmas_used_s.push(vec![None; n]);
+                out.choices.push(vec!["absent"; n]);
+                out.static_removed.push(vec![0; n]);
+                k += 1;
+            }
+        }
+    }
+    let Some(filter) = tracker else {
+        return Ok(out);
+    };
+    let first_dt = ConstantVelocity::validated(1e-3, req.process_noise)?;
+    let mut gated = GatedTracker::new(
+        filter,
+        model,
+        req.calibration,
+        first_dt,
+        MeasurementNoise::AtPrediction,
+        req.rule,
+    )?
+    .with_estimate_sigmas(req.sigma == DelaySigma::Estimator);
+    while k < len {
+        if k % every == 0 {
+            cancel.check()?;
+        }
+        let dt = est.t_s[k] - est.t_s[k - 1];
+        gated.set_motion(ConstantVelocity::validated(dt, req.process_noise).map_err(|e| {
+            Error::InvalidFile {
+                field: format!("t_s[{k}]"),
+                reason: e.to_string(),
+            }
+        })?);
+        let snap = est.snapshot(k);
+        let step = gated.step(&snap).map_err(|e| Error::InvalidFile {
+            field: format!("snapshot {k}"),
+            reason: e.to_string(),
+        })?;
+        let f = &gated.filter;
+        record_step(&mut out, Some((f.state(), f.covariance())));
+        out.links_used.push(step.summary.links_used);
+        let sel = step.selection;
+        let sig = (0..n)
+            .map(|p| sel.delays[p].map(|_| step.sigmas_s[p]))
+            .collect();
+        out.sigmas_used_s.push(sig);
+        out.choices.push(sel.choices.iter().map(|c| c.name()).collect());
+        out.delays_used_s.push(sel.delays);
+        out.static_removed.push(sel.static_removed);
+        k += 1;
+    }
+    Ok(out)
+}
+
+/// Appends one snapshot's state and covariance (`None` before the start).
+fn record_step(out: &mut CirTrackOutput, s: Option<(&Vec4, &Mat4)>) {
+    out.states.push(s.map(|(x, _)| (*x).into()));
+    out.covariances.push(s.map(|(_, p)| {
+        core::array::from_fn(|i| core::array::from_fn(|j| p[(i, j)]))
+    }));
+}
+
+/// The estimates of one snapshot as plain delay lists (the form `calibrate --snapshots` reads).
+pub fn delays_only(snapshot: &[Vec<DelayEstimate>]) -> Vec<Vec<Real>> {
+    snapshot
+        .iter()
+        .map(|l| l.iter().map(|e| e.delay_s).collect())
+        .collect()
+}
