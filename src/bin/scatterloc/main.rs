@@ -54,7 +54,7 @@ fn main() {
 /// Runs one command.
 #[cfg(not(target_arch = "wasm32"))]
 fn run(command: cli::Command) -> Result<(), CliError> {
-    use cli::{Command, MtlCommand};
+    use cli::{CirCommand, Command, MtlCommand};
     match command {
         Command::Preset(a) => cmd::preset(&a),
         Command::Crlb(a) => cmd::crlb(&a),
@@ -70,6 +70,11 @@ fn run(command: cli::Command) -> Result<(), CliError> {
             MtlCommand::Locate(a) => cmd::mtl_locate(&a),
             MtlCommand::Table2(a) => cmd::mtl_table2(&a),
             MtlCommand::Roc(a) => cmd::mtl_roc(&a),
+        },
+        Command::Cir { command } => match command {
+            CirCommand::Simulate(a) => cmd::cir_simulate(&a),
+            CirCommand::Estimate(a) => cmd::cir_estimate(&a),
+            CirCommand::Track(a) => cmd::cir_track(&a),
         },
         Command::Merge(a) => cmd::merge(&a),
         Command::Completions { shell } => cli::completions(shell),

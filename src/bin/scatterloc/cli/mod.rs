@@ -4,6 +4,7 @@
 //! every clap error into the CLI's one-line `error: …` with exit status 2 (help and version go
 //! to stdout with status 0). The commands themselves are in `crate::cmd`.
 
+mod cir;
 mod error;
 mod filters;
 mod mtl;
@@ -18,6 +19,7 @@ use std::ffi::OsString;
 
 use clap::{CommandFactory, FromArgMatches, Parser, Subcommand, ValueEnum};
 
+pub use cir::{CirCommand, CirEstimateArgs, CirSimulateArgs, CirTrackArgs, SigmaSource};
 pub use filters::{FilterName, FilterSettings};
 pub use mtl::{MtlCommand, MtlLocateArgs, RocArgs, Table2Args};
 pub use plan::PlanArgs;
@@ -44,6 +46,13 @@ Commands at a glance (`scatterloc help COMMAND` for every flag):
   scatterloc simulate-walk --scenario FILE --out-dir DIR [--duration S] [--dt T] [--seed N]
                            [--calibration-snapshots N] [--false-alarms F] [--process-noise Q]
                            [--start snapshot|truth]
+  scatterloc cir simulate --scenario FILE --out-dir DIR [--scene FILE] [--walk POINTS]
+                          [--duration S] [--dt T] [--seed N]
+  scatterloc cir estimate --scenario FILE --cir REC.npz --out EST.json [--snapshots F]
+                          [--measurements F]
+  scatterloc cir track --scenario FILE --calibration CAL.npz --cir REC.npz --out TRACK.json
+                       [--figure F.{svg,png}] [--delays-figure D.{svg,png}] [--truth FILE]
+                       [--filter ekf|ukf|pf]
   scatterloc montecarlo [--preset NAME | --scenario FILE] [--trajectory I|II|III|all]
                         [--runs N] [--noise-runs N] [--dt T] [--duration S] [--process-noise Q]
                         [--seed N] [--threads N] [--oracle-noise] [--out FIG.{svg,png}]
@@ -218,6 +227,17 @@ pub enum Command {
         /// The mtl command.
         #[command(subcommand)]
         command: MtlCommand,
+    },
+    /// From channel recordings to tracks: simulate, estimate, track (spec
+    /// channel-estimation.md).
+    ///
+    /// The front end of [S] and [I]: `cir simulate` makes recordings (.npz, docs/recording.md)
+    /// of a walk at the signal level, `cir estimate` finds each snapshot's paths (C5, C6), `cir
+    /// track` runs the whole chain to a track (C7, E4, §4, §5, E7).
+    Cir {
+        /// The cir command.
+        #[command(subcommand)]
+        command: CirCommand,
     },
     /// Merge the part files of a sharded study into the unsharded run's result (spec §9.5).
     ///

@@ -85,6 +85,11 @@ const WALK_FILES: [&str; 3] = [
 /// then every file's target is checked (a link or a FIFO planted at `truth.json` is refused
 /// before anything is written; issue 24). Returns whether the directory was created.
 fn prepare_out_dir(dir: &str) -> Result<bool, CliError> {
+    prepare_out_dir_for(dir, &WALK_FILES)
+}
+
+/// [`prepare_out_dir`] for the files `names` of a command.
+pub fn prepare_out_dir_for(dir: &str, names: &[&str]) -> Result<bool, CliError> {
     if dir.is_empty() {
         return Err(CliError::usage("--out-dir: the path is empty".to_string()));
     }
@@ -93,7 +98,7 @@ fn prepare_out_dir(dir: &str) -> Result<bool, CliError> {
             "--out-dir: '{dir}' exists and is not a directory"
         ))),
         Ok(_) => {
-            for name in WALK_FILES {
+            for name in names {
                 check_writable("out-dir", &walk_file(dir, name))?;
             }
             Ok(false)
@@ -105,7 +110,7 @@ fn prepare_out_dir(dir: &str) -> Result<bool, CliError> {
 }
 
 /// The path of `name` in `--out-dir`.
-fn walk_file(dir: &str, name: &str) -> String {
+pub fn walk_file(dir: &str, name: &str) -> String {
     Path::new(dir).join(name).to_string_lossy().into_owned()
 }
 

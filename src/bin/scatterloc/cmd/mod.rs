@@ -1,11 +1,12 @@
 //! The commands of `scatterloc`, one file per family: the single-snapshot commands (`preset`,
 //! `crlb`, `locate` in `scenario`, `crlb-map` in `crlb_map`), tracking (`track` with its figure
-//! in `track_fig`), gating (`calibrate`, `simulate-walk`), the tracking studies (`montecarlo`,
+//! in `track_fig`), the channel front end (`cir simulate|estimate|track` in `cir`), gating (`calibrate`, `simulate-walk`), the tracking studies (`montecarlo`,
 //! `pcrlb`, sharing `study` and `report`), network planning (`plan`), the multi-target commands (`mtl`), and scale-out:
 //! one shard of a study (`--shard`, its part file in `shard`) and `merge`. Each takes its
 //! parsed flags from `crate::cli`, reads its inputs (`io`), calls the library and writes JSON to
 //! stdout and files atomically (`output`).
 
+mod cir;
 mod crlb_map;
 mod filters;
 mod flags;
@@ -23,6 +24,7 @@ mod study;
 mod track;
 mod track_fig;
 
+pub use cir::{cir_estimate, cir_simulate, cir_track};
 pub use crlb_map::crlb_map;
 pub use gating::{calibrate, simulate_walk};
 pub use merge::merge;

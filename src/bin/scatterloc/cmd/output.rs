@@ -231,6 +231,13 @@ impl OutputSet {
         })
     }
 
+    /// Stages `bytes` as the whole file `path` (a recording).
+    pub fn bytes(&mut self, flag: &str, path: &str, bytes: &[u8]) -> Result<(), CliError> {
+        self.stage(flag, path, |w| {
+            w.write_all(bytes).map_err(|e| write_failed(flag, path, e))
+        })
+    }
+
     /// Stages `figure` drawn as an SVG or PNG of `size` pixels for `path`. A PNG is drawn into
     /// memory and encoded into the temporary (the encoder plotters' own PNG files use, so the
     /// bytes are the same), never through a path.

@@ -280,6 +280,19 @@ pub fn run_with_bar<T>(
     label: &str,
     run: impl FnOnce(&AtomicBool, &mut dyn FnMut(usize, usize)) -> scatterloc::Result<T>,
 ) -> Result<(scatterloc::Result<T>, f64), CliError> {
+    run_with_counter(total, unit, label, |cancel, bar| {
+        run(cancel, &mut |done, _| bar.set_position(done as u64))
+    })
+}
+
+/// [`run_with_bar`] whose work advances the bar itself, from any thread (`bar.inc(n)`): for
+/// work whose units finish inside the driver's jobs (the snapshots of a recording's links).
+pub fn run_with_counter<T>(
+    total: usize,
+    unit: &str,
+    label: &str,
+    run: impl FnOnce(&AtomicBool, &ProgressBar) -> scatterloc::Result<T>,
+) -> Result<(scatterloc::Result<T>, f64), CliError> {
     static HANDLER: std::sync::Once = std::sync::Once::new();
     HANDLER.call_once(|| {
         // A second Ctrl-C leaves at once (nothing has been written yet either way).
@@ -300,7 +313,7 @@ pub fn run_with_bar<T>(
     bar.set_prefix(label.to_string());
     bar.enable_steady_tick(Duration::from_millis(250));
     let t0 = Instant::now();
-    let res = run(&CANCEL, &mut |done, _| bar.set_position(done as u64));
+    let res = run(&CANCEL, &bar);
     let wall = t0.elapsed().as_secs_f64();
     bar.finish_and_clear();
     if CANCEL.load(Ordering::SeqCst) {

@@ -1,0 +1,174 @@
+//! Flags of the channel front end `cir simulate|estimate|track` (issue 25; spec
+//! channel-estimation.md, C1–C8).
+
+use clap::{Args, Subcommand, ValueEnum};
+
+use super::filters::{FilterName, FilterSettings};
+use super::values::{finite, seed, whole, Association};
+
+/// `scatterloc cir SUBCOMMAND`.
+#[allow(clippy::large_enum_variant)]
+#[derive(Debug, Subcommand)]
+pub enum CirCommand {
+    /// Simulate channel recordings of a walk at the signal level (C1, C3; [S] §5.3).
+    ///
+    /// The scene (walls with first- and second-order reflections, point scatterers, a walking
+    /// person as an extended, fluctuating scatterer with double reflections off the walls and
+    /// shadowing) on the scenario's links and radio, thermal noise from the link budget.
+    /// Writes DIR/recording.npz (the walk), DIR/calibration.npz (the empty area), DIR/truth.json
+    /// {t_s, states, paths} and DIR/scene.json (the scene used). Prints a JSON summary.
+    Simulate(CirSimulateArgs),
+    /// Estimate every snapshot's paths of a recording (C5, C6).
+    ///
+    /// Per link and snapshot: greedy ML with cyclic refinement and a CFAR stop, seeded by the
+    /// link's path tracks. --out EST.json: {t_s, links, estimates [snapshot][link] [{delay_s,
+    /// amplitude, sigma_s, snr_db, track, confirmed}], noise_var}. --snapshots and
+    /// --measurements also write the forms `calibrate --snapshots` and `track --measurements`
+    /// read.
+    Estimate(CirEstimateArgs),
+    /// Track a person through a recording: estimate, calibrate, gate, associate, filter.
+    ///
+    /// Estimates both recordings (C5, C6), clusters the calibration recording's estimates in
+    /// (delay, amplitude) (C7), gates every snapshot of the walk (E4), associates (§4), starts
+    /// from the first snapshot whose links give an LM fix (§5) and filters (E7). --out
+    /// TRACK.json: {t_s, states (null before the start), covariances, links_used,
+    /// delays_used_s, sigmas_used_s, choices, static_removed, start, calibration, error (with
+    /// --truth)}.
+    Track(CirTrackArgs),
+}
+
+/// `scatterloc cir simulate`.
+#[derive(Debug, Args)]
+pub struct CirSimulateArgs {
+    /// Scenario JSON file ('-' = standard input).
+    #[arg(long, value_name = "FILE")]
+    pub scenario: String,
+    /// Directory for recording.npz, calibration.npz, truth.json and scene.json (created if
+    /// missing).
+    #[arg(long, value_name = "DIR")]
+    pub out_dir: String,
+    /// Scene JSON file (walls, scatterers, body, walk; see docs/recording.md) [default: the
+    /// hangar scene of docs/reproduction.md].
+    #[arg(long, value_name = "FILE")]
+    pub scene: Option<String>,
+    /// Waypoints of the walk "x,y x,y ..." (m; at least two), replacing the scene's.
+    #[arg(long, value_name = "POINTS")]
+    pub walk: Option<String>,
+    /// Walking speed, m/s, replacing the scene's.
+    #[arg(long, value_name = "V", value_parser = finite)]
+    pub speed: Option<f64>,
+    /// Length of the walk, s [default: the scene's].
+    #[arg(long, value_name = "S", value_parser = finite)]
+    pub duration: Option<f64>,
+    /// Snapshot interval, s [default: 0.002048, the sounder of [S]].
+    #[arg(long, value_name = "T", value_parser = finite)]
+    pub dt: Option<f64>,
+    /// Length of the calibration recording of the empty area, s [default: 1].
+    #[arg(long, value_name = "S", value_parser = finite)]
+    pub calibration_duration: Option<f64>,
+    /// Random seed [default: 1].
+    #[arg(long, value_name = "N", value_parser = seed)]
+    pub seed: Option<u64>,
+}
+
+/// The front end's flags shared by `cir estimate` and `cir track`.
+#[derive(Debug, Args)]
+pub struct FrontEndArgs {
+    /// Most paths per snapshot and link (C5) [default: the estimator's].
+    #[arg(long, value_name = "K", value_parser = whole)]
+    pub max_paths: Option<usize>,
+    /// Design false-alarm probability per snapshot of the CFAR stop (C5) [default: the
+    /// estimator's].
+    #[arg(long, value_name = "P", value_parser = finite)]
+    pub pfa: Option<f64>,
+    /// Worker threads (0 = all cores) [default: 0].
+    #[arg(long, value_name = "N", value_parser = whole)]
+    pub threads: Option<usize>,
+}
+
+/// `scatterloc cir estimate`.
+#[derive(Debug, Args)]
+pub struct CirEstimateArgs {
+    /// Scenario JSON file ('-' = standard input).
+    #[arg(long, value_name = "FILE")]
+    pub scenario: String,
+    /// The recording (.npz, docs/recording.md).
+    #[arg(long, value_name = "REC.npz")]
+    pub cir: String,
+    /// The estimates (.json).
+    #[arg(long, value_name = "EST.json")]
+    pub out: String,
+    /// Also write the delays in the form `calibrate --snapshots` reads.
+    #[arg(long, value_name = "FILE.json")]
+    pub snapshots: Option<String>,
+    /// Also write the estimates as `track --measurements` reads them (raw_steps [delay,
+    /// amplitude, sigma], the first snapshot as initial_snapshot; uniform snapshot times only).
+    #[arg(long, value_name = "FILE.json")]
+    pub measurements: Option<String>,
+    /// Process-noise intensity q written to --measurements, m^2/s^3 [default: 1].
+    #[arg(long, value_name = "Q", value_parser = finite)]
+    pub process_noise: Option<f64>,
+    #[command(flatten)]
+    pub front_end: FrontEndArgs,
+}
+
+/// How `cir track` weights each delay.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum SigmaSource {
+    /// The estimator's own sigma (C4 at the fitted SNR).
+    Estimator,
+    /// The link budget's sigma at the prediction (E8).
+    Budget,
+}
+
+/// `scatterloc cir track`.
+#[derive(Debug, Args)]
+pub struct CirTrackArgs {
+    /// Scenario JSON file ('-' = standard input).
+    #[arg(long, value_name = "FILE")]
+    pub scenario: String,
+    /// Recording of the empty area (.npz): its static paths are gated (C7, E4).
+    #[arg(long, value_name = "CAL.npz")]
+    pub calibration: String,
+    /// Recording of the walk (.npz).
+    #[arg(long, value_name = "REC.npz")]
+    pub cir: String,
+    /// The track (.json).
+    #[arg(long, value_name = "TRACK.json")]
+    pub out: String,
+    /// The track on the map, the position error over time and its CDF (.svg or .png; with
+    /// --truth).
+    #[arg(long, value_name = "F.{svg,png}")]
+    pub figure: Option<String>,
+    /// [S] Fig. 4 per link: path length against time, the response's magnitude, the
+    /// estimates, the static clusters, the truth (.svg or .png).
+    #[arg(long, value_name = "D.{svg,png}")]
+    pub delays_figure: Option<String>,
+    /// Truth file (cir simulate's truth.json): adds the error to TRACK.json and the figures.
+    #[arg(long, value_name = "FILE")]
+    pub truth: Option<String>,
+    /// The tracker: ekf, ukf or pf [default: ekf].
+    #[arg(
+        long,
+        value_name = "ekf|ukf|pf",
+        ignore_case = true,
+        hide_possible_values = true
+    )]
+    pub filter: Option<FilterName>,
+    /// Process-noise intensity q of the CV model, m^2/s^3 [default: 1, a walk with turns].
+    #[arg(long, value_name = "Q", value_parser = finite)]
+    pub process_noise: Option<f64>,
+    /// Delay weights [default: estimator].
+    #[arg(long, value_name = "estimator|budget")]
+    pub sigma: Option<SigmaSource>,
+    /// Association rule [default: gated].
+    #[arg(long, value_name = "RULE")]
+    pub association: Option<Association>,
+    /// Seed of the particle filter's particles [default: 1] (--filter pf only).
+    #[arg(long, value_name = "N", value_parser = seed)]
+    pub seed: Option<u64>,
+    #[command(flatten)]
+    pub settings: FilterSettings,
+    #[command(flatten)]
+    pub front_end: FrontEndArgs,
+}

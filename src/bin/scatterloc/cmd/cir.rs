@@ -1,0 +1,396 @@
+//! `scatterloc cir simulate|estimate|track`: the channel front end (issue 25; spec
+//! channel-estimation.md). Flags → the library's use cases ([`scatterloc::study::estimate_recording`],
+//! [`scatterloc::study::calibrate_estimates`], [`scatterloc::study::cir_track`], the simulator
+//! [`scatterloc::channel::simulate_recording`]) → files written all or none.
+
+use serde::Serialize;
+
+use scatterloc::channel::{EstimatorConfig, PathTrackerConfig, Recording};
+use scatterloc::error::{limits, Cancel};
+use scatterloc::formats::{CalibrationResult, CalibrationSnapshots, Measurements, Truth};
+use scatterloc::native::Parallel;
+use scatterloc::study::{
+    calibrate_estimates, cir_track as track_recording, delays_only, estimate_recording,
+    CirTrackRequest, DelaySigma, FrontEndConfig, RecordingEstimates,
+};
+use scatterloc::track::gating::{AmplitudeClusterConfig, AssociationRule, Calibration};
+use scatterloc::track::ConstantVelocity;
+use scatterloc::{npz, Model, Scenario};
+
+use super::filters::filter_kinds;
+use super::io::{emit_summary, model_of, read_bytes, read_json_file, read_scenario};
+use super::output::{check_writable, Format, OutputSet};
+use super::study::{run_with_counter, threads};
+use crate::cli::{
+    Association, CirEstimateArgs, CirSimulateArgs, CirTrackArgs, FilterName, SigmaSource,
+};
+use crate::failure::CliError;
+
+/// Default process-noise intensity of `cir track`, m²/s³: a person at 1–2 m/s turning on 2–3 m
+/// radii accelerates by up to v²/r ≈ 1–2 m/s².
+const DEFAULT_PROCESS_NOISE: f64 = 1.0;
+
+/// Reads the recording `--flag PATH` (.npz, docs/recording.md), checked against `model`.
+fn read_recording(flag: &str, path: &str, model: &Model) -> Result<Recording, CliError> {
+    let bytes = read_bytes(flag, path, limits::MAX_RECORDING_BYTES)?;
+    let bad = |e: &dyn std::fmt::Display| CliError::usage(format!("--{flag} {path}: {e}"));
+    let rec = npz::read_recording(&bytes).map_err(|e| bad(&e))?;
+    rec.validate().map_err(|e| bad(&e))?;
+    rec.link_map(model).map_err(|e| bad(&e))?;
+    Ok(rec)
+}
+
+/// The front end's settings from the flags.
+fn front_end(max_paths: Option<usize>, pfa: Option<f64>) -> Result<FrontEndConfig, CliError> {
+    let mut cfg = FrontEndConfig {
+        estimator: EstimatorConfig::default(),
+        paths: PathTrackerConfig::default(),
+    };
+    if let Some(k) = max_paths {
+        cfg.estimator.max_paths = k;
+    }
+    if let Some(p) = pfa {
+        cfg.estimator.p_fa = p;
+    }
+    cfg.estimator.validate().map_err(|e| {
+        let flag = if e.to_string().contains("p_fa") {
+            "--pfa"
+        } else {
+            "--max-paths"
+        };
+        CliError::usage(format!("{flag}: {e}"))
+    })?;
+    Ok(cfg)
+}
+
+/// Estimates `rec` on `threads` threads under a progress bar (Ctrl-C: exit 130, nothing
+/// written).
+fn estimate(
+    flag: &str,
+    scenario: &Scenario,
+    model: &Model,
+    rec: &Recording,
+    cfg: &FrontEndConfig,
+    threads: usize,
+) -> Result<RecordingEstimates, CliError> {
+    let total = rec.t_s.len() * rec.links.len();
+    let (res, _) = run_with_counter(total, "snapshots", flag, |cancel, bar| {
+        let progress = |n: usize| bar.inc(n as u64);
+        estimate_recording(
+            model,
+            scenario.radio.bandwidth_hz,
+            rec,
+            cfg,
+            &mut Parallel::new(threads, cancel),
+            &progress,
+        )
+    })?;
+    res.map_err(|e| CliError::usage(format!("--{flag}: {e}")))
+}
+
+/// One path of `EST.json`.
+#[derive(Serialize)]
+struct PathDoc {
+    delay_s: f64,
+    amplitude: f64,
+    sigma_s: f64,
+    snr_db: Option<f64>,
+    track: u32,
+    confirmed: bool,
+}
+
+/// `EST.json`.
+#[derive(Serialize)]
+struct EstimatesDoc<'a> {
+    format: &'static str,
+    t_s: &'a [f64],
+    /// Per model link `[transmitter, receiver]`.
+    links: Vec<[usize; 2]>,
+    recorded: &'a [bool],
+    estimates: Vec<Vec<Vec<PathDoc>>>,
+    noise_var: &'a [Vec<f64>],
+    max_paths: usize,
+    p_fa: f64,
+}
+
+fn estimates_doc<'a>(model: &Model, e: &'a RecordingEstimates, cfg: &FrontEndConfig) -> EstimatesDoc<'a> {
+    EstimatesDoc {
+        format: "scatterloc-estimates",
+        t_s: &e.t_s,
+        links: model.network.links.iter().map(|l| [l.tx, l.rx]).collect(),
+        recorded: &e.recorded,
+        estimates: e
+            .paths
+            .iter()
+            .map(|s| {
+                s.iter()
+                    .map(|l| {
+                        l.iter()
+                            .map(|t| PathDoc {
+                                delay_s: t.estimate.delay_s,
+                                amplitude: t.estimate.delay_estimate().amplitude,
+                                sigma_s: t.estimate.sigma_s,
+                                snr_db: (t.estimate.snr > 0.0)
+                                    .then(|| 10.0 * t.estimate.snr.log10()),
+                                track: t.track_id,
+                                confirmed: t.confirmed,
+                            })
+                            .collect()
+                    })
+                    .collect()
+            })
+            .collect(),
+        noise_var: &e.noise_var,
+        max_paths: cfg.estimator.max_paths,
+        p_fa: cfg.estimator.p_fa,
+    }
+}
+
+/// The checked output flag `--flag PATH` of `allowed` formats.
+fn output(flag: &str, path: &str, allowed: &[Format]) -> Result<Format, CliError> {
+    let f = Format::of(flag, path, allowed)?;
+    check_writable(flag, path)?;
+    Ok(f)
+}
+
+/// `scatterloc cir estimate --scenario S --cir REC.npz --out EST.json [--snapshots F]
+/// [--measurements F]`.
+pub fn cir_estimate(args: &CirEstimateArgs) -> Result<(), CliError> {
+    output("out", &args.out, &[Format::Json])?;
+    for (flag, p) in [("snapshots", &args.snapshots), ("measurements", &args.measurements)] {
+        if let Some(p) = p {
+            output(flag, p, &[Format::Json])?;
+        }
+    }
+    let q = args.process_noise.unwrap_or(DEFAULT_PROCESS_NOISE);
+    if args.process_noise.is_some() && args.measurements.is_none() {
+        return Err(CliError::usage(
+            "--process-noise: only written to --measurements (not given)",
+        ));
+    }
+    let cfg = front_end(args.front_end.max_paths, args.front_end.pfa)?;
+    let (threads, _) = threads(args.front_end.threads)?;
+    let scenario = read_scenario(&args.scenario)?;
+    let model = model_of(&scenario)?;
+    let rec = read_recording("cir", &args.cir, &model)?;
+    let measurements = match &args.measurements {
+        Some(_) => Some(uniform_dt(&rec.t_s, q)?),
+        None => None,
+    };
+    let est = estimate("cir", &scenario, &model, &rec, &cfg, threads)?;
+    let mut files = OutputSet::new();
+    files.json("out", &args.out, &estimates_doc(&model, &est, &cfg))?;
+    let snaps = est.snapshots();
+    if let Some(p) = &args.snapshots {
+        let doc = CalibrationSnapshots {
+            snapshots: snaps.iter().map(|s| delays_only(s)).collect(),
+        };
+        files.json("snapshots", p, &doc)?;
+    }
+    if let (Some(p), Some((dt, q))) = (&args.measurements, measurements) {
+        let doc = Measurements {
+            dt_s: dt,
+            process_noise: q,
+            initial_state: None,
+            initial_covariance: None,
+            initial_snapshot: Some(Measurements::raw_step(&snaps[0])),
+            sigma_s: None,
+            steps: None,
+            raw_steps: Some(snaps[1..].iter().map(|s| Measurements::raw_step(s)).collect()),
+        };
+        files.json("measurements", p, &doc)?;
+    }
+    files.commit()?;
+    let paths: usize = est.paths.iter().flatten().map(Vec::len).sum();
+    emit_summary(
+        &serde_json::json!({
+            "out": args.out,
+            "snapshots": est.len(),
+            "links": rec.links.len(),
+            "paths": paths,
+        })
+        .to_string(),
+    )
+}
+
+/// The uniform step of `t_s` (within 1e-6 relative), checked as a CV model with `q`, for
+/// `--measurements` (a measurements file has one `dt_s`).
+fn uniform_dt(t_s: &[f64], q: f64) -> Result<(f64, f64), CliError> {
+    if t_s.len() < 2 {
+        return Err(CliError::usage(
+            "--measurements: the recording has fewer than 2 snapshots",
+        ));
+    }
+    let dt = (t_s[t_s.len() - 1] - t_s[0]) / (t_s.len() - 1) as f64;
+    if let Some(k) = (1..t_s.len()).find(|&k| ((t_s[k] - t_s[k - 1]) - dt).abs() > 1e-6 * dt) {
+        return Err(CliError::usage(format!(
+            "--measurements: the recording's snapshots are not uniform in time (t_s[{k}] − \
+             t_s[{}] = {} s, the mean step is {dt} s); a measurements file has one dt_s",
+            k - 1,
+            t_s[k] - t_s[k - 1]
+        )));
+    }
+    ConstantVelocity::validated(dt, q)
+        .map_err(|e| CliError::usage(format!("--process-noise: {e}")))?;
+    Ok((dt, q))
+}
+
+/// Position-error statistics of a track against the truth.
+#[derive(Serialize)]
+struct ErrorDoc {
+    /// Snapshots with a state (the statistics are over these).
+    count: usize,
+    median_m: Option<f64>,
+    p90_m: Option<f64>,
+    max_m: Option<f64>,
+    fraction_below_1m: Option<f64>,
+}
+
+/// `TRACK.json`.
+#[derive(Serialize)]
+struct TrackDoc<'a> {
+    #[serde(flatten)]
+    track: &'a scatterloc::study::CirTrackOutput,
+    filter: &'static str,
+    process_noise: f64,
+    sigma: &'static str,
+    calibration: CalibrationResult,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    error: Option<ErrorDoc>,
+}
+
+/// `scatterloc cir track --scenario S --calibration CAL.npz --cir REC.npz --out TRACK.json`.
+pub fn cir_track(args: &CirTrackArgs) -> Result<(), CliError> {
+    output("out", &args.out, &[Format::Json])?;
+    let figure = match &args.figure {
+        Some(p) => Some((p.as_str(), output("figure", p, &[Format::Svg, Format::Png])?)),
+        None => None,
+    };
+    let delays_figure = match &args.delays_figure {
+        Some(p) => Some((
+            p.as_str(),
+            output("delays-figure", p, &[Format::Svg, Format::Png])?,
+        )),
+        None => None,
+    };
+    let name = args.filter.unwrap_or(FilterName::Ekf);
+    let kind = filter_kinds(&[name], &args.settings, "--filter")?[0];
+    if args.seed.is_some() && name != FilterName::Pf {
+        return Err(CliError::usage(
+            "--seed: only for the pf filter (--filter is not pf)",
+        ));
+    }
+    let q = args.process_noise.unwrap_or(DEFAULT_PROCESS_NOISE);
+    ConstantVelocity::validated(1.0, q)
+        .map_err(|e| CliError::usage(format!("--process-noise: {e}")))?;
+    let cfg = front_end(args.front_end.max_paths, args.front_end.pfa)?;
+    let (threads, _) = threads(args.front_end.threads)?;
+    let scenario = read_scenario(&args.scenario)?;
+    let model = model_of(&scenario)?;
+    let cal_rec = read_recording("calibration", &args.calibration, &model)?;
+    let rec = read_recording("cir", &args.cir, &model)?;
+    let truth = match &args.truth {
+        Some(p) => {
+            let t: Truth = read_json_file("truth", p)?;
+            t.check_times(&rec.t_s)
+                .map_err(|e| CliError::usage(format!("--truth {p}: {e}")))?;
+            Some(t)
+        }
+        None => None,
+    };
+    let empty = estimate("calibration", &scenario, &model, &cal_rec, &cfg, threads)?;
+    let ccfg = AmplitudeClusterConfig::for_bandwidth(scenario.radio.bandwidth_hz)
+        .map_err(|e| CliError::usage(format!("--scenario: {e}")))?;
+    let calibration: Calibration = calibrate_estimates(&model, &empty, &ccfg)
+        .map_err(|e| CliError::usage(format!("--calibration {}: {e}", args.calibration)))?;
+    let est = estimate("cir", &scenario, &model, &rec, &cfg, threads)?;
+    let sigma = match args.sigma {
+        None | Some(SigmaSource::Estimator) => DelaySigma::Estimator,
+        Some(SigmaSource::Budget) => DelaySigma::LinkBudget,
+    };
+    let req = CirTrackRequest {
+        model: &model,
+        area: &scenario.area_m,
+        calibration: &calibration,
+        estimates: &est,
+        filter: kind,
+        process_noise: q,
+        rule: match args.association {
+            Some(Association::Spec) => AssociationRule::Spec,
+            None | Some(Association::Gated) => AssociationRule::Gated,
+        },
+        sigma,
+        seed: args.seed.unwrap_or(1),
+    };
+    let (res, _) = run_with_counter(est.len(), "snapshots", "track", |cancel, _| {
+        let stop = || cancel.load(std::sync::atomic::Ordering::Relaxed);
+        track_recording(&req, Cancel::when(&stop))
+    })?;
+    let track = res.map_err(|e| CliError::usage(format!("--cir {}: {e}", args.cir)))?;
+    let errors: Option<Vec<Option<f64>>> = truth.as_ref().map(|t| {
+        track
+            .states
+            .iter()
+            .zip(&t.states)
+            .map(|(s, x)| s.map(|s| ((s[0] - x[0]).powi(2) + (s[1] - x[1]).powi(2)).sqrt()))
+            .collect()
+    });
+    let error = errors.as_ref().map(|e| error_doc(e));
+    let doc = TrackDoc {
+        track: &track,
+        filter: name.name(),
+        process_noise: q,
+        sigma: match sigma {
+            DelaySigma::Estimator => "estimator",
+            DelaySigma::LinkBudget => "budget",
+        },
+        calibration: CalibrationResult {
+            gap_s: None,
+            min_fraction: None,
+            sigma_floor_s: None,
+            snapshot_count: Some(empty.len()),
+            links: calibration.links.clone(),
+        },
+        error,
+    };
+    let mut files = OutputSet::new();
+    files.json("out", &args.out, &doc)?;
+    if let Some((p, f)) = delays_figure {
+        super::cir_fig::stage_delays_figure(
+            &mut files, p, f, &scenario, &model, &rec, &est, &calibration, truth.as_ref(),
+        )?;
+    }
+    if let Some((p, f)) = figure {
+        super::cir_fig::stage_track_figure(
+            &mut files, p, f, &scenario, &model, &track, truth.as_ref(),
+        )?;
+    }
+    files.commit()?;
+    emit_summary(
+        &serde_json::json!({
+            "out": args.out,
+            "snapshots": track.t_s.len(),
+            "start": track.start.as_ref().map(|s| s.t_s),
+            "error": doc.error,
+        })
+        .to_string(),
+    )
+}
+
+/// The error statistics of the snapshots with a state.
+fn error_doc(errors: &[Option<f64>]) -> ErrorDoc {
+    let e: Vec<f64> = errors.iter().flatten().copied().collect();
+    let stats = scatterloc::present::ErrorStats::of(&e);
+    ErrorDoc {
+        count: e.len(),
+        median_m: stats.as_ref().map(|s| s.median_m),
+        p90_m: stats.as_ref().map(|s| s.p90_m),
+        max_m: stats.as_ref().map(|s| s.max_m),
+        fraction_below_1m: stats.as_ref().map(|s| s.fraction_below_1m),
+    }
+}
+
+/// `scatterloc cir simulate --scenario S --out-dir DIR`.
+pub fn cir_simulate(_args: &CirSimulateArgs) -> Result<(), CliError> {
+    Err(CliError::usage("cir simulate: wired after the simulator lands"))
+}
