@@ -213,3 +213,12 @@ pub const RANGE_M: Range = Range {
     max: 1e8,
     allowed: "0 to 1e8 m",
 };
+
+/// Largest `max_paths` of the snapshot estimator (C5): the joint amplitude fit and the joint
+/// Fisher matrix are `K × K` and `3K × 3K` dense solves per snapshot, so `K` beyond a few tens
+/// only costs time ([S] resolves fewer than 20 paths per link).
+pub const MAX_PATHS: usize = 64;
+
+/// Largest zero-padded periodogram of the snapshot estimator (C5): `2^20` cells (16 MiB of
+/// complex scratch), e.g. 16 384 bins oversampled 64×.
+pub const MAX_PERIODOGRAM: usize = 1 << 20;
