@@ -37,8 +37,11 @@ mod linalg;
 
 /// Paths closer than this fraction of `1/B` are merged (their joint fit is ill-conditioned).
 pub const MERGE_FRACTION: Real = 0.25;
-/// SAGE sweeps over all paths after each new path.
-const SAGE_SWEEPS: usize = 2;
+/// Most SAGE sweeps over all paths after each new path (they stop earlier once no delay moves
+/// by more than `SAGE_TOL/B`).
+const SAGE_SWEEPS: usize = 30;
+/// Convergence of the SAGE sweeps, in units of `1/B`.
+const SAGE_TOL: Real = 1e-4;
 /// Newton iterations per refinement.
 const NEWTON_ITERS: usize = 8;
 
@@ -446,7 +449,9 @@ impl Estimator {
     /// SAGE sweeps over all paths, merge of close paths, joint LS of the amplitudes; leaves
     /// `resid = h − Ĥ`.
     fn refine(&mut self, h: &[Complex], paths: &mut Vec<(Real, Complex)>) {
-        for _ in 0..SAGE_SWEEPS {
+        let tol = SAGE_TOL / (self.df * self.band.len() as Real);
+        for sweep in 0..SAGE_SWEEPS {
+            let mut moved: Real = 0.0;
             for i in 0..paths.len() {
                 let (t, a) = paths[i];
                 self.sub_path(t, a, 1.0);
@@ -454,6 +459,10 @@ impl Estimator {
                 let a2 = self.corr(&self.resid, t2) / self.energy;
                 self.sub_path(t2, a2, -1.0);
                 paths[i] = (t2, a2);
+                moved = moved.max((t2 - t).abs());
+            }
+            if paths.len() < 2 || (sweep > 0 && moved < tol) {
+                break;
             }
         }
         // merge: keep the stronger of paths closer than MERGE_FRACTION/B
