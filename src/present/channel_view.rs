@@ -237,7 +237,9 @@ fn to_db(
         ImageFloor::Global => db.iter_mut().for_each(|v| *v = v.max(top - dr)),
         ImageFloor::Column => {
             for i in 0..cols {
-                let col_top = (0..rows).map(|j| db[j * cols + i]).fold(Real::MIN, Real::max);
+                let col_top = (0..rows)
+                    .map(|j| db[j * cols + i])
+                    .fold(Real::MIN, Real::max);
                 for j in 0..rows {
                     let v = &mut db[j * cols + i];
                     *v = v.max(col_top - dr);
@@ -325,7 +327,9 @@ impl DelayFigure {
             (Some(&a), _) if a.is_finite() => [a - 0.5, a + 0.5],
             _ => [0.0, 1.0],
         };
-        let amps = links.iter().flat_map(|l| l.estimates.iter().map(|e| e.amplitude_db));
+        let amps = links
+            .iter()
+            .flat_map(|l| l.estimates.iter().map(|e| e.amplitude_db));
         let (lo, hi) = amps.fold((Real::INFINITY, Real::NEG_INFINITY), |(a, b), v| {
             (a.min(v), b.max(v))
         });
@@ -392,9 +396,11 @@ pub fn suggest_range_m(
     let values = estimates
         .iter()
         .map(|e| e.range_m)
-        .chain(statics.iter().flat_map(|b| {
-            [b.mean_m - b.halfwidth_m, b.mean_m + b.halfwidth_m]
-        }))
+        .chain(
+            statics
+                .iter()
+                .flat_map(|b| [b.mean_m - b.halfwidth_m, b.mean_m + b.halfwidth_m]),
+        )
         .chain(truth.iter().flat_map(|c| c.points.iter().map(|p| p.1)))
         .filter(|v| v.is_finite());
     let (lo, hi) = values.fold((Real::INFINITY, Real::NEG_INFINITY), |(a, b), v| {

@@ -130,7 +130,10 @@ fn points_bands_and_ranges() {
     assert!((b[0].mean_m - 10.0).abs() < 1e-12 && (b[0].halfwidth_m - 0.3).abs() < 1e-12);
     // Values from 9.7 to 20 m: margin max(0.05·10.3, 1) = 1 m.
     let r = suggest_range_m(&p, &b, &[], Real::INFINITY);
-    assert!((r[0] - 8.7).abs() < 1e-9 && (r[1] - 21.0).abs() < 1e-9, "{r:?}");
+    assert!(
+        (r[0] - 8.7).abs() < 1e-9 && (r[1] - 21.0).abs() < 1e-9,
+        "{r:?}"
+    );
     assert_eq!(suggest_range_m(&[], &[], &[], 5.0), [0.0, 5.0]);
     let fig = DelayFigure::new(&[], Vec::new());
     assert_eq!((fig.t_range_s, fig.amplitude_db_range), ([0.0, 1.0], None));
@@ -154,7 +157,10 @@ fn track_errors_before_the_start_and_without_a_start() {
     assert_eq!(v.cdf[2], (5.0, 1.0));
     let s = v.stats.unwrap();
     assert_eq!((s.count, s.p90_m, s.median_m), (3, 5.0, 0.4));
-    assert_eq!((v.track_m.len(), v.truth_m.len(), v.track_m[0].len()), (1, 1, 3));
+    assert_eq!(
+        (v.track_m.len(), v.truth_m.len(), v.track_m[0].len()),
+        (1, 1, 3)
+    );
     let never = track_errors(&t, &[None; 4], &truth).unwrap();
     assert!(never.stats.is_none() && never.cdf.is_empty() && never.track_start.is_none());
     let no_truth = track_errors(&t, &states, &[]).unwrap();
