@@ -167,7 +167,7 @@ pub fn draw_delays<DB: DrawingBackend>(
             &shrink(&bar_a),
             r,
             |v| amplitude_rgb(v, r),
-            "estimate 20·log₁₀|α̂| (dB)",
+            "estimate amplitude 20·log₁₀|α| (dB)",
             &font,
         )?;
     }
@@ -237,7 +237,7 @@ fn draw_link<DB: DrawingBackend>(
             (b.mean_m - b.halfwidth_m).max(r0),
             (b.mean_m + b.halfwidth_m).min(r1),
         );
-        if !(lo < hi) {
+        if lo.partial_cmp(&hi) != Some(core::cmp::Ordering::Less) {
             continue;
         }
         chart
@@ -362,7 +362,7 @@ fn draw_image<DB: DrawingBackend>(
     let mut cells = Vec::new();
     for i in 0..cols {
         let (x0, x1) = (clamp_t(edge(i)), clamp_t(edge(i + 1)));
-        if !(x1 > x0) {
+        if x0.partial_cmp(&x1) != Some(core::cmp::Ordering::Less) {
             continue;
         }
         let mut start = 0;
@@ -625,6 +625,23 @@ fn draw_error_time<DB: DrawingBackend>(
                 part,
                 CURVE_PALETTE[0].stroke_width(width),
             ))
+            .map_err(chart_err)?;
+    }
+    if let Some(st) = view.stats {
+        let text = format!(
+            "median {} m · 90 % {} m · max {} m · {} % below 1 m",
+            decimals(st.median_m),
+            decimals(st.p90_m),
+            decimals(st.max_m),
+            decimals(100.0 * st.fraction_below_1m),
+        );
+        let style = TextStyle::from(("sans-serif", font.ticks * 0.9).into_font())
+            .color(&RGBColor(60, 60, 60));
+        let pad = (8.0 * s) as i32;
+        chart
+            .plotting_area()
+            .strip_coord_spec()
+            .draw_text(&text, &style, (pad, pad))
             .map_err(chart_err)?;
     }
     if let Some(n) = note {

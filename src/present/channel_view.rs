@@ -136,7 +136,7 @@ pub fn delay_image<'a>(
     let [lo, hi] = cfg.range_m;
     check_finite("range_m[0]", lo)?;
     check_finite("range_m[1]", hi)?;
-    if !(hi > lo) {
+    if hi <= lo {
         return Err(Error::OutOfRange {
             field: "range_m[1]".into(),
             value: hi,

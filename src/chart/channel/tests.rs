@@ -144,7 +144,7 @@ fn delay_figure_has_a_panel_per_link_the_image_the_points_and_labels() {
     assert_eq!(n("truth: pedestrian"), 1);
     assert_eq!(n("truth: los"), 1);
     assert_eq!(n("static cluster ±3σ"), 1);
-    assert_eq!(n("estimate 20·log₁₀|α̂| (dB)"), 1);
+    assert_eq!(n("estimate amplitude 20·log₁₀|α| (dB)"), 1);
     assert_eq!(n("response power (dB)"), 1);
     // 2 links × 50 snapshots × 2 paths estimates + the legend's marker.
     assert_eq!(count(&svg, "circle"), 201);
@@ -230,6 +230,9 @@ fn track_figure_marks_the_90_percent_point() {
     let svg = draw(&view);
     let tx = texts(&svg);
     assert!(tx.iter().any(|t| t == "90 %: 1.80 m"), "{tx:?}");
+    // 18 errors 0.2 … 1.9 m: median the 9th = 1.0 m, 8 of 18 = 44.4 % strictly below 1 m.
+    let stats = "median 1.00 m · 90 % 1.80 m · max 1.90 m · 44.4 % below 1 m";
+    assert!(tx.iter().any(|t| t == stats), "{tx:?}");
     for label in [
         "x (m)",
         "time t (s)",
