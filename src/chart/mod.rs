@@ -6,8 +6,10 @@
 //! [`draw_tracking_filters`] draws the tracking figure of \[S\] Fig. 3 (spec §10) in the same style.
 //! [`draw_plan_maps`] draws a network plan: the maps before and after side by side.
 //! [`draw_curves`] draws the ROC and missed-detection curves of the multi-target experiments.
+//! [`draw_delays`] and [`draw_track_errors`] draw the channel front end's figures (\[S\] Figs. 4–6).
 //! [`draw_mtl_scene`] draws a multi-target scene and its view (the page's multi-target view).
 
+mod channel;
 mod clip;
 mod layout;
 mod map;
@@ -18,6 +20,9 @@ mod roc;
 mod scene;
 mod tracking;
 
+pub use channel::{
+    delays_size, draw_delays, draw_track_errors, track_errors_size, ChannelChartOptions,
+};
 pub(crate) use layout::{axis_label, chart_err};
 pub use layout::{register_fonts, suggested_size, ChartError};
 pub use map::{

@@ -213,3 +213,27 @@ pub const RANGE_M: Range = Range {
     max: 1e8,
     allowed: "0 to 1e8 m",
 };
+
+/// Largest `max_paths` of the snapshot estimator (C5): the joint amplitude fit and the joint
+/// Fisher matrix are `K × K` and `3K × 3K` dense solves per snapshot, so `K` beyond a few tens
+/// only costs time ([S] resolves fewer than 20 paths per link).
+pub const MAX_PATHS: usize = 64;
+
+/// Largest zero-padded periodogram of the snapshot estimator (C5): `2^20` cells (16 MiB of
+/// complex scratch), e.g. 16 384 bins oversampled 64×.
+pub const MAX_PERIODOGRAM: usize = 1 << 20;
+
+/// Most columns (snapshots) of a delay figure's magnitude image (`present::delay_image`): more
+/// snapshots are decimated to this many. 600 columns × [`MAX_DELAY_IMAGE_ROWS`] rows × N = 241
+/// bins is 4.3·10⁷ complex multiply-adds per link, about 0.1 s in release.
+pub const MAX_DELAY_IMAGE_COLS: usize = 600;
+
+/// Most rows (range cells) of a delay figure's magnitude image (`present::delay_image`).
+pub const MAX_DELAY_IMAGE_ROWS: usize = 300;
+
+/// Largest dynamic range of a delay figure's magnitude image, dB (smallest: 1 dB).
+pub const DELAY_IMAGE_DR_DB: Range = Range {
+    min: 1.0,
+    max: 200.0,
+    allowed: "1 to 200 dB",
+};

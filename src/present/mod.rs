@@ -3,9 +3,11 @@
 //! page draws it, a simulated track's frames, the planner's request and report (`plan.json`), a
 //! multi-target scene turned into what the page draws ([`mtl_view`]: nodes, targets, discs,
 //! measurements, Algorithm 1's trace), and the interactive [`Session`] (a validated scenario and
-//! its compiled model, kept in step). Pure `no_std` functions of the core's results:
+//! its compiled model, kept in step), and the channel front end's delay and track-error figures
+//! ([`DelayFigure`], [`TrackErrorView`], [`ErrorStats`]). Pure `no_std` functions of the core's results:
 //! no maths of their own beyond layout.
 
+mod channel_view;
 mod colormap;
 mod plan_view;
 mod scene;
@@ -14,6 +16,11 @@ mod snapshot;
 mod ticks;
 mod track_view;
 
+pub use channel_view::{
+    delay_image, delay_points, quantile_pct, static_bands, suggest_range_m, track_errors,
+    DelayFigure, DelayImage, DelayPoint, ErrorStats, ImageConfig, ImageFloor, LinkDelays,
+    StaticBand, TrackErrorView, TruthCurve,
+};
 pub use colormap::{
     colorbar_rgba, fill_rgba, render_rgba, viridis, LogScale, LINK_RGB, UNBOUNDED_RGB,
 };

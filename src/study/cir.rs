@@ -20,7 +20,7 @@ use serde::Serialize;
 
 use crate::channel::{
     Band, DelayEstimate, Estimator, EstimatorConfig, PathTracker, PathTrackerConfig, Recording,
-    Snapshot, TrackedPath,
+    ResponseMap, Snapshot, TrackedPath,
 };
 use crate::error::{check_every, Cancel, Error, Result};
 use crate::math::{Complex, Mat4, Real, Vec4};
@@ -86,7 +86,7 @@ impl RecordingEstimates {
 /// recording mapped by C2).
 fn link_paths(
     rec: &Recording,
-    band: &Band,
+    (band, map): &(Band, ResponseMap),
     link: usize,
     cfg: &FrontEndConfig,
     cancel: Cancel,
@@ -94,7 +94,10 @@ fn link_paths(
 ) -> Result<(Vec<Vec<TrackedPath>>, Vec<Real>)> {
     let mut estimator = Estimator::new(band.clone(), cfg.estimator)?;
     let mut tracker = PathTracker::new(cfg.paths)?;
-    let given = rec.noise_var.as_ref().map(|v| v[link]);
+    let given = rec
+        .noise_var
+        .as_ref()
+        .map(|v| map.noise_var_of_taps(v[link]));
     let mut h: Vec<Complex> = Vec::new();
     let (mut paths, mut noise) = (Vec::with_capacity(rec.t_s.len()), Vec::new());
     let every = 64;
@@ -105,7 +108,7 @@ fn link_paths(
                 progress(every);
             }
         }
-        let estimated = band.response(rec, s, link, &mut h)?;
+        let estimated = map.fill(rec, s, link, &mut h)?;
         let nv = given.or(estimated);
         let mut used = 0.0;
         let tracked = tracker.step(t, |seeds| {

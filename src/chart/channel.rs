@@ -1,0 +1,745 @@
+//! The channel front end's figures (issue 25 §4): [`draw_delays`], \[S\] Fig. 4 per link (the
+//! response's delay profile as a grey image, the path estimates coloured by amplitude, the
+//! static clusters as grey bands, the true paths dashed, path length against time), and
+//! [`draw_track_errors`], \[S\] Figs. 5–6 (the track on the map, the position error over time
+//! and its empirical CDF with the 90 % point). Both draw a [`crate::present`] view on any
+//! plotters [`DrawingBackend`].
+
+use alloc::format;
+use alloc::string::String;
+use alloc::vec::Vec;
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
+
+use super::layout::{font_scale, frame_plot, segments, series_legend, titled_body, Fonts};
+use super::overlay::{
+    draw_overlay, MapOverlay, OverlayLine, OverlayMark, OverlayMarkKind, OverlayPath,
+};
+use super::panel::{check_area, draw_nodes, legend_entry, rgb, Chart, ChartNode};
+use super::{axis_label, chart_err, register_fonts, ChartError, CURVE_PALETTE};
+use crate::math::Real;
+use crate::present::{linear_ticks, viridis, DelayFigure, DelayImage, LinkDelays, TrackErrorView};
+use crate::scenario::Area;
+
+/// Colour of the true paths (the figures' red).
+const TRUTH_RGB: RGBColor = CURVE_PALETTE[1];
+/// Colour of the static bands.
+const STATIC_RGB: RGBColor = RGBColor(110, 110, 110);
+/// Grey levels of the image are quantised to this many steps (fewer, larger rectangles).
+const GREY_STEPS: Real = 32.0;
+
+/// Title and subtitle of a figure of this module.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct ChannelChartOptions {
+    /// Title line.
+    pub title: String,
+    /// Optional smaller second line.
+    pub subtitle: Option<String>,
+}
+
+/// A size for the delay figure of `links` panels: two columns from two links on (1400 × 900
+/// for 2 × 2), one panel 1000 × 620.
+pub fn delays_size(links: usize) -> (u32, u32) {
+    match links {
+        0 | 1 => (1000, 620),
+        n => {
+            let rows = n.div_ceil(2).min(8) as u32;
+            (1400, 120 + 390 * rows)
+        }
+    }
+}
+
+/// A size for the track figure: 1400 × 720.
+pub fn track_errors_size() -> (u32, u32) {
+    (1400, 720)
+}
+
+/// The grey of image value `v` on `[lo, hi]` dB: white at `lo`, near black at `hi`.
+fn grey(v: Real, lo: Real, hi: Real) -> RGBColor {
+    let f = if hi > lo {
+        ((v - lo) / (hi - lo)).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let f = (f * GREY_STEPS).round() / GREY_STEPS;
+    let g = (255.0 - 215.0 * f) as u8;
+    RGBColor(g, g, g)
+}
+
+/// The viridis colour of amplitude `v` on `range`.
+fn amplitude_rgb(v: Real, range: [Real; 2]) -> RGBColor {
+    let f = if range[1] > range[0] {
+        (v - range[0]) / (range[1] - range[0])
+    } else {
+        0.5
+    };
+    rgb(viridis(f))
+}
+
+/// A text centred in the plotting area of `chart` (e.g. `no track`).
+fn centred_note<DB: DrawingBackend>(
+    chart: &Chart<'_, DB>,
+    text: &str,
+    font: &Fonts,
+) -> Result<(), ChartError> {
+    let plot = chart.plotting_area().strip_coord_spec();
+    let (w, h) = plot.dim_in_pixel();
+    let style = TextStyle::from(("sans-serif", font.axis).into_font())
+        .color(&RGBColor(90, 90, 90))
+        .pos(Pos::new(HPos::Center, VPos::Center));
+    plot.draw_text(text, &style, (w as i32 / 2, h as i32 / 2))
+        .map_err(chart_err)
+}
+
+/// A finite, increasing axis range from `r` (`[0, 1]` otherwise).
+fn axis(r: [Real; 2]) -> [Real; 2] {
+    if r[0].is_finite() && r[1].is_finite() && r[1] > r[0] {
+        r
+    } else if r[0].is_finite() {
+        [r[0], r[0] + 1.0]
+    } else {
+        [0.0, 1.0]
+    }
+}
+
+/// Draws the delay figure onto `root` (filled white first): the title band, one panel per link
+/// (two columns from two links on) on the figure's time axis, and on the right the colour bars of
+/// the estimates' amplitude (viridis) and of the image (grey, one scale for every link). A link
+/// without estimates says so; a figure without links says `no links`. Does not call `present()`.
+pub fn draw_delays<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    fig: &DelayFigure,
+    opts: &ChannelChartOptions,
+) -> Result<(), ChartError> {
+    register_fonts();
+    for l in &fig.links {
+        if let Some(img) = &l.image {
+            if img.db.len() != img.rows * img.cols() {
+                return Err(ChartError(format!(
+                    "{}: image has {} values for {} rows × {} columns",
+                    l.name,
+                    img.db.len(),
+                    img.rows,
+                    img.cols()
+                )));
+            }
+        }
+    }
+    let (w, h) = root.dim_in_pixel();
+    let n = fig.links.len();
+    let ncols = if n > 1 { 2 } else { 1 };
+    let nrows = n.div_ceil(ncols).max(1);
+    let s = (w as f64 / ncols as f64 / 640.0)
+        .min(h as f64 / nrows as f64 / 380.0)
+        .clamp(0.5, 4.0)
+        .min(font_scale(w, h));
+    let (font, body) = titled_body(root, s, &opts.title, opts.subtitle.as_deref())?;
+    let (bw, bh) = body.dim_in_pixel();
+    let bars_w =
+        ((2.0 * (24.0 + 16.0) * s + 2.0 * (3.0 * font.ticks + 1.4 * font.axis)) as u32).min(bw / 3);
+    let (panels, bars) = body.split_horizontally(bw.saturating_sub(bars_w));
+    let grey_range = image_range(&fig.links);
+    if n == 0 {
+        let style = TextStyle::from(("sans-serif", font.axis).into_font())
+            .pos(Pos::new(HPos::Center, VPos::Center));
+        panels
+            .draw_text(
+                "no links",
+                &style,
+                ((bw - bars_w) as i32 / 2, bh as i32 / 2),
+            )
+            .map_err(chart_err)?;
+    }
+    let areas = panels.split_evenly((nrows, ncols));
+    for (k, (area, link)) in areas.iter().zip(&fig.links).enumerate() {
+        draw_link(area, fig, link, grey_range, k == 0, &font, s)?;
+    }
+    let (bar_a, bar_g) = bars.split_horizontally(bars_w / 2);
+    let bar_h = (bh as f64 * 0.8) as u32;
+    let shrink = |a: &DrawingArea<DB, Shift>| {
+        a.clone()
+            .shrink((0, (bh - bar_h) as i32 / 2), (bars_w / 2, bar_h))
+    };
+    if let Some(r) = fig.amplitude_db_range {
+        draw_db_bar(
+            &shrink(&bar_a),
+            r,
+            |v| amplitude_rgb(v, r),
+            "estimate amplitude 20·log₁₀|α| (dB)",
+            &font,
+        )?;
+    }
+    if let Some(r) = grey_range {
+        draw_db_bar(
+            &shrink(&bar_g),
+            r,
+            |v| grey(v, r[0], r[1]),
+            "response power (dB)",
+            &font,
+        )?;
+    }
+    Ok(())
+}
+
+/// The shared scale of the images: from the lowest floor to the highest maximum, dB.
+fn image_range(links: &[LinkDelays]) -> Option<[Real; 2]> {
+    let (lo, hi) = links
+        .iter()
+        .filter_map(|l| l.image.as_ref())
+        .map(|i| i.db_range)
+        .filter(|r| r[0].is_finite() && r[1].is_finite())
+        .fold((Real::INFINITY, Real::NEG_INFINITY), |(a, b), r| {
+            (a.min(r[0]), b.max(r[1]))
+        });
+    (lo.is_finite() && hi > lo).then_some([lo, hi])
+}
+
+/// One link's panel.
+fn draw_link<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    fig: &DelayFigure,
+    link: &LinkDelays,
+    grey_range: Option<[Real; 2]>,
+    legend: bool,
+    font: &Fonts,
+    s: f64,
+) -> Result<(), ChartError> {
+    let [t0, t1] = axis(fig.t_range_s);
+    let [r0, r1] = axis(link.range_m);
+    let mut chart = ChartBuilder::on(area)
+        .caption(&link.name, ("sans-serif", font.axis * 1.05).into_font())
+        .margin((8.0 * s) as u32)
+        .x_label_area_size((font.ticks + font.axis + 20.0 * s) as u32)
+        .y_label_area_size((2.6 * font.ticks + font.axis + 20.0 * s) as u32)
+        .build_cartesian_2d(t0..t1, r0..r1)
+        .map_err(chart_err)?;
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .x_desc("time t (s)")
+        .y_desc("path length c·τ (m)")
+        .label_style(("sans-serif", font.ticks).into_font())
+        .axis_desc_style(("sans-serif", font.axis).into_font())
+        .x_labels(8)
+        .y_labels(7)
+        .set_all_tick_mark_size(font.ticks as i32 / 3 + 2)
+        .x_label_formatter(&|v| axis_label(*v))
+        .y_label_formatter(&|v| axis_label(*v))
+        .draw()
+        .map_err(chart_err)?;
+    if let (Some(img), Some(g)) = (&link.image, grey_range) {
+        draw_image(&mut chart, img, g, [t0, t1, r0, r1])?;
+    }
+    for (k, b) in link.statics.iter().enumerate() {
+        let (lo, hi) = (
+            (b.mean_m - b.halfwidth_m).max(r0),
+            (b.mean_m + b.halfwidth_m).min(r1),
+        );
+        if lo.partial_cmp(&hi) != Some(core::cmp::Ordering::Less) {
+            continue;
+        }
+        chart
+            .draw_series([Rectangle::new(
+                [(t0, lo), (t1, hi)],
+                STATIC_RGB.mix(0.3).filled(),
+            )])
+            .map_err(chart_err)?;
+        if (r0..=r1).contains(&b.mean_m) {
+            chart
+                .draw_series([PathElement::new(
+                    [(t0, b.mean_m), (t1, b.mean_m)],
+                    STATIC_RGB.stroke_width(1),
+                )])
+                .map_err(chart_err)?;
+        }
+        if legend && k == 0 {
+            let sz = (6.0 * s) as i32;
+            legend_entry(&mut chart, "static cluster ±3σ", move |(x, y)| {
+                Rectangle::new(
+                    [(x - 2 * sz, y - sz / 2), (x + 2 * sz, y + sz / 2)],
+                    STATIC_RGB.mix(0.5).filled(),
+                )
+            })?;
+        }
+    }
+    let width = (2.0 * s).round().max(1.0) as u32;
+    let (dash, gap) = ((8.0 * s) as u32, (5.0 * s) as u32);
+    let mut kinds: Vec<&str> = Vec::new();
+    for c in &link.truth {
+        let style = if c.primary {
+            TRUTH_RGB.stroke_width(width)
+        } else {
+            TRUTH_RGB.mix(0.45).stroke_width(width.div_ceil(2))
+        };
+        let inside = |t: Real, r: Real| t.is_finite() && r.is_finite() && (r0..=r1).contains(&r);
+        for part in segments(c.points.iter().copied(), inside) {
+            chart
+                .draw_series(DashedLineSeries::new(part, dash, gap, style))
+                .map_err(chart_err)?;
+        }
+        if legend && !kinds.contains(&c.kind.as_str()) {
+            kinds.push(&c.kind);
+            legend_entry(&mut chart, &format!("truth: {}", c.kind), move |(x, y)| {
+                EmptyElement::at((x, y))
+                    + PathElement::new([(-12, 0), (-3, 0)], style)
+                    + PathElement::new([(3, 0), (12, 0)], style)
+            })?;
+        }
+    }
+    let radius = (2.6 * s).round().max(1.0) as i32;
+    if let Some(range) = fig.amplitude_db_range {
+        let visible = link
+            .estimates
+            .iter()
+            .filter(|e| (t0..=t1).contains(&e.t_s) && (r0..=r1).contains(&e.range_m));
+        chart
+            .draw_series(visible.map(|e| {
+                Circle::new(
+                    (e.t_s, e.range_m),
+                    radius,
+                    amplitude_rgb(e.amplitude_db, range).filled(),
+                )
+            }))
+            .map_err(chart_err)?;
+        if legend && !link.estimates.is_empty() {
+            let c = amplitude_rgb(range[1], range);
+            legend_entry(&mut chart, "estimate (colour: amplitude)", move |(x, y)| {
+                Circle::new((x, y), radius + 1, c.filled())
+            })?;
+        }
+    }
+    if link.estimates.is_empty() {
+        centred_note(&chart, "no estimates", font)?;
+    }
+    if legend {
+        series_legend(
+            &mut chart,
+            SeriesLabelPosition::UpperRight,
+            font.ticks * 0.85,
+            6.0 * s,
+            0.85,
+        )?;
+    }
+    frame_plot(&chart)
+}
+
+/// The image in data coordinates: per column (from the middle between its time and its
+/// neighbours'), runs of rows of one grey merged into one rectangle.
+fn draw_image<DB: DrawingBackend>(
+    chart: &mut Chart<'_, DB>,
+    img: &DelayImage,
+    [lo, hi]: [Real; 2],
+    [t0, t1, r0, r1]: [Real; 4],
+) -> Result<(), ChartError> {
+    let cols = img.cols();
+    if cols == 0 || img.rows == 0 {
+        return Ok(());
+    }
+    let t = &img.t_s;
+    let half = if cols > 1 {
+        0.5 * (t[1] - t[0])
+    } else {
+        0.5 * (t1 - t0)
+    };
+    let edge = |i: usize| -> Real {
+        if i == 0 {
+            t[0] - half
+        } else if i == cols {
+            t[cols - 1]
+                + if cols > 1 {
+                    0.5 * (t[cols - 1] - t[cols - 2])
+                } else {
+                    half
+                }
+        } else {
+            0.5 * (t[i - 1] + t[i])
+        }
+    };
+    let clamp_t = |v: Real| v.clamp(t0, t1);
+    let row_edge = |j: usize| (img.r0_m + (j as Real - 0.5) * img.dr_m).clamp(r0, r1);
+    let mut cells = Vec::new();
+    for i in 0..cols {
+        let (x0, x1) = (clamp_t(edge(i)), clamp_t(edge(i + 1)));
+        if x0.partial_cmp(&x1) != Some(core::cmp::Ordering::Less) {
+            continue;
+        }
+        let mut start = 0;
+        for j in 1..=img.rows {
+            let c = grey(img.db[start * cols + i], lo, hi);
+            if j < img.rows && grey(img.db[j * cols + i], lo, hi) == c {
+                continue;
+            }
+            let (y0, y1) = (row_edge(start), row_edge(j));
+            if y1 > y0 && c != RGBColor(255, 255, 255) {
+                cells.push(Rectangle::new([(x0, y0), (x1, y1)], c.filled()));
+            }
+            start = j;
+        }
+    }
+    chart.draw_series(cells).map_err(chart_err)?;
+    Ok(())
+}
+
+/// A vertical linear colour bar over `[lo, hi]` dB with ticks and a rotated label.
+fn draw_db_bar<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    [lo, hi]: [Real; 2],
+    colour: impl Fn(Real) -> RGBColor,
+    label: &str,
+    font: &Fonts,
+) -> Result<(), ChartError> {
+    let s = font.ticks / 20.0;
+    let (w, h) = area.dim_in_pixel();
+    let (w, h) = (w as i32, h as i32);
+    let bar_w = (22.0 * s).round() as i32;
+    let steps = h.clamp(1, 256);
+    for k in 0..steps {
+        let (y0, y1) = (k * h / steps, ((k + 1) * h / steps + 1).min(h));
+        let v = hi - (k as Real + 0.5) / steps as Real * (hi - lo);
+        area.draw(&Rectangle::new([(0, y0), (bar_w, y1)], colour(v).filled()))
+            .map_err(chart_err)?;
+    }
+    area.draw(&Rectangle::new(
+        [(0, 0), (bar_w, h - 1)],
+        BLACK.stroke_width(1),
+    ))
+    .map_err(chart_err)?;
+    let tick_font = TextStyle::from(("sans-serif", font.ticks).into_font())
+        .pos(Pos::new(HPos::Left, VPos::Center));
+    let max_labels = ((h as Real) / (2.2 * font.ticks)).max(2.0) as usize;
+    for t in linear_ticks(lo, hi, max_labels) {
+        let y = ((hi - t.value) / (hi - lo) * h as Real).round() as i32;
+        let len = (6.0 * s).round() as i32;
+        area.draw(&PathElement::new(
+            [(bar_w, y), (bar_w + len, y)],
+            BLACK.stroke_width(1),
+        ))
+        .map_err(chart_err)?;
+        area.draw_text(&t.label, &tick_font, (bar_w + len + (3.0 * s) as i32, y))
+            .map_err(chart_err)?;
+    }
+    let rotated = TextStyle::from(("sans-serif", font.axis * 0.9).into_font())
+        .transform(FontTransform::Rotate270)
+        .pos(Pos::new(HPos::Center, VPos::Center));
+    area.draw_text(label, &rotated, (w - (0.6 * font.axis) as i32, h / 2))
+        .map_err(chart_err)
+}
+
+/// `area` widened about its centre so that it fills a `pw × ph` pixel plot at equal scale.
+fn equal_scale(area: &Area, pw: f64, ph: f64) -> ([Real; 2], [Real; 2]) {
+    let (xs, ys) = (area.x[1] - area.x[0], area.y[1] - area.y[0]);
+    let (cx, cy) = (0.5 * (area.x[0] + area.x[1]), 0.5 * (area.y[0] + area.y[1]));
+    let aspect = (pw / ph.max(1.0)).max(1e-3);
+    if xs / ys > aspect {
+        let ys = xs / aspect;
+        (area.x, [cy - 0.5 * ys, cy + 0.5 * ys])
+    } else {
+        let xs = ys * aspect;
+        ([cx - 0.5 * xs, cx + 0.5 * xs], area.y)
+    }
+}
+
+/// Draws the track figure onto `root` (filled white first): on the left the map of `area` at
+/// equal scale with `nodes`, the true path (dashed) and the estimated track; on the right the
+/// position error `‖r̂ − r‖` over time and its empirical CDF with the 90 % point marked and its
+/// value printed. A track that never starts, or no truth, is said in words (no curve). Does not
+/// call `present()`.
+pub fn draw_track_errors<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    view: &TrackErrorView,
+    nodes: &[ChartNode],
+    area: &Area,
+    opts: &ChannelChartOptions,
+) -> Result<(), ChartError> {
+    register_fonts();
+    check_area(area)?;
+    let (w, h) = root.dim_in_pixel();
+    let s = (w as f64 / 1400.0).min(h as f64 / 640.0).clamp(0.5, 4.0);
+    let (font, body) = titled_body(root, s, &opts.title, opts.subtitle.as_deref())?;
+    let (bw, _) = body.dim_in_pixel();
+    let (left, right) = body.split_horizontally(bw * 52 / 100);
+    draw_track_map(&left, view, nodes, area, &font, s)?;
+    let (top, bottom) = {
+        let (_, rh) = right.dim_in_pixel();
+        right.split_vertically(rh / 2)
+    };
+    let note = if view.track_start.is_none() {
+        Some("no track")
+    } else if view.stats.is_none() {
+        Some("no truth")
+    } else {
+        None
+    };
+    draw_error_time(&top, view, note, &font, s)?;
+    draw_error_cdf(&bottom, view, note, &font, s)
+}
+
+fn draw_track_map<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    view: &TrackErrorView,
+    nodes: &[ChartNode],
+    map: &Area,
+    font: &Fonts,
+    s: f64,
+) -> Result<(), ChartError> {
+    let (w, h) = area.dim_in_pixel();
+    let (xl, yl, m) = (
+        font.ticks + font.axis + 20.0 * s,
+        2.4 * font.ticks + font.axis + 20.0 * s,
+        10.0 * s,
+    );
+    let (x, y) = equal_scale(map, w as f64 - yl - 2.0 * m, h as f64 - xl - 2.0 * m);
+    let mut chart = ChartBuilder::on(area)
+        .margin(m as u32)
+        .x_label_area_size(xl as u32)
+        .y_label_area_size(yl as u32)
+        .build_cartesian_2d(x[0]..x[1], y[0]..y[1])
+        .map_err(chart_err)?;
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .x_desc("x (m)")
+        .y_desc("y (m)")
+        .label_style(("sans-serif", font.ticks).into_font())
+        .axis_desc_style(("sans-serif", font.axis).into_font())
+        .x_labels(8)
+        .y_labels(8)
+        .set_all_tick_mark_size(font.ticks as i32 / 3 + 2)
+        .x_label_formatter(&|v| axis_label(*v))
+        .y_label_formatter(&|v| axis_label(*v))
+        .draw()
+        .map_err(chart_err)?;
+    let mut overlay = MapOverlay::default();
+    let path = |label: &str, k: usize, run: &Vec<[Real; 2]>, line| OverlayPath {
+        label: (k == 0).then(|| label.into()),
+        points_m: run.clone(),
+        closed: false,
+        line,
+    };
+    overlay.paths.extend(
+        view.truth_m
+            .iter()
+            .enumerate()
+            .map(|(k, r)| path("truth", k, r, OverlayLine::Truth)),
+    );
+    overlay.paths.extend(
+        view.track_m
+            .iter()
+            .enumerate()
+            .map(|(k, r)| path("track", k, r, OverlayLine::Track)),
+    );
+    if let Some(p) = view.track_m.first().and_then(|r| r.first()) {
+        overlay.marks.push(OverlayMark {
+            label: Some("track start".into()),
+            position_m: *p,
+            kind: OverlayMarkKind::Start,
+        });
+    }
+    draw_overlay(&mut chart, &overlay, font.nodes)?;
+    draw_nodes(&mut chart, nodes, font.nodes)?;
+    if nodes.is_empty() && !overlay.is_empty() {
+        series_legend(
+            &mut chart,
+            SeriesLabelPosition::UpperRight,
+            font.ticks * 0.9,
+            8.0 * s,
+            0.85,
+        )?;
+    }
+    if view.track_m.is_empty() {
+        centred_note(&chart, "no track", font)?;
+    }
+    frame_plot(&chart)
+}
+
+/// A curve panel with linear axes.
+fn curve_chart<'a, DB: DrawingBackend>(
+    area: &'a DrawingArea<DB, Shift>,
+    x: [Real; 2],
+    y: [Real; 2],
+    (x_desc, y_desc): (&str, &str),
+    font: &Fonts,
+    s: f64,
+) -> Result<Chart<'a, DB>, ChartError> {
+    let mut chart = ChartBuilder::on(area)
+        .margin((10.0 * s) as u32)
+        .x_label_area_size((font.ticks + font.axis + 20.0 * s) as u32)
+        .y_label_area_size((2.4 * font.ticks + font.axis + 20.0 * s) as u32)
+        .build_cartesian_2d(x[0]..x[1], y[0]..y[1])
+        .map_err(chart_err)?;
+    chart
+        .configure_mesh()
+        .bold_line_style(RGBColor(215, 215, 215).stroke_width(1))
+        .light_line_style(RGBColor(240, 240, 240).stroke_width(1))
+        .x_desc(x_desc)
+        .y_desc(y_desc)
+        .label_style(("sans-serif", font.ticks).into_font())
+        .axis_desc_style(("sans-serif", font.axis).into_font())
+        .x_labels(8)
+        .y_labels(6)
+        .set_all_tick_mark_size(font.ticks as i32 / 3 + 2)
+        .x_label_formatter(&|v| axis_label(*v))
+        .y_label_formatter(&|v| axis_label(*v))
+        .draw()
+        .map_err(chart_err)?;
+    Ok(chart)
+}
+
+/// The largest error with room above it, m (1 m without errors).
+fn error_top(view: &TrackErrorView) -> Real {
+    view.stats
+        .map_or(1.0, |st| if st.max_m > 0.0 { st.max_m * 1.08 } else { 1.0 })
+}
+
+fn draw_error_time<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    view: &TrackErrorView,
+    note: Option<&str>,
+    font: &Fonts,
+    s: f64,
+) -> Result<(), ChartError> {
+    let t = axis([
+        view.t_s.first().copied().unwrap_or(0.0),
+        view.t_s.last().copied().unwrap_or(1.0),
+    ]);
+    let chart = curve_chart(
+        area,
+        t,
+        [0.0, error_top(view)],
+        ("time t (s)", "position error (m)"),
+        font,
+        s,
+    )?;
+    let width = (2.0 * s).round().max(1.0) as u32;
+    let points = view
+        .t_s
+        .iter()
+        .zip(&view.error_m)
+        .map(|(&t, e)| (t, e.unwrap_or(Real::NAN)));
+    for part in segments(points, |t, e| t.is_finite() && e.is_finite()) {
+        chart
+            .plotting_area()
+            .draw(&PathElement::new(
+                part,
+                CURVE_PALETTE[0].stroke_width(width),
+            ))
+            .map_err(chart_err)?;
+    }
+    if let Some(st) = view.stats {
+        let text = format!(
+            "median {} m · 90 % {} m · max {} m · {} % below 1 m",
+            decimals(st.median_m),
+            decimals(st.p90_m),
+            decimals(st.max_m),
+            decimals(100.0 * st.fraction_below_1m),
+        );
+        let style = TextStyle::from(("sans-serif", font.ticks * 0.9).into_font())
+            .color(&RGBColor(60, 60, 60));
+        let pad = (8.0 * s) as i32;
+        chart
+            .plotting_area()
+            .strip_coord_spec()
+            .draw_text(&text, &style, (pad, pad))
+            .map_err(chart_err)?;
+    }
+    if let Some(n) = note {
+        centred_note(&chart, n, font)?;
+    }
+    frame_plot(&chart)
+}
+
+fn draw_error_cdf<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    view: &TrackErrorView,
+    note: Option<&str>,
+    font: &Fonts,
+    s: f64,
+) -> Result<(), ChartError> {
+    let top = error_top(view);
+    let chart = curve_chart(
+        area,
+        [0.0, top],
+        [0.0, 1.0],
+        ("position error e (m)", "empirical CDF F(e)"),
+        font,
+        s,
+    )?;
+    let width = (2.0 * s).round().max(1.0) as u32;
+    let plot = chart.plotting_area();
+    if !view.cdf.is_empty() {
+        let mut steps = Vec::with_capacity(2 * view.cdf.len() + 2);
+        let mut prev = 0.0;
+        steps.push((0.0, 0.0));
+        for &(e, f) in &view.cdf {
+            steps.push((e, prev));
+            steps.push((e, f));
+            prev = f;
+        }
+        steps.push((top, prev));
+        plot.draw(&PathElement::new(
+            steps,
+            CURVE_PALETTE[0].stroke_width(width),
+        ))
+        .map_err(chart_err)?;
+    }
+    if let Some(st) = view.stats {
+        let p90 = st.p90_m;
+        let dashed = TRUTH_RGB.stroke_width(width.div_ceil(2));
+        let (d, g) = ((6.0 * s) as u32, (4.0 * s) as u32);
+        chart_dashed(plot, [(0.0, 0.9), (p90, 0.9)], d, g, dashed)?;
+        chart_dashed(plot, [(p90, 0.0), (p90, 0.9)], d, g, dashed)?;
+        let r = (5.0 * s).round().max(2.0) as i32;
+        let label = format!("90 %: {} m", decimals(p90));
+        let style = TextStyle::from(("sans-serif", font.ticks).into_font()).color(&TRUTH_RGB);
+        // The label right of the marker, or left of it near the right edge.
+        let dx = if p90 > 0.6 * top {
+            -(r + (6.5 * font.ticks) as i32)
+        } else {
+            r + 4
+        };
+        plot.draw(
+            &(EmptyElement::at((p90, 0.9))
+                + Circle::new((0, 0), r, TRUTH_RGB.filled())
+                + Text::new(label, (dx, -(font.ticks as i32) - r), style)),
+        )
+        .map_err(chart_err)?;
+    }
+    if let Some(n) = note {
+        centred_note(&chart, n, font)?;
+    }
+    frame_plot(&chart)
+}
+
+/// A dashed line between two points in data coordinates.
+fn chart_dashed<DB: DrawingBackend>(
+    plot: &DrawingArea<
+        DB,
+        plotters::coord::cartesian::Cartesian2d<
+            plotters::coord::types::RangedCoordf64,
+            plotters::coord::types::RangedCoordf64,
+        >,
+    >,
+    pts: [(Real, Real); 2],
+    dash: u32,
+    gap: u32,
+    style: ShapeStyle,
+) -> Result<(), ChartError> {
+    plot.draw(&plotters::element::DashedPathElement::new(
+        pts, dash, gap, style,
+    ))
+    .map_err(chart_err)
+}
+
+/// `v` with 2 decimals below 10 and 1 from there (m in labels).
+fn decimals(v: Real) -> String {
+    if v < 10.0 {
+        format!("{v:.2}")
+    } else {
+        format!("{v:.1}")
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,261 @@
+use super::*;
+use crate::channel::DelayEstimate;
+use crate::math::{cos, sin, Complex, PI, SPEED_OF_LIGHT};
+use crate::present::{
+    delay_image, delay_points, track_errors, DelayPoint, ImageConfig, StaticBand, TruthCurve,
+};
+
+/// The SVG of `draw` on a `size` canvas, and the same drawn into an RGB buffer (PNG backend).
+fn render(
+    size: (u32, u32),
+    draw: impl Fn(&DrawingArea<SVGBackend, Shift>) -> Result<(), ChartError>,
+    draw_png: impl Fn(&DrawingArea<BitMapBackend, Shift>) -> Result<(), ChartError>,
+) -> String {
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
+        draw(&root).unwrap();
+        root.present().unwrap();
+    }
+    let mut buf = vec![0u8; (size.0 * size.1 * 3) as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut buf, size).into_drawing_area();
+        draw_png(&root).unwrap();
+        root.present().unwrap();
+    }
+    // Not all white: something was drawn.
+    assert!(buf.iter().any(|&b| b < 200));
+    assert!(
+        !svg.contains("NaN") && !svg.contains("inf"),
+        "non-finite in the SVG"
+    );
+    svg
+}
+
+fn texts(svg: &str) -> Vec<String> {
+    let doc = roxmltree::Document::parse(svg).expect("well-formed SVG");
+    doc.descendants()
+        .filter(|n| n.has_tag_name("text"))
+        .map(|n| n.text().unwrap_or("").trim().to_string())
+        .collect()
+}
+
+fn count(svg: &str, tag: &str) -> usize {
+    let doc = roxmltree::Document::parse(svg).unwrap();
+    doc.descendants().filter(|n| n.has_tag_name(tag)).count()
+}
+
+/// A walk's figure: four links; link 0 with an image of two paths (a static one at 20 m and the
+/// pedestrian's from 25 to 40 m), link 1 without truth, link 2 without estimates, link 3 bare.
+fn figure() -> DelayFigure {
+    let t: Vec<Real> = (0..50).map(|k| k as Real * 0.1).collect();
+    let ped = |t: Real| 25.0 + 3.0 * t;
+    let n = 64;
+    let f: Vec<Real> = (0..n).map(|k| (k as Real - 31.5) * 2e6).collect();
+    let cfr: Vec<Vec<Complex>> = t
+        .iter()
+        .map(|&ts| {
+            f.iter()
+                .map(|&fk| {
+                    [(20.0, 0.01), (ped(ts), 0.003)]
+                        .iter()
+                        .map(|&(r, a)| {
+                            let ph = -2.0 * PI * fk * r / SPEED_OF_LIGHT;
+                            Complex::new(a * cos(ph), a * sin(ph))
+                        })
+                        .sum()
+                })
+                .collect()
+        })
+        .collect();
+    let mut cfg = ImageConfig::new([0.0, 60.0]);
+    cfg.rows = 60;
+    let image = delay_image(&f, &t, |s| cfr[s].as_slice(), &cfg).unwrap();
+    let est: Vec<Vec<DelayEstimate>> = t
+        .iter()
+        .map(|&ts| {
+            [(20.0, 0.01), (ped(ts), 0.003)]
+                .iter()
+                .map(|&(r, a)| DelayEstimate {
+                    delay_s: r / SPEED_OF_LIGHT,
+                    amplitude: a,
+                    sigma_s: None,
+                })
+                .collect()
+        })
+        .collect();
+    let points: Vec<DelayPoint> = delay_points(&t, &est);
+    let statics = vec![StaticBand {
+        mean_m: 20.0,
+        halfwidth_m: 0.5,
+    }];
+    let truth = vec![
+        TruthCurve {
+            kind: "pedestrian".into(),
+            primary: true,
+            points: t.iter().map(|&ts| (ts, ped(ts))).collect(),
+        },
+        TruthCurve {
+            kind: "los".into(),
+            primary: false,
+            points: t.iter().map(|&ts| (ts, 20.0)).collect(),
+        },
+    ];
+    let link = |name: &str, image, estimates, truth| LinkDelays {
+        name: name.into(),
+        range_m: [0.0, 60.0],
+        image,
+        estimates,
+        statics: statics.clone(),
+        truth,
+    };
+    DelayFigure::new(
+        &t,
+        vec![
+            link("Tx → Rx1", Some(image), points.clone(), truth.clone()),
+            link("Tx → Rx2", None, points, Vec::new()),
+            link("Tx → Rx3", None, Vec::new(), truth),
+            link("Tx → Rx4", None, Vec::new(), Vec::new()),
+        ],
+    )
+}
+
+#[test]
+fn delay_figure_has_a_panel_per_link_the_image_the_points_and_labels() {
+    let fig = figure();
+    let opts = ChannelChartOptions {
+        title: "Delays".into(),
+        subtitle: Some("simulated walk".into()),
+    };
+    let size = delays_size(4);
+    let svg = render(
+        size,
+        |r| draw_delays(r, &fig, &opts),
+        |r| draw_delays(r, &fig, &opts),
+    );
+    let tx = texts(&svg);
+    let n = |s: &str| tx.iter().filter(|t| *t == s).count();
+    assert_eq!(n("time t (s)"), 4, "{tx:?}");
+    assert_eq!(n("path length c·τ (m)"), 4);
+    for name in ["Tx → Rx1", "Tx → Rx2", "Tx → Rx3", "Tx → Rx4"] {
+        assert_eq!(n(name), 1, "{name}");
+    }
+    assert_eq!(n("no estimates"), 2);
+    assert_eq!(n("truth: pedestrian"), 1);
+    assert_eq!(n("truth: los"), 1);
+    assert_eq!(n("static cluster ±3σ"), 1);
+    assert_eq!(n("estimate amplitude 20·log₁₀|α| (dB)"), 1);
+    assert_eq!(n("response power (dB)"), 1);
+    // 2 links × 50 snapshots × 2 paths estimates + the legend's marker.
+    assert_eq!(count(&svg, "circle"), 201);
+    // The image: at least one grey cell per column; the dashed truth lines.
+    assert!(count(&svg, "rect") > 50 + 4 * 4, "{}", count(&svg, "rect"));
+    assert!(svg.contains("#D62728"), "truth red");
+}
+
+#[test]
+fn empty_delay_figures_draw() {
+    let opts = ChannelChartOptions::default();
+    let none = DelayFigure::new(&[], Vec::new());
+    let svg = render(
+        (800, 500),
+        |r| draw_delays(r, &none, &opts),
+        |r| draw_delays(r, &none, &opts),
+    );
+    assert!(texts(&svg).iter().any(|t| t == "no links"));
+    let mut fig = figure();
+    fig.links.truncate(1);
+    fig.links[0].estimates.clear();
+    fig.amplitude_db_range = None;
+    let svg = render(
+        (1000, 620),
+        |r| draw_delays(r, &fig, &opts),
+        |r| draw_delays(r, &fig, &opts),
+    );
+    assert!(texts(&svg).iter().any(|t| t == "no estimates"));
+    let mut bad = figure();
+    bad.links[0].image.as_mut().unwrap().db.pop();
+    let mut s = String::new();
+    let root = SVGBackend::with_string(&mut s, (800, 500)).into_drawing_area();
+    let e = draw_delays(&root, &bad, &opts).unwrap_err();
+    assert!(e.0.contains("Tx → Rx1"), "{}", e.0);
+}
+
+fn nodes() -> Vec<ChartNode> {
+    use crate::chart::NodeKind;
+    vec![
+        ChartNode {
+            name: "Tx".into(),
+            position_m: [0.0, 0.0],
+            kind: NodeKind::Transmitter,
+        },
+        ChartNode {
+            name: "Rx1".into(),
+            position_m: [10.0, 0.0],
+            kind: NodeKind::Receiver,
+        },
+    ]
+}
+
+#[test]
+fn track_figure_marks_the_90_percent_point() {
+    let t: Vec<Real> = (0..20).map(|k| k as Real * 0.5).collect();
+    let truth: Vec<Option<[Real; 4]>> = t.iter().map(|&ts| Some([ts, 2.0, 1.0, 0.0])).collect();
+    // Errors 0.1·k m from snapshot 2 on: 0.2 … 1.9 m (18 of them); the 90 % quantile is the
+    // ⌈16.2⌉ = 17th smallest, 1.8 m.
+    let states: Vec<Option<[Real; 4]>> = t
+        .iter()
+        .enumerate()
+        .map(|(k, &ts)| (k >= 2).then_some([ts, 2.0 + 0.1 * k as Real, 1.0, 0.0]))
+        .collect();
+    let view = track_errors(&t, &states, &truth).unwrap();
+    assert!((view.stats.unwrap().p90_m - 1.8).abs() < 1e-12);
+    let area = Area {
+        x: [-1.0, 12.0],
+        y: [-2.0, 6.0],
+    };
+    let opts = ChannelChartOptions {
+        title: "Track".into(),
+        subtitle: None,
+    };
+    let draw = |v: &TrackErrorView| {
+        let v = v.clone();
+        let n = nodes();
+        render(
+            track_errors_size(),
+            |r| draw_track_errors(r, &v, &n, &area, &opts),
+            |r| draw_track_errors(r, &v, &n, &area, &opts),
+        )
+    };
+    let svg = draw(&view);
+    let tx = texts(&svg);
+    assert!(tx.iter().any(|t| t == "90 %: 1.80 m"), "{tx:?}");
+    // 18 errors 0.2 … 1.9 m: median the 9th = 1.0 m, 8 of 18 = 44.4 % strictly below 1 m.
+    let stats = "median 1.00 m · 90 % 1.80 m · max 1.90 m · 44.4 % below 1 m";
+    assert!(tx.iter().any(|t| t == stats), "{tx:?}");
+    for label in [
+        "x (m)",
+        "time t (s)",
+        "position error (m)",
+        "empirical CDF F(e)",
+        "truth",
+        "track",
+        "Rx1",
+    ] {
+        assert!(tx.iter().any(|t| t == label), "{label} in {tx:?}");
+    }
+    assert!(!tx.iter().any(|t| t == "no track"));
+    // The track never starts: said, no curve, no NaN.
+    let never = track_errors(&t, &vec![None; 20], &truth).unwrap();
+    let svg = draw(&never);
+    let tx = texts(&svg);
+    assert!(
+        tx.iter().filter(|t| *t == "no track").count() >= 3,
+        "{tx:?}"
+    );
+    assert!(!tx.iter().any(|t| t.starts_with("90 %")));
+    // No truth: the map still shows the track.
+    let bare = track_errors(&t, &states, &[]).unwrap();
+    let tx = texts(&draw(&bare));
+    assert!(tx.iter().any(|t| t == "no truth") && tx.iter().any(|t| t == "track"));
+}
