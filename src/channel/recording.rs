@@ -4,9 +4,49 @@
 //! links as (transmitter, receiver) indices into the scenario, and the optional system response,
 //! pulse and noise variances. Amplitudes are √W at the receiver input (C3).
 
+use alloc::format;
+use alloc::string::String;
+use alloc::vec;
 use alloc::vec::Vec;
 
-use crate::math::{Complex, Real};
+use crate::error::limits::{
+    FREQ_UNIFORM_TOL, MAX_BINS_PER_LINK, MAX_LINKS, MAX_PULSE_SAMPLES, MAX_RECORDING_SAMPLES,
+    MAX_SNAPSHOTS, PULSE_NORM_TOL,
+};
+use crate::error::{Error, Result};
+use crate::math::{sqrt, Complex, Real};
+use crate::measure::Model;
+
+#[cfg(test)]
+mod tests;
+
+fn invalid(field: &str, reason: String) -> Error {
+    Error::InvalidFile {
+        field: field.into(),
+        reason,
+    }
+}
+
+fn size(field: &'static str, value: usize, min: usize, max: usize) -> Result<()> {
+    if value < min || value > max {
+        return Err(Error::SizeLimit {
+            field,
+            value,
+            min,
+            max,
+        });
+    }
+    Ok(())
+}
+
+fn finite_c(z: &Complex) -> bool {
+    z.re.is_finite() && z.im.is_finite()
+}
+
+/// `|z|` with the crate's portable square root.
+fn abs_c(z: &Complex) -> Real {
+    sqrt(z.re * z.re + z.im * z.im)
+}
 
 /// The system pulse of a CIR recording (C2): samples at `spacing_s`, the middle sample at
 /// `t = 0`, normalised to `p(0) = 1` by the reader.
@@ -16,6 +56,31 @@ pub struct Pulse {
     pub samples: Vec<Complex>,
     /// Their spacing, s.
     pub spacing_s: Real,
+}
+
+impl Pulse {
+    /// Divides every sample by the middle one, so `p(0) = 1`; [`Error::InvalidFile`] naming
+    /// `pulse` when K is even (no middle sample) or `p(0) = 0` or not finite.
+    pub fn normalise(&mut self) -> Result<()> {
+        let k = self.samples.len();
+        if k % 2 == 0 {
+            return Err(invalid(
+                "pulse",
+                format!("{k} samples: an odd count is required (the middle one is t = 0)"),
+            ));
+        }
+        let p0 = self.samples[k / 2];
+        if !finite_c(&p0) || (p0.re == 0.0 && p0.im == 0.0) {
+            return Err(invalid(
+                "pulse",
+                "the middle sample p(0) is 0 or not finite: cannot normalise to p(0) = 1".into(),
+            ));
+        }
+        for z in &mut self.samples {
+            *z /= p0;
+        }
+        Ok(())
+    }
 }
 
 /// Which of the two layouts (C1 or C2) a recording holds.
@@ -37,6 +102,16 @@ pub enum Layout {
         /// The system pulse (`None`: the ideal sinc of the scenario's bandwidth).
         pulse: Option<Pulse>,
     },
+}
+
+impl Layout {
+    /// The name of the samples' array: `cfr` or `cir`.
+    pub fn array(&self) -> &'static str {
+        match self {
+            Layout::Cfr { .. } => "cfr",
+            Layout::Cir { .. } => "cir",
+        }
+    }
 }
 
 /// A channel recording: `samples[(s·P + p)·L + i]` is sample `i` (frequency bin or tap) of link
@@ -81,4 +156,245 @@ impl Recording {
         let start = (s * self.links.len() + p) * l;
         &self.samples[start..start + l]
     }
+
+    /// Checks everything a recording promises (docs/recording.md), naming the array at fault:
+    /// `t_s` non-empty, finite and strictly increasing; at least one link; the sample count
+    /// `S·P·L` with `L ≥ 2` (bins or taps) and all samples finite (the first bad one named as
+    /// `[s, p, i]`); `freq_hz` finite, increasing and uniform within
+    /// [`FREQ_UNIFORM_TOL`]`·Δf`; `system_response` of length N and finite; `tap0_s` finite,
+    /// `tap_spacing_s` finite > 0; `pulse` of odd length K, finite, spacing > 0 and
+    /// `|p(0) − 1| ≤` [`PULSE_NORM_TOL`]; `noise_var` one per link, finite > 0; and the caps
+    /// [`MAX_SNAPSHOTS`], [`MAX_LINKS`], [`MAX_BINS_PER_LINK`], [`MAX_RECORDING_SAMPLES`],
+    /// [`MAX_PULSE_SAMPLES`] ([`Error::SizeLimit`]).
+    pub fn validate(&self) -> Result<()> {
+        let s_count = self.t_s.len();
+        let p_count = self.links.len();
+        size("t_s", s_count, 1, MAX_SNAPSHOTS)?;
+        size("links", p_count, 1, MAX_LINKS)?;
+        for (s, &t) in self.t_s.iter().enumerate() {
+            if !t.is_finite() {
+                return Err(invalid("t_s", format!("t_s[{s}] is not a finite number")));
+            }
+            if s > 0 && t <= self.t_s[s - 1] {
+                return Err(invalid(
+                    "t_s",
+                    format!(
+                        "not strictly increasing: t_s[{s}] = {} after t_s[{}] = {}",
+                        crate::error::Num(t),
+                        s - 1,
+                        crate::error::Num(self.t_s[s - 1])
+                    ),
+                ));
+            }
+        }
+        let array = self.layout.array();
+        let per_link = match &self.layout {
+            Layout::Cfr {
+                freq_hz,
+                system_response,
+            } => {
+                check_freq(freq_hz)?;
+                if let Some(p) = system_response {
+                    if p.len() != freq_hz.len() {
+                        return Err(invalid(
+                            "system_response",
+                            format!(
+                                "{} values, expected one per freq_hz bin ({})",
+                                p.len(),
+                                freq_hz.len()
+                            ),
+                        ));
+                    }
+                    if let Some(n) = p.iter().position(|z| !finite_c(z)) {
+                        return Err(invalid(
+                            "system_response",
+                            format!("system_response[{n}] is not finite"),
+                        ));
+                    }
+                }
+                freq_hz.len()
+            }
+            Layout::Cir {
+                tap0_s,
+                tap_spacing_s,
+                pulse,
+            } => {
+                if !tap0_s.is_finite() {
+                    return Err(Error::NonFinite {
+                        field: "tap0_s".into(),
+                    });
+                }
+                if !(tap_spacing_s.is_finite() && *tap_spacing_s > 0.0) {
+                    return Err(Error::NotPositive {
+                        field: "tap_spacing_s".into(),
+                        value: *tap_spacing_s,
+                    });
+                }
+                if let Some(p) = pulse {
+                    check_pulse(p)?;
+                }
+                let rows = s_count * p_count;
+                if self.samples.len() % rows != 0 {
+                    return Err(invalid(
+                        "cir",
+                        format!(
+                            "{} samples is not a multiple of S·P = {s_count}·{p_count}",
+                            self.samples.len()
+                        ),
+                    ));
+                }
+                self.samples.len() / rows
+            }
+        };
+        size(
+            if array == "cfr" { "freq_hz" } else { "cir" },
+            per_link,
+            2,
+            MAX_BINS_PER_LINK,
+        )?;
+        let total = s_count
+            .checked_mul(p_count)
+            .and_then(|r| r.checked_mul(per_link))
+            .unwrap_or(usize::MAX);
+        size(
+            if array == "cfr" { "cfr" } else { "cir" },
+            total,
+            1,
+            MAX_RECORDING_SAMPLES,
+        )?;
+        if self.samples.len() != total {
+            return Err(invalid(
+                array,
+                format!(
+                    "{} samples, expected S·P·{} = {s_count}·{p_count}·{per_link} = {total}",
+                    self.samples.len(),
+                    if array == "cfr" { "N" } else { "M" }
+                ),
+            ));
+        }
+        if let Some(k) = self.samples.iter().position(|z| !finite_c(z)) {
+            let (s, rest) = (k / (p_count * per_link), k % (p_count * per_link));
+            let (p, i) = (rest / per_link, rest % per_link);
+            return Err(invalid(
+                array,
+                format!("sample [{s}, {p}, {i}] is not finite"),
+            ));
+        }
+        if let Some(nv) = &self.noise_var {
+            if nv.len() != p_count {
+                return Err(invalid(
+                    "noise_var",
+                    format!("{} values, expected one per link ({p_count})", nv.len()),
+                ));
+            }
+            for (p, &v) in nv.iter().enumerate() {
+                if !(v.is_finite() && v > 0.0) {
+                    return Err(invalid(
+                        "noise_var",
+                        format!(
+                            "noise_var[{p}] = {} must be a finite number > 0",
+                            crate::error::Num(v)
+                        ),
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Per recorded link, its index in `model`'s link order: recorded link `(tx, rx)` is the
+    /// model link `i` with `links[i].tx == tx` and `links[i].rx == rx`. A link the scenario
+    /// does not have, or one recorded twice, is an [`Error::InvalidFile`] naming `links[p]`.
+    pub fn link_map(&self, model: &Model) -> Result<Vec<usize>> {
+        let links = &model.network.links;
+        let mut seen = vec![usize::MAX; links.len()];
+        let mut map = Vec::with_capacity(self.links.len());
+        for (p, &[tx, rx]) in self.links.iter().enumerate() {
+            let Some(i) = links.iter().position(|l| l.tx == tx && l.rx == rx) else {
+                return Err(invalid(
+                    &format!("links[{p}]"),
+                    format!(
+                        "the link (transmitter {tx}, receiver {rx}) is not one of the scenario's \
+                         {} links",
+                        links.len()
+                    ),
+                ));
+            };
+            if seen[i] != usize::MAX {
+                return Err(invalid(
+                    &format!("links[{p}]"),
+                    format!(
+                        "the link (transmitter {tx}, receiver {rx}) is recorded twice (also \
+                         links[{}])",
+                        seen[i]
+                    ),
+                ));
+            }
+            seen[i] = p;
+            map.push(i);
+        }
+        Ok(map)
+    }
+}
+
+fn check_freq(f: &[Real]) -> Result<()> {
+    if let Some(n) = f.iter().position(|v| !v.is_finite()) {
+        return Err(invalid("freq_hz", format!("freq_hz[{n}] is not finite")));
+    }
+    let n = f.len();
+    if n < 2 {
+        return Ok(()); // the count is checked against its cap by the caller
+    }
+    let df = (f[n - 1] - f[0]) / (n - 1) as Real;
+    if !(df > 0.0 && df.is_finite()) {
+        return Err(invalid(
+            "freq_hz",
+            "must be increasing (f[N-1] > f[0])".into(),
+        ));
+    }
+    for k in 1..n {
+        let step = f[k] - f[k - 1];
+        let dev = step - df;
+        if dev > FREQ_UNIFORM_TOL * df || -dev > FREQ_UNIFORM_TOL * df {
+            return Err(invalid(
+                "freq_hz",
+                format!(
+                    "not uniformly spaced: freq_hz[{k}] - freq_hz[{}] = {} Hz, the mean \
+                     spacing is {} Hz (tolerance 1e-6 relative)",
+                    k - 1,
+                    crate::error::Num(step),
+                    crate::error::Num(df)
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+fn check_pulse(p: &Pulse) -> Result<()> {
+    let k = p.samples.len();
+    size("pulse", k, 1, MAX_PULSE_SAMPLES)?;
+    if !(p.spacing_s.is_finite() && p.spacing_s > 0.0) {
+        return Err(Error::NotPositive {
+            field: "pulse_spacing_s".into(),
+            value: p.spacing_s,
+        });
+    }
+    if let Some(i) = p.samples.iter().position(|z| !finite_c(z)) {
+        return Err(invalid("pulse", format!("pulse[{i}] is not finite")));
+    }
+    if k % 2 == 0 {
+        return Err(invalid(
+            "pulse",
+            format!("{k} samples: an odd count is required (the middle one is t = 0)"),
+        ));
+    }
+    let p0 = p.samples[k / 2];
+    if abs_c(&(p0 - Complex::new(1.0, 0.0))) > PULSE_NORM_TOL {
+        return Err(invalid(
+            "pulse",
+            "not normalised: the middle sample p(0) must be 1".into(),
+        ));
+    }
+    Ok(())
 }

@@ -237,3 +237,33 @@ pub const DELAY_IMAGE_DR_DB: Range = Range {
     max: 200.0,
     allowed: "1 to 200 dB",
 };
+
+/// Largest channel recording, complex samples in all (`S·P·N` or `S·P·M`, docs/recording.md):
+/// 64 Mi = 1 GiB of complex128 in memory. A 10-minute walk at [S]'s rate (4 links every
+/// 2.048 ms) with N = 241 subcarriers is 2.8·10⁸: record it in pieces of ≤ 2 minutes.
+pub const MAX_RECORDING_SAMPLES: usize = 64 << 20;
+
+/// Largest `.npz` recording file, and the largest total of its members once inflated, bytes:
+/// the samples' cap as complex128 plus 64 MiB for the other arrays and the headers. A member
+/// that declares more is refused before inflating, one that inflates to more while inflating
+/// (zip bombs).
+pub const MAX_RECORDING_BYTES: u64 = (1 << 30) + (64 << 20);
+
+/// Most snapshots of a recording: 2²⁴ (9.5 h at [S]'s 2.048 ms).
+pub const MAX_SNAPSHOTS: usize = 1 << 24;
+
+/// Most frequency bins (`N`) or taps (`M`) per link and snapshot: 65 536 (a 20 MHz Wi-Fi CSI has
+/// 56–242, [S]'s sounder 241, a UWB CIR accumulator 1016).
+pub const MAX_BINS_PER_LINK: usize = 65_536;
+
+/// Most samples of a recording's system pulse (`pulse`, K): 65 537.
+pub const MAX_PULSE_SAMPLES: usize = 65_537;
+
+/// Relative tolerance of the uniform spacing of `freq_hz`: every step `f[n+1] − f[n]` is within
+/// `1e-6·Δf` of `Δf = (f[N−1] − f[0])/(N−1)` (float64 bins written as `f0 + n·Δf` or by
+/// `numpy.linspace` are within 1e-12).
+pub const FREQ_UNIFORM_TOL: f64 = 1e-6;
+
+/// Tolerance of the pulse's normalisation `p(0) = 1` (its middle sample) in a validated
+/// recording: `|p(0) − 1| ≤ 1e-9` (the reader divides by `p(0)`).
+pub const PULSE_NORM_TOL: f64 = 1e-9;
