@@ -7,6 +7,7 @@
 //! ([`DelayFigure`], [`TrackErrorView`], [`ErrorStats`]). Pure `no_std` functions of the core's results:
 //! no maths of their own beyond layout.
 
+mod channel_figure;
 mod channel_view;
 mod colormap;
 mod plan_view;
@@ -16,6 +17,7 @@ mod snapshot;
 mod ticks;
 mod track_view;
 
+pub use channel_figure::delay_figure;
 pub use channel_view::{
     delay_image, delay_points, quantile_pct, static_bands, suggest_range_m, track_errors,
     DelayFigure, DelayImage, DelayPoint, ErrorStats, ImageConfig, ImageFloor, LinkDelays,

@@ -15,6 +15,7 @@ use scatterloc::study::{
 };
 use scatterloc::track::gating::{AmplitudeClusterConfig, AssociationRule, Calibration};
 use scatterloc::track::ConstantVelocity;
+use scatterloc::present::ErrorStats;
 use scatterloc::{npz, Model, Scenario};
 
 use super::filters::filter_kinds;
@@ -362,7 +363,13 @@ pub fn cir_track(args: &CirTrackArgs) -> Result<(), CliError> {
     }
     if let Some((p, f)) = figure {
         super::cir_fig::stage_track_figure(
-            &mut files, p, f, &scenario, &model, &track, truth.as_ref(),
+            &mut files,
+            p,
+            f,
+            &scenario,
+            &track,
+            truth.as_ref(),
+            name.name(),
         )?;
     }
     files.commit()?;
@@ -380,7 +387,7 @@ pub fn cir_track(args: &CirTrackArgs) -> Result<(), CliError> {
 /// The error statistics of the snapshots with a state.
 fn error_doc(errors: &[Option<f64>]) -> ErrorDoc {
     let e: Vec<f64> = errors.iter().flatten().copied().collect();
-    let stats = scatterloc::present::ErrorStats::of(&e);
+    let stats = ErrorStats::of(&e);
     ErrorDoc {
         count: e.len(),
         median_m: stats.as_ref().map(|s| s.median_m),

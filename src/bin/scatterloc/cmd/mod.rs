@@ -7,6 +7,7 @@
 //! stdout and files atomically (`output`).
 
 mod cir;
+mod cir_fig;
 mod crlb_map;
 mod filters;
 mod flags;
