@@ -250,8 +250,7 @@ impl Band {
                     let idx = k.rem_euclid(m as i64) as usize;
                     if f.abs() < edge {
                         bins.push((idx, f));
-                    } else if f.abs() > b / 2.0 * (1.0 + 1e-9) && 2 * k.unsigned_abs() < m as u64
-                    {
+                    } else if f.abs() > b / 2.0 * (1.0 + 1e-9) && 2 * k.unsigned_abs() < m as u64 {
                         oob.push(idx);
                     }
                 }
@@ -265,8 +264,7 @@ impl Band {
                 let resp: Vec<Complex> = match pulse {
                     None => vec![Complex::new(1.0, 0.0); freq.len()],
                     Some(p) => {
-                        if !(p.spacing_s > 0.0 && p.spacing_s.is_finite()) || p.samples.is_empty()
-                        {
+                        if !(p.spacing_s > 0.0 && p.spacing_s.is_finite()) || p.samples.is_empty() {
                             return Err(Error::NotPositive {
                                 field: "pulse_spacing_s".into(),
                                 value: p.spacing_s,

@@ -32,7 +32,13 @@ impl Fft {
             .collect();
         let bits = n.trailing_zeros();
         let bitrev = (0..n as u32)
-            .map(|i| if bits == 0 { 0 } else { i.reverse_bits() >> (32 - bits) })
+            .map(|i| {
+                if bits == 0 {
+                    0
+                } else {
+                    i.reverse_bits() >> (32 - bits)
+                }
+            })
             .collect();
         Fft {
             n,
@@ -108,7 +114,10 @@ mod tests {
                 let d = direct(&x, inverse);
                 let scale = n as Real;
                 for (a, b) in y.iter().zip(&d) {
-                    assert!(crate::math::sqrt((a - b).norm_sqr()) <= 1e-12 * scale, "n {n}: {a} vs {b}");
+                    assert!(
+                        crate::math::sqrt((a - b).norm_sqr()) <= 1e-12 * scale,
+                        "n {n}: {a} vs {b}"
+                    );
                 }
             }
         }

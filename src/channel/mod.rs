@@ -8,15 +8,17 @@
 //! [`DelayEstimate`]s (a [`Snapshot`]), is what `track::gating` reads, whatever filter runs.
 
 mod band;
-mod fft;
 mod estimate;
+mod fft;
 mod paths;
 mod recording;
 mod simulate;
 mod snapshot;
 
 pub use band::{Band, ResponseMap};
-pub use estimate::{fisher_matrix, Estimator, EstimatorConfig, PathEstimate, SnapshotEstimate, MERGE_FRACTION};
+pub use estimate::{
+    fisher_matrix, Estimator, EstimatorConfig, PathEstimate, SnapshotEstimate, MERGE_FRACTION,
+};
 pub use paths::{PathTracker, PathTrackerConfig, TrackedPath};
 pub use recording::{Layout, Pulse, Recording};
 pub use simulate::{simulate_recording, ChannelScene, ChannelTruth};

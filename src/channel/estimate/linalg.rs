@@ -7,11 +7,16 @@ use alloc::vec::Vec;
 use crate::math::{Complex, Real};
 
 /// Solves `G x = b` (`G` row-major `k×k`, overwritten); `None` if singular.
-pub(crate) fn solve_complex(g: &mut [Complex], b: &mut [Complex], k: usize) -> Option<Vec<Complex>> {
+pub(crate) fn solve_complex(
+    g: &mut [Complex],
+    b: &mut [Complex],
+    k: usize,
+) -> Option<Vec<Complex>> {
     let scale = (0..k).map(|i| g[i * k + i].norm_sqr()).fold(0.0, Real::max);
     let tol = scale * 1e-24;
     for c in 0..k {
-        let p = (c..k).max_by(|&x, &y| g[x * k + c].norm_sqr().total_cmp(&g[y * k + c].norm_sqr()))?;
+        let p =
+            (c..k).max_by(|&x, &y| g[x * k + c].norm_sqr().total_cmp(&g[y * k + c].norm_sqr()))?;
         if !(g[p * k + c].norm_sqr() > tol) {
             return None;
         }

@@ -295,9 +295,7 @@ impl Estimator {
             let tau = self.newton(fold(seed, self.win_start, self.span));
             let c = self.corr(&self.resid, tau);
             if c.norm_sqr() / (sigma2 * self.energy) >= self.gamma
-                && paths
-                    .iter()
-                    .all(|p| (p.0 - tau).abs() >= self.merge_sep())
+                && paths.iter().all(|p| (p.0 - tau).abs() >= self.merge_sep())
             {
                 let a = c / self.energy;
                 self.sub_path(tau, a, -1.0);
@@ -374,7 +372,12 @@ impl Estimator {
         for v in self.scratch.iter_mut() {
             *v = Complex::new(0.0, 0.0);
         }
-        for ((s, r), p) in self.scratch.iter_mut().zip(&self.resid).zip(&self.band.response) {
+        for ((s, r), p) in self
+            .scratch
+            .iter_mut()
+            .zip(&self.resid)
+            .zip(&self.band.response)
+        {
             *s = p.conj() * r;
         }
         self.fft.run(&mut self.scratch, true);
@@ -421,7 +424,11 @@ impl Estimator {
         for _ in 0..NEWTON_ITERS {
             let mut ph = cis(2.0 * PI * self.fc[0] * tau);
             let step = cis(2.0 * PI * self.df * tau);
-            let (mut c0, mut c1, mut c2) = (Complex::new(0.0, 0.0), Complex::new(0.0, 0.0), Complex::new(0.0, 0.0));
+            let (mut c0, mut c1, mut c2) = (
+                Complex::new(0.0, 0.0),
+                Complex::new(0.0, 0.0),
+                Complex::new(0.0, 0.0),
+            );
             for i in 0..n {
                 let x = self.band.response[i].conj() * self.resid[i] * ph;
                 let f = 2.0 * PI * self.fc[i];
@@ -435,7 +442,13 @@ impl Estimator {
             let mut dt = if d2 < 0.0 { -d1 / d2 } else { 0.0 };
             if d2 >= 0.0 || !dt.is_finite() {
                 // not concave here: a small gradient step towards the rise
-                dt = if d1 > 0.0 { max_step * 0.25 } else if d1 < 0.0 { -max_step * 0.25 } else { 0.0 };
+                dt = if d1 > 0.0 {
+                    max_step * 0.25
+                } else if d1 < 0.0 {
+                    -max_step * 0.25
+                } else {
+                    0.0
+                };
             }
             let dt = dt.clamp(-max_step, max_step);
             tau += dt;
@@ -550,7 +563,10 @@ impl Estimator {
                 .collect(),
             None => paths
                 .iter()
-                .map(|p| self.band.delay_bound_s(self.energy * p.1.norm_sqr() / sigma2))
+                .map(|p| {
+                    self.band
+                        .delay_bound_s(self.energy * p.1.norm_sqr() / sigma2)
+                })
                 .collect(),
         }
     }
@@ -576,7 +592,11 @@ pub fn fisher_matrix(
             let d = paths[l].0 - paths[i].0;
             let mut ph = cis(-tp * fc[0] * d);
             let step = cis(-tp * df * d);
-            let (mut s0, mut s1, mut s2) = (Complex::new(0.0, 0.0), Complex::new(0.0, 0.0), Complex::new(0.0, 0.0));
+            let (mut s0, mut s1, mut s2) = (
+                Complex::new(0.0, 0.0),
+                Complex::new(0.0, 0.0),
+                Complex::new(0.0, 0.0),
+            );
             for (wn, f) in w.iter().zip(fc) {
                 s0 += ph * *wn;
                 s1 += ph * (wn * f);
@@ -588,7 +608,11 @@ pub fn fisher_matrix(
             let dt_i = Complex::new(0.0, -tp) * ai; // times f
             let dt_l = Complex::new(0.0, -tp) * al;
             let blocks = [
-                [dt_i.conj() * dt_l * s2, dt_i.conj() * s1, dt_i.conj() * j * s1],
+                [
+                    dt_i.conj() * dt_l * s2,
+                    dt_i.conj() * s1,
+                    dt_i.conj() * j * s1,
+                ],
                 [dt_l * s1, s0, j * s0],
                 [(-j) * dt_l * s1, (-j) * s0, s0],
             ];

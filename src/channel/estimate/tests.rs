@@ -106,7 +106,12 @@ fn single_path(snr_db: Real, trials: usize, seed: u64) -> (Real, Real, Real, Rea
     let det = (trials - miss).max(1) as Real;
     let rmse = sqrt(se / det) * SPEED_OF_LIGHT;
     let bound = b.delay_bound_s(snr) * SPEED_OF_LIGHT;
-    (rmse, bound, outl as Real / det, miss as Real / trials as Real)
+    (
+        rmse,
+        bound,
+        outl as Real / det,
+        miss as Real / trials as Real,
+    )
 }
 
 fn check1(trials: usize) {
@@ -219,13 +224,22 @@ fn median_noise_unbiased() {
     let se = sd / sqrt(n as Real);
     std::println!("σ̂² mean {mean:.5} (true 2.5), sd {sd:.4}, SE {se:.5}");
     // 4 SE plus the O(1/N) small-sample bias of a median (≤ 1/(2·241) relative)
-    assert!((mean - 2.5).abs() <= 4.0 * se + 2.5 / (2.0 * N as Real), "{mean}");
+    assert!(
+        (mean - 2.5).abs() <= 4.0 * se + 2.5 / (2.0 * N as Real),
+        "{mean}"
+    );
 }
 
 /// Found-rate and RMSE of each of `truth`'s paths listed in `watch` (nearest estimate within
 /// 0.5/B), against the joint bound (its mean square over the trials' random path phases: the
 /// two-path bound depends on the paths' relative phase).
-fn multi(truth: &[(Real, Complex)], var: Real, watch: &[usize], trials: usize, seed: u64) -> Vec<(Real, Real, Real)> {
+fn multi(
+    truth: &[(Real, Complex)],
+    var: Real,
+    watch: &[usize],
+    trials: usize,
+    seed: u64,
+) -> Vec<(Real, Real, Real)> {
     let b = band();
     let mut est = Estimator::new(b.clone(), EstimatorConfig::default()).unwrap();
     let mut rng = Pcg64::seed_from_u64(seed);
@@ -233,7 +247,10 @@ fn multi(truth: &[(Real, Complex)], var: Real, watch: &[usize], trials: usize, s
     let mut found = vec![0usize; watch.len()];
     let mut se = vec![0.0; watch.len()];
     for _ in 0..trials {
-        let ph: Vec<(Real, Complex)> = truth.iter().map(|&(t, a)| (t, a * phase(&mut rng))).collect();
+        let ph: Vec<(Real, Complex)> = truth
+            .iter()
+            .map(|&(t, a)| (t, a * phase(&mut rng)))
+            .collect();
         let h = response(&b, &ph, var, &mut rng);
         let r = est.estimate(&h, None, &[]).unwrap();
         let bd = joint_bounds(&b, &ph, var);
@@ -264,10 +281,16 @@ fn multi(truth: &[(Real, Complex)], var: Real, watch: &[usize], trials: usize, s
 
 fn check3(trials: usize) {
     let var = N as Real / 1000.0; // 30 dB each
-    let truth = [(80e-9, Complex::new(1.0, 0.0)), (80e-9 + 1.0 / B, Complex::new(1.0, 0.0))];
+    let truth = [
+        (80e-9, Complex::new(1.0, 0.0)),
+        (80e-9 + 1.0 / B, Complex::new(1.0, 0.0)),
+    ];
     let tol = 1.5 * (1.0 + 3.0 / sqrt(2.0 * trials as Real));
     for seed in [21u64, 22, 23] {
-        for (i, (f, rmse, bound)) in multi(&truth, var, &[0, 1], trials, seed).into_iter().enumerate() {
+        for (i, (f, rmse, bound)) in multi(&truth, var, &[0, 1], trials, seed)
+            .into_iter()
+            .enumerate()
+        {
             std::println!("C8.3 seed {seed} path {i}: found {f:.3}, RMSE {rmse:.4} m, two-path bound {bound:.4} m, ratio {:.3}", rmse / bound);
             assert!(f >= 0.95, "found {f}");
             assert!(rmse <= tol * bound, "ratio {}", rmse / bound);
@@ -290,7 +313,12 @@ fn c8_3_two_paths_full() {
 
 fn check4(trials: usize) {
     let var = 1.0;
-    let amp = |snr_db: Real| Complex::new(sqrt(crate::math::db_to_linear(snr_db) * var / N as Real), 0.0);
+    let amp = |snr_db: Real| {
+        Complex::new(
+            sqrt(crate::math::db_to_linear(snr_db) * var / N as Real),
+            0.0,
+        )
+    };
     let los = 50e-9;
     let truth = [
         (los, amp(60.0)),
@@ -377,7 +405,10 @@ fn c8_5_cir_equals_cfr() {
     for ((p, q), bd) in a.paths.iter().zip(&c.paths).zip(&bounds) {
         let d = (p.delay_s - q.delay_s).abs() / bd;
         let da = sqrt((p.alpha - q.alpha).norm_sqr()) / sqrt(q.alpha.norm_sqr());
-        std::println!("C8.5 τ {:.4} ns: |Δτ|/bound {d:.2e}, |Δα|/|α| {da:.2e}", q.delay_s * 1e9);
+        std::println!(
+            "C8.5 τ {:.4} ns: |Δτ|/bound {d:.2e}, |Δα|/|α| {da:.2e}",
+            q.delay_s * 1e9
+        );
         assert!(d <= 1e-2, "{d}");
         assert!(da <= 1e-2, "{da}");
     }
@@ -390,17 +421,36 @@ fn config_and_input_errors() {
     let d = EstimatorConfig::default();
     assert!(bad(EstimatorConfig { p_fa: 0.0, ..d }));
     assert!(bad(EstimatorConfig { p_fa: 1.0, ..d }));
-    assert!(bad(EstimatorConfig { p_fa: Real::NAN, ..d }));
+    assert!(bad(EstimatorConfig {
+        p_fa: Real::NAN,
+        ..d
+    }));
     assert!(bad(EstimatorConfig { oversample: 3, ..d }));
-    assert!(bad(EstimatorConfig { oversample: 65, ..d }));
+    assert!(bad(EstimatorConfig {
+        oversample: 65,
+        ..d
+    }));
     assert!(bad(EstimatorConfig { max_paths: 0, ..d }));
-    assert!(bad(EstimatorConfig { max_paths: limits::MAX_PATHS + 1, ..d }));
-    assert!(bad(EstimatorConfig { window_s: Some((1e-6, 0.0)), ..d }));
-    assert!(bad(EstimatorConfig { window_s: Some((0.0, 3e-6)), ..d }));
+    assert!(bad(EstimatorConfig {
+        max_paths: limits::MAX_PATHS + 1,
+        ..d
+    }));
+    assert!(bad(EstimatorConfig {
+        window_s: Some((1e-6, 0.0)),
+        ..d
+    }));
+    assert!(bad(EstimatorConfig {
+        window_s: Some((0.0, 3e-6)),
+        ..d
+    }));
     let mut e = Estimator::new(b.clone(), d).unwrap();
     assert!(matches!(
         e.estimate(&[Complex::new(1.0, 0.0); 10], None, &[]),
-        Err(Error::LengthMismatch { expected: N, found: 10, .. })
+        Err(Error::LengthMismatch {
+            expected: N,
+            found: 10,
+            ..
+        })
     ));
     let mut h = vec![Complex::new(0.0, 0.0); N];
     let z = e.estimate(&h, None, &[]).unwrap();
@@ -420,7 +470,12 @@ fn seeds_refined_and_tested() {
     let mut e = Estimator::new(b.clone(), EstimatorConfig::default()).unwrap();
     let mut rng = Pcg64::seed_from_u64(9);
     let tau = 73.3e-9;
-    let h = response(&b, &[(tau, Complex::new(1.0, 0.0))], N as Real / 1000.0, &mut rng);
+    let h = response(
+        &b,
+        &[(tau, Complex::new(1.0, 0.0))],
+        N as Real / 1000.0,
+        &mut rng,
+    );
     let r = e.estimate(&h, None, &[tau + 0.2 / B, 400e-9]).unwrap();
     assert_eq!(r.paths.len(), 1, "{:?}", r.paths);
     let bound = b.delay_bound_s(1000.0);
