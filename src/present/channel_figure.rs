@@ -9,12 +9,13 @@ use alloc::vec;
 use alloc::vec::Vec;
 
 use crate::channel::{Band, Recording, ResponseMap};
+use crate::error::limits::MAX_DELAY_IMAGE_COLS;
 use crate::error::Result;
 use crate::math::{Complex, Real, Vec2, SPEED_OF_LIGHT};
 use crate::measure::Model;
 use crate::present::{
     delay_image, delay_points, static_bands, suggest_range_m, DelayFigure, ImageConfig,
-    LinkDelays, TruthCurve, MAX_DELAY_IMAGE_COLS,
+    LinkDelays, TruthCurve,
 };
 use crate::study::RecordingEstimates;
 use crate::track::gating::Calibration;

@@ -71,6 +71,38 @@ impl Default for EstimatorConfig {
     }
 }
 
+impl EstimatorConfig {
+    /// Checks the settings: `p_fa` in (0, 1), `oversample` 4 … 64, `max_paths` 1 …
+    /// [`limits::MAX_PATHS`] (the window is checked against the band by [`Estimator::new`]).
+    pub fn validate(&self) -> Result<()> {
+        let cfg = self;
+        if !(cfg.p_fa > 0.0 && cfg.p_fa < 1.0) {
+            return Err(Error::OutOfRange {
+                field: "p_fa".into(),
+                value: cfg.p_fa,
+                allowed: "0 < p_fa < 1",
+            });
+        }
+        if !(4..=64).contains(&cfg.oversample) {
+            return Err(Error::SizeLimit {
+                field: "oversample",
+                value: cfg.oversample,
+                min: 4,
+                max: 64,
+            });
+        }
+        if !(1..=limits::MAX_PATHS).contains(&cfg.max_paths) {
+            return Err(Error::SizeLimit {
+                field: "max_paths",
+                value: cfg.max_paths,
+                min: 1,
+                max: limits::MAX_PATHS,
+            });
+        }
+        Ok(())
+    }
+}
+
 /// One estimated path (C5 output).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PathEstimate {
@@ -130,29 +162,7 @@ impl Estimator {
     /// An estimator for `band` with `cfg` (validated: `p_fa` in (0, 1), `oversample` 4 … 64,
     /// `max_paths` 1 … [`limits::MAX_PATHS`], a finite window `start < end ≤ start + 1/Δf`).
     pub fn new(band: Band, cfg: EstimatorConfig) -> Result<Estimator> {
-        if !(cfg.p_fa > 0.0 && cfg.p_fa < 1.0) {
-            return Err(Error::OutOfRange {
-                field: "p_fa".into(),
-                value: cfg.p_fa,
-                allowed: "0 < p_fa < 1",
-            });
-        }
-        if !(4..=64).contains(&cfg.oversample) {
-            return Err(Error::SizeLimit {
-                field: "oversample",
-                value: cfg.oversample,
-                min: 4,
-                max: 64,
-            });
-        }
-        if !(1..=limits::MAX_PATHS).contains(&cfg.max_paths) {
-            return Err(Error::SizeLimit {
-                field: "max_paths",
-                value: cfg.max_paths,
-                min: 1,
-                max: limits::MAX_PATHS,
-            });
-        }
+        cfg.validate()?;
         let n = band.len();
         let l = (cfg.oversample * n).next_power_of_two();
         if l > limits::MAX_PERIODOGRAM {

@@ -5,7 +5,9 @@
 
 use serde::Serialize;
 
-use scatterloc::channel::{EstimatorConfig, PathTrackerConfig, Recording};
+use scatterloc::channel::{
+    simulate_recording, ChannelScene, EstimatorConfig, PathTrackerConfig, Recording,
+};
 use scatterloc::error::{limits, Cancel};
 use scatterloc::formats::{CalibrationResult, CalibrationSnapshots, Measurements, Truth};
 use scatterloc::native::Parallel;
@@ -19,6 +21,7 @@ use scatterloc::present::ErrorStats;
 use scatterloc::{npz, Model, Scenario};
 
 use super::filters::filter_kinds;
+use super::gating::{prepare_out_dir_for, walk_file};
 use super::io::{emit_summary, model_of, read_bytes, read_json_file, read_scenario};
 use super::output::{check_writable, Format, OutputSet};
 use super::study::{run_with_counter, threads};
@@ -397,7 +400,110 @@ fn error_doc(errors: &[Option<f64>]) -> ErrorDoc {
     }
 }
 
-/// `scatterloc cir simulate --scenario S --out-dir DIR`.
-pub fn cir_simulate(_args: &CirSimulateArgs) -> Result<(), CliError> {
-    Err(CliError::usage("cir simulate: wired after the simulator lands"))
+/// The files of `cir simulate`.
+const SIM_FILES: [&str; 4] = ["recording.npz", "calibration.npz", "truth.json", "scene.json"];
+
+/// Parses `--walk "x,y x,y ..."` (at least two points).
+fn parse_walk(text: &str) -> Result<Vec<[f64; 2]>, CliError> {
+    let bad = |why: String| CliError::usage(format!("--walk: {why}"));
+    let pts = text
+        .split_whitespace()
+        .enumerate()
+        .map(|(i, p)| {
+            let (x, y) = p
+                .split_once(',')
+                .ok_or_else(|| bad(format!("point {i} '{p}' is not x,y")))?;
+            let num = |v: &str| {
+                v.trim()
+                    .parse::<f64>()
+                    .ok()
+                    .filter(|v| v.is_finite())
+                    .ok_or_else(|| bad(format!("point {i} '{p}': '{v}' is not a finite number")))
+            };
+            Ok([num(x)?, num(y)?])
+        })
+        .collect::<Result<Vec<_>, CliError>>()?;
+    if pts.len() < 2 {
+        return Err(bad(format!("{} points, at least 2 are needed", pts.len())));
+    }
+    Ok(pts)
+}
+
+/// `scatterloc cir simulate --scenario S --out-dir DIR [--scene F] [--walk P] [--speed V]
+/// [--duration S] [--dt T] [--calibration-duration S] [--seed N]`.
+pub fn cir_simulate(args: &CirSimulateArgs) -> Result<(), CliError> {
+    let scenario = read_scenario(&args.scenario)?;
+    let model = model_of(&scenario)?;
+    let mut scene: ChannelScene = match &args.scene {
+        Some(p) => read_json_file("scene", p)?,
+        None => ChannelScene::hangar(),
+    };
+    if let Some(w) = &args.walk {
+        scene.walk.waypoints_m = parse_walk(w)?;
+    }
+    if let Some(v) = args.speed {
+        scene.walk.speed_mps = v;
+    }
+    if let Some(d) = args.duration {
+        scene.duration_s = d;
+    }
+    if let Some(dt) = args.dt {
+        scene.dt_s = dt;
+    }
+    let flag_of = |e: &scatterloc::Error| {
+        let t = e.to_string();
+        if t.contains("walk.waypoints") {
+            "--walk"
+        } else if t.contains("speed") {
+            "--speed"
+        } else if t.contains("duration") {
+            "--duration"
+        } else if t.contains("dt_s") {
+            "--dt"
+        } else {
+            "--scene"
+        }
+    };
+    scene
+        .validate()
+        .map_err(|e| CliError::usage(format!("{}: {e}", flag_of(&e))))?;
+    let mut empty = scene.clone();
+    empty.duration_s = args.calibration_duration.unwrap_or(1.0);
+    empty
+        .validate()
+        .map_err(|e| CliError::usage(format!("--calibration-duration: {e}")))?;
+    let seed = args.seed.unwrap_or(1);
+    let dir = args.out_dir.as_str();
+    let created = prepare_out_dir_for(dir, &SIM_FILES)?;
+    let written = (|| {
+        let fail = |e: scatterloc::Error| CliError::usage(format!("{}: {e}", flag_of(&e)));
+        let (rec, truth) =
+            simulate_recording(&scenario, &model, &scene, true, seed).map_err(fail)?;
+        let (cal, _) = simulate_recording(&scenario, &model, &empty, false, seed).map_err(fail)?;
+        let enc = |r: &Recording| {
+            npz::write_recording(r).map_err(|e| CliError::output(format!("--out-dir: {e}")))
+        };
+        let mut files = OutputSet::new();
+        let [rec_f, cal_f, truth_f, scene_f] = SIM_FILES.map(|n| walk_file(dir, n));
+        files.bytes("out-dir", &rec_f, &enc(&rec)?)?;
+        files.bytes("out-dir", &cal_f, &enc(&cal)?)?;
+        files.json("out-dir", &truth_f, &truth)?;
+        files.json("out-dir", &scene_f, &scene)?;
+        files.commit()?;
+        Ok::<_, CliError>((rec.t_s.len(), cal.t_s.len()))
+    })();
+    if written.is_err() && created {
+        let _ = std::fs::remove_dir(dir);
+    }
+    let (snapshots, cal_snapshots) = written?;
+    emit_summary(
+        &serde_json::json!({
+            "snapshots": snapshots,
+            "calibration_snapshots": cal_snapshots,
+            "links": model.link_count(),
+            "subcarriers": scene.subcarriers,
+            "files": SIM_FILES,
+        })
+        .to_string(),
+    )
 }
