@@ -213,3 +213,8 @@ pub const RANGE_M: Range = Range {
     max: 1e8,
     allowed: "0 to 1e8 m",
 };
+
+/// Largest number of live path tracks of one link's path tracker (C6, `paths.max_tracks`; the
+/// default is 64): association costs tracks × estimates per snapshot, and the estimator
+/// refines one seed per track.
+pub const MAX_PATH_TRACKS: usize = 4096;
