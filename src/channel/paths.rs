@@ -3,9 +3,10 @@
 //! Per link, every path track carries the state `x = [τ, τ̇]` (s, s/s) with a constant-velocity
 //! model in delay: over `Δt`, `F = [[1, Δt], [0, 1]]` and the process noise of a white
 //! delay-acceleration of intensity `q_τ` (s²/s³), `Q = q_τ·[[Δt³/3, Δt²/2], [Δt²/2, Δt]]`. The
-//! default `q_τ = (2/c)²` covers a walker's bistatic-range acceleration of about 2 m/s² (a
-//! range acceleration `a` moves the delay by `a/c` per s², and the white-acceleration model
-//! with intensity `q` has a 1σ acceleration of order `√q` per √s over the snapshot spacing).
+//! default `q_τ = (a/c)²` with `a = 2 m/s²` covers a walker's bistatic-range acceleration:
+//! under this model the delay rate random-walks by `√(q_τ·Δt) = (a/c)·√Δt` over `Δt`, which
+//! equals the rate change `(a/c)·Δt` of a steady acceleration `a` at `Δt = 1 s` and exceeds it
+//! at the shorter snapshot spacings of recordings.
 //!
 //! One [`PathTracker::step`] per snapshot:
 //! 1. predict every live track to the snapshot time `t_s`;

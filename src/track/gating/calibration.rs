@@ -14,8 +14,9 @@
 //! Estimator false alarms recorded during calibration are a known weakness of this delay-only
 //! rule: when they are denser than one per `g` they chain into one wide cluster that holds
 //! most snapshots and then gates the echo as well; calibrate with a detection threshold that
-//! keeps them sparse (X-means on amplitude, as the papers, separates them). X-means on
-//! (amplitude, delay), which the papers use, would sit behind the same [`LinkCalibration`].
+//! keeps them sparse, or cluster by amplitude too: the papers use X-means on (amplitude, delay);
+//! [`crate::track::gating::AmplitudeClusterConfig`] with [`Calibration::from_estimates`] is the
+//! deterministic alternative (C7) behind the same [`LinkCalibration`].
 
 use alloc::format;
 use alloc::vec::Vec;
