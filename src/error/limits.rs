@@ -267,3 +267,8 @@ pub const FREQ_UNIFORM_TOL: f64 = 1e-6;
 /// Tolerance of the pulse's normalisation `p(0) = 1` (its middle sample) in a validated
 /// recording: `|p(0) − 1| ≤ 1e-9` (the reader divides by `p(0)`).
 pub const PULSE_NORM_TOL: f64 = 1e-9;
+
+/// Largest number of live path tracks of one link's path tracker (C6, `paths.max_tracks`; the
+/// default is 64): association costs tracks × estimates per snapshot, and the estimator
+/// refines one seed per track.
+pub const MAX_PATH_TRACKS: usize = 4096;

@@ -47,6 +47,8 @@ fn check12_gating_removes_a_gaussian_static_estimate_with_probability_0_9973() {
         sigma_s: 0.3e-9,
         count: 1,
         snapshots: 1,
+        amplitude_db_mean: None,
+        amplitude_db_sigma: None,
     };
     let link = LinkCalibration::from_clusters(0, vec![cluster]).unwrap();
     let n = 1_000_000;

@@ -14,8 +14,9 @@
 //! Estimator false alarms recorded during calibration are a known weakness of this delay-only
 //! rule: when they are denser than one per `g` they chain into one wide cluster that holds
 //! most snapshots and then gates the echo as well; calibrate with a detection threshold that
-//! keeps them sparse (X-means on amplitude, as the papers, separates them). X-means on
-//! (amplitude, delay), which the papers use, would sit behind the same [`LinkCalibration`].
+//! keeps them sparse, or cluster by amplitude too: the papers use X-means on (amplitude, delay);
+//! [`crate::track::gating::AmplitudeClusterConfig`] with [`Calibration::from_estimates`] is the
+//! deterministic alternative (C7) behind the same [`LinkCalibration`].
 
 use alloc::format;
 use alloc::vec::Vec;
@@ -86,7 +87,7 @@ impl ClusterConfig {
 }
 
 /// One static path of a link: `τ̄_kl,r` and `σ̄_kl,r` (JSON: `{"mean_s", "sigma_s", "count",
-/// "snapshots"}`, the counts optional).
+/// "snapshots", "amplitude_db_mean", "amplitude_db_sigma"}`, all but the first two optional).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct StaticCluster {
@@ -100,6 +101,13 @@ pub struct StaticCluster {
     /// Calibration snapshots with at least one delay in the cluster (the 50 % rule counts these).
     #[serde(default)]
     pub snapshots: usize,
+    /// Mean amplitude of the cluster's estimates, dB (`20·log10|α̂|`), when clustered by
+    /// amplitude too (C7, [`crate::track::gating::AmplitudeClusterConfig`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub amplitude_db_mean: Option<Real>,
+    /// Sample standard deviation of those amplitudes, dB.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub amplitude_db_sigma: Option<Real>,
 }
 
 impl StaticCluster {
@@ -139,23 +147,8 @@ impl LinkCalibration {
     ) -> Result<LinkCalibration> {
         cfg.validate()?;
         let count = lists.len();
-        if count == 0 || count > MAX_CALIBRATION_SNAPSHOTS {
-            return Err(Error::SizeLimit {
-                field: "calibration snapshots per link",
-                value: count,
-                min: 1,
-                max: MAX_CALIBRATION_SNAPSHOTS,
-            });
-        }
         let total: usize = lists.clone().map(<[Real]>::len).sum();
-        if total > MAX_CALIBRATION_DELAYS {
-            return Err(Error::SizeLimit {
-                field: "calibration delays per link",
-                value: total,
-                min: 0,
-                max: MAX_CALIBRATION_DELAYS,
-            });
-        }
+        check_sizes(count, total)?;
         // (delay, snapshot index), sorted by delay.
         let mut delays = Vec::with_capacity(total);
         for (k, snapshot) in lists.enumerate() {
@@ -168,18 +161,11 @@ impl LinkCalibration {
         let needed = cfg.min_fraction * count as Real;
         let mut clusters = Vec::new();
         let mut seen = Vec::new();
-        let mut start = 0;
-        for end in 1..=delays.len() {
-            if end == delays.len() || delays[end].0 - delays[end - 1].0 > cfg.gap_s {
-                let members = &delays[start..end];
-                seen.clear();
-                seen.extend(members.iter().map(|m| m.1));
-                seen.sort_unstable();
-                seen.dedup();
-                if seen.len() as Real >= needed {
-                    clusters.push(cluster_of(members, seen.len(), cfg.sigma_floor_s));
-                }
-                start = end;
+        for group in gap_groups(&delays, |m| m.0, cfg.gap_s) {
+            let members = &delays[group];
+            let snapshots = distinct_snapshots(members.iter().map(|m| m.1), &mut seen);
+            if snapshots as Real >= needed {
+                clusters.push(cluster_of(members, snapshots, cfg.sigma_floor_s));
             }
         }
         Ok(LinkCalibration { clusters })
@@ -210,22 +196,82 @@ impl LinkCalibration {
     }
 }
 
+/// The snapshot-count and total-size caps of one link's calibration: `1 ≤ count ≤`
+/// [`MAX_CALIBRATION_SNAPSHOTS`] snapshots, at most [`MAX_CALIBRATION_DELAYS`] delays.
+pub(super) fn check_sizes(count: usize, total: usize) -> Result<()> {
+    if count == 0 || count > MAX_CALIBRATION_SNAPSHOTS {
+        return Err(Error::SizeLimit {
+            field: "calibration snapshots per link",
+            value: count,
+            min: 1,
+            max: MAX_CALIBRATION_SNAPSHOTS,
+        });
+    }
+    if total > MAX_CALIBRATION_DELAYS {
+        return Err(Error::SizeLimit {
+            field: "calibration delays per link",
+            value: total,
+            min: 0,
+            max: MAX_CALIBRATION_DELAYS,
+        });
+    }
+    Ok(())
+}
+
+/// The index ranges of `sorted` (ascending in `key`) split where consecutive keys differ by
+/// more than `gap`.
+pub(super) fn gap_groups<T>(
+    sorted: &[T],
+    key: impl Fn(&T) -> Real,
+    gap: Real,
+) -> Vec<core::ops::Range<usize>> {
+    let mut groups = Vec::new();
+    let mut start = 0;
+    for end in 1..=sorted.len() {
+        if end == sorted.len() || key(&sorted[end]) - key(&sorted[end - 1]) > gap {
+            groups.push(start..end);
+            start = end;
+        }
+    }
+    groups
+}
+
+/// Number of distinct snapshot indices in `ids` (`scratch` is reused storage).
+pub(super) fn distinct_snapshots(
+    ids: impl Iterator<Item = usize>,
+    scratch: &mut Vec<usize>,
+) -> usize {
+    scratch.clear();
+    scratch.extend(ids);
+    scratch.sort_unstable();
+    scratch.dedup();
+    scratch.len()
+}
+
+/// Mean and sample standard deviation (`n − 1`; 0 for one value) of `values` (non-empty).
+pub(super) fn mean_sigma(values: impl Iterator<Item = Real> + Clone) -> (Real, Real) {
+    let n = values.clone().count() as Real;
+    let mean = values.clone().sum::<Real>() / n;
+    let ss: Real = values.map(|v| (v - mean) * (v - mean)).sum();
+    let sigma = if n > 1.0 { sqrt(ss / (n - 1.0)) } else { 0.0 };
+    (mean, sigma)
+}
+
 /// Mean and sample standard deviation (`n − 1`; 0 for one member) floored at `floor` of
 /// `(delay, snapshot)` members seen in `snapshots` distinct snapshots.
-fn cluster_of(members: &[(Real, usize)], snapshots: usize, floor: Real) -> StaticCluster {
-    let n = members.len() as Real;
-    let mean = members.iter().map(|m| m.0).sum::<Real>() / n;
-    let ss: Real = members.iter().map(|m| (m.0 - mean) * (m.0 - mean)).sum();
-    let sigma = if members.len() > 1 {
-        sqrt(ss / (n - 1.0))
-    } else {
-        0.0
-    };
+pub(super) fn cluster_of(
+    members: &[(Real, usize)],
+    snapshots: usize,
+    floor: Real,
+) -> StaticCluster {
+    let (mean, sigma) = mean_sigma(members.iter().map(|m| m.0));
     StaticCluster {
         mean_s: mean,
         sigma_s: sigma.max(floor),
         count: members.len(),
         snapshots,
+        amplitude_db_mean: None,
+        amplitude_db_sigma: None,
     }
 }
 

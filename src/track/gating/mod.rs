@@ -3,12 +3,14 @@
 //! scatterer, the gated tracker that feeds the EKF, the simulated output of the per-snapshot
 //! estimator, and the synthetic stand-in of the measurement case (spec §9.6).
 
+mod amplitude_clusters;
 mod association;
 mod calibration;
 mod gated_track;
 mod measurement_case;
 mod raw_snapshot;
 
+pub use amplitude_clusters::AmplitudeClusterConfig;
 pub use association::{
     associate, select, AssociationRule, Choice, DelayEstimate, Selection, INNOVATION_GATE,
     MAX_ESTIMATES_PER_LINK,

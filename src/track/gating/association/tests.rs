@@ -70,6 +70,8 @@ fn select_gates_then_associates_per_link() {
         sigma_s: sigma_ns * 1e-9,
         count: 10,
         snapshots: 10,
+        amplitude_db_mean: None,
+        amplitude_db_sigma: None,
     };
     let cal = Calibration {
         links: vec![

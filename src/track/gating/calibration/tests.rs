@@ -64,6 +64,8 @@ fn bad_calibrations_are_named_errors() {
             sigma_s: 0.0,
             count: 1,
             snapshots: 1,
+            amplitude_db_mean: None,
+            amplitude_db_sigma: None,
         }],
     )
     .unwrap_err();
