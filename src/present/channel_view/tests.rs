@@ -124,6 +124,8 @@ fn points_bands_and_ranges() {
             sigma_s: 0.1 / SPEED_OF_LIGHT,
             count: 3,
             snapshots: 3,
+            amplitude_db_mean: None,
+            amplitude_db_sigma: None,
         }],
     };
     let b = static_bands(&cal);
