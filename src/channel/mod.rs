@@ -18,5 +18,8 @@ pub use band::Band;
 pub use estimate::{Estimator, EstimatorConfig, PathEstimate, SnapshotEstimate};
 pub use paths::{PathTracker, PathTrackerConfig, TrackedPath};
 pub use recording::{Layout, Pulse, Recording};
-pub use simulate::{simulate_recording, ChannelScene, ChannelTruth};
+pub use simulate::{
+    simulate_recording, Body, ChannelScene, ChannelTruth, PathKind, PointScatterer, TruePath, Walk,
+    Wall, DEFAULT_DT_S, DEFAULT_SUBCARRIERS,
+};
 pub use snapshot::{DelayEstimate, Snapshot};
