@@ -141,7 +141,7 @@ impl Line {
     /// sides, the crossing on the wall's segment).
     fn crossing(&self, p: Vec2, q: Vec2) -> Option<Vec2> {
         let (sp, sq) = (self.side(p), self.side(q));
-        if !(sp * sq < 0.0) {
+        if sp * sq >= 0.0 {
             return None;
         }
         let t = sp / (sp - sq);
@@ -449,7 +449,7 @@ fn synthesize(
         min: 1,
         max: cap / per_snapshot.max(1),
     };
-    if !(steps < (cap as Real)) {
+    if steps >= cap as Real {
         return Err(too_big(usize::MAX));
     }
     let snapshots = steps as usize + 1;

@@ -115,10 +115,10 @@ fn processing_gain_enters_through_the_noise() {
     }];
     let (rec, truth) = synthesize(&sc, &m, &scene, false, 1, false).unwrap();
     let nv = rec.noise_var.as_ref().unwrap();
-    for p in 0..m.link_count() {
+    for (p, &nvp) in nv.iter().enumerate() {
         let sp = truth.paths[0][p][1];
         assert_eq!(sp.kind, PathKind::Scatterer);
-        let snr = scene.subcarriers as Real * sp.power_w / nv[p];
+        let snr = scene.subcarriers as Real * sp.power_w / nvp;
         assert!(rel(snr, m.snr(p, r)) < 1e-12);
     }
 }
@@ -270,8 +270,8 @@ fn noise_variance_is_n_times_pn() {
             let (clean, _) = synthesize(&sc, &m, &scene, with_person, seed, false).unwrap();
             let (noisy, _) = synthesize(&sc, &m, &scene, with_person, seed, true).unwrap();
             let nv = noisy.noise_var.as_ref().unwrap();
-            for p in 0..m.link_count() {
-                assert!(rel(nv[p], want) < 1e-15);
+            for (p, &nvp) in nv.iter().enumerate() {
+                assert!(rel(nvp, want) < 1e-15);
                 let mut sum = 0.0;
                 let mut count = 0usize;
                 let mut re2 = 0.0;

@@ -118,7 +118,7 @@ impl Walk {
             }
         }
         check_positive(&format!("{field}.speed_mps"), self.speed_mps)?;
-        if !(self.speed_mps <= 1e3) {
+        if self.speed_mps > 1e3 {
             return Err(Error::OutOfRange {
                 field: format!("{field}.speed_mps"),
                 value: self.speed_mps,
