@@ -544,3 +544,46 @@ fn json_round_trips_and_truth_reads_as_formats_truth() {
     let back: ChannelTruth = serde_json::from_str(&json).unwrap();
     assert_eq!(back, truth);
 }
+
+#[test]
+fn body_wall_delays_are_the_image_method() {
+    let (sc, m) = setup();
+    let mut scene = bare_scene();
+    let c = 24.0;
+    scene.walls = vec![Wall {
+        a_m: [-8.0, c],
+        b_m: [30.0, c],
+        gamma: -0.6,
+    }];
+    let (_, truth) = synthesize(&sc, &m, &scene, true, 1, false).unwrap();
+    let st = truth.states[3];
+    let r = Vec2::new(st[0], st[1]);
+    let mirror = |p: Vec2| Vec2::new(p.x, 2.0 * c - p.y);
+    for p in 0..m.link_count() {
+        let (tx, rx) = m.network.link_nodes(p);
+        let mut got: Vec<(Real, Real)> = truth.paths[3][p]
+            .iter()
+            .filter(|t| t.kind == PathKind::BodyWall)
+            .map(|t| (t.delay_s, t.power_w))
+            .collect();
+        got.sort_by(|a, b| a.0.partial_cmp(&b.0).unwrap());
+        let (d1, d2) = (dist(mirror(tx), r), dist(r, rx));
+        let (e1, e2) = (dist(tx, r), dist(r, mirror(rx)));
+        let mut want = vec![(d1 + d2) / SPEED_OF_LIGHT, (e1 + e2) / SPEED_OF_LIGHT];
+        want.sort_by(|a, b| a.partial_cmp(b).unwrap());
+        assert_eq!(got.len(), 2, "link {p}");
+        for (g, w) in got.iter().zip(&want) {
+            assert!(rel(g.0, *w) < 1e-14);
+        }
+        // Tx → walker → wall → Rx: the radar equation with the Rx's image, × Γ².
+        let via_rx = if rel(got[0].0, (e1 + e2) / SPEED_OF_LIGHT) < 1e-14 {
+            got[0].1
+        } else {
+            got[1].1
+        };
+        let model_like = m.snr_from_geometry(p, m.patterns[0].gain_toward((r - tx) / e1), e1, e2)
+            * m.noise_power_w
+            * 0.36;
+        assert!(rel(via_rx, model_like) < 1e-12);
+    }
+}
