@@ -587,3 +587,17 @@ fn body_wall_delays_are_the_image_method() {
         assert!(rel(via_rx, model_like) < 1e-12);
     }
 }
+
+#[test]
+#[ignore = "the full 30 s hangar recording (≈ 15 k snapshots × 4 links, 0.23 GB, 6 s in debug); run in release by scripts/reproduce.sh"]
+fn full_hangar_recording() {
+    let (sc, m) = setup();
+    let scene = ChannelScene::hangar();
+    let (rec, truth) = simulate_recording(&sc, &m, &scene, true, 1).unwrap();
+    let dur = scene.walk.duration_s().unwrap();
+    assert_eq!(rec.snapshot_count(), (dur / DEFAULT_DT_S) as usize + 1);
+    assert_eq!(truth.states.len(), rec.snapshot_count());
+    assert!(rec.samples.iter().all(|z| z.re.is_finite() && z.im.is_finite()));
+    // The walk crosses LoS paths somewhere: some snapshot is shadowed.
+    assert!(truth.shadowed.iter().flatten().any(|&s| s));
+}
