@@ -597,7 +597,10 @@ fn full_hangar_recording() {
     let dur = scene.walk.duration_s().unwrap();
     assert_eq!(rec.snapshot_count(), (dur / DEFAULT_DT_S) as usize + 1);
     assert_eq!(truth.states.len(), rec.snapshot_count());
-    assert!(rec.samples.iter().all(|z| z.re.is_finite() && z.im.is_finite()));
+    assert!(rec
+        .samples
+        .iter()
+        .all(|z| z.re.is_finite() && z.im.is_finite()));
     // The walk crosses LoS paths somewhere: some snapshot is shadowed.
     assert!(truth.shadowed.iter().flatten().any(|&s| s));
 }
