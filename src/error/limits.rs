@@ -272,3 +272,18 @@ pub const PULSE_NORM_TOL: f64 = 1e-9;
 /// default is 64): association costs tracks × estimates per snapshot, and the estimator
 /// refines one seed per track.
 pub const MAX_PATH_TRACKS: usize = 4096;
+
+/// Channel simulator: total complex samples of a recording (snapshots × links × subcarriers),
+/// 64 Mi = 1 GiB of `Complex<f64>`; an hour of [S]'s 2.048 ms snapshots on 4 links × 241 bins
+/// is past it, a minute is far below.
+pub const MAX_CHANNEL_SAMPLES: usize = 64 << 20;
+/// Channel simulator: subcarriers per link (a sounder's FFT size).
+pub const MAX_SUBCARRIERS: usize = 1 << 16;
+/// Channel simulator: walls of a scene (second-order paths grow with its square).
+pub const MAX_SCENE_WALLS: usize = 64;
+/// Channel simulator: point scatterers of a scene.
+pub const MAX_SCENE_SCATTERERS: usize = 4096;
+/// Channel simulator: scattering centres of the walker's body.
+pub const MAX_BODY_CENTRES: usize = 64;
+/// Channel simulator: waypoints of a walk.
+pub const MAX_WAYPOINTS: usize = 4096;

@@ -445,7 +445,7 @@ pub fn cir_simulate(args: &CirSimulateArgs) -> Result<(), CliError> {
         scene.walk.speed_mps = v;
     }
     if let Some(d) = args.duration {
-        scene.duration_s = d;
+        scene.duration_s = Some(d);
     }
     if let Some(dt) = args.dt {
         scene.dt_s = dt;
@@ -468,7 +468,7 @@ pub fn cir_simulate(args: &CirSimulateArgs) -> Result<(), CliError> {
         .validate()
         .map_err(|e| CliError::usage(format!("{}: {e}", flag_of(&e))))?;
     let mut empty = scene.clone();
-    empty.duration_s = args.calibration_duration.unwrap_or(1.0);
+    empty.duration_s = Some(args.calibration_duration.unwrap_or(1.0));
     empty
         .validate()
         .map_err(|e| CliError::usage(format!("--calibration-duration: {e}")))?;

@@ -1,0 +1,263 @@
+//! The scene of a simulated recording: walls, point scatterers, the walker's body and walk, and
+//! the sounder settings (subcarriers, snapshot interval, dynamic range).
+
+use alloc::format;
+use alloc::vec;
+use alloc::vec::Vec;
+
+use serde::{Deserialize, Serialize};
+
+use super::walk::Walk;
+use crate::error::limits::{
+    COORDINATE_M, MAX_BODY_CENTRES, MAX_SCENE_SCATTERERS, MAX_SCENE_WALLS, MAX_SUBCARRIERS, RCS_M2,
+};
+use crate::error::{check_positive, Error, Result};
+
+/// A wall: the segment `a_m`–`b_m` reflecting specularly with the (real) amplitude reflection
+/// coefficient `gamma` (`|Γ| ≤ 1`; negative: a phase flip).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Wall {
+    /// One end, m.
+    pub a_m: [f64; 2],
+    /// The other end, m.
+    pub b_m: [f64; 2],
+    /// Amplitude reflection coefficient Γ, in [−1, 1].
+    pub gamma: f64,
+}
+
+/// A static point scatterer (pole, parked car) of radar cross section `rcs_m2`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PointScatterer {
+    /// Position, m.
+    pub position_m: [f64; 2],
+    /// Radar cross section, m².
+    pub rcs_m2: f64,
+}
+
+/// The walker as an extended scatterer: `centres` scattering centres on a circle of `radius_m`
+/// (fixed angles `2πk/K` in the body frame, turning with the heading), each with RCS
+/// `target.rcs_m2 / K` and a complex Gaussian fluctuation of unit mean power, AR(1) over
+/// snapshots with coefficient `correlation` (0: independent, Swerling II); the body shadows a
+/// LoS or wall path that passes within `shadow_radius_m` by `shadow_loss_db`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Body {
+    /// Number of scattering centres K (1 to [`MAX_BODY_CENTRES`]).
+    pub centres: usize,
+    /// Radius of the circle of centres, m.
+    pub radius_m: f64,
+    /// Snapshot-to-snapshot correlation ρ of each centre's fluctuation, in [0, 1).
+    pub correlation: f64,
+    /// A LoS or wall path passing this close to the walker is shadowed, m.
+    pub shadow_radius_m: f64,
+    /// Attenuation of a shadowed path, dB (≥ 0).
+    pub shadow_loss_db: f64,
+}
+
+impl Default for Body {
+    fn default() -> Body {
+        Body {
+            centres: 6,
+            radius_m: 0.2,
+            correlation: 0.9,
+            shadow_radius_m: 0.3,
+            shadow_loss_db: 15.0,
+        }
+    }
+}
+
+/// [S]'s snapshot interval `T_g`, s.
+pub const DEFAULT_DT_S: f64 = 2.048e-3;
+/// Default number of subcarriers N.
+pub const DEFAULT_SUBCARRIERS: usize = 241;
+
+fn default_dt() -> f64 {
+    DEFAULT_DT_S
+}
+fn default_subcarriers() -> usize {
+    DEFAULT_SUBCARRIERS
+}
+fn default_true() -> bool {
+    true
+}
+
+/// The static and mobile scene of a simulated recording and the sounder's settings.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ChannelScene {
+    /// Reflecting walls.
+    #[serde(default)]
+    pub walls: Vec<Wall>,
+    /// Static point scatterers.
+    #[serde(default)]
+    pub scatterers: Vec<PointScatterer>,
+    /// The walker's body.
+    #[serde(default)]
+    pub body: Body,
+    /// The walker's walk.
+    pub walk: Walk,
+    /// Number of frequency bins N (C1), spacing `B/N`.
+    #[serde(default = "default_subcarriers")]
+    pub subcarriers: usize,
+    /// Snapshot interval, s.
+    #[serde(default = "default_dt")]
+    pub dt_s: f64,
+    /// Recording length, s (`None`: the walk's duration).
+    #[serde(default)]
+    pub duration_s: Option<f64>,
+    /// Sounder dynamic range, dB: the noise floor is at least the strongest path minus this
+    /// (`None`: thermal noise only).
+    #[serde(default)]
+    pub dynamic_range_db: Option<f64>,
+    /// Second-order wall–wall reflections.
+    #[serde(default = "default_true")]
+    pub second_order: bool,
+    /// Body–wall double reflections.
+    #[serde(default = "default_true")]
+    pub double_reflections: bool,
+}
+
+fn check_point(field: &str, p: &[f64; 2]) -> Result<()> {
+    for v in p {
+        COORDINATE_M.check(field, *v)?;
+    }
+    Ok(())
+}
+
+fn too_many(field: &'static str, value: usize, min: usize, max: usize) -> Result<()> {
+    if (min..=max).contains(&value) {
+        Ok(())
+    } else {
+        Err(Error::SizeLimit {
+            field,
+            value,
+            min,
+            max,
+        })
+    }
+}
+
+impl ChannelScene {
+    /// Checks every field; errors name it (`scene.walls[0].gamma`, `scene.body.centres`, …).
+    pub fn validate(&self) -> Result<()> {
+        too_many("scene.walls", self.walls.len(), 0, MAX_SCENE_WALLS)?;
+        for (i, w) in self.walls.iter().enumerate() {
+            check_point(&format!("scene.walls[{i}].a_m"), &w.a_m)?;
+            check_point(&format!("scene.walls[{i}].b_m"), &w.b_m)?;
+            let (dx, dy) = (w.b_m[0] - w.a_m[0], w.b_m[1] - w.a_m[1]);
+            if dx * dx + dy * dy < 1e-6 {
+                return Err(Error::InvalidFile {
+                    field: format!("scene.walls[{i}]"),
+                    reason: "a_m and b_m are closer than 1 mm".into(),
+                });
+            }
+            if !(w.gamma.is_finite() && (-1.0..=1.0).contains(&w.gamma)) {
+                return Err(Error::OutOfRange {
+                    field: format!("scene.walls[{i}].gamma"),
+                    value: w.gamma,
+                    allowed: "-1 to 1",
+                });
+            }
+        }
+        too_many(
+            "scene.scatterers",
+            self.scatterers.len(),
+            0,
+            MAX_SCENE_SCATTERERS,
+        )?;
+        for (i, s) in self.scatterers.iter().enumerate() {
+            check_point(&format!("scene.scatterers[{i}].position_m"), &s.position_m)?;
+            RCS_M2.check(&format!("scene.scatterers[{i}].rcs_m2"), s.rcs_m2)?;
+        }
+        let b = &self.body;
+        too_many("scene.body.centres", b.centres, 1, MAX_BODY_CENTRES)?;
+        let range = |field: &str, v: f64, lo: f64, hi: f64, allowed| {
+            if v.is_finite() && (lo..=hi).contains(&v) {
+                Ok(())
+            } else {
+                Err(Error::OutOfRange {
+                    field: field.into(),
+                    value: v,
+                    allowed,
+                })
+            }
+        };
+        range("scene.body.radius_m", b.radius_m, 0.0, 10.0, "0 to 10 m")?;
+        range(
+            "scene.body.correlation",
+            b.correlation,
+            0.0,
+            0.999_999,
+            "0 to 0.999999",
+        )?;
+        range(
+            "scene.body.shadow_radius_m",
+            b.shadow_radius_m,
+            0.0,
+            10.0,
+            "0 to 10 m",
+        )?;
+        range(
+            "scene.body.shadow_loss_db",
+            b.shadow_loss_db,
+            0.0,
+            200.0,
+            "0 to 200 dB",
+        )?;
+        self.walk.validate("scene.walk")?;
+        too_many("scene.subcarriers", self.subcarriers, 2, MAX_SUBCARRIERS)?;
+        check_positive("scene.dt_s", self.dt_s)?;
+        range("scene.dt_s", self.dt_s, 1e-9, 1e3, "1e-9 to 1000 s")?;
+        if let Some(d) = self.duration_s {
+            range("scene.duration_s", d, 0.0, 1e6, "0 to 1e6 s")?;
+        }
+        if let Some(d) = self.dynamic_range_db {
+            range("scene.dynamic_range_db", d, 0.0, 300.0, "0 to 300 dB")?;
+        }
+        Ok(())
+    }
+
+    /// The hangar scene for the `sensors2019` preset (Tx (0, 0); Rx (−5, 12), (10, 10), (−6, −8),
+    /// (12, −6); area x ∈ [−7.5, 30], y ∈ [−10, 26]): a wall along y = 24 (Γ = −0.6), two
+    /// point scatterers and a ≈ 30 s walk at 1.4 m/s with three turns of radius 2.5 m, inside the
+    /// area and more than 1 m from every node.
+    pub fn hangar() -> ChannelScene {
+        ChannelScene {
+            walls: vec![Wall {
+                a_m: [-8.0, 24.0],
+                b_m: [30.0, 24.0],
+                gamma: -0.6,
+            }],
+            scatterers: vec![
+                PointScatterer {
+                    position_m: [20.0, 14.0],
+                    rcs_m2: 5.0,
+                },
+                PointScatterer {
+                    position_m: [4.0, -8.0],
+                    rcs_m2: 3.0,
+                },
+            ],
+            body: Body::default(),
+            walk: Walk {
+                waypoints_m: vec![
+                    [2.0, 4.0],
+                    [16.0, 4.0],
+                    [16.0, 16.0],
+                    [4.0, 16.0],
+                    [4.0, 8.0],
+                ],
+                speed_mps: 1.4,
+                turn_radius_m: 2.5,
+            },
+            subcarriers: DEFAULT_SUBCARRIERS,
+            dt_s: DEFAULT_DT_S,
+            duration_s: None,
+            dynamic_range_db: None,
+            second_order: true,
+            double_reflections: true,
+        }
+    }
+}
