@@ -15,6 +15,9 @@
 //! The DFT is our radix-2 FFT when `M` is a power of two, else a direct DFT of the in-band and
 //! out-of-band bins (`O(M²)`, phasor recursion).
 
+// `!(x > 0.0)` is meant: a NaN must fail these checks as well.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 use alloc::vec;
 use alloc::vec::Vec;
 

@@ -10,10 +10,10 @@ use alloc::vec::Vec;
 
 use serde::{Deserialize, Serialize};
 
+use crate::channel::{DelayEstimate, Snapshot};
 use crate::error::{Error, Result};
 use crate::math::{Mat4, Real, Vec4};
 use crate::scenario::parse_json;
-use crate::channel::{DelayEstimate, Snapshot};
 use crate::track::{ConstantVelocity, MAX_STEPS};
 
 /// One raw estimate of a measurements file: `[delay_s, amplitude]`, or `[delay_s, amplitude,

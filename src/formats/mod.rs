@@ -13,7 +13,9 @@ mod measurements;
 mod truth;
 
 pub use calibration::{CalibrationResult, CalibrationSnapshots};
-pub use measurements::{one_list_per_link, Measurements, RawEstimate, RawStep, Sigma, Start, Steps};
+pub use measurements::{
+    one_list_per_link, Measurements, RawEstimate, RawStep, Sigma, Start, Steps,
+};
 pub use truth::Truth;
 
 #[cfg(test)]

@@ -14,8 +14,8 @@ use crate::error::Result;
 use crate::math::{Complex, Real, Vec2, SPEED_OF_LIGHT};
 use crate::measure::Model;
 use crate::present::{
-    delay_image, delay_points, static_bands, suggest_range_m, DelayFigure, ImageConfig,
-    LinkDelays, TruthCurve,
+    delay_image, delay_points, static_bands, suggest_range_m, DelayFigure, ImageConfig, LinkDelays,
+    TruthCurve,
 };
 use crate::study::RecordingEstimates;
 use crate::track::gating::Calibration;
@@ -66,7 +66,10 @@ pub fn delay_figure(
                     .iter()
                     .zip(states)
                     .map(|(&t, x)| {
-                        (t, SPEED_OF_LIGHT * model.network.delay(p, Vec2::new(x[0], x[1])))
+                        (
+                            t,
+                            SPEED_OF_LIGHT * model.network.delay(p, Vec2::new(x[0], x[1])),
+                        )
                     })
                     .collect(),
             }],
@@ -90,10 +93,7 @@ pub fn delay_figure(
             _ => None,
         };
         links.push(LinkDelays {
-            name: names
-                .get(p)
-                .cloned()
-                .unwrap_or_else(|| format!("link {p}")),
+            name: names.get(p).cloned().unwrap_or_else(|| format!("link {p}")),
             range_m,
             image,
             estimates: points,

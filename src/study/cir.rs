@@ -23,7 +23,7 @@ use crate::channel::{
     ResponseMap, Snapshot, TrackedPath,
 };
 use crate::error::{check_every, Cancel, Error, Result};
-use crate::math::{Complex, Mat4, Real, Vec4};
+use crate::math::{sqrt, Complex, Mat4, Real, Vec4, SPEED_OF_LIGHT};
 use crate::measure::{rng, Model};
 use crate::scenario::Area;
 use crate::study::{Driver, TrackStart};
@@ -175,6 +175,9 @@ pub enum DelaySigma {
     LinkBudget,
 }
 
+/// Default [`CirTrackRequest::extent_sigma_m`], m: a person's extent (body radius ≈ 0.2 m).
+pub const EXTENT_SIGMA_M: Real = 0.2;
+
 /// What [`cir_track`] runs on.
 #[derive(Debug, Clone, Copy)]
 pub struct CirTrackRequest<'a> {
@@ -194,6 +197,11 @@ pub struct CirTrackRequest<'a> {
     pub rule: AssociationRule,
     /// How each delay is weighted.
     pub sigma: DelaySigma,
+    /// With [`DelaySigma::Estimator`]: the spread of the scatterer's own extent, as path length
+    /// (m), added in quadrature to each estimate's σ̂ (a person is not a point: the strongest
+    /// scattering centre moves over a body of radius ≈ 0.2 m, which moves the path length by up
+    /// to ≈ 0.4 m, far more than σ̂_τ at tens of dB). Default [`EXTENT_SIGMA_M`].
+    pub extent_sigma_m: Real,
     /// The particle filter's seed.
     pub seed: u64,
 }
@@ -264,6 +272,21 @@ pub fn cir_track(req: &CirTrackRequest, cancel: Cancel) -> Result<CirTrackOutput
         start: None,
     };
     let every = check_every(step_ns(req.filter, n));
+    if !(req.extent_sigma_m.is_finite() && req.extent_sigma_m >= 0.0) {
+        return Err(Error::OutOfRange {
+            field: "extent_sigma_m".into(),
+            value: req.extent_sigma_m,
+            allowed: "0 … finite m",
+        });
+    }
+    let extent = req.extent_sigma_m / SPEED_OF_LIGHT;
+    let snapshot = |k: usize| -> Snapshot {
+        let mut s = est.snapshot(k);
+        for e in s.iter_mut().flatten() {
+            e.sigma_s = e.sigma_s.map(|v| sqrt(v * v + extent * extent));
+        }
+        s
+    };
     // Before the start: one fix attempt per snapshot.
     let mut k = 0;
     let mut tracker = None;
@@ -271,9 +294,14 @@ pub fn cir_track(req: &CirTrackRequest, cancel: Cancel) -> Result<CirTrackOutput
         if k % every == 0 {
             cancel.check()?;
         }
-        let snap = est.snapshot(k);
-        match start_from_snapshot(model, req.calibration, &snap, req.area, START_SPEED_SIGMA_MPS)
-        {
+        let snap = snapshot(k);
+        match start_from_snapshot(
+            model,
+            req.calibration,
+            &snap,
+            req.area,
+            START_SPEED_SIGMA_MPS,
+        ) {
             Ok(f) => {
                 let c = &f.ekf.covariance;
                 out.start = Some(CirStart {
@@ -299,12 +327,8 @@ pub fn cir_track(req: &CirTrackRequest, cancel: Cancel) -> Result<CirTrackOutput
                     .push(f.selection.choices.iter().map(|c| c.name()).collect());
                 out.delays_used_s.push(f.selection.delays);
                 out.static_removed.push(f.selection.static_removed);
-                let filter = Tracker::new(
-                    req.filter,
-                    f.ekf.state,
-                    f.ekf.covariance,
-                    rng(req.seed, 0),
-                )?;
+                let filter =
+                    Tracker::new(req.filter, f.ekf.state, f.ekf.covariance, rng(req.seed, 0))?;
                 tracker = Some(filter);
                 k += 1;
                 break;
@@ -338,13 +362,13 @@ pub fn cir_track(req: &CirTrackRequest, cancel: Cancel) -> Result<CirTrackOutput
             cancel.check()?;
         }
         let dt = est.t_s[k] - est.t_s[k - 1];
-        gated.set_motion(ConstantVelocity::validated(dt, req.process_noise).map_err(|e| {
-            Error::InvalidFile {
+        gated.set_motion(
+            ConstantVelocity::validated(dt, req.process_noise).map_err(|e| Error::InvalidFile {
                 field: format!("t_s[{k}]"),
                 reason: e.to_string(),
-            }
-        })?);
-        let snap = est.snapshot(k);
+            })?,
+        );
+        let snap = snapshot(k);
         let step = gated.step(&snap).map_err(|e| Error::InvalidFile {
             field: format!("snapshot {k}"),
             reason: e.to_string(),
@@ -357,7 +381,8 @@ pub fn cir_track(req: &CirTrackRequest, cancel: Cancel) -> Result<CirTrackOutput
             .map(|p| sel.delays[p].map(|_| step.sigmas_s[p]))
             .collect();
         out.sigmas_used_s.push(sig);
-        out.choices.push(sel.choices.iter().map(|c| c.name()).collect());
+        out.choices
+            .push(sel.choices.iter().map(|c| c.name()).collect());
         out.delays_used_s.push(sel.delays);
         out.static_removed.push(sel.static_removed);
         k += 1;
@@ -368,9 +393,8 @@ pub fn cir_track(req: &CirTrackRequest, cancel: Cancel) -> Result<CirTrackOutput
 /// Appends one snapshot's state and covariance (`None` before the start).
 fn record_step(out: &mut CirTrackOutput, s: Option<(&Vec4, &Mat4)>) {
     out.states.push(s.map(|(x, _)| (*x).into()));
-    out.covariances.push(s.map(|(_, p)| {
-        core::array::from_fn(|i| core::array::from_fn(|j| p[(i, j)]))
-    }));
+    out.covariances
+        .push(s.map(|(_, p)| core::array::from_fn(|i| core::array::from_fn(|j| p[(i, j)]))));
 }
 
 /// The estimates of one snapshot as plain delay lists (the form `calibrate --snapshots` reads).

@@ -2,6 +2,9 @@
 //! amplitude fit and the inverse of the `3K×3K` real Fisher matrix (Gauss–Jordan with partial
 //! pivoting; `None` when a pivot falls below `1e-12` of the largest diagonal entry).
 
+// `!(x > 0.0)` is meant: a NaN must fail these checks as well.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 use alloc::vec::Vec;
 
 use crate::math::{Complex, Real};

@@ -24,6 +24,9 @@
 //! the joint Fisher matrix of C1 for all fitted paths (3 real parameters each), falling back to
 //! C4 at the fitted SNR if that matrix is singular.
 
+// `!(x > 0.0)` is meant: a NaN must fail these checks as well.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 use alloc::vec;
 use alloc::vec::Vec;
 
@@ -475,13 +478,13 @@ impl Estimator {
         let tol = SAGE_TOL / (self.df * self.band.len() as Real);
         for sweep in 0..SAGE_SWEEPS {
             let mut moved: Real = 0.0;
-            for i in 0..paths.len() {
-                let (t, a) = paths[i];
+            for path in paths.iter_mut() {
+                let (t, a) = *path;
                 self.sub_path(t, a, 1.0);
                 let t2 = self.newton(t);
                 let a2 = self.corr(&self.resid, t2) / self.energy;
                 self.sub_path(t2, a2, -1.0);
-                paths[i] = (t2, a2);
+                *path = (t2, a2);
                 moved = moved.max((t2 - t).abs());
             }
             if paths.len() < 2 || (sweep > 0 && moved < tol) {
@@ -507,7 +510,7 @@ impl Estimator {
     }
 
     /// Joint least squares of all amplitudes at fixed delays; `resid` ← `h − Ĥ`.
-    fn joint_ls(&mut self, h: &[Complex], paths: &mut Vec<(Real, Complex)>) {
+    fn joint_ls(&mut self, h: &[Complex], paths: &mut [(Real, Complex)]) {
         let k = paths.len();
         if k == 0 {
             self.resid.clear();

@@ -193,7 +193,7 @@ fn check2(p_fa: Real, snapshots: usize, seed: u64) -> Real {
 fn c8_2_false_alarms() {
     for seed in [11u64, 12] {
         let f = check2(1e-2, 10_000, seed);
-        assert!(f >= 0.5e-2 && f <= 2e-2, "{f}");
+        assert!((0.5e-2..=2e-2).contains(&f), "{f}");
     }
 }
 
@@ -202,7 +202,7 @@ fn c8_2_false_alarms() {
 #[ignore = "10⁵ snapshots: slow in debug; run in release by scripts/reproduce.sh"]
 fn c8_2_false_alarms_full() {
     let f = check2(1e-3, 100_000, 13);
-    assert!(f >= 0.5e-3 && f <= 2e-3, "{f}");
+    assert!((0.5e-3..=2e-3).contains(&f), "{f}");
 }
 
 /// The noise estimate (median of the periodogram / ln 2) is unbiased on noise to its standard

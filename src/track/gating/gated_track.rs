@@ -103,7 +103,11 @@ impl<'a, F: Filter> GatedTracker<'a, F> {
             })
             .collect();
         let summary = if own && selection.sigmas.iter().any(Option::is_some) {
-            next.update(self.model, &selection.delays, MeasurementNoise::Fixed(&sigmas_s))?
+            next.update(
+                self.model,
+                &selection.delays,
+                MeasurementNoise::Fixed(&sigmas_s),
+            )?
         } else {
             next.update(self.model, &selection.delays, self.noise)?
         };

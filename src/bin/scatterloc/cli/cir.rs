@@ -161,6 +161,10 @@ pub struct CirTrackArgs {
     /// Delay weights [default: estimator].
     #[arg(long, value_name = "estimator|budget")]
     pub sigma: Option<SigmaSource>,
+    /// The scatterer's extent as path length, m, added in quadrature to each estimate's sigma
+    /// (--sigma estimator) [default: 0.2, a person].
+    #[arg(long, value_name = "M", value_parser = finite)]
+    pub extent_sigma_m: Option<f64>,
     /// Association rule [default: gated].
     #[arg(long, value_name = "RULE")]
     pub association: Option<Association>,

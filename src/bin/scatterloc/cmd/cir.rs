@@ -11,13 +11,13 @@ use scatterloc::channel::{
 use scatterloc::error::{limits, Cancel};
 use scatterloc::formats::{CalibrationResult, CalibrationSnapshots, Measurements, Truth};
 use scatterloc::native::Parallel;
+use scatterloc::present::ErrorStats;
 use scatterloc::study::{
     calibrate_estimates, cir_track as track_recording, delays_only, estimate_recording,
-    CirTrackRequest, DelaySigma, FrontEndConfig, RecordingEstimates,
+    CirTrackRequest, DelaySigma, FrontEndConfig, RecordingEstimates, EXTENT_SIGMA_M,
 };
 use scatterloc::track::gating::{AmplitudeClusterConfig, AssociationRule, Calibration};
 use scatterloc::track::ConstantVelocity;
-use scatterloc::present::ErrorStats;
 use scatterloc::{npz, Model, Scenario};
 
 use super::filters::filter_kinds;
@@ -117,7 +117,11 @@ struct EstimatesDoc<'a> {
     p_fa: f64,
 }
 
-fn estimates_doc<'a>(model: &Model, e: &'a RecordingEstimates, cfg: &FrontEndConfig) -> EstimatesDoc<'a> {
+fn estimates_doc<'a>(
+    model: &Model,
+    e: &'a RecordingEstimates,
+    cfg: &FrontEndConfig,
+) -> EstimatesDoc<'a> {
     EstimatesDoc {
         format: "scatterloc-estimates",
         t_s: &e.t_s,
@@ -161,7 +165,10 @@ fn output(flag: &str, path: &str, allowed: &[Format]) -> Result<Format, CliError
 /// [--measurements F]`.
 pub fn cir_estimate(args: &CirEstimateArgs) -> Result<(), CliError> {
     output("out", &args.out, &[Format::Json])?;
-    for (flag, p) in [("snapshots", &args.snapshots), ("measurements", &args.measurements)] {
+    for (flag, p) in [
+        ("snapshots", &args.snapshots),
+        ("measurements", &args.measurements),
+    ] {
         if let Some(p) = p {
             output(flag, p, &[Format::Json])?;
         }
@@ -200,7 +207,12 @@ pub fn cir_estimate(args: &CirEstimateArgs) -> Result<(), CliError> {
             initial_snapshot: Some(Measurements::raw_step(&snaps[0])),
             sigma_s: None,
             steps: None,
-            raw_steps: Some(snaps[1..].iter().map(|s| Measurements::raw_step(s)).collect()),
+            raw_steps: Some(
+                snaps[1..]
+                    .iter()
+                    .map(|s| Measurements::raw_step(s))
+                    .collect(),
+            ),
         };
         files.json("measurements", p, &doc)?;
     }
@@ -267,7 +279,10 @@ struct TrackDoc<'a> {
 pub fn cir_track(args: &CirTrackArgs) -> Result<(), CliError> {
     output("out", &args.out, &[Format::Json])?;
     let figure = match &args.figure {
-        Some(p) => Some((p.as_str(), output("figure", p, &[Format::Svg, Format::Png])?)),
+        Some(p) => Some((
+            p.as_str(),
+            output("figure", p, &[Format::Svg, Format::Png])?,
+        )),
         None => None,
     };
     let delays_figure = match &args.delays_figure {
@@ -324,6 +339,7 @@ pub fn cir_track(args: &CirTrackArgs) -> Result<(), CliError> {
             None | Some(Association::Gated) => AssociationRule::Gated,
         },
         sigma,
+        extent_sigma_m: args.extent_sigma_m.unwrap_or(EXTENT_SIGMA_M),
         seed: args.seed.unwrap_or(1),
     };
     let (res, _) = run_with_counter(est.len(), "snapshots", "track", |cancel, _| {
@@ -361,7 +377,15 @@ pub fn cir_track(args: &CirTrackArgs) -> Result<(), CliError> {
     files.json("out", &args.out, &doc)?;
     if let Some((p, f)) = delays_figure {
         super::cir_fig::stage_delays_figure(
-            &mut files, p, f, &scenario, &model, &rec, &est, &calibration, truth.as_ref(),
+            &mut files,
+            p,
+            f,
+            &scenario,
+            &model,
+            &rec,
+            &est,
+            &calibration,
+            truth.as_ref(),
         )?;
     }
     if let Some((p, f)) = figure {
@@ -401,7 +425,12 @@ fn error_doc(errors: &[Option<f64>]) -> ErrorDoc {
 }
 
 /// The files of `cir simulate`.
-const SIM_FILES: [&str; 4] = ["recording.npz", "calibration.npz", "truth.json", "scene.json"];
+const SIM_FILES: [&str; 4] = [
+    "recording.npz",
+    "calibration.npz",
+    "truth.json",
+    "scene.json",
+];
 
 /// Parses `--walk "x,y x,y ..."` (at least two points).
 fn parse_walk(text: &str) -> Result<Vec<[f64; 2]>, CliError> {

@@ -79,12 +79,14 @@ pub fn read_input_named(what: &str, path: &str) -> Result<String, CliError> {
 /// Reads the binary file `path` of `--flag` (a recording), at most `cap` bytes (a larger one is
 /// refused after reading one byte past the cap; `-` = standard input).
 pub fn read_bytes(flag: &str, path: &str, cap: u64) -> Result<Vec<u8>, CliError> {
-    let cannot = |e: &dyn std::fmt::Display| {
-        CliError::usage(format!("--{flag}: cannot read '{path}': {e}"))
-    };
+    let cannot =
+        |e: &dyn std::fmt::Display| CliError::usage(format!("--{flag}: cannot read '{path}': {e}"));
     let mut bytes = Vec::new();
     let res = if path == "-" {
-        std::io::stdin().lock().take(cap + 1).read_to_end(&mut bytes)
+        std::io::stdin()
+            .lock()
+            .take(cap + 1)
+            .read_to_end(&mut bytes)
     } else {
         std::fs::File::open(path).and_then(|f| f.take(cap + 1).read_to_end(&mut bytes))
     };
