@@ -133,3 +133,43 @@ fn documented_numpy_snippet_writes_a_valid_recording() {
     }
     assert!(worst < 0.5e-9, "{worst:e}");
 }
+
+/// The committed fixture of scripts/make-recording-fixture.py: int16 I/Q CIR, 3 snapshots × 4
+/// links × 64 taps, tap m of link p in snapshot s = (100s + 10p + m − 500) + j(7m − 3p − 200 + s).
+#[test]
+fn int16_cir_fixture_reads_the_values_numpy_wrote() {
+    let bytes = include_bytes!("../data/recording-cir-int16.npz");
+    let r = read_recording(bytes).unwrap();
+    assert_eq!(
+        (r.snapshot_count(), r.link_count(), r.samples_per_link()),
+        (3, 4, 64)
+    );
+    assert_eq!(r.t_s, vec![0.0, 2.048e-3, 4.096e-3]);
+    assert_eq!(r.links, vec![[0, 0], [0, 1], [0, 2], [0, 3]]);
+    assert_eq!(
+        r.layout,
+        Layout::Cir {
+            tap0_s: -10e-9,
+            tap_spacing_s: 1.0 / 240e6,
+            pulse: None
+        }
+    );
+    assert_eq!(r.noise_var, None);
+    for s in 0..3 {
+        for p in 0..4 {
+            for (m, z) in r.response(s, p).iter().enumerate() {
+                let (s, p, m) = (s as Real, p as Real, m as Real);
+                let want = Complex::new(
+                    100.0 * s + 10.0 * p + m - 500.0,
+                    7.0 * m - 3.0 * p - 200.0 + s,
+                );
+                assert_eq!(*z, want, "[{s}, {p}, {m}]");
+            }
+        }
+    }
+    // Two taps spelled out: [0, 0, 0] = −500 − 200j, [2, 3, 63] = −207 + 234j.
+    assert_eq!(r.response(0, 0)[0], Complex::new(-500.0, -200.0));
+    assert_eq!(r.response(2, 3)[63], Complex::new(-207.0, 234.0));
+    let model = Model::new(&presets::sensors2019()).unwrap();
+    assert_eq!(r.link_map(&model).unwrap(), vec![0, 1, 2, 3]);
+}
