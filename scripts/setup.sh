@@ -13,9 +13,21 @@ rustup target add wasm32-unknown-unknown wasm32v1-none >/dev/null 2>&1 || rustup
 # The fmt and clippy stages of scripts/test.sh.
 rustup component add rustfmt clippy >/dev/null 2>&1 || rustup component add rustfmt clippy
 
+# Debian packages: chromium (the page's browser tests) and python3-numpy (/usr/bin/python3 runs
+# the numpy snippet of docs/recording.md in tests/library/recording.rs). apt-get update runs
+# once, and only when something is missing; installing needs root.
+apt_pkgs=()
 if ! command -v chromium >/dev/null || ! command -v chromedriver >/dev/null; then
+  apt_pkgs+=(chromium chromium-driver)
+fi
+/usr/bin/python3 -c 'import numpy' 2>/dev/null || apt_pkgs+=(python3-numpy)
+if [ ${#apt_pkgs[@]} -gt 0 ]; then
+  if [ "$(id -u)" -ne 0 ]; then
+    echo "setup: as root, run: apt-get install -y ${apt_pkgs[*]}" >&2
+    exit 1
+  fi
   apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium chromium-driver >/dev/null
+  DEBIAN_FRONTEND=noninteractive apt-get install -y -qq "${apt_pkgs[@]}" >/dev/null
 fi
 
 ver() { command -v "$1" >/dev/null && "$1" --version 2>/dev/null | awk '{print $2; exit}'; }

@@ -1,7 +1,8 @@
 //! The library's API across layers, one module per topic: one test per bad-input class
 //! (`bad_input`), the SIMD CRLB map kernel against its scalar reference (`map_kernel`), the
 //! planner's evidence (`planning`, `filters-and-planning.md` §3) and property tests of the core
-//! (`properties`, proptest; shrunk failures in `library/properties.proptest-regressions`).
+//! (`properties`, proptest; shrunk failures in `library/properties.proptest-regressions`) and the
+//! `.npz` recording format of docs/recording.md (`recording`, feature `npz`).
 #![cfg(not(target_arch = "wasm32"))]
 
 mod common;
@@ -17,3 +18,7 @@ mod planning;
 
 #[path = "library/properties.rs"]
 mod properties;
+
+#[cfg(feature = "npz")]
+#[path = "library/recording.rs"]
+mod recording;

@@ -30,6 +30,10 @@ mod svg;
 #[path = "wasm/export.rs"]
 mod export;
 
+/// A dropped `.npz` channel recording (`read_recording_summary`).
+#[path = "wasm/recording.rs"]
+mod recording;
+
 fn message(e: JsError) -> String {
     let v: JsValue = e.into();
     v.dyn_into::<js_sys::Error>()

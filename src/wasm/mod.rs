@@ -14,7 +14,8 @@
 //! `Track` it returns), `montecarlo.rs` (`MonteCarloJob`, run chunk by chunk in a Web Worker),
 //! `chart.rs` (the plotters ε_EKF / ε_PCRLB chart on a canvas), `mtl.rs` (the multi-target view
 //! of a scene, [`crate::present::scene`]), `plan.rs` (the planner, run in a Web Worker), `export.rs`
-//! (the page's "Save figure": the map and tracking figures as SVG through the CLI's chart code).
+//! (the page's "Save figure": the map and tracking figures as SVG through the CLI's chart code),
+//! `recording.rs` (`read_recording_summary`: a dropped `.npz` channel recording).
 
 mod app;
 mod base;
@@ -24,6 +25,7 @@ mod json;
 mod montecarlo;
 mod mtl;
 mod plan;
+mod recording;
 mod render;
 mod tracking;
 
@@ -35,6 +37,7 @@ pub use export::{mtl_scene_svg, tracking_chart_svg, MAX_FIGURE_PX, MAX_FIGURE_RE
 pub use montecarlo::MonteCarloJob;
 pub use mtl::{mtl_check_scene, mtl_default_scene, mtl_view_of, MtlSession};
 pub use plan::{plan_field_ranges, plan_network};
+pub use recording::read_recording_summary;
 pub use render::{
     axis_ticks, colorbar_rgba, colorbar_ticks, format_length, link_rgb, render_map_rgba, scale_bar,
     unbounded_rgb, MAX_AXIS_TICKS,
