@@ -12,6 +12,9 @@ mod common;
 #[path = "cli/basics.rs"]
 mod basics;
 
+#[path = "cli/cir.rs"]
+mod cir;
+
 #[path = "cli/filters.rs"]
 mod filters;
 

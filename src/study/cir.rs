@@ -356,7 +356,8 @@ pub fn cir_track(req: &CirTrackRequest, cancel: Cancel) -> Result<CirTrackOutput
         MeasurementNoise::AtPrediction,
         req.rule,
     )?
-    .with_estimate_sigmas(req.sigma == DelaySigma::Estimator);
+    .with_estimate_sigmas(req.sigma == DelaySigma::Estimator)
+    .with_gate_sigma((req.sigma == DelaySigma::Estimator).then_some(extent));
     while k < len {
         if k % every == 0 {
             cancel.check()?;

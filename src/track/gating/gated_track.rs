@@ -46,6 +46,7 @@ pub struct GatedTracker<'a, F: Filter = Ekf> {
     noise: MeasurementNoise<'a>,
     rule: AssociationRule,
     estimate_sigmas: bool,
+    gate_sigma_s: Option<Real>,
 }
 
 impl<'a, F: Filter> GatedTracker<'a, F> {
@@ -68,6 +69,7 @@ impl<'a, F: Filter> GatedTracker<'a, F> {
             noise,
             rule,
             estimate_sigmas: true,
+            gate_sigma_s: None,
         })
     }
 
@@ -76,6 +78,13 @@ impl<'a, F: Filter> GatedTracker<'a, F> {
     /// ([`MeasurementNoise::Fixed`]) always wins: a file that fixes `sigma_s` means it.
     pub fn with_estimate_sigmas(mut self, on: bool) -> Self {
         self.estimate_sigmas = on;
+        self
+    }
+
+    /// A floor of every link's measurement σ in the innovation gate of the association (s):
+    /// the gate then holds an extended scatterer's spread (`None`: the tracker's noise, E8).
+    pub fn with_gate_sigma(mut self, sigma_s: Option<Real>) -> Self {
+        self.gate_sigma_s = sigma_s;
         self
     }
 
@@ -90,7 +99,16 @@ impl<'a, F: Filter> GatedTracker<'a, F> {
     pub fn step(&mut self, snapshot: &[Vec<DelayEstimate>]) -> Result<GatedStep> {
         let mut next = self.filter.clone();
         next.predict(&self.motion);
-        let predictions = next.predicted_delays(self.model, self.noise)?;
+        let predictions = match self.gate_sigma_s {
+            Some(g) => {
+                let r = next.position();
+                let floor: Vec<Real> = (0..self.model.link_count())
+                    .map(|p| self.noise.sigma(self.model, p, r).max(g))
+                    .collect();
+                next.predicted_delays(self.model, MeasurementNoise::Fixed(&floor))?
+            }
+            None => next.predicted_delays(self.model, self.noise)?,
+        };
         let selection = select(self.calibration, snapshot, Some(&predictions), self.rule)?;
         let own = self.estimate_sigmas && !matches!(self.noise, MeasurementNoise::Fixed(_));
         // The estimator's σ where it gave one (and `own`), else the tracker's noise at the

@@ -24,7 +24,7 @@ use super::filters::filter_kinds;
 use super::gating::{prepare_out_dir_for, walk_file};
 use super::io::{emit_summary, model_of, read_bytes, read_json_file, read_scenario};
 use super::output::{check_writable, Format, OutputSet};
-use super::study::{run_with_counter, threads};
+use super::study::{catch_ctrl_c, interrupted, run_with_counter, threads};
 use crate::cli::{
     Association, CirEstimateArgs, CirSimulateArgs, CirTrackArgs, FilterName, SigmaSource,
 };
@@ -164,6 +164,7 @@ fn output(flag: &str, path: &str, allowed: &[Format]) -> Result<Format, CliError
 /// `scatterloc cir estimate --scenario S --cir REC.npz --out EST.json [--snapshots F]
 /// [--measurements F]`.
 pub fn cir_estimate(args: &CirEstimateArgs) -> Result<(), CliError> {
+    catch_ctrl_c();
     output("out", &args.out, &[Format::Json])?;
     for (flag, p) in [
         ("snapshots", &args.snapshots),
@@ -277,6 +278,7 @@ struct TrackDoc<'a> {
 
 /// `scatterloc cir track --scenario S --calibration CAL.npz --cir REC.npz --out TRACK.json`.
 pub fn cir_track(args: &CirTrackArgs) -> Result<(), CliError> {
+    catch_ctrl_c();
     output("out", &args.out, &[Format::Json])?;
     let figure = match &args.figure {
         Some(p) => Some((
@@ -461,6 +463,7 @@ fn parse_walk(text: &str) -> Result<Vec<[f64; 2]>, CliError> {
 /// `scatterloc cir simulate --scenario S --out-dir DIR [--scene F] [--walk P] [--speed V]
 /// [--duration S] [--dt T] [--calibration-duration S] [--seed N]`.
 pub fn cir_simulate(args: &CirSimulateArgs) -> Result<(), CliError> {
+    catch_ctrl_c();
     let scenario = read_scenario(&args.scenario)?;
     let model = model_of(&scenario)?;
     let mut scene: ChannelScene = match &args.scene {
@@ -512,6 +515,9 @@ pub fn cir_simulate(args: &CirSimulateArgs) -> Result<(), CliError> {
         let enc = |r: &Recording| {
             npz::write_recording(r).map_err(|e| CliError::output(format!("--out-dir: {e}")))
         };
+        if interrupted() {
+            return Err(super::study::cancelled());
+        }
         let mut files = OutputSet::new();
         let [rec_f, cal_f, truth_f, scene_f] = SIM_FILES.map(|n| walk_file(dir, n));
         files.bytes("out-dir", &rec_f, &enc(&rec)?)?;

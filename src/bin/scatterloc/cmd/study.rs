@@ -231,6 +231,21 @@ pub fn report_failures(label: &str, results: &FilterResults, doc: &mut CurveDoc<
     }
 }
 
+/// Installs the Ctrl-C handler (once) that sets the flag every long run asks: from then on
+/// Ctrl-C cancels the command (exit status 130, nothing written) instead of killing it. Long
+/// runs install it themselves; a command that reads large inputs first (a recording) calls it
+/// at its start. A second Ctrl-C leaves at once (nothing has been written yet either way).
+pub fn catch_ctrl_c() {
+    static HANDLER: std::sync::Once = std::sync::Once::new();
+    HANDLER.call_once(|| {
+        let _ = ctrlc::set_handler(|| {
+            if CANCEL.swap(true, Ordering::SeqCst) {
+                std::process::exit(130);
+            }
+        });
+    });
+}
+
 /// Whether Ctrl-C was pressed (after a run of [`run_with_bar`], e.g. while a figure is drawn).
 pub fn interrupted() -> bool {
     CANCEL.load(Ordering::SeqCst)
@@ -293,15 +308,7 @@ pub fn run_with_counter<T>(
     label: &str,
     run: impl FnOnce(&AtomicBool, &ProgressBar) -> scatterloc::Result<T>,
 ) -> Result<(scatterloc::Result<T>, f64), CliError> {
-    static HANDLER: std::sync::Once = std::sync::Once::new();
-    HANDLER.call_once(|| {
-        // A second Ctrl-C leaves at once (nothing has been written yet either way).
-        let _ = ctrlc::set_handler(|| {
-            if CANCEL.swap(true, Ordering::SeqCst) {
-                std::process::exit(130);
-            }
-        });
-    });
+    catch_ctrl_c();
     let bar = ProgressBar::new(total as u64);
     let style = ProgressStyle::with_template(&format!(
         "{{prefix}} {{elapsed_precise}} [{{wide_bar}}] {{human_pos}}/{{human_len}} {unit} · {{per_sec}} · ETA {{eta}}"
