@@ -741,5 +741,5 @@ fn decimals(v: Real) -> String {
     }
 }
 
-#[cfg(test)]
+#[cfg(all(test, not(target_arch = "wasm32")))]
 mod tests;
