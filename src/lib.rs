@@ -58,14 +58,15 @@ pub mod scenario;
 pub mod study;
 pub mod track;
 
+mod edge;
 #[cfg(feature = "chart")]
-pub mod chart;
+pub use edge::chart;
 #[cfg(all(feature = "parallel", not(target_arch = "wasm32")))]
-pub mod native;
+pub use edge::native;
 #[cfg(feature = "npz")]
-pub mod npz;
+pub use edge::npz;
 #[cfg(all(feature = "wasm", target_arch = "wasm32"))]
-pub mod wasm;
+pub use edge::wasm;
 
 pub use error::{Error, Result};
 pub use math::{Mat2, Real, Vec2};

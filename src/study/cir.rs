@@ -29,7 +29,7 @@ use crate::scenario::Area;
 use crate::study::{Driver, TrackStart};
 use crate::track::gating::{
     start_from_snapshot, AmplitudeClusterConfig, AssociationRule, Calibration, GatedTracker,
-    START_SPEED_SIGMA_MPS,
+    Selection, START_SPEED_SIGMA_MPS,
 };
 use crate::track::{step_ns, ConstantVelocity, Filter, FilterKind, MeasurementNoise, Tracker};
 
@@ -100,12 +100,13 @@ fn link_paths(
         .map(|v| map.noise_var_of_taps(v[link]));
     let mut h: Vec<Complex> = Vec::new();
     let (mut paths, mut noise) = (Vec::with_capacity(rec.t_s.len()), Vec::new());
-    let every = 64;
+    // Cancel and progress every 64 snapshots (≈ 0.1 s of work at 8 paths).
+    const EVERY: usize = 64;
     for (s, &t) in rec.t_s.iter().enumerate() {
-        if s % every == 0 {
+        if s % EVERY == 0 {
             cancel.check()?;
             if s > 0 {
-                progress(every);
+                progress(EVERY);
             }
         }
         let estimated = map.fill(rec, s, link, &mut h)?;
@@ -119,7 +120,9 @@ fn link_paths(
         paths.push(tracked);
         noise.push(used);
     }
-    progress(rec.t_s.len() % every);
+    // The snapshots after the last report (1 … EVERY of them).
+    let len = rec.t_s.len();
+    progress(len - EVERY * (len.saturating_sub(1) / EVERY));
     Ok((paths, noise))
 }
 
@@ -259,19 +262,6 @@ pub fn cir_track(req: &CirTrackRequest, cancel: Cancel) -> Result<CirTrackOutput
     let (model, est) = (req.model, req.estimates);
     let n = model.link_count();
     req.calibration.check_links(n)?;
-    let len = est.len();
-    let mut out = CirTrackOutput {
-        t_s: est.t_s.clone(),
-        states: Vec::with_capacity(len),
-        covariances: Vec::with_capacity(len),
-        links_used: Vec::with_capacity(len),
-        delays_used_s: Vec::with_capacity(len),
-        sigmas_used_s: Vec::with_capacity(len),
-        choices: Vec::with_capacity(len),
-        static_removed: Vec::with_capacity(len),
-        start: None,
-    };
-    let every = check_every(step_ns(req.filter, n));
     if !(req.extent_sigma_m.is_finite() && req.extent_sigma_m >= 0.0) {
         return Err(Error::OutOfRange {
             field: "extent_sigma_m".into(),
@@ -287,115 +277,139 @@ pub fn cir_track(req: &CirTrackRequest, cancel: Cancel) -> Result<CirTrackOutput
         }
         s
     };
+    let len = est.len();
+    let mut out = CirTrackOutput {
+        t_s: est.t_s.clone(),
+        states: Vec::with_capacity(len),
+        covariances: Vec::with_capacity(len),
+        links_used: Vec::with_capacity(len),
+        delays_used_s: Vec::with_capacity(len),
+        sigmas_used_s: Vec::with_capacity(len),
+        choices: Vec::with_capacity(len),
+        static_removed: Vec::with_capacity(len),
+        start: None,
+    };
+    let every = check_every(step_ns(req.filter, n));
     // Before the start: one fix attempt per snapshot.
     let mut k = 0;
-    let mut tracker = None;
-    while k < len {
+    let fix = loop {
+        if k == len {
+            return Ok(out);
+        }
         if k % every == 0 {
             cancel.check()?;
         }
-        let snap = snapshot(k);
-        match start_from_snapshot(
+        let start = start_from_snapshot(
             model,
             req.calibration,
-            &snap,
+            &snapshot(k),
             req.area,
             START_SPEED_SIGMA_MPS,
-        ) {
-            Ok(f) => {
-                let c = &f.ekf.covariance;
-                out.start = Some(CirStart {
-                    snapshot: k,
-                    t_s: est.t_s[k],
-                    fix: TrackStart {
-                        position_m: [f.report.position.x, f.report.position.y],
-                        covariance_m2: [[c[(0, 0)], c[(0, 1)]], [c[(1, 0)], c[(1, 1)]]],
-                        termination: f.report.termination.as_str(),
-                        links_used: f.report.links_used,
-                        choices: f.selection.choices.iter().map(|c| c.name()).collect(),
-                        delays_used_s: f.selection.delays.clone(),
-                    },
-                });
-                record_step(&mut out, Some((&f.ekf.state, &f.ekf.covariance)));
-                out.links_used.push(f.report.links_used);
-                let at = f.report.position;
-                let sig = (0..n)
-                    .map(|p| f.selection.delays[p].map(|_| model.sigma_delay(p, at)))
-                    .collect();
-                out.sigmas_used_s.push(sig);
-                out.choices
-                    .push(f.selection.choices.iter().map(|c| c.name()).collect());
-                out.delays_used_s.push(f.selection.delays);
-                out.static_removed.push(f.selection.static_removed);
-                let filter =
-                    Tracker::new(req.filter, f.ekf.state, f.ekf.covariance, rng(req.seed, 0))?;
-                tracker = Some(filter);
-                k += 1;
-                break;
-            }
-            Err(_) => {
-                record_step(&mut out, None);
-                out.links_used.push(0);
-                out.delays_used_s.push(vec![None; n]);
-                out.sigmas_used_s.push(vec![None; n]);
-                out.choices.push(vec!["absent"; n]);
-                out.static_removed.push(vec![0; n]);
-                k += 1;
-            }
+        );
+        k += 1;
+        match start {
+            Ok(f) => break f,
+            Err(_) => out.record(None, 0, None, vec![None; n]),
         }
-    }
-    let Some(filter) = tracker else {
-        return Ok(out);
     };
-    let first_dt = ConstantVelocity::validated(1e-3, req.process_noise)?;
+    let c = &fix.ekf.covariance;
+    out.start = Some(CirStart {
+        snapshot: k - 1,
+        t_s: est.t_s[k - 1],
+        fix: TrackStart {
+            position_m: [fix.report.position.x, fix.report.position.y],
+            covariance_m2: [[c[(0, 0)], c[(0, 1)]], [c[(1, 0)], c[(1, 1)]]],
+            termination: fix.report.termination.as_str(),
+            links_used: fix.report.links_used,
+            choices: fix.selection.choices.iter().map(|c| c.name()).collect(),
+            delays_used_s: fix.selection.delays.clone(),
+        },
+    });
+    // The LM fix weights with the link budget's σ at the fix (§5).
+    let at = fix.report.position;
+    let sig = (0..n)
+        .map(|p| fix.selection.delays[p].map(|_| model.sigma_delay(p, at)))
+        .collect();
+    let (x0, p0) = (fix.ekf.state, fix.ekf.covariance);
+    out.record(
+        Some((&x0, &p0)),
+        fix.report.links_used,
+        Some(fix.selection),
+        sig,
+    );
+    let filter = Tracker::new(req.filter, x0, p0, rng(req.seed, 0))?;
+    let motion = |k: usize| {
+        ConstantVelocity::validated(est.t_s[k] - est.t_s[k - 1], req.process_noise).map_err(|e| {
+            Error::InvalidFile {
+                field: format!("t_s[{k}]"),
+                reason: e.to_string(),
+            }
+        })
+    };
+    if k == len {
+        return Ok(out);
+    }
     let mut gated = GatedTracker::new(
         filter,
         model,
         req.calibration,
-        first_dt,
+        motion(k)?,
         MeasurementNoise::AtPrediction,
         req.rule,
     )?
     .with_estimate_sigmas(req.sigma == DelaySigma::Estimator)
     .with_gate_sigma((req.sigma == DelaySigma::Estimator).then_some(extent));
-    while k < len {
+    for k in k..len {
         if k % every == 0 {
             cancel.check()?;
         }
-        let dt = est.t_s[k] - est.t_s[k - 1];
-        gated.set_motion(
-            ConstantVelocity::validated(dt, req.process_noise).map_err(|e| Error::InvalidFile {
-                field: format!("t_s[{k}]"),
-                reason: e.to_string(),
-            })?,
-        );
-        let snap = snapshot(k);
-        let step = gated.step(&snap).map_err(|e| Error::InvalidFile {
+        gated.set_motion(motion(k)?);
+        let step = gated.step(&snapshot(k)).map_err(|e| Error::InvalidFile {
             field: format!("snapshot {k}"),
             reason: e.to_string(),
         })?;
         let f = &gated.filter;
-        record_step(&mut out, Some((f.state(), f.covariance())));
-        out.links_used.push(step.summary.links_used);
-        let sel = step.selection;
-        let sig = (0..n)
-            .map(|p| sel.delays[p].map(|_| step.sigmas_s[p]))
-            .collect();
-        out.sigmas_used_s.push(sig);
-        out.choices
-            .push(sel.choices.iter().map(|c| c.name()).collect());
-        out.delays_used_s.push(sel.delays);
-        out.static_removed.push(sel.static_removed);
-        k += 1;
+        out.record(
+            Some((f.state(), f.covariance())),
+            step.summary.links_used,
+            Some(step.selection),
+            step.sigmas_s,
+        );
     }
     Ok(out)
 }
 
-/// Appends one snapshot's state and covariance (`None` before the start).
-fn record_step(out: &mut CirTrackOutput, s: Option<(&Vec4, &Mat4)>) {
-    out.states.push(s.map(|(x, _)| (*x).into()));
-    out.covariances
-        .push(s.map(|(_, p)| core::array::from_fn(|i| core::array::from_fn(|j| p[(i, j)]))));
+impl CirTrackOutput {
+    /// Appends one snapshot: the state and covariance (`None` before the start), the links
+    /// used, what gating and association made of it (`None`: no attempt that counted, every
+    /// link absent) and the σ of each used delay.
+    fn record(
+        &mut self,
+        s: Option<(&Vec4, &Mat4)>,
+        links_used: usize,
+        selection: Option<Selection>,
+        sigmas_s: Vec<Option<Real>>,
+    ) {
+        let n = sigmas_s.len();
+        self.states.push(s.map(|(x, _)| (*x).into()));
+        self.covariances
+            .push(s.map(|(_, p)| core::array::from_fn(|i| core::array::from_fn(|j| p[(i, j)]))));
+        self.links_used.push(links_used);
+        self.sigmas_used_s.push(sigmas_s);
+        match selection {
+            Some(sel) => {
+                self.choices
+                    .push(sel.choices.iter().map(|c| c.name()).collect());
+                self.delays_used_s.push(sel.delays);
+                self.static_removed.push(sel.static_removed);
+            }
+            None => {
+                self.choices.push(vec!["absent"; n]);
+                self.delays_used_s.push(vec![None; n]);
+                self.static_removed.push(vec![0; n]);
+            }
+        }
+    }
 }
 
 /// The estimates of one snapshot as plain delay lists (the form `calibrate --snapshots` reads).

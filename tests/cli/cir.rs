@@ -162,78 +162,38 @@ fn bad_recordings_and_flags_are_named_errors() {
     let rec = format!("{sim}/recording.npz");
     let junk = dir.write_text("junk.npz", "not a zip file at all");
     let out = dir.path("o.json");
-    fails(
-        &[
+    // `cir estimate` of `recording` on `scenario` with `extra` flags fails naming `needles`.
+    let estimate = |scenario: &str, recording: &str, extra: &[&str], needles: &[&str]| {
+        let mut args = vec![
             "cir",
             "estimate",
             "--scenario",
-            &scenario,
+            scenario,
             "--cir",
-            &junk,
+            recording,
             "--out",
             &out,
-        ],
-        &["--cir"],
-    );
-    fails(
-        &[
-            "cir",
-            "estimate",
-            "--scenario",
-            &scenario,
-            "--cir",
-            &dir.path("missing.npz"),
-            "--out",
-            &out,
-        ],
+        ];
+        args.extend_from_slice(extra);
+        fails(&args, needles);
+    };
+    estimate(&scenario, &junk, &[], &["--cir"]);
+    estimate(
+        &scenario,
+        &dir.path("missing.npz"),
+        &[],
         &["--cir", "cannot read"],
     );
-    fails(
-        &[
-            "cir",
-            "estimate",
-            "--scenario",
-            &scenario,
-            "--cir",
-            &rec,
-            "--out",
-            &out,
-            "--pfa",
-            "2",
-        ],
-        &["--pfa", "p_fa"],
-    );
-    fails(
-        &[
-            "cir",
-            "estimate",
-            "--scenario",
-            &scenario,
-            "--cir",
-            &rec,
-            "--out",
-            &out,
-            "--max-paths",
-            "0",
-        ],
-        &["--max-paths"],
-    );
+    estimate(&scenario, &rec, &["--pfa", "2"], &["--pfa", "p_fa"]);
+    estimate(&scenario, &rec, &["--max-paths", "0"], &["--max-paths"]);
     // A scenario with two receivers: the recording's links (0, 2) and (0, 3) are not in it.
-    let small = read_json(&scenario);
-    let mut small = small.clone();
+    let mut small = read_json(&scenario);
     small["receivers"].as_array_mut().unwrap().truncate(2);
     let small = dir.write("small.json", &small);
-    fails(
-        &[
-            "cir",
-            "estimate",
-            "--scenario",
-            &small,
-            "--cir",
-            &rec,
-            "--out",
-            &out,
-        ],
+    estimate(
+        &small,
+        &rec,
+        &[],
         &["--cir", "links[2]", "not one of the scenario's 2 links"],
     );
     fails(

@@ -30,9 +30,9 @@ pub struct GatedStep {
     pub summary: UpdateSummary,
     /// What gating and association made of the snapshot.
     pub selection: Selection,
-    /// Per link the delay σ of the update, s (the estimator's where it was used, else the
-    /// tracker's noise at the predicted position).
-    pub sigmas_s: Vec<Real>,
+    /// Per link the σ its delay was weighted with in the update, s (the estimator's where it
+    /// was used, else the tracker's noise at the predicted position); `None` for an absent link.
+    pub sigmas_s: Vec<Option<Real>>,
 }
 
 /// A filter (by default the EKF) whose measurements pass through gating and association.
@@ -112,19 +112,23 @@ impl<'a, F: Filter> GatedTracker<'a, F> {
         let selection = select(self.calibration, snapshot, Some(&predictions), self.rule)?;
         let own = self.estimate_sigmas && !matches!(self.noise, MeasurementNoise::Fixed(_));
         // The estimator's σ where it gave one (and `own`), else the tracker's noise at the
-        // prediction.
+        // prediction; only for the links that have a delay.
         let r = next.position();
-        let sigmas_s: Vec<Real> = (0..self.model.link_count())
-            .map(|p| match selection.sigmas[p] {
-                Some(s) if own => s,
-                _ => self.noise.sigma(self.model, p, r),
+        let sigmas_s: Vec<Option<Real>> = (0..self.model.link_count())
+            .map(|p| {
+                selection.delays[p].map(|_| match selection.sigmas[p] {
+                    Some(s) if own => s,
+                    _ => self.noise.sigma(self.model, p, r),
+                })
             })
             .collect();
         let summary = if own && selection.sigmas.iter().any(Option::is_some) {
+            // Absent links' rows are skipped: their σ is never read.
+            let fixed: Vec<Real> = sigmas_s.iter().map(|s| s.unwrap_or(1.0)).collect();
             next.update(
                 self.model,
                 &selection.delays,
-                MeasurementNoise::Fixed(&sigmas_s),
+                MeasurementNoise::Fixed(&fixed),
             )?
         } else {
             next.update(self.model, &selection.delays, self.noise)?

@@ -11,7 +11,7 @@ use scatterloc::channel::{
 use scatterloc::error::{limits, Cancel};
 use scatterloc::formats::{CalibrationResult, CalibrationSnapshots, Measurements, Truth};
 use scatterloc::native::Parallel;
-use scatterloc::present::ErrorStats;
+use scatterloc::present::{track_errors, ErrorStats};
 use scatterloc::study::{
     calibrate_estimates, cir_track as track_recording, delays_only, estimate_recording,
     CirTrackRequest, DelaySigma, FrontEndConfig, RecordingEstimates, EXTENT_SIGMA_M,
@@ -38,8 +38,8 @@ const DEFAULT_PROCESS_NOISE: f64 = 1.0;
 fn read_recording(flag: &str, path: &str, model: &Model) -> Result<Recording, CliError> {
     let bytes = read_bytes(flag, path, limits::MAX_RECORDING_BYTES)?;
     let bad = |e: &dyn std::fmt::Display| CliError::usage(format!("--{flag} {path}: {e}"));
+    // The reader validates what it read (`Recording::validate`); the links against the scenario.
     let rec = npz::read_recording(&bytes).map_err(|e| bad(&e))?;
-    rec.validate().map_err(|e| bad(&e))?;
     rec.link_map(model).map_err(|e| bad(&e))?;
     Ok(rec)
 }
@@ -252,17 +252,6 @@ fn uniform_dt(t_s: &[f64], q: f64) -> Result<(f64, f64), CliError> {
     Ok((dt, q))
 }
 
-/// Position-error statistics of a track against the truth.
-#[derive(Serialize)]
-struct ErrorDoc {
-    /// Snapshots with a state (the statistics are over these).
-    count: usize,
-    median_m: Option<f64>,
-    p90_m: Option<f64>,
-    max_m: Option<f64>,
-    fraction_below_1m: Option<f64>,
-}
-
 /// `TRACK.json`.
 #[derive(Serialize)]
 struct TrackDoc<'a> {
@@ -272,8 +261,10 @@ struct TrackDoc<'a> {
     process_noise: f64,
     sigma: &'static str,
     calibration: CalibrationResult,
+    /// With `--truth`: the position error's statistics over the snapshots with a state (absent
+    /// when the track never started).
     #[serde(skip_serializing_if = "Option::is_none")]
-    error: Option<ErrorDoc>,
+    error: Option<ErrorStats>,
 }
 
 /// `scatterloc cir track --scenario S --calibration CAL.npz --cir REC.npz --out TRACK.json`.
@@ -349,15 +340,14 @@ pub fn cir_track(args: &CirTrackArgs) -> Result<(), CliError> {
         track_recording(&req, Cancel::when(&stop))
     })?;
     let track = res.map_err(|e| CliError::usage(format!("--cir {}: {e}", args.cir)))?;
-    let errors: Option<Vec<Option<f64>>> = truth.as_ref().map(|t| {
-        track
-            .states
-            .iter()
-            .zip(&t.states)
-            .map(|(s, x)| s.map(|s| ((s[0] - x[0]).powi(2) + (s[1] - x[1]).powi(2)).sqrt()))
-            .collect()
-    });
-    let error = errors.as_ref().map(|e| error_doc(e));
+    // The error view (per snapshot, its statistics and CDF) once, for TRACK.json and --figure.
+    let truth_states: Vec<Option<[f64; 4]>> = truth
+        .as_ref()
+        .map(|t| t.states.iter().map(|s| Some(*s)).collect())
+        .unwrap_or_default();
+    let view = track_errors(&track.t_s, &track.states, &truth_states)
+        .map_err(|e| CliError::usage(format!("--truth: {e}")))?;
+    let error = truth.as_ref().and(view.stats);
     let doc = TrackDoc {
         track: &track,
         filter: name.name(),
@@ -391,15 +381,7 @@ pub fn cir_track(args: &CirTrackArgs) -> Result<(), CliError> {
         )?;
     }
     if let Some((p, f)) = figure {
-        super::cir_fig::stage_track_figure(
-            &mut files,
-            p,
-            f,
-            &scenario,
-            &track,
-            truth.as_ref(),
-            name.name(),
-        )?;
+        super::cir_fig::stage_track_figure(&mut files, p, f, &scenario, &track, view, name.name())?;
     }
     files.commit()?;
     emit_summary(
@@ -411,19 +393,6 @@ pub fn cir_track(args: &CirTrackArgs) -> Result<(), CliError> {
         })
         .to_string(),
     )
-}
-
-/// The error statistics of the snapshots with a state.
-fn error_doc(errors: &[Option<f64>]) -> ErrorDoc {
-    let e: Vec<f64> = errors.iter().flatten().copied().collect();
-    let stats = ErrorStats::of(&e);
-    ErrorDoc {
-        count: e.len(),
-        median_m: stats.as_ref().map(|s| s.median_m),
-        p90_m: stats.as_ref().map(|s| s.p90_m),
-        max_m: stats.as_ref().map(|s| s.max_m),
-        fraction_below_1m: stats.as_ref().map(|s| s.fraction_below_1m),
-    }
 }
 
 /// The files of `cir simulate`.

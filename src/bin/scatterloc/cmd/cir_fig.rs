@@ -11,7 +11,7 @@ use scatterloc::chart::{
     ChannelChartOptions, ChartError,
 };
 use scatterloc::formats::Truth;
-use scatterloc::present::{delay_figure, track_errors, DelayFigure, TrackErrorView};
+use scatterloc::present::{delay_figure, DelayFigure, TrackErrorView};
 use scatterloc::study::{CirTrackOutput, RecordingEstimates};
 use scatterloc::track::gating::Calibration;
 use scatterloc::{Model, Scenario};
@@ -102,14 +102,9 @@ pub fn stage_track_figure(
     format: Format,
     scenario: &Scenario,
     track: &CirTrackOutput,
-    truth: Option<&Truth>,
+    view: TrackErrorView,
     filter: &str,
 ) -> Result<(), CliError> {
-    let states: Vec<Option<[f64; 4]>> = truth
-        .map(|t| t.states.iter().map(|s| Some(*s)).collect())
-        .unwrap_or_default();
-    let view = track_errors(&track.t_s, &track.states, &states)
-        .map_err(|e| CliError::usage(format!("--figure: {e}")))?;
     let opts = ChannelChartOptions {
         title: format!("Track from channel recordings ({filter}; [S] Figs. 5–6)"),
         subtitle: Some(format!(

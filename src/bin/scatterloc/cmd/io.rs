@@ -50,26 +50,9 @@ pub fn read_input(flag: &str, path: &str) -> Result<String, CliError> {
 /// [`read_input`] with `what` (a flag with its dashes, or e.g. `PART a.json`) naming the input
 /// in errors.
 pub fn read_input_named(what: &str, path: &str) -> Result<String, CliError> {
-    let cannot =
-        |e: &dyn std::fmt::Display| CliError::usage(format!("{what}: cannot read '{path}': {e}"));
-    let mut bytes = Vec::new();
-    let cap = limits::MAX_INPUT_BYTES;
-    let res = if path == "-" {
-        std::io::stdin()
-            .lock()
-            .take(cap + 1)
-            .read_to_end(&mut bytes)
-    } else {
-        std::fs::File::open(path).and_then(|f| f.take(cap + 1).read_to_end(&mut bytes))
-    };
-    res.map_err(|e| cannot(&e))?;
-    if bytes.len() as u64 > cap {
-        return Err(CliError::usage(format!(
-            "{what}: '{path}' is larger than {} MiB, the largest input read",
-            cap >> 20
-        )));
-    }
-    let mut s = String::from_utf8(bytes).map_err(|e| cannot(&e))?;
+    let bytes = read_capped(what, path, limits::MAX_INPUT_BYTES, "input")?;
+    let mut s = String::from_utf8(bytes)
+        .map_err(|e| CliError::usage(format!("{what}: cannot read '{path}': {e}")))?;
     if s.starts_with('\u{feff}') {
         s.drain(..'\u{feff}'.len_utf8());
     }
@@ -79,8 +62,13 @@ pub fn read_input_named(what: &str, path: &str) -> Result<String, CliError> {
 /// Reads the binary file `path` of `--flag` (a recording), at most `cap` bytes (a larger one is
 /// refused after reading one byte past the cap; `-` = standard input).
 pub fn read_bytes(flag: &str, path: &str, cap: u64) -> Result<Vec<u8>, CliError> {
-    let cannot =
-        |e: &dyn std::fmt::Display| CliError::usage(format!("--{flag}: cannot read '{path}': {e}"));
+    read_capped(&format!("--{flag}"), path, cap, "recording")
+}
+
+/// The bytes of `path` (`-` = standard input) named by `what` in errors, at most `cap` of them:
+/// a larger input, or an endless one such as `/dev/zero`, is refused after reading one byte
+/// past the cap ("the largest `kind` read").
+fn read_capped(what: &str, path: &str, cap: u64, kind: &str) -> Result<Vec<u8>, CliError> {
     let mut bytes = Vec::new();
     let res = if path == "-" {
         std::io::stdin()
@@ -90,10 +78,10 @@ pub fn read_bytes(flag: &str, path: &str, cap: u64) -> Result<Vec<u8>, CliError>
     } else {
         std::fs::File::open(path).and_then(|f| f.take(cap + 1).read_to_end(&mut bytes))
     };
-    res.map_err(|e| cannot(&e))?;
+    res.map_err(|e| CliError::usage(format!("{what}: cannot read '{path}': {e}")))?;
     if bytes.len() as u64 > cap {
         return Err(CliError::usage(format!(
-            "--{flag}: '{path}' is larger than {} MiB, the largest recording read",
+            "{what}: '{path}' is larger than {} MiB, the largest {kind} read",
             cap >> 20
         )));
     }

@@ -103,18 +103,35 @@ pub(crate) fn draw_metre_axes<'a, DB: DrawingBackend + 'a>(
     chart: &mut Chart<'a, DB>,
     lay: &layout::Layout,
 ) -> Result<(), ChartError> {
-    let tick_font = ("sans-serif", lay.font.ticks).into_font();
-    let axis_font = ("sans-serif", lay.font.axis).into_font();
-    chart
-        .configure_mesh()
-        .disable_mesh()
-        .x_desc("x (m)")
-        .y_desc("y (m)")
-        .label_style(tick_font)
-        .axis_desc_style(axis_font)
-        .x_labels(8)
-        .y_labels(8)
-        .set_all_tick_mark_size(lay.font.ticks as i32 / 3 + 2)
+    draw_axes(chart, &lay.font, ["x (m)", "y (m)"], [8, 8], None)
+}
+
+/// The axes of a plot: tick labels ([`axis_label`]), the descriptions `desc` (x, y), about
+/// `labels` ticks per axis, and the grid in the (bold, light) colours `grid` or none.
+pub(crate) fn draw_axes<DB: DrawingBackend>(
+    chart: &mut Chart<'_, DB>,
+    font: &Fonts,
+    [x_desc, y_desc]: [&str; 2],
+    [x_labels, y_labels]: [usize; 2],
+    grid: Option<[RGBColor; 2]>,
+) -> Result<(), ChartError> {
+    let mut mesh = chart.configure_mesh();
+    match grid {
+        None => {
+            mesh.disable_mesh();
+        }
+        Some([bold, light]) => {
+            mesh.bold_line_style(bold.stroke_width(1))
+                .light_line_style(light.stroke_width(1));
+        }
+    }
+    mesh.x_desc(x_desc)
+        .y_desc(y_desc)
+        .label_style(("sans-serif", font.ticks).into_font())
+        .axis_desc_style(("sans-serif", font.axis).into_font())
+        .x_labels(x_labels)
+        .y_labels(y_labels)
+        .set_all_tick_mark_size(font.ticks as i32 / 3 + 2)
         .x_label_formatter(&|v| axis_label(*v))
         .y_label_formatter(&|v| axis_label(*v))
         .draw()

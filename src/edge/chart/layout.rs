@@ -294,7 +294,7 @@ pub fn register_fonts() {
         let _ = plotters::style::register_font(
             "sans-serif",
             FontStyle::Normal,
-            include_bytes!("../../assets/DejaVuSans.ttf"),
+            include_bytes!("../../../assets/DejaVuSans.ttf"),
         );
     });
 }

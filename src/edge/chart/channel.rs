@@ -17,8 +17,8 @@ use super::layout::{font_scale, frame_plot, segments, series_legend, titled_body
 use super::overlay::{
     draw_overlay, MapOverlay, OverlayLine, OverlayMark, OverlayMarkKind, OverlayPath,
 };
-use super::panel::{check_area, draw_nodes, legend_entry, rgb, Chart, ChartNode};
-use super::{axis_label, chart_err, register_fonts, ChartError, CURVE_PALETTE};
+use super::panel::{check_area, draw_axes, draw_nodes, legend_entry, rgb, Chart, ChartNode};
+use super::{chart_err, register_fonts, ChartError, CURVE_PALETTE};
 use crate::math::Real;
 use crate::present::{linear_ticks, viridis, DelayFigure, DelayImage, LinkDelays, TrackErrorView};
 use crate::scenario::Area;
@@ -215,20 +215,13 @@ fn draw_link<DB: DrawingBackend>(
         .y_label_area_size((2.6 * font.ticks + font.axis + 20.0 * s) as u32)
         .build_cartesian_2d(t0..t1, r0..r1)
         .map_err(chart_err)?;
-    chart
-        .configure_mesh()
-        .disable_mesh()
-        .x_desc("time t (s)")
-        .y_desc("path length c·τ (m)")
-        .label_style(("sans-serif", font.ticks).into_font())
-        .axis_desc_style(("sans-serif", font.axis).into_font())
-        .x_labels(8)
-        .y_labels(7)
-        .set_all_tick_mark_size(font.ticks as i32 / 3 + 2)
-        .x_label_formatter(&|v| axis_label(*v))
-        .y_label_formatter(&|v| axis_label(*v))
-        .draw()
-        .map_err(chart_err)?;
+    draw_axes(
+        &mut chart,
+        font,
+        ["time t (s)", "path length c·τ (m)"],
+        [8, 7],
+        None,
+    )?;
     if let (Some(img), Some(g)) = (&link.image, grey_range) {
         draw_image(&mut chart, img, g, [t0, t1, r0, r1])?;
     }
@@ -497,20 +490,7 @@ fn draw_track_map<DB: DrawingBackend>(
         .y_label_area_size(yl as u32)
         .build_cartesian_2d(x[0]..x[1], y[0]..y[1])
         .map_err(chart_err)?;
-    chart
-        .configure_mesh()
-        .disable_mesh()
-        .x_desc("x (m)")
-        .y_desc("y (m)")
-        .label_style(("sans-serif", font.ticks).into_font())
-        .axis_desc_style(("sans-serif", font.axis).into_font())
-        .x_labels(8)
-        .y_labels(8)
-        .set_all_tick_mark_size(font.ticks as i32 / 3 + 2)
-        .x_label_formatter(&|v| axis_label(*v))
-        .y_label_formatter(&|v| axis_label(*v))
-        .draw()
-        .map_err(chart_err)?;
+    draw_axes(&mut chart, font, ["x (m)", "y (m)"], [8, 8], None)?;
     let mut overlay = MapOverlay::default();
     let path = |label: &str, k: usize, run: &Vec<[Real; 2]>, line| OverlayPath {
         label: (k == 0).then(|| label.into()),
@@ -569,21 +549,13 @@ fn curve_chart<'a, DB: DrawingBackend>(
         .y_label_area_size((2.4 * font.ticks + font.axis + 20.0 * s) as u32)
         .build_cartesian_2d(x[0]..x[1], y[0]..y[1])
         .map_err(chart_err)?;
-    chart
-        .configure_mesh()
-        .bold_line_style(RGBColor(215, 215, 215).stroke_width(1))
-        .light_line_style(RGBColor(240, 240, 240).stroke_width(1))
-        .x_desc(x_desc)
-        .y_desc(y_desc)
-        .label_style(("sans-serif", font.ticks).into_font())
-        .axis_desc_style(("sans-serif", font.axis).into_font())
-        .x_labels(8)
-        .y_labels(6)
-        .set_all_tick_mark_size(font.ticks as i32 / 3 + 2)
-        .x_label_formatter(&|v| axis_label(*v))
-        .y_label_formatter(&|v| axis_label(*v))
-        .draw()
-        .map_err(chart_err)?;
+    draw_axes(
+        &mut chart,
+        font,
+        [x_desc, y_desc],
+        [8, 6],
+        Some([RGBColor(215, 215, 215), RGBColor(240, 240, 240)]),
+    )?;
     Ok(chart)
 }
 
