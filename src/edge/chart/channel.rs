@@ -39,6 +39,30 @@ pub struct ChannelChartOptions {
     pub subtitle: Option<String>,
 }
 
+/// Where a drawn panel's plotting area lies on the backend, and the time it spans: what a
+/// page needs to draw a time cursor over a figure drawn here.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PlotBox {
+    /// Left and right pixel columns of the plotting area (backend pixels).
+    pub x_px: [i32; 2],
+    /// Top and bottom pixel rows of the plotting area (backend pixels).
+    pub y_px: [i32; 2],
+    /// The time axis `[t_left, t_right]`, s.
+    pub t_range_s: [Real; 2],
+}
+
+impl PlotBox {
+    /// The plotting area of `chart`, whose x axis spans `t_range_s`.
+    fn of<DB: DrawingBackend>(chart: &Chart<'_, DB>, t_range_s: [Real; 2]) -> PlotBox {
+        let (x, y) = chart.plotting_area().get_pixel_range();
+        PlotBox {
+            x_px: [x.start, x.end],
+            y_px: [y.start, y.end],
+            t_range_s,
+        }
+    }
+}
+
 /// A size for the delay figure of `links` panels: two columns from two links on (1400 × 900
 /// for 2 × 2), one panel 1000 × 620.
 pub fn delays_size(links: usize) -> (u32, u32) {
@@ -113,6 +137,15 @@ pub fn draw_delays<DB: DrawingBackend>(
     fig: &DelayFigure,
     opts: &ChannelChartOptions,
 ) -> Result<(), ChartError> {
+    draw_delays_boxes(root, fig, opts).map(|_| ())
+}
+
+/// As [`draw_delays`], returning each link panel's [`PlotBox`] (in the order of `fig.links`).
+pub fn draw_delays_boxes<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    fig: &DelayFigure,
+    opts: &ChannelChartOptions,
+) -> Result<Vec<PlotBox>, ChartError> {
     register_fonts();
     for l in &fig.links {
         if let Some(img) = &l.image {
@@ -153,8 +186,9 @@ pub fn draw_delays<DB: DrawingBackend>(
             .map_err(chart_err)?;
     }
     let areas = panels.split_evenly((nrows, ncols));
+    let mut boxes = Vec::with_capacity(fig.links.len());
     for (k, (area, link)) in areas.iter().zip(&fig.links).enumerate() {
-        draw_link(area, fig, link, grey_range, k == 0, &font, s)?;
+        boxes.push(draw_link(area, fig, link, grey_range, k == 0, &font, s)?);
     }
     let (bar_a, bar_g) = bars.split_horizontally(bars_w / 2);
     let bar_h = (bh as f64 * 0.8) as u32;
@@ -180,7 +214,7 @@ pub fn draw_delays<DB: DrawingBackend>(
             &font,
         )?;
     }
-    Ok(())
+    Ok(boxes)
 }
 
 /// The shared scale of the images: from the lowest floor to the highest maximum, dB.
@@ -205,7 +239,7 @@ fn draw_link<DB: DrawingBackend>(
     legend: bool,
     font: &Fonts,
     s: f64,
-) -> Result<(), ChartError> {
+) -> Result<PlotBox, ChartError> {
     let [t0, t1] = axis(fig.t_range_s);
     let [r0, r1] = axis(link.range_m);
     let mut chart = ChartBuilder::on(area)
@@ -315,7 +349,8 @@ fn draw_link<DB: DrawingBackend>(
             0.85,
         )?;
     }
-    frame_plot(&chart)
+    frame_plot(&chart)?;
+    Ok(PlotBox::of(&chart, [t0, t1]))
 }
 
 /// The image in data coordinates: per column (from the middle between its time and its
@@ -458,15 +493,41 @@ pub fn draw_track_errors<DB: DrawingBackend>(
         let (_, rh) = right.dim_in_pixel();
         right.split_vertically(rh / 2)
     };
-    let note = if view.track_start.is_none() {
+    let note = error_note(view);
+    draw_error_time(&top, view, note, &font, s)?;
+    draw_error_cdf(&bottom, view, note, &font, s)
+}
+
+/// What [`draw_track_errors`] says instead of a curve: `no track` or `no truth` (`None`: the
+/// curves are drawn).
+fn error_note(view: &TrackErrorView) -> Option<&'static str> {
+    if view.track_start.is_none() {
         Some("no track")
     } else if view.stats.is_none() {
         Some("no truth")
     } else {
         None
-    };
-    draw_error_time(&top, view, note, &font, s)?;
-    draw_error_cdf(&bottom, view, note, &font, s)
+    }
+}
+
+/// A size for the error-over-time chart alone: 1000 × 420.
+pub fn error_time_size() -> (u32, u32) {
+    (1000, 420)
+}
+
+/// Draws the error-over-time panel of [`draw_track_errors`] alone onto `root` (filled white
+/// first; the title band, then the panel, with the same `no track` / `no truth` notes) and
+/// returns its [`PlotBox`]. Does not call `present()`.
+pub fn draw_error_time_chart<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    view: &TrackErrorView,
+    opts: &ChannelChartOptions,
+) -> Result<PlotBox, ChartError> {
+    register_fonts();
+    let (w, h) = root.dim_in_pixel();
+    let s = (w as f64 / 1000.0).min(h as f64 / 420.0).clamp(0.5, 4.0);
+    let (font, body) = titled_body(root, s, &opts.title, opts.subtitle.as_deref())?;
+    draw_error_time(&body, view, error_note(view), &font, s)
 }
 
 fn draw_track_map<DB: DrawingBackend>(
@@ -571,7 +632,7 @@ fn draw_error_time<DB: DrawingBackend>(
     note: Option<&str>,
     font: &Fonts,
     s: f64,
-) -> Result<(), ChartError> {
+) -> Result<PlotBox, ChartError> {
     let t = axis([
         view.t_s.first().copied().unwrap_or(0.0),
         view.t_s.last().copied().unwrap_or(1.0),
@@ -619,7 +680,8 @@ fn draw_error_time<DB: DrawingBackend>(
     if let Some(n) = note {
         centred_note(&chart, n, font)?;
     }
-    frame_plot(&chart)
+    frame_plot(&chart)?;
+    Ok(PlotBox::of(&chart, t))
 }
 
 fn draw_error_cdf<DB: DrawingBackend>(

@@ -23,6 +23,7 @@ mod tracking;
 pub use channel::{
     delays_size, draw_delays, draw_track_errors, track_errors_size, ChannelChartOptions,
 };
+pub use channel::{draw_delays_boxes, draw_error_time_chart, error_time_size, PlotBox};
 pub(crate) use layout::{axis_label, chart_err};
 pub use layout::{register_fonts, suggested_size, ChartError};
 pub use map::{
