@@ -287,3 +287,13 @@ pub const MAX_SCENE_SCATTERERS: usize = 4096;
 pub const MAX_BODY_CENTRES: usize = 64;
 /// Channel simulator: waypoints of a walk.
 pub const MAX_WAYPOINTS: usize = 4096;
+
+/// Largest recording (or calibration) file the page reads, bytes, checked before parsing, and
+/// the largest total of its members once inflated (the page's `.npz` reader cap, a zip bomb is
+/// refused at it): 256 MiB, 16 Mi complex128 samples (a 300-snapshot, 4-link, 241-bin
+/// recording is 4.6 MB). The page holds the recording, its inflated arrays and the estimator's
+/// scratch in one 4 GiB wasm memory.
+pub const MAX_PAGE_RECORDING_BYTES: u64 = 256 << 20;
+
+/// Largest truth or scenario text the page's channel view reads, bytes: 64 MiB.
+pub const MAX_PAGE_TEXT_BYTES: usize = 64 << 20;

@@ -15,10 +15,12 @@
 //! `chart.rs` (the plotters ε_EKF / ε_PCRLB chart on a canvas), `mtl.rs` (the multi-target view
 //! of a scene, [`crate::present::scene`]), `plan.rs` (the planner, run in a Web Worker), `export.rs`
 //! (the page's "Save figure": the map and tracking figures as SVG through the CLI's chart code),
-//! `recording.rs` (`read_recording_summary`: a dropped `.npz` channel recording).
+//! `recording.rs` (`read_recording_summary`: a dropped `.npz` channel recording), `channel.rs`
+//! (the channel view: `simulate_channel`, `ChannelJob` run in a Web Worker, `ChannelFigures`).
 
 mod app;
 mod base;
+mod channel;
 mod chart;
 mod export;
 mod json;
@@ -32,6 +34,7 @@ mod tracking;
 pub use app::App;
 pub use base::{check_point, check_rect, preset_json, preset_names, start};
 use base::{err, point, window};
+pub use channel::{simulate_channel, ChannelFigures, ChannelJob, SimulatedChannel};
 pub use chart::draw_tracking_chart;
 pub use export::{mtl_scene_svg, tracking_chart_svg, MAX_FIGURE_PX, MAX_FIGURE_RES};
 pub use montecarlo::MonteCarloJob;
