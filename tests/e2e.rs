@@ -73,6 +73,11 @@ mod export;
 #[path = "e2e/zoom.rs"]
 mod zoom;
 
+/// Issue 26 §1: the channel view's controls (files, Simulate, Run/Stop, time cursor, saves).
+#[cfg(test)]
+#[path = "e2e/channel_ui.rs"]
+mod channel_ui;
+
 /// The docs screenshots: not a test, the example `screenshot` (`examples/screenshot.rs`) runs
 /// it through this harness. The example includes this file as a module, so the test modules
 /// above are `cfg(test)` and only the harness, the tracking helpers and this module compile

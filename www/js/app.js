@@ -19,8 +19,9 @@ import { Plan } from './plan.js';
 import { FigureExport } from './export.js';
 import { Zoomer } from './zoom.js';
 import { setLinkColors } from './draw.js';
+import { Channel } from './channel.js';
 
-const MODES = ['snapshot', 'tracking', 'mtl'];
+const MODES = ['snapshot', 'tracking', 'mtl', 'channel'];
 
 /**
  * Every option the page reads from the URL hash (anything else is named in the banner as unknown):
@@ -205,6 +206,12 @@ export async function start() {
         : plan.showsRoi() ? (c, v) => plan.overlay(c, v) : null;
       st.insetTitle = tr ? `${tracking.filterName()} zoom · true scale` : 'target zoom';
       st.insetAvoid = tr ? tracking.avoidPoints() : [];
+      if (st.mode === 'channel') {
+        // The channel view (channel.js): its track layer, no snapshot target.
+        st.fix = null;
+        st.overlay = (c, v) => channel.overlayLayer(c, v);
+        st.insetAvoid = [];
+      }
       if (st.mode === 'mtl') mtl.draw(); else map.draw();
     } catch (e) {
       showError(`Internal error: ${errorText(e)}`);
@@ -243,6 +250,9 @@ export async function start() {
   const plan = new Plan(ctx);
   ctx.plan = plan;
   const figures = new FigureExport(ctx); // "Save figure" (export.js)
+  ctx.figures = figures;
+  const channel = new Channel(ctx); // the channel view (channel.js)
+  ctx.channel = channel;
   // Zoom and pan in the three views (zoom.js); the press handlers below pan on empty map.
   const zoom = new Zoomer(ctx, mtl, (p) => (st.mode === 'mtl' ? !!mtl.hit(p) : !!hitNode(view, st.nodes, p)));
   ctx.zoom = zoom;
@@ -252,9 +262,11 @@ export async function start() {
     st.mode = MODES.includes(mode) ? mode : 'snapshot';
     document.body.classList.toggle('mode-tracking', st.mode === 'tracking');
     document.body.classList.toggle('mode-mtl', st.mode === 'mtl');
+    document.body.classList.toggle('mode-channel', st.mode === 'channel');
     for (const m of MODES) $(`mode-${m}`).setAttribute('aria-pressed', String(st.mode === m));
     tracking.setActive(st.mode === 'tracking');
     mtl.setActive(st.mode === 'mtl');
+    channel.setActive(st.mode === 'channel');
     figures.setMode(st.mode);
     zoom.show();
     if (st.mode !== 'snapshot') {
@@ -323,7 +335,7 @@ export async function start() {
   $('share-close').addEventListener('click', () => { $('share').hidden = true; });
 
   registerHooks({
-    app, wasm, view, st, setMode, panel, tracking, mtl, map, plan, link, figures, zoom,
+    app, wasm, view, st, setMode, panel, tracking, mtl, map, plan, link, figures, zoom, channel,
     isIdle: () => !scheduled && !map.busy(),
     placeTarget: ctx.placeTarget,
   });

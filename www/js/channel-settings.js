@@ -7,8 +7,8 @@ import { clip, decimal } from './dom.js';
 
 /** The trackers of `cir track --filter`. */
 export const CHANNEL_FILTERS = ['ekf', 'ukf', 'pf'];
-/** Where the static paths come from: nothing, a recording of the empty area, or a time range of the recording. */
-export const CALIBRATION_SOURCES = ['none', 'file', 'range'];
+/** Where the static paths come from: a recording of the empty area, or a time range of the recording. */
+export const CALIBRATION_SOURCES = ['file', 'range'];
 /** The playback speeds of the transport's <select>. */
 export const CHANNEL_SPEEDS = [0.25, 0.5, 1, 2, 4];
 
@@ -28,7 +28,7 @@ export const CHANNEL_FIELDS = [
   ['p_fa', 'number', 1e-3, { min: 0, max: 1, open: [true, true], allowed: '0 < P_fa < 1' }],
   ['max_paths', 'number', 12, { min: 1, max: 64, integer: true, allowed: 'an integer 1 … 64' }],
   ['extent_sigma_m', 'number', 0.2, { min: 0, max: 1000, allowed: '0 … 1000 m' }],
-  ['calibration', 'choice', 'none', { values: CALIBRATION_SOURCES }],
+  ['calibration', 'choice', 'file', { values: CALIBRATION_SOURCES }],
   ['empty_from_s', 'number', 0, { min: 0, max: 1e9, allowed: '0 … 1000000000 s' }],
   ['empty_to_s', 'number', 1, { min: 0, max: 1e9, allowed: '0 … 1000000000 s' }],
   ['link', 'number', 0, { min: 0, max: 4096, integer: true, allowed: 'an integer 0 … 4096' }],

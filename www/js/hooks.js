@@ -34,6 +34,15 @@
 //                            scaleBar {length_m, label} of the last frame, level}; reset();
 //                            hitAt(x, y) (an object under canvas pixel x, y: a press drags it);
 //                            toMetre(x, y) (canvas pixel -> {x, y} m in the view on screen)
+//   window.channel           the channel view (channel.js): state() -> {running, progress, runs,
+//                            stopped, status, statusState, error, recording, calibration, truth,
+//                            steps, step, t_s, playing, drawn (what the map layer drew: {step,
+//                            estimate, sigma, links, truth, track_points}), cursorX, delayBox,
+//                            errorBox, links, timings, wallMs, workerMs, settings}; texts()
+//                            (the result's TRACK.json, EST.json, figure and error texts, or null);
+//                            truthStates() (the truth file's states, or null);
+//                            seek(k); play(); pause(); settings() / applySettings(obj)
+//                            (channelSettings / applyChannelSettings)
 //   body[data-ready='1']     the page is up;  body[data-error]  it failed (the message)
 
 /**
@@ -133,6 +142,16 @@ export function registerHooks(p) {
       toMetre: (x, y) => p.zoom.view().toMetre(x, y),
     },
     importScenarioText: (text, name) => p.panel.importText(text, name),
+    channel: {
+      state: () => p.channel.state(),
+      texts: () => p.channel.texts(),
+      truthStates: () => (p.channel.truth ? p.channel.truth.data.states : null),
+      seek: (k) => p.channel.seek(k),
+      play: () => p.channel.play(),
+      pause: () => p.channel.pause(),
+      settings: () => p.channel.settings(),
+      applySettings: (obj) => p.channel.applySettings(obj),
+    },
     benchMap: (n = 9) => {
       const r = st.res;
       const buf = new Float64Array(r * r);

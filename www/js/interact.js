@@ -62,6 +62,7 @@ export function attachPointer(ctx) {
   const hover = (p) => {
     if (!view.inPlot(p.x, p.y)) {
       if (st.mode === 'mtl') readout.textContent = 'Multi-target · drag Tx, Rx, targets (×) and discs';
+      else if (st.mode === 'channel') readout.textContent = 'Channel · open, drop or simulate a recording, then Run · drag Tx/Rx markers · wheel to zoom';
       else if (ctx.plan && ctx.plan.wantsRoi()) readout.textContent = 'Press and drag on the map to draw the region of interest';
       else readout.textContent = st.mode !== 'tracking'
         ? 'Move over the map to read the bound · drag Tx/Rx markers · click to place a target'
@@ -127,7 +128,7 @@ export function attachPointer(ctx) {
 
   /** The press ends at canvas pixel p; `up`: released (not cancelled). */
   const finish = (p, up) => {
-    const wasClick = up && !press.node && !press.roi && !press.moved && st.mode !== 'tracking';
+    const wasClick = up && !press.node && !press.roi && !press.moved && st.mode !== 'tracking' && st.mode !== 'channel';
     if (press.roi) ctx.plan.roiEnd(p, up);
     if (press.draw) ctx.tracking.drawEnd(view.toMetre(p.x, p.y));
     // A map reduced while dragging (map.js) is now computed at full resolution.

@@ -1,0 +1,444 @@
+//! Issue 26 §1, the channel view's controls with real input: the view opened from the top bar,
+//! a malformed recording chosen through the file input (chromedriver types the file's path, as
+//! a user picks it) is named in the banner with the core reader's own message, a malformed
+//! number is named, "Simulate walk" makes a recording of the current scenario, Run estimates
+//! and tracks it in the worker and Stop cancels a run (nothing replaces the result), the time
+//! cursor moved with the keyboard on its range input shows on the map exactly the track's state,
+//! the links used and the truth of that snapshot (TRACK.json and truth.json, the page's own
+//! result texts), its line moves right on both charts, the save buttons produce the delay
+//! figure (SVG, PNG) and the track file (the TRACK.json text plus the newline the CLI writes),
+//! and the settings hook round-trips and refuses a bad value by name.
+
+use std::time::{Duration, Instant};
+
+use fantoccini::{Client, Locator};
+use serde_json::{json, Value};
+
+use super::mtl::banner;
+use super::{console_errors, js, open_hash, settle, with_browser};
+
+const PNG_SIGNATURE: [u8; 8] = [0x89, b'P', b'N', b'G', 0x0d, 0x0a, 0x1a, 0x0a];
+const HOME: &str = "\u{E011}";
+const END: &str = "\u{E010}";
+const RIGHT: &str = "\u{E014}";
+
+async fn click(c: &Client, id: &str) -> Result<(), String> {
+    let e = c.find(Locator::Id(id)).await.map_err(|e| e.to_string())?;
+    e.click().await.map_err(|e| format!("click {id}: {e}"))
+}
+
+async fn state(c: &Client) -> Result<Value, String> {
+    js(c, "return window.channel.state()").await
+}
+
+/// Polls the channel state until `done` holds (at most `secs`), failing fast on a console error.
+async fn wait_state(
+    c: &Client,
+    secs: u64,
+    what: &str,
+    done: impl Fn(&Value) -> bool,
+) -> Result<Value, String> {
+    let t0 = Instant::now();
+    loop {
+        let s = state(c).await?;
+        if done(&s) {
+            return Ok(s);
+        }
+        let errors = console_errors(c).await?;
+        if !errors.is_empty() {
+            return Err(format!("{what}: console errors {errors:?}; state {s}"));
+        }
+        if t0.elapsed() > Duration::from_secs(secs) {
+            return Err(format!("{what}: not after {secs} s; state {s}"));
+        }
+        tokio::time::sleep(Duration::from_millis(50)).await;
+    }
+}
+
+/// The error banner's text once shown (at most 10 s).
+async fn wait_banner(c: &Client) -> Result<String, String> {
+    let t0 = Instant::now();
+    loop {
+        let b = banner(c).await?;
+        if !b.is_empty() || t0.elapsed() > Duration::from_secs(10) {
+            return Ok(b);
+        }
+        tokio::time::sleep(Duration::from_millis(30)).await;
+    }
+}
+
+async fn dismiss(c: &Client) -> Result<(), String> {
+    js(c, "document.getElementById('error-close').click()")
+        .await
+        .map(|_| ())
+}
+
+/// Keys typed into element `id` (it gets the focus).
+async fn keys(c: &Client, id: &str, k: &str) -> Result<(), String> {
+    let e = c.find(Locator::Id(id)).await.map_err(|e| e.to_string())?;
+    e.send_keys(k)
+        .await
+        .map_err(|e| format!("keys to {id}: {e}"))
+}
+
+/// Chooses `what` in #chan-save-what, clicks Save and reads the file through its download link.
+async fn save(c: &Client, what: &str) -> Result<(Value, String, Vec<u8>), String> {
+    let before = js(
+        c,
+        "return Number(document.getElementById('chan-save').dataset.count || 0)",
+    )
+    .await?
+    .as_u64()
+    .unwrap_or(0);
+    js(
+        c,
+        &format!("document.getElementById('chan-save-what').value = '{what}';"),
+    )
+    .await?;
+    click(c, "chan-save").await?;
+    let t0 = Instant::now();
+    let info = loop {
+        let got = js(
+            c,
+            "return { info: window.figureExport.last(), \
+                      count: Number(document.getElementById('chan-save').dataset.count || 0) }",
+        )
+        .await?;
+        if got["count"].as_u64() == Some(before + 1) && got["info"]["href"].is_string() {
+            break got["info"].clone();
+        }
+        let b = banner(c).await?;
+        if !b.is_empty() || t0.elapsed() > Duration::from_secs(30) {
+            return Err(format!("save {what}: no file (banner {b:?})"));
+        }
+        tokio::time::sleep(Duration::from_millis(25)).await;
+    };
+    let content = c
+        .execute_async(
+            "const done = arguments[arguments.length - 1]; \
+             fetch(window.figureExport.last().href).then((r) => r.arrayBuffer()).then((b) => \
+               done({ text: new TextDecoder().decode(b), head: Array.from(new Uint8Array(b.slice(0, 8))) }), \
+               (e) => done({ error: String(e) }));",
+            vec![],
+        )
+        .await
+        .map_err(|e| e.to_string())?;
+    if let Some(e) = content.get("error") {
+        return Err(format!("reading the download link: {e}"));
+    }
+    let head: Vec<u8> =
+        serde_json::from_value(content["head"].clone()).map_err(|e| e.to_string())?;
+    Ok((
+        info,
+        content["text"].as_str().unwrap_or_default().to_string(),
+        head,
+    ))
+}
+
+struct Outcome {
+    mode_pressed: Value,
+    bad_banner: String,
+    pfa_banner: String,
+    simulated: Value,
+    after_stop: Value,
+    done: Value,
+    track: Value,
+    truth: Value,
+    /// The state after the cursor was moved to each step, in the order Home, 5 × →, End.
+    cursors: Vec<Value>,
+    saved_track: (Value, String),
+    saved_svg: (Value, String),
+    saved_png: (Value, Vec<u8>),
+    settings: Value,
+    applied: Value,
+    refused: Value,
+    errors: Vec<String>,
+}
+
+async fn run(c: &Client, port: u16, bad: &str) -> Result<Outcome, String> {
+    open_hash(c, port, "").await?;
+    settle(c).await?;
+    click(c, "mode-channel").await?;
+    settle(c).await?;
+    let mode_pressed = js(c, "return [document.body.className, document.getElementById('mode-channel').getAttribute('aria-pressed')]").await?;
+    js(c, "window.figureExport.setDryRun(true)").await?;
+
+    // A malformed recording through the file input.
+    c.find(Locator::Id("chan-file"))
+        .await
+        .map_err(|e| e.to_string())?
+        .send_keys(bad)
+        .await
+        .map_err(|e| e.to_string())?;
+    let bad_banner = wait_banner(c).await?;
+    dismiss(c).await?;
+
+    // A malformed number, typed into P_fa and committed with Enter (change).
+    let pfa = c
+        .find(Locator::Id("chan-pfa"))
+        .await
+        .map_err(|e| e.to_string())?;
+    pfa.clear().await.map_err(|e| e.to_string())?;
+    pfa.send_keys("0x10\u{E007}")
+        .await
+        .map_err(|e| e.to_string())?;
+    let pfa_banner = wait_banner(c).await?;
+    pfa.clear().await.map_err(|e| e.to_string())?;
+    pfa.send_keys("0.001\u{E007}")
+        .await
+        .map_err(|e| e.to_string())?;
+    dismiss(c).await?;
+
+    // Simulate a walk through the scenario.
+    click(c, "chan-simulate").await?;
+    let simulated = wait_state(c, 300, "simulate", |s| {
+        s["recording"].is_object() && s["running"].is_null()
+    })
+    .await?;
+
+    // Run, and stop it while it estimates.
+    click(c, "chan-run").await?;
+    wait_state(c, 120, "run started", |s| {
+        s["running"] == "run" && s["progress"].is_object()
+    })
+    .await?;
+    click(c, "chan-stop").await?;
+    let after_stop = wait_state(c, 30, "stop", |s| s["running"].is_null()).await?;
+
+    // Run to the end.
+    click(c, "chan-run").await?;
+    let done = wait_state(c, 900, "run", |s| s["runs"] == 1 && s["running"].is_null()).await?;
+    let texts = js(c, "return window.channel.texts()").await?;
+    let track: Value = serde_json::from_str(texts["track"].as_str().unwrap_or("null"))
+        .map_err(|e| e.to_string())?;
+    // The simulated truth as the page holds it (the file the simulator wrote).
+    let truth = js(c, "return window.channel.truthStates()").await?;
+
+    // The cursor, with the keyboard on the range input.
+    let mut cursors = Vec::new();
+    keys(c, "chan-scrub", HOME).await?;
+    settle(c).await?;
+    cursors.push(state(c).await?);
+    for _ in 0..5 {
+        keys(c, "chan-scrub", RIGHT).await?;
+    }
+    settle(c).await?;
+    cursors.push(state(c).await?);
+    keys(c, "chan-scrub", END).await?;
+    settle(c).await?;
+    cursors.push(state(c).await?);
+
+    // Saves.
+    let (i, t, _) = save(c, "track-json").await?;
+    let saved_track = (i, t);
+    let (i, t, _) = save(c, "delays-svg").await?;
+    let saved_svg = (i, t);
+    let (i, _, h) = save(c, "delays-png").await?;
+    let saved_png = (i, h);
+
+    // The settings hook.
+    let settings = js(c, "return window.channel.settings()").await?;
+    let applied = js(
+        c,
+        "const s = window.channel.settings(); window.channel.applySettings({ ...s, filter: 'ukf', p_fa: 0.01, step: 3 }); \
+         return { settings: window.channel.settings(), filter: document.getElementById('chan-filter').value, \
+                  pfa: document.getElementById('chan-pfa').value, step: window.channel.state().step };",
+    )
+    .await?;
+    let refused = js(
+        c,
+        "const before = window.channel.settings(); let message = null; \
+         try { window.channel.applySettings({ ...before, p_fa: 2 }); } catch (e) { message = e.message; } \
+         let unknown = null; try { window.channel.applySettings({ colour: 1 }); } catch (e) { unknown = e.message; } \
+         return { message, unknown, same: JSON.stringify(before) === JSON.stringify(window.channel.settings()) };",
+    )
+    .await?;
+    Ok(Outcome {
+        mode_pressed,
+        bad_banner,
+        pfa_banner,
+        simulated,
+        after_stop,
+        done,
+        track,
+        truth,
+        cursors,
+        saved_track,
+        saved_svg,
+        saved_png,
+        settings,
+        applied,
+        refused,
+        errors: console_errors(c).await?,
+    })
+}
+
+/// The positions `[x, y]` of states `[x, y, vx, vy]` (`null` stays `null`).
+fn position(v: &Value) -> Value {
+    match v.as_array() {
+        Some(a) if a.len() >= 2 => json!([a[0], a[1]]),
+        _ => Value::Null,
+    }
+}
+
+#[test]
+#[ignore = "needs chromium + chromedriver and www/pkg (wasm-pack build); run with --ignored"]
+fn channel_view_simulate_run_stop_scrub_save() {
+    // Not a zip archive: the core's reader names what is wrong.
+    let bytes = b"PK\x03\x04 this is not a recording".to_vec();
+    let bad = std::env::temp_dir().join(format!("scatterloc-e2e-bad-{}.npz", std::process::id()));
+    std::fs::write(&bad, &bytes).unwrap();
+    let expected = match scatterloc::npz::read_recording(&bytes) {
+        Err(e) => e.to_string(),
+        Ok(_) => panic!("the malformed file was read"),
+    };
+    let path = bad.to_str().unwrap().to_string();
+    let o = with_browser(async |c, port, _| run(c, port, &path).await);
+    let _ = std::fs::remove_file(&bad);
+    assert!(o.errors.is_empty(), "console errors: {:?}", o.errors);
+
+    assert!(
+        o.mode_pressed[0].as_str().unwrap().contains("mode-channel"),
+        "{:?}",
+        o.mode_pressed
+    );
+    assert_eq!(o.mode_pressed[1], "true");
+    let name = bad.file_name().unwrap().to_str().unwrap();
+    assert_eq!(o.bad_banner, format!("Recording {name}: {expected}"));
+    assert_eq!(o.pfa_banner, "P_fa: \"0x10\" is not a decimal number");
+
+    // The simulated recording: the scenario's links.
+    let rec = &o.simulated["recording"];
+    println!("simulated: {rec}");
+    assert!(rec["snapshots"].as_u64().unwrap() >= 2, "{rec}");
+    assert_eq!(
+        rec["links"].as_u64(),
+        Some(4),
+        "sensors2019 has 4 links: {rec}"
+    );
+
+    // Stop: the run ended without a result.
+    assert_eq!(o.after_stop["stopped"], 1, "{}", o.after_stop);
+    assert_eq!(o.after_stop["runs"], 0, "{}", o.after_stop);
+    assert_eq!(o.after_stop["statusState"], "stopped", "{}", o.after_stop);
+
+    // The run: one state slot per snapshot of the recording.
+    let d = &o.done;
+    println!(
+        "channel run: wall {} ms, worker {} ms, timings {}",
+        d["wallMs"], d["workerMs"], d["timings"]
+    );
+    println!("status: {}", d["status"]);
+    let t_s = o.track["t_s"].as_array().unwrap();
+    let states = o.track["states"].as_array().unwrap();
+    assert_eq!(t_s.len() as u64, rec["snapshots"].as_u64().unwrap());
+    assert_eq!(d["steps"].as_u64(), Some(t_s.len() as u64));
+    assert!(
+        states.iter().any(|s| !s.is_null()),
+        "the track never started"
+    );
+
+    // The cursor: Home → 0, five → → 5, End → the last snapshot; the map drew that snapshot's
+    // state, links and truth; the chart cursors move right.
+    let last = t_s.len() - 1;
+    let truth = o.truth.as_array().expect("truth states");
+    let mut xs = Vec::new();
+    for (s, k) in o.cursors.iter().zip([0, 5, last]) {
+        assert_eq!(s["step"].as_u64(), Some(k as u64), "{s}");
+        assert_eq!(s["t_s"], t_s[k], "t at step {k}");
+        let drawn = &s["drawn"];
+        assert_eq!(drawn["step"].as_u64(), Some(k as u64), "{drawn}");
+        assert_eq!(
+            drawn["estimate"],
+            position(&states[k]),
+            "estimate drawn at step {k}"
+        );
+        let used: Vec<usize> = o.track["delays_used_s"][k]
+            .as_array()
+            .unwrap()
+            .iter()
+            .enumerate()
+            .filter(|(_, v)| !v.is_null())
+            .map(|(p, _)| p)
+            .collect();
+        assert_eq!(drawn["links"], json!(used), "links drawn at step {k}");
+        assert_eq!(
+            drawn["truth"],
+            position(&truth[k]),
+            "truth drawn at step {k}"
+        );
+        let x = s["cursorX"]["delays"].as_f64().expect("delay cursor");
+        let e = s["cursorX"]["errors"].as_f64().expect("error cursor");
+        let b = &s["delayBox"]["x_px"];
+        assert!(
+            x >= b[0].as_f64().unwrap() - 0.5 && x <= b[1].as_f64().unwrap() + 0.5,
+            "{x} in {b}"
+        );
+        xs.push((x, e));
+    }
+    assert!(
+        xs[0].0 < xs[1].0 && xs[1].0 < xs[2].0,
+        "delay cursor {xs:?}"
+    );
+    assert!(
+        xs[0].1 < xs[1].1 && xs[1].1 < xs[2].1,
+        "error cursor {xs:?}"
+    );
+
+    // The saved files.
+    let (info, text) = &o.saved_track;
+    assert!(
+        info["name"]
+            .as_str()
+            .unwrap()
+            .ends_with("-channel-track.json"),
+        "{info}"
+    );
+    assert!(text.ends_with('\n'));
+    let saved: Value = serde_json::from_str(text).unwrap();
+    assert_eq!(saved, o.track);
+    let (info, svg) = &o.saved_svg;
+    assert_eq!(info["type"], "image/svg+xml");
+    assert!(svg.contains("<svg"), "not an SVG");
+    for l in o.done["links"].as_array().unwrap() {
+        assert!(
+            svg.contains(l.as_str().unwrap()),
+            "link {l} in the delay figure"
+        );
+    }
+    let (info, head) = &o.saved_png;
+    assert_eq!(info["type"], "image/png");
+    assert_eq!(head.as_slice(), PNG_SIGNATURE);
+
+    // The settings: the CLI's defaults, applied and refused by name.
+    let s = &o.settings;
+    for (k, v) in [
+        ("filter", json!("ekf")),
+        ("particles", json!(1000)),
+        ("seed", json!(1)),
+        ("process_noise", json!(1)),
+        ("p_fa", json!(0.001)),
+        ("max_paths", json!(12)),
+        ("extent_sigma_m", json!(0.2)),
+        ("calibration", json!("file")),
+    ] {
+        assert_eq!(s[k], v, "setting {k}: {s}");
+    }
+    assert_eq!(o.applied["filter"], "ukf");
+    assert_eq!(o.applied["pfa"], "0.01");
+    assert_eq!(o.applied["step"], 3);
+    assert_eq!(o.applied["settings"]["filter"], "ukf");
+    assert_eq!(
+        o.refused["message"],
+        "channel setting p_fa: 2 is out of range (allowed 0 < P_fa < 1)"
+    );
+    assert!(
+        o.refused["unknown"]
+            .as_str()
+            .unwrap()
+            .starts_with("channel settings: unknown setting \"colour\""),
+        "{}",
+        o.refused
+    );
+    assert_eq!(o.refused["same"], true);
+}
