@@ -73,6 +73,11 @@ mod export;
 #[path = "e2e/zoom.rs"]
 mod zoom;
 
+/// Issue 26 §1: the channel view's worker (estimates and track) against the CLI.
+#[cfg(test)]
+#[path = "e2e/channel.rs"]
+mod channel;
+
 /// The docs screenshots: not a test, the example `screenshot` (`examples/screenshot.rs`) runs
 /// it through this harness. The example includes this file as a module, so the test modules
 /// above are `cfg(test)` and only the harness, the tracking helpers and this module compile

@@ -566,3 +566,64 @@ pub fn delays_only(snapshot: &[Vec<DelayEstimate>]) -> Vec<Vec<Real>> {
         .map(|l| l.iter().map(|e| e.delay_s).collect())
         .collect()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::channel::{simulate_recording, ChannelScene};
+    use crate::scenario::presets;
+    use crate::study::Sequential;
+
+    /// 0.2 s of the hangar walk at 20 ms (11 snapshots) on sensors2019's 4 links.
+    fn recording() -> (crate::Scenario, Model, Recording) {
+        let s = presets::preset("sensors2019").unwrap();
+        let m = Model::new(&s).unwrap();
+        let mut scene = ChannelScene::hangar();
+        scene.duration_s = Some(0.2);
+        scene.dt_s = 0.02;
+        let (rec, _) = simulate_recording(&s, &m, &scene, true, 3).unwrap();
+        (s, m, rec)
+    }
+
+    #[test]
+    fn the_sliced_estimation_equals_estimate_recording() {
+        let (s, m, rec) = recording();
+        let cfg = FrontEndConfig::default();
+        let bw = s.radio.bandwidth_hz;
+        let whole =
+            estimate_recording(&m, bw, &rec, &cfg, &mut Sequential::new(), &|_| {}).unwrap();
+        let mut run = EstimationRun::new(&m, bw, &rec, &cfg).unwrap();
+        assert_eq!(run.total(), 4 * 11);
+        let mut calls = 0;
+        while !run.run(&rec, 3).unwrap() {
+            calls += 1;
+            assert_eq!(run.done(), 3 * calls);
+        }
+        assert_eq!(calls, 14); // 44 units in slices of 3: 14 partial slices, then the last
+        assert_eq!(run.done(), run.total());
+        assert_eq!(run.finish(&m, &rec).unwrap(), whole);
+        // Unfinished: no estimates.
+        let run = EstimationRun::new(&m, bw, &rec, &cfg).unwrap();
+        assert_eq!(run.finish(&m, &rec), Err(Error::Cancelled));
+    }
+
+    #[test]
+    fn a_time_range_of_a_recording_is_a_recording_of_its_snapshots() {
+        let (_, _, rec) = recording();
+        let part = rec
+            .between("range", rec.t_s[3] - 1e-9, rec.t_s[5] + 1e-9)
+            .unwrap();
+        assert_eq!(part.t_s, rec.t_s[3..=5].to_vec());
+        for s in 0..3 {
+            for p in 0..4 {
+                assert_eq!(part.response(s, p), rec.response(s + 3, p));
+            }
+        }
+        part.validate().unwrap();
+        let e = rec.between("range", 1.0, 2.0).unwrap_err().to_string();
+        assert!(e.starts_with("range: no snapshot between 1 s and 2 s"), "{e}");
+        let e = rec.between("range", 0.1, 0.0).unwrap_err().to_string();
+        assert!(e.starts_with("range: 0 is outside"), "{e}");
+        assert!(rec.between("range", f64::NAN, 0.0).is_err());
+    }
+}

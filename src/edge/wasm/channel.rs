@@ -257,7 +257,7 @@ fn check_simulated_size(
     let per_snapshot = (links * scene.subcarriers * 16).max(1) as f64;
     let max = MAX_PAGE_RECORDING_BYTES as f64 / per_snapshot;
     let snapshots = duration / scene.dt_s + 1.0;
-    if !(snapshots <= max) {
+    if snapshots.is_nan() || snapshots > max {
         return Err(err(Error::SizeLimit {
             field,
             value: snapshots.min(usize::MAX as f64) as usize,
@@ -379,9 +379,15 @@ fn track_settings(set: &JobSettings, snapshots: usize) -> Result<TrackSettings, 
 /// Reads a dropped `.npz` recording named `what` (`recording`, `calibration`): its size is
 /// checked before parsing ([`MAX_PAGE_RECORDING_BYTES`]), the reader's caps while parsing, and
 /// its links against `model`.
-fn read_page_recording(what: &'static str, bytes: &[u8], model: &Model) -> Result<Recording, JsError> {
-    check_size(what, bytes.len(), MAX_PAGE_RECORDING_BYTES).map_err(err)?;
-    let rec = npz::read_recording_within(bytes, MAX_PAGE_RECORDING_BYTES).map_err(named(what))?;
+fn read_page_recording(
+    what: &'static str,
+    bytes: &js_sys::Uint8Array,
+    model: &Model,
+) -> Result<Recording, JsError> {
+    // Before the bytes are copied into the module's memory.
+    check_size(what, bytes.length() as usize, MAX_PAGE_RECORDING_BYTES).map_err(err)?;
+    let bytes = bytes.to_vec();
+    let rec = npz::read_recording_within(&bytes, MAX_PAGE_RECORDING_BYTES).map_err(named(what))?;
     rec.link_map(model).map_err(named(what))?;
     Ok(rec)
 }
@@ -493,8 +499,8 @@ impl ChannelJob {
     #[wasm_bindgen(constructor)]
     pub fn new(
         scenario_json: &str,
-        recording: &[u8],
-        calibration: Option<Vec<u8>>,
+        recording: &js_sys::Uint8Array,
+        calibration: Option<js_sys::Uint8Array>,
         truth_json: Option<String>,
         settings_json: &str,
     ) -> Result<ChannelJob, JsError> {
@@ -568,10 +574,10 @@ impl ChannelJob {
     pub fn step(&mut self, budget_ms: f64) -> Result<JsValue, JsError> {
         let start = now_ms();
         loop {
-            let t = now_ms();
+            let (t, phase) = (now_ms(), self.phase);
             self.unit()?;
             let spent = now_ms() - t;
-            match self.phase {
+            match phase {
                 Phase::Calibration => self.timings.calibration_ms += spent,
                 Phase::Estimate => self.timings.estimate_ms += spent,
                 _ => {}
