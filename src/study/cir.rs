@@ -621,7 +621,10 @@ mod tests {
         }
         part.validate().unwrap();
         let e = rec.between("range", 1.0, 2.0).unwrap_err().to_string();
-        assert!(e.starts_with("range: no snapshot between 1 s and 2 s"), "{e}");
+        assert!(
+            e.starts_with("range: no snapshot between 1 s and 2 s"),
+            "{e}"
+        );
         let e = rec.between("range", 0.1, 0.0).unwrap_err().to_string();
         assert!(e.starts_with("range: 0 is outside"), "{e}");
         assert!(rec.between("range", f64::NAN, 0.0).is_err());

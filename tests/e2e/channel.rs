@@ -106,7 +106,11 @@ fn cli_files(dir: &Path) -> Files {
     assert_eq!(summary["snapshots"], 300, "{summary}");
     assert_eq!(summary["links"], 4, "{summary}");
     assert_eq!(summary["subcarriers"], 241, "{summary}");
-    let (rec, cal, truth) = (p("sim/recording.npz"), p("sim/calibration.npz"), p("sim/truth.json"));
+    let (rec, cal, truth) = (
+        p("sim/recording.npz"),
+        p("sim/calibration.npz"),
+        p("sim/truth.json"),
+    );
     cli(&[
         "cir",
         "estimate",
@@ -305,8 +309,8 @@ fn npy(descr: &str, shape: &str, data: &[u8]) -> Vec<u8> {
 /// A stored (uncompressed) zip of `members`.
 fn npz(members: &[(&str, Vec<u8>)]) -> Vec<u8> {
     let mut w = zip::ZipWriter::new(std::io::Cursor::new(Vec::new()));
-    let opts = zip::write::SimpleFileOptions::default()
-        .compression_method(zip::CompressionMethod::Stored);
+    let opts =
+        zip::write::SimpleFileOptions::default().compression_method(zip::CompressionMethod::Stored);
     for (name, data) in members {
         w.start_file(*name, opts).unwrap();
         w.write_all(data).unwrap();
@@ -349,10 +353,17 @@ fn channel_view_worker_equals_the_cli() {
         );
         assert!(n_est > 10_000 && n_track > 10_000, "{n_est} {n_track}");
         assert!(track["start"].is_object(), "the track never started");
-        assert!(track["error"]["median_m"].as_f64().unwrap() < 0.5, "{}", track["error"]);
+        assert!(
+            track["error"]["median_m"].as_f64().unwrap() < 0.5,
+            "{}",
+            track["error"]
+        );
         assert_eq!(r["summary"]["snapshots"], 300);
         assert_eq!(r["summary"]["samples_per_link"], 241);
-        assert!(o["progress"].as_u64().unwrap() > 0, "no progress reported: {o}");
+        assert!(
+            o["progress"].as_u64().unwrap() > 0,
+            "no progress reported: {o}"
+        );
         assert!(r["figure_len"].as_u64().unwrap() > 1000);
         let t = &r["timings"];
         let ms = |k: &str| t[k].as_f64().unwrap();
@@ -410,7 +421,10 @@ fn channel_view_worker_equals_the_cli() {
         }
         assert!(last["sigma_ellipse"]["a"].as_f64().unwrap() > 0.0, "{last}");
         assert!(
-            fig["out"].as_str().unwrap().starts_with("snapshot: 300 is outside"),
+            fig["out"]
+                .as_str()
+                .unwrap()
+                .starts_with("snapshot: 300 is outside"),
             "{}",
             fig["out"]
         );
@@ -476,7 +490,10 @@ fn channel_view_worker_equals_the_cli() {
         );
         js(
             c,
-            &format!("window.__big = new ArrayBuffer({});", MAX_PAGE_RECORDING_BYTES + 1),
+            &format!(
+                "window.__big = new ArrayBuffer({});",
+                MAX_PAGE_RECORDING_BYTES + 1
+            ),
         )
         .await?;
         let m = failure(c, &f.scenario, "BIG", &cal64).await?;

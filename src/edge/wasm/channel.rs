@@ -197,9 +197,7 @@ pub fn simulate_channel(
     scene.validate().map_err(named("scene"))?;
     let mut empty = scene.clone();
     empty.duration_s = Some(set.calibration_duration_s.unwrap_or(1.0));
-    empty
-        .validate()
-        .map_err(named("calibration_duration_s"))?;
+    empty.validate().map_err(named("calibration_duration_s"))?;
     check_simulated_size("duration_s", &scene, model.link_count())?;
     check_simulated_size("calibration_duration_s", &empty, model.link_count())?;
     let seed = set.seed.unwrap_or(1);
@@ -654,10 +652,11 @@ impl ChannelJob {
     /// fraction_below_1m} (with a truth and a started track)}`. Throws before the `"track"`
     /// phase is done.
     pub fn track_json(&self) -> Result<String, JsError> {
-        let (track, view, cal, empty) = match (&self.track, &self.view, &self.calibration, &self.empty) {
-            (Some(t), Some(v), Some(c), Some(e)) => (t, v, c, e),
-            _ => return Err(pending("track_json")),
-        };
+        let (track, view, cal, empty) =
+            match (&self.track, &self.view, &self.calibration, &self.empty) {
+                (Some(t), Some(v), Some(c), Some(e)) => (t, v, c, e),
+                _ => return Err(pending("track_json")),
+            };
         let error = self.truth.as_ref().and(view.stats);
         to_json(&track_doc(
             track,
@@ -720,9 +719,11 @@ impl ChannelJob {
                 let run = self.run.take().ok_or_else(|| pending("step"))?;
                 let est = run.finish(&self.model, rec).map_err(named(what))?;
                 if self.phase == Phase::Calibration {
-                    let ccfg = AmplitudeClusterConfig::for_bandwidth(bw).map_err(named("scenario"))?;
+                    let ccfg =
+                        AmplitudeClusterConfig::for_bandwidth(bw).map_err(named("scenario"))?;
                     self.calibration = Some(
-                        calibrate_estimates(&self.model, &est, &ccfg).map_err(named("calibration"))?,
+                        calibrate_estimates(&self.model, &est, &ccfg)
+                            .map_err(named("calibration"))?,
                     );
                     self.empty = Some(est);
                     self.run = Some(
@@ -968,7 +969,9 @@ impl ChannelFigures {
         subtitle: &str,
     ) -> Result<(), JsError> {
         let opts = chart_options(title, subtitle);
-        on_canvas("draw_delays", canvas, |root| draw_delays(root, &self.figure, &opts))
+        on_canvas("draw_delays", canvas, |root| {
+            draw_delays(root, &self.figure, &opts)
+        })
     }
 
     /// The delay figure as SVG text of `width × height` px (0, 0: the CLI's size; else each
@@ -983,7 +986,9 @@ impl ChannelFigures {
         let size = chart_size(delays_size(self.figure.links.len()), width, height)
             .map_err(named("delays_svg"))?;
         let opts = chart_options(title, subtitle);
-        to_svg("delays_svg", size, |root| draw_delays(root, &self.figure, &opts))
+        to_svg("delays_svg", size, |root| {
+            draw_delays(root, &self.figure, &opts)
+        })
     }
 
     /// Draws the track figure (`chart::draw_track_errors`, as `cir track --figure`: the track on
