@@ -78,6 +78,11 @@ mod zoom;
 #[path = "e2e/channel_ui.rs"]
 mod channel_ui;
 
+/// Issue 26 §1: the channel view's worker (estimates and track) against the CLI.
+#[cfg(test)]
+#[path = "e2e/channel.rs"]
+mod channel;
+
 /// The docs screenshots: not a test, the example `screenshot` (`examples/screenshot.rs`) runs
 /// it through this harness. The example includes this file as a module, so the test modules
 /// above are `cfg(test)` and only the harness, the tracking helpers and this module compile

@@ -157,6 +157,54 @@ impl Recording {
         &self.samples[start..start + l]
     }
 
+    /// The snapshots with `t0_s ≤ t ≤ t1_s` as a recording of their own (e.g. a stretch of a
+    /// recording marked as the empty area, used as the calibration recording). Errors:
+    /// non-finite or reversed bounds ([`Error::OutOfRange`] of `field`), no snapshot in the
+    /// range ([`Error::InvalidFile`] of `field`).
+    pub fn between(&self, field: &str, t0_s: Real, t1_s: Real) -> Result<Recording> {
+        for v in [t0_s, t1_s] {
+            if !v.is_finite() {
+                return Err(Error::OutOfRange {
+                    field: field.into(),
+                    value: v,
+                    allowed: "finite times, s",
+                });
+            }
+        }
+        if t1_s < t0_s {
+            return Err(Error::OutOfRange {
+                field: field.into(),
+                value: t1_s,
+                allowed: "t1 >= t0",
+            });
+        }
+        let keep: Vec<usize> = (0..self.t_s.len())
+            .filter(|&s| self.t_s[s] >= t0_s && self.t_s[s] <= t1_s)
+            .collect();
+        if keep.is_empty() {
+            return Err(Error::InvalidFile {
+                field: field.into(),
+                reason: alloc::format!(
+                    "no snapshot between {t0_s} s and {t1_s} s (the recording spans {} … {} s)",
+                    self.t_s.first().copied().unwrap_or(0.0),
+                    self.t_s.last().copied().unwrap_or(0.0)
+                ),
+            });
+        }
+        let per = self.links.len() * self.samples_per_link();
+        let mut samples = Vec::with_capacity(keep.len() * per);
+        for &s in &keep {
+            samples.extend_from_slice(&self.samples[s * per..(s + 1) * per]);
+        }
+        Ok(Recording {
+            t_s: keep.iter().map(|&s| self.t_s[s]).collect(),
+            links: self.links.clone(),
+            layout: self.layout.clone(),
+            samples,
+            noise_var: self.noise_var.clone(),
+        })
+    }
+
     /// Checks everything a recording promises (docs/recording.md), naming the array at fault:
     /// `t_s` non-empty, finite and strictly increasing; at least one link; the sample count
     /// `S·P·L` with `L ≥ 2` (bins or taps) and all samples finite (the first bad one named as

@@ -18,7 +18,7 @@ use crate::track::gating::LinkCalibration;
 /// The delay profile of one link as an image: `db[j·cols + i]` is the power at range
 /// `r0_m + j·dr_m` (row `j`, ascending range) in the snapshot of column `i` (time `t_s[i]`),
 /// dB, within `db_range`.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct DelayImage {
     /// Time of each column's snapshot, s (ascending; `cols = t_s.len()`).
     pub t_s: Vec<Real>,
@@ -259,7 +259,7 @@ fn to_db(
 }
 
 /// One path estimate as drawn: its time, path length and amplitude.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct DelayPoint {
     /// Snapshot time, s.
     pub t_s: Real,
@@ -270,7 +270,7 @@ pub struct DelayPoint {
 }
 
 /// A static cluster as drawn: a band at its mean path length, as wide as its 3σ gate (E4).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct StaticBand {
     /// `c·τ̄`, m.
     pub mean_m: Real,
@@ -279,7 +279,7 @@ pub struct StaticBand {
 }
 
 /// A true path over time (built by the caller from its truth file).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct TruthCurve {
     /// What the path is, e.g. `pedestrian`, `pedestrian-wall`, `los` (shown in the legend).
     pub kind: String,
@@ -290,7 +290,7 @@ pub struct TruthCurve {
 }
 
 /// One link's panel of the delay figure.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct LinkDelays {
     /// Panel title, e.g. `Tx → Rx2`.
     pub name: String,
@@ -308,7 +308,7 @@ pub struct LinkDelays {
 
 /// The \[S\] Fig. 4 figure: one panel per link on a shared time axis and a shared amplitude
 /// colour scale.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct DelayFigure {
     /// Time axis `[t_first, t_last]`, s.
     pub t_range_s: [Real; 2],
@@ -429,7 +429,7 @@ pub fn suggest_range_m(
 /// below 1 m). Quantiles are the empirical distribution's: the `q`-quantile is the smallest
 /// error `e` with `F(e) ≥ q`, `F(e) = #{e_k ≤ e}/n` — the `⌈q·n⌉`-th smallest error (so the
 /// median of an even count is the lower middle value).
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ErrorStats {
     /// Errors counted (the finite ones).
     pub count: usize,
@@ -477,7 +477,7 @@ impl ErrorStats {
 
 /// The track figure's data (\[S\] Figs. 5–6): the estimated and true paths on the map, the
 /// position error over time and its empirical CDF.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct TrackErrorView {
     /// Snapshot times, s.
     pub t_s: Vec<Real>,

@@ -8,6 +8,7 @@
 //! no maths of their own beyond layout.
 
 mod channel_figure;
+mod channel_files;
 mod channel_view;
 mod colormap;
 mod plan_view;
@@ -18,6 +19,7 @@ mod ticks;
 mod track_view;
 
 pub use channel_figure::delay_figure;
+pub use channel_files::{estimates_doc, link_names, track_doc, EstimatesDoc, PathDoc, TrackDoc};
 pub use channel_view::{
     delay_image, delay_points, quantile_pct, static_bands, suggest_range_m, track_errors,
     DelayFigure, DelayImage, DelayPoint, ErrorStats, ImageConfig, ImageFloor, LinkDelays,

@@ -82,48 +82,123 @@ impl RecordingEstimates {
     }
 }
 
-/// The frequency-domain responses of one recorded link, snapshot after snapshot (C1; a CIR
-/// recording mapped by C2).
+/// One recorded link's estimation in progress (C5, C6): the estimator and path tracker of
+/// that link and what they produced so far, snapshot after snapshot.
+struct LinkRun {
+    link: usize,
+    estimator: Estimator,
+    tracker: PathTracker,
+    given: Option<Real>,
+    h: Vec<Complex>,
+    paths: Vec<Vec<TrackedPath>>,
+    noise: Vec<Real>,
+}
+
+impl LinkRun {
+    /// Recorded link `link` (index into the recording's links) of `rec`.
+    fn new(
+        rec: &Recording,
+        (band, map): &(Band, ResponseMap),
+        link: usize,
+        cfg: &FrontEndConfig,
+    ) -> Result<LinkRun> {
+        Ok(LinkRun {
+            link,
+            estimator: Estimator::new(band.clone(), cfg.estimator)?,
+            tracker: PathTracker::new(cfg.paths)?,
+            given: rec
+                .noise_var
+                .as_ref()
+                .map(|v| map.noise_var_of_taps(v[link])),
+            h: Vec::new(),
+            paths: Vec::with_capacity(rec.t_s.len()),
+            noise: Vec::with_capacity(rec.t_s.len()),
+        })
+    }
+
+    /// Estimates the next snapshot of the link (the frequency-domain response of C1; a CIR
+    /// recording mapped by C2).
+    fn step(&mut self, rec: &Recording, map: &ResponseMap) -> Result<()> {
+        let s = self.paths.len();
+        let estimated = map.fill(rec, s, self.link, &mut self.h)?;
+        let nv = self.given.or(estimated);
+        let mut used = 0.0;
+        let (estimator, h) = (&mut self.estimator, &self.h);
+        let tracked = self.tracker.step(rec.t_s[s], |seeds| {
+            let e = estimator.estimate(h, nv, seeds)?;
+            used = e.noise_var;
+            Ok(e)
+        })?;
+        self.paths.push(tracked);
+        self.noise.push(used);
+        Ok(())
+    }
+}
+
+/// The paths and noise variances of one recorded link, snapshot after snapshot.
 fn link_paths(
     rec: &Recording,
-    (band, map): &(Band, ResponseMap),
+    band_map: &(Band, ResponseMap),
     link: usize,
     cfg: &FrontEndConfig,
     cancel: Cancel,
     progress: &(dyn Fn(usize) + Sync),
 ) -> Result<(Vec<Vec<TrackedPath>>, Vec<Real>)> {
-    let mut estimator = Estimator::new(band.clone(), cfg.estimator)?;
-    let mut tracker = PathTracker::new(cfg.paths)?;
-    let given = rec
-        .noise_var
-        .as_ref()
-        .map(|v| map.noise_var_of_taps(v[link]));
-    let mut h: Vec<Complex> = Vec::new();
-    let (mut paths, mut noise) = (Vec::with_capacity(rec.t_s.len()), Vec::new());
+    let mut run = LinkRun::new(rec, band_map, link, cfg)?;
     // Cancel and progress every 64 snapshots (≈ 0.1 s of work at 8 paths).
     const EVERY: usize = 64;
-    for (s, &t) in rec.t_s.iter().enumerate() {
+    for s in 0..rec.t_s.len() {
         if s % EVERY == 0 {
             cancel.check()?;
             if s > 0 {
                 progress(EVERY);
             }
         }
-        let estimated = map.fill(rec, s, link, &mut h)?;
-        let nv = given.or(estimated);
-        let mut used = 0.0;
-        let tracked = tracker.step(t, |seeds| {
-            let e = estimator.estimate(&h, nv, seeds)?;
-            used = e.noise_var;
-            Ok(e)
-        })?;
-        paths.push(tracked);
-        noise.push(used);
+        run.step(rec, &band_map.1)?;
     }
     // The snapshots after the last report (1 … EVERY of them).
     let len = rec.t_s.len();
     progress(len - EVERY * (len.saturating_sub(1) / EVERY));
-    Ok((paths, noise))
+    Ok((run.paths, run.noise))
+}
+
+/// The checks of an estimation: the recording ([`Recording::validate`]), its links on `model`
+/// and its band.
+fn prepare(
+    model: &Model,
+    bandwidth_hz: Real,
+    rec: &Recording,
+) -> Result<(Vec<usize>, (Band, ResponseMap))> {
+    rec.validate()?;
+    let map = rec.link_map(model)?;
+    let band = Band::of_recording(rec, bandwidth_hz)?;
+    Ok((map, band))
+}
+
+/// The estimates from each recorded link's results (in the recording's link order `map`).
+fn assemble(
+    model: &Model,
+    rec: &Recording,
+    map: &[usize],
+    results: Vec<(Vec<Vec<TrackedPath>>, Vec<Real>)>,
+) -> RecordingEstimates {
+    let n = model.link_count();
+    let snapshots = rec.t_s.len();
+    let mut out = RecordingEstimates {
+        t_s: rec.t_s.clone(),
+        recorded: vec![false; n],
+        paths: vec![vec![Vec::new(); n]; snapshots],
+        noise_var: vec![vec![0.0; n]; snapshots],
+    };
+    for (link, (paths, noise)) in results.into_iter().enumerate() {
+        let p = map[link];
+        out.recorded[p] = true;
+        for (s, (l, v)) in paths.into_iter().zip(noise).enumerate() {
+            out.paths[s][p] = l;
+            out.noise_var[s][p] = v;
+        }
+    }
+    out
 }
 
 /// The estimates of every snapshot of `rec` on `model`'s links (C5, C6), one `driver` job per
@@ -138,17 +213,7 @@ pub fn estimate_recording(
     driver: &mut impl Driver,
     progress: &(dyn Fn(usize) + Sync),
 ) -> Result<RecordingEstimates> {
-    rec.validate()?;
-    let map = rec.link_map(model)?;
-    let band = Band::of_recording(rec, bandwidth_hz)?;
-    let n = model.link_count();
-    let snapshots = rec.t_s.len();
-    let mut out = RecordingEstimates {
-        t_s: rec.t_s.clone(),
-        recorded: vec![false; n],
-        paths: vec![vec![Vec::new(); n]; snapshots],
-        noise_var: vec![vec![0.0; n]; snapshots],
-    };
+    let (map, band) = prepare(model, bandwidth_hz, rec)?;
     let mut results = Vec::with_capacity(map.len());
     driver.run(
         map.len(),
@@ -157,15 +222,87 @@ pub fn estimate_recording(
         &mut |r| results.push(r),
         &mut |_| {},
     )?;
-    for (link, (paths, noise)) in results.into_iter().enumerate() {
-        let p = map[link];
-        out.recorded[p] = true;
-        for (s, (l, v)) in paths.into_iter().zip(noise).enumerate() {
-            out.paths[s][p] = l;
-            out.noise_var[s][p] = v;
-        }
+    Ok(assemble(model, rec, &map, results))
+}
+
+/// [`estimate_recording`] a few snapshots at a time, for a caller that must return between
+/// slices of work (the page's worker reports progress and obeys Stop between two calls of
+/// [`EstimationRun::run`]): the same per-link estimation in the same order, so the finished
+/// estimates equal [`estimate_recording`]'s.
+pub struct EstimationRun {
+    map: Vec<usize>,
+    band: (Band, ResponseMap),
+    cfg: FrontEndConfig,
+    current: Option<LinkRun>,
+    results: Vec<(Vec<Vec<TrackedPath>>, Vec<Real>)>,
+    snapshots: usize,
+}
+
+impl EstimationRun {
+    /// The estimation of `rec` (checked as [`estimate_recording`] does); nothing runs yet.
+    pub fn new(
+        model: &Model,
+        bandwidth_hz: Real,
+        rec: &Recording,
+        cfg: &FrontEndConfig,
+    ) -> Result<EstimationRun> {
+        let (map, band) = prepare(model, bandwidth_hz, rec)?;
+        // The settings' errors now, not at the first slice.
+        Estimator::new(band.0.clone(), cfg.estimator)?;
+        PathTracker::new(cfg.paths)?;
+        Ok(EstimationRun {
+            results: Vec::with_capacity(map.len()),
+            map,
+            band,
+            cfg: *cfg,
+            current: None,
+            snapshots: rec.t_s.len(),
+        })
     }
-    Ok(out)
+
+    /// Work units in all: recorded links × snapshots.
+    pub fn total(&self) -> usize {
+        self.map.len() * self.snapshots
+    }
+
+    /// Work units done.
+    pub fn done(&self) -> usize {
+        self.results.len() * self.snapshots + self.current.as_ref().map_or(0, |r| r.paths.len())
+    }
+
+    /// Whether every link is estimated.
+    pub fn is_done(&self) -> bool {
+        self.results.len() == self.map.len()
+    }
+
+    /// Estimates up to `units` more link-snapshots of `rec` (the recording given to
+    /// [`EstimationRun::new`]); returns whether the estimation is complete.
+    pub fn run(&mut self, rec: &Recording, units: usize) -> Result<bool> {
+        let mut left = units;
+        while left > 0 && !self.is_done() {
+            let link = self.results.len();
+            if self.current.is_none() {
+                self.current = Some(LinkRun::new(rec, &self.band, link, &self.cfg)?);
+            }
+            if let Some(run) = self.current.as_mut() {
+                run.step(rec, &self.band.1)?;
+                left -= 1;
+                if run.paths.len() == self.snapshots {
+                    let run = self.current.take().ok_or(Error::Cancelled)?;
+                    self.results.push((run.paths, run.noise));
+                }
+            }
+        }
+        Ok(self.is_done())
+    }
+
+    /// The estimates of `rec` once done ([`Error::Cancelled`] before).
+    pub fn finish(self, model: &Model, rec: &Recording) -> Result<RecordingEstimates> {
+        if !self.is_done() {
+            return Err(Error::Cancelled);
+        }
+        Ok(assemble(model, rec, &self.map, self.results))
+    }
 }
 
 /// How `cir track` weights each delay.
@@ -176,6 +313,16 @@ pub enum DelaySigma {
     Estimator,
     /// The link budget's σ at the prediction (E8: needs the scenario's RCS and radio).
     LinkBudget,
+}
+
+impl DelaySigma {
+    /// The name in `TRACK.json` and on the CLI: `estimator`, `budget`.
+    pub fn name(self) -> &'static str {
+        match self {
+            DelaySigma::Estimator => "estimator",
+            DelaySigma::LinkBudget => "budget",
+        }
+    }
 }
 
 /// Default [`CirTrackRequest::extent_sigma_m`], m: a person's extent (body radius ≈ 0.2 m).
@@ -418,4 +565,68 @@ pub fn delays_only(snapshot: &[Vec<DelayEstimate>]) -> Vec<Vec<Real>> {
         .iter()
         .map(|l| l.iter().map(|e| e.delay_s).collect())
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::channel::{simulate_recording, ChannelScene};
+    use crate::scenario::presets;
+    use crate::study::Sequential;
+
+    /// 0.2 s of the hangar walk at 20 ms (11 snapshots) on sensors2019's 4 links.
+    fn recording() -> (crate::Scenario, Model, Recording) {
+        let s = presets::preset("sensors2019").unwrap();
+        let m = Model::new(&s).unwrap();
+        let mut scene = ChannelScene::hangar();
+        scene.duration_s = Some(0.2);
+        scene.dt_s = 0.02;
+        let (rec, _) = simulate_recording(&s, &m, &scene, true, 3).unwrap();
+        (s, m, rec)
+    }
+
+    #[test]
+    fn the_sliced_estimation_equals_estimate_recording() {
+        let (s, m, rec) = recording();
+        let cfg = FrontEndConfig::default();
+        let bw = s.radio.bandwidth_hz;
+        let whole =
+            estimate_recording(&m, bw, &rec, &cfg, &mut Sequential::new(), &|_| {}).unwrap();
+        let mut run = EstimationRun::new(&m, bw, &rec, &cfg).unwrap();
+        assert_eq!(run.total(), 4 * 11);
+        let mut calls = 0;
+        while !run.run(&rec, 3).unwrap() {
+            calls += 1;
+            assert_eq!(run.done(), 3 * calls);
+        }
+        assert_eq!(calls, 14); // 44 units in slices of 3: 14 partial slices, then the last
+        assert_eq!(run.done(), run.total());
+        assert_eq!(run.finish(&m, &rec).unwrap(), whole);
+        // Unfinished: no estimates.
+        let run = EstimationRun::new(&m, bw, &rec, &cfg).unwrap();
+        assert_eq!(run.finish(&m, &rec), Err(Error::Cancelled));
+    }
+
+    #[test]
+    fn a_time_range_of_a_recording_is_a_recording_of_its_snapshots() {
+        let (_, _, rec) = recording();
+        let part = rec
+            .between("range", rec.t_s[3] - 1e-9, rec.t_s[5] + 1e-9)
+            .unwrap();
+        assert_eq!(part.t_s, rec.t_s[3..=5].to_vec());
+        for s in 0..3 {
+            for p in 0..4 {
+                assert_eq!(part.response(s, p), rec.response(s + 3, p));
+            }
+        }
+        part.validate().unwrap();
+        let e = rec.between("range", 1.0, 2.0).unwrap_err().to_string();
+        assert!(
+            e.starts_with("range: no snapshot between 1 s and 2 s"),
+            "{e}"
+        );
+        let e = rec.between("range", 0.1, 0.0).unwrap_err().to_string();
+        assert!(e.starts_with("range: 0 is outside"), "{e}");
+        assert!(rec.between("range", f64::NAN, 0.0).is_err());
+    }
 }

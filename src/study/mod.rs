@@ -31,7 +31,7 @@ mod track;
 
 pub use cir::{
     calibrate_estimates, cir_track, delays_only, estimate_recording, CirStart, CirTrackOutput,
-    CirTrackRequest, DelaySigma, FrontEndConfig, RecordingEstimates, EXTENT_SIGMA_M,
+    CirTrackRequest, DelaySigma, EstimationRun, FrontEndConfig, RecordingEstimates, EXTENT_SIGMA_M,
 };
 pub use cost::{check_cost, track_cpu_s, MAX_CPU_S, PAGE_STUDY_CPU_S, PAGE_TRACK_CPU_S};
 pub use drive::{Driver, Sequential};

@@ -15,7 +15,7 @@ mod write;
 #[cfg(test)]
 mod tests;
 
-pub use read::read_recording;
+pub use read::{read_recording, read_recording_within};
 pub use write::write_recording;
 
 /// The arrays a recording may hold (docs/recording.md), in the order they are written.

@@ -13,27 +13,27 @@ use crate::error::limits::{MAX_RECORDING_BYTES, MAX_RECORDING_SAMPLES};
 use crate::error::{Error, Result};
 use crate::math::Complex;
 
-fn too_big(field: &'static str, value: u64) -> Error {
+fn too_big(field: &'static str, value: u64, cap: u64) -> Error {
     Error::SizeLimit {
         field,
         value: value.min(usize::MAX as u64) as usize,
         min: 0,
-        max: MAX_RECORDING_BYTES as usize,
+        max: cap.min(usize::MAX as u64) as usize,
     }
 }
 
 /// Reads the members of the archive: each `NAME.npy` must be one of [`ARRAYS`], declared and
-/// inflated within [`MAX_RECORDING_BYTES`] (each member and all together). A member is read
+/// inflated within `cap` bytes (each member and all together). A member is read
 /// through `take(min(declared, remaining) + 1)`, so a member that inflates past its declared size
 /// is refused after at most one byte more than it declared.
-fn members(bytes: &[u8]) -> Result<BTreeMap<&'static str, Npy>> {
-    if bytes.len() as u64 > MAX_RECORDING_BYTES {
-        return Err(too_big("npz", bytes.len() as u64));
+fn members(bytes: &[u8], cap: u64) -> Result<BTreeMap<&'static str, Npy>> {
+    if bytes.len() as u64 > cap {
+        return Err(too_big("npz", bytes.len() as u64, cap));
     }
     let mut zip = zip::ZipArchive::new(Cursor::new(bytes))
         .map_err(|e| invalid("npz", format!("not a zip archive (.npz): {e}")))?;
     let mut out = BTreeMap::new();
-    let mut budget = MAX_RECORDING_BYTES;
+    let mut budget = cap;
     for k in 0..zip.len() {
         let mut f = zip
             .by_index(k)
@@ -51,7 +51,7 @@ fn members(bytes: &[u8]) -> Result<BTreeMap<&'static str, Npy>> {
         }
         let declared = f.size();
         if declared > budget {
-            return Err(too_big(name, declared));
+            return Err(too_big(name, declared, cap));
         }
         let mut data = Vec::with_capacity(declared as usize);
         (&mut f)
@@ -100,8 +100,17 @@ fn samples_cap(name: &str, count: usize) -> Result<()> {
 /// ([`Recording::validate`]); the pulse is normalised to `p(0) = 1`. Every malformed file is a
 /// named [`Error`] naming the array (missing, unknown, wrong dtype or shape, non-finite,
 /// non-increasing `t_s`, non-uniform `freq_hz`, over a cap, not a zip, not an npy, a zip bomb).
+/// The file and its inflated members are capped at [`MAX_RECORDING_BYTES`].
 pub fn read_recording(bytes: &[u8]) -> Result<Recording> {
-    let m = members(bytes)?;
+    read_recording_within(bytes, MAX_RECORDING_BYTES)
+}
+
+/// [`read_recording`] with the file and the total of its inflated members capped at
+/// `max_bytes` (at most [`MAX_RECORDING_BYTES`]; the page reads with
+/// [`crate::error::limits::MAX_PAGE_RECORDING_BYTES`]): a larger file, or a member that declares
+/// or inflates to more, is an [`Error::SizeLimit`] or [`Error::InvalidFile`] naming it.
+pub fn read_recording_within(bytes: &[u8], max_bytes: u64) -> Result<Recording> {
+    let m = members(bytes, max_bytes.min(MAX_RECORDING_BYTES))?;
     let t = m.get("t_s").ok_or_else(|| missing("t_s", "required"))?;
     let t_s = t.f64s()?;
     if t.shape.len() != 1 {

@@ -327,3 +327,24 @@ fn zip_bombs_are_refused_quickly() {
     );
     assert!(elapsed.as_secs_f64() < 0.5, "{elapsed:?}");
 }
+
+#[test]
+fn a_smaller_cap_refuses_larger_files_and_members() {
+    let rec = cfr();
+    let bytes = write_recording(&rec).unwrap();
+    let n = bytes.len() as u64;
+    assert_eq!(read_recording_within(&bytes, n).unwrap(), rec);
+    let got = format!("{}", read_recording_within(&bytes, n - 1).unwrap_err());
+    assert_eq!(
+        got,
+        format!("npz: {n} is outside the allowed range 0..={}", n - 1)
+    );
+    // 2 MiB of zeros deflated to a few kB: the member declares more than a 1 MiB cap.
+    let z = zip_of(&[("cfr.npy", vec![0u8; 2 << 20])], true);
+    assert!(z.len() < 20_000, "{}", z.len());
+    let got = format!("{}", read_recording_within(&z, 1 << 20).unwrap_err());
+    assert!(
+        got.starts_with("cfr: 2097152 is outside the allowed range 0..=1048576"),
+        "{got}"
+    );
+}

@@ -3,15 +3,13 @@
 //! [`scatterloc::study::calibrate_estimates`], [`scatterloc::study::cir_track`], the simulator
 //! [`scatterloc::channel::simulate_recording`]) → files written all or none.
 
-use serde::Serialize;
-
 use scatterloc::channel::{
     simulate_recording, ChannelScene, EstimatorConfig, PathTrackerConfig, Recording,
 };
 use scatterloc::error::{limits, Cancel};
-use scatterloc::formats::{CalibrationResult, CalibrationSnapshots, Measurements, Truth};
+use scatterloc::formats::{CalibrationSnapshots, Measurements, Truth};
 use scatterloc::native::Parallel;
-use scatterloc::present::{track_errors, ErrorStats};
+use scatterloc::present::{estimates_doc, track_doc, track_errors};
 use scatterloc::study::{
     calibrate_estimates, cir_track as track_recording, delays_only, estimate_recording,
     CirTrackRequest, DelaySigma, FrontEndConfig, RecordingEstimates, EXTENT_SIGMA_M,
@@ -90,68 +88,6 @@ fn estimate(
         )
     })?;
     res.map_err(|e| CliError::usage(format!("--{flag}: {e}")))
-}
-
-/// One path of `EST.json`.
-#[derive(Serialize)]
-struct PathDoc {
-    delay_s: f64,
-    amplitude: f64,
-    sigma_s: f64,
-    snr_db: Option<f64>,
-    track: u32,
-    confirmed: bool,
-}
-
-/// `EST.json`.
-#[derive(Serialize)]
-struct EstimatesDoc<'a> {
-    format: &'static str,
-    t_s: &'a [f64],
-    /// Per model link `[transmitter, receiver]`.
-    links: Vec<[usize; 2]>,
-    recorded: &'a [bool],
-    estimates: Vec<Vec<Vec<PathDoc>>>,
-    noise_var: &'a [Vec<f64>],
-    max_paths: usize,
-    p_fa: f64,
-}
-
-fn estimates_doc<'a>(
-    model: &Model,
-    e: &'a RecordingEstimates,
-    cfg: &FrontEndConfig,
-) -> EstimatesDoc<'a> {
-    EstimatesDoc {
-        format: "scatterloc-estimates",
-        t_s: &e.t_s,
-        links: model.network.links.iter().map(|l| [l.tx, l.rx]).collect(),
-        recorded: &e.recorded,
-        estimates: e
-            .paths
-            .iter()
-            .map(|s| {
-                s.iter()
-                    .map(|l| {
-                        l.iter()
-                            .map(|t| PathDoc {
-                                delay_s: t.estimate.delay_s,
-                                amplitude: t.estimate.delay_estimate().amplitude,
-                                sigma_s: t.estimate.sigma_s,
-                                snr_db: (t.estimate.snr > 0.0)
-                                    .then(|| 10.0 * t.estimate.snr.log10()),
-                                track: t.track_id,
-                                confirmed: t.confirmed,
-                            })
-                            .collect()
-                    })
-                    .collect()
-            })
-            .collect(),
-        noise_var: &e.noise_var,
-        max_paths: cfg.estimator.max_paths,
-        p_fa: cfg.estimator.p_fa,
-    }
 }
 
 /// The checked output flag `--flag PATH` of `allowed` formats.
@@ -252,21 +188,6 @@ fn uniform_dt(t_s: &[f64], q: f64) -> Result<(f64, f64), CliError> {
     Ok((dt, q))
 }
 
-/// `TRACK.json`.
-#[derive(Serialize)]
-struct TrackDoc<'a> {
-    #[serde(flatten)]
-    track: &'a scatterloc::study::CirTrackOutput,
-    filter: &'static str,
-    process_noise: f64,
-    sigma: &'static str,
-    calibration: CalibrationResult,
-    /// With `--truth`: the position error's statistics over the snapshots with a state (absent
-    /// when the track never started).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    error: Option<ErrorStats>,
-}
-
 /// `scatterloc cir track --scenario S --calibration CAL.npz --cir REC.npz --out TRACK.json`.
 pub fn cir_track(args: &CirTrackArgs) -> Result<(), CliError> {
     catch_ctrl_c();
@@ -348,23 +269,15 @@ pub fn cir_track(args: &CirTrackArgs) -> Result<(), CliError> {
     let view = track_errors(&track.t_s, &track.states, &truth_states)
         .map_err(|e| CliError::usage(format!("--truth: {e}")))?;
     let error = truth.as_ref().and(view.stats);
-    let doc = TrackDoc {
-        track: &track,
-        filter: name.name(),
-        process_noise: q,
-        sigma: match sigma {
-            DelaySigma::Estimator => "estimator",
-            DelaySigma::LinkBudget => "budget",
-        },
-        calibration: CalibrationResult {
-            gap_s: None,
-            min_fraction: None,
-            sigma_floor_s: None,
-            snapshot_count: Some(empty.len()),
-            links: calibration.links.clone(),
-        },
+    let doc = track_doc(
+        &track,
+        name.name(),
+        q,
+        sigma,
+        &calibration,
+        empty.len(),
         error,
-    };
+    );
     let mut files = OutputSet::new();
     files.json("out", &args.out, &doc)?;
     if let Some((p, f)) = delays_figure {

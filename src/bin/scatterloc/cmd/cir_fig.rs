@@ -11,7 +11,7 @@ use scatterloc::chart::{
     ChannelChartOptions, ChartError,
 };
 use scatterloc::formats::Truth;
-use scatterloc::present::{delay_figure, DelayFigure, TrackErrorView};
+use scatterloc::present::{delay_figure, link_names, DelayFigure, TrackErrorView};
 use scatterloc::study::{CirTrackOutput, RecordingEstimates};
 use scatterloc::track::gating::Calibration;
 use scatterloc::{Model, Scenario};
@@ -41,21 +41,6 @@ impl Figure for Errors<'_> {
         let nodes = scenario_nodes(self.scenario);
         draw_track_errors(root, &self.view, &nodes, &self.scenario.area_m, &self.opts)
     }
-}
-
-/// The names of `model`'s links (`Tx → Rx1`).
-fn link_names(scenario: &Scenario, model: &Model) -> Vec<String> {
-    model
-        .network
-        .links
-        .iter()
-        .map(|l| {
-            format!(
-                "{} → {}",
-                scenario.transmitters[l.tx].name, scenario.receivers[l.rx].name
-            )
-        })
-        .collect()
 }
 
 /// Stages `--delays-figure`.
