@@ -31,6 +31,9 @@ use serde::{Deserialize, Serialize};
 use wasm_bindgen::prelude::*;
 use web_sys::HtmlCanvasElement;
 
+/// The charts with a time cursor (the page's channel view).
+mod cursor;
+
 use super::base::err;
 use super::json::{to_js, to_json};
 use super::tracking::page_filter;
