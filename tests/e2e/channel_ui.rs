@@ -228,6 +228,25 @@ async fn run(c: &Client, port: u16, bad: &str) -> Result<Outcome, String> {
     settle(c).await?;
     cursors.push(state(c).await?);
 
+    // A picture of the view at the last snapshot, for a look by eye (temp dir).
+    if let Ok(png) = c.screenshot().await {
+        let _ = std::fs::write(
+            std::env::temp_dir().join("scatterloc-e2e-channel-view.png"),
+            png,
+        );
+    }
+    js(
+        c,
+        "document.getElementById('chan-figures').scrollIntoView()",
+    )
+    .await?;
+    if let Ok(png) = c.screenshot().await {
+        let _ = std::fs::write(
+            std::env::temp_dir().join("scatterloc-e2e-channel-charts.png"),
+            png,
+        );
+    }
+
     // Saves.
     let (i, t, _) = save(c, "track-json").await?;
     let saved_track = (i, t);
