@@ -73,6 +73,11 @@ mod export;
 #[path = "e2e/zoom.rs"]
 mod zoom;
 
+/// Issue 26 §3: the particle filter's failed runs on the page, the legend, partial figures.
+#[cfg(test)]
+#[path = "e2e/pf.rs"]
+mod pf;
+
 /// The docs screenshots: not a test, the example `screenshot` (`examples/screenshot.rs`) runs
 /// it through this harness. The example includes this file as a module, so the test modules
 /// above are `cfg(test)` and only the harness, the tracking helpers and this module compile
