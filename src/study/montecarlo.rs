@@ -282,7 +282,8 @@ pub fn curve_label(filter: &str, alone: bool) -> String {
 /// the run's filter broke down numerically — its covariance stopped being positive definite
 /// (a particle filter whose weights collapsed onto one particle, so it has no NEES), or an
 /// update failed ([`crate::track::run_filter_chunk`]); such runs are left out of the curves.
-pub const FAILED_NOTE: &str = "failed = filter broke down (covariance not positive definite), left out of its RMSE";
+pub const FAILED_NOTE: &str =
+    "failed = filter broke down (covariance not positive definite), left out of its RMSE";
 
 /// The legend label of a filter's RMSE curve with its failed runs: `PF RMSE (3/192 failed)`.
 pub fn failed_label(filter: &str, failed: usize, runs: usize) -> String {

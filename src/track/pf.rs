@@ -41,8 +41,8 @@ use crate::math::portable::{exp, ln};
 use crate::math::{sqrt, Mat4, Real, Vec2, Vec4, SPEED_OF_LIGHT};
 use crate::measure::{Model, Rng};
 use crate::track::shared::{
-    check_covariance, check_state, check_update, first_input_error, link_sigmas,
-    predict_gaussian, rolled_back, spd_quadratic_form, Ldl4, NO_UPDATE,
+    check_covariance, check_state, check_update, first_input_error, link_sigmas, predict_gaussian,
+    rolled_back, spd_quadratic_form, Ldl4, NO_UPDATE,
 };
 use crate::track::trajectory::normal4;
 use crate::track::{
@@ -62,7 +62,10 @@ pub const PROPOSAL_INFLATION: Real = 2.0;
 /// (Musso et al.: optimal for a Gaussian density), `d = 4` state components: 0.40 at N = 1000.
 pub fn kernel_bandwidth(particles: usize) -> Real {
     let d = 4.0;
-    libm::pow(4.0 / (particles.max(1) as Real * (d + 2.0)), 1.0 / (d + 4.0))
+    libm::pow(
+        4.0 / (particles.max(1) as Real * (d + 2.0)),
+        1.0 / (d + 4.0),
+    )
 }
 
 /// Settings of a [`ParticleFilter`].
@@ -264,7 +267,15 @@ impl ParticleFilter {
             })
             .collect();
         let mut q = vec![0.0; n];
-        range_pass(model, &used, &zc, &info, &self.particles, &mut self.ranges, &mut q);
+        range_pass(
+            model,
+            &used,
+            &zc,
+            &info,
+            &self.particles,
+            &mut self.ranges,
+            &mut q,
+        );
         // The NIS of the predicted particles, before any redraw.
         let nis = self.nis(&zc, &info, m);
         let proposal = match self.gaussian {
@@ -273,7 +284,15 @@ impl ParticleFilter {
         };
         let mut log_w = self.log_weights.clone();
         if let Some((particles, extra, _)) = &proposal {
-            range_pass(model, &used, &zc, &info, particles, &mut self.ranges, &mut q);
+            range_pass(
+                model,
+                &used,
+                &zc,
+                &info,
+                particles,
+                &mut self.ranges,
+                &mut q,
+            );
             // The cloud was unweighted: ln p(z|x) + ln prior(x) − ln q(x) (constants cancel).
             for ((l, qj), e) in log_w.iter_mut().zip(&q).zip(extra) {
                 *l = -0.5 * qj + e;

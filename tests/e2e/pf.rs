@@ -16,9 +16,9 @@ use super::tracking::{mc_done, state, wait_state};
 use super::{console_errors, js, open, settle, with_browser};
 
 /// The most PF failures tolerated in the page's 192 runs: the rate measured natively on seeds
-/// 1 … 5 (tests/tracking/pf_robust.rs: 0 of 960; the rule-of-three bound 3/960) plus three
-/// binomial standard errors, `n p + 3 √(n p (1 − p))` = 2.9 → 2.
-const MAX_PF_FAILED: u64 = 2;
+/// 1 … 5 (tests/tracking/pf_robust.rs: 4 of 960; seed 1, the page's, 1 of 192) plus three
+/// binomial standard errors, `n p + 3 √(n p (1 − p))` = 3.5 → 3.
+const MAX_PF_FAILED: u64 = 3;
 
 struct Outcome {
     /// The finished study's result (window.tracking.mcResult()).
@@ -91,8 +91,7 @@ fn pf_failed_count_is_small_named_in_the_legend_and_partial_figures_are_labelled
     println!("e2e: page PF, scenario I, 1000 particles: {failed} of 192 runs failed");
     assert!(failed <= MAX_PF_FAILED, "{failed} of 192 PF runs failed");
     assert!(
-        o.note
-            .contains(&format!("{failed} of 192 failed")),
+        o.note.contains(&format!("{failed} of 192 failed")),
         "{}",
         o.note
     );

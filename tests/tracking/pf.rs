@@ -369,7 +369,11 @@ fn regularized_first_update_is_importance_sampling_from_the_ekf_proposal() {
         let max = l.iter().copied().fold(Real::NEG_INFINITY, Real::max);
         let norm = max + l.iter().map(|v| (v - max).exp()).sum::<Real>().ln();
         for (got, want) in f.log_weights().iter().zip(&l) {
-            assert!((got - (want - norm)).abs() < 1e-7, "seed {seed}: {got} vs {}", want - norm);
+            assert!(
+                (got - (want - norm)).abs() < 1e-7,
+                "seed {seed}: {got} vs {}",
+                want - norm
+            );
         }
         for i in 0..4 {
             let se = (ekf.covariance[(i, i)] / u.ess).sqrt();
@@ -411,7 +415,9 @@ fn regularized_resampling_jitters_with_the_optimal_kernel() {
         let mut resampled = false;
         for _ in 0..5 {
             f.predict(&motion);
-            let u = f.update(&model, &z, MeasurementNoise::AtPrediction).unwrap();
+            let u = f
+                .update(&model, &z, MeasurementNoise::AtPrediction)
+                .unwrap();
             if u.resampled {
                 resampled = true;
                 let estimate = f.covariance;
@@ -420,8 +426,8 @@ fn regularized_resampling_jitters_with_the_optimal_kernel() {
                 assert_eq!(all_distinct, distinct, "{cfg:?}");
                 if distinct {
                     let mean: Vec4 = p.iter().sum::<Vec4>() / p.len() as Real;
-                    let var = p.iter().map(|x| (x[0] - mean[0]).powi(2)).sum::<Real>()
-                        / p.len() as Real;
+                    let var =
+                        p.iter().map(|x| (x[0] - mean[0]).powi(2)).sum::<Real>() / p.len() as Real;
                     let h2 = kernel_bandwidth(1000).powi(2);
                     let ratio = var / estimate[(0, 0)];
                     assert!((ratio / (1.0 + h2) - 1.0).abs() < 0.25, "{ratio}");
@@ -429,6 +435,9 @@ fn regularized_resampling_jitters_with_the_optimal_kernel() {
                 break;
             }
         }
-        assert!(resampled, "{cfg:?}: a cm-level update of a 10 cm cloud resamples");
+        assert!(
+            resampled,
+            "{cfg:?}: a cm-level update of a 10 cm cloud resamples"
+        );
     }
 }

@@ -16,10 +16,7 @@ use scatterloc::track::{
 };
 
 /// The failed runs and the curves of `pf` over the study `cfg` (every chunk).
-fn pf_study(
-    cfg: &MonteCarloConfig,
-    pf: PfConfig,
-) -> (usize, scatterloc::track::MonteCarloResult) {
+fn pf_study(cfg: &MonteCarloConfig, pf: PfConfig) -> (usize, scatterloc::track::MonteCarloResult) {
     let model = model();
     let mut sums = StudySums::new(cfg.steps);
     for c in 0..cfg.chunk_count() {
@@ -38,15 +35,15 @@ fn page_study(trajectories: usize, seed: u64) -> MonteCarloConfig {
 
 /// The failure rate of the regularised PF measured natively at the page's settings (release
 /// build, `scatterloc montecarlo --trajectory I --filters pf --particles 1000 --runs 192
-/// --noise-runs 1 --dt 0.1 --seed S`, S = 1 … 5: MEASURED_FAILED of MEASURED_RUNS;
-/// docs/reproduction.md "Particle filter robustness").
-const MEASURED_FAILED: usize = 0;
+/// --noise-runs 1 --dt 0.1 --seed S`, S = 1 … 5: 1, 1, 0, 1, 1 failed, MEASURED_FAILED of
+/// MEASURED_RUNS; docs/reproduction.md "Particle filter robustness").
+const MEASURED_FAILED: usize = 4;
 /// The runs of that measurement.
 const MEASURED_RUNS: usize = 960;
 
 /// The most failures tolerated in `runs` runs: the expected count at the measured rate plus 3
-/// binomial standard errors, `n p + 3 √(n p (1 − p))`, with the rate taken as at least the
-/// 95 % upper bound of a measured zero (`3 / MEASURED_RUNS`, the rule of three).
+/// binomial standard errors, `n p + 3 √(n p (1 − p))` (2.9 → 2 for 144 runs), the rate taken
+/// as at least the 95 % upper bound of a measured zero (`3 / MEASURED_RUNS`, the rule of three).
 fn tolerated(runs: usize) -> usize {
     let p = (MEASURED_FAILED as Real / MEASURED_RUNS as Real).max(3.0 / MEASURED_RUNS as Real);
     let n = runs as Real;

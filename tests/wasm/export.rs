@@ -151,7 +151,11 @@ fn tracking_chart_svg_parses() {
     assert_eq!(count(&texts, "scenario II"), 1, "{texts:?}");
     // The label with its failed runs, the legend's last row what "failed" means (issue 26).
     assert_eq!(count(&texts, "EKF RMSE (0/10 failed)"), 1, "{texts:?}");
-    assert_eq!(count(&texts, scatterloc::study::FAILED_NOTE), 1, "{texts:?}");
+    assert_eq!(
+        count(&texts, scatterloc::study::FAILED_NOTE),
+        1,
+        "{texts:?}"
+    );
     svg_texts(
         "figure",
         &ok(wasm::tracking_chart_svg("", "t", "", "", 400, 0)),
