@@ -53,9 +53,11 @@ fn tolerated(runs: usize) -> usize {
 /// Three seeds × 48 runs of the page's scenario I study at 1000 particles: the regularised PF
 /// fails in at most [`tolerated`] of the 144 runs (the measured rate plus 3 standard errors),
 /// while the spec's bootstrap SIR on the same runs of the first seed fails in at least a quarter
-/// (measured: 105 of 192 page runs), so the test tells the two apart. The RMSE at 10 s stays
-/// within 1.5× the posterior CRLB (measured ≈ 1.0×).
+/// (measured: 107 of 192 runs of seed 1), so the test tells the two apart. The RMSE at 10 s stays
+/// within 1.5× the posterior CRLB (measured ≈ 1.2×). About 3 min in the debug build on the
+/// shared 2-core machine; the cheaper test below runs by default.
 #[test]
+#[ignore = "3 seeds × 48 runs × 1000 particles: minutes in the debug build; run with --ignored (or --release)"]
 fn regularized_pf_rarely_fails_in_the_page_study_of_scenario_i() {
     let runs_per_seed = 48;
     let mut failed = 0;
@@ -82,4 +84,15 @@ fn regularized_pf_rarely_fails_in_the_page_study_of_scenario_i() {
         4 * bootstrap >= runs_per_seed,
         "bootstrap SIR: {bootstrap} of {runs_per_seed} failed"
     );
+}
+
+/// The cheap version (one chunk of 16 runs, seed 1): the regularised PF fails in at most
+/// [`tolerated`]`(16)` = 0 of them, the bootstrap SIR in at least a quarter of the same runs.
+#[test]
+fn regularized_pf_beats_the_bootstrap_on_one_chunk_of_scenario_i() {
+    let cfg = page_study(16, 1);
+    let (failed, _) = pf_study(&cfg, PfConfig::default());
+    assert!(failed <= tolerated(16), "{failed} of 16 runs failed");
+    let (bootstrap, _) = pf_study(&cfg, PfConfig::bootstrap(1000));
+    assert!(4 * bootstrap >= 16, "bootstrap SIR: {bootstrap} of 16 failed");
 }
