@@ -94,5 +94,8 @@ fn regularized_pf_beats_the_bootstrap_on_one_chunk_of_scenario_i() {
     let (failed, _) = pf_study(&cfg, PfConfig::default());
     assert!(failed <= tolerated(16), "{failed} of 16 runs failed");
     let (bootstrap, _) = pf_study(&cfg, PfConfig::bootstrap(1000));
-    assert!(4 * bootstrap >= 16, "bootstrap SIR: {bootstrap} of 16 failed");
+    assert!(
+        4 * bootstrap >= 16,
+        "bootstrap SIR: {bootstrap} of 16 failed"
+    );
 }
