@@ -219,6 +219,7 @@ fn benches(c: &mut Criterion) {
             PfConfig {
                 particles: n,
                 roughening: None,
+                regularized: true,
             },
             measure::rng(SEED, 7),
         )
@@ -276,6 +277,7 @@ fn benches(c: &mut Criterion) {
     let pf = FilterKind::Pf(PfConfig {
         particles: 1000,
         roughening: None,
+        regularized: true,
     });
     g.bench_function("run_filter_chunk_pf1000_fast_0.1s_16x1x100", |b| {
         b.iter(|| run_filter_chunk(&s.model, black_box(&fast_one), pf, 0).unwrap())

@@ -82,6 +82,10 @@ mod channel_ui;
 #[cfg(test)]
 #[path = "e2e/channel.rs"]
 mod channel;
+/// Issue 26 §3: the particle filter's failed runs on the page, the legend, partial figures.
+#[cfg(test)]
+#[path = "e2e/pf.rs"]
+mod pf;
 
 /// The docs screenshots: not a test, the example `screenshot` (`examples/screenshot.rs`) runs
 /// it through this harness. The example includes this file as a module, so the test modules

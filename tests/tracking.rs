@@ -37,5 +37,8 @@ mod pcrlb;
 #[path = "tracking/pf.rs"]
 mod pf;
 
+#[path = "tracking/pf_robust.rs"]
+mod pf_robust;
+
 #[path = "tracking/ukf.rs"]
 mod ukf;

@@ -37,8 +37,8 @@ pub use cost::{check_cost, track_cpu_s, MAX_CPU_S, PAGE_STUDY_CPU_S, PAGE_TRACK_
 pub use drive::{Driver, Sequential};
 pub use filters::{particle_chunks, FilterResults, FilterRun, FilterStudy};
 pub use montecarlo::{
-    curve_label, CurveDoc, FilterCurves, FilterDoc, FiltersConfig, McConfig, McMeta,
-    MonteCarloStudy, RunTime, TrackStudy,
+    curve_label, failed_label, CurveDoc, FilterCurves, FilterDoc, FiltersConfig, McConfig, McMeta,
+    MonteCarloStudy, RunTime, TrackStudy, FAILED_NOTE,
 };
 pub use part::{
     differs, inconsistent, load_sums, merged_timing, software, sums_digest, Part, PartFile,

@@ -172,6 +172,10 @@ pub struct FiltersConfig {
     /// Roughening constant (when `pf` runs with it).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub roughening: Option<f64>,
+    /// `true` when `pf` runs as the spec's plain bootstrap SIR (`--pf-bootstrap`); absent (not
+    /// written) for the regularised particle filter, the default.
+    #[serde(default, skip_serializing_if = "core::ops::Not::not")]
+    pub bootstrap: bool,
 }
 
 impl FiltersConfig {
@@ -185,6 +189,7 @@ impl FiltersConfig {
             ukf: None,
             particles: None,
             roughening: None,
+            bootstrap: false,
         };
         for k in kinds {
             match k {
@@ -193,6 +198,7 @@ impl FiltersConfig {
                 FilterKind::Pf(p) => {
                     c.particles = Some(p.particles);
                     c.roughening = p.roughening;
+                    c.bootstrap = !p.regularized;
                 }
             }
         }
@@ -209,6 +215,7 @@ impl FiltersConfig {
         let pf = PfConfig {
             particles: self.particles.unwrap_or(PfConfig::default().particles),
             roughening: self.roughening,
+            regularized: !self.bootstrap,
         };
         self.names
             .iter()
@@ -255,6 +262,10 @@ pub struct CurveDoc<M: Serialize> {
     /// part of the JSON.
     #[serde(skip)]
     pub figure_curves: Vec<(String, Vec<f64>)>,
+    /// The figure's last legend row (what a failed run is, [`FAILED_NOTE`], when the legend
+    /// gives the failed counts); not part of the JSON.
+    #[serde(skip)]
+    pub figure_note: Option<&'static str>,
 }
 
 /// The legend label of a filter's RMSE curve in the tracking figures (the one home of these
@@ -265,6 +276,18 @@ pub fn curve_label(filter: &str, alone: bool) -> String {
         ("ekf", true) => "EKF RMSE  ε_EKF".to_string(),
         _ => format!("{} RMSE", filter.to_uppercase()),
     }
+}
+
+/// What a failed run is, as the tracking figures' legends say it (the one home of this text):
+/// the run's filter broke down numerically — its covariance stopped being positive definite
+/// (a particle filter whose weights collapsed onto one particle, so it has no NEES), or an
+/// update failed ([`crate::track::run_filter_chunk`]); such runs are left out of the curves.
+pub const FAILED_NOTE: &str =
+    "failed = filter broke down (covariance not positive definite), left out of its RMSE";
+
+/// The legend label of a filter's RMSE curve with its failed runs: `PF RMSE (3/192 failed)`.
+pub fn failed_label(filter: &str, failed: usize, runs: usize) -> String {
+    format!("{} ({failed}/{runs} failed)", curve_label(filter, false))
 }
 
 /// Scalars of one Monte Carlo study, after the curves in the JSON file and in the summary.
@@ -509,10 +532,15 @@ impl MonteCarloStudy {
                 .curves
                 .iter()
                 .map(|(i, r)| {
-                    let label = curve_label(name(*i), self.ekf_only());
+                    let label = if self.ekf_only() {
+                        curve_label(name(*i), true)
+                    } else {
+                        failed_label(name(*i), r.failed_runs, r.runs + r.failed_runs)
+                    };
                     (label, r.rmse_m.clone())
                 })
                 .collect(),
+            figure_note: None,
             meta: McMeta {
                 runs: top.runs,
                 seed: cfg.seed,
@@ -535,6 +563,7 @@ impl MonteCarloStudy {
         if self.ekf_only() {
             return doc;
         }
+        doc.figure_note = Some(FAILED_NOTE);
         let ekf_counted = results
             .curves
             .iter()

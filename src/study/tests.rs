@@ -36,6 +36,7 @@ fn config(trajectories: usize, noise_runs: usize, steps: usize, seed: u64) -> Mo
 const PF: FilterKind = FilterKind::Pf(PfConfig {
     particles: 40,
     roughening: None,
+    regularized: true,
 });
 
 #[test]
@@ -163,6 +164,7 @@ fn bad_filter_lists_are_named_errors() {
     let bad_pf = FilterKind::Pf(PfConfig {
         particles: 0,
         roughening: None,
+        regularized: true,
     });
     assert_eq!(
         FilterStudy::new(cfg, &[bad_pf]).unwrap_err().field(),
@@ -716,6 +718,7 @@ fn a_run_is_cancelled_inside_its_steps() {
     let pf = FilterKind::Pf(PfConfig {
         particles: 20_000,
         roughening: None,
+        regularized: true,
     });
     let links = model().link_count();
     assert_eq!(
@@ -761,6 +764,7 @@ fn a_filter_failing_every_run_keeps_the_others_results() {
     let pf = FilterKind::Pf(PfConfig {
         particles: 1,
         roughening: None,
+        regularized: true,
     });
     let cfg = config(16, 1, 5, 1);
     let mut s = FilterStudy::new(cfg, &[FilterKind::Ekf, pf]).unwrap();
@@ -794,6 +798,7 @@ fn predicted_cost_is_runs_times_steps_times_the_step_cost() {
     let pf = PfConfig {
         particles: 1000,
         roughening: None,
+        regularized: true,
     };
     let cfg = config(40, 3, 50, 1);
     // The particle filter held to 1 chunk of the 3 (16 × 3 runs × 50 steps × 1000 ≤ 2.4e6).

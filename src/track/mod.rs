@@ -33,7 +33,9 @@ pub use montecarlo::{
 };
 pub use motion::ConstantVelocity;
 pub use pcrlb::{nominal_pcrlb_rmse, pcrlb_rmse, PosteriorInformation};
-pub use pf::{ParticleFilter, PfConfig, PfUpdate, MAX_PARTICLES};
+pub use pf::{
+    kernel_bandwidth, ParticleFilter, PfConfig, PfUpdate, MAX_PARTICLES, PROPOSAL_INFLATION,
+};
 pub use shared::{check_covariance, MeasurementNoise, PredictedDelay, UpdateSummary};
 pub(crate) use shared::{range_information_per_snr, spd_quadratic_form, NodeView};
 pub use track_sim::{simulate_track, TrackRun};

@@ -12,6 +12,22 @@
 //!   optional roughening `𝒩(0, c·diag(spread²)·N^(−1/5))` (spread = the particles' range per
 //!   state component; off by default).
 //!
+//! **Regularised** ([`PfConfig::regularized`], the default; issue 26): two additions to the
+//! spec's bootstrap SIR, which stays available with `regularized: false`. The filtered target —
+//! the posterior of the same prior `𝒩(x̄₀, P(t₀))`, motion and likelihood — is the same; only
+//! how the particles sample it changes:
+//! - *First update from a Gaussian proposal.* While the cloud is still the un-updated sample of
+//!   the Gaussian prior (propagated by E7: `(A x̄, A P Aᵀ + Q)`), the first update with links
+//!   redraws the particles from `q = 𝒩(x̂⁺, κ P⁺)`, the EKF update of that Gaussian (S17)
+//!   widened by [`PROPOSAL_INFLATION`], and weights them by importance sampling,
+//!   `ℓ_j = ln p(z | x_j) + ln 𝒩(x_j; x̂⁻, P⁻) − ln q(x_j)` (normalised with log-sum-exp as
+//!   above). Without it, a wide prior against mm-level delays leaves one or a few particles
+//!   with weight (scenario I of spec §9.4: 105 of 192 page runs failed).
+//! - *Gaussian kernel after resampling* (Musso, Oudjane & Le Gland, 2001): each resampled
+//!   particle moves by `h L ε`, `ε ~ 𝒩(0, I)`, `L` the Cholesky factor of the weighted
+//!   covariance (the estimate's), `h = (4 / (N (d + 2)))^(1/(d + 4))`, `d = 4`, the bandwidth
+//!   that is optimal for a Gaussian density; then the optional roughening as before.
+//!
 //! Each filter owns its random stream, so a result depends on the seed only, whatever the thread
 //! count.
 
@@ -25,14 +41,32 @@ use crate::math::portable::{exp, ln};
 use crate::math::{sqrt, Mat4, Real, Vec2, Vec4, SPEED_OF_LIGHT};
 use crate::measure::{Model, Rng};
 use crate::track::shared::{
-    check_covariance, check_state, check_update, first_input_error, link_sigmas, rolled_back,
-    spd_quadratic_form, NO_UPDATE,
+    check_covariance, check_state, check_update, first_input_error, link_sigmas, predict_gaussian,
+    rolled_back, spd_quadratic_form, Ldl4, NO_UPDATE,
 };
 use crate::track::trajectory::normal4;
-use crate::track::{ConstantVelocity, Filter, MeasurementNoise, PredictedDelay, UpdateSummary};
+use crate::track::{
+    ConstantVelocity, Ekf, Filter, MeasurementNoise, PredictedDelay, UpdateSummary,
+};
 
 /// Most particles of a filter.
 pub const MAX_PARTICLES: usize = 1_000_000;
+
+/// `κ`: the regularised filter's first-update proposal is the EKF posterior's covariance times
+/// this (wider than the posterior, so the importance weights stay bounded where the delays are
+/// not linear over the cloud; for a Gaussian target the expected ESS is then
+/// `N ((2κ − 1)/κ²)^(d/2)` = 0.56 N).
+pub const PROPOSAL_INFLATION: Real = 2.0;
+
+/// The kernel bandwidth `h = (4 / (N (d + 2)))^(1/(d + 4))` of the regularised particle filter
+/// (Musso et al.: optimal for a Gaussian density), `d = 4` state components: 0.40 at N = 1000.
+pub fn kernel_bandwidth(particles: usize) -> Real {
+    let d = 4.0;
+    libm::pow(
+        4.0 / (particles.max(1) as Real * (d + 2.0)),
+        1.0 / (d + 4.0),
+    )
+}
 
 /// Settings of a [`ParticleFilter`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -41,6 +75,9 @@ pub struct PfConfig {
     pub particles: usize,
     /// Roughening constant `c` (≥ 0, ≤ 10); `None` = off (the default).
     pub roughening: Option<Real>,
+    /// The regularised filter (module docs; the default): the first update from a Gaussian
+    /// proposal and a Gaussian kernel after each resampling. `false`: the spec's bootstrap SIR.
+    pub regularized: bool,
 }
 
 impl Default for PfConfig {
@@ -48,6 +85,19 @@ impl Default for PfConfig {
         PfConfig {
             particles: 1000,
             roughening: None,
+            regularized: true,
+        }
+    }
+}
+
+impl PfConfig {
+    /// The spec's plain bootstrap SIR (`filters-and-planning.md` §2) with `particles`, no
+    /// roughening, not regularised.
+    pub fn bootstrap(particles: usize) -> PfConfig {
+        PfConfig {
+            particles,
+            roughening: None,
+            regularized: false,
         }
     }
 }
@@ -103,6 +153,10 @@ pub struct ParticleFilter {
     pub covariance: Mat4,
     /// Scratch: the predicted ranges of every particle (`N × m`).
     ranges: Vec<Real>,
+    /// The Gaussian `(mean, covariance)` the cloud is a sample of, while no update with links
+    /// has happened yet (the prior, propagated by each predict); the regularised filter's first
+    /// update draws from a proposal against it.
+    gaussian: Option<(Vec4, Mat4)>,
 }
 
 impl ParticleFilter {
@@ -133,6 +187,7 @@ impl ParticleFilter {
             state: mean,
             covariance,
             ranges: Vec::new(),
+            gaussian: Some((mean, covariance)),
         };
         f.estimate();
         Ok(f)
@@ -169,6 +224,9 @@ impl ParticleFilter {
                 vx + l21 * w[0] + l22 * w[2],
                 vy + l21 * w[1] + l22 * w[3],
             );
+        }
+        if let Some((m, p)) = self.gaussian.as_mut() {
+            predict_gaussian(m, p, motion);
         }
         self.estimate();
     }
@@ -208,29 +266,42 @@ impl ParticleFilter {
                 1.0 / (s * s)
             })
             .collect();
-        self.ranges.clear();
-        self.ranges.resize(n * m, 0.0);
-        let net = &model.network;
-        let (ntx, nrx) = (net.transmitters.len(), net.receivers.len());
-        let mut d = vec![0.0; ntx + nrx];
-        let mut log_w = self.log_weights.clone();
-        for (j, x) in self.particles.iter().enumerate() {
-            // Each node's distance once (E1: a link's range is the sum of its two).
-            for (k, node) in net.transmitters.iter().chain(&net.receivers).enumerate() {
-                let (dx, dy) = (x[0] - node.x, x[1] - node.y);
-                d[k] = sqrt(dx * dx + dy * dy);
-            }
-            let mut q = 0.0;
-            for (k, &p) in used.iter().enumerate() {
-                let l = net.links[p];
-                let h = d[l.tx] + d[ntx + l.rx];
-                self.ranges[j * m + k] = h;
-                let e = zc[k] - h;
-                q += e * e * info[k];
-            }
-            log_w[j] -= 0.5 * q;
-        }
+        let mut q = vec![0.0; n];
+        range_pass(
+            model,
+            &used,
+            &zc,
+            &info,
+            &self.particles,
+            &mut self.ranges,
+            &mut q,
+        );
+        // The NIS of the predicted particles, before any redraw.
         let nis = self.nis(&zc, &info, m);
+        let proposal = match self.gaussian {
+            Some(g) if self.config.regularized => self.first_proposal(model, z, noise, g),
+            _ => None,
+        };
+        let mut log_w = self.log_weights.clone();
+        if let Some((particles, extra, _)) = &proposal {
+            range_pass(
+                model,
+                &used,
+                &zc,
+                &info,
+                particles,
+                &mut self.ranges,
+                &mut q,
+            );
+            // The cloud was unweighted: ln p(z|x) + ln prior(x) − ln q(x) (constants cancel).
+            for ((l, qj), e) in log_w.iter_mut().zip(&q).zip(extra) {
+                *l = -0.5 * qj + e;
+            }
+        } else {
+            for (l, qj) in log_w.iter_mut().zip(&q) {
+                *l -= 0.5 * qj;
+            }
+        }
         let max = log_w.iter().copied().fold(Real::NEG_INFINITY, Real::max);
         if !max.is_finite() {
             return Err(Error::Degenerate {
@@ -247,6 +318,11 @@ impl ParticleFilter {
                 field: "pf.weights".into(),
             });
         }
+        if let Some((particles, _, rng)) = proposal {
+            self.particles = particles;
+            self.rng = rng;
+        }
+        self.gaussian = None;
         self.weights = log_w.iter().map(|l| exp(*l)).collect();
         self.log_weights = log_w;
         self.estimate();
@@ -342,6 +418,44 @@ impl ParticleFilter {
             .collect()
     }
 
+    /// The regularised filter's first-update proposal (module docs): `N` particles drawn from
+    /// `𝒩(x̂⁺, κ P⁺)` (the EKF update of the cloud's Gaussian `(x̂⁻, P⁻)` with `z`, S17) with a
+    /// clone of the filter's stream, and each particle's `ln 𝒩(x; x̂⁻, P⁻) − ln q(x)` up to a
+    /// common constant; the stream after the draws. `None` (the bootstrap update instead) when
+    /// that update fails or a covariance is not positive definite.
+    fn first_proposal(
+        &self,
+        model: &Model,
+        z: &[Option<Real>],
+        noise: MeasurementNoise,
+        (mean, covariance): (Vec4, Mat4),
+    ) -> Option<(Vec<Vec4>, Vec<Real>, Rng)> {
+        let mut ekf = Ekf {
+            state: mean,
+            covariance,
+        };
+        ekf.update(model, z, noise, None).ok()?;
+        let pq = (ekf.covariance + ekf.covariance.transpose()) * (0.5 * PROPOSAL_INFLATION);
+        let l = nalgebra::Cholesky::new(pq)?.l();
+        let prior = Ldl4::new(&covariance)?;
+        let proposal = Ldl4::new(&pq)?;
+        let mut rng = self.rng.clone();
+        let n = self.particles.len();
+        let mut particles = Vec::with_capacity(n);
+        let mut extra = Vec::with_capacity(n);
+        for _ in 0..n {
+            let e = l * normal4(&mut rng);
+            let x = ekf.state + e;
+            extra.push(0.5 * (proposal.quadratic_form(&e) - prior.quadratic_form(&(x - mean))));
+            particles.push(x);
+        }
+        if extra.iter().all(|v| v.is_finite()) {
+            Some((particles, extra, rng))
+        } else {
+            None
+        }
+    }
+
     /// NIS of the weighted predicted measurement, from the ranges just computed and the
     /// weights before this update.
     fn nis(&self, zc: &[Real], info: &[Real], m: usize) -> Real {
@@ -420,7 +534,8 @@ impl ParticleFilter {
         self.covariance = cov;
     }
 
-    /// Systematic resampling (one uniform draw), then the optional roughening.
+    /// Systematic resampling (one uniform draw), then the regularised filter's kernel and the
+    /// optional roughening.
     fn resample(&mut self) {
         let n = self.particles.len();
         let step = 1.0 / n as Real;
@@ -443,6 +558,16 @@ impl ParticleFilter {
         self.particles = out;
         self.log_weights.fill(-ln(n as Real));
         self.weights.fill(step);
+        if self.config.regularized {
+            // The kernel `h L ε` of the weighted covariance (the estimate, before resampling);
+            // none if it is not positive definite (the weights collapsed onto one particle).
+            if let Some(c) = nalgebra::Cholesky::new(self.covariance) {
+                let hl = c.l() * kernel_bandwidth(n);
+                for x in self.particles.iter_mut() {
+                    *x += hl * normal4(&mut self.rng);
+                }
+            }
+        }
         if let Some(c) = self.config.roughening {
             let mut lo = Vec4::repeat(Real::INFINITY);
             let mut hi = Vec4::repeat(Real::NEG_INFINITY);
@@ -457,6 +582,41 @@ impl ParticleFilter {
                 *x += sd.component_mul(&z);
             }
         }
+    }
+}
+
+/// Every particle's range on each used link (E1, into `ranges`, `N × m`) and
+/// `q_j = Σ_links (z − h(x_j))² / σ_p²` in the range domain (into `q`).
+fn range_pass(
+    model: &Model,
+    used: &[usize],
+    zc: &[Real],
+    info: &[Real],
+    particles: &[Vec4],
+    ranges: &mut Vec<Real>,
+    q: &mut [Real],
+) {
+    let m = used.len();
+    ranges.clear();
+    ranges.resize(particles.len() * m, 0.0);
+    let net = &model.network;
+    let (ntx, nrx) = (net.transmitters.len(), net.receivers.len());
+    let mut d = vec![0.0; ntx + nrx];
+    for (j, x) in particles.iter().enumerate() {
+        // Each node's distance once (E1: a link's range is the sum of its two).
+        for (k, node) in net.transmitters.iter().chain(&net.receivers).enumerate() {
+            let (dx, dy) = (x[0] - node.x, x[1] - node.y);
+            d[k] = sqrt(dx * dx + dy * dy);
+        }
+        let mut s = 0.0;
+        for (k, &p) in used.iter().enumerate() {
+            let l = net.links[p];
+            let h = d[l.tx] + d[ntx + l.rx];
+            ranges[j * m + k] = h;
+            let e = zc[k] - h;
+            s += e * e * info[k];
+        }
+        q[j] = s;
     }
 }
 

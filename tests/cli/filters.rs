@@ -263,6 +263,14 @@ fn montecarlo_multi_filter_files_and_figure() {
     for label in ["UKF RMSE", "EKF RMSE", "UKF, EKF vs posterior CRLB"] {
         assert!(text.contains(label), "{label}");
     }
+    // Each legend label gives the filter's failed runs; the legend says what "failed" means.
+    for (name, f) in [("EKF", "ekf"), ("UKF", "ukf")] {
+        let d = &v["filters"][f];
+        let n = d["runs"].as_u64().unwrap() + d["failed_runs"].as_u64().unwrap();
+        let label = format!("{name} RMSE ({}/{n} failed)", d["failed_runs"]);
+        assert!(text.contains(&label), "{label}");
+    }
+    assert!(text.contains(scatterloc::study::FAILED_NOTE));
     // ukf alone: no EKF curve at the top level.
     let u = ok_json(&refs(&tiny(&["--filters", "ukf"])));
     assert!(u.get("rmse_ekf_m").is_none() && u.get("nees").is_none());

@@ -472,6 +472,7 @@ fn native_filters_difference(params: &Value, result: &Value) -> f64 {
     let pf = FilterKind::Pf(PfConfig {
         particles: params["particles"].as_f64().unwrap() as usize,
         roughening: None,
+        regularized: true,
     });
     let mut worst: f64 = 0.0;
     for (name, kind) in [("ukf", FilterKind::Ukf(Default::default())), ("pf", pf)] {

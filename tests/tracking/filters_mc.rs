@@ -47,6 +47,7 @@ fn ukf_and_pf_studies_share_the_ekf_data_and_agree_where_near_linear() {
         FilterKind::Pf(PfConfig {
             particles: 2000,
             roughening: None,
+            regularized: true,
         }),
         &cfg,
         &order,
@@ -86,6 +87,7 @@ fn filter_studies_depend_on_the_seed_only() {
         FilterKind::Pf(PfConfig {
             particles: 300,
             roughening: Some(0.2),
+            regularized: true,
         }),
     ] {
         let a = finish(&cfg, &run(filter, &cfg, &[0, 1, 2])).unwrap();
@@ -125,6 +127,7 @@ fn native_filter_driver_matches_the_chunks_for_any_thread_count() {
     let pf = PfConfig {
         particles: 100,
         roughening: None,
+        regularized: true,
     };
     for filter in [FilterKind::Ukf(UkfParams::default()), FilterKind::Pf(pf)] {
         let want = run(filter, &cfg, &[0, 1, 2]);
@@ -147,6 +150,7 @@ fn native_filter_driver_matches_the_chunks_for_any_thread_count() {
     let bad = FilterKind::Pf(PfConfig {
         particles: 0,
         roughening: None,
+        regularized: true,
     });
     let e = run_filter_chunks_parallel(&model, &cfg, bad, all, 1, &cancel, |_, _| {});
     assert!(e.unwrap_err().to_string().contains("particles"));

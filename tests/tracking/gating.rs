@@ -465,6 +465,7 @@ fn every_filter_predicts_the_delays_the_ekf_does() {
         let pf_kind = FilterKind::Pf(PfConfig {
             particles: n,
             roughening: None,
+            regularized: true,
         });
         let pf = Tracker::new(pf_kind, x, p, measure::rng(2, 0))
             .unwrap()

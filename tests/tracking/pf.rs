@@ -23,6 +23,7 @@ fn pf(n: usize, mean: Vec4, cov: Mat4, seed: u64) -> ParticleFilter {
         PfConfig {
             particles: n,
             roughening: None,
+            regularized: false,
         },
         rng(seed, 0),
     )
@@ -237,6 +238,7 @@ fn extreme_steps_stay_finite_and_bad_inputs_are_named() {
             PfConfig {
                 particles: 0,
                 roughening: None,
+                regularized: false,
             },
             "particles",
         ),
@@ -244,6 +246,7 @@ fn extreme_steps_stay_finite_and_bad_inputs_are_named() {
             PfConfig {
                 particles: 10,
                 roughening: Some(-1.0),
+                regularized: false,
             },
             "roughening",
         ),
@@ -277,6 +280,7 @@ fn near_linear_ekf_ukf_and_pf_agree_within_monte_carlo_error() {
             PfConfig {
                 particles: 10_000,
                 roughening: None,
+                regularized: false,
             },
             rng(100 + run, 2),
         )
@@ -311,6 +315,129 @@ fn near_linear_ekf_ukf_and_pf_agree_within_monte_carlo_error() {
         assert!(
             md.abs() <= 4.0 * stderr + 1e-12,
             "{name}: mean squared error differs from the EKF's by {md:.3e} m² (standard error {stderr:.3e})"
+        );
+    }
+}
+
+/// Issue 26, the regularised filter's first update: the particles are redrawn from
+/// `q = 𝒩(x̂⁺, κ P⁺)`, the EKF update of the prior (S17) widened by κ, and weighted by
+/// `ln p(z | x) + ln 𝒩(x; x̄₀, P₀) − ln q(x)`, normalised — recomputed here from the drawn
+/// particles with explicit inverses (5 seeds; the updates that resampled cannot be checked so and
+/// are skipped, at least 3 must remain). The redrawn cloud's weighted mean is the EKF's within
+/// 5 of its standard errors.
+#[test]
+fn regularized_first_update_is_importance_sampling_from_the_ekf_proposal() {
+    use scatterloc::track::PROPOSAL_INFLATION;
+    let model = model();
+    let x0 = Vec4::new(3.0, 4.0, 0.5, 0.0);
+    let p0 = Mat4::from_diagonal(&Vec4::new(0.01, 0.01, 0.01, 0.01));
+    let z: Vec<Option<Real>> = model
+        .network
+        .delays(Vec2::new(3.05, 3.98))
+        .into_iter()
+        .map(Some)
+        .collect();
+    let noise = MeasurementNoise::AtPrediction;
+    let mut ekf = Ekf::new(x0, p0).unwrap();
+    ekf.update(&model, &z, noise, None).unwrap();
+    let pq = ekf.covariance * PROPOSAL_INFLATION;
+    let (p0_inv, pq_inv) = (p0.try_inverse().unwrap(), pq.try_inverse().unwrap());
+    let n = 2000;
+    let mut checked = 0;
+    for seed in 1..=5 {
+        let cfg = PfConfig {
+            particles: n,
+            ..PfConfig::default()
+        };
+        let mut f = ParticleFilter::new(x0, p0, cfg, rng(seed, 0)).unwrap();
+        let r_pred = f.position();
+        let u = f.update(&model, &z, noise).unwrap();
+        if u.resampled {
+            continue;
+        }
+        checked += 1;
+        let loglik = log_likelihoods(&model, f.particles(), &z, r_pred);
+        let l: Vec<Real> = f
+            .particles()
+            .iter()
+            .zip(&loglik)
+            .map(|(x, ll)| {
+                let (a, b) = (x - x0, x - ekf.state);
+                ll - 0.5 * (a.transpose() * p0_inv * a)[0] + 0.5 * (b.transpose() * pq_inv * b)[0]
+            })
+            .collect();
+        let max = l.iter().copied().fold(Real::NEG_INFINITY, Real::max);
+        let norm = max + l.iter().map(|v| (v - max).exp()).sum::<Real>().ln();
+        for (got, want) in f.log_weights().iter().zip(&l) {
+            assert!(
+                (got - (want - norm)).abs() < 1e-7,
+                "seed {seed}: {got} vs {}",
+                want - norm
+            );
+        }
+        for i in 0..4 {
+            let se = (ekf.covariance[(i, i)] / u.ess).sqrt();
+            assert!(
+                (f.state[i] - ekf.state[i]).abs() < 5.0 * se,
+                "seed {seed}: mean[{i}] {} vs EKF {}",
+                f.state[i],
+                ekf.state[i]
+            );
+        }
+        assert_eq!(f.particles().len(), n);
+    }
+    assert!(checked >= 3, "only {checked} of 5 updates did not resample");
+}
+
+/// Issue 26, the regularised filter's kernel: `h = (4/(N(d+2)))^(1/(d+4))` (0.40086 at N = 1000),
+/// and after a resampling every particle is distinct (jittered), where the bootstrap SIR keeps
+/// copies; the cloud's covariance then grows by about `1 + h²` (checked within 25 %).
+#[test]
+fn regularized_resampling_jitters_with_the_optimal_kernel() {
+    use scatterloc::track::kernel_bandwidth;
+    assert!((kernel_bandwidth(1000) - (4.0 / 6000.0 as Real).powf(0.125)).abs() < 1e-15);
+    assert!((kernel_bandwidth(1000) - 0.40086).abs() < 1e-5);
+    let model = model();
+    let x0 = Vec4::new(3.0, 4.0, 0.0, 0.0);
+    let p0 = Mat4::from_diagonal(&Vec4::new(0.01, 0.01, 0.01, 0.01));
+    let z: Vec<Option<Real>> = model
+        .network
+        .delays(Vec2::new(3.1, 3.95))
+        .into_iter()
+        .map(Some)
+        .collect();
+    let motion = fast_motion();
+    for (cfg, distinct) in [
+        (PfConfig::bootstrap(1000), false),
+        (PfConfig::default(), true),
+    ] {
+        let mut f = ParticleFilter::new(x0, p0, cfg, rng(4, 0)).unwrap();
+        let mut resampled = false;
+        for _ in 0..5 {
+            f.predict(&motion);
+            let u = f
+                .update(&model, &z, MeasurementNoise::AtPrediction)
+                .unwrap();
+            if u.resampled {
+                resampled = true;
+                let estimate = f.covariance;
+                let p = f.particles();
+                let all_distinct = (1..p.len()).all(|j| p[j] != p[j - 1]);
+                assert_eq!(all_distinct, distinct, "{cfg:?}");
+                if distinct {
+                    let mean: Vec4 = p.iter().sum::<Vec4>() / p.len() as Real;
+                    let var =
+                        p.iter().map(|x| (x[0] - mean[0]).powi(2)).sum::<Real>() / p.len() as Real;
+                    let h2 = kernel_bandwidth(1000).powi(2);
+                    let ratio = var / estimate[(0, 0)];
+                    assert!((ratio / (1.0 + h2) - 1.0).abs() < 0.25, "{ratio}");
+                }
+                break;
+            }
+        }
+        assert!(
+            resampled,
+            "{cfg:?}: a cm-level update of a 10 cm cloud resamples"
         );
     }
 }

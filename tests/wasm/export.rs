@@ -149,7 +149,13 @@ fn tracking_chart_svg_parses() {
     let texts = svg_texts("figure", &svg);
     assert_eq!(count(&texts, "Position RMSE"), 1, "{texts:?}");
     assert_eq!(count(&texts, "scenario II"), 1, "{texts:?}");
-    assert!(texts.iter().any(|t| t == "EKF RMSE"), "{texts:?}");
+    // The label with its failed runs, the legend's last row what "failed" means (issue 26).
+    assert_eq!(count(&texts, "EKF RMSE (0/10 failed)"), 1, "{texts:?}");
+    assert_eq!(
+        count(&texts, scatterloc::study::FAILED_NOTE),
+        1,
+        "{texts:?}"
+    );
     svg_texts(
         "figure",
         &ok(wasm::tracking_chart_svg("", "t", "", "", 400, 0)),

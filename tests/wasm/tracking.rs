@@ -399,6 +399,7 @@ fn monte_carlo_job_runs_several_filters() {
     let pf = FilterKind::Pf(PfConfig {
         particles: 300,
         roughening: None,
+        regularized: true,
     });
     for (name, kind, chunks, planned) in [
         ("ekf", FilterKind::Ekf, 3, 40),

@@ -53,8 +53,10 @@ export class FigureExport {
     const format = $('figure-format').value;
     const t0 = performance.now();
     try {
+      // The RMSE chart of a study still running is labelled partial (chartText), here and on the canvas.
+      const partial = what === 'rmse' ? this.ctx.tracking.mc.chartText().partial : '';
       const blob = format === 'svg' ? this.svg(what) : await this.png(what);
-      this.download(blob, this.fileName(what, format), { mode: st.mode, what, format, ms: performance.now() - t0 });
+      this.download(blob, this.fileName(what, format), { mode: st.mode, what, format, ms: performance.now() - t0, partial });
     } catch (e) {
       showError(`Save figure: ${errorText(e)}`);
       console.error(e);

@@ -27,7 +27,8 @@
 //   window.importScenarioText(text, name)  loads scenario JSON as an imported file would
 //   window.benchMap(n)       n runs of the map kernel at the current resolution: core-timed ms
 //   window.figureExport      "Save figure" (export.js): last() -> {name, type, size, ms, href (the
-//                            download link's blob URL), mode, what, format} | null; save();
+//                            download link's blob URL), mode, what, format, partial (the RMSE
+//                            chart of a running study: "partial: 64 of 200 runs", else '')} | null; save();
 //                            setDryRun(bool) (build the link without clicking it)
 //   window.zoom              zoom and pan (zoom.js): state() -> {window, home ([x0, x1, y0, y1] m),
 //                            zoomed, factor, rect (the plot, CSS px), gestures, ticks {x, y} and

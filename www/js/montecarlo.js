@@ -112,11 +112,15 @@ export class MonteCarlo {
   /** The chart's {title, subtitle, caption} (the canvas and the SVG of "Save figure" share them). */
   chartText() {
     const p = this.params;
+    const r = this.result ? JSON.parse(this.result) : null;
     let sub = p ? `${p.trajectories * p.noise_runs} runs × ${p.steps} steps, T = ${p.dt_s} s` : '';
-    if (this.result) sub += ` · ${failedRuns(JSON.parse(this.result))}`;
+    if (r) sub += ` · ${failedRuns(r)}`;
     if (this.state === 'running') sub += ` · running, ${this.done}/${this.total} chunks`;
     const names = p && p.filters ? p.filters.toUpperCase().split(',').join(', ') : 'EKF';
-    return { title: `Position RMSE: ${names} vs posterior CRLB`, subtitle: sub, caption: this.caption };
+    // A study still running (or stopped) labels its figure, the canvas and a saved file alike.
+    const partial = r && !r.done ? partialRuns(r, names.includes(',')) : '';
+    const title = `Position RMSE: ${names} vs posterior CRLB${partial ? ` (${partial})` : ''}`;
+    return { title, subtitle: sub, caption: this.caption, partial };
   }
 
   /** Progress bar and status line (numbers and labels from the result). */
@@ -143,10 +147,11 @@ export class MonteCarlo {
         + `ε_PCRLB ${fmt(r.rmse_pcrlb_m[n])} · NEES 4 = consistent · ${failedRuns(r)}`;
     }
     const pf = r && r.filters.pf;
-    $('mc-pf-note').textContent = pf ? `PF: ${pf.runs_planned} runs × ${r.particles} particles `
-      + `(page budget ${r.particle_budget / 1e6}·10⁶ particle-steps)` : '';
+    $('mc-pf-note').textContent = pf ? `PF: ${pf.runs_planned} runs × ${r.particles} particles, `
+      + `${pf.failed_runs} of ${pf.runs + pf.failed_runs} failed so far (page budget ${r.particle_budget / 1e6}·10⁶ particle-steps)` : '';
     if (this.state === 'error') text = `${size} · failed`;
     el.textContent = text;
+    el.title = FAILED_MEANING;
     const ms = $('mc-ms');
     ms.textContent = this.ms === null ? 'MC –' : `MC ${size}: ${fixed(this.ms, 0)} ms`;
     ms.dataset.ms = this.ms === null ? '' : String(this.ms);
@@ -155,7 +160,7 @@ export class MonteCarlo {
 
 /**
  * The failed-run counts of a result, shown wherever the RMSE is (even when 0): "0 failed runs",
- * "EKF 0, PF 3 failed runs (excluded from the RMSE)"; a filter that failed in every run
+ * "EKF 0, PF 3 failed runs (the filter broke down numerically: excluded from the RMSE)"; a filter that failed in every run
  * (`failed_filters`, issue 24) adds its error, e.g. " · PF: particles: every run of the PF failed …".
  */
 function failedRuns(r) {
@@ -163,5 +168,22 @@ function failedRuns(r) {
   const total = f.reduce((a, [, c]) => a + c.failed_runs, 0);
   const counts = f.length === 1 ? String(total) : f.map(([name, c]) => `${name.toUpperCase()} ${c.failed_runs}`).join(', ');
   const all = (r.failed_filters || []).map((x) => ` · ${x.name.toUpperCase()}: ${x.error}`).join('');
-  return `${counts} failed run${total === 1 && f.length === 1 ? '' : 's'}${total ? ' (excluded from the RMSE)' : ''}${all}`;
+  return `${counts} failed run${total === 1 && f.length === 1 ? '' : 's'}${total ? ' (the filter broke down numerically: excluded from the RMSE)' : ''}${all}`;
 }
+
+/**
+ * The runs counted so far of a result still in progress, per filter against the runs it will
+ * make: "partial: 64 of 200 runs", or with `several` filters in the study (those counted so far)
+ * "partial: EKF 200 of 200, PF 16 of 192 runs".
+ */
+export function partialRuns(r, several) {
+  const f = Object.entries(r.filters || {});
+  if (!f.length) return `partial: ${r.runs + r.failed_runs} of ${r.trajectories * r.noise_runs} runs`;
+  const each = f.map(([name, c]) => [name.toUpperCase(), c.runs + c.failed_runs, c.runs_planned]);
+  if (!several) return `partial: ${each[0][1]} of ${each[0][2]} runs`;
+  return `partial: ${each.map(([n, d, t]) => `${n} ${d} of ${t}`).join(', ')} runs`;
+}
+
+/** What a failed run is (the chart's legend says the same, from the core). */
+export const FAILED_MEANING = 'a failed run: the filter broke down numerically (its covariance stopped '
+  + 'being positive definite, e.g. the particles collapsed onto one), so it is left out of the RMSE';

@@ -47,6 +47,9 @@ pub struct FiltersPanel<'a> {
     pub curves: &'a [FilterCurve<'a>],
     /// `ε_PCRLB(t_n)`, m, one per time (empty: not drawn; `None`: a gap).
     pub rmse_pcrlb_m: &'a [Option<Real>],
+    /// A last legend row of text without a mark, e.g. what a failed run is
+    /// ([`crate::study::FAILED_NOTE`]); `None`: none.
+    pub legend_note: Option<&'a str>,
 }
 
 /// Title and subtitle of the figure.
@@ -251,6 +254,13 @@ fn draw_panel<DB: DrawingBackend>(
                         + PathElement::new([(14, 0), (24, 0)], pcrlb)
                 });
         }
+    }
+    if let Some(note) = p.legend_note {
+        chart
+            .draw_series(core::iter::empty::<EmptyElement<(Real, Real), DB>>())
+            .map_err(chart_err)?
+            .label(note)
+            .legend(|(x, y)| EmptyElement::at((x, y)));
     }
     series_legend(
         &mut chart,

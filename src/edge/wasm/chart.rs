@@ -17,6 +17,8 @@ use crate::error::Error;
 struct FilterRmse {
     rmse_m: Vec<Option<f64>>,
     runs: usize,
+    #[serde(default)]
+    failed_runs: usize,
 }
 
 /// The curves read from a result (other keys are ignored; `null` is a gap).
@@ -32,11 +34,12 @@ struct Curves {
     particles: Option<usize>,
 }
 
-/// The legend label of filter `name`: `EKF RMSE`, `PF RMSE (192 runs × 1000 particles)`.
-fn label(name: &str, runs: usize, particles: Option<usize>) -> String {
-    let base = crate::study::curve_label(name, false);
+/// The legend label of filter `name` with its failed runs out of those run so far:
+/// `EKF RMSE (0/200 failed)`, `PF RMSE (3/192 failed, 1000 particles)`.
+fn label(name: &str, f: &FilterRmse, particles: Option<usize>) -> String {
+    let base = crate::study::failed_label(name, f.failed_runs, f.runs + f.failed_runs);
     match (name, particles) {
-        ("pf", Some(n)) => format!("{base} ({runs} runs × {n} particles)"),
+        ("pf", Some(n)) => format!("{}, {n} particles)", base.trim_end_matches(')')),
         _ => base,
     }
 }
@@ -45,8 +48,9 @@ fn drawable(v: &Option<f64>) -> bool {
     v.is_some_and(|v| v.is_finite() && v > 0.0)
 }
 
-/// Draws each tracker's RMSE (solid, one colour per filter, in the order EKF, UKF, PF;
-/// a result without `filters` draws `rmse_ekf_m` as the EKF's) and ε_PCRLB(t) (dashed) from
+/// Draws each tracker's RMSE (solid, one colour per filter, in the order EKF, UKF, PF, each
+/// labelled with its failed runs, the legend's last row saying what failed means; a result
+/// without `filters` draws `rmse_ekf_m` as the EKF's) and ε_PCRLB(t) (dashed) from
 /// `result_json` (a Monte Carlo result; `""` draws empty axes) onto `canvas` at its pixel size,
 /// with a figure `title`, optional `subtitle` and a panel `caption`. Returns how many curves were
 /// drawn (0 … filters + 1). Throws on malformed JSON or a drawing failure.
@@ -91,11 +95,11 @@ pub(super) fn draw_result<DB: DrawingBackend>(
             .filter_map(|name| map.remove(name).map(|v| (name, v)))
             .map(|(name, v)| {
                 let f: FilterRmse = serde_json::from_value(v).map_err(parse)?;
-                Ok((label(name, f.runs, c.particles), f.rmse_m))
+                Ok((label(name, &f, c.particles), f.rmse_m))
             })
             .collect::<Result<_, String>>()?,
         _ if c.rmse_ekf_m.is_empty() => Vec::new(),
-        _ => vec![(label("ekf", 0, None), c.rmse_ekf_m)],
+        _ => vec![(crate::study::curve_label("ekf", false), c.rmse_ekf_m)],
     };
     let values: Vec<Vec<f64>> = series
         .iter()
@@ -111,6 +115,7 @@ pub(super) fn draw_result<DB: DrawingBackend>(
         t_s: &c.t_s,
         curves: &curves,
         rmse_pcrlb_m: &c.rmse_pcrlb_m,
+        legend_note: (!curves.is_empty()).then_some(crate::study::FAILED_NOTE),
     };
     let opts = TrackingChartOptions {
         title: title.to_string(),

@@ -37,6 +37,7 @@ pub(super) fn page_filter(field: &str, name: &str, particles: usize) -> crate::R
     let pf = PfConfig {
         particles,
         roughening: None,
+        regularized: true,
     };
     FilterKind::named(field, name, UkfParams::default(), pf)
 }

@@ -55,6 +55,7 @@ fn every_filter_sees_the_same_data_and_tracks() {
         FilterKind::Pf(crate::track::PfConfig {
             particles: 2000,
             roughening: None,
+            regularized: true,
         }),
     ];
     for seed in [1, 2, 3] {

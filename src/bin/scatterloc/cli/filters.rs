@@ -61,6 +61,10 @@ pub struct FilterSettings {
     /// Roughening constant c of the particle filter, 0..=10 [default: off].
     #[arg(long, value_name = "C", value_parser = finite)]
     pub roughening: Option<f64>,
+    /// The particle filter as the plain bootstrap SIR (no first-update proposal, no kernel
+    /// after resampling) [default: the regularised particle filter].
+    #[arg(long)]
+    pub pf_bootstrap: bool,
     /// UKF sigma-point spread alpha, 1e-4 <= alpha <= 1 (Wan & van der Merwe) [default: 1].
     #[arg(long, value_name = "A", value_parser = finite)]
     pub ukf_alpha: Option<f64>,

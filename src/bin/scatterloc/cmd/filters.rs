@@ -28,6 +28,7 @@ pub fn filter_kinds(
     let pf_given = [
         ("--particles", settings.particles.is_some()),
         ("--roughening", settings.roughening.is_some()),
+        ("--pf-bootstrap", settings.pf_bootstrap),
     ];
     let unused = |given: &[(&str, bool)], name: &str| -> Result<(), CliError> {
         match given.iter().find(|(_, g)| *g) {
@@ -52,6 +53,7 @@ pub fn filter_kinds(
     let pf = PfConfig {
         particles: settings.particles.unwrap_or(PfConfig::default().particles),
         roughening: settings.roughening,
+        regularized: !settings.pf_bootstrap,
     };
     names
         .iter()

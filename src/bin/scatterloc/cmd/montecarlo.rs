@@ -238,6 +238,7 @@ pub fn pcrlb(args: &PcrlbArgs) -> Result<(), CliError> {
             nees: None,
             caption_note: None,
             figure_curves: Vec::new(),
+            figure_note: None,
             meta,
         });
     }

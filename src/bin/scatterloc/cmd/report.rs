@@ -153,6 +153,7 @@ impl Outputs {
                     t_s: &d.t_s,
                     curves,
                     rmse_pcrlb_m: &d.rmse_pcrlb_m,
+                    legend_note: d.figure_note,
                 })
                 .collect();
             files.figure("out", path, *format, size, &FiltersFigure { panels, opts })?;

@@ -17,6 +17,7 @@ fn range_and_gaps() {
         t_s: &t,
         curves: &curves,
         rmse_pcrlb_m: &pcrlb,
+        legend_note: None,
     };
     let (lo, hi) = y_range(&[p]);
     // 2.2 mm is within 15 % of 2 mm: one more 1-2-5 step below; 0.447 m fits under 0.5 m.
@@ -62,6 +63,7 @@ fn tracking_figure_of_one_and_of_two_filters() {
         t_s: &t,
         curves,
         rmse_pcrlb_m: &pcrlb,
+        legend_note: None,
     };
     let single = svg_of(|root| draw_tracking_filters(root, &[panel(&one)], &opts));
     assert!(single.contains("EKF RMSE  ε_EKF"), "{single}");
@@ -85,4 +87,34 @@ fn tracking_figure_of_one_and_of_two_filters() {
     let root = SVGBackend::with_string(&mut svg, (1000, 620)).into_drawing_area();
     let e = draw_tracking_filters(&root, &[panel(&short)], &opts).unwrap_err();
     assert!(e.0.contains("PF RMSE"), "{}", e.0);
+}
+
+/// The failed counts in the labels and the legend's last row saying what "failed" means (issue
+/// 26): both in the SVG's text, the note after every curve's label.
+#[test]
+fn legend_names_failed_runs_and_what_failed_means() {
+    let t = [0.0, 1.0, 2.0];
+    let pf = [0.4, 0.02, 0.01];
+    let pcrlb = [Some(0.4), Some(0.015), Some(0.008)];
+    let label = crate::study::failed_label("pf", 3, 192);
+    assert_eq!(label, "PF RMSE (3/192 failed)");
+    let curves = [FilterCurve {
+        label: &label,
+        rmse_m: &pf,
+    }];
+    let panel = FiltersPanel {
+        title: "Scenario I",
+        t_s: &t,
+        curves: &curves,
+        rmse_pcrlb_m: &pcrlb,
+        legend_note: Some(crate::study::FAILED_NOTE),
+    };
+    let opts = TrackingChartOptions {
+        title: "t".into(),
+        subtitle: None,
+    };
+    let svg = svg_of(|root| draw_tracking_filters(root, &[panel], &opts));
+    let at = |s: &str| svg.find(s).unwrap_or_else(|| panic!("{s} not in {svg}"));
+    assert!(at("PF RMSE (3/192 failed)") < at("failed = filter broke down"));
+    assert!(at("posterior CRLB") < at("failed = filter broke down"));
 }

@@ -235,6 +235,7 @@ fn track_frame_estimate_and_data() {
                 let pf = FilterKind::Pf(PfConfig {
                     particles: 300,
                     roughening: None,
+                    regularized: true,
                 });
                 let v = value(&TrackDataJs::new(kind, pf, 5, 6, &run, &est, model));
                 assert_eq!(
