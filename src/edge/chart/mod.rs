@@ -16,6 +16,7 @@ mod map;
 mod overlay;
 mod panel;
 mod plan;
+mod raster;
 mod roc;
 mod scene;
 mod tracking;
@@ -26,9 +27,11 @@ pub use channel::{
 pub(crate) use layout::{axis_label, chart_err};
 pub use layout::{register_fonts, suggested_size, ChartError};
 pub use map::{
-    default_titles, draw_crlb_map, draw_crlb_map_with, scenario_nodes, ChartOptions, ChartSummary,
+    crlb_map_svg, default_titles, draw_crlb_map, draw_crlb_map_with, scenario_nodes, ChartOptions,
+    ChartSummary,
 };
 pub use overlay::{MapOverlay, OverlayLine, OverlayMark, OverlayMarkKind, OverlayPath};
+pub use raster::{base64, encode_png, map_rgb, PNG_DATA_URI, PNG_SIGNATURE};
 pub use panel::{check_area, ChartNode, MapData, NodeKind};
 pub use plan::{
     draw_plan_maps, plan_caption, plan_chart_size, PlanChartOptions, PlanPanel, PlanPath,
