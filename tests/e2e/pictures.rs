@@ -435,6 +435,9 @@ async fn strip(c: &Client, x0: f64, x1: f64) -> Result<Value, String> {
     .await
 }
 
+const BANNER: &str = "return document.getElementById('error').hidden ? '' \
+    : document.getElementById('error-text').textContent";
+
 async fn outside_run(c: &Client, port: u16) -> Result<Value, String> {
     open(c, port).await?;
     settle(c).await?;
@@ -445,13 +448,14 @@ async fn outside_run(c: &Client, port: u16) -> Result<Value, String> {
     let near = js(
         c,
         &format!(
-            "const ok = window.importScenarioText({}, 'near.json'); return {{ ok, \
-             banner: document.getElementById('error').hidden ? '' : document.getElementById('error-text').textContent }};",
+            "return window.importScenarioText({}, 'near.json');",
             serde_json::to_string(&s.to_string()).unwrap()
         ),
     )
     .await?;
     settle(c).await?;
+    // The warning is shown by the refresh the import schedules.
+    let near = json!({ "ok": near, "banner": js(c, BANNER).await? });
     let near_home = js(c, "return window.zoom.state().home").await?;
     let near_base = js(c, "return window.pictures.baselines()").await?;
     let rect = js(c, "return window.view.rect").await?;
@@ -460,13 +464,14 @@ async fn outside_run(c: &Client, port: u16) -> Result<Value, String> {
     let far = js(
         c,
         &format!(
-            "const ok = window.importScenarioText({}, 'far.json'); return {{ ok, \
-             banner: document.getElementById('error').hidden ? '' : document.getElementById('error-text').textContent }};",
+            "return window.importScenarioText({}, 'far.json');",
             serde_json::to_string(&s.to_string()).unwrap()
         ),
     )
     .await?;
     settle(c).await?;
+    // The warning is shown by the refresh the import schedules.
+    let far = json!({ "ok": far, "banner": js(c, BANNER).await? });
     let far_home = js(c, "return window.zoom.state().home").await?;
     let far_base = js(c, "return window.pictures.baselines()").await?;
     let far_rect = js(c, "return window.view.rect").await?;
