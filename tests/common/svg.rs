@@ -34,7 +34,12 @@ pub fn embedded_png(what: &str, svg: &str) -> Vec<u8> {
     let href = images[0].attribute("href").unwrap_or("");
     let b64 = href
         .strip_prefix("data:image/png;base64,")
-        .unwrap_or_else(|| panic!("{what}: not a PNG data URI: {}", &href[..href.len().min(40)]));
+        .unwrap_or_else(|| {
+            panic!(
+                "{what}: not a PNG data URI: {}",
+                &href[..href.len().min(40)]
+            )
+        });
     let val = |c: u8| -> u32 {
         match c {
             b'A'..=b'Z' => u32::from(c - b'A'),

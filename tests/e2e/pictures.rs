@@ -127,7 +127,12 @@ async fn lock_run(c: &Client, port: u16) -> Result<LockOutcome, String> {
     let range_after_drag = js(c, "return window.pictures.range()").await?;
     let (values_after, window, res) = page_map(c).await?;
     let mut pixels = Vec::new();
-    for (i, j) in [(3, 5), (res / 2, res / 3), (res - 4, res - 2), (res / 5, res - 9)] {
+    for (i, j) in [
+        (3, 5),
+        (res / 2, res / 3),
+        (res - 4, res - 2),
+        (res / 5, res - 9),
+    ] {
         pixels.push(((i, j), cell_rgb(c, i, j).await?));
     }
     // Strict setter: each bad range throws a ColourRangeError and changes nothing.
@@ -212,7 +217,10 @@ fn colour_lock_keeps_the_scale_through_a_drag() {
     assert_eq!(o.locked, json!({"locked": true, "min_m": lo, "max_m": hi}));
     assert_eq!(o.bar_before["locked"], true);
     for k in ["min_m", "max_m", "ticks", "bar"] {
-        assert_eq!(o.bar_before[k], o.bar_after[k], "colour bar {k} changed by the drag");
+        assert_eq!(
+            o.bar_before[k], o.bar_after[k],
+            "colour bar {k} changed by the drag"
+        );
     }
     assert_eq!(o.bar_after["min_m"].as_f64(), Some(lo));
     assert_eq!(o.bar_after["max_m"].as_f64(), Some(hi));
@@ -349,6 +357,43 @@ async fn inset_run(c: &Client, port: u16) -> Result<(Vec<(String, Value)>, Vec<S
         settle(c).await?;
         out.push((format!("target near {name}"), inset_geometry(c).await?));
     }
+    // Receivers in the four corners of the area (and the transmitter in the middle): every
+    // corner box is taken, so the inset must find another place.
+    let base = js(c, "return window.app.scenario_json()").await?;
+    let mut sc: Value = serde_json::from_str(base.as_str().unwrap()).unwrap();
+    let (x0, x1, y0, y1) = (area[0], area[1], area[2], area[3]);
+    let corners = [
+        [x0 + 1.0, y1 - 1.0],
+        [x1 - 1.0, y1 - 1.0],
+        [x0 + 1.0, y0 + 1.0],
+        [x1 - 1.0, y0 + 1.0],
+    ];
+    for (k, p) in corners.iter().enumerate() {
+        sc["receivers"][k]["position_m"] = json!(p);
+    }
+    sc["transmitters"][0]["position_m"] = json!([cx, cy]);
+    let ok = js(
+        c,
+        &format!(
+            "return window.importScenarioText({}, 'corners.json');",
+            serde_json::to_string(&sc.to_string()).unwrap()
+        ),
+    )
+    .await?;
+    if ok != Value::Bool(true) {
+        return Err(format!("corner scenario refused: {}", js(c, BANNER).await?));
+    }
+    settle(c).await?;
+    for (k, p) in corners.iter().enumerate() {
+        let tx = p[0] + 1.5 * (cx - p[0]).signum();
+        let ty = p[1] + 1.5 * (cy - p[1]).signum();
+        js(c, &format!("window.placeTarget({tx:?}, {ty:?});")).await?;
+        settle(c).await?;
+        out.push((
+            format!("target near corner Rx{}", k + 1),
+            inset_geometry(c).await?,
+        ));
+    }
     // Moved by its header (the real mouse), then closed and reopened.
     let before = inset_geometry(c).await?;
     drag_grip(c, -120.0, 60.0).await?;
@@ -380,7 +425,10 @@ async fn inset_run(c: &Client, port: u16) -> Result<(Vec<(String, Value)>, Vec<S
         .map_err(|e| e.to_string())?;
     wait_state(c, 120, |s| s["steps"].as_u64().unwrap_or(0) > 0).await?;
     js(c, "window.tracking.pause();").await?;
-    let steps = js(c, "return window.tracking.state().steps").await?.as_u64().unwrap_or(0);
+    let steps = js(c, "return window.tracking.state().steps")
+        .await?
+        .as_u64()
+        .unwrap_or(0);
     for k in [0, steps / 3, 2 * steps / 3, steps] {
         js(c, &format!("window.tracking.seek({k});")).await?;
         settle(c).await?;
@@ -400,6 +448,11 @@ fn inset_keeps_clear_of_nodes_moves_and_closes() {
     let get = |k: &str| &cases.iter().find(|(n, _)| n == k).unwrap().1;
     for (name, g) in &cases {
         if name.starts_with("target near") || name.starts_with("tracking") || name == "reopened" {
+            // Every box must be a full inset (at least 80 px), not a sliver.
+            assert!(
+                g["inset"]["box"]["size"].as_f64().unwrap_or(0.0) >= 80.0,
+                "{name}: {g}"
+            );
             assert_clear(name, g);
             println!("e2e: {name}: inset {}", g["inset"]["box"]);
         }
@@ -408,7 +461,10 @@ fn inset_keeps_clear_of_nodes_moves_and_closes() {
     assert_eq!(b1["moved"], true, "{b1}");
     let dx = b1["box"]["x"].as_f64().unwrap() - b0["x"].as_f64().unwrap();
     let dy = b1["box"]["y"].as_f64().unwrap() - b0["y"].as_f64().unwrap();
-    assert!((dx + 120.0).abs() <= 2.0 && (dy - 60.0).abs() <= 2.0, "moved by ({dx}, {dy})");
+    assert!(
+        (dx + 120.0).abs() <= 2.0 && (dy - 60.0).abs() <= 2.0,
+        "moved by ({dx}, {dy})"
+    );
     let closed = get("closed");
     assert_eq!(closed["inset"]["closed"], true);
     assert!(closed["inset"]["box"].is_null());
@@ -505,11 +561,20 @@ fn outside_node_is_named_and_shown_and_baselines_are_clipped() {
         "{w}"
     );
     let h = f64s(&o["near_home"]);
-    assert!(h[0] <= -7.5 && h[1] >= 40.0 && h[2] <= -10.0 && h[3] >= 26.0, "{h:?}");
+    assert!(
+        h[0] <= -7.5 && h[1] >= 40.0 && h[2] <= -10.0 && h[3] >= 26.0,
+        "{h:?}"
+    );
     let f = o["far"]["banner"].as_str().unwrap();
-    assert!(f.contains("Rx3 at (400, 2) m") && f.contains("too far"), "{f}");
+    assert!(
+        f.contains("Rx3 at (400, 2) m") && f.contains("too far"),
+        "{f}"
+    );
     assert_eq!(f64s(&o["far_home"]), vec![-7.5, 30.0, -10.0, 26.0]);
-    for (key, rect) in [("near_baselines", &o["rect"]), ("far_baselines", &o["far_rect"])] {
+    for (key, rect) in [
+        ("near_baselines", &o["rect"]),
+        ("far_baselines", &o["far_rect"]),
+    ] {
         let (x, y, w, h) = (
             rect["x"].as_f64().unwrap(),
             rect["y"].as_f64().unwrap(),
@@ -541,7 +606,11 @@ fn outside_node_is_named_and_shown_and_baselines_are_clipped() {
         far_edge.iter().all(|x| (x - right).abs() < 1e-9),
         "{far_edge:?} vs {right}"
     );
-    assert_eq!(o["gap"], json!(["20,25,34"]), "only the background #141922 in the gap");
+    assert_eq!(
+        o["gap"],
+        json!(["20,25,34"]),
+        "only the background #141922 in the gap"
+    );
 }
 
 /// The text of a blob URL.
@@ -601,7 +670,10 @@ async fn data_run(c: &Client, port: u16) -> Result<Value, String> {
         .click()
         .await
         .map_err(|e| e.to_string())?;
-    wait_state(c, 180, |s| mc_done(s) && s["steps"].as_u64().unwrap_or(0) > 0).await?;
+    wait_state(c, 180, |s| {
+        mc_done(s) && s["steps"].as_u64().unwrap_or(0) > 0
+    })
+    .await?;
     js(c, "window.tracking.pause();").await?;
     let track_csv = js(c, "return window.pictures.data.text('track', 'csv')").await?;
     let track_json = js(c, "return window.pictures.data.text('track', 'json')").await?;
@@ -691,7 +763,10 @@ fn data_exports_and_svg_map_image_equal_the_core() {
     assert_eq!(m["scenario"], "sensors2019");
     assert_eq!(m["units"], "m");
     assert_eq!(f64s(&m["rmse_m"]), values);
-    assert_eq!(f64s(&m["x_m"]), (0..res).map(|i| grid.x(i)).collect::<Vec<_>>());
+    assert_eq!(
+        f64s(&m["x_m"]),
+        (0..res).map(|i| grid.x(i)).collect::<Vec<_>>()
+    );
     println!("e2e: map data {res}x{res}: CSV {} bytes", info["size"]);
 
     // The SVG: one embedded PNG at the grid's resolution, the colours of the values on the
@@ -708,7 +783,11 @@ fn data_exports_and_svg_map_image_equal_the_core() {
     for j in 0..res {
         for i in 0..res {
             let p = img.get_pixel(i as u32, (res - 1 - j) as u32).0;
-            assert_eq!(p, scale.color(values[j * res + i]), "pixel of cell ({i}, {j})");
+            assert_eq!(
+                p,
+                scale.color(values[j * res + i]),
+                "pixel of cell ({i}, {j})"
+            );
         }
     }
     println!(
@@ -716,8 +795,15 @@ fn data_exports_and_svg_map_image_equal_the_core() {
         o["svg_size"],
         png.len()
     );
-    assert!(o["svg_size"].as_u64().unwrap() < 600_000, "{}", o["svg_size"]);
-    assert!(rects < 1000, "{rects} rects: the map is not drawn as rectangles");
+    assert!(
+        o["svg_size"].as_u64().unwrap() < 600_000,
+        "{}",
+        o["svg_size"]
+    );
+    assert!(
+        rects < 1000,
+        "{rects} rects: the map is not drawn as rectangles"
+    );
 
     // The track.
     let d = &o["track_data"];
@@ -751,10 +837,19 @@ fn data_exports_and_svg_map_image_equal_the_core() {
     assert!(!filters.is_empty());
     for f in &filters {
         assert_eq!(mj["filters"][f]["rmse_m"], r["filters"][f]["rmse_m"], "{f}");
-        assert_eq!(mj["filters"][f]["failed_runs"], r["filters"][f]["failed_runs"]);
-        let col = head.iter().position(|h| *h == format!("rmse_{f}_m")).unwrap();
+        assert_eq!(
+            mj["filters"][f]["failed_runs"],
+            r["filters"][f]["failed_runs"]
+        );
+        let col = head
+            .iter()
+            .position(|h| *h == format!("rmse_{f}_m"))
+            .unwrap();
         let runs = head.iter().position(|h| *h == format!("runs_{f}")).unwrap();
-        let failed = head.iter().position(|h| *h == format!("failed_runs_{f}")).unwrap();
+        let failed = head
+            .iter()
+            .position(|h| *h == format!("failed_runs_{f}"))
+            .unwrap();
         let want = f64s(&r["filters"][f]["rmse_m"]);
         for (k, row) in rows.iter().enumerate() {
             assert_eq!(num(&row[col]), want[k], "{f} step {k}");

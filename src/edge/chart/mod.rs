@@ -31,11 +31,11 @@ pub use map::{
     ChartSummary,
 };
 pub use overlay::{MapOverlay, OverlayLine, OverlayMark, OverlayMarkKind, OverlayPath};
-pub use raster::{base64, encode_png, map_rgb, PNG_DATA_URI, PNG_SIGNATURE};
 pub use panel::{check_area, ChartNode, MapData, NodeKind};
 pub use plan::{
     draw_plan_maps, plan_caption, plan_chart_size, PlanChartOptions, PlanPanel, PlanPath,
 };
+pub use raster::{base64, encode_png, map_rgb, PNG_DATA_URI, PNG_SIGNATURE};
 pub use roc::{
     curve_chart_size, draw_curves, CurveChartOptions, CurveSeries, LineKind, Marker, CURVE_PALETTE,
 };

@@ -388,17 +388,22 @@ pub(crate) fn draw_colorbar_marked<DB: DrawingBackend>(
         ))?;
         let max_labels = (bar_h as Real / (2.0 * font.ticks)) as usize;
         let room = (1.2 * font.ticks) as i32;
-        let ends = [(clamped[0], bar_h, "≤", scale.min), (clamped[1], 0, "≥", scale.max)];
+        let ends = [
+            (clamped[0], bar_h, "≤", scale.min),
+            (clamped[1], 0, "≥", scale.max),
+        ];
         for (on, y, mark, v) in ends {
             if on {
                 let text = alloc::format!("{mark} {}", format_length_m(v, 3));
                 let x = bar_w + (11.0 * s) as i32;
-                area.draw_text(&text, &tick_font, (x, y)).map_err(chart_err)?;
+                area.draw_text(&text, &tick_font, (x, y))
+                    .map_err(chart_err)?;
             }
         }
         for t in colorbar_ticks(scale.min, scale.max, max_labels) {
             let y = ((1.0 - scale.fraction(t.value)) * bar_h as Real).round() as i32;
-            let near_end = |(on, end, _, _): &(bool, i32, &str, Real)| *on && (y - end).abs() < room;
+            let near_end =
+                |(on, end, _, _): &(bool, i32, &str, Real)| *on && (y - end).abs() < room;
             let major = !t.label.is_empty() && !ends.iter().any(near_end);
             let len = ((if major { 7.0 } else { 4.0 }) * s).round() as i32;
             area.draw(&PathElement::new(

@@ -171,10 +171,7 @@ mod tests {
         let grid = Grid::new(s.area_m, 256, 256).unwrap();
         let mut v = vec![0.0; grid.len()];
         crlb_map(&model, &grid, &mut v).unwrap();
-        let map = MapData {
-            grid,
-            values_m: &v,
-        };
+        let map = MapData { grid, values_m: &v };
         let nodes = scenario_nodes(&s);
         let opts = ChartOptions::default();
         let size = crate::chart::suggested_size(&s.area_m, 1000);
@@ -187,7 +184,8 @@ mod tests {
         let (new, summary) =
             crlb_map_svg(size, &map, &nodes, &MapOverlay::default(), &opts).unwrap();
         let doc = roxmltree::Document::parse(&new).unwrap();
-        let rects = |d: &roxmltree::Document| d.descendants().filter(|n| n.has_tag_name("rect")).count();
+        let rects =
+            |d: &roxmltree::Document| d.descendants().filter(|n| n.has_tag_name("rect")).count();
         let old_doc = roxmltree::Document::parse(&old).unwrap();
         println!(
             "map SVG 256²: before {} bytes ({} rect), after {} bytes ({} rect, 1 image)",
@@ -197,12 +195,24 @@ mod tests {
             rects(&doc)
         );
         assert!(new.len() * 5 < old.len(), "{} vs {}", new.len(), old.len());
-        let images: Vec<_> = doc.descendants().filter(|n| n.has_tag_name("image")).collect();
+        let images: Vec<_> = doc
+            .descendants()
+            .filter(|n| n.has_tag_name("image"))
+            .collect();
         assert_eq!(images.len(), 1);
         // The image is the first element after the white background: under every vector layer.
-        let first: Vec<_> = doc.root_element().children().filter(|n| n.is_element()).take(2).collect();
+        let first: Vec<_> = doc
+            .root_element()
+            .children()
+            .filter(|n| n.is_element())
+            .take(2)
+            .collect();
         assert!(first[0].has_tag_name("rect") && first[1].has_tag_name("image"));
-        let b64 = images[0].attribute("href").unwrap().strip_prefix(PNG_DATA_URI).unwrap();
+        let b64 = images[0]
+            .attribute("href")
+            .unwrap()
+            .strip_prefix(PNG_DATA_URI)
+            .unwrap();
         let png = decode(b64);
         let img = image::load_from_memory_with_format(&png, image::ImageFormat::Png)
             .unwrap()
@@ -216,7 +226,11 @@ mod tests {
                 assert_eq!(p, scale.color(v[j * 256 + i]), "cell ({i}, {j})");
             }
         }
-        let texts: Vec<&str> = doc.descendants().filter(|n| n.has_tag_name("text")).filter_map(|n| n.text()).collect();
+        let texts: Vec<&str> = doc
+            .descendants()
+            .filter(|n| n.has_tag_name("text"))
+            .filter_map(|n| n.text())
+            .collect();
         for n in ["Tx", "Rx1", "Rx4", "x (m)", "RMSE bound √(σx² + σy²)"] {
             assert!(texts.iter().any(|t| t.trim() == n), "{n} in {texts:?}");
         }
@@ -244,21 +258,30 @@ mod tests {
             scale: Some(locked),
             ..ChartOptions::default()
         };
-        let map = MapData {
-            grid,
-            values_m: &v,
-        };
-        let (svg, summary) =
-            crlb_map_svg((900, 800), &map, &scenario_nodes(&s), &MapOverlay::default(), &opts)
-                .unwrap();
+        let map = MapData { grid, values_m: &v };
+        let (svg, summary) = crlb_map_svg(
+            (900, 800),
+            &map,
+            &scenario_nodes(&s),
+            &MapOverlay::default(),
+            &opts,
+        )
+        .unwrap();
         assert_eq!(summary.scale, Some(locked));
         let doc = roxmltree::Document::parse(&svg).unwrap();
-        let texts: Vec<&str> = doc.descendants().filter(|n| n.has_tag_name("text")).filter_map(|n| n.text()).collect();
+        let texts: Vec<&str> = doc
+            .descendants()
+            .filter(|n| n.has_tag_name("text"))
+            .filter_map(|n| n.text())
+            .collect();
         for want in [
             format!("≤ {}", format_length_m(locked.min, 3)),
             format!("≥ {}", format_length_m(locked.max, 3)),
         ] {
-            assert!(texts.iter().any(|t| t.trim() == want), "{want} in {texts:?}");
+            assert!(
+                texts.iter().any(|t| t.trim() == want),
+                "{want} in {texts:?}"
+            );
         }
     }
 

@@ -15,13 +15,13 @@ use wasm_bindgen::prelude::*;
 use super::tracking::Track;
 use super::{window, App};
 use crate::chart::{
-    crlb_map_svg, default_titles, draw_mtl_scene, scenario_nodes, scene_window,
-    suggested_size, ChartOptions, MapData, MapOverlay, SceneChartOptions,
+    crlb_map_svg, default_titles, draw_mtl_scene, scenario_nodes, scene_window, suggested_size,
+    ChartOptions, MapData, MapOverlay, SceneChartOptions,
 };
 use crate::error::{limits, Error};
 use crate::localize::{crlb_map, Grid};
-use crate::present::{simulate_snapshot, LogScale};
 use crate::present::{mtl_view, MtlScene};
+use crate::present::{simulate_snapshot, LogScale};
 use crate::scenario::Area;
 use crate::{Model, Scenario, Vec2};
 
@@ -439,11 +439,9 @@ pub fn map_data_text(
         x_m: (0..nx).map(|i| grid.x(i)).collect(),
         y_m: (0..ny).map(|j| grid.y(j)).collect(),
         order: "row-major, y ascending: rmse_m[j * nx + i] is at (x_m[i], y_m[j])",
-        rmse_m: values
-            .iter()
-            .map(|v| v.is_finite().then_some(*v))
-            .collect(),
-        unbounded: "null: the Fisher matrix is singular there (no unbiased estimator has a finite RMSE)",
+        rmse_m: values.iter().map(|v| v.is_finite().then_some(*v)).collect(),
+        unbounded:
+            "null: the Fisher matrix is singular there (no unbiased estimator has a finite RMSE)",
     };
     serde_json::to_string(&doc).map_err(|e| fail(F, e))
 }

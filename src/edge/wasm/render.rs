@@ -38,8 +38,8 @@ pub fn render_map_rgba_locked(
     max: f64,
 ) -> Result<Vec<f64>, JsError> {
     const F: &str = "render_map_rgba_locked";
-    let scale = super::export::locked_scale([min, max])
-        .map_err(|e| JsError::new(&format!("{F}: {e}")))?;
+    let scale =
+        super::export::locked_scale([min, max]).map_err(|e| JsError::new(&format!("{F}: {e}")))?;
     let values = values.to_vec();
     let mut px = vec![0u8; rgba.length() as usize];
     if !present::fill_rgba(&values, &scale, &mut px) {
