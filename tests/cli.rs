@@ -9,6 +9,11 @@
 
 mod common;
 
+/// SVG checks shared with the page tests (the map figure's embedded PNG).
+#[allow(dead_code)]
+#[path = "common/svg.rs"]
+mod svg;
+
 #[path = "cli/basics.rs"]
 mod basics;
 

@@ -95,6 +95,12 @@ mod pf;
 #[path = "e2e/screenshot.rs"]
 pub(crate) mod screenshot;
 
+/// Issue 26 §3/§5: colour lock, the inset clear of nodes (move, close), clipped baselines, a
+/// node outside the area, data export against the core, the map SVG's embedded image.
+#[cfg(test)]
+#[path = "e2e/pictures.rs"]
+mod pictures;
+
 /// One browser at a time (2-core machines).
 static SERIAL: Mutex<()> = Mutex::new(());
 

@@ -99,6 +99,22 @@ impl LogScale {
         viridis(self.fraction(v))
     }
 
+    /// How many bounded (finite, > 0) `values` lie below `min` and above `max`: `[below,
+    /// above]`, the cells a fixed scale draws in its end colours.
+    pub fn clamped_counts(&self, values: &[Real]) -> [usize; 2] {
+        let mut n = [0, 0];
+        for &v in values.iter().filter(|v| v.is_finite() && **v > 0.0) {
+            n[0] += usize::from(v < self.min);
+            n[1] += usize::from(v > self.max);
+        }
+        n
+    }
+
+    /// Whether some bounded `values` lie below `min` and above `max` ([`clamped_counts`](LogScale::clamped_counts) > 0).
+    pub fn clamped(&self, values: &[Real]) -> [bool; 2] {
+        self.clamped_counts(values).map(|n| n > 0)
+    }
+
     /// The ticks of a colour bar on this scale ([`colorbar_ticks`], at most `max_labels`
     /// labels; minor ticks have an empty label), each with its
     /// [`fraction`](LogScale::fraction) from the dark end.

@@ -218,6 +218,28 @@ fn crlb_map_svg_has_the_figure() {
     ] {
         assert!(svg.contains(name), "missing {name}");
     }
+    // The map is one embedded PNG of 64 × 64 pixels (one per cell, the top row the highest y),
+    // each the colour of the core's bound at that cell on the figure's scale (the finite range).
+    let png = crate::svg::embedded_png("crlb-map svg", &svg);
+    let img = image::load_from_memory_with_format(&png, image::ImageFormat::Png)
+        .unwrap()
+        .to_rgb8();
+    assert_eq!((img.width(), img.height()), (64, 64));
+    let sc = presets::sensors2019();
+    let model = Model::new(&sc).unwrap();
+    let grid = Grid::new(sc.area_m, 64, 64).unwrap();
+    let mut v = vec![0.0; grid.len()];
+    scatterloc::localize::crlb_map(&model, &grid, &mut v).unwrap();
+    let scale = scatterloc::present::LogScale::spanning(&v).unwrap();
+    for j in 0..64 {
+        for i in 0..64 {
+            let p = img.get_pixel(i as u32, 63 - j as u32).0;
+            assert_eq!(p, scale.color(v[j * 64 + i]), "cell ({i}, {j})");
+        }
+    }
+    // No rectangle per cell any more: the colour bar's runs and the labels' boxes only.
+    let rects = svg.matches("<rect").count();
+    assert!(rects < 1000, "{rects} rectangles");
 }
 
 fn png_size(path: &Path) -> (u32, u32, usize) {

@@ -20,6 +20,7 @@ import { FigureExport } from './export.js';
 import { Zoomer } from './zoom.js';
 import { setLinkColors } from './draw.js';
 import { Channel } from './channel.js';
+import { homeWithNodes } from './outside.js';
 
 const MODES = ['snapshot', 'tracking', 'mtl', 'channel'];
 
@@ -175,6 +176,18 @@ export async function start() {
   const dirty = {};
   let scheduled = false;
 
+  /**
+   * The view's home: the area, widened to show nodes outside it (outside.js: a warning names
+   * them; the area is drawn as a dashed outline). Returns homeWithNodes' {home, outline, warning}.
+   */
+  function setHomeFor() {
+    const h = homeWithNodes(app.area(), app.nodes());
+    view.setHome(h.home);
+    st.areaOutline = h.outline;
+    st.outsideWarning = h.warning;
+    return h;
+  }
+
   function refresh() {
     scheduled = false;
     const d = { ...dirty };
@@ -183,7 +196,8 @@ export async function start() {
     const dragging = !!d.dragging && !d.dragEnd;
     try {
       if (d.reset) {
-        view.setHome(app.area());
+        const home = setHomeFor();
+        if (home.warning) showError(home.warning);
         view.reset();
         zoom.show();
         st.target = null;
@@ -205,7 +219,7 @@ export async function start() {
       st.overlay = tr ? (c, v) => tracking.overlay(c, v)
         : plan.showsRoi() ? (c, v) => plan.overlay(c, v) : null;
       st.insetTitle = tr ? `${tracking.filterName()} zoom · true scale` : 'target zoom';
-      st.insetAvoid = tr ? tracking.avoidPoints() : [];
+      st.insetAvoid = tr ? tracking.avoidPoints() : map.avoidPoints();
       if (st.mode === 'channel') {
         // The channel view (channel.js): its track layer, no snapshot target.
         st.fix = null;
@@ -283,7 +297,8 @@ export async function start() {
   ctx.showHint = () => pointer.showHint();
 
   view.resize();
-  view.setHome(app.area());
+  const home0 = setHomeFor();
+  if (home0.warning) errors.push(home0.warning);
   if (opts.view) {
     try {
       view.setWindow(opts.view);

@@ -7,6 +7,7 @@
 // here runs until the button is pressed (the drag stays as fast as it was).
 
 import { $, errorText, showError } from './dom.js';
+import { DataExport } from './data-export.js';
 
 /** Width of an exported SVG figure, px (the CLI's default); the height fits the plot. */
 const SVG_WIDTH = 1000;
@@ -27,6 +28,7 @@ export class FigureExport {
     this.last = null; // {name, type, size, ms, blob, href, mode, what, format}
     this.count = 0;
     $('figure-save').addEventListener('click', () => this.save());
+    this.data = new DataExport(ctx); // "Export data" (data-export.js)
   }
 
   /** Shows the choices of `mode`: the RMSE chart only in tracking. */
@@ -37,6 +39,7 @@ export class FigureExport {
     rmse.disabled = mode !== 'tracking';
     if (rmse.disabled && what.value === 'rmse') what.value = 'map';
     what.querySelector('option[value="map"]').textContent = mode === 'mtl' ? 'Scene' : 'Map';
+    this.data.setMode(mode);
   }
 
   /** The file name of figure `what` ('map' | 'rmse') of the current view. */
@@ -72,6 +75,9 @@ export class FigureExport {
     }
     const res = Number($('resolution').value) || 256;
     const options = { window: Array.from(view.area), res };
+    // A locked colour range (colour-lock.js) colours the figure as the canvas.
+    const locked = st.colourLock ? st.colourLock.scale() : null;
+    if (locked) options.scale = locked;
     let text;
     if (what === 'rmse') {
       const mc = tracking.mc;

@@ -44,6 +44,13 @@
 //                            truthStates() (the truth file's states, or null);
 //                            seek(k); play(); pause(); settings() / applySettings(obj)
 //                            (channelSettings / applyChannelSettings)
+//   window.pictures          map.js hooks(): getColourRange(), setColourRange(obj), colourBar()
+//                            (last frame's {min_m, max_m, locked, ticks, marks, bar}), inset()
+//                            ({closed, moved, box}), baselines() (clipped segments, CSS px),
+//                            range(); data {text(what, format), save(), last(), setDryRun};
+//                            outsideWarning() (nodes outside the area, outside.js)
+//   window.getColourRange() / setColourRange(obj)  the colour lock (colour-lock.js; the latter
+//                            throws a ColourRangeError)
 //   body[data-ready='1']     the page is up;  body[data-error]  it failed (the message)
 
 /**
@@ -153,6 +160,10 @@ export function registerHooks(p) {
       settings: () => p.channel.settings(),
       applySettings: (obj) => p.channel.applySettings(obj),
     },
+    // Pictures (map.js hooks(), data-export.js): colour range, inset, baselines, data export.
+    pictures: { ...p.map.hooks(), data: p.figures.data.hooks(), outsideWarning: () => st.outsideWarning || '' },
+    getColourRange: () => p.map.lock.get(),
+    setColourRange: (obj) => p.map.lock.set(obj),
     benchMap: (n = 9) => {
       const r = st.res;
       const buf = new Float64Array(r * r);

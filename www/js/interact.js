@@ -77,6 +77,7 @@ export function attachPointer(ctx) {
     readout.append(
       `x = ${fixed(m.x, 2)} m, y = ${fixed(m.y, 2)} m  ·  RMSE bound `, b,
       c.bounded ? `  ·  σx ${c.sigma_x_label}, σy ${c.sigma_y_label}` : '  ·  Fisher matrix singular here',
+      st.colourLock ? st.colourLock.note(c.rmse_m) : '',
     );
   };
 

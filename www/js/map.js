@@ -15,6 +15,8 @@ import { $, fixed, showError } from './dom.js';
 import { Zoom } from './view.js';
 import { JobWorker } from './workers.js';
 import { C, FONT, FONT_B, FULL, clipTo, cross, drawAxes, drawNodes, drawScaleBar, ellipsePath, haloText, linkColor, polyline } from './draw.js';
+import { ColourLock } from './colour-lock.js';
+import { HARD, InsetControls, chooseBox } from './inset.js';
 
 /** Main-thread budget of the map kernel per refresh, ms (about 60 % of a 60 Hz frame). */
 const FRAME_MS = 10;
@@ -35,8 +37,17 @@ export class MapView {
       mapWindow: null, // the window [x0, x1, y0, y1] (m) the values were computed for
       image: null,
       range: null,
+      clamped: [0, 0], // cells below / above a locked colour range (colour-lock.js)
       res: 256,
     });
+    // "Lock colours" (colour-lock.js): a new range recolours the map without recomputing it.
+    this.lock = new ColourLock(ctx, () => {
+      if (ctx.st.values && ctx.st.image) this.paint();
+      ctx.changed({ draw: true });
+    });
+    ctx.st.colourLock = this.lock;
+    // The zoom inset's drag handle, × and "Show zoom inset" (inset.js).
+    ctx.st.insetControls = new InsetControls(ctx.view.canvas, () => ctx.changed({ draw: true }));
     this.nsPerCellLink = null; // learnt from every map computed (null: none yet)
     this.worker = new JobWorker(new URL('./map-worker.js', import.meta.url), ctx.module, {
       staleMs: 0,
@@ -110,11 +121,35 @@ export class MapView {
     }
   }
 
-  /** Colours st.values into the map image. */
+  /** Colours st.values into the map image (on the locked colour range, if any). */
   paint() {
-    const { wasm, st } = this.ctx;
-    st.range = Array.from(wasm.render_map_rgba(st.values, st.image.data));
+    const { st } = this.ctx;
+    const r = this.lock.render(st.values, st.image.data);
+    st.range = r.range;
+    st.clamped = r.clamped;
     st.mapCanvas.getContext('2d').putImageData(st.image, 0, 0);
+  }
+
+  /**
+   * What the snapshot view's inset keeps clear of ([x, y, weight] m): every node (never
+   * covered); the target is always avoided by drawInset.
+   */
+  avoidPoints() {
+    const n = this.ctx.st.nodes;
+    return [...n.transmitters, ...n.receivers].map((p) => [p.x, p.y, HARD]);
+  }
+
+  /** The hooks of the pictures (hooks.js: window.pictures). */
+  hooks() {
+    const { st, view } = this.ctx;
+    return {
+      getColourRange: () => this.lock.get(),
+      setColourRange: (obj) => this.lock.set(obj),
+      colourBar: () => (view.drawn.colourBar ? JSON.parse(JSON.stringify(view.drawn.colourBar)) : null),
+      inset: () => st.insetControls.state(),
+      baselines: () => (view.drawn.baselines || []).map((b) => ({ ...b })),
+      range: () => ({ range: st.range ? st.range.slice() : null, clamped: st.clamped.slice() }),
+    };
   }
 
   /**
@@ -241,6 +276,15 @@ function drawColorbar(ctx, view, st, w) {
   ctx.textAlign = 'left';
   ctx.textBaseline = 'middle';
   const [min, max] = st.range || [Infinity, Infinity];
+  // A locked range that cells pass: "≤ min" / "≥ max" at that end (colour-lock.js), its tick
+  // labels within 14 px of the end left out.
+  const lockedScale = st.colourLock ? st.colourLock.scale() : null;
+  const clamped = st.clamped || [0, 0];
+  const ends = [
+    { on: !!lockedScale && clamped[0] > 0, y: r.y + r.h, text: `≤ ${w.format_length(min, 3)}`, base: 'bottom' },
+    { on: !!lockedScale && clamped[1] > 0, y: r.y, text: `≥ ${w.format_length(max, 3)}`, base: 'top' },
+  ];
+  const drawnTicks = [];
   // The figures' algorithm (core colorbar_ticks): labels thinned to the bar's height, minor
   // ticks (empty label) drawn shorter.
   const maxLabels = Math.max(2, Math.floor(r.h / 24));
@@ -248,8 +292,19 @@ function drawColorbar(ctx, view, st, w) {
     const y = r.y + r.h - t.frac * r.h;
     const len = t.label ? 5 : 3;
     ctx.beginPath(); ctx.moveTo(bx + bw, y); ctx.lineTo(bx + bw + len, y); ctx.stroke();
-    if (t.label) ctx.fillText(t.label, bx + bw + 8, y);
+    const label = t.label && !ends.some((e) => e.on && Math.abs(e.y - y) < 14);
+    if (label) ctx.fillText(t.label, bx + bw + 8, y);
+    drawnTicks.push({ value_m: t.value_m, frac: t.frac, label: label ? t.label : '' });
   }
+  for (const e of ends.filter((x) => x.on)) {
+    ctx.textBaseline = e.base;
+    ctx.fillText(e.text, bx + bw + 8, e.y);
+  }
+  ctx.textBaseline = 'middle';
+  view.drawn.colourBar = {
+    min_m: min, max_m: max, locked: !!lockedScale, ticks: drawnTicks,
+    marks: ends.filter((x) => x.on).map((x) => x.text), bar: { x: bx, y: r.y, w: bw, h: r.h },
+  };
   // Unbounded swatch under the bar.
   ctx.fillStyle = st.unboundedColor;
   ctx.fillRect(bx, r.y + r.h + 10, bw, 10);
@@ -266,12 +321,18 @@ function drawNetwork(ctx, view, n, selected) {
   ctx.strokeStyle = C.baseline;
   ctx.lineWidth = 1;
   ctx.beginPath();
+  // Clipped to the plot (view.clipSegment), so none crosses the colour bar or the margins.
+  const drawn = [];
   for (const [k, l] of n.links) {
     const a = view.toPixel(n.transmitters[k].x, n.transmitters[k].y);
     const b = view.toPixel(n.receivers[l].x, n.receivers[l].y);
-    ctx.moveTo(a.x, a.y); ctx.lineTo(b.x, b.y);
+    const c = view.clipSegment(a, b);
+    if (!c) continue;
+    ctx.moveTo(c[0].x, c[0].y); ctx.lineTo(c[1].x, c[1].y);
+    drawn.push({ tx: k, rx: l, a: c[0], b: c[1] });
   }
   ctx.stroke();
+  view.drawn.baselines = drawn;
   ctx.setLineDash([]);
   drawNodes(ctx, view, n.receivers, n.transmitters, selected);
 }
@@ -309,37 +370,11 @@ function drawTargetMain(ctx, view, fix) {
  * Zoom inset around the target: iso-delay ellipses, CRLB and LM (or EKF) 1σ ellipses, scale bar.
  * `title` names it; inside the plot it keeps off the `avoid` points ([[x, y, weight?], …] m) if it can.
  */
-function drawInset(ctx, view, fix, w, title, avoid) {
-  const r = view.rect;
+function drawInset(ctx, view, fix, w, title, avoid, controls) {
   const t = view.toPixel(fix.truth.x, fix.truth.y);
-  const pad = 10;
-  // Outside the plot when a wide area leaves room above or below it, else in a plot corner.
-  const below = view.height - (r.y + r.h) - 52;
-  const above = r.y - 4;
-  let size;
-  let box;
-  if (below >= 170) {
-    size = Math.min(270, below - pad);
-    box = { x: r.x + r.w - size, y: r.y + r.h + 52 };
-  } else if (above >= 170) {
-    size = Math.min(270, above - pad);
-    box = { x: r.x + r.w - size, y: r.y - size - pad };
-  } else {
-    size = Math.min(250, r.w * 0.42, r.h * 0.55);
-    if (size < 80) return;
-    const corners = [
-      { x: r.x + r.w - size - pad, y: r.y + pad },
-      { x: r.x + pad, y: r.y + pad },
-      { x: r.x + r.w - size - pad, y: r.y + r.h - size - pad },
-      { x: r.x + pad, y: r.y + r.h - size - pad },
-    ];
-    // The corner whose box keeps clear of the target marker and covers the least weight of the
-    // `avoid` points ([x, y, weight = 1], m; e.g. a track), the first in this order on ties.
-    const inside = (c, p, m) => p.x > c.x - m && p.x < c.x + size + m && p.y > c.y - m && p.y < c.y + size + m;
-    const cost = (c) => avoid.reduce((sum, [x, y, wt = 1]) => sum + (inside(c, view.toPixel(x, y), 6) ? wt : 0),
-      inside(c, t, 12) ? 1e9 : 0);
-    box = corners.reduce((best, c) => (cost(c) < cost(best) ? c : best));
-  }
+  const placed = placeInset(view, t, avoid, controls);
+  if (!placed) return null;
+  const { size, box } = placed;
   const z = new Zoom(box.x, box.y, size, fix.truth, fix.view_radius_m);
   // Leader line from the target to the inset.
   ctx.strokeStyle = 'rgba(255,255,255,0.45)';
@@ -390,6 +425,40 @@ function drawInset(ctx, view, fix, w, title, avoid) {
   ctx.restore();
   ctx.strokeStyle = C.frame; ctx.lineWidth = 1;
   ctx.strokeRect(box.x + 0.5, box.y + 0.5, size, size);
+  return { x: box.x, y: box.y, size };
+}
+
+/**
+ * Where the inset goes ({size, box: {x, y}} CSS px, or null: closed, or no room): where the user
+ * moved it (inset.js), else outside the plot when a wide area leaves room above or below it, else
+ * the free place in the plot (chooseBox: clear of the target and the `avoid` points, [x, y,
+ * weight = 1] m).
+ */
+function placeInset(view, t, avoid, controls) {
+  const r = view.rect;
+  const pad = 10;
+  const below = view.height - (r.y + r.h) - 52;
+  const above = r.y - 4;
+  const auto = () => {
+    if (below >= 170) {
+      const size = Math.min(270, below - pad);
+      return { x: r.x + r.w - size, y: r.y + r.h + 52, size };
+    }
+    if (above >= 170) {
+      const size = Math.min(270, above - pad);
+      return { x: r.x + r.w - size, y: r.y - size - pad, size };
+    }
+    const size = Math.min(250, r.w * 0.42, r.h * 0.55);
+    if (size < 80) return null;
+    const points = avoid.map(([x, y, wt = 1]) => ({ ...view.toPixel(x, y), w: wt, m: wt >= HARD ? 14 : 6 }));
+    points.push({ ...t, w: 1e3 * HARD, m: 12 });
+    return chooseBox(r, Math.floor(size), points, pad);
+  };
+  const preferred = below >= 170 ? Math.min(270, below - pad) : above >= 170 ? Math.min(270, above - pad)
+    : Math.min(250, r.w * 0.42, r.h * 0.55);
+  const b = controls ? controls.place(Math.max(80, Math.floor(preferred)), auto) : auto();
+  if (!b) return null;
+  return { size: b.size, box: { x: b.x, y: b.y } };
 }
 
 /**
@@ -409,13 +478,31 @@ function drawScene(view, st, w) {
   if (zoomed) clipTo(ctx, view.rect);
   if (st.overlay) st.overlay(ctx, view);
   if (st.fix) drawTargetMain(ctx, view, st.fix);
+  if (st.areaOutline) drawAreaOutline(ctx, view, st.areaOutline);
   drawNetwork(ctx, view, st.nodes, st.selected);
   if (zoomed) ctx.restore();
   drawScaleBar(ctx, view, w);
-  if (st.fix) {
-    const t = view.toPixel(st.fix.truth.x, st.fix.truth.y);
-    if (view.inPlot(t.x, t.y)) drawInset(ctx, view, st.fix, w, st.insetTitle || 'target zoom', st.insetAvoid || []);
-  }
+  let inset = null;
+  const t = st.fix ? view.toPixel(st.fix.truth.x, st.fix.truth.y) : null;
+  const targetShown = !!t && view.inPlot(t.x, t.y);
+  if (targetShown) inset = drawInset(ctx, view, st.fix, w, st.insetTitle || 'target zoom', st.insetAvoid || [], st.insetControls);
+  if (st.insetControls) st.insetControls.shown(inset, targetShown);
+}
+
+/**
+ * The scenario's area [x0, x1, y0, y1] m as a dashed outline (shown when the view is widened to
+ * show a node outside it, outside.js), clipped to the plot.
+ */
+function drawAreaOutline(ctx, view, a) {
+  const p = view.toPixel(a[0], a[3]);
+  const q = view.toPixel(a[1], a[2]);
+  clipTo(ctx, view.rect);
+  ctx.setLineDash([6, 4]);
+  ctx.strokeStyle = C.text;
+  ctx.lineWidth = 1.5;
+  ctx.strokeRect(p.x, p.y, q.x - p.x, q.y - p.y);
+  ctx.setLineDash([]);
+  ctx.restore();
 }
 
 /** A 1-pixel-wide canvas holding the colour bar gradient (dark first = bottom). */

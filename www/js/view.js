@@ -180,6 +180,26 @@ export class View {
     return this.toMetre(Math.min(Math.max(p.x, a.x), b.x), Math.min(Math.max(p.y, a.y), b.y));
   }
 
+  /**
+   * The part of the segment from pixel `a` to pixel `b` inside the plot rectangle (Liang–Barsky),
+   * [a', b'] ({x, y} CSS px), or null when it misses the plot.
+   */
+  clipSegment(a, b) {
+    const r = this.rect;
+    const dx = b.x - a.x;
+    const dy = b.y - a.y;
+    let t0 = 0;
+    let t1 = 1;
+    for (const [p, q] of [[-dx, a.x - r.x], [dx, r.x + r.w - a.x], [-dy, a.y - r.y], [dy, r.y + r.h - a.y]]) {
+      if (p === 0) {
+        if (q < 0) return null;
+      } else if (p < 0) t0 = Math.max(t0, q / p);
+      else t1 = Math.min(t1, q / p);
+    }
+    if (t0 > t1) return null;
+    return [{ x: a.x + t0 * dx, y: a.y + t0 * dy }, { x: a.x + t1 * dx, y: a.y + t1 * dy }];
+  }
+
   /** A length in metres as CSS pixels. */
   len(m) {
     return m * this.scale;

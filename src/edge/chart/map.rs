@@ -76,6 +76,32 @@ pub fn draw_crlb_map<DB: DrawingBackend>(
     draw_crlb_map_with(root, map, nodes, &MapOverlay::default(), opts)
 }
 
+/// The CRLB map figure ([`draw_crlb_map_with`]) of `size` px as SVG text with the map embedded
+/// as ONE image ([`super::raster`]: a PNG at the grid's resolution, a `data:` URI) under the
+/// vector layers (axes, overlay, nodes, colour bar, text), instead of one rectangle per run of
+/// equal colour. Also returns the scale used.
+pub fn crlb_map_svg(
+    size: (u32, u32),
+    map: &MapData,
+    nodes: &[ChartNode],
+    overlay: &MapOverlay,
+    opts: &ChartOptions,
+) -> Result<(String, ChartSummary), ChartError> {
+    let mut svg = String::new();
+    let (summary, plot) = {
+        let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
+        let drawn = draw_map_figure(&root, map, nodes, overlay, opts, false)?;
+        root.present().map_err(chart_err)?;
+        drawn
+    };
+    let rgb = super::raster::map_rgb(map, summary.scale.as_ref());
+    let png = super::raster::encode_png(map.grid.nx, map.grid.ny, &rgb)
+        .ok_or_else(|| ChartError("the map image could not be encoded".to_string()))?;
+    let svg = super::raster::embed_png(&svg, plot, &png)
+        .ok_or_else(|| ChartError("the figure has no element to put the map under".to_string()))?;
+    Ok((svg, summary))
+}
+
 /// [`draw_crlb_map`] with `overlay` drawn over the map, under the nodes (its labelled lines and
 /// markers join the legend).
 pub fn draw_crlb_map_with<DB: DrawingBackend>(
@@ -85,6 +111,19 @@ pub fn draw_crlb_map_with<DB: DrawingBackend>(
     overlay: &MapOverlay,
     opts: &ChartOptions,
 ) -> Result<ChartSummary, ChartError> {
+    draw_map_figure(root, map, nodes, overlay, opts, true).map(|(summary, _)| summary)
+}
+
+/// [`draw_crlb_map_with`], the cells drawn only when `cells` (else the caller puts the map's
+/// image under the plot); also returns the plot's pixel rectangle.
+fn draw_map_figure<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    map: &MapData,
+    nodes: &[ChartNode],
+    overlay: &MapOverlay,
+    opts: &ChartOptions,
+    cells: bool,
+) -> Result<(ChartSummary, super::raster::PlotPixels), ChartError> {
     register_fonts();
     if map.values_m.len() != map.grid.len() {
         return Err(ChartError(alloc::format!(
@@ -116,24 +155,37 @@ pub fn draw_crlb_map_with<DB: DrawingBackend>(
     )?;
 
     let chart_area = root.clone().shrink(lay.chart_origin, lay.chart_size);
-    let mut chart = map_panel(&chart_area, &lay, map, scale.as_ref())?;
+    let mut chart = if cells {
+        map_panel(&chart_area, &lay, map, scale.as_ref())?
+    } else {
+        let mut chart = panel::metre_chart(&chart_area, &lay, &map.grid.area)?;
+        panel::draw_metre_axes(&mut chart, &lay)?;
+        chart
+    };
+    let (px, py) = chart.plotting_area().get_pixel_range();
+    let plot = (px.start, py.start, px.end - px.start, py.end - py.start);
+    let clamped = scale.map_or([false; 2], |s| s.clamped(map.values_m));
     if !overlay.is_empty() {
         super::overlay::draw_overlay(&mut chart, overlay, lay.font.nodes)?;
     }
     finish_panel(&mut chart, nodes, &lay)?;
 
     let bar_area = root.clone().shrink(lay.bar_origin, lay.bar_size);
-    panel::draw_colorbar(
+    panel::draw_colorbar_marked(
         &bar_area,
         scale.as_ref(),
         unbounded_cells > 0,
         &opts.colorbar_label,
         &lay.font,
+        clamped,
     )?;
-    Ok(ChartSummary {
-        scale,
-        unbounded_cells,
-    })
+    Ok((
+        ChartSummary {
+            scale,
+            unbounded_cells,
+        },
+        plot,
+    ))
 }
 
 /// The default title and subtitle of a scenario's map figure.

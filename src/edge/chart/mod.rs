@@ -16,6 +16,7 @@ mod map;
 mod overlay;
 mod panel;
 mod plan;
+mod raster;
 mod roc;
 mod scene;
 mod tracking;
@@ -27,13 +28,15 @@ pub use channel::{draw_delays_boxes, draw_error_time_chart, error_time_size, Plo
 pub(crate) use layout::{axis_label, chart_err};
 pub use layout::{register_fonts, suggested_size, ChartError};
 pub use map::{
-    default_titles, draw_crlb_map, draw_crlb_map_with, scenario_nodes, ChartOptions, ChartSummary,
+    crlb_map_svg, default_titles, draw_crlb_map, draw_crlb_map_with, scenario_nodes, ChartOptions,
+    ChartSummary,
 };
 pub use overlay::{MapOverlay, OverlayLine, OverlayMark, OverlayMarkKind, OverlayPath};
 pub use panel::{check_area, ChartNode, MapData, NodeKind};
 pub use plan::{
     draw_plan_maps, plan_caption, plan_chart_size, PlanChartOptions, PlanPanel, PlanPath,
 };
+pub use raster::{base64, encode_png, map_rgb, PNG_DATA_URI, PNG_SIGNATURE};
 pub use roc::{
     curve_chart_size, draw_curves, CurveChartOptions, CurveSeries, LineKind, Marker, CURVE_PALETTE,
 };

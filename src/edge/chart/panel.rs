@@ -14,7 +14,7 @@ use plotters::style::text_anchor::{HPos, Pos, VPos};
 use super::layout::{self, axis_label, chart_err, series_legend, ChartError, Fonts};
 use crate::localize::Grid;
 use crate::math::Real;
-use crate::present::colorbar_ticks;
+use crate::present::{colorbar_ticks, format_length_m};
 use crate::present::{viridis, LogScale, UNBOUNDED_RGB};
 use crate::scenario::Area;
 
@@ -337,6 +337,20 @@ pub(crate) fn draw_colorbar<DB: DrawingBackend>(
     label: &str,
     font: &Fonts,
 ) -> Result<(), ChartError> {
+    draw_colorbar_marked(area, scale, has_unbounded, label, font, [false; 2])
+}
+
+/// [`draw_colorbar`] of a fixed scale that values pass: `clamped` = [some below `min`, some
+/// above `max`] (drawn in the end colour); each such end is labelled `≤ min` or `≥ max` (its
+/// tick labels too near that end left out).
+pub(crate) fn draw_colorbar_marked<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    scale: Option<&LogScale>,
+    has_unbounded: bool,
+    label: &str,
+    font: &Fonts,
+    clamped: [bool; 2],
+) -> Result<(), ChartError> {
     let s = font.ticks / 20.0;
     let (w, h) = area.dim_in_pixel();
     let (w, h) = (w as i32, h as i32);
@@ -373,9 +387,24 @@ pub(crate) fn draw_colorbar<DB: DrawingBackend>(
             BLACK.stroke_width(1),
         ))?;
         let max_labels = (bar_h as Real / (2.0 * font.ticks)) as usize;
+        let room = (1.2 * font.ticks) as i32;
+        let ends = [
+            (clamped[0], bar_h, "≤", scale.min),
+            (clamped[1], 0, "≥", scale.max),
+        ];
+        for (on, y, mark, v) in ends {
+            if on {
+                let text = alloc::format!("{mark} {}", format_length_m(v, 3));
+                let x = bar_w + (11.0 * s) as i32;
+                area.draw_text(&text, &tick_font, (x, y))
+                    .map_err(chart_err)?;
+            }
+        }
         for t in colorbar_ticks(scale.min, scale.max, max_labels) {
             let y = ((1.0 - scale.fraction(t.value)) * bar_h as Real).round() as i32;
-            let major = !t.label.is_empty();
+            let near_end =
+                |(on, end, _, _): &(bool, i32, &str, Real)| *on && (y - end).abs() < room;
+            let major = !t.label.is_empty() && !ends.iter().any(near_end);
             let len = ((if major { 7.0 } else { 4.0 }) * s).round() as i32;
             area.draw(&PathElement::new(
                 [(bar_w, y), (bar_w + len, y)],

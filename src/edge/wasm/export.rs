@@ -15,13 +15,13 @@ use wasm_bindgen::prelude::*;
 use super::tracking::Track;
 use super::{window, App};
 use crate::chart::{
-    default_titles, draw_crlb_map_with, draw_mtl_scene, scenario_nodes, scene_window,
-    suggested_size, ChartOptions, MapData, MapOverlay, SceneChartOptions,
+    crlb_map_svg, default_titles, draw_mtl_scene, scenario_nodes, scene_window, suggested_size,
+    ChartOptions, MapData, MapOverlay, SceneChartOptions,
 };
 use crate::error::{limits, Error};
 use crate::localize::{crlb_map, Grid};
-use crate::present::simulate_snapshot;
 use crate::present::{mtl_view, MtlScene};
+use crate::present::{simulate_snapshot, LogScale};
 use crate::scenario::Area;
 use crate::{Model, Scenario, Vec2};
 
@@ -59,6 +59,33 @@ struct MapOptions {
     /// The snapshot target (App.map_svg only).
     #[serde(default)]
     target: Option<TargetOpt>,
+    /// `[min, max]`, m: a locked colour range (values outside it in the end colours, marked
+    /// `≤`/`≥` on the colour bar); default the range of the map's finite values.
+    #[serde(default)]
+    scale: Option<[f64; 2]>,
+}
+
+/// The locked colour range `[min, max]` (m) as a scale: finite, `0 < min < max`, else the named
+/// error of `scale.min` or `scale.max`.
+pub(super) fn locked_scale([min, max]: [f64; 2]) -> crate::Result<LogScale> {
+    for (field, v) in [("scale.min", min), ("scale.max", max)] {
+        if !v.is_finite() {
+            return Err(Error::NonFinite {
+                field: field.into(),
+            });
+        }
+    }
+    if min <= 0.0 {
+        return Err(Error::NotPositive {
+            field: "scale.min".into(),
+            value: min,
+        });
+    }
+    LogScale::new(min, max).ok_or_else(|| Error::OutOfRange {
+        field: "scale.max".into(),
+        value: max,
+        allowed: "above scale.min",
+    })
 }
 
 fn fail(func: &str, e: impl core::fmt::Display) -> JsError {
@@ -138,9 +165,14 @@ fn map_figure(
     let mut values = vec![0.0; grid.len()];
     crlb_map(model, &grid, &mut values).map_err(|e| fail(func, e))?;
     let (title, subtitle) = default_titles(s, &grid);
+    let scale = match opts.scale {
+        Some(v) => Some(locked_scale(v).map_err(|e| fail(func, e))?),
+        None => None,
+    };
     let chart_opts = ChartOptions {
         title: opts.title.clone().unwrap_or(title),
         subtitle: Some(subtitle),
+        scale,
         ..ChartOptions::default()
     };
     let map = MapData {
@@ -148,9 +180,9 @@ fn map_figure(
         values_m: &values,
     };
     let nodes = scenario_nodes(s);
-    render_svg(func, size, |root| {
-        draw_crlb_map_with(root, &map, &nodes, overlay, &chart_opts).map(|_| ())
-    })
+    crlb_map_svg(size, &map, &nodes, overlay, &chart_opts)
+        .map(|(svg, _)| svg)
+        .map_err(|e| fail(func, e))
 }
 
 /// The SVG text of `size` px that `draw` writes through plotters' SVG backend; its error (or the
@@ -176,7 +208,8 @@ impl App {
     /// simulated snapshot (iso-delay ellipses, LM fix, CRLB ellipse; as `simulate_fix`).
     /// `width` 200 … 8000 px, `height` 0 (fit the plot) or 150 … 8000 px. `options_json`: `""`
     /// or `{window?: [x_min, x_max, y_min, y_max] (m; default the area), res?: cells per side
-    /// (8 … 1024, default 256), title?: text, target?: {x, y, seed}}`. Throws `map_svg: …`.
+    /// (8 … 1024, default 256), title?: text, target?: {x, y, seed}, scale?: [min, max] (m, a
+    /// locked colour range)}`. The map is one embedded PNG image. Throws `map_svg: …`.
     pub fn map_svg(&self, width: u32, height: u32, options_json: &str) -> Result<String, JsError> {
         const F: &str = "map_svg";
         let opts: MapOptions = parse_options(F, options_json)?;
@@ -296,4 +329,189 @@ pub fn mtl_scene_svg(
     render_svg(F, size, |root| {
         draw_mtl_scene(root, &scene, &view, &chart_opts)
     })
+}
+
+/// A data file's format: `"csv"` or `"json"`, else the named error of `func`.
+fn data_format(func: &str, format: &str) -> Result<bool, JsError> {
+    match format {
+        "csv" => Ok(true),
+        "json" => Ok(false),
+        other => Err(fail(
+            func,
+            Error::Parse {
+                message: format!("format: \"{other}\" is not csv or json"),
+            },
+        )),
+    }
+}
+
+/// A number of a CSV file: Rust's shortest text that reads back as the same `f64`; empty for a
+/// non-finite value (an unbounded cell).
+fn csv_num(v: f64) -> String {
+    if v.is_finite() {
+        format!("{v}")
+    } else {
+        String::new()
+    }
+}
+
+/// The grid of an exported map.
+#[derive(serde::Serialize)]
+struct MapGridJs {
+    x0: f64,
+    x1: f64,
+    y0: f64,
+    y1: f64,
+    nx: usize,
+    ny: usize,
+}
+
+/// The JSON of an exported map ([`map_data_text`]).
+#[derive(serde::Serialize)]
+struct MapDataJs<'a> {
+    scenario: &'a str,
+    quantity: &'static str,
+    units: &'static str,
+    grid: MapGridJs,
+    x_m: Vec<f64>,
+    y_m: Vec<f64>,
+    order: &'static str,
+    rmse_m: Vec<Option<f64>>,
+    unbounded: &'static str,
+}
+
+/// The CRLB map `values` (m, row-major, row `j` at the `j`-th lowest y, as `App.compute_map_in`
+/// writes them) over the window `[x0, x1] × [y0, y1]` m on an `nx × ny` grid, as a data file:
+/// `format` `"csv"`: a header `x_m,y_m,rmse_m` and one line per cell (cell centres, rows from
+/// the lowest y; an unbounded cell's `rmse_m` empty); `"json"`: `{scenario, quantity, units,
+/// grid: {x0, x1, y0, y1, nx, ny}, x_m: [centres], y_m: [centres], order: "row-major, y
+/// ascending", rmse_m: [nx·ny values, null where unbounded], unbounded}`. Every number is the
+/// core's, written so that it reads back as the same `f64`. Throws `map_data_text: …`.
+#[wasm_bindgen]
+#[allow(clippy::too_many_arguments)]
+pub fn map_data_text(
+    values: &[f64],
+    x0: f64,
+    x1: f64,
+    y0: f64,
+    y1: f64,
+    nx: usize,
+    ny: usize,
+    scenario: &str,
+    format: &str,
+) -> Result<String, JsError> {
+    const F: &str = "map_data_text";
+    let csv = data_format(F, format)?;
+    let area = window([x0, x1, y0, y1]).map_err(|e| fail(F, e))?;
+    let grid = Grid::new(area, nx, ny).map_err(|e| fail(F, e))?;
+    if values.len() != grid.len() {
+        return Err(fail(
+            F,
+            Error::LengthMismatch {
+                field: "map values (nx × ny)",
+                expected: grid.len(),
+                found: values.len(),
+            },
+        ));
+    }
+    if csv {
+        let mut out = String::from("x_m,y_m,rmse_m\n");
+        for j in 0..ny {
+            for i in 0..nx {
+                let v = values[j * nx + i];
+                out.push_str(&format!("{},{},{}\n", grid.x(i), grid.y(j), csv_num(v)));
+            }
+        }
+        return Ok(out);
+    }
+    let doc = MapDataJs {
+        scenario,
+        quantity: "CRLB RMSE bound sqrt(σx² + σy²) of a snapshot fix",
+        units: "m",
+        grid: MapGridJs {
+            x0,
+            x1,
+            y0,
+            y1,
+            nx,
+            ny,
+        },
+        x_m: (0..nx).map(|i| grid.x(i)).collect(),
+        y_m: (0..ny).map(|j| grid.y(j)).collect(),
+        order: "row-major, y ascending: rmse_m[j * nx + i] is at (x_m[i], y_m[j])",
+        rmse_m: values.iter().map(|v| v.is_finite().then_some(*v)).collect(),
+        unbounded:
+            "null: the Fisher matrix is singular there (no unbiased estimator has a finite RMSE)",
+    };
+    serde_json::to_string(&doc).map_err(|e| fail(F, e))
+}
+
+/// The JSON of an exported track ([`Track::data_text`]).
+#[derive(serde::Serialize)]
+struct TrackDataJs<'a> {
+    scenario: &'a str,
+    filter: &'a str,
+    units: &'static str,
+    failed_at: Option<usize>,
+    t_s: &'a [f64],
+    truth: Vec<[f64; 4]>,
+    estimate: Vec<[f64; 4]>,
+    covariance: Vec<[f64; 16]>,
+}
+
+/// The state names of the CSV columns.
+const STATE: [&str; 4] = ["x_m", "y_m", "vx_mps", "vy_mps"];
+
+#[wasm_bindgen]
+impl Track {
+    /// The simulated track as a data file, one row per entry: time, the true state, the filter's
+    /// estimate and its covariance `P` (4 × 4 over x, y, vx, vy; m, m/s). `format` `"csv"`:
+    /// columns `t_s, truth_x_m, truth_y_m, truth_vx_mps, truth_vy_mps, est_x_m, …, est_vy_mps,
+    /// P_0_0, P_0_1, …, P_3_3` (row-major); `"json"`: `{scenario, filter, units, failed_at, t_s,
+    /// truth: [[x, y, vx, vy]], estimate: [[…]], covariance: [[16 values, row-major]]}`. The
+    /// core's numbers, written to read back as the same `f64`. Throws `Track.data_text: …`.
+    pub fn data_text(&self, format: &str) -> Result<String, JsError> {
+        const F: &str = "Track.data_text";
+        let csv = data_format(F, format)?;
+        let (s, _, run, filter) = self.parts();
+        let n = run.estimates.len().min(run.truth.len()).min(run.t_s.len());
+        let v4 = |v: &crate::math::Vec4| [v[0], v[1], v[2], v[3]];
+        let p16 = |p: &crate::math::Mat4| {
+            let mut out = [0.0; 16];
+            for r in 0..4 {
+                for c in 0..4 {
+                    out[4 * r + c] = p[(r, c)];
+                }
+            }
+            out
+        };
+        if csv {
+            let mut head: Vec<String> = vec!["t_s".into()];
+            head.extend(STATE.iter().map(|k| format!("truth_{k}")));
+            head.extend(STATE.iter().map(|k| format!("est_{k}")));
+            head.extend((0..16).map(|k| format!("P_{}_{}", k / 4, k % 4)));
+            let mut out = head.join(",");
+            out.push('\n');
+            for k in 0..n {
+                let mut row = vec![csv_num(run.t_s[k])];
+                row.extend(v4(&run.truth[k]).map(csv_num));
+                row.extend(v4(&run.estimates[k]).map(csv_num));
+                row.extend(p16(&run.covariances[k]).map(csv_num));
+                out.push_str(&row.join(","));
+                out.push('\n');
+            }
+            return Ok(out);
+        }
+        let doc = TrackDataJs {
+            scenario: &s.name,
+            filter: filter.name(),
+            units: "m, m/s, s; covariance row-major over (x, y, vx, vy)",
+            failed_at: run.failed_at,
+            t_s: &run.t_s[..n],
+            truth: run.truth[..n].iter().map(v4).collect(),
+            estimate: run.estimates[..n].iter().map(v4).collect(),
+            covariance: run.covariances[..n].iter().map(p16).collect(),
+        };
+        serde_json::to_string(&doc).map_err(|e| fail(F, e))
+    }
 }

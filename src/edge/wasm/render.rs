@@ -26,6 +26,34 @@ pub fn render_map_rgba(
     })
 }
 
+/// Colours a map (`values`, m) into `rgba` on the fixed log scale `[min, max]` (a locked colour
+/// range: values outside it take the end colours). Returns `[min, max, below, above]`: the scale
+/// and how many bounded cells lie below `min` and above `max`. Throws `render_map_rgba_locked:
+/// …` for a bad range (finite, 0 < min < max) or buffer length.
+#[wasm_bindgen]
+pub fn render_map_rgba_locked(
+    values: &Float64Array,
+    rgba: &Uint8ClampedArray,
+    min: f64,
+    max: f64,
+) -> Result<Vec<f64>, JsError> {
+    const F: &str = "render_map_rgba_locked";
+    let scale =
+        super::export::locked_scale([min, max]).map_err(|e| JsError::new(&format!("{F}: {e}")))?;
+    let values = values.to_vec();
+    let mut px = vec![0u8; rgba.length() as usize];
+    if !present::fill_rgba(&values, &scale, &mut px) {
+        return Err(JsError::new(&format!(
+            "{F}: the rgba buffer has {} bytes for {} values (4 per value)",
+            px.len(),
+            values.len()
+        )));
+    }
+    rgba.copy_from(&px);
+    let [below, above] = scale.clamped_counts(&values);
+    Ok(vec![scale.min, scale.max, below as f64, above as f64])
+}
+
 /// `n` RGBA pixels of the colour bar, dark (small error) first.
 #[wasm_bindgen]
 pub fn colorbar_rgba(n: usize) -> Vec<u8> {

@@ -8,9 +8,9 @@ use serde::Serialize;
 use serde_json::json;
 
 use scatterloc::chart::{
-    check_area, default_titles, draw_crlb_map, scenario_nodes, suggested_size,
+    check_area, crlb_map_svg, default_titles, draw_crlb_map, scenario_nodes, suggested_size,
 };
-use scatterloc::chart::{ChartError, ChartNode, ChartOptions, MapData};
+use scatterloc::chart::{ChartError, ChartNode, ChartOptions, MapData, MapOverlay};
 use scatterloc::localize::Grid;
 use scatterloc::native::crlb_map_parallel;
 use scatterloc::scenario::Area;
@@ -172,5 +172,10 @@ struct MapFigure<'a> {
 impl Figure for MapFigure<'_> {
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), ChartError> {
         draw_crlb_map(root, &self.map, &self.nodes, &self.opts).map(|_| ())
+    }
+
+    fn svg(&self, size: (u32, u32)) -> Option<Result<String, ChartError>> {
+        let none = MapOverlay::default();
+        Some(crlb_map_svg(size, &self.map, &self.nodes, &none, &self.opts).map(|(svg, _)| svg))
     }
 }

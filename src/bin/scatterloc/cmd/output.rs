@@ -253,7 +253,9 @@ impl OutputSet {
         match format {
             Format::Svg => {
                 let mut svg = String::new();
-                {
+                if let Some(own) = figure.svg(size) {
+                    svg = own.map_err(|e| fail(e.to_string()))?;
+                } else {
                     let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
                     figure.draw(&root).map_err(|e| fail(e.to_string()))?;
                     root.present().map_err(|e| fail(e.to_string()))?;
@@ -357,6 +359,12 @@ pub fn write_json_file<T: Serialize>(flag: &str, path: &str, value: &T) -> Resul
 pub trait Figure {
     /// Draws onto `root` (without `present()`).
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), ChartError>;
+
+    /// The figure's own SVG text of `size` px, when it has one (the map figure: its map as one
+    /// embedded image); `None` draws [`Figure::draw`] through plotters' SVG backend.
+    fn svg(&self, _size: (u32, u32)) -> Option<Result<String, ChartError>> {
+        None
+    }
 }
 
 /// Draws `figure` into an SVG or PNG file of `size` pixels at `path`, atomically (one-file
