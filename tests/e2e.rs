@@ -73,6 +73,11 @@ mod export;
 #[path = "e2e/zoom.rs"]
 mod zoom;
 
+/// Issue 26 §2: the page state saved, shared and undone (state file, link, undo/redo).
+#[cfg(test)]
+#[path = "e2e/state.rs"]
+mod state;
+
 /// The docs screenshots: not a test, the example `screenshot` (`examples/screenshot.rs`) runs
 /// it through this harness. The example includes this file as a module, so the test modules
 /// above are `cfg(test)` and only the harness, the tracking helpers and this module compile

@@ -34,6 +34,10 @@
 //                            scaleBar {length_m, label} of the last frame, level}; reset();
 //                            hitAt(x, y) (an object under canvas pixel x, y: a press drags it);
 //                            toMetre(x, y) (canvas pixel -> {x, y} m in the view on screen)
+//   window.pageStateModel    the page state (state.js): capture() (the whole state object);
+//                            restore(obj) -> null | the banner's message; history() -> {index,
+//                            length, pending, busy}; undo(); redo(); dirty(); lastSaved() -> {name,
+//                            text} of the last "Save state"; setDryRun(bool)
 //   body[data-ready='1']     the page is up;  body[data-error]  it failed (the message)
 
 /**
@@ -121,6 +125,7 @@ export function registerHooks(p) {
       armRoi: (on) => p.plan.arm(on),
     },
     shareLink: () => p.link(),
+    pageStateModel: p.pageState,
     figureExport: {
       last: () => p.figures.lastInfo(),
       save: () => p.figures.save(),
