@@ -120,6 +120,25 @@ async fn window_point(c: &Client, fx: f64, fy: f64) -> Result<[f64; 2], String> 
     Ok([a[0] + fx * (a[1] - a[0]), a[2] + fy * (a[3] - a[2])])
 }
 
+/// CSS px from the plot's centre of a map point with no object under it, near fractions
+/// (fx, fy) of the window shown.
+async fn empty_at(c: &Client, fx: f64, fy: f64) -> Result<[f64; 2], String> {
+    let v = c
+        .execute(
+            "const [fx, fy] = arguments; const v = window.view; \
+             const b = document.getElementById('plot').getBoundingClientRect(); \
+             for (const d of [0, 0.05, -0.05, 0.1, -0.1, 0.15, -0.15]) for (const e of [0, 0.05, -0.05, 0.1, -0.1]) { \
+               const [x0, x1, y0, y1] = v.area; \
+               const p = v.toPixel(x0 + (fx + d) * (x1 - x0), y0 + (fy + e) * (y1 - y0)); \
+               if (!window.zoom.hitAt(p.x, p.y)) return [p.x - b.width / 2, p.y - b.height / 2]; } \
+             return null;",
+            vec![json!(fx), json!(fy)],
+        )
+        .await
+        .map_err(|e| e.to_string())?;
+    serde_json::from_value(v).map_err(|e| format!("no empty point near ({fx}, {fy}): {e}"))
+}
+
 /// `[path, value]` leaves of a state: objects are walked, arrays, null and the scenario JSON
 /// (and the blocking model) are leaves.
 fn leaves(v: &Value, path: &str, out: &mut Vec<(String, Value)>) {
@@ -140,7 +159,8 @@ fn leaves(v: &Value, path: &str, out: &mut Vec<(String, Value)>) {
 
 /// The value at dotted `path` (or null).
 fn at_path<'a>(v: &'a Value, path: &str) -> &'a Value {
-    path.split('.').fold(v, |v, k| v.get(k).unwrap_or(&Value::Null))
+    path.split('.')
+        .fold(v, |v, k| v.get(k).unwrap_or(&Value::Null))
 }
 
 /// Equal, numbers within 1e-12 (relative to their size, at least absolute).
@@ -154,10 +174,7 @@ fn close(a: &Value, b: &Value) -> bool {
             x.len() == y.len() && x.iter().zip(y).all(|(a, b)| close(a, b))
         }
         (Value::Object(x), Value::Object(y)) => {
-            x.len() == y.len()
-                && x
-                    .iter()
-                    .all(|(k, a)| y.get(k).is_some_and(|b| close(a, b)))
+            x.len() == y.len() && x.iter().all(|(k, a)| y.get(k).is_some_and(|b| close(a, b)))
         }
         _ => a == b,
     }
@@ -223,8 +240,7 @@ async fn set_everything(c: &Client) -> Result<(), String> {
     quiet(c).await?;
     select(c, "resolution", "128").await?;
     quiet(c).await?;
-    let [x, y] = window_point(c, 0.37, 0.63).await?;
-    drag_on_plot(c, at(c, x, y).await?, &[]).await?;
+    drag_on_plot(c, empty_at(c, 0.37, 0.63).await?, &[]).await?;
     quiet(c).await?;
     // The Plan panel's settings and a drawn ROI.
     click(c, "plan-toggle").await?;
@@ -249,11 +265,8 @@ async fn set_everything(c: &Client) -> Result<(), String> {
     quiet(c).await?;
     select(c, "track-kind", "custom").await?;
     quiet(c).await?;
-    let [x0, y0] = window_point(c, 0.3, 0.3).await?;
-    let [x1, y1] = window_point(c, 0.55, 0.6).await?;
-    let a = at(c, x0, y0).await?;
-    let b = at(c, x1, y1).await?;
-    drag_on_plot(c, a, &[(b[0] - a[0], b[1] - a[1], 200)]).await?;
+    let a = empty_at(c, 0.3, 0.3).await?;
+    drag_on_plot(c, a, &[(60.0, -45.0, 200)]).await?;
     quiet(c).await?;
     select(c, "track-dt", "0.05").await?;
     type_in(c, "track-seed", "5").await?;
@@ -321,9 +334,12 @@ async fn set_everything(c: &Client) -> Result<(), String> {
 #[test]
 #[ignore = "needs chromium + chromedriver and www/pkg (wasm-pack build); run with --ignored"]
 fn state_file_and_link_restore_every_field() {
-    let file = std::env::temp_dir().join(format!("scatterloc-e2e-state-{}.json", std::process::id()));
-    let bad_file =
-        std::env::temp_dir().join(format!("scatterloc-e2e-bad-state-{}.json", std::process::id()));
+    let file =
+        std::env::temp_dir().join(format!("scatterloc-e2e-state-{}.json", std::process::id()));
+    let bad_file = std::env::temp_dir().join(format!(
+        "scatterloc-e2e-bad-state-{}.json",
+        std::process::id()
+    ));
     let (file2, bad2) = (file.clone(), bad_file.clone());
     let o = session(|c, port| async move {
         open(&c, port).await?;
@@ -368,7 +384,10 @@ fn state_file_and_link_restore_every_field() {
         let t0 = Instant::now();
         while capture(&c).await?["mode"] != "mtl" {
             if t0.elapsed() > Duration::from_secs(20) {
-                return Err(format!("the state file was not opened: {}", banner(&c).await?));
+                return Err(format!(
+                    "the state file was not opened: {}",
+                    banner(&c).await?
+                ));
             }
             tokio::time::sleep(Duration::from_millis(30)).await;
         }
@@ -405,8 +424,12 @@ fn state_file_and_link_restore_every_field() {
     let _ = std::fs::remove_file(&file);
     let _ = std::fs::remove_file(&bad_file);
     let (d, s) = (&o["defaults"], &o["set"]);
-    println!("e2e: state {} bytes as a file ({}), link of {} characters", s.to_string().len(),
-        o["file_name"], o["link"].as_str().unwrap_or_default().len());
+    println!(
+        "e2e: state {} bytes as a file ({}), link of {} characters",
+        s.to_string().len(),
+        o["file_name"],
+        o["link"].as_str().unwrap_or_default().len()
+    );
     assert_eq!(o["set_banner"], "", "no banner while setting the fields");
     assert_eq!(o["link_banner"], "", "no banner on opening the link");
     assert_eq!(o["file_banner"], "", "no banner on opening the file");
@@ -429,17 +452,32 @@ fn state_file_and_link_restore_every_field() {
     assert_eq!(got, want, "the state's fields");
     for (path, value) in &paths {
         if !NO_CONTROL.contains(&path.as_str()) {
-            assert_ne!(value, at_path(d, path), "{path}: set to a non-default value");
+            assert_ne!(
+                value,
+                at_path(d, path),
+                "{path}: set to a non-default value"
+            );
         }
-        assert_eq!(at_path(&o["from_link"], path), value, "{path}: from the link");
-        assert_eq!(at_path(&o["from_file"], path), value, "{path}: from the state file");
+        assert_eq!(
+            at_path(&o["from_link"], path),
+            value,
+            "{path}: from the link"
+        );
+        assert_eq!(
+            at_path(&o["from_file"], path),
+            value,
+            "{path}: from the state file"
+        );
     }
     assert_eq!(s["mode"], "mtl");
     assert_eq!(s["tracking"]["mc_filters"], json!(["ukf", "pf"]));
     assert_eq!(s["view"]["step"], 3);
     let b = o["bad_banner"].as_str().unwrap_or_default();
     assert!(b.contains("state.tracking.dt") && b.contains("0.3"), "{b}");
-    assert_eq!(o["after_bad"], o["from_file"], "a bad state file changes nothing");
+    assert_eq!(
+        o["after_bad"], o["from_file"],
+        "a bad state file changes nothing"
+    );
 }
 
 /// Waits for the plan to end (no glide left).
@@ -465,7 +503,8 @@ fn undo_and_redo_restore_every_kind_of_edit() {
     let scenario = scatterloc::scenario::presets::iclgnss2019()
         .to_json()
         .replace("\"iclgnss2019\"", "\"imported\"");
-    let file = std::env::temp_dir().join(format!("scatterloc-e2e-undo-{}.json", std::process::id()));
+    let file =
+        std::env::temp_dir().join(format!("scatterloc-e2e-undo-{}.json", std::process::id()));
     std::fs::write(&file, &scenario).unwrap();
     let file2 = file.clone();
     let o = session(|c, port| async move {
@@ -511,7 +550,11 @@ fn undo_and_redo_restore_every_kind_of_edit() {
             .await
             .map_err(|e| e.to_string())?;
         let t0 = Instant::now();
-        while !js(&c, "return window.app.scenario().name === 'imported'").await?.as_bool().unwrap_or(false) {
+        while !js(&c, "return window.app.scenario().name === 'imported'")
+            .await?
+            .as_bool()
+            .unwrap_or(false)
+        {
             if t0.elapsed() > Duration::from_secs(10) {
                 return Err(format!("import failed: {}", banner(&c).await?));
             }
@@ -520,9 +563,18 @@ fn undo_and_redo_restore_every_kind_of_edit() {
         record(&c, &mut steps, "import", b, i, "buttons").await?;
         // A node drag (many moves: one step).
         let (b, i) = (doc(&c).await?, history_index(&c).await?);
-        let r = js(&c, "const r = window.app.nodes().receivers[0]; return [r.x, r.y]").await?;
+        let r = js(
+            &c,
+            "const r = window.app.nodes().receivers[0]; return [r.x, r.y]",
+        )
+        .await?;
         let a = at(&c, r[0].as_f64().unwrap(), r[1].as_f64().unwrap()).await?;
-        drag_on_plot(&c, a, &[(15.0, 10.0, 100), (15.0, 10.0, 100), (10.0, -5.0, 100)]).await?;
+        drag_on_plot(
+            &c,
+            a,
+            &[(15.0, 10.0, 100), (15.0, 10.0, 100), (10.0, -5.0, 100)],
+        )
+        .await?;
         record(&c, &mut steps, "node drag", b, i, "keys").await?;
         // A keyboard move (Shift+Right: 1 m).
         let (b, i) = (doc(&c).await?, history_index(&c).await?);
@@ -540,12 +592,11 @@ fn undo_and_redo_restore_every_kind_of_edit() {
         record(&c, &mut steps, "panel edit", b, i, "buttons").await?;
         // A target placement.
         let (b, i) = (doc(&c).await?, history_index(&c).await?);
-        let [x, y] = window_point(&c, 0.4, 0.55).await?;
-        drag_on_plot(&c, at(&c, x, y).await?, &[]).await?;
+        drag_on_plot(&c, empty_at(&c, 0.4, 0.55).await?, &[]).await?;
         record(&c, &mut steps, "target placement", b, i, "keys").await?;
         // Optimize (its own Undo button is the history's too).
         click(&c, "plan-toggle").await?;
-        type_in(&c, "plan-budget", "300").await?;
+        type_in(&c, "plan-budget", "1000").await?;
         quiet(&c).await?;
         let (b, i) = (doc(&c).await?, history_index(&c).await?);
         click(&c, "plan-run").await?;
@@ -567,32 +618,67 @@ fn undo_and_redo_restore_every_kind_of_edit() {
         let (b, i) = (doc(&c).await?, history_index(&c).await?);
         let t = js(&c, "return window.mtl.state().scene.targets[0]").await?;
         let a = at(&c, t[0].as_f64().unwrap(), t[1].as_f64().unwrap()).await?;
-        drag_on_plot(&c, a, &[(-12.0, 9.0, 80), (-12.0, 9.0, 80), (-12.0, 9.0, 80)]).await?;
+        drag_on_plot(
+            &c,
+            a,
+            &[(-12.0, 9.0, 80), (-12.0, 9.0, 80), (-12.0, 9.0, 80)],
+        )
+        .await?;
         wait_view(&c, 60).await?;
         record(&c, &mut steps, "multi-target drag", b, i, "keys").await?;
         let (b, i) = (doc(&c).await?, history_index(&c).await?);
-        let slider = c.find(Locator::Id("mtl-tb")).await.map_err(|e| e.to_string())?;
+        let slider = c
+            .find(Locator::Id("mtl-tb"))
+            .await
+            .map_err(|e| e.to_string())?;
         slider.click().await.map_err(|e| e.to_string())?;
         wait_view(&c, 60).await?;
         record(&c, &mut steps, "multi-target slider", b, i, "buttons").await?;
-        Ok(json!({"steps": steps, "in_field": in_field, "plan_undo": plan_undo,
-            "errors": console_errors(&c).await?, "banner": banner(&c).await?}))
+        Ok(
+            json!({"steps": steps, "in_field": in_field, "plan_undo": plan_undo,
+            "errors": console_errors(&c).await?, "banner": banner(&c).await?}),
+        )
     });
     let _ = std::fs::remove_file(&file);
     for s in o["steps"].as_array().unwrap() {
         let name = s[0].as_str().unwrap();
         println!("e2e: undo/redo {name}: history {} -> {}", s[5], s[6]);
         assert_ne!(s[1], s[2], "{name}: the edit changed the state");
-        assert_eq!(s[6].as_i64().unwrap(), s[5].as_i64().unwrap() + 1, "{name}: one undo step");
-        assert!(close(&s[3], &s[1]), "{name}: undo restores the state before\n{}\n{}", s[3], s[1]);
-        assert!(close(&s[4], &s[2]), "{name}: redo reapplies the edit\n{}\n{}", s[4], s[2]);
+        assert_eq!(
+            s[6].as_i64().unwrap(),
+            s[5].as_i64().unwrap() + 1,
+            "{name}: one undo step"
+        );
+        assert!(
+            close(&s[3], &s[1]),
+            "{name}: undo restores the state before\n{}\n{}",
+            s[3],
+            s[1]
+        );
+        assert!(
+            close(&s[4], &s[2]),
+            "{name}: redo reapplies the edit\n{}\n{}",
+            s[4],
+            s[2]
+        );
     }
     assert_eq!(o["steps"].as_array().unwrap().len(), 9);
     let f = &o["in_field"];
-    assert_eq!(f, &json!([true, true]), "Ctrl+Z in a text field does not undo the page");
+    assert_eq!(
+        f,
+        &json!([true, true]),
+        "Ctrl+Z in a text field does not undo the page"
+    );
     let p = &o["plan_undo"];
-    assert_eq!(p[0]["kept"], false, "the plan found a better layout: {}", p[0]);
-    assert!(close(&p[1], &p[2]), "the Plan panel's Undo restores the state before Optimize");
+    assert_eq!(
+        p[0]["kept"], false,
+        "the plan found a better layout: {}",
+        p[0]
+    );
+    assert!(
+        close(&p[1], &p[2]),
+        "the Plan panel's Undo restores the state before Optimize"
+    );
     assert_eq!(o["banner"], "");
     assert_eq!(o["errors"], json!([]), "console errors");
 }
@@ -609,34 +695,62 @@ fn scenario_switch_over_unsaved_edits_asks_first() {
         // No edits: no question.
         select(&c, "preset", "iclgnss2019").await?;
         quiet(&c).await?;
-        let clean = json!([js(&c, dialog).await?, js(&c, "return window.app.scenario().name").await?]);
+        let clean = json!([
+            js(&c, dialog).await?,
+            js(&c, "return window.app.scenario().name").await?
+        ]);
         type_in(&c, "carrier", "31").await?;
         quiet(&c).await?;
         let edited = doc(&c).await?;
         select(&c, "preset", "sensors2019").await?;
         quiet(&c).await?;
-        let asked = json!([js(&c, dialog).await?,
-            js(&c, "return document.getElementById('confirm-text').textContent").await?]);
+        let asked = json!([
+            js(&c, dialog).await?,
+            js(
+                &c,
+                "return document.getElementById('confirm-text').textContent"
+            )
+            .await?
+        ]);
         click(&c, "confirm-cancel").await?;
         quiet(&c).await?;
-        let cancelled = json!([js(&c, dialog).await?, doc(&c).await? == edited,
-            js(&c, "return document.getElementById('preset').value").await?]);
+        let cancelled = json!([
+            js(&c, dialog).await?,
+            doc(&c).await? == edited,
+            js(&c, "return document.getElementById('preset').value").await?
+        ]);
         select(&c, "preset", "sensors2019").await?;
         quiet(&c).await?;
         let asked_again = js(&c, dialog).await?;
         click(&c, "confirm-ok").await?;
         quiet(&c).await?;
-        let replaced = json!([js(&c, dialog).await?, js(&c, "return window.app.scenario_json()").await?,
+        let replaced = json!([
+            js(&c, dialog).await?,
+            js(&c, "return window.app.scenario_json()").await?,
             js(&c, "return window.wasm.preset_json('sensors2019')").await?,
-            js(&c, "return document.getElementById('preset').value").await?]);
-        Ok(json!({"clean": clean, "asked": asked, "cancelled": cancelled, "asked_again": asked_again,
-            "replaced": replaced, "errors": console_errors(&c).await?}))
+            js(&c, "return document.getElementById('preset').value").await?
+        ]);
+        Ok(
+            json!({"clean": clean, "asked": asked, "cancelled": cancelled, "asked_again": asked_again,
+            "replaced": replaced, "errors": console_errors(&c).await?}),
+        )
     });
     println!("e2e: confirm: {}", o["asked"][1]);
-    assert_eq!(o["clean"], json!([false, "iclgnss2019"]), "no question without edits");
+    assert_eq!(
+        o["clean"],
+        json!([false, "iclgnss2019"]),
+        "no question without edits"
+    );
     assert_eq!(o["asked"][0], true, "the dialog asks");
-    assert!(o["asked"][1].as_str().unwrap_or_default().contains("sensors2019"));
-    assert_eq!(o["cancelled"], json!([false, true, ""]), "Cancel keeps everything");
+    assert!(o["asked"][1]
+        .as_str()
+        .unwrap_or_default()
+        .contains("sensors2019"));
+    assert_eq!(
+        o["cancelled"],
+        json!([false, true, ""]),
+        "Cancel keeps everything"
+    );
     assert_eq!(o["asked_again"], true);
     let r = &o["replaced"];
     assert_eq!(r[0], false);
@@ -659,23 +773,40 @@ fn optimize_without_improvement_keeps_the_layout_and_says_so() {
         type_in(&c, "plan-t", "0.000001").await?;
         type_in(&c, "plan-budget", "200").await?;
         quiet(&c).await?;
-        let before = json!([js(&c, "return window.app.scenario_json()").await?, history_index(&c).await?]);
+        let before = json!([
+            js(&c, "return window.app.scenario_json()").await?,
+            history_index(&c).await?
+        ]);
         click(&c, "plan-run").await?;
         let plan = plan_done(&c).await?;
         quiet(&c).await?;
-        let after = json!([js(&c, "return window.app.scenario_json()").await?, history_index(&c).await?]);
+        let after = json!([
+            js(&c, "return window.app.scenario_json()").await?,
+            history_index(&c).await?
+        ]);
         let text = js(&c, "return [document.getElementById('plan-result').textContent, \
             document.getElementById('plan-status').textContent, document.getElementById('plan-undo').disabled]").await?;
-        Ok(json!({"before": before, "after": after, "plan": plan, "text": text,
-            "errors": console_errors(&c).await?}))
+        Ok(
+            json!({"before": before, "after": after, "plan": plan, "text": text,
+            "errors": console_errors(&c).await?}),
+        )
     });
-    println!("e2e: optimize without improvement: {} · {}", o["text"][0], o["text"][1]);
+    println!(
+        "e2e: optimize without improvement: {} · {}",
+        o["text"][0], o["text"][1]
+    );
     assert_eq!(o["plan"]["state"], "done", "{}", o["plan"]);
     assert_eq!(o["plan"]["kept"], true);
     assert_eq!(o["after"][0], o["before"][0], "the layout is kept exactly");
     assert_eq!(o["after"][1], o["before"][1], "no undo step");
-    assert!(o["text"][0].as_str().unwrap_or_default().contains("No better layout found"));
-    assert!(o["text"][1].as_str().unwrap_or_default().contains("no better layout found"));
+    assert!(o["text"][0]
+        .as_str()
+        .unwrap_or_default()
+        .contains("No better layout found"));
+    assert!(o["text"][1]
+        .as_str()
+        .unwrap_or_default()
+        .contains("no better layout found"));
     assert_eq!(o["text"][2], true, "nothing to undo");
     assert_eq!(o["errors"], json!([]), "console errors");
 }

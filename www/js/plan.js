@@ -65,6 +65,17 @@ function sameLayout(a, b) {
   return same(a.transmitters, b.transmitters) && same(a.receivers, b.receivers);
 }
 
+/**
+ * True when plan.json's objective `o` is better after than before as the panel reports it: fewer
+ * unbounded cells, else a lower value (a higher one for coverage). A layout the planner ranks
+ * better only by a tie-break the panel does not show (0 % → 0 %) is not.
+ */
+function improved(o) {
+  if (o.unbounded_after !== o.unbounded_before) return o.unbounded_after < o.unbounded_before;
+  if (o.before === null || o.after === null) return o.before === null && o.after !== null;
+  return o.maximised ? o.after > o.before : o.after < o.before;
+}
+
 export class Plan {
   /** @param {object} ctx - {app, wasm, module, st, view, changed, showHint}. */
   constructor(ctx) {
@@ -422,7 +433,7 @@ export class Plan {
     r.evaluations = m.result.evaluations;
     this.result = m.result;
     this.points = m.result.history.map((h) => [h.evaluations, h.best]);
-    this.kept = sameLayout(JSON.parse(this.undoJson), m.result.scenario);
+    this.kept = sameLayout(JSON.parse(this.undoJson), m.result.scenario) || !improved(m.result.objective);
     if (this.kept) {
       // No better layout: the one from before Optimize stays, exactly (the glides undone).
       this.glide = null;

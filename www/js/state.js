@@ -475,11 +475,13 @@ class StateModel {
       if (this.replaceNext) {
         this.entries[this.index] = t;
       } else {
+        // A new edit over undone steps drops them, and with them the Optimize the Plan panel would undo.
+        if (this.planMark !== null && this.index <= this.planMark) this.planMark = null;
         this.entries.splice(this.index + 1);
         this.entries.push(t);
         if (this.entries.length > HISTORY_MAX) {
           this.entries.shift();
-          if (this.planMark !== null) this.planMark -= 1;
+          if (this.planMark !== null) this.planMark = this.planMark > 0 ? this.planMark - 1 : null;
         }
         this.index = this.entries.length - 1;
       }
@@ -516,9 +518,12 @@ class StateModel {
     } finally {
       this.restoring = false;
     }
-    if (this.planMark !== null && this.index <= this.planMark) {
-      plan.undoJson = null;
-      plan.applied = null;
+    if (this.planMark !== null) {
+      // The Plan panel's Undo is available while the history is past the snapshot before Optimize.
+      const before = JSON.parse(this.entries[this.planMark]).scenario;
+      plan.undoJson = this.index > this.planMark ? JSON.stringify(before.json) : null;
+      plan.undoPreset = before.preset;
+      if (plan.undoJson === null) plan.applied = null;
       plan.sync();
     }
     this.replaceNext = true;
@@ -533,7 +538,11 @@ class StateModel {
 
   bindEvents() {
     const { panel } = this.p;
-    addEventListener('pointerdown', () => { this.pointers += 1; }, true);
+    // The gestures that edit continuously: a press on the plot (a drag) or on a slider.
+    addEventListener('pointerdown', (ev) => {
+      const t = ev.target;
+      if (t && (t.id === 'plot' || (t.tagName === 'INPUT' && t.type === 'range'))) this.pointers = 1;
+    }, true);
     const up = () => {
       this.pointers = 0;
       this.note();
