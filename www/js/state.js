@@ -659,13 +659,25 @@ class StateModel {
         }
         const name = el.value;
         if (!name) return;
-        if (!this.dirty()) {
+        // The select shows the new name already: judge the state with the one loaded.
+        const loaded = this.index >= 0 ? JSON.parse(this.entries[this.index]).scenario.preset : name;
+        el.value = loaded;
+        const dirty = this.dirty();
+        el.value = name;
+        if (!dirty) {
           this.cleanPending = true;
           return;
         }
         ev.stopImmediatePropagation();
-        el.value = JSON.parse(this.entries[this.index]).scenario.preset;
-        if (await this.confirm(`Loading the scenario ${name}`)) {
+        // Back to what is loaded; the option chosen is replaced by its copy, so that choosing it
+        // again is a change the browser reports.
+        const chosen = [...el.options].find((o) => o.value === name);
+        chosen.replaceWith(chosen.cloneNode(true));
+        el.value = loaded;
+        const asking = this.confirm(`Loading the scenario ${name}`);
+        // (Some automation selects the option again after its change event: show what is loaded.)
+        setTimeout(() => { if (!pass) el.value = loaded; }, 0);
+        if (await asking) {
           el.value = name;
           pass = true;
           el.dispatchEvent(new Event('change', { bubbles: true }));
