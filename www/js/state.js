@@ -476,7 +476,8 @@ class StateModel {
         this.entries[this.index] = t;
       } else {
         // A new edit over undone steps drops them, and with them the Optimize the Plan panel would undo.
-        if (this.planMark !== null && this.index <= this.planMark) this.planMark = null;
+        const truncates = this.index < this.entries.length - 1;
+        if (this.planMark !== null && truncates && this.index <= this.planMark) this.planMark = null;
         this.entries.splice(this.index + 1);
         this.entries.push(t);
         if (this.entries.length > HISTORY_MAX) {
@@ -777,7 +778,9 @@ class StateModel {
     return {
       capture: () => captureState(),
       restore: (obj) => this.openObject(obj, 'state') ? null : document.getElementById('error-text').textContent,
-      history: () => ({ index: this.index, length: this.entries.length, pending: this.scheduled, busy: this.busy() }),
+      history: () => ({
+        index: this.index, length: this.entries.length, pending: this.scheduled, busy: this.busy(), planMark: this.planMark,
+      }),
       undo: () => this.undo(),
       redo: () => this.redo(),
       dirty: () => this.dirty(),
