@@ -86,6 +86,10 @@ mod channel;
 #[cfg(test)]
 #[path = "e2e/pf.rs"]
 mod pf;
+/// Issue 26 §2: the page state saved, shared and undone (state file, link, undo/redo).
+#[cfg(test)]
+#[path = "e2e/state.rs"]
+mod state;
 
 /// The docs screenshots: not a test, the example `screenshot` (`examples/screenshot.rs`) runs
 /// it through this harness. The example includes this file as a module, so the test modules

@@ -298,7 +298,9 @@ fn plan_stop_drag_and_preset_cancel_and_undo_restores() {
                  const tick = () => { \
                    if (window.plan.state().gliding) { \
                      const p = document.getElementById('preset'); p.value = 'iclgnss2019'; \
-                     p.dispatchEvent(new Event('change')); done(true); \
+                     p.dispatchEvent(new Event('change')); \
+                     if (document.getElementById('confirm-dialog').open) document.getElementById('confirm-ok').click(); \
+                     done(true); \
                    } else if (performance.now() - t0 > 30000) done(false); else setTimeout(tick, 2); \
                  }; tick();",
                 vec![],

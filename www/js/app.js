@@ -6,7 +6,8 @@
 
 import init, * as wasm from '../pkg/scatterloc.js';
 import { $, clip, decimal, decimalIn, errorText, showError } from './dom.js';
-import { decodeScenario, viewLink } from './share.js';
+import { decodeScenario, decodeState, viewLink } from './share.js';
+import { attachState } from './state.js';
 import { registerHooks } from './hooks.js';
 import { View } from './view.js';
 import { MapView } from './map.js';
@@ -35,7 +36,8 @@ const MODES = ['snapshot', 'tracking', 'mtl', 'channel'];
  * (share.js; a scenario replaces the preset).
  */
 const KNOWN = ['mode', 'preset', 'res', 'target', 'seed', 'view', 'roi', 'scenario', 'z', 'track', 'step',
-  'play', 'runs', 'ex', 'tseed', 'dt', 'speed', 'filter', 'particles', 'filters', 'custom'];
+  'play', 'runs', 'ex', 'tseed', 'dt', 'speed', 'filter', 'particles', 'filters', 'custom',
+  'state', 'zstate']; // state, zstate: the rest of the page state (state.js; "Copy link" writes it)
 
 /**
  * The URL hash -> {opts, errors}. Every option is parsed strictly with the panel's own ranges
@@ -128,7 +130,11 @@ function hashOptions(presets) {
     roi: rect('roi'),
     view: rect('view'),
     scenario: scenarioKeys.length === 1 ? [scenarioKeys[0], h.get(scenarioKeys[0])] : null,
+    state: null,
   };
+  const stateKeys = ['zstate', 'state'].filter((k) => h.has(k) && !bad.has(k));
+  if (stateKeys.length > 1) report('state', 'zstate and state: both given (one page state at most)');
+  else if (stateKeys.length === 1) opts.state = [stateKeys[0], h.get(stateKeys[0])];
   return { opts, errors };
 }
 
@@ -334,6 +340,17 @@ export async function start() {
   Object.assign(dirty, { map: true, geometry: true, target: true, panel: true });
   refresh();
   setMode(opts.mode);
+  // The page state (state.js): saved and opened as a file, carried by the link, undo/redo.
+  const pageState = attachState({ app, wasm, st, view, panel, tracking, mtl, plan, zoom, ctx, setMode });
+  if (opts.state) {
+    const [key, value] = opts.state;
+    try {
+      const bad = pageState.openLink(await decodeState(key, value));
+      if (bad) errors.push(`URL option ${key}: ${bad}`);
+    } catch (e) {
+      errors.push(`URL option ${key}: ${errorText(e)}`);
+    }
+  }
   if (opts.play) tracking.play();
   if (errors.length) showError(errors.join(' · '));
 
@@ -345,6 +362,7 @@ export async function start() {
     roi: plan.roi,
     window: view.zoomed() ? Array.from(view.area) : null,
     scenario: app.scenario_json(),
+    state: pageState.linkState(),
   });
   $('share-copy').addEventListener('click', () => copyLink(link, () => panel.exportJson()));
   $('share-close').addEventListener('click', () => { $('share').hidden = true; });
@@ -352,6 +370,7 @@ export async function start() {
   registerHooks({
     app, wasm, view, st, setMode, panel, tracking, mtl, map, plan, link, figures, zoom, channel,
     isIdle: () => !scheduled && !map.busy(),
+    pageState: pageState.hooks(),
     placeTarget: ctx.placeTarget,
   });
 }

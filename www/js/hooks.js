@@ -51,6 +51,10 @@
 //                            outsideWarning() (nodes outside the area, outside.js)
 //   window.getColourRange() / setColourRange(obj)  the colour lock (colour-lock.js; the latter
 //                            throws a ColourRangeError)
+//   window.pageStateModel    the page state (state.js): capture() (the whole state object);
+//                            restore(obj) -> null | the banner's message; history() -> {index,
+//                            length, pending, busy}; undo(); redo(); dirty(); lastSaved() -> {name,
+//                            text} of the last "Save state"; setDryRun(bool)
 //   body[data-ready='1']     the page is up;  body[data-error]  it failed (the message)
 
 /**
@@ -138,6 +142,7 @@ export function registerHooks(p) {
       armRoi: (on) => p.plan.arm(on),
     },
     shareLink: () => p.link(),
+    pageStateModel: p.pageState,
     figureExport: {
       last: () => p.figures.lastInfo(),
       save: () => p.figures.save(),

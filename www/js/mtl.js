@@ -12,7 +12,8 @@ import { MARGIN, View } from './view.js';
 import { hitRadius, pickNearest } from './interact.js';
 import { drawMtl } from './mtl-draw.js';
 
-const MARGIN_M = 0.4; // shown around the region, m
+/** Shown around the region, m. */
+export const MARGIN_M = 0.4;
 /** Where "+ target" / "+ disc" try to put a new one (first valid wins), m. */
 const SPOTS = [[5, 5], [5, 7], [3, 6], [7, 3], [6, 8.5], [8, 6], [3, 2], [1.5, 7], [8.5, 1], [4.5, 2.5]];
 /**
@@ -33,7 +34,8 @@ const FIELDS = [
   ['mtl-pu', 'model.p_u', 'p_u', { min: 0, max: 1 }],
   ['mtl-plos', 'model.p_los', 'p_LoS', { min: 0, max: 1 }],
 ];
-const FIELD = Object.fromEntries(FIELDS.map(([id, key, name, range]) => [id, { key, name, range }]));
+/** The numeric inputs by id: {key, name, range}. */
+export const FIELD = Object.fromEntries(FIELDS.map(([id, key, name, range]) => [id, { key, name, range }]));
 /** A worker busy this long with a scene an edit has replaced is terminated and replaced, ms. */
 const STALE_MS = 250;
 

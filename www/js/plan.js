@@ -21,7 +21,7 @@ const ROI_MIN_PX = 4;
 const ROI_COLOR = '#ffd166';
 
 /** Inputs of the panel: the name in messages and the allowed range (dom.js decimalIn). */
-const FIELDS = {
+export const FIELDS = {
   // min, max: the core's (MAX_PLAN_BUDGET), from plan_field_ranges in the constructor.
   'plan-budget': { name: 'plan budget', integer: true, unit: 'evaluations' },
   'plan-seed': { name: 'plan seed', min: 0, max: Number.MAX_SAFE_INTEGER, integer: true },
@@ -53,6 +53,27 @@ function between(from, to, t) {
   move(out.transmitters, from.transmitters);
   move(out.receivers, from.receivers);
   return out;
+}
+
+/**
+ * True when scenario objects `a` and `b` place every node alike (positions and beam boresights):
+ * the planner handed back the layout it started from.
+ */
+function sameLayout(a, b) {
+  const same = (x, y) => x.length === y.length && x.every((n, i) => n.position_m[0] === y[i].position_m[0]
+    && n.position_m[1] === y[i].position_m[1] && (n.pattern?.boresight_deg ?? null) === (y[i].pattern?.boresight_deg ?? null));
+  return same(a.transmitters, b.transmitters) && same(a.receivers, b.receivers);
+}
+
+/**
+ * True when plan.json's objective `o` is better after than before as the panel reports it: fewer
+ * unbounded cells, else a lower value (a higher one for coverage). A layout the planner ranks
+ * better only by a tie-break the panel does not show (0 % → 0 %) is not.
+ */
+function improved(o) {
+  if (o.unbounded_after !== o.unbounded_before) return o.unbounded_after < o.unbounded_before;
+  if (o.before === null || o.after === null) return o.before === null && o.after !== null;
+  return o.maximised ? o.after > o.before : o.after < o.before;
 }
 
 export class Plan {
@@ -163,10 +184,10 @@ export class Plan {
 
   /**
    * Throws unless `r` is a rectangle the planner accepts (the core's rule for areas: a span of at
-   * least its minimum, check_rect) inside the scenario area.
+   * least its minimum, check_rect) inside the scenario area (or `area`, [x0, x1, y0, y1] m).
    */
-  checkRoi(r) {
-    const [ax0, ax1, ay0, ay1] = Array.from(this.ctx.app.area());
+  checkRoi(r, area = null) {
+    const [ax0, ax1, ay0, ay1] = Array.from(area ?? this.ctx.app.area());
     const text = `[${r.join(', ')}]`;
     if (!(r.length === 4 && r.every(Number.isFinite))) throw new Error(`${text} is not 4 finite numbers x0, x1, y0, y1`);
     if (!(r[0] < r[1] && r[2] < r[3])) throw new Error(`${text} is empty (x0 < x1 and y0 < y1 are needed)`);
@@ -322,6 +343,7 @@ export class Plan {
     this.applied = null;
     this.points = [];
     this.result = null;
+    this.kept = false;
     this.error = null;
     this.run = {
       id: null, request, t0: performance.now(), evaluations: 0,
@@ -411,6 +433,20 @@ export class Plan {
     r.evaluations = m.result.evaluations;
     this.result = m.result;
     this.points = m.result.history.map((h) => [h.evaluations, h.best]);
+    this.kept = sameLayout(JSON.parse(this.undoJson), m.result.scenario) || !improved(m.result.objective);
+    if (this.kept) {
+      // No better layout: the one from before Optimize stays, exactly (the glides undone).
+      this.glide = null;
+      if (this.frame) cancelAnimationFrame(this.frame);
+      this.frame = 0;
+      if (this.apply(this.undoJson, true)) $('preset').value = this.undoPreset;
+      this.applied = null;
+      this.undoJson = null;
+      this.status = 'done';
+      this.sync();
+      this.drawChart();
+      return;
+    }
     this.glideTo(JSON.stringify(m.result.scenario), () => {
       this.status = 'done';
       this.sync();
@@ -537,9 +573,16 @@ export class Plan {
       res.replaceChildren();
       const b = document.createElement('b');
       b.textContent = `${this.format(o.before, o.kind)} → ${this.format(o.after, o.kind)}`;
-      res.append(`${o.label} on the ${o.grid}×${o.grid} ROI grid: `, b, holes);
+      if (this.kept) {
+        b.textContent = `No better layout found: the current one is kept (${this.format(o.before, o.kind)}).`;
+        res.append(b, ` ${o.label} on the ${o.grid}×${o.grid} ROI grid${holes}`);
+      } else {
+        res.append(`${o.label} on the ${o.grid}×${o.grid} ROI grid: `, b, holes);
+      }
       el.textContent = `${this.result.evaluations} evaluations · ${this.result.runs} CMA-ES run`
-        + `${this.result.runs === 1 ? '' : 's'} (${this.result.termination}) · moved ${this.result.moved.join(', ')}`
+        + `${this.result.runs === 1 ? '' : 's'} (${this.result.termination}) · `
+        + (this.kept ? 'no better layout found: the current one is kept'
+          : `moved ${this.result.moved.join(', ')}`)
         + ` · ${fixed(r.wallMs / 1000, 1)} s`;
     } else if (this.status === 'error') {
       el.textContent = `Failed: ${this.error}`;
@@ -637,6 +680,7 @@ export class Plan {
       open: this.open,
       drawing: this.drawing,
       error: this.error,
+      kept: !!this.kept,
     };
   }
 }

@@ -112,14 +112,26 @@ function tooLarge(what) {
  * shortest round-trip form, which the page's strict parser reads back exactly. What the page
  * writes it reads (issue 24): a scenario over MAX_BYTES of compact JSON, or whose link the
  * reader would refuse (decodeScenario, run here on the link's own text), throws `tooLarge`
- * instead of giving a link.
+ * instead of giving a link. `state` (JSON text, or null): the rest of the page state (state.js
+ * linkState), carried as `zstate=` (deflated) or `state=` (base64url), read back by decodeState.
  */
-export async function viewLink({ mode, res, target, roi, window, scenario }) {
+export async function viewLink({ mode, res, target, roi, window, scenario, state = null }) {
   const parts = [`mode=${mode}`];
   if (res) parts.push(`res=${res}`);
   if (window) parts.push(`view=${window.join(',')}`);
   if (target) parts.push(`target=${target.x},${target.y}`, `seed=${target.seed}`);
   if (roi) parts.push(`roi=${roi.join(',')}`);
+  if (state !== null) {
+    // The rest of the page state (state.js), before the scenario: `zstate=` (deflated) or `state=`.
+    const size = new TextEncoder().encode(state).length;
+    if (size > MAX_BYTES) throw tooLarge(`the page state is ${size} bytes of JSON`);
+    const [k, v] = await encodeScenario(state);
+    const key = k === 'z' ? 'zstate' : 'state';
+    if ((await decodeState(key, v)) !== JSON.stringify(JSON.parse(state))) {
+      throw new Error(`the ${key}= text does not read back as the page state`);
+    }
+    parts.push(`${key}=${v}`);
+  }
   const compact = JSON.stringify(JSON.parse(scenario));
   const size = new TextEncoder().encode(compact).length;
   if (size > MAX_BYTES) throw tooLarge(`the scenario is ${size} bytes of JSON`);
@@ -133,4 +145,9 @@ export async function viewLink({ mode, res, target, roi, window, scenario }) {
   if (back !== compact) throw new Error(`the ${key}= text does not read back as the scenario`);
   parts.push(`${key}=${value}`);
   return `${location.origin}${location.pathname}#${parts.join('&')}`;
+}
+
+/** The page-state text of hash option `key` ('state' or 'zstate'): decoded as decodeScenario does. */
+export function decodeState(key, value) {
+  return decodeScenario(key === 'state' ? 'scenario' : 'z', value);
 }
