@@ -49,8 +49,8 @@ async fn click(c: &Client, id: &str) -> Result<(), String> {
     e.click().await.map_err(|e| e.to_string())
 }
 
-/// Pixels of the chart canvas in the EKF curve's blue (0, 94, 184) and the PCRLB curve's red
-/// (214, 39, 40), also where antialiasing blends them with the white background (grid, text
+/// Pixels of the chart canvas in the EKF curve's blue (0, 114, 178) and the PCRLB curve's
+/// vermillion (213, 94, 0), also where antialiasing blends them with the white background (grid, text
 /// and frame are grey or black).
 async fn chart_pixels(c: &Client) -> Result<(u64, u64), String> {
     let v = js(

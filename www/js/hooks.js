@@ -34,6 +34,9 @@
 //                            scaleBar {length_m, label} of the last frame, level}; reset();
 //                            hitAt(x, y) (an object under canvas pixel x, y: a press drags it);
 //                            toMetre(x, y) (canvas pixel -> {x, y} m in the view on screen)
+//   window.help              the Help dialog (help.js): open(), close(), isOpen()
+//   window.theme             the colour theme (theme.js): get() -> 'dark' | 'light'; set('dark' |
+//                            'light' | null (follow the system)); colors() (the canvas' colours)
 //   body[data-ready='1']     the page is up;  body[data-error]  it failed (the message)
 
 /**
@@ -132,6 +135,8 @@ export function registerHooks(p) {
       hitAt: (x, y) => !!p.zoom.hitAt({ x, y }),
       toMetre: (x, y) => p.zoom.view().toMetre(x, y),
     },
+    help: p.help,
+    theme: p.theme,
     importScenarioText: (text, name) => p.panel.importText(text, name),
     benchMap: (n = 9) => {
       const r = st.res;
