@@ -24,15 +24,6 @@ pub const LINK_RGB: [[u8; 3]; 8] = [
     [213, 94, 0],    // vermillion
     [244, 244, 240], // off-white (for Okabe–Ito's black)
     [0, 114, 178],   // blue
-]; 8] = [
-    [244, 244, 240],
-    [255, 209, 102],
-    [155, 229, 100],
-    [255, 143, 171],
-    [184, 192, 255],
-    [126, 232, 250],
-    [255, 184, 107],
-    [208, 162, 247],
 ];
 
 /// Control points of the perceptually ordered "viridis" map (dark = small error = good).

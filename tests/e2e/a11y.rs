@@ -92,7 +92,10 @@ async fn view_ready(c: &Client) -> Result<(), String> {
 /// axe in both themes and every view (each of the top bar's `.modes` buttons, clicked in turn;
 /// the snapshot view also with a placed target, the Plan panel open and the Help dialog open).
 /// Returns `(theme, view, violations)` per run and the rule count.
-async fn axe_views(c: &Client, port: u16) -> Result<(Vec<(String, String, Vec<Value>)>, usize), String> {
+async fn axe_views(
+    c: &Client,
+    port: u16,
+) -> Result<(Vec<(String, String, Vec<Value>)>, usize), String> {
     let axe = axe_source();
     c.set_window_size(1440, 900)
         .await
@@ -172,7 +175,10 @@ fn axe_all_rules_no_violations() {
             );
             for n in x["nodes"].as_array().into_iter().flatten().take(12) {
                 println!("    {}", n["target"].as_str().unwrap_or("?"));
-                println!("      {}", n["summary"].as_str().unwrap_or("").replace('\n', " "));
+                println!(
+                    "      {}",
+                    n["summary"].as_str().unwrap_or("").replace('\n', " ")
+                );
             }
             bad.push(format!("{theme} {name}: {}", x["id"]));
         }

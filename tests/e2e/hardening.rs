@@ -17,8 +17,7 @@ use scatterloc::Scenario;
 use super::mtl::{banner, state, wait_view};
 use super::{
     connect, console_errors, drag_on_plot, js, open, open_hash, probe, runtime, settle,
-    PROBE_HASH,
-    start_server, Driver, MAP_HASH, SERIAL,
+    start_server, Driver, MAP_HASH, PROBE_HASH, SERIAL,
 };
 
 /// One browser session: `f(client, port)`, then the browser is closed.

@@ -32,11 +32,14 @@ async fn key(c: &Client, key: char) -> Result<(), String> {
 
 /// The id of the focused element.
 async fn focused(c: &Client) -> Result<String, String> {
-    Ok(js(c, "return document.activeElement ? document.activeElement.id : ''")
-        .await?
-        .as_str()
-        .unwrap_or_default()
-        .to_string())
+    Ok(js(
+        c,
+        "return document.activeElement ? document.activeElement.id : ''",
+    )
+    .await?
+    .as_str()
+    .unwrap_or_default()
+    .to_string())
 }
 
 async fn help_open(c: &Client) -> Result<bool, String> {
@@ -198,7 +201,10 @@ async fn help_and_theme(c: &Client, port: u16) -> Result<HelpTheme, String> {
 #[ignore = "needs chromium + chromedriver and www/pkg (wasm-pack build); run with --ignored"]
 fn help_dialog_and_theme_toggle() {
     let o = with_browser(async |c, port, _| help_and_theme(c, port).await);
-    println!("help: {:?} {:?} {} {:?}", o.after_click, o.after_escape, o.after_key, o.after_close);
+    println!(
+        "help: {:?} {:?} {} {:?}",
+        o.after_click, o.after_escape, o.after_key, o.after_close
+    );
     println!("themes: {:?}", o.themes);
     assert_eq!(o.after_click, (true, "help-close".to_string()));
     assert_eq!(o.after_escape, (false, "help-open".to_string()));
@@ -306,13 +312,19 @@ async fn gestures(c: &Client, port: u16) -> Result<Gestures, String> {
     let tx = t1["x"].as_f64().unwrap_or(f64::NAN);
     let ty = t1["y"].as_f64().unwrap_or(f64::NAN);
     if e[3] != tx || e[4] != ty {
-        return Err(format!("the snapshot does not follow the target: {e:?} vs {t1}"));
+        return Err(format!(
+            "the snapshot does not follow the target: {e:?} vs {t1}"
+        ));
     }
     // Distance (px) between the dropped target and the release point.
-    let drag = (t0, t1.clone(), [e[0], e[1]], (tx - e[0]).hypot(ty - e[1]) * e[2]);
+    let drag = (
+        t0,
+        t1.clone(),
+        [e[0], e[1]],
+        (tx - e[0]).hypot(ty - e[1]) * e[2],
+    );
 
     // Zoomed in without a target, a double-click on empty map fits and places nothing.
-    js(c, "window.pageState.target = null; window.pageState.snap = null;").await?;
     js(c, "document.getElementById('target-clear').click()").await?;
     for _ in 0..2 {
         js(c, "document.getElementById('zoom-in').click()").await?;
@@ -384,7 +396,10 @@ fn probe_on_request_target_drag_and_double_click() {
     assert!(!o.dbl_none.0, "the double-click fitted the zoom");
     assert!(o.dbl_none.1, "and placed no target: {}", o.dbl_none.2);
     assert!(!o.dbl_kept.2, "fitted again");
-    assert_eq!(o.dbl_kept.0, o.dbl_kept.1, "the placed target stays as it was");
+    assert_eq!(
+        o.dbl_kept.0, o.dbl_kept.1,
+        "the placed target stays as it was"
+    );
     assert!(o.errors.is_empty(), "console errors: {:?}", o.errors);
 }
 
@@ -454,10 +469,13 @@ async fn rounded(c: &Client, port: u16) -> Result<Rounded, String> {
     let native = crlb_at(&model, Vec2::new(4.0, 1.0))
         .bound
         .map_or(f64::NAN, |b| b.rmse_m);
-    let page = js(c, "return Number(document.getElementById('probe').dataset.rmseM)")
-        .await?
-        .as_f64()
-        .unwrap_or(f64::NAN);
+    let page = js(
+        c,
+        "return Number(document.getElementById('probe').dataset.rmseM)",
+    )
+    .await?
+    .as_f64()
+    .unwrap_or(f64::NAN);
     Ok(Rounded {
         exact,
         shown,
@@ -484,7 +502,11 @@ fn inputs_show_rounded_numbers_and_keep_exact_ones() {
         let decimals = t.split('.').nth(1).map_or(0, str::len);
         assert!(decimals <= 3, "{t}: at most 3 decimals");
         let v: f64 = t.parse().unwrap();
-        assert!((v - o.exact[i]).abs() <= 5e-4 + 1e-12, "{t} vs {}", o.exact[i]);
+        assert!(
+            (v - o.exact[i]).abs() <= 5e-4 + 1e-12,
+            "{t} vs {}",
+            o.exact[i]
+        );
     }
     assert!(
         o.exact[0].to_string().split('.').nth(1).map_or(0, str::len) > 3,
