@@ -249,6 +249,15 @@ async fn gestures(c: &Client, port: u16) -> Result<Gestures, String> {
     );
     // Shift+click pins it (and places no target).
     let [px, py] = empty_pixel(c).await?;
+    // The metre point aimed at and the metres of one CSS pixel, before the click.
+    let aim: Vec<f64> = serde_json::from_value(
+        js(
+            c,
+            &format!("const m = window.view.toMetre({px}, {py}); return [m.x, m.y, 1 / window.view.len(1)];"),
+        )
+        .await?,
+    )
+    .map_err(|e| e.to_string())?;
     click_plot(c, px, py, 1, true).await?;
     settle(c).await?;
     let v = js(
@@ -257,7 +266,11 @@ async fn gestures(c: &Client, port: u16) -> Result<Gestures, String> {
             "const p = document.getElementById('probe'); const m = window.view.toMetre({px}, {py}); \
              return [!p.hidden && p.getClientRects().length > 0, Number(p.dataset.x), Number(p.dataset.y), \
                      Number(p.dataset.rmseM), window.app.rmse_at(Number(p.dataset.x), Number(p.dataset.y)), \
-                     m.x, m.y, window.pageState.target === null];"
+                     Math.hypot(Number(p.dataset.x) - {ax}, Number(p.dataset.y) - {ay}) / {mpp}, m.y, \
+                     window.pageState.target === null];",
+            ax = aim[0],
+            ay = aim[1],
+            mpp = aim[2]
         ),
     )
     .await?;
@@ -265,13 +278,7 @@ async fn gestures(c: &Client, port: u16) -> Result<Gestures, String> {
     if v[7] != true {
         return Err("Shift+click placed a target".into());
     }
-    let probe_pinned = (
-        v[0] == true,
-        (f(1) - f(5)).hypot(f(2) - f(6)),
-        f(3),
-        f(4),
-        f(1),
-    );
+    let probe_pinned = (v[0] == true, f(5), f(3), f(4), f(1));
     c.find(Locator::Id("probe-clear"))
         .await
         .map_err(|e| e.to_string())?
@@ -381,9 +388,10 @@ fn probe_on_request_target_drag_and_double_click() {
         o.probe_default.1
     );
     assert_eq!(o.probe_default.2, "");
-    let (shown, dist_m, value, core, _) = o.probe_pinned;
+    let (shown, dist_px, value, core, _) = o.probe_pinned;
     assert!(shown, "Shift+click shows the probe");
-    assert!(dist_m < 1e-9, "probe at the click ({dist_m} m away)");
+    // The click lands on a whole viewport pixel, within a pixel of the one aimed at.
+    assert!(dist_px < 1.5, "probe at the click ({dist_px} px away)");
     assert_eq!(value, core, "the probe's value is the core's bound there");
     assert!(o.probe_cleared, "× removes the probe");
     let (t0, t1, _, px) = &o.drag;
@@ -444,7 +452,11 @@ async fn rounded(c: &Client, port: u16) -> Result<Rounded, String> {
         .find(Locator::Id("rx-y"))
         .await
         .map_err(|e| e.to_string())?;
-    y.clear().await.map_err(|e| e.to_string())?;
+    js(
+        c,
+        "const e = document.getElementById('rx-y'); e.focus(); e.select();",
+    )
+    .await?;
     y.send_keys(&format!("7{ENTER}"))
         .await
         .map_err(|e| e.to_string())?;
