@@ -59,7 +59,7 @@ async fn chart_pixels(c: &Client) -> Result<(u64, u64), String> {
          const d = cv.getContext('2d').getImageData(0, 0, cv.width, cv.height).data; \
          let blue = 0, red = 0; \
          for (let i = 0; i < d.length; i += 4) { const r = d[i], g = d[i + 1], b = d[i + 2]; \
-           if (b - r > 50 && b - g > 20) blue++; if (r - g > 60 && r - b > 60) red++; } \
+           if (b - r > 50 && b - g > 20) blue++; if (r - g > 40 && r - b > 80) red++; } \
          return [blue, red];",
     )
     .await?;
