@@ -43,8 +43,8 @@ fi
 # axe-core (the accessibility engine of tests/e2e/a11y.rs), pinned and checked against the npm
 # registry's sha512 integrity; unpacked into the git-ignored .tools/axe-core/ (never served by the
 # page, no CDN). npm pack when npm is there, else the same tarball from registry.npmjs.org.
-AXE_VERSION=4.10.2
-AXE_SHA512=RE3mdQ7P3FRSe7eqCWoeQ/Z9QXrtniSjp1wUjt5nRC3WIpz5rSCve6o3fsZ2aCpJtrZjSZgjwXAoTO5k4tEI0w==
+AXE_VERSION=4.14.1
+AXE_SHA512=FHfa+lmNjQZfJz1q8wKqIDwC6DExcHt/pkjNQb09a3NPjCKg2rhu5qb2S4r76ASyFNNtuFooJpZe37OgudVGtQ==
 AXE_DIR=.tools/axe-core
 if [ "$(cat "$AXE_DIR/VERSION" 2>/dev/null || true)" != "$AXE_VERSION" ] || [ ! -s "$AXE_DIR/axe.min.js" ]; then
   tmp=$(mktemp -d)

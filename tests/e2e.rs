@@ -90,6 +90,10 @@ mod pf;
 #[cfg(test)]
 #[path = "e2e/state.rs"]
 mod state;
+/// Issue 26 §4–5: help, themes, legends, the probe on request, rounded inputs, target gestures.
+#[cfg(test)]
+#[path = "e2e/ux.rs"]
+mod ux;
 
 /// The docs screenshots: not a test, the example `screenshot` (`examples/screenshot.rs`) runs
 /// it through this harness. The example includes this file as a module, so the test modules
@@ -305,6 +309,11 @@ const MAP_HASH: &str = "const c = window.mapCanvas; \
     let h = 2166136261; for (let i = 0; i < d.length; i++) { h ^= d[i]; h = Math.imul(h, 16777619) >>> 0; } \
     return h;";
 
+/// The URL option pinning the status bar's probe at (4, 1) m, which [`probe`] reads (the page
+/// shows no probe unless asked for one).
+const PROBE_HASH: &str = "#probe=4,1";
+
+/// The bound at the pinned probe (the page opened with [`PROBE_HASH`]), m.
 async fn probe(c: &Client) -> Result<f64, String> {
     let v = js(c, "return document.getElementById('probe').dataset.rmseM").await?;
     v.as_str()
@@ -379,7 +388,7 @@ struct DragOutcome {
 }
 
 async fn drag_receiver(c: &Client, port: u16) -> Result<DragOutcome, String> {
-    open(c, port).await?;
+    open_hash(c, port, PROBE_HASH).await?;
     settle(c).await?;
     let hash_before = js(c, MAP_HASH).await?.as_u64().unwrap_or(0);
     let probe_before = probe(c).await?;
@@ -497,7 +506,7 @@ struct ImportOutcome {
 }
 
 async fn import_broken(c: &Client, port: u16, file: &Path) -> Result<ImportOutcome, String> {
-    open(c, port).await?;
+    open_hash(c, port, PROBE_HASH).await?;
     settle(c).await?;
     let before = js(c, "return window.app.scenario_json()").await?;
     let probe_before = probe(c).await?;

@@ -12,16 +12,18 @@ pub const UNBOUNDED_RGB: [u8; 3] = [72, 72, 80];
 
 /// The colours of the links (their iso-delay ellipses; the multi-target view's TRPs) over the
 /// map: link `i` takes entry `i mod 8`. The page draws with them and the map figure's overlays
-/// ([`crate::chart::MapOverlay`]) too.
+/// ([`crate::chart::MapOverlay`]) too. Colour-blind safe: the Okabe–Ito palette (M. Okabe and
+/// K. Ito, "Color Universal Design", 2008), its black replaced by an off-white (the overlays lie
+/// on a dark map) and its dark blue last (the least visible on the map's dark end).
 pub const LINK_RGB: [[u8; 3]; 8] = [
-    [244, 244, 240],
-    [255, 209, 102],
-    [155, 229, 100],
-    [255, 143, 171],
-    [184, 192, 255],
-    [126, 232, 250],
-    [255, 184, 107],
-    [208, 162, 247],
+    [86, 180, 233],  // sky blue
+    [230, 159, 0],   // orange
+    [0, 158, 115],   // bluish green
+    [240, 228, 66],  // yellow
+    [204, 121, 167], // reddish purple
+    [213, 94, 0],    // vermillion
+    [244, 244, 240], // off-white (for Okabe–Ito's black)
+    [0, 114, 178],   // blue
 ];
 
 /// Control points of the perceptually ordered "viridis" map (dark = small error = good).

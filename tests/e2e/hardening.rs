@@ -17,7 +17,7 @@ use scatterloc::Scenario;
 use super::mtl::{banner, state, wait_view};
 use super::{
     connect, console_errors, drag_on_plot, js, open, open_hash, probe, runtime, settle,
-    start_server, Driver, MAP_HASH, SERIAL,
+    start_server, Driver, MAP_HASH, PROBE_HASH, SERIAL,
 };
 
 /// One browser session: `f(client, port)`, then the browser is closed.
@@ -298,7 +298,7 @@ fn huge_area_import_is_rejected_and_the_plot_stays() {
     std::fs::write(&bom_file, format!("\u{feff}{}", bom.to_json())).unwrap();
     let bom_path = bom_file.clone();
     let o = session(|c, port| async move {
-        open(&c, port).await?;
+        open_hash(&c, port, PROBE_HASH).await?;
         settle(&c).await?;
         let scenario = "return [window.app.scenario_json(), window.view.area]";
         let before = (

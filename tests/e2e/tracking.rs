@@ -49,8 +49,8 @@ async fn click(c: &Client, id: &str) -> Result<(), String> {
     e.click().await.map_err(|e| e.to_string())
 }
 
-/// Pixels of the chart canvas in the EKF curve's blue (0, 94, 184) and the PCRLB curve's red
-/// (214, 39, 40), also where antialiasing blends them with the white background (grid, text
+/// Pixels of the chart canvas in the EKF curve's blue (0, 114, 178) and the PCRLB curve's
+/// vermillion (213, 94, 0), also where antialiasing blends them with the white background (grid, text
 /// and frame are grey or black).
 async fn chart_pixels(c: &Client) -> Result<(u64, u64), String> {
     let v = js(
@@ -59,7 +59,7 @@ async fn chart_pixels(c: &Client) -> Result<(u64, u64), String> {
          const d = cv.getContext('2d').getImageData(0, 0, cv.width, cv.height).data; \
          let blue = 0, red = 0; \
          for (let i = 0; i < d.length; i += 4) { const r = d[i], g = d[i + 1], b = d[i + 2]; \
-           if (b - r > 50 && b - g > 20) blue++; if (r - g > 60 && r - b > 60) red++; } \
+           if (b - r > 50 && b - g > 20) blue++; if (r - g > 40 && r - b > 80) red++; } \
          return [blue, red];",
     )
     .await?;

@@ -278,7 +278,7 @@ fn chart_draws_both_curves_on_a_canvas() {
         "Scenario I",
     ));
     assert_eq!(n, 2);
-    // Pixels close to the EKF blue (0, 94, 184) and the PCRLB red (214, 39, 40).
+    // Pixels close to the EKF blue (0, 114, 178) and the PCRLB vermillion (213, 94, 0).
     let count = Function::new_with_args(
         "c, r, g, b",
         "const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data; let n = 0; \
@@ -294,7 +294,7 @@ fn chart_draws_both_curves_on_a_canvas() {
             .as_f64()
             .unwrap()
     };
-    let (blue, red) = (px([0.0, 94.0, 184.0]), px([214.0, 39.0, 40.0]));
+    let (blue, red) = (px([0.0, 114.0, 178.0]), px([213.0, 94.0, 0.0]));
     assert!(
         blue > 200.0 && red > 200.0,
         "curve pixels: EKF {blue}, PCRLB {red}"

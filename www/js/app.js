@@ -22,6 +22,8 @@ import { Zoomer } from './zoom.js';
 import { setLinkColors } from './draw.js';
 import { Channel } from './channel.js';
 import { homeWithNodes } from './outside.js';
+import { attachHelp } from './help.js';
+import { attachTheme } from './theme.js';
 
 const MODES = ['snapshot', 'tracking', 'mtl', 'channel'];
 
@@ -33,11 +35,12 @@ const MODES = ['snapshot', 'tracking', 'mtl', 'channel'];
  * Carlo's filters); multi-target: `#mode=mtl`; a shared view ("Copy link"): `view=x0,x1,y0,y1`
  * (the map's zoomed window, m), `roi=x0,x1,y0,y1` (the Plan panel's region of interest, m) and
  * the scenario as `scenario=<base64url of its JSON>` or `z=<base64url of its raw-deflated JSON>`
- * (share.js; a scenario replaces the preset).
+ * (share.js; a scenario replaces the preset); `probe=x,y` pins the status bar's probe at (x, y) m.
  */
 const KNOWN = ['mode', 'preset', 'res', 'target', 'seed', 'view', 'roi', 'scenario', 'z', 'track', 'step',
   'play', 'runs', 'ex', 'tseed', 'dt', 'speed', 'filter', 'particles', 'filters', 'custom',
   'state', 'zstate']; // state, zstate: the rest of the page state (state.js; "Copy link" writes it)
+KNOWN.push('probe'); // the pinned probe (map.js pinProbe)
 
 /**
  * The URL hash -> {opts, errors}. Every option is parsed strictly with the panel's own ranges
@@ -95,6 +98,7 @@ function hashOptions(presets) {
   // The step index's range is the core's (MAX_TRACK_STEPS, one definition).
   const stepRange = JSON.parse(wasm.track_field_ranges()).step;
   const target = checked('target', 2, ([x, y]) => wasm.check_point('target', x, y));
+  const probe = checked('probe', 2, ([x, y]) => wasm.check_point('probe', x, y));
   const custom = checked('custom', 4, ([x0, y0, x1, y1]) => {
     wasm.check_point('custom.start', x0, y0);
     wasm.check_point('custom.end', x1, y1);
@@ -125,6 +129,7 @@ function hashOptions(presets) {
     custom: custom ? { x0: custom[0], y0: custom[1], x1: custom[2], y1: custom[3] } : null,
     preset: oneOf('preset', presets),
     target: target ? { x: target[0], y: target[1] } : null,
+    probe: probe ? { x: probe[0], y: probe[1] } : null,
     seed: read('seed', (t) => decimalIn(t, 'seed', SEED_RANGE)) ?? 1,
     res: option('res', 'resolution'),
     roi: rect('roi'),
@@ -175,6 +180,7 @@ export async function start() {
     insetTitle: 'target zoom',
     insetAvoid: [],
     nextSeed: opts.seed,
+    probe: opts.probe, // the pinned probe {x, y} m, or null (map.js)
     refreshLog: [], // [{ms, mapMs, res, dragging}] of the last 64 refreshes (main thread)
     // + the map's fields (map.js)
   };
@@ -261,6 +267,8 @@ export async function start() {
   ctx.placeTarget = (x, y) => map.placeTarget(x, y);
   ctx.resample = () => map.resample();
   ctx.clearTarget = () => map.clearTarget();
+  ctx.pinProbe = (x, y) => map.pinProbe(x, y);
+  $('probe-clear').addEventListener('click', () => map.pinProbe(null));
   const panel = new Panel(ctx);
   ctx.panel = panel;
   const tracking = new Tracking(ctx, opts);
@@ -301,6 +309,13 @@ export async function start() {
   const pointer = attachPointer(ctx);
   attachKeyboard(ctx, mtl);
   ctx.showHint = () => pointer.showHint();
+  zoom.onFit.push(() => pointer.undoDoubleClick());
+  const help = attachHelp();
+  const theme = attachTheme((now) => {
+    if (now) refresh(); else changed({ draw: true });
+    tracking.mc.drawChart();
+    plan.drawChart();
+  });
 
   view.resize();
   const home0 = setHomeFor();
@@ -339,6 +354,7 @@ export async function start() {
   if (opts.target) st.target = { x: opts.target.x, y: opts.target.y, seed: st.nextSeed++ };
   Object.assign(dirty, { map: true, geometry: true, target: true, panel: true });
   refresh();
+  $('loading').hidden = true; // the first map is drawn
   setMode(opts.mode);
   // The page state (state.js): saved and opened as a file, carried by the link, undo/redo.
   const pageState = attachState({ app, wasm, st, view, panel, tracking, mtl, plan, zoom, ctx, setMode });
@@ -371,6 +387,7 @@ export async function start() {
     app, wasm, view, st, setMode, panel, tracking, mtl, map, plan, link, figures, zoom, channel,
     isIdle: () => !scheduled && !map.busy(),
     pageState: pageState.hooks(),
+    help, theme,
     placeTarget: ctx.placeTarget,
   });
 }

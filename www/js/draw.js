@@ -198,3 +198,18 @@ export function drawNodes(ctx, view, receivers, transmitters, sel) {
     txMarker(ctx, p, n.name, isSelected(sel, 'tx', i));
   });
 }
+
+/**
+ * The canvas colours of the theme (theme.js): the plot's background, frame, axis text, muted
+ * text and grid from the CSS variables --plot-bg, --plot-frame, --plot-text, --plot-muted and
+ * --plot-grid (style.css, per theme) into C. The map, its overlays and the markers keep their
+ * colours in both themes (they are drawn over the map's dark-to-bright scale).
+ */
+export function applyThemeColors() {
+  const css = getComputedStyle(document.documentElement);
+  for (const [key, name] of [['bg', '--plot-bg'], ['frame', '--plot-frame'], ['text', '--plot-text'],
+    ['muted', '--plot-muted'], ['grid', '--plot-grid']]) {
+    const v = css.getPropertyValue(name).trim();
+    if (v) C[key] = v;
+  }
+}

@@ -55,6 +55,9 @@
 //                            restore(obj) -> null | the banner's message; history() -> {index,
 //                            length, pending, busy}; undo(); redo(); dirty(); lastSaved() -> {name,
 //                            text} of the last "Save state"; setDryRun(bool)
+//   window.help              the Help dialog (help.js): open(), close(), isOpen()
+//   window.theme             the colour theme (theme.js): get() -> 'dark' | 'light'; set('dark' |
+//                            'light' | null (follow the system)); colors() (the canvas' colours)
 //   body[data-ready='1']     the page is up;  body[data-error]  it failed (the message)
 
 /**
@@ -154,6 +157,8 @@ export function registerHooks(p) {
       hitAt: (x, y) => !!p.zoom.hitAt({ x, y }),
       toMetre: (x, y) => p.zoom.view().toMetre(x, y),
     },
+    help: p.help,
+    theme: p.theme,
     importScenarioText: (text, name) => p.panel.importText(text, name),
     channel: {
       state: () => p.channel.state(),

@@ -9,6 +9,8 @@ import { $, errorText, fixed, showError, clearError } from './dom.js';
 const HIT_PX = 12; // pick radius around a marker, CSS px (mouse)
 const TOUCH_HIT_PX = 22; // the same for a finger or pen: a target about 44 CSS px across
 const CLICK_PX = 4; // a press that moves less than this is a click
+const DOUBLE_MS = 500; // a second click this soon after the first and …
+const DOUBLE_PX = 8; // … this close to it is the second click of a double-click (zoom.js: fit)
 
 /** The pick radius for a pointer event: finger-sized for touch and pen, HIT_PX for a mouse. */
 export const hitRadius = (ev) => (ev && (ev.pointerType === 'touch' || ev.pointerType === 'pen') ? TOUCH_HIT_PX : HIT_PX);
@@ -57,7 +59,10 @@ export function attachPointer(ctx) {
   const { view, st, app } = ctx;
   const canvas = view.canvas;
   const readout = $('readout');
-  let press = null; // { start, last, anchor (of the pan): {x, y}, node: {kind, index} | null, moved, draw, roi, pan }
+  let press = null; // { start, last, anchor (of the pan): {x, y}, node: {kind, index} | null, target, moved, draw, roi, pan }
+  // The last click that placed a target: {t (ms), p (pixel), before (st.target before it)}; a
+  // double-click that fits the zoom puts the target back (undoDoubleClick, zoom.js).
+  let lastClick = null;
 
   const hover = (p) => {
     if (!view.inPlot(p.x, p.y)) {
@@ -65,7 +70,7 @@ export function attachPointer(ctx) {
       else if (st.mode === 'channel') readout.textContent = 'Channel · open, drop or simulate a recording, then Run · drag Tx/Rx markers · wheel to zoom';
       else if (ctx.plan && ctx.plan.wantsRoi()) readout.textContent = 'Press and drag on the map to draw the region of interest';
       else readout.textContent = st.mode !== 'tracking'
-        ? 'Move over the map to read the bound · drag Tx/Rx markers · click to place a target'
+        ? 'Move over the map to read the bound · drag Tx/Rx markers · click to place a target, drag it to move it · ? for help'
         : `Move over the map to read the bound · drag Tx/Rx markers${ctx.tracking.wantsDraw() ? ' · press and drag to draw a trajectory' : ''}`;
       return;
     }
@@ -87,10 +92,14 @@ export function attachPointer(ctx) {
     // "Draw ROI" armed: the press draws the ROI, even over a node.
     const roi = !!ctx.plan && ctx.plan.wantsRoi() && view.inPlot(p.x, p.y);
     const node = roi ? null : hitNode(view, st.nodes, p, hitRadius(ev));
-    const draw = !node && !roi && view.inPlot(p.x, p.y) && ctx.tracking.wantsDraw();
+    // The placed target (snapshot view) is dragged like a node.
+    const target = !node && !roi && st.mode === 'snapshot' && !!st.target
+      && !!pickNearest(view, [['target', [st.target]]], p, hitRadius(ev));
+    const draw = !node && !roi && !target && view.inPlot(p.x, p.y) && ctx.tracking.wantsDraw();
     // Anything else in the plot: a click (snapshot: place the target) or, once it moves, a pan.
-    const pan = !node && !roi && !draw && view.inPlot(p.x, p.y);
-    press = { start: p, last: p, anchor: p, node, moved: false, draw, roi, pan };
+    const pan = !node && !roi && !draw && !target && view.inPlot(p.x, p.y);
+    press = { start: p, last: p, anchor: p, node, target, moved: false, draw, roi, pan };
+    if (target) canvas.classList.add('dragging');
     if (roi) ctx.plan.roiStart(p);
     if (node) {
       ctx.panel.select(node.kind, node.index);
@@ -110,6 +119,15 @@ export function attachPointer(ctx) {
       const box = view.dragBox();
       const m = view.toMetreWithin(p, box.a, box.b);
       moveNode(ctx, press.node, m.x, m.y);
+    } else if (press && press.target) {
+      if (Math.hypot(p.x - press.start.x, p.y - press.start.y) > CLICK_PX) press.moved = true;
+      if (press.moved) {
+        const box = view.dragBox();
+        const m = view.toMetreWithin(p, box.a, box.b);
+        // The same noise realisation follows the target (New noise draws another).
+        st.target = { x: m.x, y: m.y, seed: st.target.seed };
+        ctx.changed({ target: true });
+      }
     } else if (press && press.roi) {
       ctx.plan.roiMove(p);
     } else if (press && press.draw) {
@@ -121,14 +139,18 @@ export function attachPointer(ctx) {
         press.anchor = p;
       }
     } else {
-      canvas.classList.toggle('over-node', !!hitNode(view, st.nodes, p));
+      canvas.classList.toggle('over-node', !!hitNode(view, st.nodes, p)
+        || (st.mode === 'snapshot' && !!st.target && !!pickNearest(view, [['target', [st.target]]], p)));
     }
     if (press) press.last = p;
     hover(p);
   });
 
-  /** The press ends at canvas pixel p; `up`: released (not cancelled). */
-  const finish = (p, up) => {
+  /**
+   * The press ends at canvas pixel p; `up`: released (not cancelled); `shift`: Shift was held
+   * (a Shift+click pins the probe there instead of placing the target).
+   */
+  const finish = (p, up, shift = false) => {
     const wasClick = up && !press.node && !press.roi && !press.moved && st.mode !== 'tracking' && st.mode !== 'channel';
     if (press.roi) ctx.plan.roiEnd(p, up);
     if (press.draw) ctx.tracking.drawEnd(view.toMetre(p.x, p.y));
@@ -141,18 +163,39 @@ export function attachPointer(ctx) {
     }
     press = null;
     canvas.classList.remove('dragging');
+    const now = performance.now();
+    const second = !!lastClick && !lastClick.second && now - lastClick.t < DOUBLE_MS
+      && Math.hypot(p.x - lastClick.p.x, p.y - lastClick.p.y) < DOUBLE_PX;
     if (wasClick && view.inPlot(p.x, p.y)) {
       const m = view.toMetre(p.x, p.y);
-      ctx.placeTarget(m.x, m.y);
+      if (shift && ctx.pinProbe) {
+        ctx.pinProbe(m.x, m.y);
+      } else if (!second) {
+        // The second click of a double-click places nothing (the double-click may fit the zoom).
+        lastClick = { t: now, p, before: st.target ? { ...st.target } : null };
+        ctx.placeTarget(m.x, m.y);
+        return;
+      }
     }
+    if (second) lastClick.second = true; else lastClick = null;
   };
   const end = (ev) => {
-    if (press) finish(view.eventPixel(ev), ev.type === 'pointerup');
+    if (press) finish(view.eventPixel(ev), ev.type === 'pointerup', !!ev.shiftKey);
   };
   // A second finger (a pinch, zoom.js) ends the press where it is, as a cancel.
   ctx.zoom.cancelPress.push(() => { if (press) finish(press.last, false); });
   canvas.addEventListener('pointerup', end);
   canvas.addEventListener('pointercancel', end);
   canvas.addEventListener('pointerleave', () => { if (!press) hover({ x: -1, y: -1 }); });
-  return { showHint: () => hover({ x: -1, y: -1 }) };
+  /**
+   * A double-click fitted the zoom (zoom.js): the target its first click placed goes back to
+   * where it was (or away), so the double-click changes the window only.
+   */
+  const undoDoubleClick = () => {
+    if (!lastClick || performance.now() - lastClick.t > 2 * DOUBLE_MS) return;
+    st.target = lastClick.before;
+    lastClick = null;
+    ctx.changed({ target: true });
+  };
+  return { showHint: () => hover({ x: -1, y: -1 }), undoDoubleClick };
 }

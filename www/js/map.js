@@ -194,15 +194,31 @@ export class MapView {
     }[source];
   }
 
-  /** The bound at #probe's data-x, data-y (m) into its data-rmse-m and text. */
+  /**
+   * The pinned probe (st.probe {x, y} m: a Shift+click on the map or the URL option
+   * `probe=x,y`): its bound into #probe's data-x, data-y, data-rmse-m and text; no probe pinned,
+   * #probe and its remove button are hidden.
+   */
   probe() {
-    const { app, wasm } = this.ctx;
+    const { app, wasm, st } = this.ctx;
     const el = $('probe');
-    const x = Number(el.dataset.x);
-    const y = Number(el.dataset.y);
-    const rmse = app.rmse_at(x, y);
-    el.dataset.rmseM = String(rmse);
-    el.textContent = `probe (${x}, ${y}) m: ${wasm.format_length(rmse, 4)}`;
+    const pin = st.probe;
+    el.hidden = !pin;
+    $('probe-clear').hidden = !pin;
+    if (!pin) {
+      el.dataset.rmseM = '';
+      el.textContent = 'probe –';
+      return;
+    }
+    const rmse = app.rmse_at(pin.x, pin.y);
+    Object.assign(el.dataset, { x: String(pin.x), y: String(pin.y), rmseM: String(rmse) });
+    el.textContent = `probe (${fixed(pin.x, 2)}, ${fixed(pin.y, 2)}) m: ${wasm.format_length(rmse, 4)}`;
+  }
+
+  /** Pins the probe at (x, y) m (null: removes it). */
+  pinProbe(x, y) {
+    this.ctx.st.probe = x === null ? null : { x, y };
+    this.probe();
   }
 
   /** Places the target at (x, y) m with the next noise seed. */

@@ -5,7 +5,6 @@
 
 import { C, FONT_B, FULL, clipTo, cross, drawAxes, drawNodes, drawScaleBar, ellipsePath, focusRing, haloText, isSelected, linkColor, plotFocus, ring } from './draw.js';
 
-const BG = '#10141c';
 const DISC = 'rgba(150,160,178,0.55)';
 const BLOCKED = '#ff4d4f';
 const LOS = 'rgba(255,255,255,0.16)';
@@ -133,7 +132,7 @@ function targets(ctx, view, scene, v, sel) {
  */
 export function drawMtl(view, scene, v, sel, w) {
   const ctx = view.context();
-  view.clear(ctx, BG);
+  view.clear(ctx, C.bg);
   const r = view.rect;
   // Zoomed in (zoom.js), everything stays inside the plot; at the home extent the node labels may
   // reach into the margin.

@@ -2,8 +2,9 @@
 // goes to a validating wasm setter; a rejected value shows its message in the error banner and
 // leaves the scenario unchanged.
 
-import { $, decimal, errorText, fillKeyValues, fixed, showError, clearError } from './dom.js';
+import { $, errorText, fillKeyValues, fixed, showError, clearError } from './dom.js';
 import { linkColor } from './draw.js';
+import { readNumber, showNumber } from './numfield.js';
 
 export class Panel {
   /**
@@ -74,9 +75,12 @@ export class Panel {
     $('target-resample').addEventListener('click', () => ctx.resample());
   }
 
-  /** The number in input `id`, strictly parsed; a bad one throws naming the scenario field. */
+  /**
+   * The number in input `id`: the exact value behind its rounded display while untouched
+   * (numfield.js), else strictly parsed; a bad one throws naming the scenario field.
+   */
   field(id) {
-    return decimal($(id).value, this.fieldName(id));
+    return readNumber($(id), this.fieldName(id));
   }
 
   /** The scenario field input `id` edits (the path the core's messages use). */
@@ -194,7 +198,7 @@ export class Panel {
     const set = (id, v) => {
       const el = $(id);
       if (document.activeElement === el && el.classList.contains('invalid')) return;
-      if (document.activeElement !== el) el.value = v === null || v === undefined ? '' : String(v);
+      if (document.activeElement !== el) showNumber(el, v);
       el.classList.remove('invalid');
     };
     set('carrier', s.radio.carrier_hz / 1e9);

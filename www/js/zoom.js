@@ -34,9 +34,13 @@ export class Zoomer {
     const canvas = ctx.view.canvas;
     this.canvas = canvas;
     canvas.addEventListener('wheel', (ev) => this.wheel(ev), { passive: false });
+    this.onFit = []; // called after a double-click fitted the zoom (interact.js: no target placed)
     canvas.addEventListener('dblclick', (ev) => {
       const p = this.view().eventPixel(ev);
-      if (this.view().inPlot(p.x, p.y) && !this.hitAt(p)) this.reset();
+      if (this.view().inPlot(p.x, p.y) && !this.hitAt(p) && this.view().zoomed()) {
+        this.reset();
+        for (const f of this.onFit) f();
+      }
     });
     // Document capture: the pinch sees the pointers before interact.js and mtl.js do.
     document.addEventListener('pointerdown', (ev) => this.down(ev), true);

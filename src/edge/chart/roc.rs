@@ -15,14 +15,16 @@ use super::layout::{font_scale, frame_plot, segments, series_legend, titled_body
 use super::{axis_label, chart_err, register_fonts, ChartError};
 use crate::math::Real;
 
-/// The curve colours (colour-blind-safe palette, as matplotlib's `tab10` start).
+/// The curve colours: the colour-blind-safe Okabe–Ito palette (M. Okabe and K. Ito, "Color
+/// Universal Design", 2008) on a white chart: blue, vermillion, bluish green, orange, reddish
+/// purple, sky blue.
 pub const CURVE_PALETTE: [RGBColor; 6] = [
-    RGBColor(0, 94, 184),
-    RGBColor(214, 39, 40),
-    RGBColor(44, 160, 44),
-    RGBColor(255, 127, 14),
-    RGBColor(148, 103, 189),
-    RGBColor(140, 86, 75),
+    RGBColor(0, 114, 178),
+    RGBColor(213, 94, 0),
+    RGBColor(0, 158, 115),
+    RGBColor(230, 159, 0),
+    RGBColor(204, 121, 167),
+    RGBColor(86, 180, 233),
 ];
 
 /// How the points of a curve are joined.

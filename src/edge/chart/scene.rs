@@ -33,10 +33,10 @@ const MARGIN_FRACTION: Real = 0.04;
 const REGION_FILL: RGBColor = RGBColor(241, 243, 247);
 const REGION_EDGE: RGBColor = RGBColor(150, 156, 168);
 const DISC_RGB: RGBColor = RGBColor(120, 128, 142);
-const BLOCKED_RGB: RGBColor = RGBColor(214, 39, 40);
+const BLOCKED_RGB: RGBColor = CURVE_PALETTE[1];
 const CLUTTER_RGB: RGBColor = RGBColor(128, 128, 128);
 const SEED_RGB: RGBColor = RGBColor(90, 90, 90);
-const HYPOTHESIS_RGB: RGBColor = RGBColor(148, 103, 189);
+const HYPOTHESIS_RGB: RGBColor = CURVE_PALETTE[4];
 const DETECTED_RGB: RGBColor = RGBColor(255, 127, 14);
 const FALSE_ALARM_RGB: RGBColor = RGBColor(227, 119, 194);
 

@@ -150,7 +150,7 @@ fn delay_figure_has_a_panel_per_link_the_image_the_points_and_labels() {
     assert_eq!(count(&svg, "circle"), 201);
     // The image: at least one grey cell per column; the dashed truth lines.
     assert!(count(&svg, "rect") > 50 + 4 * 4, "{}", count(&svg, "rect"));
-    assert!(svg.contains("#D62728"), "truth red");
+    assert!(svg.contains("#D55E00"), "truth vermillion");
 }
 
 #[test]
