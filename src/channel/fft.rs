@@ -2,13 +2,14 @@
 //!
 //! Why our own: the core is `no_std` and its results must be bit-identical natively and in wasm.
 //! `rustfft` needs `std` and picks AVX/SSE kernels at run time (different rounding per CPU);
-//! this one is plain iterative Cooley–Tukey on `f64` with twiddles from [`crate::math`]'s
-//! `sin`/`cos` (libm in wasm, the same correctly rounded values natively), no FMA, so every
-//! platform gets the same bits. Sizes are powers of two (the periodogram zero-pads to one).
+//! this one is plain iterative Cooley–Tukey on `f64` with twiddles from
+//! [`crate::math::portable`]'s `sin`/`cos` (the `libm` crate on every platform; the platform's
+//! own differ in the last bits), no FMA, so every platform gets the same bits. Sizes are powers of two (the periodogram zero-pads to one).
 
 use alloc::vec::Vec;
 
-use crate::math::{cos, sin, Complex, Real, PI};
+use crate::math::portable::{cos, sin};
+use crate::math::{Complex, Real, PI};
 
 /// A plan for transforms of one power-of-two size `n`: twiddles and the bit-reversal table.
 #[derive(Debug, Clone, PartialEq)]
