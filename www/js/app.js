@@ -7,7 +7,7 @@
 import init, * as wasm from '../pkg/scatterloc.js';
 import { $, clip, decimal, decimalIn, errorText, showError } from './dom.js';
 import { decodeScenario, decodeState, viewLink } from './share.js';
-import { attachState } from './state.js';
+import { attachState, registerSection } from './state.js';
 import { registerHooks } from './hooks.js';
 import { View } from './view.js';
 import { MapView } from './map.js';
@@ -20,7 +20,7 @@ import { Plan } from './plan.js';
 import { FigureExport } from './export.js';
 import { Zoomer } from './zoom.js';
 import { setLinkColors } from './draw.js';
-import { Channel } from './channel.js';
+import { Channel, applyChannelSettings, channelSettings } from './channel.js';
 import { homeWithNodes } from './outside.js';
 import { attachHelp } from './help.js';
 import { attachTheme } from './theme.js';
@@ -356,7 +356,11 @@ export async function start() {
   refresh();
   $('loading').hidden = true; // the first map is drawn
   setMode(opts.mode);
-  // The page state (state.js): saved and opened as a file, carried by the link, undo/redo.
+  // The page state (state.js): saved and opened as a file, carried by the link, undo/redo. The
+  // channel view's settings (not its recordings) and the colour lock are sections of it; a state
+  // file written before they existed still opens (optional).
+  registerSection('channel', { get: channelSettings, apply: applyChannelSettings, optional: true });
+  registerSection('colours', { get: () => map.lock.get(), apply: (v) => map.lock.set(v), optional: true });
   const pageState = attachState({ app, wasm, st, view, panel, tracking, mtl, plan, zoom, ctx, setMode });
   if (opts.state) {
     const [key, value] = opts.state;
