@@ -90,6 +90,11 @@ export class InsetControls {
     close.addEventListener('click', () => this.setClosed(true));
     open.addEventListener('click', () => this.setClosed(false));
     this.attachDrag();
+    // A wheel or pinch over the header zooms the map under it, as anywhere else on the map.
+    head.addEventListener('wheel', (ev) => {
+      ev.preventDefault();
+      canvas.dispatchEvent(new WheelEvent('wheel', ev));
+    }, { passive: false });
     grip.addEventListener('keydown', (ev) => {
       const d = { ArrowLeft: [-1, 0], ArrowRight: [1, 0], ArrowUp: [0, -1], ArrowDown: [0, 1] }[ev.key];
       if (!d || !this.box) return;
