@@ -56,9 +56,9 @@ fn unbase64(s: &str) -> Vec<u8> {
     let mut out = Vec::with_capacity(s.len() / 4 * 3);
     for q in s.as_bytes().chunks(4) {
         let pad = q.iter().filter(|&&c| c == b'=').count();
-        let n = q
-            .iter()
-            .fold(0u32, |n, &c| n << 6 | if c == b'=' { 0 } else { val(c) as u32 });
+        let n = q.iter().fold(0u32, |n, &c| {
+            n << 6 | if c == b'=' { 0 } else { val(c) as u32 }
+        });
         let b = [(n >> 16) as u8, (n >> 8) as u8, n as u8];
         out.extend_from_slice(&b[..3 - pad]);
     }
@@ -550,7 +550,11 @@ fn channel_view_worker_equals_the_cli() {
             let cli = read_recording(cli).unwrap();
             println!(
                 "{what} (page simulator): {}",
-                if page == cli { "bit-equal" } else { "not bit-equal" }
+                if page == cli {
+                    "bit-equal"
+                } else {
+                    "not bit-equal"
+                }
             );
             let (p, q) = (recording_value(&page), recording_value(&cli));
             let mut d = Diff::new(EST_TOL);
