@@ -62,7 +62,7 @@ async fn run(c: &Client, port: u16) -> Result<Outcome, String> {
     let gen = done["mcGeneration"].as_u64().unwrap_or(0);
     click(c, "mc-restart").await?;
     let running_state = wait_state(c, 60, |s| {
-        s["mcState"] == "running" && newer(s, gen) && s["chartSeries"].as_u64().unwrap_or(0) > 0
+        s["mcState"] == "running" && newer(s, gen) && s["mcDone"].as_u64().unwrap_or(0) > 0
     })
     .await?;
     let running_svg = save(c, "rmse", "svg").await?;

@@ -148,7 +148,7 @@ export class MonteCarlo {
     }
     const pf = r && r.filters.pf;
     $('mc-pf-note').textContent = pf ? `PF: ${pf.runs_planned} runs × ${r.particles} particles, `
-      + `${pf.failed_runs} of ${pf.runs + pf.failed_runs} failed so far (page budget ${r.particle_budget / 1e6}·10⁶ particle-steps)` : '';
+      + `${pf.failed_runs} of ${pf.runs + pf.failed_runs} failed (page budget ${r.particle_budget / 1e6}·10⁶ particle-steps)` : '';
     if (this.state === 'error') text = `${size} · failed`;
     el.textContent = text;
     el.title = FAILED_MEANING;
