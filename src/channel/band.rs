@@ -24,8 +24,7 @@ use alloc::vec::Vec;
 use crate::channel::fft::Fft;
 use crate::channel::{Layout, Recording};
 use crate::error::{Error, Result};
-use crate::math::portable::{cos, ln, sin};
-use crate::math::{Complex, Real, PI};
+use crate::math::{cos, ln, sin, Complex, Real, PI};
 
 /// Relative tolerance of "uniformly spaced" for `f_n` (a float64 grid written by numpy as
 /// `f0 + n·Δf` is uniform to ~1e-12 relative).

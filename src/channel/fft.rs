@@ -3,13 +3,12 @@
 //! Why our own: the core is `no_std` and its results must be bit-identical natively and in wasm.
 //! `rustfft` needs `std` and picks AVX/SSE kernels at run time (different rounding per CPU);
 //! this one is plain iterative Cooley–Tukey on `f64` with twiddles from
-//! [`crate::math::portable`]'s `sin`/`cos` (the `libm` crate on every platform; the platform's
-//! own differ in the last bits), no FMA, so every platform gets the same bits. Sizes are powers of two (the periodogram zero-pads to one).
+//! [`crate::math`]'s `sin`/`cos` (the `libm` crate on every platform; the platform's own
+//! differ in the last bits), no FMA, so every platform gets the same bits. Sizes are powers of two (the periodogram zero-pads to one).
 
 use alloc::vec::Vec;
 
-use crate::math::portable::{cos, sin};
-use crate::math::{Complex, Real, PI};
+use crate::math::{cos, sin, Complex, Real, PI};
 
 /// A plan for transforms of one power-of-two size `n`: twiddles and the bit-reversal table.
 #[derive(Debug, Clone, PartialEq)]

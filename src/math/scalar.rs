@@ -1,6 +1,10 @@
 //! Scalar and small-matrix aliases, physical constants and the few elementary functions the
-//! core needs. With `std` the platform's libm is used; without it the `libm` crate, so the same
-//! code builds for `wasm32v1-none`.
+//! core needs. The transcendental functions (`exp`, `ln`, `log10`, `cos`, `sin`, `acos`,
+//! `atan2`) are the `libm` crate's on every platform, with or without `std`: the platform's own
+//! (glibc natively, Rust's musl port in wasm) differ in the last bit for some arguments, and
+//! iterations that stop at a tolerance (the LM start fix, the estimator's fits) carried that to
+//! 10⁻⁷ relative between the CLI and the page (issue 26). Now native and wasm give the same bits.
+//! `sqrt` and `round` are exact (IEEE) everywhere and stay the platform's.
 
 /// The one floating-point type of the crate.
 pub type Real = f64;
@@ -40,53 +44,25 @@ pub fn sqrt(x: Real) -> Real {
 /// Arc cosine.
 #[inline(always)]
 pub fn acos(x: Real) -> Real {
-    #[cfg(feature = "std")]
-    {
-        x.acos()
-    }
-    #[cfg(not(feature = "std"))]
-    {
-        libm::acos(x)
-    }
+    libm::acos(x)
 }
 
 /// Natural exponential.
 #[inline(always)]
 pub fn exp(x: Real) -> Real {
-    #[cfg(feature = "std")]
-    {
-        x.exp()
-    }
-    #[cfg(not(feature = "std"))]
-    {
-        libm::exp(x)
-    }
+    libm::exp(x)
 }
 
 /// Base-10 logarithm.
 #[inline(always)]
 pub fn log10(x: Real) -> Real {
-    #[cfg(feature = "std")]
-    {
-        x.log10()
-    }
-    #[cfg(not(feature = "std"))]
-    {
-        libm::log10(x)
-    }
+    libm::log10(x)
 }
 
 /// Natural logarithm.
 #[inline(always)]
 pub fn ln(x: Real) -> Real {
-    #[cfg(feature = "std")]
-    {
-        x.ln()
-    }
-    #[cfg(not(feature = "std"))]
-    {
-        libm::log(x)
-    }
+    libm::log(x)
 }
 
 /// Complementary error function.
@@ -98,40 +74,19 @@ pub fn erfc(x: Real) -> Real {
 /// Cosine.
 #[inline(always)]
 pub fn cos(x: Real) -> Real {
-    #[cfg(feature = "std")]
-    {
-        x.cos()
-    }
-    #[cfg(not(feature = "std"))]
-    {
-        libm::cos(x)
-    }
+    libm::cos(x)
 }
 
 /// Sine.
 #[inline(always)]
 pub fn sin(x: Real) -> Real {
-    #[cfg(feature = "std")]
-    {
-        x.sin()
-    }
-    #[cfg(not(feature = "std"))]
-    {
-        libm::sin(x)
-    }
+    libm::sin(x)
 }
 
 /// Two-argument arc tangent.
 #[inline(always)]
 pub fn atan2(y: Real, x: Real) -> Real {
-    #[cfg(feature = "std")]
-    {
-        y.atan2(x)
-    }
-    #[cfg(not(feature = "std"))]
-    {
-        libm::atan2(y, x)
-    }
+    libm::atan2(y, x)
 }
 
 /// Nearest integer, halves away from zero.
@@ -181,61 +136,4 @@ pub fn deg_to_rad(deg: Real) -> Real {
 #[inline]
 pub fn rad_to_deg(rad: Real) -> Real {
     rad * (180.0 / PI)
-}
-
-/// The elementary functions of iterations whose path must not depend on the platform (the
-/// planner's CMA-ES; the channel front end — simulator, estimator, figures — whose page results
-/// must equal the CLI's): always the `libm` crate, so native and wasm builds get the same bits.
-/// (With `std`, [`exp`], [`ln`], [`cos`], … are the platform's, which differ in the last bits:
-/// through the estimator's joint Fisher matrix that was 1.3·10⁻¹² relative in a path's σ̂_τ.)
-pub mod portable {
-    use super::Real;
-
-    /// Natural exponential, the same bits on every platform.
-    #[inline]
-    pub fn exp(x: Real) -> Real {
-        libm::exp(x)
-    }
-
-    /// Natural logarithm, the same bits on every platform.
-    #[inline]
-    pub fn ln(x: Real) -> Real {
-        libm::log(x)
-    }
-
-    /// Cosine, the same bits on every platform.
-    #[inline]
-    pub fn cos(x: Real) -> Real {
-        libm::cos(x)
-    }
-
-    /// Sine, the same bits on every platform.
-    #[inline]
-    pub fn sin(x: Real) -> Real {
-        libm::sin(x)
-    }
-
-    /// Base-10 logarithm, the same bits on every platform.
-    #[inline]
-    pub fn log10(x: Real) -> Real {
-        libm::log10(x)
-    }
-
-    /// `atan2(y, x)`, the same bits on every platform.
-    #[inline]
-    pub fn atan2(y: Real, x: Real) -> Real {
-        libm::atan2(y, x)
-    }
-
-    /// Decibels to a linear power ratio `10^(db/10)`, the same bits on every platform.
-    #[inline]
-    pub fn db_to_linear(db: Real) -> Real {
-        exp(db * (core::f64::consts::LN_10 / 10.0))
-    }
-
-    /// dBm to watts, the same bits on every platform.
-    #[inline]
-    pub fn dbm_to_watt(dbm: Real) -> Real {
-        db_to_linear(dbm - 30.0)
-    }
 }

@@ -9,7 +9,7 @@
 //! lexicographic key (feasibility first, then the objective).
 //!
 //! Every step is seeded arithmetic: normals by the polar method and `exp`/`ln` from
-//! [`crate::math::portable`], the eigendecomposition by cyclic Jacobi rotations (only `+ − × ÷ √`),
+//! [`crate::math`] (the `libm` crate on every platform), the eigendecomposition by cyclic Jacobi rotations (only `+ − × ÷ √`),
 //! so a run gives the same bits on every platform and thread count.
 
 use alloc::vec;
@@ -18,8 +18,7 @@ use core::cmp::Ordering;
 
 use rand::Rng as _;
 
-use crate::math::portable::{exp, ln};
-use crate::math::{sqrt, Real};
+use crate::math::{exp, ln, sqrt, Real};
 use crate::measure::{rng, Rng};
 
 /// What CMA-ES minimises: a score per point of `ℝⁿ`, ranked by [`SearchProblem::rank`].

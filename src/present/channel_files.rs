@@ -9,8 +9,7 @@ use alloc::vec::Vec;
 use serde::Serialize;
 
 use crate::formats::CalibrationResult;
-use crate::math::portable::log10;
-use crate::math::Real;
+use crate::math::{log10, Real};
 use crate::measure::Model;
 use crate::present::ErrorStats;
 use crate::scenario::Scenario;

@@ -12,8 +12,7 @@ use alloc::vec::Vec;
 use crate::channel::DelayEstimate;
 use crate::error::limits::{DELAY_IMAGE_DR_DB, MAX_DELAY_IMAGE_COLS, MAX_DELAY_IMAGE_ROWS};
 use crate::error::{check_finite, check_len, Error, Result};
-use crate::math::portable::{cos, log10, sin};
-use crate::math::{sqrt, Complex, Real, PI, SPEED_OF_LIGHT};
+use crate::math::{cos, log10, sin, sqrt, Complex, Real, PI, SPEED_OF_LIGHT};
 use crate::track::gating::LinkCalibration;
 
 /// The delay profile of one link as an image: `db[j·cols + i]` is the power at range

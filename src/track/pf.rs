@@ -37,8 +37,7 @@ use alloc::vec::Vec;
 use rand::Rng as _;
 
 use crate::error::{Error, Result};
-use crate::math::portable::{exp, ln};
-use crate::math::{sqrt, Mat4, Real, Vec2, Vec4, SPEED_OF_LIGHT};
+use crate::math::{exp, ln, sqrt, Mat4, Real, Vec2, Vec4, SPEED_OF_LIGHT};
 use crate::measure::{Model, Rng};
 use crate::track::shared::{
     check_covariance, check_state, check_update, first_input_error, link_sigmas, predict_gaussian,

@@ -170,11 +170,11 @@ fn cli_files(dir: &Path) -> Files {
 }
 
 /// Relative tolerances of the page's numbers against the CLI's: 1e-12, as the issue asks. The
-/// page's wasm and the native CLI run the same code in the same order; the channel front end's
-/// elementary functions are `math::portable` (the `libm` crate on both), because the platform's
-/// `sin`/`cos`/`ln` (glibc natively, Rust's musl port in wasm) differ in the last bit, which the
-/// estimator's fits carried to 9.6e-10 and the start fix's LM iterations to 1.1e-7 (measured
-/// 2026-12-04 before the change).
+/// page's wasm and the native CLI run the same code in the same order, and the core's elementary
+/// functions are the `libm` crate's on both (`crate::math`): the platform's `sin`/`cos`/`ln`/`exp`
+/// (glibc natively, Rust's musl port in wasm) differ in the last bit, which the estimator's fits
+/// carried to 9.6e-10 and the start fix's LM iterations to 1.1e-7 (measured 2026-12-04 before
+/// the change).
 const EST_TOL: f64 = 1e-12;
 /// See [`EST_TOL`].
 const TRACK_TOL: f64 = 1e-12;

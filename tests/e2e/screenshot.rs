@@ -1,5 +1,5 @@
 //! The docs screenshots (docs/screenshot-tracking.png by default; any mode through
-//! `SCATTERLOC_SCREENSHOT_HASH`), taken through the same browser harness as the end-to-end tests.
+//! `SCATTERLOC_SCREENSHOT_HASH`; `mode=channel` simulates, estimates and tracks a walk first), taken through the same browser harness as the end-to-end tests.
 //! Not a test (it asserts nothing): `cargo run --example screenshot` (examples/screenshot.rs).
 
 use super::tracking::{mc_done, wait_state};
@@ -66,6 +66,34 @@ pub(crate) fn tracking_screenshot() {
                     }
                     tokio::time::sleep(std::time::Duration::from_millis(25)).await;
                 }
+            }
+            if hash.contains("mode=channel") {
+                // Simulate a walk, estimate and track it, and put the time cursor at 2/3.
+                let state = "return window.channel.state()";
+                let wait = async |what: &str, done: &dyn Fn(&serde_json::Value) -> bool| {
+                    let t0 = std::time::Instant::now();
+                    loop {
+                        let s = js(&c, state).await?;
+                        if done(&s) {
+                            return Ok::<_, String>(s);
+                        }
+                        if t0.elapsed() > std::time::Duration::from_secs(600) {
+                            return Err(format!(
+                                "channel view: no {what} in 600 s; last state {s}"
+                            ));
+                        }
+                        tokio::time::sleep(std::time::Duration::from_millis(100)).await;
+                    }
+                };
+                js(&c, "document.getElementById('chan-simulate').click()").await?;
+                wait("recording", &|s| {
+                    s["recording"].is_object() && s["running"].is_null()
+                })
+                .await?;
+                js(&c, "document.getElementById('chan-run').click()").await?;
+                let s = wait("result", &|s| s["runs"] == 1 && s["running"].is_null()).await?;
+                let k = s["steps"].as_u64().unwrap_or(1) * 2 / 3;
+                js(&c, &format!("window.channel.seek({k})")).await?;
             }
             settle(&c).await?;
             c.screenshot().await.map_err(|e| e.to_string())

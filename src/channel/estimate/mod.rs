@@ -34,8 +34,7 @@ use crate::channel::band::{cis, median};
 use crate::channel::fft::Fft;
 use crate::channel::{Band, DelayEstimate};
 use crate::error::{limits, Error, Result};
-use crate::math::portable::ln;
-use crate::math::{round, sqrt, Complex, Real, PI};
+use crate::math::{ln, round, sqrt, Complex, Real, PI};
 
 mod linalg;
 

@@ -21,8 +21,9 @@ use serde::{Deserialize, Serialize};
 use crate::channel::{Layout, Recording};
 use crate::error::limits::MAX_CHANNEL_SAMPLES;
 use crate::error::{check_len, Error, Result};
-use crate::math::portable::{cos, db_to_linear, dbm_to_watt, sin};
-use crate::math::{sqrt, Complex, Real, Vec2, PI, SPEED_OF_LIGHT};
+use crate::math::{
+    cos, db_to_linear, dbm_to_watt, sin, sqrt, Complex, Real, Vec2, PI, SPEED_OF_LIGHT,
+};
 use crate::measure::SNR_DISTANCE_FLOOR_M;
 use crate::measure::{noise_power_w, rng, standard_normal, unit_from, Model, Rng};
 use crate::scenario::Scenario;

@@ -8,8 +8,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::limits::{COORDINATE_M, MAX_WAYPOINTS};
 use crate::error::{check_positive, Error, Result};
-use crate::math::portable::{atan2, cos, sin};
-use crate::math::{sqrt, Real};
+use crate::math::{atan2, cos, sin, sqrt, Real};
 
 /// A walk: waypoints joined by straight segments whose corners are rounded by arcs of
 /// `turn_radius_m` (clamped where a segment is too short for the full radius), walked at
