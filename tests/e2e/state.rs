@@ -218,10 +218,28 @@ const FIELDS: &[&str] = &[
     "view.mtl",
     "view.plan_open",
     "view.step",
+    "colours.locked",
+    "colours.min_m",
+    "colours.max_m",
+    "channel.filter",
+    "channel.particles",
+    "channel.seed",
+    "channel.process_noise",
+    "channel.p_fa",
+    "channel.max_paths",
+    "channel.extent_sigma_m",
+    "channel.calibration",
+    "channel.empty_from_s",
+    "channel.empty_to_s",
+    "channel.link",
+    "channel.step",
+    "channel.speed",
 ];
 /// Fields the page has no control for (the multi-target region, range cap and detection radius
 /// are the scene's own) and the envelope: they keep their default.
 const NO_CONTROL: &[&str] = &[
+    "channel.link",
+    "channel.step",
     "format",
     "version",
     "mtl.scene.region",
@@ -283,6 +301,33 @@ async fn set_everything(c: &Client) -> Result<(), String> {
     click(c, "track-play").await?;
     tokio::time::sleep(Duration::from_millis(600)).await;
     click(c, "track-play").await?;
+    quiet(c).await?;
+    // The colour lock (snapshot and tracking views): ticked, with a typed range.
+    click(c, "colour-lock").await?;
+    type_in(c, "colour-min", "0.002").await?;
+    type_in(c, "colour-max", "3").await?;
+    quiet(c).await?;
+    // The channel view's settings (its recordings are not part of the state; the link and the
+    // step need a result and keep their default).
+    click(c, "mode-channel").await?;
+    quiet(c).await?;
+    select(c, "chan-filter", "pf").await?;
+    quiet(c).await?;
+    for (id, v) in [
+        ("chan-particles", "3000"),
+        ("chan-seed", "4"),
+        ("chan-q", "0.5"),
+        ("chan-pfa", "0.0001"),
+        ("chan-max-paths", "9"),
+        ("chan-extent", "0.3"),
+    ] {
+        type_in(c, id, v).await?;
+    }
+    select(c, "chan-cal-source", "range").await?;
+    quiet(c).await?;
+    type_in(c, "chan-empty-from", "0.5").await?;
+    type_in(c, "chan-empty-to", "2.5").await?;
+    select(c, "chan-speed", "2").await?;
     quiet(c).await?;
     // Multi-target: every number, the model and both of its probabilities, the sliders, the
     // scene's objects (added, removed, dragged) and its zoom window.
