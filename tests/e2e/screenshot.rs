@@ -43,6 +43,15 @@ pub(crate) fn tracking_screenshot() {
                 .await
                 .map_err(|e| e.to_string())?;
             open_hash(&c, port, &hash).await?;
+            // The docs' screenshots are in the dark theme unless asked (`SCATTERLOC_SCREENSHOT_THEME`
+            // = light); headless Chromium reports a light system preference.
+            let theme =
+                std::env::var("SCATTERLOC_SCREENSHOT_THEME").unwrap_or_else(|_| "dark".into());
+            js(
+                &c,
+                &format!("window.theme.set({})", serde_json::json!(theme)),
+            )
+            .await?;
             if hash.contains("mode=tracking") {
                 let s = wait_state(&c, 60, mc_done).await?;
                 // Once more with the worker warm (the first run includes its start-up).

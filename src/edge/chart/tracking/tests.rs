@@ -75,8 +75,11 @@ fn tracking_figure_of_one_and_of_two_filters() {
         },
     ];
     let both = svg_of(|root| draw_tracking_filters(root, &[panel(&two)], &opts));
+    // The UKF curve takes the palette's third colour.
+    let c = crate::chart::CURVE_PALETTE[2];
+    let ukf_rgb = format!("#{:02X}{:02X}{:02X}", c.0, c.1, c.2);
     assert!(
-        both.contains("UKF RMSE") && both.contains("#2CA02C"),
+        both.contains("UKF RMSE") && both.contains(&ukf_rgb),
         "{both}"
     );
     let short = [FilterCurve {
