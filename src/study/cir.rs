@@ -42,6 +42,23 @@ pub struct FrontEndConfig {
     pub paths: PathTrackerConfig,
 }
 
+impl FrontEndConfig {
+    /// The defaults ([S]'s estimator settings, the default path tracker) with `max_paths` and
+    /// `p_fa` replaced where given — `cir estimate --max-paths --pfa` and the page's channel
+    /// settings — validated ([`EstimatorConfig::validate`]'s named errors).
+    pub fn with_overrides(max_paths: Option<usize>, p_fa: Option<Real>) -> Result<FrontEndConfig> {
+        let mut cfg = FrontEndConfig::default();
+        if let Some(k) = max_paths {
+            cfg.estimator.max_paths = k;
+        }
+        if let Some(p) = p_fa {
+            cfg.estimator.p_fa = p;
+        }
+        cfg.estimator.validate()?;
+        Ok(cfg)
+    }
+}
+
 /// The estimates of a recording: per snapshot and per link of the model (scenario link order)
 /// the tracked paths; a link the recording does not hold has none.
 #[derive(Debug, Clone, PartialEq)]

@@ -38,9 +38,7 @@ use super::base::err;
 use super::json::{to_js, to_json};
 use super::tracking::page_filter;
 use super::MAX_FIGURE_PX;
-use crate::channel::{
-    simulate_recording, Band, ChannelScene, EstimatorConfig, PathTrackerConfig, Recording,
-};
+use crate::channel::{simulate_recording, Band, ChannelScene, Recording};
 use crate::chart::{
     delays_size, draw_delays, draw_track_errors, scenario_nodes, track_errors_size,
     ChannelChartOptions,
@@ -305,23 +303,6 @@ struct TrackSettings {
     seed: u64,
 }
 
-/// The front end's settings with `max_paths` and `pfa` over the estimator's defaults (as `cir
-/// estimate --max-paths --pfa`).
-fn front_end(max_paths: Option<usize>, pfa: Option<f64>) -> Result<FrontEndConfig, Error> {
-    let mut cfg = FrontEndConfig {
-        estimator: EstimatorConfig::default(),
-        paths: PathTrackerConfig::default(),
-    };
-    if let Some(k) = max_paths {
-        cfg.estimator.max_paths = k;
-    }
-    if let Some(p) = pfa {
-        cfg.estimator.p_fa = p;
-    }
-    cfg.estimator.validate()?;
-    Ok(cfg)
-}
-
 /// The tracker settings (as `cir track --filter --particles --seed --process-noise --sigma
 /// --extent-sigma-m --association`, with its defaults).
 fn track_settings(set: &JobSettings, snapshots: usize) -> Result<TrackSettings, Error> {
@@ -508,7 +489,7 @@ impl ChannelJob {
         let t0 = now_ms();
         let (scenario, model) = scenario_and_model(scenario_json)?;
         let set: JobSettings = parse_settings("settings", settings_json)?;
-        let cfg = front_end(set.max_paths, set.pfa).map_err(err)?;
+        let cfg = FrontEndConfig::with_overrides(set.max_paths, set.pfa).map_err(err)?;
         let rec = read_page_recording("recording", recording, &model)?;
         let tracking = track_settings(&set, rec.t_s.len()).map_err(err)?;
         let (cal, cal_source) = match (calibration, set.calibration_range_s) {

@@ -3,9 +3,7 @@
 //! [`scatterloc::study::calibrate_estimates`], [`scatterloc::study::cir_track`], the simulator
 //! [`scatterloc::channel::simulate_recording`]) → files written all or none.
 
-use scatterloc::channel::{
-    simulate_recording, ChannelScene, EstimatorConfig, PathTrackerConfig, Recording,
-};
+use scatterloc::channel::{simulate_recording, ChannelScene, Recording};
 use scatterloc::error::{limits, Cancel};
 use scatterloc::formats::{CalibrationSnapshots, Measurements, Truth};
 use scatterloc::native::Parallel;
@@ -42,27 +40,17 @@ fn read_recording(flag: &str, path: &str, model: &Model) -> Result<Recording, Cl
     Ok(rec)
 }
 
-/// The front end's settings from the flags.
+/// The front end's settings from the flags (the core's defaults and checks; an error names
+/// its flag).
 fn front_end(max_paths: Option<usize>, pfa: Option<f64>) -> Result<FrontEndConfig, CliError> {
-    let mut cfg = FrontEndConfig {
-        estimator: EstimatorConfig::default(),
-        paths: PathTrackerConfig::default(),
-    };
-    if let Some(k) = max_paths {
-        cfg.estimator.max_paths = k;
-    }
-    if let Some(p) = pfa {
-        cfg.estimator.p_fa = p;
-    }
-    cfg.estimator.validate().map_err(|e| {
+    FrontEndConfig::with_overrides(max_paths, pfa).map_err(|e| {
         let flag = if e.to_string().contains("p_fa") {
             "--pfa"
         } else {
             "--max-paths"
         };
         CliError::usage(format!("{flag}: {e}"))
-    })?;
-    Ok(cfg)
+    })
 }
 
 /// Estimates `rec` on `threads` threads under a progress bar (Ctrl-C: exit 130, nothing
