@@ -254,6 +254,46 @@ pub enum Error {
 }
 
 impl Error {
+    /// The variant's name (`OutOfRange`, `InvalidDelay`, …): what a front end that exposes
+    /// errors as values (the Python package's `ScatterlocError.kind`) tells them apart by.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Error::Parse { .. } => "Parse",
+            Error::InvalidFile { .. } => "InvalidFile",
+            Error::NonFinite { .. } => "NonFinite",
+            Error::NotPositive { .. } => "NotPositive",
+            Error::OutOfRange { .. } => "OutOfRange",
+            Error::EmptyNodeList { .. } => "EmptyNodeList",
+            Error::EmptyLinkList => "EmptyLinkList",
+            Error::DuplicateName { .. } => "DuplicateName",
+            Error::UnknownNode { .. } => "UnknownNode",
+            Error::DuplicateLink { .. } => "DuplicateLink",
+            Error::InvertedArea { .. } => "InvertedArea",
+            Error::AmbiguousNoise => "AmbiguousNoise",
+            Error::LengthMismatch { .. } => "LengthMismatch",
+            Error::TooFewLinks { .. } => "TooFewLinks",
+            Error::InvalidDelay { .. } => "InvalidDelay",
+            Error::InvalidSigma { .. } => "InvalidSigma",
+            Error::SizeLimit { .. } => "SizeLimit",
+            Error::NameTooLong { .. } => "NameTooLong",
+            Error::NotPositiveDefinite { .. } => "NotPositiveDefinite",
+            Error::WorkLimit { .. } => "WorkLimit",
+            Error::Cancelled => "Cancelled",
+            Error::AllRunsFailed { .. } => "AllRunsFailed",
+            Error::TooLong { .. } => "TooLong",
+            Error::UnknownPreset { .. } => "UnknownPreset",
+            Error::IndexOutOfRange { .. } => "IndexOutOfRange",
+            Error::LastNode { .. } => "LastNode",
+            Error::UnknownTrajectory { .. } => "UnknownTrajectory",
+            Error::Degenerate { .. } => "Degenerate",
+            Error::Infeasible { .. } => "Infeasible",
+            Error::UnknownPattern { .. } => "UnknownPattern",
+            Error::UnknownFilter { .. } => "UnknownFilter",
+            Error::InconsistentPart { .. } => "InconsistentPart",
+            Error::PartSet { .. } => "PartSet",
+        }
+    }
+
     /// The input field the error names, when it names one (`runs`, `receivers[2].position_m`,
     /// `filters[1]`, …): what a front end maps to its own flag or form control. `Display` starts
     /// with it for every variant that has one.

@@ -4,7 +4,9 @@
 //! multi-target scene turned into what the page draws ([`mtl_view`]: nodes, targets, discs,
 //! measurements, Algorithm 1's trace), and the interactive [`Session`] (a validated scenario and
 //! its compiled model, kept in step), and the channel front end's delay and track-error figures
-//! ([`DelayFigure`], [`TrackErrorView`], [`ErrorStats`]). Pure `no_std` functions of the core's results:
+//! ([`DelayFigure`], [`TrackErrorView`], [`ErrorStats`]), and the documents of the
+//! single-snapshot use cases ([`CrlbDoc`], [`FixDoc`]) the CLI prints and the Python package
+//! returns. Pure `no_std` functions of the core's results:
 //! no maths of their own beyond layout.
 
 mod channel_figure;
@@ -15,6 +17,7 @@ mod plan_view;
 mod scene;
 mod session;
 mod snapshot;
+mod snapshot_docs;
 mod ticks;
 mod track_view;
 
@@ -46,6 +49,7 @@ pub use snapshot::{
     simulate_snapshot, LinkSim, SnapshotFix, SnapshotSimulation, ARC_POINTS, FALLBACK_EXTENT_M,
     OUTLINE_POINTS, VIEW_MARGIN,
 };
+pub use snapshot_docs::{sym2, CrlbDoc, EllipseDoc, FixDoc, LinkDoc};
 pub use ticks::{
     colorbar_ticks, decimal, format_length_m, linear_ticks, log_length_ticks, nice_below,
     scale_bar, Tick,

@@ -179,6 +179,26 @@ fn link_paths(
     Ok((run.paths, run.noise))
 }
 
+/// The paths of every snapshot of recorded link `link` of `rec` alone (C5 + C6), without a
+/// scenario: the estimation [`estimate_recording`] runs per link, for a caller that holds
+/// responses but no network (the Python package's `estimate`). `bandwidth_hz` is used by CIR
+/// recordings only ([`Band::of_recording`]). Returns per snapshot the tracked paths (ascending
+/// in delay) and the noise variance used. Errors: the recording's ([`Recording::validate`]),
+/// [`Error::IndexOutOfRange`] (`links`), the estimator's settings, [`Error::Cancelled`].
+pub fn estimate_link(
+    rec: &Recording,
+    bandwidth_hz: Real,
+    link: usize,
+    cfg: &FrontEndConfig,
+    cancel: Cancel,
+    progress: &(dyn Fn(usize) + Sync),
+) -> Result<(Vec<Vec<TrackedPath>>, Vec<Real>)> {
+    rec.validate()?;
+    crate::error::checked_index("links", link, rec.links.len())?;
+    let band = Band::of_recording(rec, bandwidth_hz)?;
+    link_paths(rec, &band, link, cfg, cancel, progress)
+}
+
 /// The checks of an estimation: the recording ([`Recording::validate`]), its links on `model`
 /// and its band.
 fn prepare(

@@ -30,15 +30,16 @@ mod sums;
 mod track;
 
 pub use cir::{
-    calibrate_estimates, cir_track, delays_only, estimate_recording, CirStart, CirTrackOutput,
-    CirTrackRequest, DelaySigma, EstimationRun, FrontEndConfig, RecordingEstimates, EXTENT_SIGMA_M,
+    calibrate_estimates, cir_track, delays_only, estimate_link, estimate_recording, CirStart,
+    CirTrackOutput, CirTrackRequest, DelaySigma, EstimationRun, FrontEndConfig, RecordingEstimates,
+    EXTENT_SIGMA_M,
 };
 pub use cost::{check_cost, track_cpu_s, MAX_CPU_S, PAGE_STUDY_CPU_S, PAGE_TRACK_CPU_S};
 pub use drive::{Driver, Sequential};
 pub use filters::{particle_chunks, FilterResults, FilterRun, FilterStudy};
 pub use montecarlo::{
     curve_label, failed_label, CurveDoc, FilterCurves, FilterDoc, FiltersConfig, McConfig, McMeta,
-    MonteCarloStudy, RunTime, TrackStudy, FAILED_NOTE,
+    MonteCarloStudy, PcrlbMeta, RunTime, TrackStudy, FAILED_NOTE,
 };
 pub use part::{
     differs, inconsistent, load_sums, merged_timing, software, sums_digest, Part, PartFile,

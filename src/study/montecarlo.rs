@@ -128,6 +128,68 @@ impl TrackStudy {
     }
 }
 
+/// The scalars of one posterior-CRLB curve (`scatterloc pcrlb`, `scatterloc.pcrlb` in Python).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PcrlbMeta {
+    /// `I`, `II` or `III`.
+    pub trajectory: &'static str,
+    /// Step `T`, s.
+    pub dt_s: f64,
+    /// At the noise-free path (spec check 9) rather than `E[F̃]` over truth trajectories.
+    pub nominal: bool,
+    /// Steps after `t₀`.
+    pub steps: usize,
+    /// `q̃`, m²/s³.
+    pub process_noise: f64,
+    /// The layout's name.
+    pub layout: String,
+    /// Truth trajectories of `E[F̃]` (Monte Carlo only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub trajectories: Option<usize>,
+    /// The seed (Monte Carlo only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub seed: Option<u64>,
+    /// Wall time, s.
+    pub wall_time_s: f64,
+}
+
+impl TrackStudy {
+    /// The document of a posterior-CRLB curve `rmse` (spec §8, E9) of trajectory `t` computed
+    /// with `cfg` (`nominal`: at the noise-free path; else `E[F̃]` over `cfg.trajectories`
+    /// truths of `cfg.seed`) in `wall_s` seconds.
+    pub fn pcrlb_doc(
+        &self,
+        t: TrackScenario,
+        cfg: &MonteCarloConfig,
+        nominal: bool,
+        rmse: Vec<Option<f64>>,
+        wall_s: f64,
+    ) -> CurveDoc<PcrlbMeta> {
+        CurveDoc {
+            t_s: (0..=cfg.steps)
+                .map(|n| n as f64 * cfg.motion.dt_s)
+                .collect(),
+            rmse_ekf_m: None,
+            rmse_pcrlb_m: rmse,
+            nees: None,
+            caption_note: None,
+            figure_curves: Vec::new(),
+            figure_note: None,
+            meta: PcrlbMeta {
+                trajectory: t.name(),
+                dt_s: cfg.motion.dt_s,
+                nominal,
+                steps: cfg.steps,
+                process_noise: cfg.motion.intensity,
+                layout: self.layout.clone(),
+                trajectories: (!nominal).then_some(cfg.trajectories),
+                seed: (!nominal).then_some(cfg.seed),
+                wall_time_s: wall_s,
+            },
+        }
+    }
+}
+
 /// Everything a Monte Carlo study's result depends on: the `config` of its part files.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]

@@ -14,7 +14,7 @@ mod parallel;
 mod sweep;
 
 pub use driver::{run_ordered, thread_pool, Parallel};
-pub use map::{crlb_map_parallel, PARALLEL_MAP_MIN_CELLS};
+pub use map::{crlb_map_parallel, crlb_map_parallel_in, PARALLEL_MAP_MIN_CELLS};
 pub use parallel::{
     run_chunks_parallel, run_filter_chunks_parallel, run_parallel, run_pcrlb_parallel,
 };

@@ -11,6 +11,8 @@
 //!   §6.3) and its parameters; [`ModelSpec::build`] gives a boxed [`BlockingModel`] plus whether
 //!   Algorithm 1 branches on consistency (off for i.c.b, whose vectors are all consistent).
 //! - [`TargetReport`]: one detected target in serialisable form ([`target_reports`]).
+//! - [`locate_request`]: a [`LocateRequest`] run through Algorithm 1, reported as a
+//!   [`LocateDoc`] (`scatterloc mtl locate`, `scatterloc.mtl_locate` in Python).
 //!
 //! Every type is serde with `deny_unknown_fields`; positions are `[x, y]` in metres. Nothing
 //! here panics on bad input: every check returns a named [`Error`] whose field is the JSON path
@@ -19,7 +21,9 @@
 use alloc::format;
 use alloc::vec::Vec;
 
+mod doc;
 mod model;
+pub use doc::{locate_request, LocateDoc, LocateStage, ModelSummary};
 pub use model::{BuiltModel, ModelSpec, TrainingSpec};
 
 use serde::{Deserialize, Serialize};

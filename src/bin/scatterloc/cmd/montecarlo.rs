@@ -10,8 +10,7 @@ use serde::Serialize;
 use scatterloc::chart::TrackingChartOptions;
 use scatterloc::math::Shard;
 use scatterloc::study::{
-    CurveDoc, FilterStudy, MonteCarloStudy, PartFile, PartSet, RunTime, ShardDoc, Timing,
-    TrackStudy,
+    FilterStudy, MonteCarloStudy, PartFile, PartSet, RunTime, ShardDoc, Timing, TrackStudy,
 };
 use scatterloc::track::{nominal_pcrlb_rmse, paper_initial_covariance};
 
@@ -163,23 +162,6 @@ pub fn merge_parts(
     outputs.finish(&study.track, &docs, &chart_options(&study))
 }
 
-/// Scalars of one bound curve (`pcrlb`).
-#[derive(Serialize)]
-struct PcrlbMeta {
-    trajectory: &'static str,
-    dt_s: f64,
-    nominal: bool,
-    steps: usize,
-    process_noise: f64,
-    layout: String,
-    /// Truth trajectories of `E[F̃]` (Monte Carlo only).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    trajectories: Option<usize>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    seed: Option<u64>,
-    wall_time_s: f64,
-}
-
 /// `scatterloc pcrlb`.
 pub fn pcrlb(args: &PcrlbArgs) -> Result<(), CliError> {
     let study: TrackStudy = parse_study(&args.study)?;
@@ -207,9 +189,6 @@ pub fn pcrlb(args: &PcrlbArgs) -> Result<(), CliError> {
     let mut docs = Vec::new();
     for (t, cfg) in study.trajectories.iter().zip(&configs) {
         let start = std::time::Instant::now();
-        let t_s = (0..=cfg.steps)
-            .map(|n| n as f64 * cfg.motion.dt_s)
-            .collect();
         let (rmse, wall) = if nominal {
             let (p0, mean) = (paper_initial_covariance(), t.mean_state());
             let rmse = nominal_pcrlb_rmse(&study.model, &cfg.motion, &mean, &p0, cfg.steps)
@@ -220,27 +199,7 @@ pub fn pcrlb(args: &PcrlbArgs) -> Result<(), CliError> {
             let label = format!("scenario {:>3} (PCRLB)", t.name());
             run_pcrlb_with_progress(&study.model, cfg, threads, &label)?
         };
-        let meta = PcrlbMeta {
-            trajectory: t.name(),
-            dt_s: cfg.motion.dt_s,
-            nominal,
-            steps: cfg.steps,
-            process_noise: cfg.motion.intensity,
-            layout: study.layout.clone(),
-            trajectories: (!nominal).then_some(runs),
-            seed: (!nominal).then_some(seed),
-            wall_time_s: wall,
-        };
-        docs.push(CurveDoc {
-            t_s,
-            rmse_ekf_m: None,
-            rmse_pcrlb_m: rmse,
-            nees: None,
-            caption_note: None,
-            figure_curves: Vec::new(),
-            figure_note: None,
-            meta,
-        });
+        docs.push(study.pcrlb_doc(*t, cfg, nominal, rmse, wall));
     }
     let kind = if nominal {
         "nominal path".to_string()

@@ -11,14 +11,14 @@ use serde::Serialize;
 use scatterloc::chart::{
     curve_chart_size, draw_curves, ChartError, CurveChartOptions, CurveSeries, LineKind, Marker,
 };
-use scatterloc::mtl::algorithm::{locate, MtlConfig};
+use scatterloc::mtl::algorithm::MtlConfig;
 use scatterloc::mtl::empirical::EmpiricalTable;
 use scatterloc::mtl::experiment::{
     Experiment, ExperimentConfig, ExperimentResult, Method, Tally, MAX_REALISATIONS,
 };
 use scatterloc::mtl::input::{
-    from_json, target_reports, ModelSpec, NetworkInput, RangesInput, TargetReport, TrainingSpec,
-    DEFAULT_DIAMETER_M, DEFAULT_LAMBDA, DEFAULT_P_D,
+    from_json, locate_request, LocateRequest, LocateStage, ModelSpec, NetworkInput, RangesInput,
+    TrainingSpec, DEFAULT_DIAMETER_M, DEFAULT_LAMBDA, DEFAULT_P_D,
 };
 use scatterloc::mtl::sim::table2::{icb_row, table2_buckets, true_row};
 use scatterloc::mtl::sim::{SimSettings, VB_ICB_P_U};

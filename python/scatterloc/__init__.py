@@ -1,0 +1,92 @@
+"""scatterloc: locate and track non-cooperative scatterers (people, cars) from bistatic radio
+delays, with numpy in and out.
+
+The functions run the same Rust library as the ``scatterloc`` command line and the web page
+(PyO3 bindings that only convert types and call its use cases), so a notebook gets the CLI's
+numbers bit for bit; ``to_dict()`` on a result gives the document the CLI prints for the same
+input. Units are SI: positions in metres, delays in seconds, frequencies in hertz, dB where a
+name says so. Bad input raises :class:`ScatterlocError` (a ``ValueError``) whose ``field``
+names the input at fault; no output holds NaN (an unbounded CRLB is ``inf``, a missing value is
+masked). Long work releases the GIL, runs on all cores, reports ``progress(done, total)`` and
+stops on Ctrl-C (``KeyboardInterrupt``).
+
+Scenario and snapshot
+    :class:`Scenario`, :func:`crlb`, :func:`crlb_map`, :func:`locate`
+Tracking
+    :func:`track`, :func:`calibrate`, :func:`montecarlo`, :func:`pcrlb`
+Planning and multi-target
+    :func:`plan`, :func:`mtl_locate`
+Channel recordings (CFR/CIR to delays)
+    :class:`Recording`, :func:`read_recording`, :func:`write_recording`,
+    :func:`simulate_recording`, :func:`estimate`, :func:`estimate_recording`, :func:`cir_track`
+Stone Soup
+    :mod:`scatterloc.stonesoup` (``BistaticDelayModel``; needs ``pip install scatterloc[stonesoup]``)
+
+Docs: ``docs/python.md`` in the repository.
+"""
+
+from ._scatterloc import (
+    ChannelTrack,
+    Crlb,
+    CrlbMap,
+    Curves,
+    Fix,
+    MtlResult,
+    Paths,
+    Plan,
+    Recording,
+    Scenario,
+    ScatterlocError,
+    StaticCalibration,
+    StudyResult,
+    Track,
+    __version__,
+    calibrate,
+    cir_track,
+    crlb,
+    crlb_map,
+    estimate,
+    estimate_recording,
+    locate,
+    montecarlo,
+    mtl_locate,
+    pcrlb,
+    plan,
+    read_recording,
+    simulate_recording,
+    track,
+    write_recording,
+)
+
+__all__ = [
+    "ChannelTrack",
+    "Crlb",
+    "CrlbMap",
+    "Curves",
+    "Fix",
+    "MtlResult",
+    "Paths",
+    "Plan",
+    "Recording",
+    "Scenario",
+    "ScatterlocError",
+    "StaticCalibration",
+    "StudyResult",
+    "Track",
+    "__version__",
+    "calibrate",
+    "cir_track",
+    "crlb",
+    "crlb_map",
+    "estimate",
+    "estimate_recording",
+    "locate",
+    "montecarlo",
+    "mtl_locate",
+    "pcrlb",
+    "plan",
+    "read_recording",
+    "simulate_recording",
+    "track",
+    "write_recording",
+]

@@ -1,0 +1,538 @@
+"""Type stubs of the native module ``scatterloc._scatterloc`` (re-exported by ``scatterloc``)."""
+
+import os
+from typing import Any, Callable, Literal, Mapping, Optional, Sequence, Union
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+__version__: str
+
+F64 = NDArray[np.float64]
+I64 = NDArray[np.int64]
+Bools = NDArray[np.bool_]
+C128 = NDArray[np.complex128]
+Masked = np.ma.MaskedArray[Any, np.dtype[np.float64]]
+PathLike = Union[str, "os.PathLike[str]"]
+Progress = Optional[Callable[[int, int], object]]
+Window = tuple[float, float, float, float]
+ScenarioLike = Union["Scenario", str, Mapping[str, Any], "os.PathLike[str]"]
+FilterName = Literal["ekf", "ukf", "pf"]
+
+class ScatterlocError(ValueError):
+    """Bad input: ``field`` names the input at fault as the core names it (or is None),
+    ``kind`` is the error's kind (``OutOfRange``, ``InvalidDelay``, ...)."""
+
+    field: Optional[str]
+    kind: str
+
+class Scenario:
+    """A validated scenario (schema v1, docs/cli.md) with its measurement model compiled."""
+
+    def __init__(self, source: Union[str, Mapping[str, Any], "os.PathLike[str]"]) -> None: ...
+    @staticmethod
+    def preset(name: str) -> Scenario: ...
+    @staticmethod
+    def presets() -> list[str]: ...
+    @staticmethod
+    def from_dict(d: Mapping[str, Any]) -> Scenario: ...
+    @staticmethod
+    def from_json(text: str) -> Scenario: ...
+    @staticmethod
+    def from_file(path: PathLike) -> Scenario: ...
+    def to_dict(self) -> dict[str, Any]: ...
+    def to_json(self) -> str: ...
+    def save(self, path: PathLike) -> None: ...
+    def copy(self) -> Scenario: ...
+    def __copy__(self) -> Scenario: ...
+    def __deepcopy__(self, memo: Any) -> Scenario: ...
+    def __eq__(self, other: object) -> bool: ...
+    @property
+    def name(self) -> str: ...
+    @property
+    def transmitters(self) -> F64: ...
+    @property
+    def receivers(self) -> F64: ...
+    @property
+    def transmitter_names(self) -> list[str]: ...
+    @property
+    def receiver_names(self) -> list[str]: ...
+    @property
+    def links(self) -> list[tuple[str, str]]: ...
+    @property
+    def link_indices(self) -> I64: ...
+    @property
+    def link_count(self) -> int: ...
+    @property
+    def area(self) -> Window: ...
+    @property
+    def carrier_hz(self) -> float: ...
+    @property
+    def bandwidth_hz(self) -> float: ...
+    @property
+    def rcs_m2(self) -> float: ...
+    def delays(self, points: ArrayLike) -> F64: ...
+    def sigma_delays(self, points: ArrayLike) -> F64: ...
+    def snr_db(self, points: ArrayLike) -> F64: ...
+    def delay_jacobian(self, points: ArrayLike) -> F64: ...
+    def move_transmitter(self, i: int, position: ArrayLike) -> None: ...
+    def move_receiver(self, i: int, position: ArrayLike) -> None: ...
+    def add_transmitter(self, position: ArrayLike) -> int: ...
+    def add_receiver(self, position: ArrayLike) -> int: ...
+    def remove_transmitter(self, i: int) -> None: ...
+    def remove_receiver(self, i: int) -> None: ...
+    def set_area(self, x_min: float, x_max: float, y_min: float, y_max: float) -> None: ...
+    def set_name(self, name: str) -> None: ...
+    def set_carrier_hz(self, value: float) -> None: ...
+    def set_bandwidth_hz(self, value: float) -> None: ...
+    def set_noise_figure_db(self, value: float) -> None: ...
+    def set_rcs_m2(self, value: float) -> None: ...
+    def set_tx_power_dbm(self, i: int, value: float) -> None: ...
+    def set_tx_gain_dbi(self, i: int, value: float) -> None: ...
+    def set_rx_gain_dbi(self, i: int, value: float) -> None: ...
+    def set_tx_pattern(
+        self,
+        i: int,
+        kind: Literal["omni", "parabolic"],
+        boresight_deg: float = 0.0,
+        beamwidth_deg: float = 70.0,
+        floor_db: float = 20.0,
+    ) -> None: ...
+
+class Crlb:
+    """The CRLB at points; arrays have the points' leading shape."""
+
+    @property
+    def points(self) -> F64: ...
+    @property
+    def sigma_x(self) -> Union[float, F64]: ...
+    @property
+    def sigma_y(self) -> Union[float, F64]: ...
+    @property
+    def rmse(self) -> Union[float, F64]: ...
+    @property
+    def bounded(self) -> Union[bool, Bools]: ...
+    @property
+    def fisher(self) -> F64: ...
+    @property
+    def covariance(self) -> F64: ...
+    @property
+    def snr_db(self) -> F64: ...
+    @property
+    def sigma_delay(self) -> F64: ...
+    @property
+    def delay(self) -> F64: ...
+    def ellipses(self) -> Masked: ...
+    def to_dicts(self) -> list[dict[str, Any]]: ...
+
+def crlb(scenario: ScenarioLike, points: ArrayLike) -> Crlb: ...
+
+class CrlbMap:
+    """The RMSE bound over a grid (rows ascending in y)."""
+
+    @property
+    def x(self) -> F64: ...
+    @property
+    def y(self) -> F64: ...
+    @property
+    def rmse(self) -> F64: ...
+    @property
+    def sigma_x(self) -> Optional[F64]: ...
+    @property
+    def sigma_y(self) -> Optional[F64]: ...
+    @property
+    def extent(self) -> Window: ...
+    @property
+    def compute_s(self) -> float: ...
+    def to_dict(self) -> dict[str, Any]: ...
+
+def crlb_map(
+    scenario: ScenarioLike,
+    nx: int = 256,
+    ny: int = 256,
+    window: Optional[Window] = None,
+    *,
+    threads: int = 0,
+    components: bool = False,
+) -> CrlbMap: ...
+
+class Fix:
+    """A Levenberg-Marquardt fix."""
+
+    @property
+    def position(self) -> F64: ...
+    @property
+    def covariance(self) -> Optional[F64]: ...
+    @property
+    def cost(self) -> float: ...
+    @property
+    def iterations(self) -> int: ...
+    @property
+    def termination(self) -> str: ...
+    @property
+    def converged(self) -> bool: ...
+    @property
+    def links_used(self) -> int: ...
+    @property
+    def start(self) -> F64: ...
+    def to_dict(self) -> dict[str, Any]: ...
+
+def locate(
+    scenario: ScenarioLike,
+    delays: ArrayLike,
+    sigma: Union[float, ArrayLike],
+    *,
+    initial: Optional[ArrayLike] = None,
+) -> Fix: ...
+
+class StaticCalibration:
+    """Static clusters per link (spec section 4)."""
+
+    @property
+    def clusters(self) -> list[F64]: ...
+    def to_dict(self) -> dict[str, Any]: ...
+
+def calibrate(
+    scenario: ScenarioLike,
+    snapshots: Sequence[Sequence[Sequence[float]]],
+    *,
+    gap: Optional[float] = None,
+    min_fraction: Optional[float] = None,
+    sigma_floor: Optional[float] = None,
+) -> StaticCalibration: ...
+
+class Track:
+    """A track: one entry per step."""
+
+    @property
+    def t(self) -> F64: ...
+    @property
+    def states(self) -> F64: ...
+    @property
+    def covariances(self) -> F64: ...
+    @property
+    def nis(self) -> Masked: ...
+    @property
+    def links_used(self) -> I64: ...
+    @property
+    def delays_used(self) -> Optional[Masked]: ...
+    @property
+    def choices(self) -> Optional[list[list[str]]]: ...
+    @property
+    def static_removed(self) -> Optional[I64]: ...
+    @property
+    def start(self) -> Optional[dict[str, Any]]: ...
+    def to_dict(self) -> dict[str, Any]: ...
+    def __len__(self) -> int: ...
+
+def track(
+    scenario: ScenarioLike,
+    measurements: Union[ArrayLike, Sequence[Sequence[ArrayLike]], Mapping[str, Any], PathLike],
+    *,
+    dt: Optional[float] = None,
+    process_noise: Optional[float] = None,
+    initial_state: Optional[ArrayLike] = None,
+    initial_covariance: Optional[ArrayLike] = None,
+    initial_snapshot: Optional[Sequence[ArrayLike]] = None,
+    sigma: Optional[Union[float, ArrayLike]] = None,
+    filter: FilterName = "ekf",
+    particles: Optional[int] = None,
+    roughening: Optional[float] = None,
+    bootstrap: Optional[bool] = None,
+    seed: Optional[int] = None,
+    ukf_alpha: Optional[float] = None,
+    ukf_beta: Optional[float] = None,
+    ukf_kappa: Optional[float] = None,
+    calibration: Optional[Union[StaticCalibration, Mapping[str, Any], PathLike]] = None,
+    association: Optional[Literal["spec", "gated"]] = None,
+    max_cpu_hours: Optional[float] = None,
+) -> Track: ...
+
+class Curves:
+    """The curves of one trajectory of a study."""
+
+    @property
+    def trajectory(self) -> str: ...
+    @property
+    def t(self) -> F64: ...
+    @property
+    def pcrlb(self) -> F64: ...
+    @property
+    def rmse(self) -> dict[str, F64]: ...
+    @property
+    def nees(self) -> dict[str, F64]: ...
+    @property
+    def runs(self) -> dict[str, int]: ...
+    @property
+    def failed_runs(self) -> dict[str, int]: ...
+    @property
+    def errors(self) -> dict[str, str]: ...
+    @property
+    def wall_time_s(self) -> float: ...
+
+class StudyResult:
+    """A study's result: one Curves per trajectory."""
+
+    @property
+    def curves(self) -> list[Curves]: ...
+    def to_dict(self) -> dict[str, Any]: ...
+    def __getitem__(self, key: Union[int, str]) -> Curves: ...
+    def __len__(self) -> int: ...
+
+def montecarlo(
+    scenario: Optional[ScenarioLike] = None,
+    *,
+    trajectory: Optional[Union[str, Sequence[str]]] = None,
+    runs: int = 5000,
+    noise_runs: int = 50,
+    dt: float = 2.048e-3,
+    duration: float = 10.0,
+    process_noise: float = 0.01,
+    seed: int = 1,
+    threads: int = 0,
+    oracle_noise: bool = False,
+    filters: Optional[Union[str, Sequence[FilterName]]] = None,
+    particles: Optional[int] = None,
+    roughening: Optional[float] = None,
+    bootstrap: Optional[bool] = None,
+    ukf_alpha: Optional[float] = None,
+    ukf_beta: Optional[float] = None,
+    ukf_kappa: Optional[float] = None,
+    max_cpu_hours: Optional[float] = None,
+    progress: Progress = None,
+) -> StudyResult: ...
+def pcrlb(
+    scenario: Optional[ScenarioLike] = None,
+    *,
+    nominal: bool = False,
+    trajectory: Optional[Union[str, Sequence[str]]] = None,
+    runs: Optional[int] = None,
+    dt: float = 2.048e-3,
+    duration: float = 10.0,
+    process_noise: float = 0.01,
+    seed: Optional[int] = None,
+    threads: Optional[int] = None,
+    progress: Progress = None,
+) -> StudyResult: ...
+
+class Plan:
+    """A plan: the optimised scenario and its history."""
+
+    @property
+    def scenario(self) -> Scenario: ...
+    @property
+    def before(self) -> float: ...
+    @property
+    def after(self) -> float: ...
+    @property
+    def history(self) -> F64: ...
+    @property
+    def paths(self) -> dict[str, F64]: ...
+    @property
+    def evaluations(self) -> int: ...
+    @property
+    def termination(self) -> str: ...
+    @property
+    def moved(self) -> list[str]: ...
+    def to_dict(self) -> dict[str, Any]: ...
+
+def plan(
+    scenario: ScenarioLike,
+    *,
+    move: str,
+    objective: str,
+    roi: Window,
+    bounds: Optional[Window] = None,
+    allowed: Optional[Sequence[ArrayLike]] = None,
+    min_spacing: float = 0.0,
+    grid: int = 64,
+    budget: int = 10000,
+    seed: int = 1,
+    progress: Progress = None,
+) -> Plan: ...
+
+class MtlResult:
+    """The targets found by multi-target localization."""
+
+    @property
+    def positions(self) -> F64: ...
+    @property
+    def scores(self) -> F64: ...
+    @property
+    def blocking(self) -> F64: ...
+    @property
+    def direct_paths(self) -> I64: ...
+    @property
+    def matchings(self) -> list[list[tuple[int, int]]]: ...
+    @property
+    def candidates(self) -> int: ...
+    def to_dict(self) -> dict[str, Any]: ...
+    def __len__(self) -> int: ...
+
+def mtl_locate(
+    tx: ArrayLike,
+    rx: ArrayLike,
+    ranges: Sequence[Sequence[float]],
+    *,
+    region: Optional[Window] = None,
+    c_sigma: float = 0.1,
+    model: Literal["icb", "ppp", "empirical"] = "icb",
+    p_u: Optional[float] = None,
+    p_d: Optional[float] = None,
+    p_los: Optional[float] = None,
+    lambda_: Optional[float] = None,
+    diameter: Optional[float] = None,
+    exact: Optional[bool] = None,
+    table: Optional[Mapping[str, Any]] = None,
+    cells: Optional[int] = None,
+    scenes: Optional[int] = None,
+    seed: Optional[int] = None,
+    te: Optional[float] = None,
+    tb: Optional[float] = None,
+    b_max: Optional[float] = None,
+    n_min: Optional[int] = None,
+    order: Optional[Sequence[int]] = None,
+    max_candidates: Optional[int] = None,
+) -> MtlResult: ...
+
+class Recording:
+    """A channel recording (docs/recording.md)."""
+
+    def __init__(
+        self,
+        t: ArrayLike,
+        links: ArrayLike,
+        *,
+        cfr: Optional[ArrayLike] = None,
+        freq_hz: Optional[ArrayLike] = None,
+        system_response: Optional[ArrayLike] = None,
+        cir: Optional[ArrayLike] = None,
+        tap0_s: Optional[float] = None,
+        tap_spacing_s: Optional[float] = None,
+        pulse: Optional[ArrayLike] = None,
+        pulse_spacing_s: Optional[float] = None,
+        noise_var: Optional[ArrayLike] = None,
+    ) -> None: ...
+    @property
+    def t(self) -> F64: ...
+    @property
+    def links(self) -> I64: ...
+    @property
+    def layout(self) -> Literal["cfr", "cir"]: ...
+    @property
+    def samples(self) -> C128: ...
+    @property
+    def freq_hz(self) -> Optional[F64]: ...
+    @property
+    def taps(self) -> Optional[tuple[float, float]]: ...
+    @property
+    def noise_var(self) -> Optional[F64]: ...
+    def between(self, t0: float, t1: float) -> Recording: ...
+    def __len__(self) -> int: ...
+
+def read_recording(path: PathLike) -> Recording: ...
+def write_recording(path: PathLike, recording: Recording) -> None: ...
+def simulate_recording(
+    scenario: ScenarioLike,
+    *,
+    scene: Optional[Mapping[str, Any]] = None,
+    walk: Optional[ArrayLike] = None,
+    speed: Optional[float] = None,
+    duration: Optional[float] = None,
+    dt: Optional[float] = None,
+    calibration_duration: float = 1.0,
+    seed: int = 1,
+) -> tuple[Recording, Recording, dict[str, Any]]: ...
+
+class Paths:
+    """Estimated paths in long format (one row per path)."""
+
+    @property
+    def snapshot(self) -> I64: ...
+    @property
+    def link(self) -> Optional[I64]: ...
+    @property
+    def delay(self) -> F64: ...
+    @property
+    def amplitude(self) -> C128: ...
+    @property
+    def sigma(self) -> F64: ...
+    @property
+    def snr_db(self) -> Masked: ...
+    @property
+    def track(self) -> I64: ...
+    @property
+    def confirmed(self) -> Bools: ...
+    @property
+    def noise_var(self) -> F64: ...
+    @property
+    def t(self) -> F64: ...
+    def to_dict(self) -> Optional[dict[str, Any]]: ...
+    def __len__(self) -> int: ...
+
+def estimate(
+    response: ArrayLike,
+    *,
+    freq_hz: Optional[ArrayLike] = None,
+    system_response: Optional[ArrayLike] = None,
+    tap0_s: Optional[float] = None,
+    tap_spacing_s: Optional[float] = None,
+    pulse: Optional[ArrayLike] = None,
+    pulse_spacing_s: Optional[float] = None,
+    bandwidth_hz: Optional[float] = None,
+    t: Optional[ArrayLike] = None,
+    noise_var: Optional[float] = None,
+    max_paths: Optional[int] = None,
+    pfa: Optional[float] = None,
+    progress: Progress = None,
+) -> Paths: ...
+def estimate_recording(
+    scenario: ScenarioLike,
+    recording: Recording,
+    *,
+    max_paths: Optional[int] = None,
+    pfa: Optional[float] = None,
+    threads: int = 0,
+    progress: Progress = None,
+) -> Paths: ...
+
+class ChannelTrack:
+    """A recording's track."""
+
+    @property
+    def t(self) -> F64: ...
+    @property
+    def states(self) -> Masked: ...
+    @property
+    def covariances(self) -> Masked: ...
+    @property
+    def links_used(self) -> I64: ...
+    @property
+    def delays_used(self) -> Masked: ...
+    @property
+    def error(self) -> Optional[Masked]: ...
+    def to_dict(self) -> dict[str, Any]: ...
+
+def cir_track(
+    scenario: ScenarioLike,
+    recording: Recording,
+    calibration: Recording,
+    *,
+    truth: Optional[Union[Mapping[str, Any], PathLike]] = None,
+    filter: FilterName = "ekf",
+    process_noise: float = 1.0,
+    association: Literal["gated", "spec"] = "gated",
+    sigma: Literal["estimator", "budget"] = "estimator",
+    extent_sigma: float = 0.2,
+    seed: Optional[int] = None,
+    particles: Optional[int] = None,
+    roughening: Optional[float] = None,
+    bootstrap: Optional[bool] = None,
+    ukf_alpha: Optional[float] = None,
+    ukf_beta: Optional[float] = None,
+    ukf_kappa: Optional[float] = None,
+    max_paths: Optional[int] = None,
+    pfa: Optional[float] = None,
+    threads: int = 0,
+    progress: Progress = None,
+) -> ChannelTrack: ...

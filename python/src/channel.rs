@@ -1,0 +1,885 @@
+//! The channel front end (spec `channel-estimation.md`, C1–C7): `Recording` (the `.npz` format
+//! of docs/recording.md, read and written by the library's `npz` edge), `simulate_recording`
+//! (`scatterloc cir simulate`), `estimate` (C5 + C6 on responses without a scenario),
+//! `estimate_recording` (`scatterloc cir estimate`) and `cir_track` (`scatterloc cir track`).
+
+use numpy::{Complex64, PyArray1, PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
+use pyo3::prelude::*;
+
+use scatterloc::channel::{
+    simulate_recording as simulate, ChannelScene, Layout, Pulse, Recording, TrackedPath,
+};
+use scatterloc::error::{limits, Cancel};
+use scatterloc::formats::Truth;
+use scatterloc::native::Parallel;
+use scatterloc::npz;
+use scatterloc::present::{estimates_doc, track_doc, track_errors};
+use scatterloc::study::{
+    calibrate_estimates, cir_track as track_recording, estimate_link,
+    estimate_recording as estimate_all, CirTrackRequest, DelaySigma, FrontEndConfig,
+    RecordingEstimates, EXTENT_SIGMA_M,
+};
+use scatterloc::track::gating::{AmplitudeClusterConfig, AssociationRule};
+use scatterloc::track::ConstantVelocity;
+
+use crate::convert::{array, bool_array, f64_array, int_array, masked, path_string, to_python};
+use crate::errors::{arg_error, Core};
+use crate::run::run_job;
+use crate::scenario::scenario_arg;
+use crate::tracking::FilterSettings;
+
+/// A complex128 array of `shape` from row-major `data`.
+fn complex_array<'py>(
+    py: Python<'py>,
+    data: Vec<Complex64>,
+    shape: &[usize],
+) -> PyResult<Bound<'py, PyAny>> {
+    let a = PyArray1::from_vec(py, data);
+    if shape.len() == 1 {
+        return Ok(a.into_any());
+    }
+    Ok(a.reshape(shape.to_vec())?.into_any())
+}
+
+/// A complex argument as (shape, row-major values): complex128 read directly, anything else
+/// through `numpy.asarray(x, dtype=complex)`.
+fn complex_arg(obj: &Bound<'_, PyAny>, field: &str) -> PyResult<(Vec<usize>, Vec<Complex64>)> {
+    let py = obj.py();
+    let a = match obj.cast::<PyArrayDyn<Complex64>>() {
+        Ok(a) => a.clone(),
+        Err(_) => {
+            let kwargs = pyo3::types::PyDict::new(py);
+            kwargs.set_item("dtype", "complex128")?;
+            let np = py.import("numpy")?;
+            np.getattr("asarray")?
+                .call((obj,), Some(&kwargs))
+                .map_err(|e| arg_error(field, format!("not an array of complex numbers ({e})")))?
+                .cast_into::<PyArrayDyn<Complex64>>()
+                .map_err(|_| arg_error(field, "not an array of complex numbers"))?
+        }
+    };
+    let shape = a.shape().to_vec();
+    let data = match a.to_vec() {
+        Ok(v) => v,
+        Err(_) => a.readonly().as_array().iter().copied().collect(),
+    };
+    Ok((shape, data))
+}
+
+/// A channel recording (docs/recording.md): per snapshot and link a channel frequency response
+/// (`cfr`, C1) at `freq_hz`, or a band-limited impulse response (`cir`, C2) of taps at
+/// `tap0_s + m·tap_spacing_s`; snapshot times `t` (s), links as (transmitter, receiver)
+/// indices into the scenario, and optionally the system response, the pulse and the noise
+/// variance per link. Amplitudes are √W at the receiver input (C3).
+#[pyclass(module = "scatterloc", name = "Recording", frozen)]
+#[derive(Clone)]
+pub struct PyRecording {
+    pub(crate) rec: Recording,
+}
+
+#[pymethods]
+impl PyRecording {
+    /// A recording from arrays (checked as the reader checks a file): `t` (S,), `links` (P, 2)
+    /// and exactly one of `cfr` (S, P, N) with `freq_hz` (N,) (and `system_response` (N,)) or
+    /// `cir` (S, P, M) with `tap0_s`, `tap_spacing_s` (and `pulse` (K,) at `pulse_spacing_s`);
+    /// `noise_var` (P,), W.
+    #[new]
+    #[pyo3(signature = (
+        t, links, *, cfr = None, freq_hz = None, system_response = None, cir = None,
+        tap0_s = None, tap_spacing_s = None, pulse = None, pulse_spacing_s = None,
+        noise_var = None
+    ))]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        t: &Bound<'_, PyAny>,
+        links: &Bound<'_, PyAny>,
+        cfr: Option<&Bound<'_, PyAny>>,
+        freq_hz: Option<&Bound<'_, PyAny>>,
+        system_response: Option<&Bound<'_, PyAny>>,
+        cir: Option<&Bound<'_, PyAny>>,
+        tap0_s: Option<f64>,
+        tap_spacing_s: Option<f64>,
+        pulse: Option<&Bound<'_, PyAny>>,
+        pulse_spacing_s: Option<f64>,
+        noise_var: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<PyRecording> {
+        let t_s = crate::convert::f64_vec(t, "t", None)?;
+        let l = f64_array(links, "links")?;
+        if l.shape.len() != 2 || l.shape[1] != 2 {
+            return Err(arg_error(
+                "links",
+                format!("expected shape (P, 2), got {:?}", l.shape),
+            ));
+        }
+        let links: Vec<[usize; 2]> = l
+            .data
+            .chunks_exact(2)
+            .map(|p| {
+                let ok = |v: f64| v >= 0.0 && v.fract() == 0.0 && v < 1e9;
+                if ok(p[0]) && ok(p[1]) {
+                    Ok([p[0] as usize, p[1] as usize])
+                } else {
+                    Err(arg_error("links", "indices must be whole numbers >= 0"))
+                }
+            })
+            .collect::<PyResult<_>>()?;
+        let (layout, samples) = match (cfr, cir) {
+            (Some(h), None) => {
+                for (f, g) in [
+                    ("tap0_s", tap0_s.is_some()),
+                    ("tap_spacing_s", tap_spacing_s.is_some()),
+                    ("pulse", pulse.is_some()),
+                ] {
+                    if g {
+                        return Err(arg_error(f, "only for a cir recording"));
+                    }
+                }
+                let f = freq_hz.ok_or_else(|| arg_error("freq_hz", "required with cfr"))?;
+                let (shape, data) = complex_arg(h, "cfr")?;
+                check_samples("cfr", &shape, t_s.len(), links.len())?;
+                let sys = system_response
+                    .map(|p| complex_arg(p, "system_response").map(|v| v.1))
+                    .transpose()?;
+                (
+                    Layout::Cfr {
+                        freq_hz: crate::convert::f64_vec(f, "freq_hz", None)?,
+                        system_response: sys,
+                    },
+                    data,
+                )
+            }
+            (None, Some(h)) => {
+                for (f, g) in [
+                    ("freq_hz", freq_hz.is_some()),
+                    ("system_response", system_response.is_some()),
+                ] {
+                    if g {
+                        return Err(arg_error(f, "only for a cfr recording"));
+                    }
+                }
+                let (shape, data) = complex_arg(h, "cir")?;
+                check_samples("cir", &shape, t_s.len(), links.len())?;
+                let pulse = match pulse {
+                    Some(p) => {
+                        let mut p = Pulse {
+                            samples: complex_arg(p, "pulse")?.1,
+                            spacing_s: pulse_spacing_s.ok_or_else(|| {
+                                arg_error("pulse_spacing_s", "required with pulse")
+                            })?,
+                        };
+                        p.normalise().py()?;
+                        Some(p)
+                    }
+                    None => None,
+                };
+                (
+                    Layout::Cir {
+                        tap0_s: tap0_s.ok_or_else(|| arg_error("tap0_s", "required with cir"))?,
+                        tap_spacing_s: tap_spacing_s
+                            .ok_or_else(|| arg_error("tap_spacing_s", "required with cir"))?,
+                        pulse,
+                    },
+                    data,
+                )
+            }
+            _ => return Err(arg_error("cfr", "give exactly one of cfr and cir")),
+        };
+        let rec = Recording {
+            t_s,
+            links,
+            layout,
+            samples,
+            noise_var: noise_var
+                .map(|v| crate::convert::f64_vec(v, "noise_var", None))
+                .transpose()?,
+        };
+        rec.validate().py()?;
+        Ok(PyRecording { rec })
+    }
+
+    /// Snapshot times, s, shape (S,).
+    #[getter]
+    fn t<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        array(py, self.rec.t_s.clone(), &[self.rec.t_s.len()])
+    }
+
+    /// Links as (transmitter, receiver) indices, shape (P, 2).
+    #[getter]
+    fn links<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let l = &self.rec.links;
+        int_array(
+            py,
+            l.iter().flat_map(|p| [p[0] as i64, p[1] as i64]).collect(),
+            &[l.len(), 2],
+        )
+    }
+
+    /// `"cfr"` or `"cir"`.
+    #[getter]
+    fn layout(&self) -> &'static str {
+        self.rec.layout.array()
+    }
+
+    /// The samples: the CFR (S, P, N) or the CIR (S, P, M), complex128, √W.
+    #[getter]
+    fn samples<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let r = &self.rec;
+        complex_array(
+            py,
+            r.samples.clone(),
+            &[r.snapshot_count(), r.link_count(), r.samples_per_link()],
+        )
+    }
+
+    /// The baseband frequencies of a CFR, Hz (N,); None for a CIR.
+    #[getter]
+    fn freq_hz<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        match &self.rec.layout {
+            Layout::Cfr { freq_hz, .. } => {
+                Some(array(py, freq_hz.clone(), &[freq_hz.len()])).transpose()
+            }
+            Layout::Cir { .. } => Ok(None),
+        }
+    }
+
+    /// A CIR's tap 0 delay and tap spacing, s; None for a CFR.
+    #[getter]
+    fn taps(&self) -> Option<(f64, f64)> {
+        match &self.rec.layout {
+            Layout::Cir {
+                tap0_s,
+                tap_spacing_s,
+                ..
+            } => Some((*tap0_s, *tap_spacing_s)),
+            Layout::Cfr { .. } => None,
+        }
+    }
+
+    /// The noise variance per link, W (P,); None when the estimator estimates it.
+    #[getter]
+    fn noise_var<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        self.rec
+            .noise_var
+            .as_ref()
+            .map(|v| array(py, v.clone(), &[v.len()]))
+            .transpose()
+    }
+
+    /// The snapshots with `t0 ≤ t ≤ t1` as a recording of their own (e.g. a stretch of the
+    /// empty area for calibration).
+    fn between(&self, t0: f64, t1: f64) -> PyResult<PyRecording> {
+        Ok(PyRecording {
+            rec: self.rec.between("t", t0, t1).py()?,
+        })
+    }
+
+    fn __len__(&self) -> usize {
+        self.rec.snapshot_count()
+    }
+
+    fn __repr__(&self) -> String {
+        let r = &self.rec;
+        format!(
+            "Recording({}, snapshots={}, links={}, samples_per_link={})",
+            r.layout.array(),
+            r.snapshot_count(),
+            r.link_count(),
+            r.samples_per_link()
+        )
+    }
+}
+
+/// `shape` must be (S, P, N) for `s` snapshots and `p` links.
+fn check_samples(field: &str, shape: &[usize], s: usize, p: usize) -> PyResult<()> {
+    match shape {
+        [a, b, _] if *a == s && *b == p => Ok(()),
+        _ => Err(arg_error(
+            field,
+            format!("expected shape ({s}, {p}, N) (snapshots, links, samples), got {shape:?}"),
+        )),
+    }
+}
+
+/// Reads a recording (`.npz`, docs/recording.md; at most the CLI's cap of 1 GiB + 64 MiB).
+#[pyfunction]
+pub fn read_recording(py: Python<'_>, path: &Bound<'_, PyAny>) -> PyResult<PyRecording> {
+    use std::io::Read;
+    let p = path_string(path)?;
+    let f = std::fs::File::open(&p)?;
+    let mut bytes = Vec::new();
+    f.take(limits::MAX_RECORDING_BYTES + 1)
+        .read_to_end(&mut bytes)?;
+    if bytes.len() as u64 > limits::MAX_RECORDING_BYTES {
+        return Err(arg_error(
+            "path",
+            format!("'{p}' is larger than {} bytes", limits::MAX_RECORDING_BYTES),
+        ));
+    }
+    let rec = py.detach(|| npz::read_recording(&bytes)).py()?;
+    Ok(PyRecording { rec })
+}
+
+/// Writes `recording` to `path` as `.npz` (docs/recording.md; `numpy.load` reads it), through a
+/// temporary file renamed into place.
+#[pyfunction]
+pub fn write_recording(
+    py: Python<'_>,
+    path: &Bound<'_, PyAny>,
+    recording: &PyRecording,
+) -> PyResult<()> {
+    let p = std::path::PathBuf::from(path_string(path)?);
+    let bytes = py.detach(|| npz::write_recording(&recording.rec)).py()?;
+    let dir = p
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(std::path::Path::new("."));
+    let name = p
+        .file_name()
+        .ok_or_else(|| arg_error("path", "not a file name"))?
+        .to_string_lossy()
+        .into_owned();
+    let tmp = dir.join(format!(".{name}.{}.tmp", std::process::id()));
+    std::fs::write(&tmp, &bytes)?;
+    std::fs::rename(&tmp, &p).inspect_err(|_| {
+        let _ = std::fs::remove_file(&tmp);
+    })?;
+    Ok(())
+}
+
+/// Signal-level recordings of a walk through a scene (C1, C3; `scatterloc cir simulate`): the
+/// LoS, walls with first- and second-order reflections, point scatterers, a walking person, with
+/// thermal noise from the link budget. `scene` is the scene dict (`scene.json` of the CLI;
+/// default the hangar of docs/reproduction.md); `walk` ((x, y) waypoints), `speed` (m/s),
+/// `duration` (s) and `dt` (s) override it. Returns `(recording, calibration, truth)`: the walk,
+/// `calibration_duration` seconds of the empty area (same seed, no person), and the truth as
+/// the CLI's `truth.json` dict.
+#[pyfunction]
+#[pyo3(signature = (
+    scenario, *, scene = None, walk = None, speed = None, duration = None, dt = None,
+    calibration_duration = 1.0, seed = 1
+))]
+#[allow(clippy::too_many_arguments)]
+pub fn simulate_recording<'py>(
+    py: Python<'py>,
+    scenario: &Bound<'py, PyAny>,
+    scene: Option<&Bound<'py, PyAny>>,
+    walk: Option<&Bound<'py, PyAny>>,
+    speed: Option<f64>,
+    duration: Option<f64>,
+    dt: Option<f64>,
+    calibration_duration: f64,
+    seed: u64,
+) -> PyResult<(PyRecording, PyRecording, Bound<'py, PyAny>)> {
+    let sc = scenario_arg(scenario)?;
+    let mut scene: ChannelScene = match scene {
+        Some(d) => {
+            scatterloc::scenario::parse_json(&crate::convert::to_json_text(d, "scene")?).py()?
+        }
+        None => ChannelScene::hangar(),
+    };
+    if let Some(w) = walk {
+        let (pts, lead) = crate::convert::points(w, "walk")?;
+        if lead.len() != 1 {
+            return Err(arg_error("walk", "expected waypoints of shape (K, 2)"));
+        }
+        scene.walk.waypoints_m = pts;
+    }
+    if let Some(v) = speed {
+        scene.walk.speed_mps = v;
+    }
+    if duration.is_some() {
+        scene.duration_s = duration;
+    }
+    if let Some(dt) = dt {
+        scene.dt_s = dt;
+    }
+    scene.validate().py()?;
+    let mut empty = scene.clone();
+    empty.duration_s = Some(calibration_duration);
+    empty.validate().py()?;
+    let (s, m) = (sc.scenario(), sc.model());
+    let ((rec, truth), (cal, _)) = run_job(py, 2, None, |_| {
+        Ok((
+            simulate(s, m, &scene, true, seed)?,
+            simulate(s, m, &empty, false, seed)?,
+        ))
+    })?;
+    Ok((
+        PyRecording { rec },
+        PyRecording { rec: cal },
+        to_python(py, &truth)?,
+    ))
+}
+
+/// Paths in long format: one row per path, with the snapshot (and link) it belongs to.
+#[pyclass(module = "scatterloc", frozen)]
+pub struct Paths {
+    /// The snapshot of each path, shape (K,).
+    #[pyo3(get)]
+    snapshot: Py<PyAny>,
+    /// The scenario link of each path (`estimate_recording`), shape (K,); None for `estimate`.
+    #[pyo3(get)]
+    link: Py<PyAny>,
+    /// Delay τ̂, s, shape (K,).
+    #[pyo3(get)]
+    delay: Py<PyAny>,
+    /// Complex amplitude α̂ (√W for recordings), shape (K,).
+    #[pyo3(get)]
+    amplitude: Py<PyAny>,
+    /// The delay's standard deviation σ̂_τ (C4 at the fitted SNR), s, shape (K,).
+    #[pyo3(get)]
+    sigma: Py<PyAny>,
+    /// The fitted SNR, dB, shape (K,), masked at SNR ≤ 0.
+    #[pyo3(get)]
+    snr_db: Py<PyAny>,
+    /// The path track's id (C6), shape (K,).
+    #[pyo3(get)]
+    track: Py<PyAny>,
+    /// Whether the path track is confirmed, shape (K,).
+    #[pyo3(get)]
+    confirmed: Py<PyAny>,
+    /// The noise variance the estimator used per snapshot (and link), W: shape (S,) or (S, L).
+    #[pyo3(get)]
+    noise_var: Py<PyAny>,
+    /// Snapshot times, s (S,).
+    #[pyo3(get)]
+    t: Py<PyAny>,
+    doc: Option<serde_json::Value>,
+}
+
+#[pymethods]
+impl Paths {
+    /// `EST.json` as `scatterloc cir estimate --out` writes it (from `estimate_recording`);
+    /// None for `estimate`.
+    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        match &self.doc {
+            Some(d) => to_python(py, d),
+            None => Ok(py.None().into_bound(py)),
+        }
+    }
+
+    fn __len__(&self, py: Python<'_>) -> PyResult<usize> {
+        self.delay.bind(py).len()
+    }
+
+    fn __repr__(&self, py: Python<'_>) -> String {
+        format!("Paths(paths={})", self.delay.bind(py).len().unwrap_or(0))
+    }
+}
+
+/// The long-format [`Paths`] of `paths[s][l]` (`links`: whether the second index is a link).
+fn paths_object(
+    py: Python<'_>,
+    t: &[f64],
+    paths: &[Vec<Vec<TrackedPath>>],
+    noise: Vec<f64>,
+    noise_shape: &[usize],
+    links: bool,
+    doc: Option<serde_json::Value>,
+) -> PyResult<Paths> {
+    let (mut snap, mut link, mut delay, mut amp, mut sigma, mut snr, mut track, mut conf) = (
+        Vec::new(),
+        Vec::new(),
+        Vec::new(),
+        Vec::new(),
+        Vec::new(),
+        Vec::new(),
+        Vec::new(),
+        Vec::new(),
+    );
+    for (s, per) in paths.iter().enumerate() {
+        for (l, ps) in per.iter().enumerate() {
+            for p in ps {
+                let e = &p.estimate;
+                snap.push(s as i64);
+                link.push(l as i64);
+                delay.push(e.delay_s);
+                amp.push(e.alpha);
+                sigma.push(e.sigma_s);
+                snr.push((e.snr > 0.0).then(|| 10.0 * scatterloc::math::log10(e.snr)));
+                track.push(p.track_id as i64);
+                conf.push(p.confirmed);
+            }
+        }
+    }
+    let k = delay.len();
+    Ok(Paths {
+        snapshot: int_array(py, snap, &[k])?.unbind(),
+        link: if links {
+            int_array(py, link, &[k])?.unbind()
+        } else {
+            py.None()
+        },
+        delay: array(py, delay, &[k])?.unbind(),
+        amplitude: complex_array(py, amp, &[k])?.unbind(),
+        sigma: array(py, sigma, &[k])?.unbind(),
+        snr_db: masked(py, &snr, &[k])?.unbind(),
+        track: int_array(py, track, &[k])?.unbind(),
+        confirmed: bool_array(py, conf, &[k])?.unbind(),
+        noise_var: array(py, noise, noise_shape)?.unbind(),
+        t: array(py, t.to_vec(), &[t.len()])?.unbind(),
+        doc,
+    })
+}
+
+/// The front end's settings from `max_paths` and `pfa` (the CLI's defaults: 12, 10⁻³).
+fn front_end(max_paths: Option<usize>, pfa: Option<f64>) -> PyResult<FrontEndConfig> {
+    FrontEndConfig::with_overrides(max_paths, pfa).py()
+}
+
+/// Every snapshot's paths (C5: greedy ML with SAGE refinement, joint amplitudes and a CFAR stop
+/// at `pfa` per snapshot, at most `max_paths`; C6: paths tracked over snapshots) in responses
+/// without a scenario. `response`: one CFR (N,) or snapshots (S, N) at `freq_hz` (N,), Hz
+/// (with `system_response` (N,) when the system is not flat); or CIR taps (N,) / (S, N) at
+/// `tap0_s + m·tap_spacing_s` with the `pulse` (K,) at `pulse_spacing_s` or, without it, the
+/// ideal sinc of `bandwidth_hz`. `t` (S,) are the snapshot times (default 0, 1, 2, … s);
+/// `noise_var` (W per sample) fixes the noise instead of estimating it. Returns the paths in
+/// long format.
+#[pyfunction]
+#[pyo3(signature = (
+    response, *, freq_hz = None, system_response = None, tap0_s = None, tap_spacing_s = None,
+    pulse = None, pulse_spacing_s = None, bandwidth_hz = None, t = None, noise_var = None,
+    max_paths = None, pfa = None, progress = None
+))]
+#[allow(clippy::too_many_arguments)]
+pub fn estimate(
+    py: Python<'_>,
+    response: &Bound<'_, PyAny>,
+    freq_hz: Option<&Bound<'_, PyAny>>,
+    system_response: Option<&Bound<'_, PyAny>>,
+    tap0_s: Option<f64>,
+    tap_spacing_s: Option<f64>,
+    pulse: Option<&Bound<'_, PyAny>>,
+    pulse_spacing_s: Option<f64>,
+    bandwidth_hz: Option<f64>,
+    t: Option<&Bound<'_, PyAny>>,
+    noise_var: Option<f64>,
+    max_paths: Option<usize>,
+    pfa: Option<f64>,
+    progress: Option<&Bound<'_, PyAny>>,
+) -> PyResult<Paths> {
+    let cfg = front_end(max_paths, pfa)?;
+    let (shape, data) = complex_arg(response, "response")?;
+    let (s, n) = match shape.as_slice() {
+        [n] => (1, *n),
+        [s, n] => (*s, *n),
+        other => {
+            return Err(arg_error(
+                "response",
+                format!("expected shape (N,) or (S, N), got {other:?}"),
+            ))
+        }
+    };
+    let t_s = match t {
+        Some(t) => crate::convert::f64_vec(t, "t", Some(s))?,
+        None => (0..s).map(|k| k as f64).collect(),
+    };
+    let is_cir = tap0_s.is_some() || tap_spacing_s.is_some();
+    let py_rec = |cfr: Option<&Bound<'_, PyAny>>, cir: Option<&Bound<'_, PyAny>>| {
+        let arr = PyArray1::from_vec(py, data.clone()).reshape(vec![s, 1, n])?;
+        let links = int_array(py, vec![0, 0], &[1, 2])?;
+        let tt = array(py, t_s.clone(), &[s])?;
+        let (cfr, cir) = match (cfr, cir) {
+            (Some(_), _) => (Some(arr.as_any().clone()), None),
+            _ => (None, Some(arr.as_any().clone())),
+        };
+        let nv = noise_var
+            .map(|v| vec![v])
+            .map(|v| array(py, v, &[1]))
+            .transpose()?;
+        PyRecording::new(
+            &tt,
+            &links,
+            cfr.as_ref(),
+            freq_hz,
+            system_response,
+            cir.as_ref(),
+            tap0_s,
+            tap_spacing_s,
+            pulse,
+            pulse_spacing_s,
+            nv.as_ref(),
+        )
+    };
+    let rec = if is_cir {
+        py_rec(None, Some(response))?
+    } else {
+        py_rec(Some(response), None)?
+    }
+    .rec;
+    let b = bandwidth_hz.unwrap_or(0.0);
+    if is_cir && bandwidth_hz.is_none() && pulse.is_none() {
+        return Err(arg_error(
+            "bandwidth_hz",
+            "required for a CIR without a pulse (the ideal sinc of the band)",
+        ));
+    }
+    let (paths, noise) = run_job(py, s, progress, |job| {
+        let stop = || job.cancelled();
+        estimate_link(&rec, b, 0, &cfg, Cancel::when(&stop), &|k| job.add_done(k))
+    })?;
+    let per: Vec<Vec<Vec<TrackedPath>>> = paths.into_iter().map(|p| vec![p]).collect();
+    paths_object(py, &rec.t_s, &per, noise, &[s], false, None)
+}
+
+/// The estimates of a recording on `scenario`'s links (`scatterloc cir estimate`): every
+/// recorded link's snapshots through C5 + C6 on `threads` workers (0 = all cores), without the
+/// GIL; Ctrl-C stops it; `progress(done, total)` counts link-snapshots. `to_dict()` is the
+/// CLI's `EST.json`.
+#[pyfunction]
+#[pyo3(signature = (scenario, recording, *, max_paths = None, pfa = None, threads = 0, progress = None))]
+pub fn estimate_recording(
+    py: Python<'_>,
+    scenario: &Bound<'_, PyAny>,
+    recording: &PyRecording,
+    max_paths: Option<usize>,
+    pfa: Option<f64>,
+    threads: usize,
+    progress: Option<&Bound<'_, PyAny>>,
+) -> PyResult<Paths> {
+    let sc = scenario_arg(scenario)?;
+    let cfg = front_end(max_paths, pfa)?;
+    let est = estimate_on(py, &sc, &recording.rec, &cfg, threads, progress)?;
+    let doc = serde_json::to_value(estimates_doc(sc.model(), &est, &cfg))
+        .map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(e.to_string()))?;
+    let l = sc.model().link_count();
+    let noise: Vec<f64> = est.noise_var.iter().flatten().copied().collect();
+    paths_object(
+        py,
+        &est.t_s,
+        &est.paths,
+        noise,
+        &[est.len(), l],
+        true,
+        Some(doc),
+    )
+}
+
+/// [`estimate_all`] off the GIL with Ctrl-C and progress.
+fn estimate_on(
+    py: Python<'_>,
+    sc: &crate::scenario::PyScenario,
+    rec: &Recording,
+    cfg: &FrontEndConfig,
+    threads: usize,
+    progress: Option<&Bound<'_, PyAny>>,
+) -> PyResult<RecordingEstimates> {
+    rec.link_map(sc.model()).py()?;
+    let total = rec.snapshot_count() * rec.link_count();
+    run_job(py, total, progress, |job| {
+        estimate_all(
+            sc.model(),
+            sc.scenario().radio.bandwidth_hz,
+            rec,
+            cfg,
+            &mut Parallel::new(threads, &job.cancel),
+            &|k| job.add_done(k),
+        )
+    })
+}
+
+/// A recording's track (returned by `cir_track`).
+#[pyclass(module = "scatterloc", frozen)]
+pub struct ChannelTrack {
+    /// Snapshot times, s (S,).
+    #[pyo3(get)]
+    t: Py<PyAny>,
+    /// States [x, y, vx, vy], shape (S, 4), masked before the track starts.
+    #[pyo3(get)]
+    states: Py<PyAny>,
+    /// Covariances (S, 4, 4), masked before the start.
+    #[pyo3(get)]
+    covariances: Py<PyAny>,
+    /// Links used per snapshot (S,).
+    #[pyo3(get)]
+    links_used: Py<PyAny>,
+    /// The delay taken per snapshot and link, s (S, L), masked where absent.
+    #[pyo3(get)]
+    delays_used: Py<PyAny>,
+    /// With `truth`: the position error per snapshot, m (S,), masked where there is no
+    /// estimate; else None.
+    #[pyo3(get)]
+    error: Py<PyAny>,
+    doc: serde_json::Value,
+}
+
+#[pymethods]
+impl ChannelTrack {
+    /// `TRACK.json` as `scatterloc cir track --out` writes it for the same inputs.
+    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        to_python(py, &self.doc)
+    }
+
+    fn __repr__(&self, py: Python<'_>) -> String {
+        format!(
+            "ChannelTrack(snapshots={})",
+            self.t.bind(py).len().unwrap_or(0)
+        )
+    }
+}
+
+/// The whole chain from recordings to a track (`scatterloc cir track`): both recordings
+/// estimated (C5 + C6), the empty area's estimates clustered in (delay, amplitude) (C7), each
+/// snapshot gated (E4) and associated (`association`, default `"gated"`), the track started
+/// at the first snapshot whose links give an LM fix (§5) and filtered (`filter`, CV model with
+/// `process_noise` q̃, m²/s³). Each delay is weighted with the estimator's σ̂_τ widened by the
+/// scatterer's extent `extent_sigma` (m of path length), or with the link budget
+/// (`sigma="budget"`). `truth` (a dict as `truth.json`, or a path) adds the error statistics.
+/// `to_dict()` is the CLI's `TRACK.json`.
+#[pyfunction]
+#[pyo3(signature = (
+    scenario, recording, calibration, *, truth = None, filter = "ekf", process_noise = 1.0,
+    association = "gated", sigma = "estimator", extent_sigma = EXTENT_SIGMA_M, seed = None,
+    particles = None, roughening = None, bootstrap = None, ukf_alpha = None, ukf_beta = None,
+    ukf_kappa = None, max_paths = None, pfa = None, threads = 0, progress = None
+))]
+#[allow(clippy::too_many_arguments)]
+pub fn cir_track(
+    py: Python<'_>,
+    scenario: &Bound<'_, PyAny>,
+    recording: &PyRecording,
+    calibration: &PyRecording,
+    truth: Option<&Bound<'_, PyAny>>,
+    filter: &str,
+    process_noise: f64,
+    association: &str,
+    sigma: &str,
+    extent_sigma: f64,
+    seed: Option<u64>,
+    particles: Option<usize>,
+    roughening: Option<f64>,
+    bootstrap: Option<bool>,
+    ukf_alpha: Option<f64>,
+    ukf_beta: Option<f64>,
+    ukf_kappa: Option<f64>,
+    max_paths: Option<usize>,
+    pfa: Option<f64>,
+    threads: usize,
+    progress: Option<&Bound<'_, PyAny>>,
+) -> PyResult<ChannelTrack> {
+    let sc = scenario_arg(scenario)?;
+    let settings = FilterSettings {
+        ukf_alpha,
+        ukf_beta,
+        ukf_kappa,
+        particles,
+        roughening,
+        bootstrap,
+    };
+    let kind = settings.kinds(&[filter.to_string()], "filter")?[0];
+    if seed.is_some() && filter != "pf" {
+        return Err(arg_error(
+            "seed",
+            "only for the pf filter (filter is not pf)",
+        ));
+    }
+    ConstantVelocity::validated(1.0, process_noise).py()?;
+    let rule = match association {
+        "gated" => AssociationRule::Gated,
+        "spec" => AssociationRule::Spec,
+        other => {
+            return Err(arg_error(
+                "association",
+                format!("'{other}' is not 'gated' or 'spec'"),
+            ))
+        }
+    };
+    let sigma = match sigma {
+        "estimator" => DelaySigma::Estimator,
+        "budget" => DelaySigma::LinkBudget,
+        other => {
+            return Err(arg_error(
+                "sigma",
+                format!("'{other}' is not 'estimator' or 'budget'"),
+            ))
+        }
+    };
+    let truth: Option<Truth> = match truth {
+        None => None,
+        Some(t) => {
+            let text = if t.cast::<pyo3::types::PyDict>().is_ok() {
+                crate::convert::to_json_text(t, "truth")?
+            } else {
+                crate::scenario::read_text(&path_string(t)?, "truth")?
+            };
+            let t = Truth::from_json(&text).py()?;
+            t.check_times(&recording.rec.t_s).py()?;
+            Some(t)
+        }
+    };
+    let cfg = front_end(max_paths, pfa)?;
+    let (model, scen) = (sc.model(), sc.scenario());
+    let empty = estimate_on(py, &sc, &calibration.rec, &cfg, threads, None)?;
+    let ccfg = AmplitudeClusterConfig::for_bandwidth(scen.radio.bandwidth_hz).py()?;
+    let cal = calibrate_estimates(model, &empty, &ccfg).py()?;
+    let est = estimate_on(py, &sc, &recording.rec, &cfg, threads, progress)?;
+    let req = CirTrackRequest {
+        model,
+        area: &scen.area_m,
+        calibration: &cal,
+        estimates: &est,
+        filter: kind,
+        process_noise,
+        rule,
+        sigma,
+        extent_sigma_m: extent_sigma,
+        seed: seed.unwrap_or(1),
+    };
+    let track = run_job(py, est.len(), None, |job| {
+        let stop = || job.cancelled();
+        track_recording(&req, Cancel::when(&stop))
+    })?;
+    let truth_states: Vec<Option<[f64; 4]>> = truth
+        .as_ref()
+        .map(|t| t.states.iter().map(|s| Some(*s)).collect())
+        .unwrap_or_default();
+    let view = track_errors(&track.t_s, &track.states, &truth_states).py()?;
+    let stats = truth.as_ref().and(view.stats);
+    let doc = serde_json::to_value(track_doc(
+        &track,
+        kind.name(),
+        process_noise,
+        sigma,
+        &cal,
+        empty.len(),
+        stats,
+    ))
+    .map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(e.to_string()))?;
+    let s = track.t_s.len();
+    let l = model.link_count();
+    let states: Vec<Option<f64>> = track
+        .states
+        .iter()
+        .flat_map(|st| match st {
+            Some(v) => v.map(Some),
+            None => [None; 4],
+        })
+        .collect();
+    let covs: Vec<Option<f64>> = track
+        .covariances
+        .iter()
+        .flat_map(|c| match c {
+            Some(m) => m.iter().flatten().map(|v| Some(*v)).collect::<Vec<_>>(),
+            None => vec![None; 16],
+        })
+        .collect();
+    let used: Vec<Option<f64>> = track.delays_used_s.iter().flatten().copied().collect();
+    let error = match &truth {
+        Some(_) => masked(py, &view.error_m, &[s])?.unbind(),
+        None => py.None(),
+    };
+    Ok(ChannelTrack {
+        t: array(py, track.t_s.clone(), &[s])?.unbind(),
+        states: masked(py, &states, &[s, 4])?.unbind(),
+        covariances: masked(py, &covs, &[s, 4, 4])?.unbind(),
+        links_used: int_array(
+            py,
+            track.links_used.iter().map(|&n| n as i64).collect(),
+            &[s],
+        )?
+        .unbind(),
+        delays_used: masked(py, &used, &[s, l])?.unbind(),
+        error,
+        doc,
+    })
+}

@@ -1,0 +1,78 @@
+//! `scatterloc._scatterloc`, the native module of the Python package `scatterloc` (issue 27):
+//! PyO3 + rust-numpy bindings that only convert types and call the library's use cases — the
+//! same functions the CLI and the page call — so a notebook gets the CLI's numbers bit for bit,
+//! as numpy arrays. One file per family, like the CLI's `cmd/`:
+//!
+//! - `errors`: the core's `Error` as `ScatterlocError` (a `ValueError` with `field` and `kind`).
+//! - `convert`: arrays in and out, documents as the dicts the CLI's JSON parses to.
+//! - `run`: long work on a worker thread without the GIL, Ctrl-C and progress.
+//! - `scenario`: `Scenario` (the core's `present::Session`).
+//! - `snapshot`: `crlb`, `crlb_map`, `locate`.
+//! - `tracking`: `track`, `calibrate` and the filter settings.
+//! - `studies`: `montecarlo`, `pcrlb`.
+//! - `planning`: `plan`.
+//! - `mtl`: `mtl_locate`.
+//! - `channel`: `Recording`, `read_recording`, `write_recording`, `simulate_recording`,
+//!   `estimate`, `estimate_recording`, `cir_track`.
+//! - `bench`: native timings for the package's benchmark (docs/benchmarks.md).
+//!
+//! The Python side (`python/scatterloc/`) re-exports these, adds the Stone Soup model and
+//! carries the type stubs.
+
+mod bench;
+mod channel;
+mod convert;
+mod errors;
+mod mtl;
+mod planning;
+mod run;
+mod scenario;
+mod snapshot;
+mod studies;
+mod tracking;
+
+use pyo3::prelude::*;
+
+/// The native module; `scatterloc/__init__.py` re-exports it.
+#[pymodule]
+fn _scatterloc(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    let py = m.py();
+    m.add("ScatterlocError", py.get_type::<errors::ScatterlocError>())?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    m.add_class::<scenario::PyScenario>()?;
+    m.add_class::<snapshot::Crlb>()?;
+    m.add_class::<snapshot::CrlbMap>()?;
+    m.add_class::<snapshot::Fix>()?;
+    m.add_class::<tracking::Track>()?;
+    m.add_class::<tracking::StaticCalibration>()?;
+    m.add_class::<studies::Curves>()?;
+    m.add_class::<studies::StudyResult>()?;
+    m.add_class::<planning::Plan>()?;
+    m.add_class::<mtl::MtlResult>()?;
+    m.add_class::<channel::PyRecording>()?;
+    m.add_class::<channel::Paths>()?;
+    m.add_class::<channel::ChannelTrack>()?;
+    for f in [
+        wrap_pyfunction!(snapshot::crlb, m)?,
+        wrap_pyfunction!(snapshot::crlb_map, m)?,
+        wrap_pyfunction!(snapshot::locate, m)?,
+        wrap_pyfunction!(tracking::track, m)?,
+        wrap_pyfunction!(tracking::calibrate, m)?,
+        wrap_pyfunction!(studies::montecarlo, m)?,
+        wrap_pyfunction!(studies::pcrlb, m)?,
+        wrap_pyfunction!(planning::plan, m)?,
+        wrap_pyfunction!(mtl::mtl_locate, m)?,
+        wrap_pyfunction!(channel::read_recording, m)?,
+        wrap_pyfunction!(channel::write_recording, m)?,
+        wrap_pyfunction!(channel::simulate_recording, m)?,
+        wrap_pyfunction!(channel::estimate, m)?,
+        wrap_pyfunction!(channel::estimate_recording, m)?,
+        wrap_pyfunction!(channel::cir_track, m)?,
+    ] {
+        m.add_function(f)?;
+    }
+    let bench = PyModule::new(py, "_bench")?;
+    bench::register(&bench)?;
+    m.add_submodule(&bench)?;
+    Ok(())
+}

@@ -1,0 +1,123 @@
+//! Long work off the interpreter: a study runs on a worker thread with the GIL released while
+//! the calling thread wakes every 50 ms to check Python's signals — Ctrl-C in a terminal or a
+//! notebook's interrupt button sets the core's cancel flag, the work stops within milliseconds
+//! ([`scatterloc::error::Cancel`]) and the call raises `KeyboardInterrupt` — and to report
+//! progress to an optional Python callable `progress(done, total)`.
+
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::mpsc;
+use std::time::Duration;
+
+use pyo3::prelude::*;
+
+use crate::errors::core_error;
+
+/// How often the calling thread checks signals and reports progress.
+const POLL: Duration = Duration::from_millis(50);
+
+/// The flags a running job shares with the calling thread.
+pub struct Job {
+    /// Set on Ctrl-C (or when the progress callback raised): the work stops.
+    pub cancel: AtomicBool,
+    /// Units done so far (set by the work).
+    pub done: AtomicUsize,
+}
+
+impl Job {
+    /// Records `n` units done.
+    pub fn set_done(&self, n: usize) {
+        self.done.store(n, Ordering::Relaxed);
+    }
+
+    /// Adds `n` units done.
+    pub fn add_done(&self, n: usize) {
+        self.done.fetch_add(n, Ordering::Relaxed);
+    }
+
+    /// Whether the caller asked the work to stop.
+    pub fn cancelled(&self) -> bool {
+        self.cancel.load(Ordering::Relaxed)
+    }
+}
+
+/// Runs `work` on a scoped worker thread with the GIL released (see the module doc). `total` is
+/// the unit count `progress` is called with. Core errors become Python exceptions; a cancelled
+/// run raises the `KeyboardInterrupt` (or the callback's exception) that stopped it.
+pub fn run_job<T: Send>(
+    py: Python<'_>,
+    total: usize,
+    progress: Option<&Bound<'_, PyAny>>,
+    work: impl FnOnce(&Job) -> scatterloc::Result<T> + Send,
+) -> PyResult<T> {
+    let job = Job {
+        cancel: AtomicBool::new(false),
+        done: AtomicUsize::new(0),
+    };
+    let (tx, rx) = mpsc::channel();
+    std::thread::scope(|scope| {
+        let job = &job;
+        scope.spawn(move || {
+            // The receiver outlives the scope; a send cannot fail before it returns.
+            let _ = tx.send(work(job));
+        });
+        let mut stopped: Option<PyErr> = None;
+        let mut reported = usize::MAX;
+        let mut rx = rx;
+        loop {
+            // The receiver goes into the GIL-free wait and comes back (it is Send, not Sync).
+            let (got, back) = py.detach(move || (rx.recv_timeout(POLL), rx));
+            rx = back;
+            match got {
+                Ok(result) => {
+                    return match (stopped, result) {
+                        (Some(e), _) => Err(e),
+                        (None, Ok(v)) => {
+                            // The last report: everything done.
+                            if let Some(cb) = progress {
+                                if reported != total {
+                                    cb.call1((total, total))?;
+                                }
+                            }
+                            Ok(v)
+                        }
+                        (None, Err(e)) => Err(core_error(e)),
+                    };
+                }
+                Err(mpsc::RecvTimeoutError::Timeout) => {
+                    if stopped.is_some() {
+                        continue;
+                    }
+                    if let Err(e) = py.check_signals() {
+                        job.cancel.store(true, Ordering::SeqCst);
+                        stopped = Some(e);
+                        continue;
+                    }
+                    if let Some(cb) = progress {
+                        let done = job.done.load(Ordering::Relaxed).min(total);
+                        if done != reported {
+                            reported = done;
+                            if let Err(e) = cb.call1((done, total)) {
+                                job.cancel.store(true, Ordering::SeqCst);
+                                stopped = Some(e);
+                            }
+                        }
+                    }
+                }
+                Err(mpsc::RecvTimeoutError::Disconnected) => {
+                    return Err(pyo3::exceptions::PyRuntimeError::new_err(
+                        "scatterloc: the worker thread ended without a result",
+                    ));
+                }
+            }
+        }
+    })
+}
+
+/// Runs short `work` with the GIL released on the calling thread (no polling): for calls of
+/// bounded, small cost (a map, a fix, a track of a few thousand steps).
+pub fn run_quick<T: Send>(
+    py: Python<'_>,
+    work: impl FnOnce() -> scatterloc::Result<T> + Send,
+) -> PyResult<T> {
+    py.detach(work).map_err(core_error)
+}

@@ -1,0 +1,550 @@
+//! Tracking: `track` (a delay sequence, or raw estimates gated and associated, through the
+//! EKF, UKF or particle filter — the library's `study::track_measurements`, as `scatterloc
+//! track`) and `calibrate` (the static paths of the empty area, spec §4, as `scatterloc
+//! calibrate`), plus the filter settings shared with the studies.
+
+use pyo3::prelude::*;
+
+use scatterloc::error::Cancel;
+use scatterloc::formats::{
+    CalibrationResult, CalibrationSnapshots, Measurements, RawEstimate, RawStep, Sigma,
+};
+use scatterloc::study::{track_cpu_s, track_measurements_in, TrackOutput, TrackRequest, MAX_CPU_S};
+use scatterloc::track::gating::{AssociationRule, Calibration, ClusterConfig};
+use scatterloc::track::{FilterKind, PfConfig, UkfParams};
+
+use crate::convert::{array, f64_array, int_array, masked, matrix, to_json_text, to_python};
+use crate::errors::{arg_error, Core};
+use crate::run::run_job;
+use crate::scenario::{read_text, scenario_arg};
+
+/// The filter settings of `track` and `montecarlo`, as given (None = not given): a setting of
+/// a filter that is not run is an error naming it, as the CLI's flags.
+#[derive(Default, Clone, Copy)]
+pub struct FilterSettings {
+    /// UKF α.
+    pub ukf_alpha: Option<f64>,
+    /// UKF β.
+    pub ukf_beta: Option<f64>,
+    /// UKF κ.
+    pub ukf_kappa: Option<f64>,
+    /// PF particles.
+    pub particles: Option<usize>,
+    /// PF roughening constant.
+    pub roughening: Option<f64>,
+    /// The PF as the plain bootstrap filter.
+    pub bootstrap: Option<bool>,
+}
+
+impl FilterSettings {
+    /// The filters `names` with these settings, validated by the core (`field` names the
+    /// argument holding the names).
+    pub fn kinds(&self, names: &[String], field: &str) -> PyResult<Vec<FilterKind>> {
+        let has = |n: &str| names.iter().any(|x| x == n);
+        let ukf_given = [
+            ("ukf_alpha", self.ukf_alpha.is_some()),
+            ("ukf_beta", self.ukf_beta.is_some()),
+            ("ukf_kappa", self.ukf_kappa.is_some()),
+        ];
+        let pf_given = [
+            ("particles", self.particles.is_some()),
+            ("roughening", self.roughening.is_some()),
+            ("bootstrap", self.bootstrap.is_some()),
+        ];
+        for (given, name) in [(&ukf_given[..], "ukf"), (&pf_given[..], "pf")] {
+            if !has(name) {
+                if let Some((f, _)) = given.iter().find(|(_, g)| *g) {
+                    return Err(arg_error(
+                        f,
+                        format!("only for the {name} filter ({field} does not include {name})"),
+                    ));
+                }
+            }
+        }
+        let d = UkfParams::default();
+        let ukf = UkfParams {
+            alpha: self.ukf_alpha.unwrap_or(d.alpha),
+            beta: self.ukf_beta.unwrap_or(d.beta),
+            kappa: self.ukf_kappa.unwrap_or(d.kappa),
+        };
+        let pf = PfConfig {
+            particles: self.particles.unwrap_or(PfConfig::default().particles),
+            roughening: self.roughening,
+            regularized: !self.bootstrap.unwrap_or(false),
+        };
+        names
+            .iter()
+            .enumerate()
+            .map(|(i, n)| FilterKind::named(&format!("{field}[{i}]"), n, ukf, pf).py())
+            .collect()
+    }
+}
+
+/// The CPU cap in seconds from `max_cpu_hours` (default 24 h, at most 10⁶ h).
+pub fn cpu_cap(max_cpu_hours: Option<f64>) -> PyResult<f64> {
+    match max_cpu_hours {
+        None => Ok(MAX_CPU_S),
+        Some(h) if h > 0.0 && h <= 1e6 => Ok(h * 3600.0),
+        Some(h) => Err(arg_error(
+            "max_cpu_hours",
+            format!("{h} is outside the allowed range 0 < H <= 1e6"),
+        )),
+    }
+}
+
+/// A static-path calibration (returned by `calibrate`; `track(..., calibration=c)` takes it).
+#[pyclass(module = "scatterloc", frozen)]
+pub struct StaticCalibration {
+    file: CalibrationResult,
+}
+
+#[pymethods]
+impl StaticCalibration {
+    /// The calibration file `scatterloc calibrate` writes (`track --calibration` reads it).
+    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        to_python(py, &self.file)
+    }
+
+    /// Per link, the static clusters as an array (K, 2) of (mean delay, σ̄), s.
+    #[getter]
+    fn clusters<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyAny>>> {
+        self.file
+            .links
+            .iter()
+            .map(|l| {
+                let v: Vec<f64> = l
+                    .clusters
+                    .iter()
+                    .flat_map(|c| [c.mean_s, c.sigma_s])
+                    .collect();
+                array(py, v, &[l.clusters.len(), 2])
+            })
+            .collect()
+    }
+
+    fn __repr__(&self) -> String {
+        let n: usize = self.file.links.iter().map(|l| l.clusters.len()).sum();
+        format!(
+            "StaticCalibration(links={}, clusters={n})",
+            self.file.links.len()
+        )
+    }
+}
+
+/// The static paths of the empty area (spec §4): per link the delays of `snapshots` (a list of
+/// snapshots, each a list per link of delays, s) sorted and split where neighbours differ by
+/// more than `gap` (default 1/B), the clusters seen in at least `min_fraction` of the snapshots
+/// kept, σ̄ floored at `sigma_floor` (default 0.01/B). The result of `scatterloc calibrate`.
+#[pyfunction]
+#[pyo3(signature = (scenario, snapshots, *, gap = None, min_fraction = None, sigma_floor = None))]
+pub fn calibrate(
+    scenario: &Bound<'_, PyAny>,
+    snapshots: &Bound<'_, PyAny>,
+    gap: Option<f64>,
+    min_fraction: Option<f64>,
+    sigma_floor: Option<f64>,
+) -> PyResult<StaticCalibration> {
+    let sc = scenario_arg(scenario)?;
+    let n = sc.model().link_count();
+    let mut cfg = ClusterConfig::for_bandwidth(sc.scenario().radio.bandwidth_hz).py()?;
+    if let Some(g) = gap {
+        cfg.gap_s = g;
+    }
+    if let Some(f) = min_fraction {
+        cfg.min_fraction = f;
+    }
+    if let Some(s) = sigma_floor {
+        cfg.sigma_floor_s = s;
+    }
+    cfg.validate().py()?;
+    let snaps: Vec<Vec<Vec<f64>>> = snapshots.extract().map_err(|_| {
+        arg_error(
+            "snapshots",
+            "expected a list of snapshots, each a list per link of delays (s)",
+        )
+    })?;
+    let f = CalibrationSnapshots { snapshots: snaps };
+    let cal = f.calibrate(n, &cfg).py()?;
+    Ok(StaticCalibration {
+        file: CalibrationResult::of(cal, &cfg, f.snapshots.len()),
+    })
+}
+
+/// A calibration argument: a [`StaticCalibration`], a dict (the calibration file) or a path.
+fn calibration_arg(obj: &Bound<'_, PyAny>, links: usize) -> PyResult<Calibration> {
+    let file = if let Ok(c) = obj.cast::<StaticCalibration>() {
+        c.get().file.clone()
+    } else if obj.cast::<pyo3::types::PyDict>().is_ok() {
+        CalibrationResult::from_json(&to_json_text(obj, "calibration")?).py()?
+    } else {
+        let p = crate::convert::path_string(obj)?;
+        CalibrationResult::from_json(&read_text(&p, "calibration")?).py()?
+    };
+    file.into_calibration(links).py()
+}
+
+/// One raw step from Python: per link an array (K, 2) of (delay, amplitude) or (K, 3) of
+/// (delay, amplitude, σ).
+fn raw_step(obj: &Bound<'_, PyAny>, field: &str, links: usize) -> PyResult<RawStep> {
+    let per_link: Vec<Bound<'_, PyAny>> = obj.extract().map_err(|_| {
+        arg_error(
+            field,
+            "expected a list with one array of estimates per link",
+        )
+    })?;
+    if per_link.len() != links {
+        return Err(arg_error(
+            field,
+            format!("expected {links} links, got {}", per_link.len()),
+        ));
+    }
+    per_link
+        .iter()
+        .enumerate()
+        .map(|(p, l)| {
+            let f = format!("{field}[{p}]");
+            let a = f64_array(l, &f)?;
+            match a.shape.as_slice() {
+                [0] | [0, _] => Ok(Vec::new()),
+                [_, 2] => Ok(a
+                    .data
+                    .chunks_exact(2)
+                    .map(|e| RawEstimate::Pair([e[0], e[1]]))
+                    .collect()),
+                [_, 3] => Ok(a
+                    .data
+                    .chunks_exact(3)
+                    .map(|e| RawEstimate::WithSigma([e[0], e[1], e[2]]))
+                    .collect()),
+                s => Err(arg_error(
+                    &f,
+                    format!("expected estimates of shape (K, 2) or (K, 3), got {s:?}"),
+                )),
+            }
+        })
+        .collect()
+}
+
+/// A track (returned by `track`): per step (after its update) the time, the state and its
+/// covariance, the NIS and the links used; with raw estimates also the delays used, how each
+/// link was chosen and the static estimates removed.
+#[pyclass(module = "scatterloc", frozen)]
+pub struct Track {
+    /// `t_k = (k + 1) T`, s, shape (S,).
+    #[pyo3(get)]
+    t: Py<PyAny>,
+    /// States [x, y, vx, vy] (m, m/s), shape (S, 4).
+    #[pyo3(get)]
+    states: Py<PyAny>,
+    /// Covariances, shape (S, 4, 4).
+    #[pyo3(get)]
+    covariances: Py<PyAny>,
+    /// NIS νᵀS⁻¹ν per step, shape (S,), masked where no link was used.
+    #[pyo3(get)]
+    nis: Py<PyAny>,
+    /// Links used per step, shape (S,).
+    #[pyo3(get)]
+    links_used: Py<PyAny>,
+    /// Raw estimates only: the delay taken per step and link, s, shape (S, L), masked where
+    /// absent; else None.
+    #[pyo3(get)]
+    delays_used: Py<PyAny>,
+    /// Raw estimates only: how each link was chosen (`absent`, `single`, `nearest`,
+    /// `strongest`), a list per step; else None.
+    #[pyo3(get)]
+    choices: Py<PyAny>,
+    /// Raw estimates only: estimates removed as static (E4) per step and link, shape (S, L);
+    /// else None.
+    #[pyo3(get)]
+    static_removed: Py<PyAny>,
+    /// `initial_snapshot` only: the LM fix that started the filter (a dict); else None.
+    #[pyo3(get)]
+    start: Py<PyAny>,
+    out: TrackOutput,
+}
+
+#[pymethods]
+impl Track {
+    /// The document `scatterloc track` prints for the same input.
+    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        to_python(py, &self.out)
+    }
+
+    fn __repr__(&self) -> String {
+        format!("Track(steps={})", self.out.t_s.len())
+    }
+
+    fn __len__(&self) -> usize {
+        self.out.t_s.len()
+    }
+}
+
+/// The Python object of a track.
+pub fn track_object(py: Python<'_>, out: TrackOutput) -> PyResult<Track> {
+    let s = out.t_s.len();
+    let states: Vec<f64> = out.states.iter().flatten().copied().collect();
+    let covs: Vec<f64> = out
+        .covariances
+        .iter()
+        .flatten()
+        .flatten()
+        .copied()
+        .collect();
+    let links = out
+        .delays_used_s
+        .as_ref()
+        .and_then(|d| d.first())
+        .map_or(0, Vec::len);
+    let delays_used = match &out.delays_used_s {
+        Some(d) => {
+            let flat: Vec<Option<f64>> = d.iter().flatten().copied().collect();
+            masked(py, &flat, &[s, links])?.unbind()
+        }
+        None => py.None(),
+    };
+    let static_removed = match &out.static_removed {
+        Some(r) => int_array(
+            py,
+            r.iter().flatten().map(|&n| n as i64).collect(),
+            &[s, links],
+        )?
+        .unbind(),
+        None => py.None(),
+    };
+    let choices = match &out.choices {
+        Some(c) => c.clone().into_pyobject(py)?.into_any().unbind(),
+        None => py.None(),
+    };
+    let start = match &out.start {
+        Some(st) => to_python(py, st)?.unbind(),
+        None => py.None(),
+    };
+    Ok(Track {
+        t: array(py, out.t_s.clone(), &[s])?.unbind(),
+        states: array(py, states, &[s, 4])?.unbind(),
+        covariances: array(py, covs, &[s, 4, 4])?.unbind(),
+        nis: masked(py, &out.nis, &[s])?.unbind(),
+        links_used: int_array(py, out.links_used.iter().map(|&n| n as i64).collect(), &[s])?
+            .unbind(),
+        delays_used,
+        choices,
+        static_removed,
+        start,
+        out,
+    })
+}
+
+/// Tracks `measurements` on `scenario` (spec §6; §4 for raw estimates) with the EKF, the UKF or
+/// the particle filter (`filter`), as `scatterloc track` does with the same file.
+///
+/// `measurements` is one of:
+/// - an array (S, L) of delays, s, one per step and link (NaN = missing): the `steps` form,
+///   with `dt` (s), `process_noise` (q̃, m²/s³), `initial_state` [x, y, vx, vy] and
+///   `initial_covariance` (4, 4), and `sigma` (s, one or per link; default the link budget at
+///   the prediction, E8);
+/// - a list of S raw steps, each a list per link of an array (K, 2) of (delay, amplitude) or
+///   (K, 3) with the estimator's σ: the `raw_steps` form, gated against `calibration` (E4) and
+///   associated (`association`: `"spec"` or `"gated"`); start from `initial_state` and
+///   `initial_covariance`, or from the LM fix of `initial_snapshot` (one raw step at t₀);
+/// - a dict (a measurement file, as `json.load` gives it) or a path to one; the other
+///   measurement arguments must then be absent.
+///
+/// `filter` settings (`ukf_alpha`, `ukf_beta`, `ukf_kappa`; `particles`, `roughening`,
+/// `bootstrap`, `seed`) apply to their filter only (an error otherwise, as the CLI's flags).
+/// A track predicted to take more than `max_cpu_hours` (24) is refused. Runs without the GIL;
+/// Ctrl-C stops it.
+#[pyfunction]
+#[pyo3(signature = (
+    scenario, measurements, *, dt = None, process_noise = None, initial_state = None,
+    initial_covariance = None, initial_snapshot = None, sigma = None, filter = "ekf",
+    particles = None, roughening = None, bootstrap = None, seed = None, ukf_alpha = None,
+    ukf_beta = None, ukf_kappa = None, calibration = None, association = None,
+    max_cpu_hours = None
+))]
+#[allow(clippy::too_many_arguments)]
+pub fn track(
+    py: Python<'_>,
+    scenario: &Bound<'_, PyAny>,
+    measurements: &Bound<'_, PyAny>,
+    dt: Option<f64>,
+    process_noise: Option<f64>,
+    initial_state: Option<&Bound<'_, PyAny>>,
+    initial_covariance: Option<&Bound<'_, PyAny>>,
+    initial_snapshot: Option<&Bound<'_, PyAny>>,
+    sigma: Option<&Bound<'_, PyAny>>,
+    filter: &str,
+    particles: Option<usize>,
+    roughening: Option<f64>,
+    bootstrap: Option<bool>,
+    seed: Option<u64>,
+    ukf_alpha: Option<f64>,
+    ukf_beta: Option<f64>,
+    ukf_kappa: Option<f64>,
+    calibration: Option<&Bound<'_, PyAny>>,
+    association: Option<&str>,
+    max_cpu_hours: Option<f64>,
+) -> PyResult<Track> {
+    let sc = scenario_arg(scenario)?;
+    let model = sc.model();
+    let n = model.link_count();
+    let settings = FilterSettings {
+        ukf_alpha,
+        ukf_beta,
+        ukf_kappa,
+        particles,
+        roughening,
+        bootstrap,
+    };
+    let kind = settings.kinds(&[filter.to_string()], "filter")?[0];
+    if seed.is_some() && filter != "pf" {
+        return Err(arg_error(
+            "seed",
+            "only for the pf filter (filter is not pf)",
+        ));
+    }
+    let is_file = measurements.cast::<pyo3::types::PyDict>().is_ok()
+        || measurements.cast::<pyo3::types::PyString>().is_ok()
+        || measurements.hasattr("__fspath__")?;
+    let m: Measurements = if is_file {
+        let given = [
+            ("dt", dt.is_some()),
+            ("process_noise", process_noise.is_some()),
+            ("initial_state", initial_state.is_some()),
+            ("initial_covariance", initial_covariance.is_some()),
+            ("initial_snapshot", initial_snapshot.is_some()),
+            ("sigma", sigma.is_some()),
+        ];
+        if let Some((f, _)) = given.iter().find(|(_, g)| *g) {
+            return Err(arg_error(
+                f,
+                "given twice: the measurement file (dict or path) holds it",
+            ));
+        }
+        let text = if measurements.cast::<pyo3::types::PyDict>().is_ok() {
+            to_json_text(measurements, "measurements")?
+        } else {
+            read_text(&crate::convert::path_string(measurements)?, "measurements")?
+        };
+        Measurements::from_json(text.trim_start_matches('\u{feff}')).py()?
+    } else {
+        let dt = dt.ok_or_else(|| arg_error("dt", "required with delays or raw estimates"))?;
+        let q = process_noise
+            .ok_or_else(|| arg_error("process_noise", "required with delays or raw estimates"))?;
+        let initial_state = initial_state
+            .map(|s| crate::convert::f64_vec(s, "initial_state", Some(4)))
+            .transpose()?
+            .map(|v| [v[0], v[1], v[2], v[3]]);
+        let initial_covariance = initial_covariance
+            .map(|c| matrix::<4>(c, "initial_covariance"))
+            .transpose()?;
+        let sigma_s = match sigma {
+            None => None,
+            Some(s) => Some(match s.extract::<f64>() {
+                Ok(v) => Sigma::One(v),
+                Err(_) => Sigma::PerLink(crate::convert::f64_vec(s, "sigma", None)?),
+            }),
+        };
+        let is_array = measurements.cast::<numpy::PyUntypedArray>().is_ok();
+        let plain = if is_array {
+            true
+        } else {
+            // A list: plain when its first step is a flat list of numbers.
+            let steps: Vec<Bound<'_, PyAny>> = measurements.extract().map_err(|_| {
+                arg_error(
+                    "measurements",
+                    "expected an array (S, L), a list of raw steps, a dict or a path",
+                )
+            })?;
+            steps
+                .first()
+                .is_none_or(|s| s.extract::<Vec<f64>>().is_ok())
+        };
+        let (steps, raw_steps) = if plain {
+            let a = f64_array(measurements, "measurements")?;
+            let rows = match a.shape.as_slice() {
+                [_, l] if *l == n => a.data.chunks_exact(n).count(),
+                [0] => 0,
+                s => {
+                    return Err(arg_error(
+                        "measurements",
+                        format!("expected delays of shape (S, {n}), got {s:?}"),
+                    ))
+                }
+            };
+            let steps: Vec<Vec<Option<f64>>> = (0..rows)
+                .map(|k| {
+                    a.data[k * n..(k + 1) * n]
+                        .iter()
+                        .map(|&v| if v.is_nan() { None } else { Some(v) })
+                        .collect()
+                })
+                .collect();
+            (Some(steps), None)
+        } else {
+            let list: Vec<Bound<'_, PyAny>> = measurements.extract()?;
+            let raw = list
+                .iter()
+                .enumerate()
+                .map(|(k, s)| raw_step(s, &format!("measurements[{k}]"), n))
+                .collect::<PyResult<Vec<_>>>()?;
+            (None, Some(raw))
+        };
+        let initial_snapshot = initial_snapshot
+            .map(|s| raw_step(s, "initial_snapshot", n))
+            .transpose()?;
+        Measurements {
+            dt_s: dt,
+            process_noise: q,
+            initial_state,
+            initial_covariance,
+            initial_snapshot,
+            sigma_s,
+            steps,
+            raw_steps,
+        }
+    };
+    let raw = m.raw_steps.is_some();
+    if !raw && (calibration.is_some() || association.is_some()) {
+        return Err(arg_error(
+            if calibration.is_some() {
+                "calibration"
+            } else {
+                "association"
+            },
+            "applies to raw estimates only (these are delays per step)",
+        ));
+    }
+    let rule = match association {
+        None | Some("spec") => AssociationRule::Spec,
+        Some("gated") => AssociationRule::Gated,
+        Some(other) => {
+            return Err(arg_error(
+                "association",
+                format!("'{other}' is not 'spec' or 'gated'"),
+            ))
+        }
+    };
+    let cal = calibration.map(|c| calibration_arg(c, n)).transpose()?;
+    let steps = m.steps.as_ref().map_or(0, Vec::len) + m.raw_steps.as_ref().map_or(0, Vec::len);
+    scatterloc::study::check_cost(
+        "track",
+        track_cpu_s(kind, n, steps),
+        cpu_cap(max_cpu_hours)?,
+    )
+    .py()?;
+    let area = sc.scenario().area_m;
+    let req = TrackRequest {
+        model,
+        area: &area,
+        measurements: &m,
+        calibration: cal.as_ref(),
+        rule,
+        filter: kind,
+        seed: seed.unwrap_or(1),
+    };
+    let out = run_job(py, steps, None, |job| {
+        let stop = || job.cancelled();
+        track_measurements_in(&req, Cancel::when(&stop))
+    })?;
+    track_object(py, out)
+}
