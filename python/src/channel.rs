@@ -22,7 +22,9 @@ use scatterloc::study::{
 use scatterloc::track::gating::{AmplitudeClusterConfig, AssociationRule};
 use scatterloc::track::ConstantVelocity;
 
-use crate::convert::{array, bool_array, f64_array, int_array, masked, path_string, to_python};
+use crate::convert::{
+    array, bool_array, f64_array, int_array, masked, path_string, to_python, JsonDoc,
+};
 use crate::errors::{arg_error, Core};
 use crate::run::run_job;
 use crate::scenario::scenario_arg;
@@ -444,7 +446,7 @@ pub struct Paths {
     /// Snapshot times, s (S,).
     #[pyo3(get)]
     t: Py<PyAny>,
-    doc: Option<serde_json::Value>,
+    doc: Option<JsonDoc>,
 }
 
 #[pymethods]
@@ -453,7 +455,7 @@ impl Paths {
     /// None for `estimate`.
     fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         match &self.doc {
-            Some(d) => to_python(py, d),
+            Some(d) => d.to_python(py),
             None => Ok(py.None().into_bound(py)),
         }
     }
@@ -475,7 +477,7 @@ fn paths_object(
     noise: Vec<f64>,
     noise_shape: &[usize],
     links: bool,
-    doc: Option<serde_json::Value>,
+    doc: Option<JsonDoc>,
 ) -> PyResult<Paths> {
     let (mut snap, mut link, mut delay, mut amp, mut sigma, mut snr, mut track, mut conf) = (
         Vec::new(),
@@ -640,8 +642,7 @@ pub fn estimate_recording(
     let sc = scenario_arg(scenario)?;
     let cfg = front_end(max_paths, pfa)?;
     let est = estimate_on(py, &sc, &recording.rec, &cfg, threads, progress)?;
-    let doc = serde_json::to_value(estimates_doc(sc.model(), &est, &cfg))
-        .map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(e.to_string()))?;
+    let doc = JsonDoc::of(&estimates_doc(sc.model(), &est, &cfg))?;
     let l = sc.model().link_count();
     let noise: Vec<f64> = est.noise_var.iter().flatten().copied().collect();
     paths_object(
@@ -700,14 +701,14 @@ pub struct ChannelTrack {
     /// estimate; else None.
     #[pyo3(get)]
     error: Py<PyAny>,
-    doc: serde_json::Value,
+    doc: JsonDoc,
 }
 
 #[pymethods]
 impl ChannelTrack {
     /// `TRACK.json` as `scatterloc cir track --out` writes it for the same inputs.
     fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        to_python(py, &self.doc)
+        self.doc.to_python(py)
     }
 
     fn __repr__(&self, py: Python<'_>) -> String {
@@ -835,7 +836,7 @@ pub fn cir_track(
         .unwrap_or_default();
     let view = track_errors(&track.t_s, &track.states, &truth_states).py()?;
     let stats = truth.as_ref().and(view.stats);
-    let doc = serde_json::to_value(track_doc(
+    let doc = JsonDoc::of(&track_doc(
         &track,
         kind.name(),
         process_noise,
@@ -843,8 +844,7 @@ pub fn cir_track(
         &cal,
         empty.len(),
         stats,
-    ))
-    .map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(e.to_string()))?;
+    ))?;
     let s = track.t_s.len();
     let l = model.link_count();
     let states: Vec<Option<f64>> = track

@@ -206,10 +206,26 @@ pub fn to_python<'py, T: serde::Serialize>(
     py: Python<'py>,
     doc: &T,
 ) -> PyResult<Bound<'py, PyAny>> {
-    static LOADS: PyOnceLock<Py<PyAny>> = PyOnceLock::new();
-    let text = serde_json::to_string(doc)
-        .map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(format!("encoding JSON: {e}")))?;
-    LOADS.import(py, "json", "loads")?.call1((text,))
+    JsonDoc::of(doc)?.to_python(py)
+}
+
+/// A serde document kept as its JSON text: the keys in its structs' order, as the CLI prints
+/// them (a `serde_json::Value` would sort them).
+pub struct JsonDoc(String);
+
+impl JsonDoc {
+    /// The JSON text of `doc`.
+    pub fn of<T: serde::Serialize>(doc: &T) -> PyResult<JsonDoc> {
+        serde_json::to_string(doc)
+            .map(JsonDoc)
+            .map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(format!("encoding JSON: {e}")))
+    }
+
+    /// The document as the Python object its JSON parses to (`json.loads`).
+    pub fn to_python<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        static LOADS: PyOnceLock<Py<PyAny>> = PyOnceLock::new();
+        LOADS.import(py, "json", "loads")?.call1((self.0.as_str(),))
+    }
 }
 
 /// A Python object (a dict from `json.load`, a list) as JSON text (`json.dumps`), for the core's

@@ -188,12 +188,10 @@ impl PyScenario {
         )
     }
 
-    fn __getstate__(&self) -> String {
-        self.scenario().to_json()
-    }
-
-    fn __getnewargs__(&self) -> (String,) {
-        (self.scenario().to_json(),)
+    /// Pickling: the scenario's JSON, read back by `Scenario.from_json`.
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, (String,))> {
+        let ctor = slf.get_type().getattr("from_json")?;
+        Ok((ctor, (slf.borrow().scenario().to_json(),)))
     }
 
     /// The scenario's name.

@@ -13,7 +13,7 @@ use scatterloc::track::{
 };
 use scatterloc::Error;
 
-use crate::convert::{array, to_python};
+use crate::convert::{array, JsonDoc};
 use crate::errors::{arg_error, Core};
 use crate::run::run_job;
 use crate::scenario::scenario_arg;
@@ -73,7 +73,7 @@ pub struct StudyResult {
     /// The curves, one per trajectory in the order asked.
     #[pyo3(get)]
     curves: Vec<Py<Curves>>,
-    doc: serde_json::Value,
+    doc: JsonDoc,
 }
 
 #[pymethods]
@@ -81,7 +81,7 @@ impl StudyResult {
     /// The JSON document the CLI writes with `--json` for the same study (`{"scenarios":
     /// [...]}` for several trajectories, one object for one).
     fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        to_python(py, &self.doc)
+        self.doc.to_python(py)
     }
 
     /// The curves of trajectory `key` (`"I"`, `"II"`, `"III"`) or of index `key`.
@@ -172,13 +172,14 @@ fn mc_curves(py: Python<'_>, doc: &CurveDoc<McMeta>) -> PyResult<Curves> {
 }
 
 /// The CLI's `--json` body: one document, or `{"scenarios": [...]}` for several.
-fn body<T: serde::Serialize>(docs: &[T]) -> PyResult<serde_json::Value> {
-    let enc = |e: serde_json::Error| {
-        pyo3::exceptions::PyRuntimeError::new_err(format!("encoding JSON: {e}"))
-    };
+fn body<T: serde::Serialize>(docs: &[T]) -> PyResult<JsonDoc> {
+    #[derive(serde::Serialize)]
+    struct Scenarios<'a, T> {
+        scenarios: &'a [T],
+    }
     match docs {
-        [one] => serde_json::to_value(one).map_err(enc),
-        _ => Ok(serde_json::json!({ "scenarios": serde_json::to_value(docs).map_err(enc)? })),
+        [one] => JsonDoc::of(one),
+        _ => JsonDoc::of(&Scenarios { scenarios: docs }),
     }
 }
 
