@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Sets up (idempotently) and runs every test: rustfmt and clippy (native and wasm32), native
-# cargo test, the no_std build, wasm-pack test in headless Chromium, and the browser end-to-end
-# test.
+# cargo test, the no_std build, wasm-pack test in headless Chromium, the browser end-to-end
+# test, and the Python package (pip install ./python, its pytest suite, mypy on docs/python.md).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 export PATH="$HOME/.cargo/bin:$PATH"
@@ -14,11 +14,14 @@ export CARGO_INCREMENTAL="${CARGO_INCREMENTAL:-0}"
 step() { printf '\n==== [%dm%02ds] %s\n' $(((SECONDS - start) / 60)) $(((SECONDS - start) % 60)) "$*"; }
 log=$(mktemp); trap 'rm -f "$log"' EXIT
 
-step "cargo fmt --check"
-cargo fmt --check
+step "cargo fmt --check (the library, the CLI and the Python bindings)"
+cargo fmt --all --check
 
 step "cargo clippy --all-targets -- -D warnings (native: library, CLI, tests, benches)"
 cargo clippy --all-targets -- -D warnings
+
+step "cargo clippy of the Python bindings (python/, PyO3)"
+cargo clippy -p scatterloc-python --all-targets -- -D warnings
 
 step "cargo clippy for wasm32 (the page's bindings and tests/wasm.rs)"
 cargo clippy --target wasm32-unknown-unknown --lib --test wasm -- -D warnings
@@ -53,9 +56,15 @@ cargo test --release --test tracking --test mtl -- --ignored pcrlb:: check11:: s
 step "browser end-to-end (Debian chromium + chromedriver; prints the page's own map timing)"
 cargo test --test e2e -- --ignored --nocapture --test-threads=1 2>&1 | tee -a "$log"
 
+step "Python package: pip install ./python, mypy --strict and a run of docs/python.md, pytest against the CLI"
+SCATTERLOC_CLI="$PWD/target/debug/scatterloc" bash scripts/python.sh 2>&1 | tee -a "$log"
+
 # One closing line over every runner above (cargo's last binary may legitimately hold 0 tests).
 passed=$(grep -oE 'test result: [a-zA-Z]+\. [0-9]+ passed' "$log" | awk '{s+=$4} END {print s+0}')
 failed=$(grep -E 'test result:' "$log" | grep -oE '[0-9]+ failed' | awk '{s+=$1} END {print s+0}')
+# pytest's summary line ("12 passed, 1 xfailed in 3.2s"; a failure stops the script above).
+py_passed=$(grep -E '^[0-9]+ passed.* in [0-9.]+s' "$log" | grep -oE '^[0-9]+' | awk '{s+=$1} END {print s+0}')
+passed=$((passed + py_passed))
 echo
 echo "total: ${passed} passed, ${failed} failed ($(((SECONDS - start) / 60)) min $(((SECONDS - start) % 60)) s)"
 [ "$failed" -eq 0 ] && [ "$passed" -gt 0 ]

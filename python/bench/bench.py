@@ -10,12 +10,13 @@ Python call and the native kernel it is compared with are timed in alternating r
 a change of the machine's load hits both):
 
 1. ``scatterloc.crlb_map(s, 256, 256, threads=t)`` against the native kernel
-   ``_bench.crlb_map_seconds`` (same process) for t = 1, 2: the call's overhead in %.
+   ``_bench.crlb_map_seconds`` (same process) for t = 1, 2 (each call builds a pool of t
+   workers, in both) and 0 (all cores, rayon's global pool): the call's overhead in %.
 2. A Python loop of 10^4 ``scatterloc.locate`` calls (truth (4, 1) m, start 2.8 m off at truth +
    (2, 2) m, as benches/core.rs) against the native fix ``_bench.locate_seconds``: µs per call
    and the overhead per call, also with ``.position`` read on every call.
 3. The CRLB map 256² in vectorised numpy (scripts/numpy_map.py, checked against
-   ``scatterloc.crlb_map``) against ``scatterloc.crlb_map`` on 1 and 2 threads.
+   ``scatterloc.crlb_map``) against ``scatterloc.crlb_map`` on 1, 2 and all threads.
 4. ``scipy.optimize.least_squares(method="lm")`` on the same weighted problem (residuals
    (τ_p(r) − τ̂_p)/σ, analytic Jacobian from ``Scenario.delay_jacobian``, same start) against
    ``scatterloc.locate``; the fixes must agree to 1e-9 m.
@@ -35,7 +36,6 @@ import importlib.util
 import json
 import os
 import platform
-import sys
 import time
 from pathlib import Path
 
@@ -70,26 +70,27 @@ MODES = {
 
 
 def batch(fn, inner):
-    """Seconds per call of ``fn`` over one batch of ``inner`` calls (gc off, as timeit)."""
-    was = gc.isenabled()
-    gc.disable()
-    try:
-        t0 = time.perf_counter()
-        for _ in range(inner):
-            fn()
-        return (time.perf_counter() - t0) / inner
-    finally:
-        if was:
-            gc.enable()
+    """Seconds per call of ``fn`` over one batch of ``inner`` calls."""
+    t0 = time.perf_counter()
+    for _ in range(inner):
+        fn()
+    return (time.perf_counter() - t0) / inner
 
 
 def rounds(timers, n):
     """Runs each of ``timers`` (name -> function returning seconds per call) once per round,
-    alternating, for ``n`` rounds; the best (least) seconds per call of each."""
+    alternating, for ``n`` rounds, with the garbage collector off (as timeit); the best
+    (least) seconds per call of each."""
     best = {k: float("inf") for k in timers}
-    for _ in range(n):
-        for k, f in timers.items():
-            best[k] = min(best[k], f())
+    try:
+        for _ in range(n):
+            for k, f in timers.items():
+                gc.collect()
+                gc.disable()
+                best[k] = min(best[k], f())
+                gc.enable()
+    finally:
+        gc.enable()
     return best
 
 
@@ -112,8 +113,18 @@ def machine():
         "python": platform.python_version(),
         "numpy": np.__version__,
         "scatterloc": sl.__version__,
+        "extension": ext_info(),
         "platform": platform.platform(),
     }
+
+
+def ext_info():
+    """The native module's file and build time (the extension may be rebuilt between runs)."""
+    from scatterloc import _scatterloc
+
+    path = Path(_scatterloc.__file__)
+    stamp = datetime.datetime.fromtimestamp(path.stat().st_mtime, datetime.timezone.utc)
+    return f"{path.name}, built {stamp:%Y-%m-%d %H:%M:%S} UTC"
 
 
 def loadavg():
@@ -285,23 +296,12 @@ def bench_locate(s, cfg, rows, checks):
             pass
         return (time.perf_counter() - t0) / n
 
-    def no_gc(f):
-        def g():
-            was = gc.isenabled()
-            gc.disable()
-            try:
-                return f()
-            finally:
-                if was:
-                    gc.enable()
-        return g
-
     dl = d.tolist()
     timers = {
         "native": lambda: _bench.locate_seconds(s, dl, SIGMA, init, 1, n),
-        "py": no_gc(loop),
-        "py_position": no_gc(loop_position),
-        "empty": no_gc(empty),
+        "py": loop,
+        "py_position": loop_position,
+        "empty": empty,
     }
     best = rounds(timers, cfg["locate_rounds"])
     nat, pyt, pyp = best["native"], best["py"], best["py_position"]
@@ -514,26 +514,14 @@ def bench_ekf(s, cfg, rows, checks):
             return sec
         return g
 
-    def no_gc(f):
-        def g():
-            was = gc.isenabled()
-            gc.disable()
-            try:
-                return f()
-            finally:
-                if was:
-                    gc.enable()
-        return g
-
     rounds_n = cfg["ekf_rounds"]
     timers = {
-        "filterpy": no_gc(keep("filterpy", lambda: filterpy_run(s, z, x0, p0, cfg["fp_steps"]))),
-        "ss_scatterloc": no_gc(keep("ss_scatterloc",
-                                    lambda: stonesoup_run(ss_sl, z, x0, p0, cfg["ss_steps"]))),
-        "ss_python": no_gc(keep("ss_python",
-                                lambda: stonesoup_run(ss_py, z, x0, p0, cfg["ss_steps"]))),
-        "track": no_gc(track_time),
-        "stepwise": no_gc(keep("stepwise", stepwise)),
+        "filterpy": keep("filterpy", lambda: filterpy_run(s, z, x0, p0, cfg["fp_steps"])),
+        "ss_scatterloc": keep("ss_scatterloc",
+                              lambda: stonesoup_run(ss_sl, z, x0, p0, cfg["ss_steps"])),
+        "ss_python": keep("ss_python", lambda: stonesoup_run(ss_py, z, x0, p0, cfg["ss_steps"])),
+        "track": track_time,
+        "stepwise": keep("stepwise", stepwise),
     }
     best = rounds(timers, rounds_n)
 
@@ -607,7 +595,8 @@ def main():
     print(f"## scatterloc Python benchmark ({mode} mode)\n")
     print(f"- machine: {m['cpu']}, {m['cores']} cores; {m['platform']}")
     print(f"- Python {m['python']}, numpy {m['numpy']}, scipy {v['scipy']}, filterpy "
-          f"{v['filterpy']}, stonesoup {v['stonesoup']}, scatterloc {m['scatterloc']}")
+          f"{v['filterpy']}, stonesoup {v['stonesoup']}, scatterloc {m['scatterloc']} "
+          f"({m['extension']})")
     print(f"- load average (1, 5, 15 min) before: {' '.join(load0 or ['?'])}, "
           f"after: {' '.join(load1 or ['?'])}; run took {wall:.0f} s")
     print("- scenario: preset sensors2019 (1 Tx, 4 Rx, 4 links); σ = 3.5e-11 s on every link\n")

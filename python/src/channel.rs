@@ -30,6 +30,9 @@ use crate::run::run_job;
 use crate::scenario::scenario_arg;
 use crate::tracking::FilterSettings;
 
+// `cir_track`'s default `extent_sigma` is the library's (written as a number for Python).
+const _: () = assert!(EXTENT_SIGMA_M == 0.2);
+
 /// A complex128 array of `shape` from row-major `data`.
 fn complex_array<'py>(
     py: Python<'py>,
@@ -730,7 +733,7 @@ impl ChannelTrack {
 #[pyfunction]
 #[pyo3(signature = (
     scenario, recording, calibration, *, truth = None, filter = "ekf", process_noise = 1.0,
-    association = "gated", sigma = "estimator", extent_sigma = EXTENT_SIGMA_M, seed = None,
+    association = "gated", sigma = "estimator", extent_sigma = 0.2, seed = None,
     particles = None, roughening = None, bootstrap = None, ukf_alpha = None, ukf_beta = None,
     ukf_kappa = None, max_paths = None, pfa = None, threads = 0, progress = None
 ))]

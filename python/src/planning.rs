@@ -13,6 +13,9 @@ use crate::run::run_job;
 use crate::scenario::{scenario_arg, PyScenario};
 use scatterloc::present::Session;
 
+// `plan`'s default budget is the library's (written as a number for Python).
+const _: () = assert!(DEFAULT_PLAN_BUDGET == 10_000);
+
 /// A plan (returned by `plan`).
 #[pyclass(module = "scatterloc", frozen)]
 pub struct Plan {
@@ -73,7 +76,7 @@ impl Plan {
 #[pyfunction]
 #[pyo3(signature = (
     scenario, *, r#move, objective, roi, bounds = None, allowed = None, min_spacing = 0.0,
-    grid = 64, budget = DEFAULT_PLAN_BUDGET, seed = 1, progress = None
+    grid = 64, budget = 10000, seed = 1, progress = None
 ))]
 #[allow(clippy::too_many_arguments)]
 pub fn plan(

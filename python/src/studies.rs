@@ -19,6 +19,11 @@ use crate::run::run_job;
 use crate::scenario::scenario_arg;
 use crate::tracking::{cpu_cap, FilterSettings};
 
+// The defaults of `montecarlo` and `pcrlb` are written as numbers (so that Python's
+// signatures show them); they are the CLI's, the paper's study ([S] Fig. 3):
+const _: () = assert!(PAPER_STEP_S == 2.048e-3 && PAPER_DURATION_S == 10.0);
+const _: () = assert!(PAPER_INTENSITY == 0.01);
+
 /// The curves of one trajectory of a study.
 #[pyclass(module = "scatterloc", frozen)]
 pub struct Curves {
@@ -267,8 +272,8 @@ fn track_study(
 /// with the runs done. The same numbers as `scatterloc montecarlo --json` (`to_dict()`).
 #[pyfunction]
 #[pyo3(signature = (
-    scenario = None, *, trajectory = None, runs = 5000, noise_runs = 50, dt = PAPER_STEP_S,
-    duration = PAPER_DURATION_S, process_noise = PAPER_INTENSITY, seed = 1, threads = 0,
+    scenario = None, *, trajectory = None, runs = 5000, noise_runs = 50, dt = 2.048e-3,
+    duration = 10.0, process_noise = 0.01, seed = 1, threads = 0,
     oracle_noise = false, filters = None, particles = None, roughening = None, bootstrap = None,
     ukf_alpha = None, ukf_beta = None, ukf_kappa = None, max_cpu_hours = None, progress = None
 ))]
@@ -400,8 +405,8 @@ fn check_threads(threads: usize) -> PyResult<()> {
 /// --json` (`to_dict()`).
 #[pyfunction]
 #[pyo3(signature = (
-    scenario = None, *, nominal = false, trajectory = None, runs = None, dt = PAPER_STEP_S,
-    duration = PAPER_DURATION_S, process_noise = PAPER_INTENSITY, seed = None, threads = None,
+    scenario = None, *, nominal = false, trajectory = None, runs = None, dt = 2.048e-3,
+    duration = 10.0, process_noise = 0.01, seed = None, threads = None,
     progress = None
 ))]
 #[allow(clippy::too_many_arguments)]
