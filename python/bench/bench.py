@@ -36,6 +36,7 @@ import importlib.util
 import json
 import os
 import platform
+import statistics
 import time
 from pathlib import Path
 
@@ -80,18 +81,19 @@ def batch(fn, inner):
 def rounds(timers, n):
     """Runs each of ``timers`` (name -> function returning seconds per call) once per round,
     alternating, for ``n`` rounds, with the garbage collector off (as timeit); the best
-    (least) seconds per call of each."""
-    best = {k: float("inf") for k in timers}
+    (least) seconds per call of each. The median of each is left in ``rounds.median``."""
+    samples = {k: [] for k in timers}
     try:
         for _ in range(n):
             for k, f in timers.items():
                 gc.collect()
                 gc.disable()
-                best[k] = min(best[k], f())
+                samples[k].append(f())
                 gc.enable()
     finally:
         gc.enable()
-    return best
+    rounds.median = {k: statistics.median(v) for k, v in samples.items()}
+    return {k: min(v) for k, v in samples.items()}
 
 
 # --------------------------------------------------------------------------------------------
@@ -223,6 +225,7 @@ def bench_maps(s, cfg, rows, checks):
     timers["numpy"] = lambda: batch(lambda: nm.crlb_map(doc, links, GRID), cfg["numpy_inner"])
     sl.crlb_map(s, GRID, GRID, threads=0)  # start rayon's global pool
     best = rounds(timers, cfg["map_rounds"])
+    med = rounds.median
 
     how = f"best of {cfg['map_rounds']} rounds × {inner} calls, alternating, gc off"
     res = {}
@@ -230,15 +233,18 @@ def bench_maps(s, cfg, rows, checks):
         nat, pyt = best[f"native{t}"], best[f"py{t}"]
         over = (pyt / nat - 1.0) * 100.0
         name = {1: "1 thread", 2: "2 threads", 0: "threads=0 (all cores, global pool)"}[t]
+        mn, mp = med[f"native{t}"], med[f"py{t}"]
         res[t] = dict(native_ms=nat * 1e3, python_ms=pyt * 1e3, overhead_pct=over,
-                      compute_s_ms=compute[t] * 1e3)
+                      compute_s_ms=compute[t] * 1e3, native_median_ms=mn * 1e3,
+                      python_median_ms=mp * 1e3, overhead_median_pct=(mp / mn - 1.0) * 100.0)
         rows.append(dict(
             what=f"CRLB map 256², native kernel `_bench.crlb_map_seconds`, {name}",
-            method=how, value=f"{nat * 1e3:.3f} ms", ratio="1 (reference)"))
+            method=how, value=f"{nat * 1e3:.3f} ms (median {mn * 1e3:.3f})", ratio="1 (reference)"))
         rows.append(dict(
             what=f"`scatterloc.crlb_map(s, 256, 256, threads={t})` from Python",
-            method=how, value=f"{pyt * 1e3:.3f} ms",
-            ratio=f"{pyt / nat:.3f}× native: overhead **{over:+.1f} %**"))
+            method=how, value=f"{pyt * 1e3:.3f} ms (median {mp * 1e3:.3f})",
+            ratio=f"{pyt / nat:.3f}× native: overhead **{over:+.1f} %** "
+                  f"(medians: {(mp / mn - 1.0) * 100.0:+.1f} %)"))
         rows.append(dict(
             what=f"  its `.compute_s` (kernel incl. a fresh output buffer, timed inside the call)",
             method="mean over a batch, best batch of the same calls",
@@ -304,23 +310,29 @@ def bench_locate(s, cfg, rows, checks):
         "empty": empty,
     }
     best = rounds(timers, cfg["locate_rounds"])
+    med = rounds.median
     nat, pyt, pyp = best["native"], best["py"], best["py_position"]
     how = f"best of {cfg['locate_rounds']} rounds × 10⁴ calls, alternating, gc off"
+    mn, mp, mpp = med["native"], med["py"], med["py_position"]
     rows.append(dict(what="LM fix, native `_bench.locate_seconds` (4 links, start 2.8 m off)",
-                     method=how, value=f"{nat * 1e6:.3f} µs", ratio="1 (reference)"))
+                     method=how, value=f"{nat * 1e6:.3f} µs (median {mn * 1e6:.3f})",
+                     ratio="1 (reference)"))
     rows.append(dict(
         what="`scatterloc.locate(s, delays, 3.5e-11, initial=[x, y])`, Python loop",
-        method=how, value=f"{pyt * 1e6:.3f} µs",
-        ratio=f"{pyt / nat:.2f}× native: overhead **{(pyt - nat) * 1e6:.3f} µs** per call"))
+        method=how, value=f"{pyt * 1e6:.3f} µs (median {mp * 1e6:.3f})",
+        ratio=f"{pyt / nat:.2f}× native: overhead **{(pyt - nat) * 1e6:.3f} µs** per call "
+              f"(medians: {(mp - mn) * 1e6:.3f} µs)"))
     rows.append(dict(
         what="  the same, reading `.position` on every call",
-        method=how, value=f"{pyp * 1e6:.3f} µs",
-        ratio=f"{pyp / nat:.2f}× native: overhead **{(pyp - nat) * 1e6:.3f} µs** per call"))
+        method=how, value=f"{pyp * 1e6:.3f} µs (median {mpp * 1e6:.3f})",
+        ratio=f"{pyp / nat:.2f}× native: overhead **{(pyp - nat) * 1e6:.3f} µs** per call "
+              f"(medians: {(mpp - mn) * 1e6:.3f} µs)"))
     rows.append(dict(what="  (the empty Python loop, per iteration)", method=how,
                      value=f"{best['empty'] * 1e6:.3f} µs", ratio=""))
     res = dict(native_us=nat * 1e6, python_us=pyt * 1e6, python_position_us=pyp * 1e6,
                overhead_us=(pyt - nat) * 1e6, overhead_position_us=(pyp - nat) * 1e6,
-               empty_loop_us=best["empty"] * 1e6)
+               empty_loop_us=best["empty"] * 1e6, native_median_us=mn * 1e6,
+               python_median_us=mp * 1e6, python_position_median_us=mpp * 1e6)
 
     # 4: SciPy's MINPACK LM on the same weighted problem from the same start.
     def fun(r):
@@ -581,6 +593,7 @@ def main():
 
     start = time.time()
     load0 = loadavg()
+    m = machine()
     s = sl.Scenario.preset("sensors2019")
     rows, checks = [], {}
     results = {}
@@ -590,7 +603,6 @@ def main():
     load1 = loadavg()
     wall = time.time() - start
 
-    m = machine()
     v = versions()
     print(f"## scatterloc Python benchmark ({mode} mode)\n")
     print(f"- machine: {m['cpu']}, {m['cores']} cores; {m['platform']}")
@@ -606,13 +618,18 @@ def main():
     for t in (1, 2, 0):
         o = cm[t]["overhead_pct"]
         targets.append(dict(target=f"crlb_map 256², threads={t}: within 10 % of native",
-                            measured=f"{o:+.1f} % ({cm[t]['python_ms']:.3f} vs {cm[t]['native_ms']:.3f} ms)",
+                            measured=(f"{o:+.1f} % ({cm[t]['python_ms']:.3f} vs "
+                                      f"{cm[t]['native_ms']:.3f} ms); medians "
+                                      f"{cm[t]['overhead_median_pct']:+.1f} %"),
                             met=abs(o) <= 10.0))
     targets.append(dict(target="locate: overhead ≤ 2 µs per call",
-                        measured=f"{lo['overhead_us']:.3f} µs ({lo['python_us']:.3f} vs {lo['native_us']:.3f} µs)",
+                        measured=(f"{lo['overhead_us']:.3f} µs ({lo['python_us']:.3f} vs "
+                                  f"{lo['native_us']:.3f} µs); medians "
+                                  f"{lo['python_median_us'] - lo['native_median_us']:.3f} µs"),
                         met=lo["overhead_us"] <= 2.0))
     targets.append(dict(target="locate reading .position: overhead ≤ 2 µs per call",
-                        measured=f"{lo['overhead_position_us']:.3f} µs",
+                        measured=(f"{lo['overhead_position_us']:.3f} µs; medians "
+                                  f"{lo['python_position_median_us'] - lo['native_median_us']:.3f} µs"),
                         met=lo["overhead_position_us"] <= 2.0))
     print("\n| target | measured | met |\n|---|---|---|")
     for t in targets:

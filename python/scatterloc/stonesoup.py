@@ -47,6 +47,14 @@ from ._scatterloc import Scenario, ScatterlocError
 __all__ = ["BistaticDelayModel"]
 
 
+def _error(field: str, message: str) -> ScatterlocError:
+    """A ScatterlocError naming ``field``, as the native functions raise them."""
+    e = ScatterlocError(f"{field}: {message}")
+    e.field = field
+    e.kind = "InvalidArgument"
+    return e
+
+
 class BistaticDelayModel(NonLinearGaussianMeasurement):  # type: ignore[misc]
     r"""Bistatic propagation delays of a scatterer on a scatterloc scenario's links.
 
@@ -87,11 +95,11 @@ class BistaticDelayModel(NonLinearGaussianMeasurement):  # type: ignore[misc]
             )
         scenario = kwargs.get("scenario")
         if scenario is None:
-            raise ScatterlocError("scenario: required")
+            raise _error("scenario", "required")
         if not isinstance(scenario, Scenario):
             kwargs["scenario"] = Scenario(scenario)
         if kwargs.get("noise_covar") is not None:
-            raise ScatterlocError("noise_covar: set sigma instead (R is built from it)")
+            raise _error("noise_covar", "set sigma instead (R is built from it)")
         # A placeholder until the real R is known (the parent converts it).
         kwargs["noise_covar"] = np.eye(1)
         super().__init__(*args, **kwargs)
@@ -99,19 +107,26 @@ class BistaticDelayModel(NonLinearGaussianMeasurement):  # type: ignore[misc]
         links = list(range(n)) if self.links is None else [int(p) for p in self.links]
         for p in links:
             if not 0 <= p < n:
-                raise ScatterlocError(f"links: link {p} is not in 0..{n - 1}")
+                raise _error("links", f"link {p} is not in 0..{n - 1}")
         if len(set(links)) != len(links) or not links:
-            raise ScatterlocError("links: expected distinct link indices, at least one")
+            raise _error("links", "expected distinct link indices, at least one")
         self._links = np.asarray(links, dtype=np.intp)
         if len(self.mapping) != 2:
-            raise ScatterlocError("mapping: expected the two position components (x, y)")
+            raise _error("mapping", "expected the two position components (x, y)")
         self._linearisation: Optional[np.ndarray] = None
         if self.sigma is None:
             self.noise_covar = None
         else:
-            s = np.broadcast_to(np.asarray(self.sigma, dtype=float), (len(links),))
+            s = np.asarray(self.sigma, dtype=float)
+            if s.ndim > 1 or (s.ndim == 1 and s.size != len(links)):
+                raise _error(
+                    "sigma",
+                    f"expected one delay sigma or {len(links)} (one per measured link), "
+                    f"got shape {s.shape}",
+                )
+            s = np.broadcast_to(s, (len(links),))
             if not np.all(np.isfinite(s) & (s > 0)):
-                raise ScatterlocError("sigma: every delay sigma must be a finite number > 0 s")
+                raise _error("sigma", "every delay sigma must be a finite number > 0 s")
             self.noise_covar = CovarianceMatrix(np.diag(s**2))
 
     @property
@@ -149,7 +164,7 @@ class BistaticDelayModel(NonLinearGaussianMeasurement):  # type: ignore[misc]
         state becomes the linearisation point of a link-budget R."""
         pos = self._positions(state)
         if pos.shape[0] != 1:
-            raise ScatterlocError("state: the Jacobian is taken at one state")
+            raise _error("state", "the Jacobian is taken at one state")
         self._linearisation = pos[0]
         g = self.scenario.delay_jacobian(pos[0])[self._links]  # (L, 2)
         h = np.zeros((self.ndim_meas, self.ndim_state))
@@ -167,9 +182,10 @@ class BistaticDelayModel(NonLinearGaussianMeasurement):  # type: ignore[misc]
         elif self._linearisation is not None:
             pos = self._linearisation
         else:
-            raise ScatterlocError(
-                "state: R from the link budget needs a state: call jacobian(state) (as the "
-                "EKF updater does) or covar(state=...), or give a fixed sigma"
+            raise _error(
+                "state",
+                "R from the link budget needs a state: call jacobian(state) (as the EKF "
+                "updater does) or covar(state=...), or give a fixed sigma",
             )
         s = self.scenario.sigma_delays(pos)[self._links]
         return CovarianceMatrix(np.diag(s**2))

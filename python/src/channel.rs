@@ -64,11 +64,7 @@ fn complex_arg(obj: &Bound<'_, PyAny>, field: &str) -> PyResult<(Vec<usize>, Vec
         }
     };
     let shape = a.shape().to_vec();
-    let data = match a.to_vec() {
-        Ok(v) => v,
-        Err(_) => a.readonly().as_array().iter().copied().collect(),
-    };
-    Ok((shape, data))
+    Ok((shape, crate::convert::logical_order(&a)))
 }
 
 /// A channel recording (docs/recording.md): per snapshot and link a channel frequency response
@@ -770,7 +766,7 @@ pub fn cir_track(
         roughening,
         bootstrap,
     };
-    let kind = settings.kinds(&[filter.to_string()], "filter")?[0];
+    let kind = settings.kind(filter)?;
     if seed.is_some() && filter != "pf" {
         return Err(arg_error(
             "seed",

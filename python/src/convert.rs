@@ -20,6 +20,19 @@ pub struct F64Array {
     pub data: Vec<f64>,
 }
 
+/// The values of `a` in C (row-major) order: a C-contiguous array copied at once, any other
+/// (Fortran order, strided views) element by element through a checked borrow. (`to_vec` alone
+/// copies the memory of a Fortran-ordered array in its own order: a transposed input would be
+/// read scrambled.)
+pub fn logical_order<T: numpy::Element + Copy>(a: &Bound<'_, PyArrayDyn<T>>) -> Vec<T> {
+    if a.is_c_contiguous() {
+        if let Ok(v) = a.to_vec() {
+            return v;
+        }
+    }
+    a.readonly().as_array().iter().copied().collect()
+}
+
 /// `numpy.asarray`.
 fn asarray<'py>(py: Python<'py>) -> PyResult<&'py Bound<'py, PyAny>> {
     static ASARRAY: PyOnceLock<Py<PyAny>> = PyOnceLock::new();
@@ -31,12 +44,10 @@ fn asarray<'py>(py: Python<'py>) -> PyResult<&'py Bound<'py, PyAny>> {
 pub fn f64_array(obj: &Bound<'_, PyAny>, field: &str) -> PyResult<F64Array> {
     if let Ok(a) = obj.cast::<PyArrayDyn<f64>>() {
         let shape = a.shape().to_vec();
-        // A contiguous array is copied at once; any other through a checked borrow.
-        let data = match a.to_vec() {
-            Ok(v) => v,
-            Err(_) => a.readonly().as_array().iter().copied().collect(),
-        };
-        return Ok(F64Array { shape, data });
+        return Ok(F64Array {
+            shape,
+            data: logical_order(a),
+        });
     }
     // A flat list or tuple of numbers (the common small argument) without numpy.
     if obj.cast::<pyo3::types::PyList>().is_ok() || obj.cast::<pyo3::types::PyTuple>().is_ok() {

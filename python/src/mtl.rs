@@ -66,7 +66,7 @@ fn count_or_inf(obj: &Bound<'_, PyAny>, field: &str) -> PyResult<usize> {
     }
     match obj.extract::<f64>() {
         Ok(v) if v == f64::INFINITY => Ok(usize::MAX),
-        _ => Err(arg_error(field, "expected a whole number >= 0 or inf")),
+        _ => Err(arg_error(field, "expected a whole number >= 1 or inf")),
     }
 }
 

@@ -126,7 +126,17 @@ pub fn plan(
         budget: Some(budget),
         seed: Some(seed),
     };
-    request.config().py()?;
+    request.config().map_err(|e| match e {
+        // The core's parse error carries no value; say which text was not understood (as the
+        // CLI does).
+        Error::OutOfRange { field, value, .. } if field == "objective" && value.is_nan() => {
+            arg_error(
+                "objective",
+                format!("'{objective}' is not mean, p90, max or coverage:T (T > 0 m)"),
+            )
+        }
+        e => crate::errors::core_error(e),
+    })?;
     let base = sc.scenario().clone();
     let doc = run_job(py, budget, progress, |job| {
         run_plan(&base, &request, |p| {

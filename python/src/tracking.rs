@@ -37,9 +37,26 @@ pub struct FilterSettings {
 }
 
 impl FilterSettings {
+    /// The one filter `name` (the `filter` argument of `track` and `cir_track`) with these
+    /// settings.
+    pub fn kind(&self, name: &str) -> PyResult<FilterKind> {
+        self.checked(&[name.to_string()], "filter", |_| "filter".to_string())
+            .map(|k| k[0])
+    }
+
     /// The filters `names` with these settings, validated by the core (`field` names the
-    /// argument holding the names).
+    /// argument holding the names; errors name `field[i]`).
     pub fn kinds(&self, names: &[String], field: &str) -> PyResult<Vec<FilterKind>> {
+        self.checked(names, field, |i| format!("{field}[{i}]"))
+    }
+
+    /// [`FilterSettings::kinds`] with the field of name `i` given by `at`.
+    fn checked(
+        &self,
+        names: &[String],
+        field: &str,
+        at: impl Fn(usize) -> String,
+    ) -> PyResult<Vec<FilterKind>> {
         let has = |n: &str| names.iter().any(|x| x == n);
         let ukf_given = [
             ("ukf_alpha", self.ukf_alpha.is_some()),
@@ -75,7 +92,7 @@ impl FilterSettings {
         names
             .iter()
             .enumerate()
-            .map(|(i, n)| FilterKind::named(&format!("{field}[{i}]"), n, ukf, pf).py())
+            .map(|(i, n)| FilterKind::named(&at(i), n, ukf, pf).py())
             .collect()
     }
 }
@@ -395,7 +412,7 @@ pub fn track(
         roughening,
         bootstrap,
     };
-    let kind = settings.kinds(&[filter.to_string()], "filter")?[0];
+    let kind = settings.kind(filter)?;
     if seed.is_some() && filter != "pf" {
         return Err(arg_error(
             "seed",

@@ -148,6 +148,12 @@ def test_mtl_locate_numpy_inputs_and_file_outputs(files):
     assert out.stdout.strip() == '{"count":%d,"out":"o.json"}' % len(res)
 
 
+def test_mtl_locate_fortran_order_nodes():
+    c = sl.mtl_locate(np.ascontiguousarray(TX), np.ascontiguousarray(RX), RANGES, region=REGION)
+    f = sl.mtl_locate(np.asfortranarray(TX), np.asfortranarray(RX), RANGES, region=REGION)
+    assert_bitwise(f.to_dict(), c.to_dict())
+
+
 def test_mtl_locate_without_region_and_other_noise(cli):
     cli.write("n.json", {"tx": TX, "rx": RX, "c_sigma_m": 0.05})
     cli.write("r.json", {"ranges_m": RANGES})

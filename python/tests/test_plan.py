@@ -178,6 +178,15 @@ def test_plan_preset_and_seed(cli):
     assert docs[0]["paths"] != docs[1]["paths"]
 
 
+def test_plan_fortran_order_polygon():
+    s = sl.Scenario.preset("sensors2019")
+    kw = dict(move="rx", objective="p90", roi=(0, 20, 0, 20), budget=50, grid=16)
+    room = np.array(ROOMS[0])
+    c = sl.plan(s, allowed=[np.ascontiguousarray(room)], **kw)
+    f = sl.plan(s, allowed=[np.asfortranarray(room)], **kw)
+    assert_bitwise(f.to_dict(), c.to_dict())
+
+
 def test_plan_progress_callback():
     calls: list[tuple[int, int]] = []
     budget = 1000
@@ -236,13 +245,6 @@ def test_plan_errors_name_the_input(cli, kw, field, cli_flag):
     assert not (cli.cwd / "x.json").exists()
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="bug: plan(objective='p95') raises 'objective: NaN is out of range (mean, p90, max or "
-    "coverage:T with T > 0 m)': python/src/planning.rs passes the core's Objective::parse error "
-    "through (it carries value NaN), while the CLI rewrites it to \"--objective: 'p95' is not "
-    "mean, p90, max or coverage:T (T > 0 m)\"; the message shows a NaN the user never gave",
-)
 def test_plan_bad_objective_message_names_the_value():
     with pytest.raises(sl.ScatterlocError) as e:
         sl.plan(sl.Scenario.preset("sensors2019"), move="rx", objective="p95", roi=(0, 20, 0, 20), budget=50)

@@ -192,3 +192,16 @@ def test_points_are_checked():
     assert e.value.field == "points"
     with pytest.raises(sl.ScatterlocError):
         s.delays("abc")
+
+
+def test_any_memory_order_reads_the_same_values():
+    """C order, Fortran order, strided views and other dtypes give the same numbers."""
+    s = sl.Scenario.preset("sensors2019")
+    rng = np.random.default_rng(5)
+    pts = rng.uniform(-5, 20, size=(6, 2))
+    ref = s.delays(pts)
+    for variant in (np.asfortranarray(pts), pts.T.copy().T, np.repeat(pts, 2, axis=0)[::2],
+                    pts.astype(np.float32).astype(np.float64), pts.tolist()):
+        assert s.delays(variant).tobytes() == ref.tobytes()
+    big = np.asfortranarray(rng.uniform(-5, 20, size=(3, 4, 2)))
+    assert s.delays(big).tobytes() == s.delays(np.ascontiguousarray(big)).tobytes()
