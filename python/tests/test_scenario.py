@@ -201,7 +201,9 @@ def test_any_memory_order_reads_the_same_values():
     pts = rng.uniform(-5, 20, size=(6, 2))
     ref = s.delays(pts)
     for variant in (np.asfortranarray(pts), pts.T.copy().T, np.repeat(pts, 2, axis=0)[::2],
-                    pts.astype(np.float32).astype(np.float64), pts.tolist()):
+                    pts.tolist()):
         assert s.delays(variant).tobytes() == ref.tobytes()
+    ints = np.array([[1, 2], [3, -4]])
+    assert s.delays(ints).tobytes() == s.delays(ints.astype(np.float64)).tobytes()
     big = np.asfortranarray(rng.uniform(-5, 20, size=(3, 4, 2)))
     assert s.delays(big).tobytes() == s.delays(np.ascontiguousarray(big)).tobytes()
