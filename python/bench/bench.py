@@ -5,9 +5,10 @@ against numpy, SciPy, FilterPy and Stone Soup, side by side in one run.
     python python/bench/bench.py [--quick] [--json out.json]
 
 Measures (preset sensors2019: one parabolic Tx, 4 Rx, 4 links; every time is the best of several
-repeats, taken with time.perf_counter, the garbage collector off while timing as in timeit; the
-Python call and the native kernel it is compared with are timed in alternating rounds, so that
-a change of the machine's load hits both):
+repeats, taken with time.perf_counter, the garbage collector off while timing as in timeit, with
+the median of the same rounds beside it; the Python call and the native kernel it is compared
+with are timed in alternating rounds, in reverse order every other round, so that a change of
+the machine's load hits both; a CRLB-map batch follows one untimed call of the same map):
 
 1. ``scatterloc.crlb_map(s, 256, 256, threads=t)`` against the native kernel
    ``_bench.crlb_map_seconds`` (same process) for t = 1, 2 (each call builds a pool of t
@@ -55,14 +56,14 @@ Q = 0.01  # m²/s³
 GRID = 256
 ROOT = Path(__file__).resolve().parents[2]
 
-# Repeats per mode: (default, quick).
+# Rounds and batch sizes per mode (default ≈ 1 min, --quick ≈ 20 s on the project's 2 cores).
 MODES = {
     "default": dict(map_rounds=80, map_inner=20, numpy_inner=3, locate_rounds=60,
                     locate_inner=10_000, lsq_rounds=40, lsq_inner=300, fp_steps=2000,
                     ss_steps=400, track_steps=100_000, step_calls=2000, ekf_rounds=30),
-    "quick": dict(map_rounds=20, map_inner=10, numpy_inner=2, locate_rounds=20,
-                  locate_inner=10_000, lsq_rounds=15, lsq_inner=100, fp_steps=1000,
-                  ss_steps=200, track_steps=100_000, step_calls=1000, ekf_rounds=10),
+    "quick": dict(map_rounds=30, map_inner=10, numpy_inner=2, locate_rounds=25,
+                  locate_inner=10_000, lsq_rounds=20, lsq_inner=100, fp_steps=1000,
+                  ss_steps=200, track_steps=100_000, step_calls=1000, ekf_rounds=15),
 }
 
 
@@ -80,20 +81,33 @@ def batch(fn, inner):
 
 def rounds(timers, n):
     """Runs each of ``timers`` (name -> function returning seconds per call) once per round,
-    alternating, for ``n`` rounds, with the garbage collector off (as timeit); the best
-    (least) seconds per call of each. The median of each is left in ``rounds.median``."""
+    alternating, for ``n`` rounds (in reverse order every other round, so that no timer always
+    follows the same one), with the garbage collector off (as timeit); the best (least)
+    seconds per call of each. The median of each is left in ``rounds.median``."""
     samples = {k: [] for k in timers}
+    order = list(timers)
     try:
-        for _ in range(n):
-            for k, f in timers.items():
+        for r in range(n):
+            for k in order if r % 2 == 0 else order[::-1]:
                 gc.collect()
                 gc.disable()
-                samples[k].append(f())
+                samples[k].append(timers[k]())
                 gc.enable()
     finally:
         gc.enable()
     rounds.median = {k: statistics.median(v) for k, v in samples.items()}
     return {k: min(v) for k, v in samples.items()}
+
+
+def warmed(warm, timer):
+    """``timer`` after an untimed call of ``warm`` (wakes the idle worker threads and the
+    second vCPU before a multi-threaded batch, whichever batch ran before it)."""
+
+    def f():
+        warm()
+        return timer()
+
+    return f
 
 
 # --------------------------------------------------------------------------------------------
@@ -220,14 +234,17 @@ def bench_maps(s, cfg, rows, checks):
 
     timers = {}
     for t in threads:
-        timers[f"native{t}"] = lambda t=t: _bench.crlb_map_seconds(s, GRID, GRID, t, 1, inner)
-        timers[f"py{t}"] = py(t)
+        warm = lambda t=t: sl.crlb_map(s, GRID, GRID, threads=t)  # noqa: E731
+        timers[f"native{t}"] = warmed(
+            warm, lambda t=t: _bench.crlb_map_seconds(s, GRID, GRID, t, 1, inner))
+        timers[f"py{t}"] = warmed(warm, py(t))
     timers["numpy"] = lambda: batch(lambda: nm.crlb_map(doc, links, GRID), cfg["numpy_inner"])
     sl.crlb_map(s, GRID, GRID, threads=0)  # start rayon's global pool
     best = rounds(timers, cfg["map_rounds"])
     med = rounds.median
 
-    how = f"best of {cfg['map_rounds']} rounds × {inner} calls, alternating, gc off"
+    how = (f"best of {cfg['map_rounds']} rounds × {inner} calls, alternating, one untimed call "
+           f"before each batch, gc off")
     res = {}
     for t in threads:
         nat, pyt = best[f"native{t}"], best[f"py{t}"]

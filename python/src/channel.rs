@@ -28,7 +28,7 @@ use crate::convert::{
 use crate::errors::{arg_error, Core};
 use crate::run::run_job;
 use crate::scenario::scenario_arg;
-use crate::tracking::FilterSettings;
+use crate::tracking::{one_filter, settings};
 
 // `cir_track`'s default `extent_sigma` is the library's (written as a number for Python).
 const _: () = assert!(EXTENT_SIGMA_M == 0.2);
@@ -758,21 +758,16 @@ pub fn cir_track(
     progress: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<ChannelTrack> {
     let sc = scenario_arg(scenario)?;
-    let settings = FilterSettings {
-        ukf_alpha,
-        ukf_beta,
-        ukf_kappa,
-        particles,
-        roughening,
-        bootstrap,
-    };
-    let kind = settings.kind(filter)?;
-    if seed.is_some() && filter != "pf" {
-        return Err(arg_error(
-            "seed",
-            "only for the pf filter (filter is not pf)",
-        ));
-    }
+    let kind = one_filter(
+        &settings(
+            [ukf_alpha, ukf_beta, ukf_kappa],
+            particles,
+            roughening,
+            bootstrap,
+        ),
+        filter,
+        seed,
+    )?;
     ConstantVelocity::validated(1.0, process_noise).py()?;
     let rule = match association {
         "gated" => AssociationRule::Gated,

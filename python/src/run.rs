@@ -113,6 +113,30 @@ pub fn run_job<T: Send>(
     })
 }
 
+/// Work predicted to take less than this runs on the calling thread ([`run_sized`]): starting
+/// and joining a worker thread costs ≈ 20 µs, a large part of a short call.
+pub const INLINE_S: f64 = 0.05;
+
+/// [`run_job`] for work the core's cost model predicts to take `predicted_s` seconds: below
+/// [`INLINE_S`] (and without a progress callback) on the calling thread with the GIL released
+/// (a Ctrl-C then waits for it, at most that long), else on a worker as [`run_job`].
+pub fn run_sized<T: Send>(
+    py: Python<'_>,
+    predicted_s: f64,
+    total: usize,
+    progress: Option<&Bound<'_, PyAny>>,
+    work: impl FnOnce(&Job) -> scatterloc::Result<T> + Send,
+) -> PyResult<T> {
+    if predicted_s < INLINE_S && progress.is_none() {
+        let job = Job {
+            cancel: AtomicBool::new(false),
+            done: AtomicUsize::new(0),
+        };
+        return py.detach(|| work(&job)).map_err(core_error);
+    }
+    run_job(py, total, progress, work)
+}
+
 /// Runs short `work` with the GIL released on the calling thread (no polling): for calls of
 /// bounded, small cost (a map, a fix, a track of a few thousand steps).
 pub fn run_quick<T: Send>(

@@ -17,7 +17,7 @@ use crate::convert::{array, JsonDoc};
 use crate::errors::{arg_error, Core};
 use crate::run::run_job;
 use crate::scenario::scenario_arg;
-use crate::tracking::{cpu_cap, FilterSettings};
+use crate::tracking::{cpu_cap, settings};
 
 // The defaults of `montecarlo` and `pcrlb` are written as numbers (so that Python's
 // signatures show them); they are the CLI's, the paper's study ([S] Fig. 3):
@@ -318,15 +318,15 @@ pub fn montecarlo(
                 .map_err(|_| arg_error("filters", "expected a list of 'ekf', 'ukf', 'pf'"))?,
         },
     };
-    let settings = FilterSettings {
-        ukf_alpha,
-        ukf_beta,
-        ukf_kappa,
+    let names: Vec<&str> = names.iter().map(String::as_str).collect();
+    let kinds = settings(
+        [ukf_alpha, ukf_beta, ukf_kappa],
         particles,
         roughening,
         bootstrap,
-    };
-    let kinds = settings.kinds(&names, "filters")?;
+    )
+    .kinds(&names, "filters", |i| format!("filters[{i}]"))
+    .py()?;
     let study = MonteCarloStudy::new(track, runs, noise_runs, seed, oracle_noise, &kinds).py()?;
     let used = if threads == 0 {
         rayon::current_num_threads()

@@ -11,90 +11,42 @@ use scatterloc::formats::{
 };
 use scatterloc::study::{track_cpu_s, track_measurements_in, TrackOutput, TrackRequest, MAX_CPU_S};
 use scatterloc::track::gating::{AssociationRule, Calibration, ClusterConfig};
-use scatterloc::track::{FilterKind, PfConfig, UkfParams};
+use scatterloc::track::{FilterKind, FilterSettings};
 
 use crate::convert::{array, f64_array, int_array, masked, matrix, to_json_text, to_python};
 use crate::errors::{arg_error, Core};
-use crate::run::run_job;
+use crate::run::run_sized;
 use crate::scenario::{read_text, scenario_arg};
 
-/// The filter settings of `track` and `montecarlo`, as given (None = not given): a setting of
-/// a filter that is not run is an error naming it, as the CLI's flags.
-#[derive(Default, Clone, Copy)]
-pub struct FilterSettings {
-    /// UKF α.
-    pub ukf_alpha: Option<f64>,
-    /// UKF β.
-    pub ukf_beta: Option<f64>,
-    /// UKF κ.
-    pub ukf_kappa: Option<f64>,
-    /// PF particles.
-    pub particles: Option<usize>,
-    /// PF roughening constant.
-    pub roughening: Option<f64>,
-    /// The PF as the plain bootstrap filter.
-    pub bootstrap: Option<bool>,
+/// The filter settings of `track`, `cir_track` and `montecarlo` as given (None = not given):
+/// the library's [`FilterSettings`], which refuses a setting of a filter that is not run.
+pub fn settings(
+    ukf: [Option<f64>; 3],
+    particles: Option<usize>,
+    roughening: Option<f64>,
+    bootstrap: Option<bool>,
+) -> FilterSettings {
+    FilterSettings {
+        ukf_alpha: ukf[0],
+        ukf_beta: ukf[1],
+        ukf_kappa: ukf[2],
+        particles,
+        roughening,
+        bootstrap: bootstrap.unwrap_or(false),
+    }
 }
 
-impl FilterSettings {
-    /// The one filter `name` (the `filter` argument of `track` and `cir_track`) with these
-    /// settings.
-    pub fn kind(&self, name: &str) -> PyResult<FilterKind> {
-        self.checked(&[name.to_string()], "filter", |_| "filter".to_string())
-            .map(|k| k[0])
+/// The one filter `name` of `track` and `cir_track` (the argument `filter`), and its `seed`
+/// checked (the particle filter's only).
+pub fn one_filter(s: &FilterSettings, name: &str, seed: Option<u64>) -> PyResult<FilterKind> {
+    let kind = s.kinds(&[name], "filter", |_| "filter".into()).py()?[0];
+    if seed.is_some() && name != "pf" {
+        return Err(arg_error(
+            "seed",
+            "only for the pf filter (filter is not pf)",
+        ));
     }
-
-    /// The filters `names` with these settings, validated by the core (`field` names the
-    /// argument holding the names; errors name `field[i]`).
-    pub fn kinds(&self, names: &[String], field: &str) -> PyResult<Vec<FilterKind>> {
-        self.checked(names, field, |i| format!("{field}[{i}]"))
-    }
-
-    /// [`FilterSettings::kinds`] with the field of name `i` given by `at`.
-    fn checked(
-        &self,
-        names: &[String],
-        field: &str,
-        at: impl Fn(usize) -> String,
-    ) -> PyResult<Vec<FilterKind>> {
-        let has = |n: &str| names.iter().any(|x| x == n);
-        let ukf_given = [
-            ("ukf_alpha", self.ukf_alpha.is_some()),
-            ("ukf_beta", self.ukf_beta.is_some()),
-            ("ukf_kappa", self.ukf_kappa.is_some()),
-        ];
-        let pf_given = [
-            ("particles", self.particles.is_some()),
-            ("roughening", self.roughening.is_some()),
-            ("bootstrap", self.bootstrap.is_some()),
-        ];
-        for (given, name) in [(&ukf_given[..], "ukf"), (&pf_given[..], "pf")] {
-            if !has(name) {
-                if let Some((f, _)) = given.iter().find(|(_, g)| *g) {
-                    return Err(arg_error(
-                        f,
-                        format!("only for the {name} filter ({field} does not include {name})"),
-                    ));
-                }
-            }
-        }
-        let d = UkfParams::default();
-        let ukf = UkfParams {
-            alpha: self.ukf_alpha.unwrap_or(d.alpha),
-            beta: self.ukf_beta.unwrap_or(d.beta),
-            kappa: self.ukf_kappa.unwrap_or(d.kappa),
-        };
-        let pf = PfConfig {
-            particles: self.particles.unwrap_or(PfConfig::default().particles),
-            roughening: self.roughening,
-            regularized: !self.bootstrap.unwrap_or(false),
-        };
-        names
-            .iter()
-            .enumerate()
-            .map(|(i, n)| FilterKind::named(&at(i), n, ukf, pf).py())
-            .collect()
-    }
+    Ok(kind)
 }
 
 /// The CPU cap in seconds from `max_cpu_hours` (default 24 h, at most 10⁶ h).
@@ -404,21 +356,16 @@ pub fn track(
     let sc = scenario_arg(scenario)?;
     let model = sc.model();
     let n = model.link_count();
-    let settings = FilterSettings {
-        ukf_alpha,
-        ukf_beta,
-        ukf_kappa,
-        particles,
-        roughening,
-        bootstrap,
-    };
-    let kind = settings.kind(filter)?;
-    if seed.is_some() && filter != "pf" {
-        return Err(arg_error(
-            "seed",
-            "only for the pf filter (filter is not pf)",
-        ));
-    }
+    let kind = one_filter(
+        &settings(
+            [ukf_alpha, ukf_beta, ukf_kappa],
+            particles,
+            roughening,
+            bootstrap,
+        ),
+        filter,
+        seed,
+    )?;
     let is_file = measurements.cast::<pyo3::types::PyDict>().is_ok()
         || measurements.cast::<pyo3::types::PyString>().is_ok()
         || measurements.hasattr("__fspath__")?;
@@ -543,12 +490,8 @@ pub fn track(
     };
     let cal = calibration.map(|c| calibration_arg(c, n)).transpose()?;
     let steps = m.steps.as_ref().map_or(0, Vec::len) + m.raw_steps.as_ref().map_or(0, Vec::len);
-    scatterloc::study::check_cost(
-        "track",
-        track_cpu_s(kind, n, steps),
-        cpu_cap(max_cpu_hours)?,
-    )
-    .py()?;
+    let predicted_s = track_cpu_s(kind, n, steps);
+    scatterloc::study::check_cost("track", predicted_s, cpu_cap(max_cpu_hours)?).py()?;
     let area = sc.scenario().area_m;
     let req = TrackRequest {
         model,
@@ -559,7 +502,8 @@ pub fn track(
         filter: kind,
         seed: seed.unwrap_or(1),
     };
-    let out = run_job(py, steps, None, |job| {
+    // A short track (the usual call in a loop) runs on this thread: no worker to start.
+    let out = run_sized(py, predicted_s, steps, None, |job| {
         let stop = || job.cancelled();
         track_measurements_in(&req, Cancel::when(&stop))
     })?;

@@ -237,6 +237,16 @@ pub enum Error {
         /// The name given.
         name: String,
     },
+    /// A setting of a tracker that is not run (a particle count when the particle filter is not
+    /// among the filters): an error, not silently ignored (issue 15, the Python package).
+    UnusedSetting {
+        /// The setting, e.g. `particles`, `ukf_alpha`, `bootstrap`.
+        field: String,
+        /// The filter it belongs to: `ukf` or `pf`.
+        filter: &'static str,
+        /// The front end's name of the filter list, e.g. `--filters` or `filters`.
+        list: String,
+    },
     /// A part file that does not fit its set (`merge` of a sharded study).
     InconsistentPart {
         /// The part's path.
@@ -289,6 +299,7 @@ impl Error {
             Error::Infeasible { .. } => "Infeasible",
             Error::UnknownPattern { .. } => "UnknownPattern",
             Error::UnknownFilter { .. } => "UnknownFilter",
+            Error::UnusedSetting { .. } => "UnusedSetting",
             Error::InconsistentPart { .. } => "InconsistentPart",
             Error::PartSet { .. } => "PartSet",
         }
@@ -312,6 +323,7 @@ impl Error {
             | Error::Infeasible { field, .. }
             | Error::UnknownPattern { field, .. }
             | Error::UnknownFilter { field, .. }
+            | Error::UnusedSetting { field, .. }
             | Error::NameTooLong { field, .. }
             | Error::InvalidFile { field, .. } => Some(field),
             Error::EmptyNodeList { field }
@@ -485,6 +497,14 @@ impl fmt::Display for Error {
                 f,
                 "{field}: unknown pattern \"{}\" (known: omni, parabolic)",
                 Clip(kind)
+            ),
+            Error::UnusedSetting {
+                field,
+                filter,
+                list,
+            } => write!(
+                f,
+                "{field}: only for the {filter} filter ({list} does not include {filter})"
             ),
             Error::UnknownFilter { field, name } => write!(
                 f,

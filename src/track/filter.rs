@@ -7,7 +7,7 @@
 //! model (E1, E8).
 
 use alloc::boxed::Box;
-use alloc::string::ToString;
+use alloc::string::{String, ToString};
 use alloc::vec::Vec;
 
 use crate::error::{Error, Result};
@@ -165,6 +165,75 @@ impl FilterKind {
             FilterKind::Ukf(p) => p.validate(),
             FilterKind::Pf(c) => c.validate(),
         }
+    }
+}
+
+/// A front end's tracker settings as its user gave them (`None` / `false`: not given): the UKF's
+/// parameters and the particle filter's. [`FilterSettings::kinds`] turns a list of filter names
+/// into [`FilterKind`]s with them, the defaults where not given, and refuses a setting of a
+/// filter that is not run — the one rule of the CLI's `--filter(s)` flags and the Python
+/// package's `filter(s)` arguments.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct FilterSettings {
+    /// UKF α.
+    pub ukf_alpha: Option<Real>,
+    /// UKF β.
+    pub ukf_beta: Option<Real>,
+    /// UKF κ.
+    pub ukf_kappa: Option<Real>,
+    /// Particles of the particle filter.
+    pub particles: Option<usize>,
+    /// Its roughening constant.
+    pub roughening: Option<Real>,
+    /// Run it as the plain bootstrap filter.
+    pub bootstrap: bool,
+}
+
+impl FilterSettings {
+    /// The filters `names` (`ekf`, `ukf`, `pf`, in order) with these settings, each validated.
+    /// A UKF setting without `ukf` in `names`, or a particle-filter setting without `pf`, is
+    /// [`Error::UnusedSetting`] naming the setting and `list` (the front end's name of the list);
+    /// an unknown name is [`Error::UnknownFilter`] naming `field_of(i)`.
+    pub fn kinds(
+        &self,
+        names: &[&str],
+        list: &str,
+        field_of: impl Fn(usize) -> String,
+    ) -> Result<Vec<FilterKind>> {
+        let given: [(&str, &'static str, bool); 6] = [
+            ("ukf_alpha", "ukf", self.ukf_alpha.is_some()),
+            ("ukf_beta", "ukf", self.ukf_beta.is_some()),
+            ("ukf_kappa", "ukf", self.ukf_kappa.is_some()),
+            ("particles", "pf", self.particles.is_some()),
+            ("roughening", "pf", self.roughening.is_some()),
+            ("bootstrap", "pf", self.bootstrap),
+        ];
+        if let Some((field, filter, _)) = given
+            .iter()
+            .find(|(_, filter, g)| *g && !names.contains(filter))
+        {
+            return Err(Error::UnusedSetting {
+                field: field.to_string(),
+                filter,
+                list: list.to_string(),
+            });
+        }
+        let d = UkfParams::default();
+        let ukf = UkfParams {
+            alpha: self.ukf_alpha.unwrap_or(d.alpha),
+            beta: self.ukf_beta.unwrap_or(d.beta),
+            kappa: self.ukf_kappa.unwrap_or(d.kappa),
+        };
+        let pf = PfConfig {
+            particles: self.particles.unwrap_or(PfConfig::default().particles),
+            roughening: self.roughening,
+            regularized: !self.bootstrap,
+        };
+        names
+            .iter()
+            .enumerate()
+            .map(|(i, n)| FilterKind::named(&field_of(i), n, ukf, pf))
+            .collect()
     }
 }
 

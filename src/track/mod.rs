@@ -25,7 +25,7 @@ pub use cost::{
 };
 pub(crate) use ekf::update_lanes;
 pub use ekf::Ekf;
-pub use filter::{Filter, FilterKind, Tracker};
+pub use filter::{Filter, FilterKind, FilterSettings, Tracker};
 pub use montecarlo::{
     finish, pcrlb_from_sums, run_chunk, run_chunk_in, run_filter_chunk, run_filter_chunk_in,
     run_pcrlb_sequential, run_sequential, run_truth_chunk, MonteCarloConfig, MonteCarloResult,

@@ -62,7 +62,9 @@ pub fn crlb_map_parallel_in(
                 crlb_map_rows(model, grid, t * ROWS_PER_TASK, rows)
             })
     };
-    if threads == 0 {
+    // The global pool when it has the threads asked for (building a pool per map cost 0.2 ms
+    // of a 0.8 ms 256² map).
+    if threads == 0 || threads == rayon::current_num_threads() {
         run(out)
     } else {
         thread_pool(threads)?.install(|| run(out))

@@ -5,7 +5,7 @@
 use scatterloc::Error;
 
 /// Core field → flag.
-const FLAGS: [(&str, &str); 32] = [
+const FLAGS: [(&str, &str); 33] = [
     // Tracking studies (`montecarlo`, `pcrlb`, `track`).
     ("runs", "--runs"),
     ("noise_runs", "--noise-runs"),
@@ -20,6 +20,7 @@ const FLAGS: [(&str, &str); 32] = [
     ("ukf_kappa", "--ukf-kappa"),
     ("particles", "--particles"),
     ("roughening", "--roughening"),
+    ("bootstrap", "--pf-bootstrap"),
     // The multi-target method (`mtl`).
     ("t_e", "--te"),
     ("t_b", "--tb"),
