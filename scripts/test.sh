@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Sets up (idempotently) and runs every test: rustfmt and clippy (native and wasm32), native
 # cargo test, the no_std build, wasm-pack test in headless Chromium, the browser end-to-end
-# test, and the Python package (pip install ./python, its pytest suite, mypy on docs/python.md).
+# test, the Python package (pip install ./python, its pytest suite, mypy on docs/python.md) and
+# the scale-out docs on a local Slurm cluster (scripts/slurm-local.sh, tests/deploy).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 export PATH="$HOME/.cargo/bin:$PATH"
@@ -58,6 +59,13 @@ cargo test --test e2e -- --ignored --nocapture --test-threads=1 2>&1 | tee -a "$
 
 step "Python package: pip install ./python, mypy --strict and a run of docs/python.md, pytest against the CLI"
 SCATTERLOC_CLI="$PWD/target/debug/scatterloc" bash scripts/python.sh 2>&1 | tee -a "$log"
+
+step "Slurm: the docs' job array, a failed task, its re-submission and the merge on a local single-node cluster; slurm submit; the Kubernetes manifests"
+# The release CLI (built by the full-size stage above): the shards' studies run in seconds.
+t_slurm=$SECONDS
+SCATTERLOC_CLI="$PWD/target/release/scatterloc" bash scripts/slurm-local.sh run -- \
+  .tools/py/bin/pytest -q -p no:cacheprovider tests/deploy 2>&1 | tee -a "$log"
+echo "Slurm stage: $((SECONDS - t_slurm)) s (daemons stopped)"
 
 # One closing line over every runner above (cargo's last binary may legitimately hold 0 tests).
 passed=$(grep -oE 'test result: [a-zA-Z]+\. [0-9]+ passed' "$log" | awk '{s+=$4} END {print s+0}')

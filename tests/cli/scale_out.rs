@@ -491,10 +491,24 @@ fn shard_env_reads_slurm_and_kubernetes_variables() {
         &[],
         &["SLURM_ARRAY_TASK_ID=20", "--array=0-19"],
     );
+    // A re-submitted task of a 3-shard array (`sbatch --array=2`: SLURM_ARRAY_TASK_COUNT=1)
+    // with the study's count is that shard (issue 28); without it, a named error.
+    let resubmitted = env_run(
+        "resubmitted.json",
+        &[
+            ("SLURM_ARRAY_TASK_ID", "2"),
+            ("SLURM_ARRAY_TASK_COUNT", "1"),
+        ],
+        &["--shards", "3"],
+    );
+    same_as(&resubmitted, &explicit[1]);
     fails_env(
-        &slurm,
-        &["--shards", "4"],
-        &["--shards 4", "SLURM_ARRAY_TASK_COUNT=3"],
+        &[
+            ("SLURM_ARRAY_TASK_ID", "2"),
+            ("SLURM_ARRAY_TASK_COUNT", "1"),
+        ],
+        &[],
+        &["SLURM_ARRAY_TASK_ID=2", "shard count 1", "--shards N"],
     );
     fails_env(
         &[("JOB_COMPLETION_INDEX", "0")],

@@ -77,6 +77,9 @@ fn run(command: cli::Command) -> Result<(), CliError> {
             CirCommand::Track(a) => cmd::cir_track(&a),
         },
         Command::Merge(a) => cmd::merge(&a),
+        Command::Slurm { command } => match command {
+            cli::SlurmCommand::Submit(a) => cmd::slurm_submit(&a),
+        },
         Command::Completions { shell } => cli::completions(shell),
     }
 }

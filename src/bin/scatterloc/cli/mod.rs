@@ -11,6 +11,7 @@ mod mtl;
 mod plan;
 mod scenario;
 mod shard;
+mod slurm;
 mod study;
 mod track;
 mod values;
@@ -25,6 +26,7 @@ pub use mtl::{MtlCommand, MtlLocateArgs, RocArgs, Table2Args};
 pub use plan::PlanArgs;
 pub use scenario::{CrlbArgs, CrlbMapArgs, LocateArgs, PresetArgs};
 pub use shard::{MergeArgs, ShardArgs};
+pub use slurm::{SlurmCommand, SubmitArgs};
 pub use study::{MontecarloArgs, PcrlbArgs, StudyArgs};
 pub use track::{CalibrateArgs, SimulateWalkArgs, TrackArgs};
 pub use values::{Association, MtlModel, RocExperiment, ShardSpec, Trajectory, WalkStart};
@@ -73,6 +75,8 @@ Commands at a glance (`scatterloc help COMMAND` for every flag):
                      [--empirical] [--exact] [--out FIG.{svg,png}] [--json OUT.json]
                      [--shard I/N|env [--shards N] --json PART.json]
   scatterloc merge --json OUT.json [--out FIG.{svg,png}] PART...
+  scatterloc slurm submit --shards N [--name NAME] [--dir DIR] [--json OUT.json]
+                          [--out FIG] [--cpus-per-task N] -- montecarlo|mtl roc [flags]
   scatterloc completions bash|zsh|fish
   scatterloc help [COMMAND] | --help | -h | --version
 
@@ -250,6 +254,12 @@ pub enum Command {
     /// threads, the most of any part; ns_per_ekf_step, wall_ns_per_ekf_step). See
     /// docs/scale-out.md.
     Merge(MergeArgs),
+    /// Run a sharded study on a Slurm cluster (docs/scale-out.md).
+    Slurm {
+        /// The Slurm command.
+        #[command(subcommand)]
+        command: SlurmCommand,
+    },
     /// Print a shell completion script (bash, zsh or fish) on stdout.
     ///
     /// For example `scatterloc completions bash > ~/.local/share/bash-completion/completions/scatterloc`,

@@ -2,7 +2,8 @@
 //! `crlb`, `locate` in `scenario`, `crlb-map` in `crlb_map`), tracking (`track` with its figure
 //! in `track_fig`), the channel front end (`cir simulate|estimate|track` in `cir`), gating (`calibrate`, `simulate-walk`), the tracking studies (`montecarlo`,
 //! `pcrlb`, sharing `study` and `report`), network planning (`plan`), the multi-target commands (`mtl`), and scale-out:
-//! one shard of a study (`--shard`, its part file in `shard`) and `merge`. Each takes its
+//! one shard of a study (`--shard`, its part file in `shard`), `merge`, and a sharded study
+//! submitted to Slurm (`slurm submit`). Each takes its
 //! parsed flags from `crate::cli`, reads its inputs (`io`), calls the library and writes JSON to
 //! stdout and files atomically (`output`).
 
@@ -21,6 +22,7 @@ mod plan;
 mod report;
 mod scenario;
 mod shard;
+mod slurm;
 mod study;
 mod track;
 mod track_fig;
@@ -33,4 +35,5 @@ pub use montecarlo::{montecarlo, pcrlb};
 pub use mtl::{mtl_locate, mtl_roc, mtl_table2};
 pub use plan::plan;
 pub use scenario::{crlb, locate, preset};
+pub use slurm::slurm_submit;
 pub use track::track;

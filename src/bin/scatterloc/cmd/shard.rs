@@ -32,7 +32,7 @@ pub fn resolve(args: &ShardArgs) -> Result<Option<Shard>, CliError> {
 }
 
 /// `--shard env`: the index and count from a Slurm job array (`SLURM_ARRAY_TASK_ID`, and
-/// `SLURM_ARRAY_TASK_COUNT` or `--shards N`) or a Kubernetes Indexed Job
+/// `--shards N` or else `SLURM_ARRAY_TASK_COUNT`) or a Kubernetes Indexed Job
 /// (`JOB_COMPLETION_INDEX` and `--shards N`); `var` looks a variable up. Errors name the
 /// variable or flag.
 pub fn from_env(
@@ -59,25 +59,20 @@ pub fn from_env(
             )),
             (Some(id), None) => {
                 let index = number("SLURM_ARRAY_TASK_ID", &id)?;
-                let count =
-                    match (var("SLURM_ARRAY_TASK_COUNT"), shards) {
-                        (Some(c), shards) => {
-                            let c = number("SLURM_ARRAY_TASK_COUNT", &c)?;
-                            if shards.is_some_and(|n| n != c) {
-                                return Err(bad(format!(
-                                    "--shards {} disagrees with SLURM_ARRAY_TASK_COUNT={c}",
-                                    shards.unwrap_or(0)
-                                )));
-                            }
-                            c
-                        }
-                        (None, Some(n)) => n,
-                        (None, None) => return Err(bad(
-                            "SLURM_ARRAY_TASK_COUNT is not set; give the number of shards with \
-                         --shards N"
+                // `--shards N` is the study's count and wins: a re-submission of some of the
+                // array's tasks (`sbatch --array=7,12-13`, issue 28) has a smaller
+                // SLURM_ARRAY_TASK_COUNT than the study's shard count.
+                let count = match (shards, var("SLURM_ARRAY_TASK_COUNT")) {
+                    (Some(n), _) => n,
+                    (None, Some(c)) => number("SLURM_ARRAY_TASK_COUNT", &c)?,
+                    (None, None) => {
+                        return Err(bad(
+                            "SLURM_ARRAY_TASK_COUNT is not set; give the number of \
+                                        shards with --shards N"
                                 .into(),
-                        )),
-                    };
+                        ))
+                    }
+                };
                 ("SLURM_ARRAY_TASK_ID", index, count)
             }
             (None, Some(i)) => {
@@ -103,7 +98,8 @@ pub fn from_env(
     Shard::new(index, count).ok_or_else(|| {
         bad(format!(
             "{source}={index} is not below the shard count {count} (shards are 0-based: \
-             sbatch --array=0-{})",
+             sbatch --array=0-{}; a re-submitted task of a larger array needs the study's \
+             count: --shards N)",
             count - 1
         ))
     })
