@@ -710,3 +710,57 @@ fn a_padded_part_is_a_named_error_within_the_memory_cap() {
     );
     assert!(!std::path::Path::new(&out).exists());
 }
+
+/// `slurm submit` checks the study and finds `sbatch` before it writes or submits anything
+/// (issue 28); the submissions themselves are tested on a real Slurm cluster by
+/// tests/deploy/test_slurm.py.
+#[test]
+fn slurm_submit_refuses_bad_input_before_anything() {
+    let dir = TempDir::new();
+    let d = dir.path("");
+    let cases: [(&[&str], &[&str]); 6] = [
+        (
+            &["--", "crlb-map", "--scenario", "s.json", "--out", "m.png"],
+            &["slurm submit", "not a study that runs in shards"],
+        ),
+        (
+            &["--", "montecarlo", "--json", "x.json"],
+            &["--json is set by slurm submit"],
+        ),
+        (
+            &["--", "mtl", "roc", "--experiment", "va", "--threads", "2"],
+            &["--threads is set by slurm submit"],
+        ),
+        (
+            &["--", "montecarlo", "--runz", "3"],
+            &["the study after --", "--runz"],
+        ),
+        (
+            &["--name", "../x", "--", "montecarlo"],
+            &["--name", "'../x'"],
+        ),
+        (&["--json", "x.txt", "--", "montecarlo"], &["--json"]),
+    ];
+    for (extra, needles) in cases {
+        let args: Vec<&str> = ["slurm", "submit", "--shards", "4", "--dir", &d]
+            .into_iter()
+            .chain(extra.iter().copied())
+            .collect();
+        fails_output(&args, &run_env(&args, &[]), needles);
+    }
+    // No sbatch on PATH: exit 1 naming it, nothing written.
+    let args = [
+        "slurm",
+        "submit",
+        "--shards",
+        "4",
+        "--dir",
+        &d,
+        "--",
+        "montecarlo",
+    ];
+    let out = run_env(&args, &[("PATH", "")]);
+    assert_eq!(out.status.code(), Some(1), "{out:?}");
+    assert!(String::from_utf8_lossy(&out.stderr).contains("sbatch"));
+    assert!(dir.files().is_empty(), "{:?}", dir.files());
+}

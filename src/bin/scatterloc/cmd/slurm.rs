@@ -143,6 +143,23 @@ pub fn slurm_submit(args: &SubmitArgs) -> Result<(), CliError> {
     let exe = std::env::current_exe()
         .map_err(|e| CliError::output(format!("the path of this binary: {e}")))?;
 
+    // Slurm must be there before anything is written.
+    match Command::new("sbatch").arg("--version").output() {
+        Ok(o) if o.status.success() => {}
+        Ok(o) => {
+            return Err(CliError::output(format!(
+                "sbatch --version failed ({}): {}",
+                o.status,
+                String::from_utf8_lossy(&o.stderr).trim()
+            )))
+        }
+        Err(e) => {
+            return Err(CliError::output(format!(
+                "sbatch: {e} (run this on a Slurm login node)"
+            )))
+        }
+    }
+
     // The docs' scripts, as files a user can read and re-run.
     let scripts = dir.join("slurm");
     std::fs::create_dir_all(&scripts)
