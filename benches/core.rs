@@ -18,7 +18,7 @@ use scatterloc::localize::{self, DelayMeasurements, LmConfig};
 use scatterloc::localize::{crlb_at, crlb_map, crlb_map_scalar, Grid};
 use scatterloc::math::{Real, Vec2, SPEED_OF_LIGHT};
 use scatterloc::measure::unit_from;
-use scatterloc::native::crlb_map_parallel;
+use scatterloc::native::{crlb_map_on, crlb_map_parallel, map_paths};
 use scatterloc::scenario::Scenario;
 use scatterloc::{measure, scenario::presets, Model};
 
@@ -209,11 +209,18 @@ fn benches(c: &mut Criterion) {
         g.bench_function("simd_2_threads", |b| {
             b.iter(|| crlb_map_parallel(&model, black_box(&grid), &mut out, 0).unwrap())
         });
+        // Issue 29: every kernel path this CPU has, one thread (`portable` = `simd_1_thread`).
+        for path in map_paths() {
+            g.bench_function(format!("path_{}", path.name()), |b| {
+                b.iter(|| crlb_map_on(path, &model, black_box(&grid), &mut out).unwrap())
+            });
+        }
         g.finish();
         assert!(out.iter().all(|v| !v.is_nan()));
     }
 
     cpu_peaks(c);
+    path_peaks(c);
 
     c.bench_function("crlb_at_single_point", |b| {
         b.iter(|| crlb_at(&s.model, black_box(truth)))
@@ -271,6 +278,84 @@ fn cpu_peaks(c: &mut Criterion) {
         })
     });
     g.finish();
+}
+
+/// Issue 29: this CPU's throughput on each kernel path's registers (`Lanes` of `native`),
+/// compiled with the path's target features (pulp's `vectorize`): multiply-adds (fused on the
+/// fast paths: one operation; two on the exact ones) over 16 independent chains, and the
+/// square-root-and-division pair `√(a/b)` of the exact paths. Throughput: lane operations
+/// (results) per second.
+fn path_peaks(c: &mut Criterion) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use criterion::Throughput;
+        use scatterloc::math::Lanes;
+        use scatterloc::native::{Avx2, Avx512};
+        const REPS: usize = 1000;
+        const CHAINS: usize = 16;
+        struct MulAdd<L: Lanes>(L::Arch);
+        impl<L: Lanes> pulp::NullaryFnOnce for MulAdd<L> {
+            type Output = Real;
+            #[inline(always)]
+            fn call(self) -> Real {
+                let m = L::splat(self.0, black_box(1.000_000_1));
+                let a = L::splat(self.0, black_box(1e-9));
+                let mut acc = [L::splat(self.0, 1.0); CHAINS];
+                for _ in 0..REPS {
+                    for x in acc.iter_mut() {
+                        *x = L::mul_add(*x, m, a);
+                    }
+                }
+                acc.iter().map(|x| x.lane(0)).sum()
+            }
+        }
+        struct Divider<L: Lanes>(L::Arch);
+        impl<L: Lanes> pulp::NullaryFnOnce for Divider<L> {
+            type Output = Real;
+            #[inline(always)]
+            fn call(self) -> Real {
+                let one = L::splat(self.0, black_box(1.0));
+                let three = L::splat(self.0, black_box(3.0));
+                let mut acc = [L::splat(self.0, 2.0); 8];
+                for _ in 0..REPS {
+                    for x in acc.iter_mut() {
+                        *x = L::root_ratio(three, *x + one);
+                    }
+                }
+                acc.iter().map(|x| x.lane(0)).sum()
+            }
+        }
+        let mut g = c.benchmark_group("cpu_peak_paths");
+        if let Some(s) = pulp::x86::V3::try_new() {
+            g.throughput(Throughput::Elements((CHAINS * REPS * 4) as u64));
+            g.bench_function("avx2_fma", |b| b.iter(|| s.vectorize(MulAdd::<Avx2<true>>(s))));
+            g.throughput(Throughput::Elements((2 * CHAINS * REPS * 4) as u64));
+            g.bench_function("avx2_mul_add", |b| {
+                b.iter(|| s.vectorize(MulAdd::<Avx2<false>>(s)))
+            });
+            g.throughput(Throughput::Elements((8 * REPS * 4) as u64));
+            g.bench_function("avx2_sqrt_div_pair", |b| {
+                b.iter(|| s.vectorize(Divider::<Avx2<false>>(s)))
+            });
+        }
+        if let Some(s) = pulp::x86::V4::try_new() {
+            g.throughput(Throughput::Elements((CHAINS * REPS * 8) as u64));
+            g.bench_function("avx512_fma", |b| {
+                b.iter(|| s.vectorize(MulAdd::<Avx512<true>>(s)))
+            });
+            g.throughput(Throughput::Elements((2 * CHAINS * REPS * 8) as u64));
+            g.bench_function("avx512_mul_add", |b| {
+                b.iter(|| s.vectorize(MulAdd::<Avx512<false>>(s)))
+            });
+            g.throughput(Throughput::Elements((8 * REPS * 8) as u64));
+            g.bench_function("avx512_sqrt_div_pair", |b| {
+                b.iter(|| s.vectorize(Divider::<Avx512<false>>(s)))
+            });
+        }
+        g.finish();
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = c;
 }
 
 /// sensors2019 with 4 transmitters (the preset's parabolic Tx turned to four boresights) and its 4

@@ -4,7 +4,8 @@
 
 use pyo3::prelude::*;
 
-use scatterloc::present::{run_plan, PlanJson, PlanRequest, DEFAULT_PLAN_BUDGET};
+use scatterloc::native::crlb_map_exact;
+use scatterloc::present::{run_plan_with, PlanJson, PlanRequest, DEFAULT_PLAN_BUDGET};
 use scatterloc::Error;
 
 use crate::convert::{array, to_python};
@@ -139,7 +140,7 @@ pub fn plan(
     })?;
     let base = sc.scenario().clone();
     let doc = run_job(py, budget, progress, |job| {
-        run_plan(&base, &request, |p| {
+        run_plan_with(&base, &request, crlb_map_exact, |p| {
             job.set_done(p.evaluations.min(p.budget));
             !job.cancelled()
         })

@@ -100,8 +100,9 @@ def test_crlb_map_threads_and_components():
     p = sl.crlb(s, np.stack([xx, yy], axis=-1))
     assert m.sigma_x.tobytes() == p.sigma_x.tobytes()
     assert m.sigma_y.tobytes() == p.sigma_y.tobytes()
-    # The kernel's beam polynomial agrees with the exact point bound to 1e-12 relative.
-    np.testing.assert_allclose(m.rmse, p.rmse, rtol=1e-12)
+    # The map kernel (this CPU's fastest path: FMA, estimates; within 64·ε·κ·(Γ + S + G) of the
+    # core's, tests/library/map_kernel.rs) against the exact point bound.
+    np.testing.assert_allclose(m.rmse, p.rmse, rtol=1e-9)
 
 
 def test_crlb_map_errors():

@@ -12,7 +12,7 @@ mod map;
 mod simd;
 
 pub use grid::{Grid, MAX_GRID_CELLS, MAX_GRID_SIDE};
-pub use map::{crlb_map, crlb_map_rows, crlb_map_scalar};
+pub use map::{crlb_map, crlb_map_rows, crlb_map_rows_with, crlb_map_scalar};
 
 /// A Fisher matrix whose reciprocal condition number `λ_min/λ_max` is below this is treated as
 /// singular: the position is unbounded along some direction (collinear or too few informative

@@ -8,8 +8,8 @@ mod crlb;
 mod lm;
 
 pub use crlb::{
-    bound_from_fisher, crlb_at, crlb_map, crlb_map_rows, crlb_map_scalar, fisher, Bound, CrlbPoint,
-    Grid, MAX_GRID_CELLS, MAX_GRID_SIDE, SINGULAR_RCOND,
+    bound_from_fisher, crlb_at, crlb_map, crlb_map_rows, crlb_map_rows_with, crlb_map_scalar,
+    fisher, Bound, CrlbPoint, Grid, MAX_GRID_CELLS, MAX_GRID_SIDE, SINGULAR_RCOND,
 };
 pub use lm::{
     chi_square_upper_tail, locate, DelayMeasurements, LmConfig, LmReport, Termination, GRID_STARTS,

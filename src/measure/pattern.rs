@@ -1,6 +1,7 @@
 //! Transmit antenna pattern (spec §9.3):
 //! `G_Tx(ψ)[dBi] = G₀ − min(12 (ψ/ψ_3dB)², A_m)`, ψ the angle between boresight and Tx→point.
 
+use crate::math::Lanes;
 use crate::math::{acos, cos, db_to_linear, deg_to_rad, exp, sin, Real, Vec2};
 use crate::scenario::Pattern;
 
@@ -203,30 +204,43 @@ impl GainPolynomial {
 }
 
 impl GainPolynomial {
-    /// [`GainPolynomial::gains_at_cos`] for `N` SIMD vectors of four directions (the CRLB map
-    /// kernel; `N = 2` interleaves two recurrences so their latencies overlap): the same
-    /// operations in the same order, so each lane is bitwise equal to the scalar result; the
-    /// floor is a branch-free blend.
+    /// [`GainPolynomial::gains_at_cos`] for `N` vectors of directions (the CRLB map kernel;
+    /// `N = 2` interleaves two recurrences so their latencies overlap). With an exact
+    /// [`Lanes`] type it performs the same operations in the same order, so each lane is
+    /// bitwise equal to the scalar result; a fused one rounds once per multiply-add. The floor
+    /// is a branch-free blend.
     #[inline(always)]
-    pub(crate) fn gains_at_cos_x4<const N: usize>(&self, c: [wide::f64x4; N]) -> [wide::f64x4; N] {
-        use wide::{f64x4, CmpGt};
-        let t = c.map(|c| (c * 2.0 - 1.0 - self.floor_cos) / (1.0 - self.floor_cos));
-        let t2 = t.map(|t| t * 2.0);
-        let (mut b1, mut b2) = ([f64x4::ZERO; N], [f64x4::ZERO; N]);
+    pub(crate) fn gains_at_cos_lanes<L: Lanes, const N: usize>(&self, c: [L; N]) -> [L; N] {
+        // Plain loops, no closures: every step must inline into the caller, whose target
+        // features (AVX2, AVX-512) the vector operations need (issue 29).
+        let arch = c[0].arch();
+        let two = L::splat(arch, 2.0);
+        let one = L::splat(arch, 1.0);
+        let fc = L::splat(arch, self.floor_cos);
+        let zero = L::splat(arch, 0.0);
+        let mut t = [zero; N];
+        let mut t2 = [zero; N];
+        for i in 0..N {
+            t[i] = (c[i] * two - one - fc).div_const(1.0 - self.floor_cos);
+            t2[i] = t[i] * two;
+        }
+        let (mut b1, mut b2) = ([zero; N], [zero; N]);
         for &a in self.coefficients[1..].iter().rev() {
-            let a = f64x4::splat(a);
+            let a = L::splat(arch, a);
             for i in 0..N {
-                let b0 = (a - b2[i]) + t2[i] * b1[i];
+                let b0 = L::mul_add(t2[i], b1[i], a - b2[i]);
                 b2[i] = b1[i];
                 b1[i] = b0;
             }
         }
-        let floor = f64x4::splat(self.floor_gain);
-        let fc = f64x4::splat(self.floor_cos);
-        core::array::from_fn(|i| {
-            let main = (t[i] * b1[i] + self.coefficients[0] - b2[i]).max(floor);
-            c[i].cmp_gt(fc).blend(main, floor)
-        })
+        let floor = L::splat(arch, self.floor_gain);
+        let c0 = L::splat(arch, self.coefficients[0]);
+        let mut out = [zero; N];
+        for i in 0..N {
+            let main = (L::mul_add(t[i], b1[i], c0) - b2[i]).max(floor);
+            out[i] = L::select(c[i].gt(fc), main, floor);
+        }
+        out
     }
 }
 

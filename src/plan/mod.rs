@@ -12,8 +12,8 @@ mod problem;
 pub use cmaes::{minimize, CmaesConfig, CmaesReport, Generation, SearchProblem, Termination};
 pub use objective::{Objective, RoiObjective, Score};
 pub use planner::{
-    plan, Improvement, PlanConfig, PlanProgress, PlanReport, MAX_PLAN_BUDGET, MAX_PLAN_GRID,
-    MIN_PLAN_GRID,
+    plan, Improvement, MapKernel, PlanConfig, PlanProgress, PlanReport, MAX_PLAN_BUDGET,
+    MAX_PLAN_GRID, MIN_PLAN_GRID,
 };
 pub use problem::{
     Constraints, Layout, MoveSpec, NodeRef, PlanScore, PlanSpace, Polygon, MAX_PLAN_DIMENSION,

@@ -177,6 +177,7 @@ pub struct RoiObjective {
     /// The ROI's cell centres.
     pub grid: Grid,
     cells: Vec<Real>,
+    kernel: super::MapKernel,
 }
 
 impl RoiObjective {
@@ -188,13 +189,20 @@ impl RoiObjective {
             objective: objective.validated()?,
             grid,
             cells: vec![0.0; grid.len()],
+            kernel: crlb_map,
         })
+    }
+
+    /// The same objective scored with `kernel` (the planner's [`super::PlanConfig::kernel`]).
+    pub fn with_kernel(mut self, kernel: super::MapKernel) -> RoiObjective {
+        self.kernel = kernel;
+        self
     }
 
     /// The score of `model` (the map kernel over the grid, then [`Objective::score`]).
     pub fn evaluate(&mut self, model: &Model) -> Score {
         // The buffer has the grid's length, so the kernel cannot fail.
-        if crlb_map(model, &self.grid, &mut self.cells).is_err() {
+        if (self.kernel)(model, &self.grid, &mut self.cells).is_err() {
             self.cells.fill(Real::INFINITY);
         }
         self.objective.score(&mut self.cells)

@@ -4,6 +4,7 @@
 use alloc::vec::Vec;
 
 use crate::error::{Error, Result};
+use crate::localize::{crlb_map, Grid};
 use crate::math::Real;
 use crate::measure::Model;
 use crate::scenario::{Area, Scenario};
@@ -22,7 +23,7 @@ pub const MAX_PLAN_BUDGET: usize = 1_000_000;
 const FINALISTS: usize = 8;
 
 /// What to plan.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone)]
 pub struct PlanConfig {
     /// The objective.
     pub objective: Objective,
@@ -44,7 +45,15 @@ pub struct PlanConfig {
     pub budget: usize,
     /// Seed of the search.
     pub seed: u64,
+    /// The CRLB map kernel that scores layouts (default the core's [`crlb_map`]). A front end
+    /// may pass a faster one (the CLI and the Python package: `native::crlb_map_exact`, this
+    /// CPU's widest registers) **that returns the same bits**, so that a plan never depends on
+    /// the CPU (issue 29).
+    pub kernel: MapKernel,
 }
+
+/// A CRLB map kernel: the RMSE bound of every cell of a grid (the signature of [`crlb_map`]).
+pub type MapKernel = fn(&Model, &Grid, &mut [Real]) -> Result<()>;
 
 impl PlanConfig {
     /// Defaults for an ROI and an objective: receivers move, grid 64, budget 3000, seed 1.
@@ -60,6 +69,7 @@ impl PlanConfig {
             min_spacing_m: 0.0,
             budget: 3000,
             seed: 1,
+            kernel: crlb_map,
         }
     }
 
@@ -181,7 +191,8 @@ pub fn plan(
     let mut search = PlanSearch {
         space: &space,
         model: base_model.clone(),
-        roi: RoiObjective::new(config.objective, config.roi, search_grid)?,
+        roi: RoiObjective::new(config.objective, config.roi, search_grid)?
+            .with_kernel(config.kernel),
     };
     let base_layout = space.base_layout();
     let x0 = space.encode(&base_layout);
@@ -218,7 +229,8 @@ pub fn plan(
     let mut fine = PlanSearch {
         space: &space,
         model: base_model,
-        roi: RoiObjective::new(config.objective, config.roi, config.grid)?,
+        roi: RoiObjective::new(config.objective, config.roi, config.grid)?
+            .with_kernel(config.kernel),
     };
     let before = fine.score_layout(&base_layout, 0.0);
     let mut chosen: Option<(PlanScore, Layout)> =

@@ -32,8 +32,8 @@ pub use colormap::{
     colorbar_rgba, fill_rgba, render_rgba, viridis, LogScale, LINK_RGB, UNBOUNDED_RGB,
 };
 pub use plan_view::{
-    area_of, run_plan, PlanHistoryJson, PlanImprovementJson, PlanJson, PlanObjectiveJson,
-    PlanPathJson, PlanProgressJson, PlanRequest, DEFAULT_PLAN_BUDGET,
+    area_of, run_plan, run_plan_with, PlanHistoryJson, PlanImprovementJson, PlanJson,
+    PlanObjectiveJson, PlanPathJson, PlanProgressJson, PlanRequest, DEFAULT_PLAN_BUDGET,
 };
 pub use scene::output::{
     DetectedView, EllipseView, HypothesisView, MetricsView, ModelView, MtlView, RangeView,

@@ -10,8 +10,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::Result;
 use crate::plan::{
-    plan, MoveSpec, NodeRef, Objective, PlanConfig, PlanProgress, PlanReport, Polygon, Score,
-    Termination,
+    plan, MapKernel, MoveSpec, NodeRef, Objective, PlanConfig, PlanProgress, PlanReport, Polygon,
+    Score, Termination,
 };
 use crate::scenario::{Area, Scenario};
 
@@ -233,9 +233,22 @@ pub struct PlanImprovementJson {
 pub fn run_plan(
     scenario: &Scenario,
     request: &PlanRequest,
+    observe: impl FnMut(&PlanProgressJson) -> bool,
+) -> Result<PlanJson> {
+    run_plan_with(scenario, request, crate::localize::crlb_map, observe)
+}
+
+/// [`run_plan`] scoring layouts with `kernel` (the CLI and the Python package pass
+/// `native::crlb_map_exact`, which returns the core kernel's bits on this CPU's widest
+/// registers: the same plan, sooner).
+pub fn run_plan_with(
+    scenario: &Scenario,
+    request: &PlanRequest,
+    kernel: MapKernel,
     mut observe: impl FnMut(&PlanProgressJson) -> bool,
 ) -> Result<PlanJson> {
-    let config = request.config()?;
+    let mut config = request.config()?;
+    config.kernel = kernel;
     let report = plan(scenario, &config, |p: &PlanProgress<'_>| {
         observe(&PlanProgressJson {
             evaluations: p.evaluations,

@@ -213,11 +213,15 @@ fn row_blocks_and_threads_equal_the_whole_map() {
         }
         assert_bitwise("row blocks", &out, &whole);
     }
-    // Threads from 128² cells up: bitwise the single-threaded map for 1, 2 and 3 workers.
+    // Threads from 128² cells up: bitwise the single-threaded map of the same kernel path (the
+    // fastest this CPU has, issue 29) for 1, 2 and 3 workers.
     let s = presets::sensors2019();
     let m = Model::new(&s).unwrap();
     let grid = Grid::new(s.area_m, 131, 129).unwrap();
-    let whole = map(crlb_map, &m, &grid);
+    let fast = |m: &Model, g: &Grid, o: &mut [Real]| {
+        scatterloc::native::crlb_map_on(scatterloc::native::fast_path(), m, g, o)
+    };
+    let whole = map(fast, &m, &grid);
     for threads in [0, 1, 2, 3] {
         let mut out = vec![Real::NAN; grid.len()];
         scatterloc::native::crlb_map_parallel(&m, &grid, &mut out, threads).unwrap();
@@ -240,4 +244,114 @@ fn row_ranges_outside_the_grid_are_errors() {
     assert!(crlb_map(&m, &grid, &mut three_rows).is_err());
     let mut whole = vec![0.0; 31];
     assert!(scatterloc::native::crlb_map_parallel(&m, &grid, &mut whole, 0).is_err());
+}
+
+/// Issue 29: every kernel path this CPU has against the core's kernel. The exact paths (AVX2,
+/// AVX-512 with the reference's IEEE operations) must equal it bitwise; the fast ones (FMA,
+/// `1/√d²` from the hardware estimate and Newton steps) within the derived bound
+/// `64·ε·κ·(Γ + S + G)` relative: a few ulps per unit-vector component, amplified by the
+/// cancellation in `g = u^Tx + u^Rx` (`Γ = Σ w|g| / Σ w|g|²`, ≥ 1/2, large when the cell lies
+/// near the baselines that carry its information), by the beams' sensitivity to the direction
+/// (`S = 2kψ_f/sin ψ_f`, the largest `|d ln G/d cos ψ|` of a beam `G₀·exp(−kψ²)` inside its floor
+/// angle ψ_f: a narrow beam turns an ulp of the unit vector into hundreds of ulps of gain), by
+/// the gain polynomial's conditioning (`G = n·Σ|c_k| / g_floor`) and by `κ = tr²/det`, the
+/// Fisher matrix's condition number (module doc of `native::lanes`); bounded and unbounded
+/// cells agree except within a factor 2 of the singular threshold. Which paths ran is printed
+/// (a CPU without AVX-512 runs fewer).
+#[test]
+fn every_dispatched_path_agrees_with_the_core_kernel() {
+    use scatterloc::native::{crlb_map_on, map_paths};
+    let paths = map_paths();
+    println!(
+        "kernel paths on this CPU: {}",
+        paths
+            .iter()
+            .map(|p| p.name())
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    let (mut worst, mut worst_plain, mut compared) = (0.0f64, 0.0f64, 0usize);
+    let (mut above, mut kappa_above) = (0usize, Real::INFINITY);
+    for seed in 0..SCENARIOS {
+        let (s, grid) = random_case(3_000 + seed);
+        let m = Model::new(&s).unwrap();
+        let reference = map(crlb_map, &m, &grid);
+        let gain_amp = m
+            .patterns
+            .iter()
+            .filter_map(|p| p.polynomial.as_ref())
+            .map(|p| {
+                let sum: Real = p.coefficients.iter().map(|c| c.abs()).sum();
+                p.coefficients.len() as Real * sum / p.floor_gain
+            })
+            .fold(0.0, Real::max);
+        let beam_sens = m
+            .patterns
+            .iter()
+            .filter_map(|p| p.beam)
+            .map(|b| {
+                let psi = b.floor_angle_rad.min(std::f64::consts::PI);
+                2.0 * b.exponent_per_rad2 * psi / psi.sin().max(1e-3)
+            })
+            .fold(0.0, Real::max);
+        for &path in &paths {
+            let mut out = vec![Real::NAN; grid.len()];
+            crlb_map_on(path, &m, &grid, &mut out).unwrap();
+            if path.exact() {
+                assert_bitwise(&format!("{} seed {seed}", path.name()), &out, &reference);
+                continue;
+            }
+            for j in 0..grid.ny {
+                for i in 0..grid.nx {
+                    let (v, r) = (out[j * grid.nx + i], reference[j * grid.nx + i]);
+                    assert!(!v.is_nan() && v > 0.0, "{} seed {seed}: {v}", path.name());
+                    let at = Vec2::new(grid.x(i), grid.y(j));
+                    let f = crlb_at(&m, at).fisher_per_m2;
+                    // Γ from each link's information and |g| = c·|∇τ| (E3, E8).
+                    let (mut num, mut den) = (0.0, 0.0);
+                    for p in 0..m.link_count() {
+                        let w = m.delay_information(p, at);
+                        let g = m.network.jacobian_row(p, at).norm() * 299_792_458.0;
+                        num += w * g;
+                        den += w * g * g;
+                    }
+                    let gamma = if den > 0.0 { num / den } else { Real::INFINITY };
+                    let (tr, det) = (
+                        f[(0, 0)] + f[(1, 1)],
+                        f[(0, 0)] * f[(1, 1)] - f[(0, 1)] * f[(1, 0)],
+                    );
+                    let near_threshold = det < 2.0 * SINGULAR_RCOND * tr * tr;
+                    if v.is_finite() && r.is_finite() {
+                        let kappa = tr * tr / det;
+                        let rel = (v - r).abs() / r;
+                        let amp = kappa * (gamma + beam_sens + gain_amp);
+                        let bound = 64.0 * Real::EPSILON * amp;
+                        assert!(
+                            rel <= bound,
+                            "{} seed {seed} ({i},{j}): {v} vs {r}: {rel:e} > {bound:e} (κ {kappa:e}, Γ {gamma:e}, S {beam_sens:e}, G {gain_amp:e})",
+                            path.name()
+                        );
+                        worst = worst.max(rel / (Real::EPSILON * amp));
+                        worst_plain = worst_plain.max(rel);
+                        if rel > 1e-12 {
+                            above += 1;
+                            kappa_above = kappa_above.min(kappa);
+                        }
+                        compared += 1;
+                    } else {
+                        assert!(
+                            v == r || near_threshold,
+                            "{} seed {seed} ({i},{j}): {v} vs {r}",
+                            path.name()
+                        );
+                    }
+                }
+            }
+        }
+    }
+    println!(
+        "fast paths: {compared} bounded cells; largest relative deviation {worst_plain:e}, \
+         largest deviation / (ε·κ·(Γ + S + G)) {worst:.2}; {above} cells beyond 1e-12 (κ ≥ \
+         {kappa_above:e})"
+    );
 }

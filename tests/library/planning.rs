@@ -382,3 +382,61 @@ fn plans_depend_on_the_seed_only() {
 /// Rx2's planned position of [`plans_depend_on_the_seed_only`] (f64 bits), the same in
 /// tests/wasm.rs.
 const DETERMINISM_RX2_BITS: [u64; 2] = [0x4021_e4d3_ec16_58ec, 0x4037_c8ac_686a_6934];
+
+/// Issue 29: the planner's result does not depend on the CPU. Layouts are scored by a map
+/// kernel of the front end's choice (`PlanConfig::kernel`): the page uses the core's, the CLI
+/// and Python this CPU's widest exact path (`native::crlb_map_exact`). Every exact path returns
+/// the core kernel's bits, so every one of them gives the same plan, field for field.
+#[test]
+fn the_plan_is_the_same_on_every_exact_kernel_path() {
+    use scatterloc::localize::Grid;
+    use scatterloc::native::{crlb_map_on, map_paths, MapPath};
+    use scatterloc::plan::MapKernel;
+    use scatterloc::present::{run_plan_with, PlanRequest};
+    fn portable(m: &scatterloc::Model, g: &Grid, o: &mut [f64]) -> scatterloc::Result<()> {
+        crlb_map_on(MapPath::Portable, m, g, o)
+    }
+    fn avx2(m: &scatterloc::Model, g: &Grid, o: &mut [f64]) -> scatterloc::Result<()> {
+        crlb_map_on(MapPath::Avx2, m, g, o)
+    }
+    fn avx512(m: &scatterloc::Model, g: &Grid, o: &mut [f64]) -> scatterloc::Result<()> {
+        crlb_map_on(MapPath::Avx512, m, g, o)
+    }
+    let kernels: [(MapPath, MapKernel); 3] = [
+        (MapPath::Portable, portable),
+        (MapPath::Avx2, avx2),
+        (MapPath::Avx512, avx512),
+    ];
+    let s = scatterloc::scenario::presets::sensors2019();
+    let available = map_paths();
+    let mut ran = Vec::new();
+    for (objective, movable) in [
+        ("p90", "rx"),
+        ("coverage:0.1", "tx-boresight"),
+        ("max", "all"),
+    ] {
+        let request = PlanRequest {
+            movable: movable.into(),
+            objective: objective.into(),
+            roi: [-7.5, 30.0, -10.0, 26.0],
+            bounds: None,
+            allowed: Vec::new(),
+            min_spacing_m: 1.0,
+            grid: Some(48),
+            budget: Some(600),
+            seed: Some(3),
+        };
+        let reference =
+            run_plan_with(&s, &request, scatterloc::localize::crlb_map, |_| true).unwrap();
+        for (path, kernel) in kernels {
+            if !available.contains(&path) {
+                continue;
+            }
+            let plan = run_plan_with(&s, &request, kernel, |_| true).unwrap();
+            assert_eq!(plan, reference, "{objective}/{movable} on {}", path.name());
+            ran.push(path.name());
+        }
+    }
+    println!("the same plans on: {ran:?}");
+    assert!(ran.contains(&"portable"));
+}

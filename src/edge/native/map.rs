@@ -1,6 +1,6 @@
-//! The CRLB map on threads: blocks of whole rows of the grid run the SIMD kernel
-//! ([`crate::localize::crlb_map_rows`]) on rayon workers. Rows are independent, so the map is
-//! bitwise the single-threaded one for any thread count. [`crlb_map_parallel_in`] also stops
+//! The CRLB map on threads: blocks of whole rows of the grid run the kernel on this CPU's
+//! fastest path ([`super::fast_path`]: AVX-512 or AVX2 when present, issue 29) on rayon workers.
+//! Rows are independent, so the map is bitwise the single-threaded one for any thread count. [`crlb_map_parallel_in`] also stops
 //! on a cancel flag (Ctrl-C in the Python package).
 
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -9,7 +9,9 @@ use rayon::prelude::*;
 
 use super::driver::thread_pool;
 use crate::error::{check_len, Error, Result};
-use crate::localize::{crlb_map_rows, Grid};
+use crate::localize::Grid;
+
+use super::dispatch::{crlb_map_rows_on, fast_path};
 use crate::math::Real;
 use crate::measure::Model;
 
@@ -20,8 +22,10 @@ pub const PARALLEL_MAP_MIN_CELLS: usize = 128 * 128;
 /// Rows per task: enough tasks for load balance, each a few hundred microseconds at most.
 const ROWS_PER_TASK: usize = 8;
 
-/// [`crlb_map`] with its rows split over `threads` workers (0 = rayon's global pool, all cores)
-/// from [`PARALLEL_MAP_MIN_CELLS`] cells up.
+/// The CRLB map ([`crate::localize::crlb_map`]) on this CPU's fastest kernel path
+/// ([`super::fast_path`]; within the bound of [`super::lanes`] of the core's kernel) with its
+/// rows split over `threads` workers (0 = rayon's global pool, all cores) from
+/// [`PARALLEL_MAP_MIN_CELLS`] cells up.
 pub fn crlb_map_parallel(
     model: &Model,
     grid: &Grid,
@@ -42,13 +46,14 @@ pub fn crlb_map_parallel_in(
     cancel: &AtomicBool,
 ) -> Result<()> {
     check_len("map buffer", grid.len(), out.len())?;
+    let path = fast_path();
     if grid.len() < PARALLEL_MAP_MIN_CELLS || threads == 1 {
         // Row blocks on this thread, with the same cancel checks.
         for (t, rows) in out.chunks_mut(ROWS_PER_TASK * grid.nx).enumerate() {
             if cancel.load(Ordering::Relaxed) {
                 return Err(Error::Cancelled);
             }
-            crlb_map_rows(model, grid, t * ROWS_PER_TASK, rows)?;
+            crlb_map_rows_on(path, model, grid, t * ROWS_PER_TASK, rows)?;
         }
         return Ok(());
     }
@@ -59,7 +64,7 @@ pub fn crlb_map_parallel_in(
                 if cancel.load(Ordering::Relaxed) {
                     return Err(Error::Cancelled);
                 }
-                crlb_map_rows(model, grid, t * ROWS_PER_TASK, rows)
+                crlb_map_rows_on(path, model, grid, t * ROWS_PER_TASK, rows)
             })
     };
     // The global pool when it has the threads asked for (building a pool per map cost 0.2 ms

@@ -8,7 +8,7 @@ use super::grid::Grid;
 use super::simd::Kernel;
 use super::{is_regular, link_weights};
 use crate::error::{check_len, Error, Result};
-use crate::math::{sqrt, Real, Vec2};
+use crate::math::{sqrt, Lanes, Real, Vec2};
 use crate::measure::TxPattern;
 use crate::measure::UNIT_VECTOR_MIN_DISTANCE_M;
 use crate::measure::{Model, SNR_DISTANCE_FLOOR_M};
@@ -30,6 +30,21 @@ pub fn crlb_map(model: &Model, grid: &Grid, out: &mut [Real]) -> Result<()> {
 /// [`crlb_map`] for the whole rows `first_row ..` of the grid that `out` holds (`out.len()` a
 /// multiple of `grid.nx`, rows inside the grid): the unit of work of a parallel map.
 pub fn crlb_map_rows(model: &Model, grid: &Grid, first_row: usize, out: &mut [Real]) -> Result<()> {
+    crlb_map_rows_with::<wide::f64x4>((), model, grid, first_row, out)
+}
+
+/// [`crlb_map_rows`] on the vector type `L` ([`Lanes`], whose instruction-set token is `arch`): the one kernel that every build runs —
+/// [`wide::f64x4`] in the core, this CPU's AVX2 or AVX-512 registers in `crate::native` (issue
+/// 29). An exact `L` gives the scalar reference's bits; a fast one a result within its stated
+/// bound. `#[inline(always)]`, so a caller compiled for wider instructions gets them.
+#[inline(always)]
+pub fn crlb_map_rows_with<L: Lanes>(
+    arch: L::Arch,
+    model: &Model,
+    grid: &Grid,
+    first_row: usize,
+    out: &mut [Real],
+) -> Result<()> {
     let rows = out.len() / grid.nx;
     check_len("map buffer", rows * grid.nx, out.len())?;
     if first_row + rows > grid.ny {
@@ -40,7 +55,7 @@ pub fn crlb_map_rows(model: &Model, grid: &Grid, first_row: usize, out: &mut [Re
             max: grid.ny,
         });
     }
-    Kernel::new(model, grid).rows(first_row, out);
+    Kernel::<L>::new(arch, model, grid).rows(first_row, out);
     Ok(())
 }
 

@@ -1,5 +1,5 @@
 //! `scatterloc plan`: network planning (`filters-and-planning.md` §3). The flags become a
-//! [`PlanRequest`] run by [`run_plan`] (the same function as the page's Plan panel) under the
+//! [`PlanRequest`] run by [`run_plan_with`] (the page's Plan panel runs the same function on the core kernel, which gives the same bits) under the
 //! progress bar and Ctrl-C handling of the long commands; the result is `plan.json` and, with
 //! `--figure`, the maps before and after ([`draw_plan_maps`]).
 
@@ -12,9 +12,10 @@ use scatterloc::chart::{
     ChartNode, MapData, PlanChartOptions, PlanPanel, PlanPath,
 };
 use scatterloc::localize::Grid;
+use scatterloc::native::crlb_map_exact;
 use scatterloc::native::crlb_map_parallel;
 use scatterloc::plan::{Polygon, MAX_PLAN_GRID, MIN_PLAN_GRID};
-use scatterloc::present::{run_plan, PlanJson, PlanRequest, DEFAULT_PLAN_BUDGET};
+use scatterloc::present::{run_plan_with, PlanJson, PlanRequest, DEFAULT_PLAN_BUDGET};
 use scatterloc::{Error, Model, Scenario};
 
 use super::io::{emit_summary, read_json_file};
@@ -72,7 +73,9 @@ pub fn plan(args: &PlanArgs) -> Result<(), CliError> {
 
     let budget = args.budget.unwrap_or(DEFAULT_PLAN_BUDGET);
     let (result, wall) = run_with_bar(budget, "evaluations", "plan", |cancel, progress| {
-        run_plan(&scenario, &request, |p| {
+        // Layouts scored on this CPU's widest exact kernel path: the core kernel's bits, so the
+        // plan is the page's and any CPU's (issue 29).
+        run_plan_with(&scenario, &request, crlb_map_exact, |p| {
             progress(p.evaluations.min(p.budget), p.budget);
             !cancel.load(std::sync::atomic::Ordering::SeqCst)
         })
