@@ -328,7 +328,9 @@ fn path_peaks(c: &mut Criterion) {
         let mut g = c.benchmark_group("cpu_peak_paths");
         if let Some(s) = pulp::x86::V3::try_new() {
             g.throughput(Throughput::Elements((CHAINS * REPS * 4) as u64));
-            g.bench_function("avx2_fma", |b| b.iter(|| s.vectorize(MulAdd::<Avx2<true>>(s))));
+            g.bench_function("avx2_fma", |b| {
+                b.iter(|| s.vectorize(MulAdd::<Avx2<true>>(s)))
+            });
             g.throughput(Throughput::Elements((2 * CHAINS * REPS * 4) as u64));
             g.bench_function("avx2_mul_add", |b| {
                 b.iter(|| s.vectorize(MulAdd::<Avx2<false>>(s)))
