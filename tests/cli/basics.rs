@@ -128,6 +128,15 @@ fn crlb_map_json_matches_core() {
     assert_eq!(summary["format"], "json");
     assert_eq!(summary["unbounded_cells"], 0);
     assert!(summary["compute_ms"].as_f64().is_some());
+    let paths: Vec<&str> = scatterloc::native::map_paths()
+        .iter()
+        .map(|p| p.name())
+        .collect();
+    assert!(
+        paths.contains(&summary["kernel"].as_str().unwrap()),
+        "{} not among {paths:?}",
+        summary["kernel"]
+    );
     let doc: Value = serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
     let (xs, ys, rows) = (
         doc["x_m"].as_array().unwrap(),

@@ -126,7 +126,8 @@ pub enum Command {
     /// area_m; any edge may be overridden). .json: {x_m, y_m, rmse_bound_m[ny][nx]} with null
     /// for unbounded cells; .svg/.png: a figure with a log colour scale (width default 1000 px).
     /// Prints a one-line JSON summary {out, format, nx, ny, x_range_m, y_range_m, compute_ms,
-    /// write_ms, min_m, max_m, unbounded_cells}.
+    /// kernel, write_ms, min_m, max_m, unbounded_cells}; kernel is the CPU path the map ran on
+    /// (portable, avx2, avx2-fast, avx512, avx512-fast; SCATTERLOC_MAP_PATH pins one).
     CrlbMap(CrlbMapArgs),
     /// Locate a scatterer from one snapshot of measured delays (Levenberg-Marquardt, spec §5).
     ///

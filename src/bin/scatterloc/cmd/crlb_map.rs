@@ -12,7 +12,7 @@ use scatterloc::chart::{
 };
 use scatterloc::chart::{ChartError, ChartNode, ChartOptions, MapData, MapOverlay};
 use scatterloc::localize::Grid;
-use scatterloc::native::crlb_map_parallel;
+use scatterloc::native::{crlb_map_parallel, fast_path};
 use scatterloc::scenario::Area;
 use scatterloc::{Error, Model, Scenario};
 
@@ -116,6 +116,7 @@ pub fn crlb_map(args: &CrlbMapArgs) -> Result<(), CliError> {
         "x_range_m": area.x,
         "y_range_m": area.y,
         "compute_ms": round3(compute_ms),
+        "kernel": fast_path().name(),
         "write_ms": round3(write_ms),
         "min_m": min,
         "max_m": max,
