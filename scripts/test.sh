@@ -48,6 +48,9 @@ wasm-pack build --release --target web --out-dir www/pkg --mode no-install
 
 step "native cargo test (unit, spec checks, properties, CLI)"
 cargo test 2>&1 | tee -a "$log"
+# The map kernel's paths this CPU ran in the agreement test above (issue 29), shown here (cargo
+# keeps a passing test's output); not logged again, so not counted twice.
+cargo test -q --test library every_dispatched_path -- --nocapture 2>&1 | grep -E 'kernel paths|fast paths'
 
 step "full-size spec checks (release): check 10 at the paper step over seeds, check 11 at full size (the cheap part of scripts/reproduce.sh)"
 # In release, as the tests' ignore notes say: the debug build took 11 min 18 s here (2026-12-03),
