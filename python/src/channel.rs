@@ -22,9 +22,7 @@ use scatterloc::study::{
 use scatterloc::track::gating::{AmplitudeClusterConfig, AssociationRule};
 use scatterloc::track::ConstantVelocity;
 
-use crate::convert::{
-    array, bool_array, f64_array, int_array, masked, path_string, to_python, JsonDoc,
-};
+use crate::convert::{array, f64_array, masked, path_string, to_python, JsonDoc};
 use crate::errors::{arg_error, Core};
 use crate::run::run_job;
 use crate::scenario::scenario_arg;
@@ -32,19 +30,6 @@ use crate::tracking::{one_filter, settings};
 
 // `cir_track`'s default `extent_sigma` is the library's (written as a number for Python).
 const _: () = assert!(EXTENT_SIGMA_M == 0.2);
-
-/// A complex128 array of `shape` from row-major `data`.
-fn complex_array<'py>(
-    py: Python<'py>,
-    data: Vec<Complex64>,
-    shape: &[usize],
-) -> PyResult<Bound<'py, PyAny>> {
-    let a = PyArray1::from_vec(py, data);
-    if shape.len() == 1 {
-        return Ok(a.into_any());
-    }
-    Ok(a.reshape(shape.to_vec())?.into_any())
-}
 
 /// A complex argument as (shape, row-major values): complex128 read directly, anything else
 /// through `numpy.asarray(x, dtype=complex)`.
@@ -208,7 +193,7 @@ impl PyRecording {
     #[getter]
     fn links<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         let l = &self.rec.links;
-        int_array(
+        array(
             py,
             l.iter().flat_map(|p| [p[0] as i64, p[1] as i64]).collect(),
             &[l.len(), 2],
@@ -225,7 +210,7 @@ impl PyRecording {
     #[getter]
     fn samples<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         let r = &self.rec;
-        complex_array(
+        array(
             py,
             r.samples.clone(),
             &[r.snapshot_count(), r.link_count(), r.samples_per_link()],
@@ -505,18 +490,18 @@ fn paths_object(
     }
     let k = delay.len();
     Ok(Paths {
-        snapshot: int_array(py, snap, &[k])?.unbind(),
+        snapshot: array(py, snap, &[k])?.unbind(),
         link: if links {
-            int_array(py, link, &[k])?.unbind()
+            array(py, link, &[k])?.unbind()
         } else {
             py.None()
         },
         delay: array(py, delay, &[k])?.unbind(),
-        amplitude: complex_array(py, amp, &[k])?.unbind(),
+        amplitude: array(py, amp, &[k])?.unbind(),
         sigma: array(py, sigma, &[k])?.unbind(),
         snr_db: masked(py, &snr, &[k])?.unbind(),
-        track: int_array(py, track, &[k])?.unbind(),
-        confirmed: bool_array(py, conf, &[k])?.unbind(),
+        track: array(py, track, &[k])?.unbind(),
+        confirmed: array(py, conf, &[k])?.unbind(),
         noise_var: array(py, noise, noise_shape)?.unbind(),
         t: array(py, t.to_vec(), &[t.len()])?.unbind(),
         doc,
@@ -578,7 +563,7 @@ pub fn estimate(
     let is_cir = tap0_s.is_some() || tap_spacing_s.is_some();
     let py_rec = |cfr: Option<&Bound<'_, PyAny>>, cir: Option<&Bound<'_, PyAny>>| {
         let arr = PyArray1::from_vec(py, data.clone()).reshape(vec![s, 1, n])?;
-        let links = int_array(py, vec![0, 0], &[1, 2])?;
+        let links = array(py, vec![0, 0], &[1, 2])?;
         let tt = array(py, t_s.clone(), &[s])?;
         let (cfr, cir) = match (cfr, cir) {
             (Some(_), _) => (Some(arr.as_any().clone()), None),
@@ -866,7 +851,7 @@ pub fn cir_track(
         t: array(py, track.t_s.clone(), &[s])?.unbind(),
         states: masked(py, &states, &[s, 4])?.unbind(),
         covariances: masked(py, &covs, &[s, 4, 4])?.unbind(),
-        links_used: int_array(
+        links_used: array(
             py,
             track.links_used.iter().map(|&n| n as i64).collect(),
             &[s],

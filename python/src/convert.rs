@@ -3,7 +3,7 @@
 //! arrays out, and the core's serde documents as the same Python dicts the CLI's JSON parses to
 //! (`json.loads` of the same text: keys, order, `null` for unbounded values, floats bit for bit).
 
-use numpy::{PyArray1, PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
+use numpy::{Element, PyArray1, PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::sync::PyOnceLock;
 use pyo3::types::PyAnyMethods;
@@ -159,32 +159,11 @@ pub fn matrix<const N: usize>(obj: &Bound<'_, PyAny>, field: &str) -> PyResult<[
     Ok(m)
 }
 
-/// A float64 array of `shape` from row-major `data`.
-pub fn array<'py>(py: Python<'py>, data: Vec<f64>, shape: &[usize]) -> PyResult<Bound<'py, PyAny>> {
-    let a = PyArray1::from_vec(py, data);
-    if shape.len() == 1 {
-        return Ok(a.into_any());
-    }
-    Ok(a.reshape(shape.to_vec())?.into_any())
-}
-
-/// An int64 array of `shape` from row-major `data`.
-pub fn int_array<'py>(
+/// An array of `shape` from row-major `data` (float64, int64, bool or complex128: numpy's dtype
+/// of `T`).
+pub fn array<'py, T: Element>(
     py: Python<'py>,
-    data: Vec<i64>,
-    shape: &[usize],
-) -> PyResult<Bound<'py, PyAny>> {
-    let a = PyArray1::from_vec(py, data);
-    if shape.len() == 1 {
-        return Ok(a.into_any());
-    }
-    Ok(a.reshape(shape.to_vec())?.into_any())
-}
-
-/// A bool array of `shape` from row-major `data`.
-pub fn bool_array<'py>(
-    py: Python<'py>,
-    data: Vec<bool>,
+    data: Vec<T>,
     shape: &[usize],
 ) -> PyResult<Bound<'py, PyAny>> {
     let a = PyArray1::from_vec(py, data);
@@ -203,7 +182,7 @@ pub fn masked<'py>(
 ) -> PyResult<Bound<'py, PyAny>> {
     static MASKED_ARRAY: PyOnceLock<Py<PyAny>> = PyOnceLock::new();
     let values = array(py, data.iter().map(|v| v.unwrap_or(0.0)).collect(), shape)?;
-    let mask = bool_array(py, data.iter().map(Option::is_none).collect(), shape)?;
+    let mask = array(py, data.iter().map(Option::is_none).collect(), shape)?;
     let kwargs = pyo3::types::PyDict::new(py);
     kwargs.set_item("mask", mask)?;
     MASKED_ARRAY

@@ -11,7 +11,7 @@ use scatterloc::mtl::input::{
     RegionInput, TrainingSpec, DEFAULT_DIAMETER_M, DEFAULT_LAMBDA, DEFAULT_P_D,
 };
 
-use crate::convert::{array, int_array, to_json_text, to_python};
+use crate::convert::{array, to_json_text, to_python};
 use crate::errors::{arg_error, Core};
 use crate::run::run_job;
 
@@ -245,7 +245,7 @@ pub fn mtl_locate(
         positions: array(py, pos, &[k, 2])?.unbind(),
         scores: array(py, doc.targets.iter().map(|t| t.j).collect(), &[k])?.unbind(),
         blocking: array(py, doc.targets.iter().map(|t| t.l_b).collect(), &[k])?.unbind(),
-        direct_paths: int_array(
+        direct_paths: array(
             py,
             doc.targets
                 .iter()

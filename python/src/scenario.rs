@@ -11,7 +11,7 @@ use scatterloc::present::Session;
 use scatterloc::scenario::{presets, Area};
 use scatterloc::{Scenario, Vec2};
 
-use crate::convert::{array, int_array, path_string, point, points, to_json_text, to_python};
+use crate::convert::{array, path_string, point, points, to_json_text, to_python};
 use crate::errors::{arg_error, Core};
 
 /// Largest scenario file read, bytes (the CLI's input cap, docs/cli.md "Size caps").
@@ -252,7 +252,7 @@ impl PyScenario {
     #[getter]
     fn link_indices<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         let l = &self.model().network.links;
-        int_array(
+        array(
             py,
             l.iter().flat_map(|l| [l.tx as i64, l.rx as i64]).collect(),
             &[l.len(), 2],

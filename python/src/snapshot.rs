@@ -11,7 +11,7 @@ use scatterloc::present::{CrlbDoc, FixDoc};
 use scatterloc::scenario::Area;
 use scatterloc::Vec2;
 
-use crate::convert::{array, bool_array, f64_array, masked, point, to_python};
+use crate::convert::{array, f64_array, masked, point, to_python};
 use crate::errors::{arg_error, Core};
 use crate::run::run_job;
 use crate::scenario::{scenario_arg, PyScenario};
@@ -172,7 +172,7 @@ pub fn crlb<'py>(
                 .into_any()
                 .unbind()
         } else {
-            bool_array(py, bounded, &lead)?.unbind()
+            array(py, bounded, &lead)?.unbind()
         },
         fisher: array(py, fim, &with(&[2, 2]))?.unbind(),
         covariance: array(py, cov, &with(&[2, 2]))?.unbind(),

@@ -13,7 +13,7 @@ use scatterloc::study::{track_cpu_s, track_measurements_in, TrackOutput, TrackRe
 use scatterloc::track::gating::{AssociationRule, Calibration, ClusterConfig};
 use scatterloc::track::{FilterKind, FilterSettings};
 
-use crate::convert::{array, f64_array, int_array, masked, matrix, to_json_text, to_python};
+use crate::convert::{array, f64_array, masked, matrix, to_json_text, to_python};
 use crate::errors::{arg_error, Core};
 use crate::run::run_sized;
 use crate::scenario::{read_text, scenario_arg};
@@ -272,7 +272,7 @@ pub fn track_object(py: Python<'_>, out: TrackOutput) -> PyResult<Track> {
         None => py.None(),
     };
     let static_removed = match &out.static_removed {
-        Some(r) => int_array(
+        Some(r) => array(
             py,
             r.iter().flatten().map(|&n| n as i64).collect(),
             &[s, links],
@@ -293,8 +293,7 @@ pub fn track_object(py: Python<'_>, out: TrackOutput) -> PyResult<Track> {
         states: array(py, states, &[s, 4])?.unbind(),
         covariances: array(py, covs, &[s, 4, 4])?.unbind(),
         nis: masked(py, &out.nis, &[s])?.unbind(),
-        links_used: int_array(py, out.links_used.iter().map(|&n| n as i64).collect(), &[s])?
-            .unbind(),
+        links_used: array(py, out.links_used.iter().map(|&n| n as i64).collect(), &[s])?.unbind(),
         delays_used,
         choices,
         static_removed,

@@ -113,35 +113,18 @@ pub fn crlb_map_rows_on(
     {
         use super::lanes::{Avx2, Avx512};
         use pulp::x86::{V3, V4};
+        let fast = !path.exact();
         match path {
             MapPath::Avx2 | MapPath::Avx2Fast => {
                 if let Some(s) = V3::try_new() {
-                    let rows = Rows {
-                        arch: s,
-                        model,
-                        grid,
-                        first_row,
-                        out,
-                    };
-                    return match path {
-                        MapPath::Avx2Fast => s.vectorize(Kernel::<Avx2<true>>(rows)),
-                        _ => s.vectorize(Kernel::<Avx2<false>>(rows)),
-                    };
+                    return on::<_, Avx2<false>, Avx2<true>>(s, fast, model, grid, first_row, out);
                 }
             }
             MapPath::Avx512 | MapPath::Avx512Fast => {
                 if let Some(s) = V4::try_new() {
-                    let rows = Rows {
-                        arch: s,
-                        model,
-                        grid,
-                        first_row,
-                        out,
-                    };
-                    return match path {
-                        MapPath::Avx512Fast => s.vectorize(Kernel::<Avx512<true>>(rows)),
-                        _ => s.vectorize(Kernel::<Avx512<false>>(rows)),
-                    };
+                    return on::<_, Avx512<false>, Avx512<true>>(
+                        s, fast, model, grid, first_row, out,
+                    );
                 }
             }
             MapPath::Portable => {}
@@ -149,6 +132,36 @@ pub fn crlb_map_rows_on(
     }
     let _ = path;
     crlb_map_rows(model, grid, first_row, out)
+}
+
+/// The kernel on the exact or the fast `Lanes` type of one instruction set `S`.
+#[cfg(target_arch = "x86_64")]
+fn on<S, Exact, Fast>(
+    arch: S,
+    fast: bool,
+    model: &Model,
+    grid: &Grid,
+    first_row: usize,
+    out: &mut [Real],
+) -> Result<()>
+where
+    S: pulp::Simd,
+    Exact: crate::math::Lanes<Arch = S>,
+    Fast: crate::math::Lanes<Arch = S>,
+{
+    let rows = Rows {
+        arch,
+        model,
+        grid,
+        first_row,
+        out,
+    };
+    let s = arch;
+    if fast {
+        s.vectorize(Kernel::<Fast>(rows))
+    } else {
+        s.vectorize(Kernel::<Exact>(rows))
+    }
 }
 
 /// The arguments of one kernel call.
