@@ -156,11 +156,10 @@ where
         first_row,
         out,
     };
-    let s = arch;
     if fast {
-        s.vectorize(Kernel::<Fast>(rows))
+        arch.vectorize(Kernel::<Fast>(rows))
     } else {
-        s.vectorize(Kernel::<Exact>(rows))
+        arch.vectorize(Kernel::<Exact>(rows))
     }
 }
 

@@ -1,7 +1,7 @@
 //! The CRLB map on threads: blocks of whole rows of the grid run the kernel on this CPU's
 //! fastest path ([`super::fast_path`]: AVX-512 or AVX2 when present, issue 29) on rayon workers.
-//! Rows are independent, so the map is bitwise the single-threaded one for any thread count. [`crlb_map_parallel_in`] also stops
-//! on a cancel flag (Ctrl-C in the Python package).
+//! Rows are independent, so the map is bitwise the single-threaded one for any thread count.
+//! [`crlb_map_parallel_in`] also stops on a cancel flag (Ctrl-C in the Python package).
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
