@@ -17,7 +17,8 @@ mod snapshot;
 
 pub use band::{Band, ResponseMap};
 pub use estimate::{
-    fisher_matrix, Estimator, EstimatorConfig, PathEstimate, SnapshotEstimate, MERGE_FRACTION,
+    fisher_matrix, EstimateWork, Estimator, EstimatorConfig, PathEstimate, SnapshotEstimate, Stop,
+    MERGE_FRACTION,
 };
 pub use paths::{PathTracker, PathTrackerConfig, TrackedPath};
 pub use recording::{Layout, Pulse, Recording};

@@ -219,6 +219,25 @@ pub const RANGE_M: Range = Range {
 /// only costs time ([S] resolves fewer than 20 paths per link).
 pub const MAX_PATHS: usize = 64;
 
+/// Most refinement sweeps of the snapshot estimator (C5) after one new path: each sweep moves
+/// every path by one Newton step; they stop earlier once no delay moves by more than 10⁻⁴/B
+/// (two to five sweeps on separated paths). A snapshot that reaches the bound keeps its paths
+/// and is counted (`EstimateWork::sweeps_capped`).
+pub const ESTIMATOR_SWEEPS: usize = 30;
+
+/// Most Newton iterations of one new path of the snapshot estimator (C5), from the parabola
+/// through the periodogram's peak (quadratic convergence: two or three suffice).
+pub const NEWTON_ITERATIONS: usize = 8;
+
+/// The estimator's dynamic range (C5), dB: the noise variance is never taken below the
+/// response's mean bin power this far down. 20 dB is a coarse receiver; 300 dB is beyond the
+/// rounding of float64 samples.
+pub const ESTIMATOR_DYNAMIC_RANGE_DB: Range = Range {
+    min: 20.0,
+    max: 300.0,
+    allowed: "20 to 300 dB",
+};
+
 /// Largest zero-padded periodogram of the snapshot estimator (C5): `2^20` cells (16 MiB of
 /// complex scratch), e.g. 16 384 bins oversampled 64×.
 pub const MAX_PERIODOGRAM: usize = 1 << 20;

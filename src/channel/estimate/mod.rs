@@ -1,28 +1,41 @@
-//! The snapshot estimator (C5): greedy ML with cyclic (SAGE) refinement, a CFAR stop and
-//! per-path delay standard deviations from the joint Fisher matrix.
+//! The snapshot estimator (C5): greedy ML with cyclic refinement, a CFAR stop and per-path
+//! delay standard deviations from the joint Fisher matrix. Every loop has a stated bound
+//! ([`limits::MAX_PATHS`], [`limits::ESTIMATOR_SWEEPS`], [`limits::NEWTON_ITERATIONS`]); what a
+//! snapshot did against them is in [`SnapshotEstimate::work`].
 //!
 //! Per snapshot, on the residual `r = H − Ĥ`:
 //! 1. the periodogram `|c(τ)|² = |Σ_n P*[n] r[n] e^{j2πf_nτ}|²` on the grid `τ_k = k/(LΔf)`,
-//!    `L` the next power of two ≥ `oversample·N`, by one zero-padded FFT (our radix-2
-//!    [`fft`](crate::channel) module: deterministic, `no_std`, bit-identical native and wasm);
+//!    `L` the next power of two ≥ `oversample·N`, by one zero-padded FFT (our `PaddedFft`:
+//!    deterministic, `no_std`, bit-identical native and wasm; its output stays in slot order);
 //! 2. CFAR: stop when `max_k |c_k|²/(σ̂²Σ|P|²) < γ = ln(G/P_fa)`, `G` the grid cells in the
 //!    window. Under noise alone each normalised cell is Exp(1), and the grid maximum exceeds γ
 //!    with probability ≈ `G_eff·e^{−γ}`, `G_eff ≈ N√(πγ/3)` (Rice's up-crossing rate for the
 //!    flat band) — with the default 4× oversampling `G = L ≈ 4N` this is ≈ 0.8–0.9·`P_fa`
 //!    (C8 check 2); larger oversampling makes the test conservative;
-//! 3. else Newton on `J(τ) = |c(τ)|²` from the grid maximum (analytic `J'`, `J''`, the
-//!    phasors `e^{j2πf_nτ}` by recursion over `n`), then SAGE sweeps (each path re-fitted by
-//!    Newton against the residual of the others), paths closer than `MERGE_FRACTION/B` merged
-//!    (the weaker dropped), and a joint least-squares fit of all amplitudes (`K×K` Hermitian
-//!    normal equations).
+//! 3. else the new delay: a parabola through the peak cell and its neighbours, then Newton on
+//!    `J(τ) = |c(τ)|²` (analytic `J'`, `J''`, the phasors `e^{j2πf_nτ}` by recursion over
+//!    `n`); then cyclic refinement (SAGE with one Newton step per path and sweep, as NOMP:
+//!    each path re-fitted against the residual of the others) until no delay moves by more
+//!    than `SAGE_TOL/B`; paths closer than `MERGE_FRACTION/B` merged (the weaker dropped), and
+//!    a joint least-squares fit of all amplitudes (`K×K` Hermitian normal equations) after a
+//!    merge and at the end.
 //!
-//! `σ̂²`: the caller's `noise_var` if given; else the median over the periodogram grid of the
-//! current residual, `median_k |c_k|²/(Σ|P|²·ln 2)` (each cell is `σ²Σ|P|²·Exp(1)` under noise;
+//! The greedy loop adds one path per pass or stops: it stops at the CFAR test, at `M_max`
+//! paths ([`Stop::PathBudget`] when a peak above γ is left), or when the strongest residual
+//! peak is an existing path's misfit or merges into one ([`Stop::Merged`]) — so it runs at most
+//! `M_max + 1` passes whatever the data (a merge that keeps the count used to re-add the same
+//! peak forever).
+//!
+//! `σ̂²`: the caller's `noise_var` if given; else the median over the periodogram cells at the
+//! natural spacing `1/(MΔf)` (`M` the next power of two ≥ N: nearly independent cells) of the
+//! current residual, `median |c_k|²/(Σ|P|²·ln 2)` (each cell is `σ²Σ|P|²·Exp(1)` under noise;
 //! the median of Exp(1) is ln 2; paths occupy few cells, so the median ignores them — tested
-//! unbiased on noise to its standard error). Seeds (C6 predictions) are refined first and kept
-//! only if they pass the same CFAR test at their refined delay. Output σ̂_τ: from the inverse of
-//! the joint Fisher matrix of C1 for all fitted paths (3 real parameters each), falling back to
-//! C4 at the fitted SNR if that matrix is singular.
+//! unbiased on noise to its standard error). Either is floored at the response's mean bin
+//! power `dynamic_range_db` below (default 120 dB): a noise-free (ray-traced) or rounding-level
+//! response gets a finite σ̂ and finite paths, never an endless fit. Seeds (C6 predictions) are
+//! refined first and kept only if they pass the same CFAR test at their refined delay. Output
+//! σ̂_τ: from the inverse of the joint Fisher matrix of C1 for all fitted paths (3 real
+//! parameters each), falling back to C4 at the fitted SNR if that matrix is singular.
 
 // `!(x > 0.0)` is meant: a NaN must fail these checks as well.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
@@ -31,22 +44,19 @@ use alloc::vec;
 use alloc::vec::Vec;
 
 use crate::channel::band::{cis, median};
-use crate::channel::fft::Fft;
+use crate::channel::fft::PaddedFft;
 use crate::channel::{Band, DelayEstimate};
 use crate::error::{limits, Error, Result};
-use crate::math::{ln, round, sqrt, Complex, Real, PI};
+use crate::math::{db_to_linear, ln, round, sin, sqrt, Complex, Real, PI};
 
 mod linalg;
 
 /// Paths closer than this fraction of `1/B` are merged (their joint fit is ill-conditioned).
 pub const MERGE_FRACTION: Real = 0.25;
-/// Most SAGE sweeps over all paths after each new path (they stop earlier once no delay moves
-/// by more than `SAGE_TOL/B`).
-const SAGE_SWEEPS: usize = 30;
-/// Convergence of the SAGE sweeps, in units of `1/B`.
+/// Convergence of the refinement sweeps, in units of `1/B`.
 const SAGE_TOL: Real = 1e-4;
-/// Newton iterations per refinement.
-const NEWTON_ITERS: usize = 8;
+/// Convergence of a new path's Newton iterations, in units of `1/B`.
+const NEWTON_TOL: Real = 1e-7;
 
 /// Settings of the snapshot estimator (C5 **[choice]**).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -60,23 +70,30 @@ pub struct EstimatorConfig {
     /// Search window `[start, end]` of absolute delays, s (`None`: the whole unambiguous span
     /// `[0, 1/Δf)`); at most `1/Δf` wide.
     pub window_s: Option<(Real, Real)>,
+    /// The noise variance is never taken below the response's mean bin power this far down,
+    /// dB ([`limits::ESTIMATOR_DYNAMIC_RANGE_DB`]; default 120): the rounding floor of a
+    /// noise-free recording (complex64 samples hold about 144 dB).
+    pub dynamic_range_db: Real,
 }
 
 impl Default for EstimatorConfig {
-    /// [S]'s settings: 12 paths, `P_fa = 10⁻³` per snapshot, 4× oversampling, whole span.
+    /// [S]'s settings: 12 paths, `P_fa = 10⁻³` per snapshot, 4× oversampling, whole span; a
+    /// 120 dB floor.
     fn default() -> Self {
         EstimatorConfig {
             max_paths: 12,
             p_fa: 1e-3,
             oversample: 4,
             window_s: None,
+            dynamic_range_db: 120.0,
         }
     }
 }
 
 impl EstimatorConfig {
     /// Checks the settings: `p_fa` in (0, 1), `oversample` 4 … 64, `max_paths` 1 …
-    /// [`limits::MAX_PATHS`] (the window is checked against the band by [`Estimator::new`]).
+    /// [`limits::MAX_PATHS`], `dynamic_range_db` in [`limits::ESTIMATOR_DYNAMIC_RANGE_DB`]
+    /// (the window is checked against the band by [`Estimator::new`]).
     pub fn validate(&self) -> Result<()> {
         let cfg = self;
         if !(cfg.p_fa > 0.0 && cfg.p_fa < 1.0) {
@@ -102,6 +119,7 @@ impl EstimatorConfig {
                 max: limits::MAX_PATHS,
             });
         }
+        limits::ESTIMATOR_DYNAMIC_RANGE_DB.check("dynamic_range_db", cfg.dynamic_range_db)?;
         Ok(())
     }
 }
@@ -130,13 +148,61 @@ impl PathEstimate {
     }
 }
 
+/// Why a snapshot's greedy loop stopped.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Stop {
+    /// Nothing left above the CFAR threshold (the normal end).
+    #[default]
+    Threshold,
+    /// `M_max` paths and a residual peak still above the threshold: a bound was reached.
+    PathBudget,
+    /// The strongest residual peak was an existing path's misfit, or merged into one.
+    Merged,
+}
+
+impl Stop {
+    /// The name in `EST.json`: `threshold`, `path_budget`, `merged`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Stop::Threshold => "threshold",
+            Stop::PathBudget => "path_budget",
+            Stop::Merged => "merged",
+        }
+    }
+}
+
+/// What one snapshot's estimation did, against the stated bounds of its loops.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct EstimateWork {
+    /// Greedy passes (periodograms), at most `M_max + 1` (plus one per seed tried).
+    pub passes: usize,
+    /// The most refinement sweeps after one new path (at most [`limits::ESTIMATOR_SWEEPS`]).
+    pub sweeps: usize,
+    /// The most Newton iterations of one new path (at most [`limits::NEWTON_ITERATIONS`]).
+    pub newton: usize,
+    /// Whether some refinement ended at its sweep bound without converging.
+    pub sweeps_capped: bool,
+    /// Why the greedy loop stopped.
+    pub stop: Stop,
+}
+
+impl EstimateWork {
+    /// Whether a bound ended this snapshot's work (the path budget with a peak left, or the
+    /// sweep bound): the snapshot returns what it has and is counted.
+    pub fn bounded(&self) -> bool {
+        self.stop == Stop::PathBudget || self.sweeps_capped
+    }
+}
+
 /// One snapshot's result.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SnapshotEstimate {
     /// The paths, ascending in delay.
     pub paths: Vec<PathEstimate>,
-    /// The noise variance used, W (given, or estimated from the final residual).
+    /// The noise variance used, W (given, or estimated from the final residual; floored).
     pub noise_var: Real,
+    /// What the estimation did against its bounds.
+    pub work: EstimateWork,
 }
 
 /// The estimator of one band (plans, scratch buffers).
@@ -144,7 +210,9 @@ pub struct SnapshotEstimate {
 pub struct Estimator {
     band: Band,
     cfg: EstimatorConfig,
-    fft: Fft,
+    fft: PaddedFft,
+    /// Whether `P[n] = 1` for every bin (the products with `P` are skipped).
+    flat: bool,
     /// `f_n − f_c` (centred for conditioning), Hz.
     fc: Vec<Real>,
     /// `|P[n]|²`.
@@ -154,11 +222,67 @@ pub struct Estimator {
     span: Real,
     win_start: Real,
     win_end: Real,
-    /// Grid cells in the window (indices into the FFT output) and their delays in the window.
-    cells: Vec<(usize, Real)>,
+    /// Grid cells in the window: (FFT output slot, delay in the window), in slot order.
+    cells: Vec<(u32, Real)>,
+    /// The slot of each frequency index `k` (for a peak's neighbours).
+    slot_of: Vec<u32>,
+    /// Slots of the window's cells at the natural spacing (the median's cells).
+    median_slots: Vec<u32>,
     gamma: Real,
     scratch: Vec<Complex>,
     resid: Vec<Complex>,
+    tmp: Vec<Complex>,
+    powers: Vec<Real>,
+}
+
+/// One pass over the bins at delay `τ`: the phasors `e^{j2π(f_n−f_c)τ}` by recursion.
+#[derive(Clone, Copy)]
+struct Phasor {
+    start: Complex,
+    step: Complex,
+}
+
+impl Phasor {
+    fn at(fc0: Real, df: Real, tau: Real) -> Phasor {
+        Phasor {
+            start: cis(2.0 * PI * fc0 * tau),
+            step: cis(2.0 * PI * df * tau),
+        }
+    }
+}
+
+/// `c(τ)` and its first two derivatives `c'`, `c''` in `τ`.
+#[derive(Clone, Copy)]
+struct Moments {
+    c0: Complex,
+    c1: Complex,
+    c2: Complex,
+}
+
+impl Moments {
+    /// Newton's step on `J = |c|²` (a quarter-resolution gradient step where `J` is not
+    /// concave), clipped to `max_step`.
+    fn newton_step(&self, max_step: Real) -> Real {
+        let Moments { c0, c1, c2 } = *self;
+        let d1 = 2.0 * (c0.conj() * c1).re;
+        let d2 = 2.0 * (c1.norm_sqr() + (c0.conj() * c2).re);
+        let mut dt = if d2 < 0.0 { -d1 / d2 } else { 0.0 };
+        if d2 >= 0.0 || !dt.is_finite() {
+            dt = if d1 > 0.0 {
+                max_step * 0.25
+            } else if d1 < 0.0 {
+                -max_step * 0.25
+            } else {
+                0.0
+            };
+        }
+        dt.clamp(-max_step, max_step)
+    }
+
+    /// `c(τ + dt)` by its second-order Taylor series.
+    fn at(&self, dt: Real) -> Complex {
+        self.c0 + self.c1 * dt + self.c2 * (0.5 * dt * dt)
+    }
 }
 
 impl Estimator {
@@ -196,12 +320,21 @@ impl Estimator {
                 (a, b)
             }
         };
+        let fft = PaddedFft::new(n, l);
         let cell = span / l as Real;
+        let mut slot_of = vec![0u32; l];
         let mut cells = Vec::new();
-        for k in 0..l {
+        let mut median_slots = Vec::new();
+        let stride = l / n.next_power_of_two().min(l);
+        for (slot, &k) in fft.natural().iter().enumerate() {
+            let k = k as usize;
+            slot_of[k] = slot as u32;
             let t = fold(k as Real * cell, ws, span);
             if cfg.window_s.is_none() || t <= we {
-                cells.push((k, t));
+                cells.push((slot as u32, t));
+                if k % stride == 0 {
+                    median_slots.push(slot as u32);
+                }
             }
         }
         if cells.is_empty() {
@@ -211,13 +344,18 @@ impl Estimator {
                 allowed: "wide enough to hold one periodogram cell",
             });
         }
+        if median_slots.is_empty() {
+            median_slots = cells.iter().map(|c| c.0).collect();
+        }
         let gamma = ln(cells.len() as Real / cfg.p_fa);
         let fcen = 0.5 * (band.freq_hz[0] + band.freq_hz[n - 1]);
         let fc = band.freq_hz.iter().map(|f| f - fcen).collect();
         let w = band.response.iter().map(|p| p.norm_sqr()).collect();
         let energy = band.response_energy();
+        let flat = band.response.iter().all(|p| *p == Complex::new(1.0, 0.0));
         Ok(Estimator {
-            fft: Fft::new(l),
+            fft,
+            flat,
             fc,
             w,
             energy,
@@ -226,9 +364,13 @@ impl Estimator {
             win_start: ws,
             win_end: we,
             cells,
+            slot_of,
+            powers: Vec::with_capacity(median_slots.len()),
+            median_slots,
             gamma,
             scratch: vec![Complex::new(0.0, 0.0); l],
             resid: vec![Complex::new(0.0, 0.0); n],
+            tmp: vec![Complex::new(0.0, 0.0); n],
             band,
             cfg,
         })
@@ -255,7 +397,8 @@ impl Estimator {
     }
 
     /// Estimates the paths of one response `h` (`None` noise: estimated from the data), with
-    /// `seeds` (predicted delays, s) refined first. Errors: `h` of the wrong length
+    /// `seeds` (predicted delays, s) refined first. The noise variance is floored at `h`'s mean
+    /// bin power [`EstimatorConfig::dynamic_range_db`] down. Errors: `h` of the wrong length
     /// ([`Error::LengthMismatch`]) or non-finite, a `noise_var` not finite and > 0, a
     /// non-finite seed. An all-zero `h` gives zero paths.
     pub fn estimate(
@@ -263,6 +406,20 @@ impl Estimator {
         h: &[Complex],
         noise_var: Option<Real>,
         seeds: &[Real],
+    ) -> Result<SnapshotEstimate> {
+        let power = h.iter().map(|v| v.norm_sqr()).sum::<Real>() / h.len().max(1) as Real;
+        self.estimate_floored(h, noise_var, seeds, power)
+    }
+
+    /// [`Estimator::estimate`] with the floor measured from `reference_power` (W per bin)
+    /// instead of `h`'s own: a residual after the background (C9) is floored at the full
+    /// response's power, where its rounding and alignment errors come from.
+    pub fn estimate_floored(
+        &mut self,
+        h: &[Complex],
+        noise_var: Option<Real>,
+        seeds: &[Real],
+        reference_power: Real,
     ) -> Result<SnapshotEstimate> {
         let n = self.band.len();
         if h.len() != n {
@@ -290,14 +447,21 @@ impl Estimator {
                 field: "seeds".into(),
             });
         }
+        let floor = if reference_power.is_finite() && reference_power > 0.0 {
+            reference_power * db_to_linear(-self.cfg.dynamic_range_db)
+        } else {
+            0.0
+        };
+        let mut work = EstimateWork::default();
         let mut paths: Vec<(Real, Complex)> = Vec::new();
         self.resid.clear();
         self.resid.extend_from_slice(h);
         let mut sigma2 = match noise_var {
-            Some(v) => v,
+            Some(v) => v.max(floor),
             None => {
                 self.periodogram();
-                self.median_noise()
+                work.passes += 1;
+                self.median_noise().max(floor)
             }
         };
         // Seeds first (C6): Newton from each prediction, kept if it passes the CFAR test.
@@ -305,45 +469,61 @@ impl Estimator {
             if paths.len() >= self.cfg.max_paths || !(sigma2 > 0.0) {
                 break;
             }
-            let tau = self.newton(fold(seed, self.win_start, self.span));
-            let c = self.corr(&self.resid, tau);
+            let (tau, m, it) = self.newton(fold(seed, self.win_start, self.span));
+            work.newton = work.newton.max(it);
+            let c = m.c0;
             if c.norm_sqr() / (sigma2 * self.energy) >= self.gamma
                 && paths.iter().all(|p| (p.0 - tau).abs() >= self.merge_sep())
             {
                 let a = c / self.energy;
-                self.sub_path(tau, a, -1.0);
+                self.add_path(tau, -a);
                 paths.push((tau, a));
-                self.refine(h, &mut paths);
+                self.refine(h, &mut paths, &mut work);
             }
         }
-        loop {
+        // The greedy loop: each pass adds a path or stops, so at most `max_paths + 1` passes.
+        for _ in 0..=self.cfg.max_paths {
             self.periodogram();
+            work.passes += 1;
             if noise_var.is_none() {
-                sigma2 = self.median_noise();
+                sigma2 = self.median_noise().max(floor);
             }
-            if paths.len() >= self.cfg.max_paths || !(sigma2 > 0.0) {
+            if !(sigma2 > 0.0) {
                 break;
             }
-            let (mut best, mut tk) = (0.0, 0.0);
-            for &(k, t) in &self.cells {
-                let v = self.scratch[k].norm_sqr();
+            let (mut best, mut slot, mut tk) = (0.0, 0u32, 0.0);
+            for &(s, t) in &self.cells {
+                let v = self.scratch[s as usize].norm_sqr();
                 if v > best {
                     best = v;
+                    slot = s;
                     tk = t;
                 }
             }
             if !(best / (sigma2 * self.energy) >= self.gamma) {
                 break;
             }
-            let tau = self.newton(tk);
-            if paths.iter().any(|p| (p.0 - tau).abs() < self.merge_sep()) {
-                break; // the strongest residual peak is an existing path's misfit
+            if paths.len() >= self.cfg.max_paths {
+                work.stop = Stop::PathBudget;
+                break;
             }
-            let a = self.corr(&self.resid, tau) / self.energy;
-            self.sub_path(tau, a, -1.0);
+            let (tau, m, it) = self.newton(tk + self.parabola(slot));
+            work.newton = work.newton.max(it);
+            if paths.iter().any(|p| (p.0 - tau).abs() < self.merge_sep()) {
+                work.stop = Stop::Merged; // the strongest residual peak is an existing path's misfit
+                break;
+            }
+            let before = paths.len();
+            let a = m.c0 / self.energy;
+            self.add_path(tau, -a);
             paths.push((tau, a));
-            self.refine(h, &mut paths);
+            self.refine(h, &mut paths, &mut work);
+            if paths.len() <= before {
+                work.stop = Stop::Merged;
+                break;
+            }
         }
+        self.joint_ls(h, &mut paths);
         if !(sigma2 > 0.0) {
             sigma2 = 0.0;
         }
@@ -373,6 +553,7 @@ impl Estimator {
         Ok(SnapshotEstimate {
             paths: out,
             noise_var: sigma2,
+            work,
         })
     }
 
@@ -380,120 +561,187 @@ impl Estimator {
         MERGE_FRACTION / (self.df * self.band.len() as Real)
     }
 
-    /// `scratch` ← the zero-padded FFT of `P*·r` (cell `k`: `c(k/(LΔf))` up to a phase).
+    /// `scratch` ← the zero-padded FFT of `P*·r` (slot `s`: `c(k/(LΔf))` up to a phase, `k`
+    /// the slot's frequency index).
     fn periodogram(&mut self) {
-        for v in self.scratch.iter_mut() {
-            *v = Complex::new(0.0, 0.0);
+        if self.flat {
+            self.fft.run(&self.resid, &mut self.scratch);
+        } else {
+            for ((t, r), p) in self
+                .tmp
+                .iter_mut()
+                .zip(&self.resid)
+                .zip(&self.band.response)
+            {
+                *t = p.conj() * r;
+            }
+            self.fft.run(&self.tmp, &mut self.scratch);
         }
-        for ((s, r), p) in self
-            .scratch
-            .iter_mut()
-            .zip(&self.resid)
-            .zip(&self.band.response)
-        {
-            *s = p.conj() * r;
-        }
-        self.fft.run(&mut self.scratch, true);
     }
 
-    /// `median_k |c_k|² / (Σ|P|² ln 2)` over the window's cells.
-    fn median_noise(&self) -> Real {
-        let mut v: Vec<Real> = self
-            .cells
-            .iter()
-            .map(|&(k, _)| self.scratch[k].norm_sqr())
-            .collect();
-        median(&mut v) / (self.energy * ln(2.0))
+    /// The sub-cell offset (s) of the peak in `slot`: the vertex of the parabola through the
+    /// magnitudes of the cell and its two neighbours, within half a cell.
+    fn parabola(&self, slot: u32) -> Real {
+        let l = self.fft.len();
+        let k = self.fft.natural()[slot as usize] as usize;
+        let mag = |k: usize| sqrt(self.scratch[self.slot_of[k % l] as usize].norm_sqr());
+        let (y0, y1, y2) = (mag(k + l - 1), mag(k), mag(k + 1));
+        let den = y0 - 2.0 * y1 + y2;
+        let off = if den < 0.0 {
+            (0.5 * (y0 - y2) / den).clamp(-0.5, 0.5)
+        } else {
+            0.0
+        };
+        off * self.span / l as Real
     }
 
-    /// `c(τ) = Σ P*[n] x[n] e^{j2π(f_n−f_c)τ}`.
-    fn corr(&self, x: &[Complex], tau: Real) -> Complex {
-        let mut ph = cis(2.0 * PI * self.fc[0] * tau);
-        let step = cis(2.0 * PI * self.df * tau);
-        let mut acc = Complex::new(0.0, 0.0);
-        for (v, p) in x.iter().zip(&self.band.response) {
-            acc += p.conj() * v * ph;
-            ph *= step;
-        }
-        acc
+    /// `median |c|² / (Σ|P|² ln 2)` over the window's cells at the natural spacing.
+    fn median_noise(&mut self) -> Real {
+        self.powers.clear();
+        self.powers.extend(
+            self.median_slots
+                .iter()
+                .map(|&s| self.scratch[s as usize].norm_sqr()),
+        );
+        median(&mut self.powers) / (self.energy * ln(2.0))
     }
 
-    /// `resid += sign·α·P·e^{−j2π(f_n−f_c)τ}`.
-    fn sub_path(&mut self, tau: Real, a: Complex, sign: Real) {
-        let mut ph = cis(-2.0 * PI * self.fc[0] * tau);
-        let step = cis(-2.0 * PI * self.df * tau);
-        let a = a * sign;
-        for (r, p) in self.resid.iter_mut().zip(&self.band.response) {
-            *r += p * ph * a;
-            ph *= step;
+    /// `c(τ)`, `c'(τ)`, `c''(τ)` of the residual (`c(τ) = Σ P*[n] r[n] e^{j2π(f_n−f_c)τ}`).
+    fn moments(&self, tau: Real) -> Moments {
+        let ph0 = Phasor::at(self.fc[0], self.df, tau);
+        let mut ph = ph0.start;
+        let (mut c0, mut c1, mut c2) = (
+            Complex::new(0.0, 0.0),
+            Complex::new(0.0, 0.0),
+            Complex::new(0.0, 0.0),
+        );
+        let tp = 2.0 * PI;
+        for i in 0..self.resid.len() {
+            let r = if self.flat {
+                self.resid[i]
+            } else {
+                self.band.response[i].conj() * self.resid[i]
+            };
+            let x = r * ph;
+            let f = tp * self.fc[i];
+            c0 += x;
+            let xf = x * f;
+            c1 += Complex::new(-xf.im, xf.re);
+            c2 -= xf * f;
+            ph *= ph0.step;
         }
+        Moments { c0, c1, c2 }
+    }
+
+    /// `resid += a·P·e^{−j2π(f_n−f_c)τ}`.
+    fn add_path(&mut self, tau: Real, a: Complex) {
+        let ph0 = Phasor::at(self.fc[0], self.df, tau);
+        let mut ph = ph0.start.conj() * a;
+        let step = ph0.step.conj();
+        if self.flat {
+            for r in self.resid.iter_mut() {
+                *r += ph;
+                ph *= step;
+            }
+        } else {
+            for (r, p) in self.resid.iter_mut().zip(&self.band.response) {
+                *r += p * ph;
+                ph *= step;
+            }
+        }
+    }
+
+    /// `resid += a·P·e^{−j2π(f_n−f_c)τ}` and the moments of the new residual at `τ`, in one
+    /// pass (a path added back before it is re-fitted).
+    fn add_back(&mut self, tau: Real, a: Complex) -> Moments {
+        let ph0 = Phasor::at(self.fc[0], self.df, tau);
+        let mut ph = ph0.start;
+        let (mut c0, mut c1, mut c2) = (
+            Complex::new(0.0, 0.0),
+            Complex::new(0.0, 0.0),
+            Complex::new(0.0, 0.0),
+        );
+        let tp = 2.0 * PI;
+        for i in 0..self.resid.len() {
+            let pa = if self.flat {
+                a
+            } else {
+                self.band.response[i] * a
+            };
+            self.resid[i] += pa * ph.conj();
+            let r = if self.flat {
+                self.resid[i]
+            } else {
+                self.band.response[i].conj() * self.resid[i]
+            };
+            let x = r * ph;
+            let f = tp * self.fc[i];
+            c0 += x;
+            let xf = x * f;
+            c1 += Complex::new(-xf.im, xf.re);
+            c2 -= xf * f;
+            ph *= ph0.step;
+        }
+        Moments { c0, c1, c2 }
     }
 
     /// Newton on `J(τ) = |c(τ)|²` of the residual from `tau`, steps clipped to a quarter of
-    /// `1/B`; the result folded into the window.
-    fn newton(&self, mut tau: Real) -> Real {
+    /// `1/B`, at most [`limits::NEWTON_ITERATIONS`]: the delay (folded into the window), the
+    /// moments at it and the iterations used.
+    fn newton(&self, mut tau: Real) -> (Real, Moments, usize) {
         let n = self.band.len();
         let max_step = 0.25 / (self.df * n as Real);
-        for _ in 0..NEWTON_ITERS {
-            let mut ph = cis(2.0 * PI * self.fc[0] * tau);
-            let step = cis(2.0 * PI * self.df * tau);
-            let (mut c0, mut c1, mut c2) = (
-                Complex::new(0.0, 0.0),
-                Complex::new(0.0, 0.0),
-                Complex::new(0.0, 0.0),
-            );
-            for i in 0..n {
-                let x = self.band.response[i].conj() * self.resid[i] * ph;
-                let f = 2.0 * PI * self.fc[i];
-                c0 += x;
-                c1 += x * Complex::new(0.0, f);
-                c2 += x * (-f * f);
-                ph *= step;
-            }
-            let d1 = 2.0 * (c0.conj() * c1).re;
-            let d2 = 2.0 * (c1.norm_sqr() + (c0.conj() * c2).re);
-            let mut dt = if d2 < 0.0 { -d1 / d2 } else { 0.0 };
-            if d2 >= 0.0 || !dt.is_finite() {
-                // not concave here: a small gradient step towards the rise
-                dt = if d1 > 0.0 {
-                    max_step * 0.25
-                } else if d1 < 0.0 {
-                    -max_step * 0.25
-                } else {
-                    0.0
-                };
-            }
-            let dt = dt.clamp(-max_step, max_step);
+        let tol = NEWTON_TOL / (self.df * n as Real);
+        let mut m = self.moments(tau);
+        let mut used = 0;
+        for _ in 0..limits::NEWTON_ITERATIONS {
+            used += 1;
+            let dt = m.newton_step(max_step);
             tau += dt;
-            if dt.abs() < 1e-7 * max_step {
+            if dt.abs() < tol {
+                let c = m.at(dt);
+                m = Moments { c0: c, ..m };
                 break;
             }
+            m = self.moments(tau);
         }
-        fold(tau, self.win_start, self.span).min(self.win_end)
+        let folded = fold(tau, self.win_start, self.span).min(self.win_end);
+        if folded != tau {
+            m = self.moments(folded);
+        }
+        (folded, m, used)
     }
 
-    /// SAGE sweeps over all paths, merge of close paths, joint LS of the amplitudes; leaves
-    /// `resid = h − Ĥ`.
-    fn refine(&mut self, h: &[Complex], paths: &mut Vec<(Real, Complex)>) {
-        let tol = SAGE_TOL / (self.df * self.band.len() as Real);
-        for sweep in 0..SAGE_SWEEPS {
+    /// Cyclic refinement (one Newton step per path and sweep, at most
+    /// [`limits::ESTIMATOR_SWEEPS`] sweeps, until no delay moves by `SAGE_TOL/B`), merge of
+    /// close paths (then a joint LS of the amplitudes); leaves `resid = h − Ĥ`.
+    fn refine(&mut self, h: &[Complex], paths: &mut Vec<(Real, Complex)>, work: &mut EstimateWork) {
+        let n = self.band.len();
+        let tol = SAGE_TOL / (self.df * n as Real);
+        let max_step = 0.25 / (self.df * n as Real);
+        let mut sweeps = 0;
+        let mut converged = paths.len() < 2;
+        while !converged && sweeps < limits::ESTIMATOR_SWEEPS {
+            sweeps += 1;
             let mut moved: Real = 0.0;
             for path in paths.iter_mut() {
                 let (t, a) = *path;
-                self.sub_path(t, a, 1.0);
-                let t2 = self.newton(t);
-                let a2 = self.corr(&self.resid, t2) / self.energy;
-                self.sub_path(t2, a2, -1.0);
+                let m = self.add_back(t, a);
+                let dt = m.newton_step(max_step);
+                let a2 = m.at(dt) / self.energy;
+                let t2 = fold(t + dt, self.win_start, self.span).min(self.win_end);
+                self.add_path(t2, -a2);
                 *path = (t2, a2);
-                moved = moved.max((t2 - t).abs());
+                moved = moved.max(dt.abs());
             }
-            if paths.len() < 2 || (sweep > 0 && moved < tol) {
-                break;
-            }
+            converged = moved < tol;
         }
+        work.sweeps = work.sweeps.max(sweeps);
+        work.sweeps_capped |= !converged;
         // merge: keep the stronger of paths closer than MERGE_FRACTION/B
         paths.sort_by(|a, b| a.0.total_cmp(&b.0));
         let sep = self.merge_sep();
+        let before = paths.len();
         let mut i = 1;
         while i < paths.len() {
             if paths[i].0 - paths[i - 1].0 < sep {
@@ -506,7 +754,9 @@ impl Estimator {
                 i += 1;
             }
         }
-        self.joint_ls(h, paths);
+        if paths.len() < before {
+            self.joint_ls(h, paths);
+        }
     }
 
     /// Joint least squares of all amplitudes at fixed delays; `resid` ← `h − Ĥ`.
@@ -519,11 +769,13 @@ impl Estimator {
         }
         let mut g = vec![Complex::new(0.0, 0.0); k * k];
         let mut b = vec![Complex::new(0.0, 0.0); k];
+        self.resid.clear();
+        self.resid.extend_from_slice(h);
         for i in 0..k {
-            b[i] = self.corr(h, paths[i].0);
+            b[i] = self.moments(paths[i].0).c0;
             g[i * k + i] = Complex::new(self.energy, 0.0);
             for j in i + 1..k {
-                let s = self.kernel(paths[j].0 - paths[i].0, 0);
+                let s = self.gram(paths[j].0 - paths[i].0);
                 g[i * k + j] = s;
                 g[j * k + i] = s.conj();
             }
@@ -533,11 +785,22 @@ impl Estimator {
                 p.1 = v;
             }
         }
-        self.resid.clear();
-        self.resid.extend_from_slice(h);
         for &(t, a) in paths.iter() {
-            self.sub_path(t, a, -1.0);
+            self.add_path(t, -a);
         }
+    }
+
+    /// `S_0(d) = Σ |P|² e^{−j2π(f_n−f_c)d}`: for a flat band on centred bins the real Dirichlet
+    /// kernel `sin(πNΔf d)/sin(πΔf d)`, else the sum.
+    fn gram(&self, d: Real) -> Complex {
+        let n = self.band.len();
+        if self.flat {
+            let den = sin(PI * self.df * d);
+            if den.abs() > 1e-9 {
+                return Complex::new(sin(PI * n as Real * self.df * d) / den, 0.0);
+            }
+        }
+        self.kernel(d, 0)
     }
 
     /// `S_a(d) = Σ |P|² (f_n−f_c)^a e^{−j2π(f_n−f_c)d}` (`a` = 0, 1, 2).

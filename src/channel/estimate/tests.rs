@@ -75,7 +75,8 @@ fn joint_bounds(b: &Band, paths: &[(Real, Complex)], var: Real) -> Vec<Real> {
     (0..k).map(|i| sqrt(inv[(3 * i, 3 * i)])).collect()
 }
 
-/// RMSE (m of path length) of the strongest path's delay over the trials that detect a path,
+/// RMSE (m of path length) of the strongest path's delay (modulo `1/Δf`) over the trials that
+/// detect a path,
 /// the C4 bound (m), the outlier rate among detections (|error| > 1/(2B)) and the miss rate.
 fn single_path(snr_db: Real, trials: usize, seed: u64) -> (Real, Real, Real, Real) {
     let b = band();
@@ -97,7 +98,11 @@ fn single_path(snr_db: Real, trials: usize, seed: u64) -> (Real, Real, Real, Rea
             miss += 1;
             continue;
         };
-        let err = best.delay_s - tau;
+        // Delays are ambiguous modulo 1/Δf (C1): a path 0.1 ns after the window's start is
+        // estimated just before it as often as after, i.e. folded to the window's end.
+        let span = b.unambiguous_s();
+        let d = best.delay_s - tau;
+        let err = d - span * crate::math::round(d / span);
         if err.abs() > 0.5 / B {
             outl += 1;
         }

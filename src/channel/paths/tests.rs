@@ -19,6 +19,7 @@ fn snap(paths: Vec<PathEstimate>) -> Result<SnapshotEstimate> {
     Ok(SnapshotEstimate {
         paths,
         noise_var: 1.0,
+        work: Default::default(),
     })
 }
 
