@@ -6,6 +6,7 @@
 //! [`crate::math`]'s `sin`/`cos` (the `libm` crate on every platform; the platform's own
 //! differ in the last bits), no FMA, so every platform gets the same bits. Sizes are powers of two (the periodogram zero-pads to one).
 
+use alloc::vec;
 use alloc::vec::Vec;
 
 use crate::math::{cos, sin, Complex, Real, PI};
@@ -97,6 +98,8 @@ pub(crate) struct PaddedFft {
     twiddles: Vec<Complex>,
     /// `natural[slot] = k`.
     natural: Vec<u32>,
+    /// `slot_of[k] = slot`.
+    slot_of: Vec<u32>,
 }
 
 impl PaddedFft {
@@ -130,9 +133,13 @@ impl PaddedFft {
                 (i as u32).reverse_bits() >> (32 - bits)
             }
         };
-        let natural = (0..l)
+        let natural: Vec<u32> = (0..l)
             .map(|slot| (r * rev(slot % m) as usize + slot / m) as u32)
             .collect();
+        let mut slot_of = vec![0u32; l];
+        for (slot, &k) in natural.iter().enumerate() {
+            slot_of[k as usize] = slot as u32;
+        }
         PaddedFft {
             n,
             m,
@@ -140,6 +147,7 @@ impl PaddedFft {
             rotate,
             twiddles,
             natural,
+            slot_of,
         }
     }
 
@@ -151,6 +159,22 @@ impl PaddedFft {
     /// `natural[slot]`: the frequency index `k` held by output slot `slot`.
     pub(crate) fn natural(&self) -> &[u32] {
         &self.natural
+    }
+
+    /// The vertex of the parabola through the magnitudes of `out`'s frequency index
+    /// `natural[slot]` and its two neighbours (cyclic), as a fraction of a cell in
+    /// `[−0.5, 0.5]` (0 where the three are not concave): a peak's sub-cell offset.
+    pub(crate) fn parabola(&self, out: &[Complex], slot: u32) -> Real {
+        let l = self.natural.len();
+        let k = self.natural[slot as usize] as usize;
+        let mag = |k: usize| crate::math::sqrt(out[self.slot_of[k % l] as usize].norm_sqr());
+        let (y0, y1, y2) = (mag(k + l - 1), mag(k), mag(k + 1));
+        let den = y0 - 2.0 * y1 + y2;
+        if den < 0.0 {
+            (0.5 * (y0 - y2) / den).clamp(-0.5, 0.5)
+        } else {
+            0.0
+        }
     }
 
     /// `out[slot] = X[natural[slot]]` of `x` (`x.len() = n`, `out.len() = L`).

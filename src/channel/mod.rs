@@ -7,6 +7,7 @@
 //! scatterers, a walking person). Its output, per snapshot and link a list of
 //! [`DelayEstimate`]s (a [`Snapshot`]), is what `track::gating` reads, whatever filter runs.
 
+mod background;
 mod band;
 mod estimate;
 mod fft;
@@ -15,6 +16,7 @@ mod recording;
 mod simulate;
 mod snapshot;
 
+pub use background::{AlignMode, Alignment, LinkBackground, DEFAULT_BACKGROUND_TIME_S};
 pub use band::{Band, ResponseMap};
 pub use estimate::{
     fisher_matrix, EstimateWork, Estimator, EstimatorConfig, PathEstimate, SnapshotEstimate, Stop,

@@ -224,8 +224,6 @@ pub struct Estimator {
     win_end: Real,
     /// Grid cells in the window: (FFT output slot, delay in the window), in slot order.
     cells: Vec<(u32, Real)>,
-    /// The slot of each frequency index `k` (for a peak's neighbours).
-    slot_of: Vec<u32>,
     /// Slots of the window's cells at the natural spacing (the median's cells).
     median_slots: Vec<u32>,
     gamma: Real,
@@ -322,13 +320,11 @@ impl Estimator {
         };
         let fft = PaddedFft::new(n, l);
         let cell = span / l as Real;
-        let mut slot_of = vec![0u32; l];
         let mut cells = Vec::new();
         let mut median_slots = Vec::new();
         let stride = l / n.next_power_of_two().min(l);
         for (slot, &k) in fft.natural().iter().enumerate() {
             let k = k as usize;
-            slot_of[k] = slot as u32;
             let t = fold(k as Real * cell, ws, span);
             if cfg.window_s.is_none() || t <= we {
                 cells.push((slot as u32, t));
@@ -364,7 +360,6 @@ impl Estimator {
             win_start: ws,
             win_end: we,
             cells,
-            slot_of,
             powers: Vec::with_capacity(median_slots.len()),
             median_slots,
             gamma,
@@ -579,20 +574,9 @@ impl Estimator {
         }
     }
 
-    /// The sub-cell offset (s) of the peak in `slot`: the vertex of the parabola through the
-    /// magnitudes of the cell and its two neighbours, within half a cell.
+    /// The sub-cell offset (s) of the peak in `slot` ([`PaddedFft::parabola`]).
     fn parabola(&self, slot: u32) -> Real {
-        let l = self.fft.len();
-        let k = self.fft.natural()[slot as usize] as usize;
-        let mag = |k: usize| sqrt(self.scratch[self.slot_of[k % l] as usize].norm_sqr());
-        let (y0, y1, y2) = (mag(k + l - 1), mag(k), mag(k + 1));
-        let den = y0 - 2.0 * y1 + y2;
-        let off = if den < 0.0 {
-            (0.5 * (y0 - y2) / den).clamp(-0.5, 0.5)
-        } else {
-            0.0
-        };
-        off * self.span / l as Real
+        self.fft.parabola(&self.scratch, slot) * self.span / self.fft.len() as Real
     }
 
     /// `median |c|² / (Σ|P|² ln 2)` over the window's cells at the natural spacing.
