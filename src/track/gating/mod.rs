@@ -9,6 +9,7 @@ mod calibration;
 mod gated_track;
 mod measurement_case;
 mod raw_snapshot;
+mod segments;
 
 pub use amplitude_clusters::AmplitudeClusterConfig;
 pub use association::{
@@ -24,3 +25,7 @@ pub use gated_track::{
 };
 pub use measurement_case::{default_channel, LoopPath, LOOP_DURATION_S};
 pub use raw_snapshot::{StaticChannel, MAX_FALSE_ALARMS};
+pub use segments::{
+    EndReason, SegmentConfig, SegmentEvent, SegmentSetup, SegmentStart, SegmentStep,
+    SegmentTracker, MAX_FIXES_PER_SNAPSHOT, MAX_START_GRID_NODES, MAX_START_TABLE, MISS_LINKS,
+};
