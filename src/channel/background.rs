@@ -38,7 +38,7 @@ use crate::channel::band::cis;
 use crate::channel::fft::PaddedFft;
 use crate::channel::Band;
 use crate::error::{limits, Error, Result};
-use crate::math::{sqrt, Complex, Real, PI};
+use crate::math::{Complex, Real, PI};
 
 /// Default time constant `τ_bg` of the recursive background, s.
 pub const DEFAULT_BACKGROUND_TIME_S: Real = 10.0;

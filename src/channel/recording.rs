@@ -129,6 +129,10 @@ pub struct Recording {
     /// Per recorded link the per-sample noise variance `σ_p²`, W (`None`: estimated from the
     /// data).
     pub noise_var: Option<Vec<Real>>,
+    /// Whether the receivers share the transmitter's clock (`true`: absolute delays; `false`:
+    /// free-running, delays relative to each link's direct path, C10; `None`: not stated,
+    /// absolute unless the user says otherwise).
+    pub synchronized: Option<bool>,
 }
 
 impl Recording {
@@ -202,6 +206,7 @@ impl Recording {
             layout: self.layout.clone(),
             samples,
             noise_var: self.noise_var.clone(),
+            synchronized: self.synchronized,
         })
     }
 

@@ -238,6 +238,14 @@ pub const ESTIMATOR_DYNAMIC_RANGE_DB: Range = Range {
     allowed: "20 to 300 dB",
 };
 
+/// The recursive background's time constant `τ_bg` (C9), s: 1 ms (a few snapshots at [S]'s
+/// rate) to 10⁶ s (a background that never forgets).
+pub const BACKGROUND_TIME_S: Range = Range {
+    min: 1e-3,
+    max: 1e6,
+    allowed: "1e-3 to 1e6 s",
+};
+
 /// Largest zero-padded periodogram of the snapshot estimator (C5): `2^20` cells (16 MiB of
 /// complex scratch), e.g. 16 384 bins oversampled 64×.
 pub const MAX_PERIODOGRAM: usize = 1 << 20;

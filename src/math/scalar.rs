@@ -102,6 +102,19 @@ pub fn round(x: Real) -> Real {
     }
 }
 
+/// Largest integer not above `x`.
+#[inline(always)]
+pub fn floor(x: Real) -> Real {
+    #[cfg(feature = "std")]
+    {
+        x.floor()
+    }
+    #[cfg(not(feature = "std"))]
+    {
+        libm::floor(x)
+    }
+}
+
 /// Decibels to a linear power ratio: `10^(db/10)`.
 #[inline]
 pub fn db_to_linear(db: Real) -> Real {

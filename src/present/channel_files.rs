@@ -13,8 +13,11 @@ use crate::math::{log10, Real};
 use crate::measure::Model;
 use crate::present::ErrorStats;
 use crate::scenario::Scenario;
-use crate::study::{CirTrackOutput, DelaySigma, FrontEndConfig, RecordingEstimates};
-use crate::track::gating::Calibration;
+use crate::channel::Alignment;
+use crate::study::{
+    BoundCounts, ChannelRequest, ChannelStatics, CirTrackOutput, FrontEndConfig,
+    LinkStaticsInfo, RecordingEstimates,
+};
 
 /// One path of `EST.json`.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -33,6 +36,58 @@ pub struct PathDoc {
     pub confirmed: bool,
 }
 
+/// A snapshot's alignment to the background in `EST.json` (C9 step 2).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct AlignmentDoc {
+    /// `δ̂`, s.
+    pub delay_s: Real,
+    /// `ĝ` as `[re, im]`.
+    pub gain: [Real; 2],
+}
+
+impl AlignmentDoc {
+    fn of(a: &Alignment) -> AlignmentDoc {
+        AlignmentDoc {
+            delay_s: a.delay_s,
+            gain: [a.gain.re, a.gain.im],
+        }
+    }
+}
+
+/// How the estimates were made, in `EST.json` and `TRACK.json`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FrontEndDoc {
+    /// The estimator's `max_paths`.
+    pub max_paths: usize,
+    /// The estimator's `p_fa`.
+    pub p_fa: Real,
+    /// `background` or `clusters`.
+    pub statics: &'static str,
+    /// `absolute` or `los`.
+    pub delay_reference: &'static str,
+    /// The recursive background's time constant, s (used without an empty-area recording).
+    pub background_time_s: Real,
+    /// Per model link what its statics were made of (`null`: not recorded).
+    pub links: Vec<Option<LinkStaticsInfo>>,
+    /// The link-snapshots that ended at a bound of the estimator.
+    pub bounds: BoundCounts,
+}
+
+impl FrontEndDoc {
+    /// The front end `cfg` with the `statics` and `est` it made.
+    pub fn of(cfg: &FrontEndConfig, statics: &ChannelStatics, est: &RecordingEstimates) -> Self {
+        FrontEndDoc {
+            max_paths: cfg.estimator.max_paths,
+            p_fa: cfg.estimator.p_fa,
+            statics: cfg.statics.name(),
+            delay_reference: cfg.delay_reference.name(),
+            background_time_s: cfg.background_time_s,
+            links: statics.links.clone(),
+            bounds: est.bounds(),
+        }
+    }
+}
+
 /// `EST.json`: the estimates of a recording.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct EstimatesDoc<'a> {
@@ -48,17 +103,24 @@ pub struct EstimatesDoc<'a> {
     pub estimates: Vec<Vec<Vec<PathDoc>>>,
     /// `noise_var[s][p]`, W.
     pub noise_var: &'a [Vec<Real>],
+    /// `alignment[s][p]`: the snapshot's alignment to the background (`null`: none made).
+    pub alignment: Vec<Vec<Option<AlignmentDoc>>>,
     /// The estimator's `max_paths`.
     pub max_paths: usize,
     /// The estimator's `p_fa`.
     pub p_fa: Real,
+    /// How the estimates were made.
+    pub front_end: FrontEndDoc,
+    /// The static clusters the tracker gates with (E4), per model link.
+    pub calibration: CalibrationResult,
 }
 
-/// The `EST.json` of `e`, estimated with `cfg` on `model`'s links.
+/// The `EST.json` of `e`, estimated with `cfg` and `statics` on `model`'s links.
 pub fn estimates_doc<'a>(
     model: &Model,
     e: &'a RecordingEstimates,
     cfg: &FrontEndConfig,
+    statics: &ChannelStatics,
 ) -> EstimatesDoc<'a> {
     EstimatesDoc {
         format: "scatterloc-estimates",
@@ -87,8 +149,32 @@ pub fn estimates_doc<'a>(
             })
             .collect(),
         noise_var: &e.noise_var,
+        alignment: e
+            .alignment
+            .iter()
+            .map(|row| row.iter().map(|a| a.as_ref().map(AlignmentDoc::of)).collect())
+            .collect(),
         max_paths: cfg.estimator.max_paths,
         p_fa: cfg.estimator.p_fa,
+        front_end: FrontEndDoc::of(cfg, statics, e),
+        calibration: calibration_doc(statics),
+    }
+}
+
+/// The static clusters of `statics` as a calibration file (`snapshot_count`: the most
+/// empty-area snapshots a link used).
+fn calibration_doc(statics: &ChannelStatics) -> CalibrationResult {
+    CalibrationResult {
+        gap_s: None,
+        min_fraction: None,
+        sigma_floor_s: None,
+        snapshot_count: statics
+            .links
+            .iter()
+            .flatten()
+            .map(|l| l.empty_snapshots)
+            .max(),
+        links: statics.calibration.links.clone(),
     }
 }
 
@@ -104,6 +190,12 @@ pub struct TrackDoc<'a> {
     pub process_noise: Real,
     /// How each delay was weighted (`estimator`, `budget`).
     pub sigma: &'static str,
+    /// The association rule (`gated`, `spec`).
+    pub association: &'static str,
+    /// The scatterer's extent added to each σ̂, m.
+    pub extent_sigma_m: Real,
+    /// How the estimates were made.
+    pub front_end: FrontEndDoc,
     /// The static clusters used.
     pub calibration: CalibrationResult,
     /// With a truth: the position error's statistics over the snapshots with a state (absent
@@ -112,32 +204,28 @@ pub struct TrackDoc<'a> {
     pub error: Option<ErrorStats>,
 }
 
-/// The `TRACK.json` of `track` made by filter `filter` with `process_noise` and `sigma`, from
-/// the `calibration` of `calibration_snapshots` snapshots; `error` the statistics against a
-/// truth (`None`: no truth, or the track never started).
+/// The `TRACK.json` of `track` made with `req` from the estimates `est` (front end `cfg`,
+/// statics `statics`); `error` the statistics against a truth (`None`: no truth, or the track
+/// never started). Errors: the request's filter ([`ChannelRequest::filter_kind`]).
 pub fn track_doc<'a>(
     track: &'a CirTrackOutput,
-    filter: &'static str,
-    process_noise: Real,
-    sigma: DelaySigma,
-    calibration: &Calibration,
-    calibration_snapshots: usize,
+    req: &ChannelRequest,
+    cfg: &FrontEndConfig,
+    statics: &ChannelStatics,
+    est: &RecordingEstimates,
     error: Option<ErrorStats>,
-) -> TrackDoc<'a> {
-    TrackDoc {
+) -> crate::error::Result<TrackDoc<'a>> {
+    Ok(TrackDoc {
         track,
-        filter,
-        process_noise,
-        sigma: sigma.name(),
-        calibration: CalibrationResult {
-            gap_s: None,
-            min_fraction: None,
-            sigma_floor_s: None,
-            snapshot_count: Some(calibration_snapshots),
-            links: calibration.links.clone(),
-        },
+        filter: req.filter_kind()?.name(),
+        process_noise: req.process_noise,
+        sigma: req.sigma.name(),
+        association: req.association.name(),
+        extent_sigma_m: req.extent_sigma_m,
+        front_end: FrontEndDoc::of(cfg, statics, est),
+        calibration: calibration_doc(statics),
         error,
-    }
+    })
 }
 
 /// The names of `model`'s links (`Tx → Rx1`), as the delay figure labels its panels.

@@ -22,7 +22,10 @@ mod ticks;
 mod track_view;
 
 pub use channel_figure::delay_figure;
-pub use channel_files::{estimates_doc, link_names, track_doc, EstimatesDoc, PathDoc, TrackDoc};
+pub use channel_files::{
+    estimates_doc, link_names, track_doc, AlignmentDoc, EstimatesDoc, FrontEndDoc, PathDoc,
+    TrackDoc,
+};
 pub use channel_view::{
     delay_image, delay_points, quantile_pct, static_bands, suggest_range_m, track_errors,
     DelayFigure, DelayImage, DelayPoint, ErrorStats, ImageConfig, ImageFloor, LinkDelays,

@@ -13,13 +13,13 @@
 //!   record [`RocConfig`].
 //! - [`track_measurements`]: a measurement file (`steps` or gated `raw_steps`) tracked by any
 //!   filter ([`TrackOutput`], the document of `scatterloc track`).
-//! - [`estimate_recording`], [`calibrate_estimates`], [`cir_track`]: a channel recording
-//!   through the front end (C5–C7) to a track (issue 25).
+//! - [`ChannelRequest`], [`estimate_recording`] / [`EstimationRun`], [`cir_track`]: a channel
+//!   recording through the front end (C5–C10) to a track with segments (C11) (issues 25, 36).
 //! - [`check_cost`], [`track_cpu_s`], [`FilterStudy::predicted_cpu_s`]: the predicted work
 //!   of a study or a track and the caps front ends refuse work over (issue 24).
 //! - [`PartSet`], [`PartFile`]: the part file format (`scatterloc-part`, version 2, with a digest of its sums) and what `merge` checks.
 
-mod cir;
+mod channel;
 mod cost;
 mod drive;
 mod filters;
@@ -29,10 +29,12 @@ mod roc;
 mod sums;
 mod track;
 
-pub use cir::{
-    calibrate_estimates, cir_track, delays_only, estimate_link, estimate_recording, CirStart,
-    CirTrackOutput, CirTrackRequest, DelaySigma, EstimationRun, FrontEndConfig, RecordingEstimates,
-    EXTENT_SIGMA_M,
+pub use channel::{
+    cir_track, delays_only, estimate_link, estimate_recording, prepare, BoundCounts,
+    ChannelRequest, ChannelStatics, CirStart, CirTrackOutput, DelayReference, DelaySigma,
+    EstimationRun, FrontEndConfig, LinkEstimates, LinkFront, LinkStatics, LinkStaticsInfo,
+    Prepared, RecordingEstimates, SegmentDoc, StaticMode, BACKGROUND_MAX_PATHS,
+    DEFAULT_PROCESS_NOISE, EXTENT_SIGMA_M, LOS_WITHIN_DB, RECURSIVE_CLUSTER_DB,
 };
 pub use cost::{check_cost, track_cpu_s, MAX_CPU_S, PAGE_STUDY_CPU_S, PAGE_TRACK_CPU_S};
 pub use drive::{Driver, Sequential};

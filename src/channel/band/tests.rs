@@ -75,6 +75,7 @@ fn cir_rec(taps: Vec<Complex>, pulse: Option<Pulse>) -> Recording {
         },
         samples: taps,
         noise_var: None,
+        synchronized: None,
     }
 }
 
@@ -164,6 +165,7 @@ fn recording_errors() {
         },
         samples: vec![one(); 6],
         noise_var: None,
+        synchronized: None,
     };
     let (band, map) = Band::of_recording(&cfr, 1.0).unwrap();
     assert_eq!(band.response, vec![one(); 3]);

@@ -393,6 +393,7 @@ fn c8_5_cir_equals_cfr() {
         },
         samples: taps,
         noise_var: None,
+        synchronized: None,
     };
     let (b, map) = Band::of_recording(&rec, B).unwrap();
     assert_eq!(b.len(), 2 * kmax as usize - 1);

@@ -11,6 +11,7 @@ fn cfr(s: usize, p: usize, n: usize) -> Recording {
         },
         samples: vec![Complex::new(1e-6, -2e-6); s * p * n],
         noise_var: Some(vec![1e-13; p]),
+        synchronized: None,
     }
 }
 

@@ -615,6 +615,7 @@ fn synthesize(
         },
         samples,
         noise_var: Some(noise_var),
+        synchronized: None,
     };
     let truth = ChannelTruth {
         t_s,

@@ -19,7 +19,7 @@ pub use read::{read_recording, read_recording_within};
 pub use write::write_recording;
 
 /// The arrays a recording may hold (docs/recording.md), in the order they are written.
-pub const ARRAYS: [&str; 11] = [
+pub const ARRAYS: [&str; 12] = [
     "t_s",
     "links",
     "cfr",
@@ -31,4 +31,5 @@ pub const ARRAYS: [&str; 11] = [
     "pulse",
     "pulse_spacing_s",
     "noise_var",
+    "synchronized",
 ];

@@ -58,7 +58,11 @@ fn parse_descr(name: &str, d: &str) -> Result<Dtype> {
         b'>' => true,
         _ => return Err(bad()),
     };
-    let size: usize = d[2..].parse().map_err(|_| bad())?;
+    // Bytes, not `&d[2..]`: a multi-byte second character must be an error, not a panic.
+    let size: usize = core::str::from_utf8(&b[2..])
+        .ok()
+        .and_then(|t| t.parse().ok())
+        .ok_or_else(bad)?;
     Ok(Dtype {
         kind: b[1],
         size,
@@ -267,6 +271,26 @@ impl Npy {
                 _ => i64::from_le_bytes(chunk::<8>(c, big)),
             })
             .collect())
+    }
+
+    /// The one element of a bool (`|b1`) or integer array as a flag: 0 is `false`, 1 `true`;
+    /// any other value is an error.
+    pub fn flag(&self) -> Result<bool> {
+        let v = match (self.dtype.kind, self.dtype.size) {
+            (b'b', 1) | (b'u', 1) => self.data.first().map(|&b| i64::from(b)),
+            (b'i', 1) => self.data.first().map(|&b| i64::from(b as i8)),
+            (b'i', _) => self
+                .ints(&[2, 4, 8], "bool or int")
+                .ok()
+                .and_then(|v| v.first().copied()),
+            _ => None,
+        };
+        match v {
+            Some(0) => Ok(false),
+            Some(1) => Ok(true),
+            Some(x) => Err(invalid(&self.name, format!("{x}: must be 0 (free-running) or 1 (a common clock)"))),
+            None => Err(self.wrong_dtype("bool or int")),
+        }
     }
 
     /// Whether the array is complex64 or complex128.

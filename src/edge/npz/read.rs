@@ -248,12 +248,20 @@ pub fn read_recording_within(bytes: &[u8], max_bytes: u64) -> Result<Recording> 
         }
         None => None,
     };
+    let synchronized = match m.get("synchronized") {
+        Some(a) => {
+            a.expect_shape(&[], "a scalar")?;
+            Some(a.flag()?)
+        }
+        None => None,
+    };
     let rec = Recording {
         t_s,
         links,
         layout,
         samples,
         noise_var,
+        synchronized,
     };
     rec.validate()?;
     Ok(rec)

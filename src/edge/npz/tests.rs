@@ -18,6 +18,7 @@ fn cfr() -> Recording {
             .map(|k| Complex::new(k as Real * 1e-7 + 1e-9 / 3.0, -(k as Real) * 3e-8))
             .collect(),
         noise_var: Some(vec![1e-13, 2e-13, 3e-13, 4e-13]),
+        synchronized: None,
     }
 }
 
@@ -36,6 +37,7 @@ fn cir(pulse: bool) -> Recording {
             }),
         },
         noise_var: None,
+        synchronized: None,
         ..cfr()
     }
 }

@@ -77,6 +77,9 @@ pub fn write_recording(rec: &Recording) -> Result<Vec<u8>> {
             }
         }
     }
+    if let Some(sync) = rec.synchronized {
+        members.push(("synchronized", npy::write("|b1", &[], &[u8::from(sync)])));
+    }
     if let Some(nv) = &rec.noise_var {
         members.push(("noise_var", npy::write("<f8", &[p], &f64_bytes(nv))));
     }

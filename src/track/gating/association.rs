@@ -50,8 +50,9 @@ impl Choice {
     }
 }
 
-/// Which association rule to apply.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+/// Which association rule to apply (JSON: `"spec"`, `"gated"`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum AssociationRule {
     /// The spec's rule (§4 **\[choice\]**), for a unique scatterer without clutter: one candidate is
     /// always taken; of several, the nearest if it passes the innovation gate, else the largest
@@ -62,6 +63,16 @@ pub enum AssociationRule {
     /// innovation gate (the nearest of those that do), else the link is absent; without a track
     /// as [`AssociationRule::Spec`].
     Gated,
+}
+
+impl AssociationRule {
+    /// `spec` or `gated`.
+    pub fn name(self) -> &'static str {
+        match self {
+            AssociationRule::Spec => "spec",
+            AssociationRule::Gated => "gated",
+        }
+    }
 }
 
 /// The association of one link's non-static candidates under `rule`: the index chosen (into

@@ -71,9 +71,58 @@ pub struct CirSimulateArgs {
     pub seed: Option<u64>,
 }
 
+/// How static paths are removed (`--statics`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum StaticsName {
+    /// Subtract the background (the empty area's mean, or a recursive mean) at the signal
+    /// level and estimate the residual (C9).
+    Background,
+    /// Estimate every full response and gate the empty area's clusters (C7, [S]'s way).
+    Clusters,
+}
+
+/// Which delays the tracker reads (`--delay-reference`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum ReferenceName {
+    /// Absolute delays (a sounder with a common clock).
+    Absolute,
+    /// Delays relative to each link's direct path (Wi-Fi CSI, free-running UWB anchors; C10).
+    Los,
+}
+
+/// Parses `T0,T1` (seconds, finite).
+fn time_range(text: &str) -> Result<[f64; 2], String> {
+    let (a, b) = text
+        .split_once(',')
+        .ok_or_else(|| format!("'{text}' is not T0,T1 (seconds)"))?;
+    let num = |v: &str| {
+        v.trim()
+            .parse::<f64>()
+            .ok()
+            .filter(|v| v.is_finite())
+            .ok_or_else(|| format!("'{v}' is not a finite number"))
+    };
+    Ok([num(a)?, num(b)?])
+}
+
 /// The front end's flags shared by `cir estimate` and `cir track`.
 #[derive(Debug, Args)]
 pub struct FrontEndArgs {
+    /// How static paths are removed: background (C9; the default) or clusters (C7).
+    #[arg(long, value_name = "background|clusters")]
+    pub statics: Option<StaticsName>,
+    /// Delays absolute (a common clock) or relative to each link's direct path (C10) [default:
+    /// the recording's `synchronized` flag, absolute without one].
+    #[arg(long, value_name = "absolute|los")]
+    pub delay_reference: Option<ReferenceName>,
+    /// Time constant of the recursive background, s, used without a recording of the empty
+    /// area [default: 10].
+    #[arg(long, value_name = "S", value_parser = finite)]
+    pub background_time: Option<f64>,
+    /// The snapshots of the recording between T0 and T1 (s) are the empty area (instead of
+    /// --calibration).
+    #[arg(long, value_name = "T0,T1", value_parser = time_range)]
+    pub calibration_range: Option<[f64; 2]>,
     /// Most paths per snapshot and link (C5) [default: the estimator's].
     #[arg(long, value_name = "K", value_parser = whole)]
     pub max_paths: Option<usize>,
@@ -98,6 +147,10 @@ pub struct CirEstimateArgs {
     /// The estimates (.json).
     #[arg(long, value_name = "EST.json")]
     pub out: String,
+    /// Recording of the empty area (.npz): its background is subtracted (C9) or its clusters
+    /// gated (C7) [default: a recursive background learnt from the recording itself].
+    #[arg(long, value_name = "CAL.npz")]
+    pub calibration: Option<String>,
     /// Also write the delays in the form `calibrate --snapshots` reads.
     #[arg(long, value_name = "FILE.json")]
     pub snapshots: Option<String>,
@@ -127,9 +180,10 @@ pub struct CirTrackArgs {
     /// Scenario JSON file ('-' = standard input).
     #[arg(long, value_name = "FILE")]
     pub scenario: String,
-    /// Recording of the empty area (.npz): its static paths are gated (C7, E4).
+    /// Recording of the empty area (.npz): its background is subtracted (C9) or its clusters
+    /// gated (C7) [default: a recursive background learnt from the recording itself].
     #[arg(long, value_name = "CAL.npz")]
-    pub calibration: String,
+    pub calibration: Option<String>,
     /// Recording of the walk (.npz).
     #[arg(long, value_name = "REC.npz")]
     pub cir: String,

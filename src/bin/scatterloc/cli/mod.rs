@@ -20,7 +20,10 @@ use std::ffi::OsString;
 
 use clap::{CommandFactory, FromArgMatches, Parser, Subcommand, ValueEnum};
 
-pub use cir::{CirCommand, CirEstimateArgs, CirSimulateArgs, CirTrackArgs, SigmaSource};
+pub use cir::{
+    CirCommand, CirEstimateArgs, CirSimulateArgs, CirTrackArgs, FrontEndArgs, ReferenceName,
+    SigmaSource, StaticsName,
+};
 pub use filters::{FilterName, FilterSettings};
 pub use mtl::{MtlCommand, MtlLocateArgs, RocArgs, Table2Args};
 pub use plan::PlanArgs;

@@ -1,7 +1,7 @@
-//! `scatterloc cir simulate|estimate|track`: the channel front end (issue 25; spec
-//! channel-estimation.md). Flags → the library's use cases ([`scatterloc::study::estimate_recording`],
-//! [`scatterloc::study::calibrate_estimates`], [`scatterloc::study::cir_track`], the simulator
-//! [`scatterloc::channel::simulate_recording`]) → files written all or none.
+//! `scatterloc cir simulate|estimate|track`: the channel front end (issues 25, 36; spec
+//! channel-estimation.md). Flags → the core's [`ChannelRequest`] (every default and check is
+//! there) → [`scatterloc::study::estimate_recording`] and [`scatterloc::study::cir_track`],
+//! the simulator [`scatterloc::channel::simulate_recording`] → files written all or none.
 
 use scatterloc::channel::{simulate_recording, ChannelScene, Recording};
 use scatterloc::error::{limits, Cancel};
@@ -9,26 +9,23 @@ use scatterloc::formats::{CalibrationSnapshots, Measurements, Truth};
 use scatterloc::native::Parallel;
 use scatterloc::present::{estimates_doc, track_doc, track_errors};
 use scatterloc::study::{
-    calibrate_estimates, cir_track as track_recording, delays_only, estimate_recording,
-    CirTrackRequest, DelaySigma, FrontEndConfig, RecordingEstimates, EXTENT_SIGMA_M,
+    cir_track as track_recording, delays_only, estimate_recording, ChannelRequest,
+    ChannelStatics, DelayReference, FrontEndConfig, RecordingEstimates, StaticMode,
+    DEFAULT_PROCESS_NOISE,
 };
-use scatterloc::track::gating::{AmplitudeClusterConfig, AssociationRule, Calibration};
 use scatterloc::track::ConstantVelocity;
 use scatterloc::{npz, Model, Scenario};
 
-use super::filters::filter_kinds;
+use super::flags::with_flag;
 use super::gating::{prepare_out_dir_for, walk_file};
 use super::io::{emit_summary, model_of, read_bytes, read_json_file, read_scenario};
 use super::output::{check_writable, Format, OutputSet};
 use super::study::{catch_ctrl_c, interrupted, run_with_counter, threads};
 use crate::cli::{
-    Association, CirEstimateArgs, CirSimulateArgs, CirTrackArgs, FilterName, SigmaSource,
+    Association, CirEstimateArgs, CirSimulateArgs, CirTrackArgs, FrontEndArgs, ReferenceName,
+    SigmaSource, StaticsName,
 };
 use crate::failure::CliError;
-
-/// Default process-noise intensity of `cir track`, m²/s³: a person at 1–2 m/s turning on 2–3 m
-/// radii accelerates by up to v²/r ≈ 1–2 m/s².
-const DEFAULT_PROCESS_NOISE: f64 = 1.0;
 
 /// Reads the recording `--flag PATH` (.npz, docs/recording.md), checked against `model`.
 fn read_recording(flag: &str, path: &str, model: &Model) -> Result<Recording, CliError> {
@@ -40,42 +37,127 @@ fn read_recording(flag: &str, path: &str, model: &Model) -> Result<Recording, Cl
     Ok(rec)
 }
 
-/// The front end's settings from the flags (the core's defaults and checks; an error names
-/// its flag).
-fn front_end(max_paths: Option<usize>, pfa: Option<f64>) -> Result<FrontEndConfig, CliError> {
-    FrontEndConfig::with_overrides(max_paths, pfa).map_err(|e| {
-        let flag = if e.to_string().contains("p_fa") {
-            "--pfa"
-        } else {
-            "--max-paths"
-        };
-        CliError::usage(format!("{flag}: {e}"))
-    })
+/// A core error of the request, named by the flag that sets its field.
+fn flag_error(e: &scatterloc::Error) -> CliError {
+    CliError::usage(with_flag(e).unwrap_or_else(|| e.to_string()))
 }
 
-/// Estimates `rec` on `threads` threads under a progress bar (Ctrl-C: exit 130, nothing
-/// written).
+/// The request of the front end's flags (and, for `cir track`, the tracker's), checked by the
+/// core.
+fn request(fe: &FrontEndArgs, track: Option<&CirTrackArgs>) -> Result<ChannelRequest, CliError> {
+    let mut r = ChannelRequest::default();
+    if let Some(k) = fe.max_paths {
+        r.max_paths = k;
+    }
+    if let Some(p) = fe.pfa {
+        r.pfa = p;
+    }
+    if let Some(s) = fe.statics {
+        r.statics = match s {
+            StaticsName::Background => StaticMode::Background,
+            StaticsName::Clusters => StaticMode::Clusters,
+        };
+    }
+    if let Some(d) = fe.delay_reference {
+        r.delay_reference = Some(match d {
+            ReferenceName::Absolute => DelayReference::Absolute,
+            ReferenceName::Los => DelayReference::Los,
+        });
+    }
+    if let Some(t) = fe.background_time {
+        r.background_time_s = t;
+    }
+    if let Some([a, b]) = fe.calibration_range {
+        r.calibration_range_s = Some([a, b]);
+    }
+    if let Some(t) = track {
+        if let Some(f) = t.filter {
+            r.filter = f.name().to_string();
+        }
+        r.ukf_alpha = t.settings.ukf_alpha;
+        r.ukf_beta = t.settings.ukf_beta;
+        r.ukf_kappa = t.settings.ukf_kappa;
+        r.particles = t.settings.particles;
+        r.roughening = t.settings.roughening;
+        r.bootstrap = t.settings.pf_bootstrap;
+        r.seed = t.seed;
+        if let Some(q) = t.process_noise {
+            r.process_noise = q;
+        }
+        if let Some(s) = t.sigma {
+            r.sigma = match s {
+                SigmaSource::Estimator => scatterloc::study::DelaySigma::Estimator,
+                SigmaSource::Budget => scatterloc::study::DelaySigma::LinkBudget,
+            };
+        }
+        if let Some(x) = t.extent_sigma_m {
+            r.extent_sigma_m = x;
+        }
+        if let Some(a) = t.association {
+            r.association = match a {
+                Association::Spec => scatterloc::track::gating::AssociationRule::Spec,
+                Association::Gated => scatterloc::track::gating::AssociationRule::Gated,
+            };
+        }
+    }
+    r.check().map_err(|e| flag_error(&e))?;
+    Ok(r)
+}
+
+/// The recording of the empty area: `--calibration CAL.npz`, or the snapshots of the recording
+/// in `--calibration-range` (`None`: neither, a recursive background).
+fn empty_area(
+    path: Option<&str>,
+    req: &ChannelRequest,
+    rec: &Recording,
+    model: &Model,
+) -> Result<Option<Recording>, CliError> {
+    match (path, req.calibration_range_s) {
+        (Some(_), Some(_)) => Err(CliError::usage(
+            "--calibration-range: give a calibration recording or a time range of the recording, \
+             not both",
+        )),
+        (Some(p), None) => Ok(Some(read_recording("calibration", p, model)?)),
+        (None, Some([a, b])) => rec
+            .between("calibration_range_s", a, b)
+            .map(Some)
+            .map_err(|e| flag_error(&e)),
+        (None, None) => Ok(None),
+    }
+}
+
+/// Statics and estimates of `rec` on `threads` threads under a progress bar (Ctrl-C: exit 130,
+/// nothing written).
 fn estimate(
-    flag: &str,
     scenario: &Scenario,
     model: &Model,
     rec: &Recording,
+    empty: Option<&Recording>,
     cfg: &FrontEndConfig,
     threads: usize,
-) -> Result<RecordingEstimates, CliError> {
+) -> Result<(ChannelStatics, RecordingEstimates), CliError> {
     let total = rec.t_s.len() * rec.links.len();
-    let (res, _) = run_with_counter(total, "snapshots", flag, |cancel, bar| {
+    let (res, _) = run_with_counter(total, "snapshots", "cir", |cancel, bar| {
         let progress = |n: usize| bar.inc(n as u64);
         estimate_recording(
             model,
             scenario.radio.bandwidth_hz,
             rec,
+            empty,
             cfg,
             &mut Parallel::new(threads, cancel),
             &progress,
         )
     })?;
-    res.map_err(|e| CliError::usage(format!("--{flag}: {e}")))
+    res.map_err(|e| {
+        let text = with_flag(&e).unwrap_or_else(|| e.to_string());
+        let flag = if text.starts_with("calibration") {
+            "--calibration"
+        } else {
+            "--cir"
+        };
+        CliError::usage(format!("{flag}: {text}"))
+    })
 }
 
 /// The checked output flag `--flag PATH` of `allowed` formats.
@@ -85,8 +167,8 @@ fn output(flag: &str, path: &str, allowed: &[Format]) -> Result<Format, CliError
     Ok(f)
 }
 
-/// `scatterloc cir estimate --scenario S --cir REC.npz --out EST.json [--snapshots F]
-/// [--measurements F]`.
+/// `scatterloc cir estimate --scenario S --cir REC.npz --out EST.json [--calibration CAL.npz]
+/// [--snapshots F] [--measurements F]`.
 pub fn cir_estimate(args: &CirEstimateArgs) -> Result<(), CliError> {
     catch_ctrl_c();
     output("out", &args.out, &[Format::Json])?;
@@ -104,18 +186,20 @@ pub fn cir_estimate(args: &CirEstimateArgs) -> Result<(), CliError> {
             "--process-noise: only written to --measurements (not given)",
         ));
     }
-    let cfg = front_end(args.front_end.max_paths, args.front_end.pfa)?;
+    let req = request(&args.front_end, None)?;
     let (threads, _) = threads(args.front_end.threads)?;
     let scenario = read_scenario(&args.scenario)?;
     let model = model_of(&scenario)?;
     let rec = read_recording("cir", &args.cir, &model)?;
+    let empty = empty_area(args.calibration.as_deref(), &req, &rec, &model)?;
     let measurements = match &args.measurements {
         Some(_) => Some(uniform_dt(&rec.t_s, q)?),
         None => None,
     };
-    let est = estimate("cir", &scenario, &model, &rec, &cfg, threads)?;
+    let cfg = req.front_end(rec.synchronized);
+    let (statics, est) = estimate(&scenario, &model, &rec, empty.as_ref(), &cfg, threads)?;
     let mut files = OutputSet::new();
-    files.json("out", &args.out, &estimates_doc(&model, &est, &cfg))?;
+    files.json("out", &args.out, &estimates_doc(&model, &est, &cfg, &statics))?;
     let snaps = est.snapshots();
     if let Some(p) = &args.snapshots {
         let doc = CalibrationSnapshots {
@@ -149,6 +233,9 @@ pub fn cir_estimate(args: &CirEstimateArgs) -> Result<(), CliError> {
             "snapshots": est.len(),
             "links": rec.links.len(),
             "paths": paths,
+            "statics": cfg.statics.name(),
+            "delay_reference": cfg.delay_reference.name(),
+            "bounds": est.bounds(),
         })
         .to_string(),
     )
@@ -176,7 +263,7 @@ fn uniform_dt(t_s: &[f64], q: f64) -> Result<(f64, f64), CliError> {
     Ok((dt, q))
 }
 
-/// `scatterloc cir track --scenario S --calibration CAL.npz --cir REC.npz --out TRACK.json`.
+/// `scatterloc cir track --scenario S --cir REC.npz --out TRACK.json [--calibration CAL.npz]`.
 pub fn cir_track(args: &CirTrackArgs) -> Result<(), CliError> {
     catch_ctrl_c();
     output("out", &args.out, &[Format::Json])?;
@@ -194,22 +281,12 @@ pub fn cir_track(args: &CirTrackArgs) -> Result<(), CliError> {
         )),
         None => None,
     };
-    let name = args.filter.unwrap_or(FilterName::Ekf);
-    let kind = filter_kinds(&[name], &args.settings, "--filter")?[0];
-    if args.seed.is_some() && name != FilterName::Pf {
-        return Err(CliError::usage(
-            "--seed: only for the pf filter (--filter is not pf)",
-        ));
-    }
-    let q = args.process_noise.unwrap_or(DEFAULT_PROCESS_NOISE);
-    ConstantVelocity::validated(1.0, q)
-        .map_err(|e| CliError::usage(format!("--process-noise: {e}")))?;
-    let cfg = front_end(args.front_end.max_paths, args.front_end.pfa)?;
+    let req = request(&args.front_end, Some(args))?;
     let (threads, _) = threads(args.front_end.threads)?;
     let scenario = read_scenario(&args.scenario)?;
     let model = model_of(&scenario)?;
-    let cal_rec = read_recording("calibration", &args.calibration, &model)?;
     let rec = read_recording("cir", &args.cir, &model)?;
+    let empty = empty_area(args.calibration.as_deref(), &req, &rec, &model)?;
     let truth = match &args.truth {
         Some(p) => {
             let t: Truth = read_json_file("truth", p)?;
@@ -219,34 +296,18 @@ pub fn cir_track(args: &CirTrackArgs) -> Result<(), CliError> {
         }
         None => None,
     };
-    let empty = estimate("calibration", &scenario, &model, &cal_rec, &cfg, threads)?;
-    let ccfg = AmplitudeClusterConfig::for_bandwidth(scenario.radio.bandwidth_hz)
-        .map_err(|e| CliError::usage(format!("--scenario: {e}")))?;
-    let calibration: Calibration = calibrate_estimates(&model, &empty, &ccfg)
-        .map_err(|e| CliError::usage(format!("--calibration {}: {e}", args.calibration)))?;
-    let est = estimate("cir", &scenario, &model, &rec, &cfg, threads)?;
-    let sigma = match args.sigma {
-        None | Some(SigmaSource::Estimator) => DelaySigma::Estimator,
-        Some(SigmaSource::Budget) => DelaySigma::LinkBudget,
-    };
-    let req = CirTrackRequest {
-        model: &model,
-        area: &scenario.area_m,
-        calibration: &calibration,
-        estimates: &est,
-        filter: kind,
-        process_noise: q,
-        rule: match args.association {
-            Some(Association::Spec) => AssociationRule::Spec,
-            None | Some(Association::Gated) => AssociationRule::Gated,
-        },
-        sigma,
-        extent_sigma_m: args.extent_sigma_m.unwrap_or(EXTENT_SIGMA_M),
-        seed: args.seed.unwrap_or(1),
-    };
+    let cfg = req.front_end(rec.synchronized);
+    let (statics, est) = estimate(&scenario, &model, &rec, empty.as_ref(), &cfg, threads)?;
     let (res, _) = run_with_counter(est.len(), "snapshots", "track", |cancel, _| {
         let stop = || cancel.load(std::sync::atomic::Ordering::Relaxed);
-        track_recording(&req, Cancel::when(&stop))
+        track_recording(
+            &req,
+            &model,
+            &scenario.area_m,
+            &statics.calibration,
+            &est,
+            Cancel::when(&stop),
+        )
     })?;
     let track = res.map_err(|e| CliError::usage(format!("--cir {}: {e}", args.cir)))?;
     // The error view (per snapshot, its statistics and CDF) once, for TRACK.json and --figure.
@@ -257,15 +318,7 @@ pub fn cir_track(args: &CirTrackArgs) -> Result<(), CliError> {
     let view = track_errors(&track.t_s, &track.states, &truth_states)
         .map_err(|e| CliError::usage(format!("--truth: {e}")))?;
     let error = truth.as_ref().and(view.stats);
-    let doc = track_doc(
-        &track,
-        name.name(),
-        q,
-        sigma,
-        &calibration,
-        empty.len(),
-        error,
-    );
+    let doc = track_doc(&track, &req, &cfg, &statics, &est, error).map_err(|e| flag_error(&e))?;
     let mut files = OutputSet::new();
     files.json("out", &args.out, &doc)?;
     if let Some((p, f)) = delays_figure {
@@ -277,12 +330,12 @@ pub fn cir_track(args: &CirTrackArgs) -> Result<(), CliError> {
             &model,
             &rec,
             &est,
-            &calibration,
+            &statics.calibration,
             truth.as_ref(),
         )?;
     }
     if let Some((p, f)) = figure {
-        super::cir_fig::stage_track_figure(&mut files, p, f, &scenario, &track, view, name.name())?;
+        super::cir_fig::stage_track_figure(&mut files, p, f, &scenario, &track, view, doc.filter)?;
     }
     files.commit()?;
     emit_summary(
@@ -290,6 +343,9 @@ pub fn cir_track(args: &CirTrackArgs) -> Result<(), CliError> {
             "out": args.out,
             "snapshots": track.t_s.len(),
             "start": track.start.as_ref().map(|s| s.t_s),
+            "segments": track.segments.len(),
+            "statics": cfg.statics.name(),
+            "delay_reference": cfg.delay_reference.name(),
             "error": doc.error,
         })
         .to_string(),

@@ -5,7 +5,7 @@
 use scatterloc::Error;
 
 /// Core field → flag.
-const FLAGS: [(&str, &str); 33] = [
+const FLAGS: [(&str, &str); 41] = [
     // Tracking studies (`montecarlo`, `pcrlb`, `track`).
     ("runs", "--runs"),
     ("noise_runs", "--noise-runs"),
@@ -42,6 +42,15 @@ const FLAGS: [(&str, &str); 33] = [
     ("empirical", "--empirical"),
     ("exact", "--exact"),
     ("filters", "--filters"),
+    // The channel front end and a recording's track (`cir`).
+    ("max_paths", "--max-paths"),
+    ("p_fa", "--pfa"),
+    ("background_time_s", "--background-time"),
+    ("calibration_range_s", "--calibration-range"),
+    ("extent_sigma_m", "--extent-sigma-m"),
+    ("filter", "--filter"),
+    ("seed", "--seed"),
+    ("statics", "--statics"),
 ];
 
 /// The flag that sets core field `field`.

@@ -1,0 +1,526 @@
+//! One recorded link through the front end: its statics (the background of C9 and the static
+//! clusters that gate what is left of it, or C7's clusters of the empty area), then snapshot
+//! after snapshot the residual (or the full response), the snapshot estimator (C5) seeded by
+//! the link's path tracker (C6), and the delays in the chosen reference (C10).
+//!
+//! **Statics** (per recorded link):
+//! - `background` with an empty-area recording: its coherent mean (C9 step 1); the static
+//!   clusters are the mean's own paths (one C5 fit at `S_bg` times the SNR, at most
+//!   [`BACKGROUND_MAX_PATHS`]) whose single-snapshot SNR (`SNR/S_bg`) passes the CFAR
+//!   threshold — a weaker path's shadow is never detected, and its poorly known delay would
+//!   gate metres of range — each with what a shadowed copy of that path measures in one
+//!   snapshot, `σ̄ = max(C4 at SNR/S_bg, 0.05/B)` (C4 alone: the joint Fisher bound of a dense
+//!   fit of diffuse multipath is metres wide where paths crowd within `1/B`).
+//! - `background` without one (recursive, C9 step 1): the mean starts at the walk's first
+//!   snapshot; its clusters are that snapshot's paths within [`RECURSIVE_CLUSTER_DB`] of its
+//!   strongest (the shadowable ones: a person's echo is 30–40 dB below the direct path).
+//! - `clusters`: C7 on the empty recording's snapshot estimates (delay and amplitude).
+//!
+//! **Delay reference** (C10): with `los` the direct path's delay is the earliest path within
+//! [`LOS_WITHIN_DB`] of the strongest — of the background once (`background`), or of each
+//! snapshot (`clusters`); a delay `τ` becomes `τ − τ₀ + ‖t − r‖/c` (excess delays taken in
+//! `[−span/4, 3·span/4)` of the unambiguous span) with `σ² + σ₀²`; a result `≤ 0` is dropped.
+//! A snapshot whose direct path is not found (`clusters`) gives that link no delay.
+//!
+//! **Realignment**: when snapshots are aligned (`los`), the first alignment is made with the
+//! dynamic part present and is biased by it; the residual's paths are taken out, the snapshot
+//! realigned from there ([`LinkBackground::realign`]) and the residual estimated again, seeded
+//! by the first pass.
+
+// `!(x > 0.0)` is meant: a NaN must fail these checks as well.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
+use alloc::vec::Vec;
+
+use crate::channel::{
+    Alignment, Band, EstimateWork, Estimator, EstimatorConfig, LinkBackground,
+    PathEstimate, PathTracker, Recording, ResponseMap, SnapshotEstimate, TrackedPath,
+};
+use crate::error::{limits, Error, Result};
+use crate::math::{db_to_linear, floor, log10, sqrt, Complex, Real, SPEED_OF_LIGHT};
+use crate::study::channel::{DelayReference, FrontEndConfig, StaticMode};
+use crate::track::gating::{AmplitudeClusterConfig, DelayEstimate, LinkCalibration, StaticCluster};
+
+/// Most paths of the background's own fit (its static clusters).
+pub const BACKGROUND_MAX_PATHS: usize = 32;
+/// Without an empty-area recording: the first snapshot's paths within this of its strongest
+/// are the static clusters, dB.
+pub const RECURSIVE_CLUSTER_DB: Real = 30.0;
+/// The direct path is the earliest path within this of the strongest, dB (C10 **\[choice\]**).
+pub const LOS_WITHIN_DB: Real = 20.0;
+/// Floor of a background cluster's σ̄, in units of `1/B`.
+const BACKGROUND_SIGMA_FLOOR: Real = 0.05;
+
+/// What the front end made of one recorded link, snapshot after snapshot.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct LinkEstimates {
+    /// The tracked paths (ascending in delay), in the output reference.
+    pub paths: Vec<Vec<TrackedPath>>,
+    /// The noise variance the estimator used, W.
+    pub noise_var: Vec<Real>,
+    /// The alignment to the background (`background` mode).
+    pub alignment: Vec<Option<Alignment>>,
+    /// What each snapshot's estimation did against its bounds (both passes when realigned).
+    pub work: Vec<EstimateWork>,
+}
+
+impl LinkEstimates {
+    fn with_capacity(n: usize) -> LinkEstimates {
+        LinkEstimates {
+            paths: Vec::with_capacity(n),
+            noise_var: Vec::with_capacity(n),
+            alignment: Vec::with_capacity(n),
+            work: Vec::with_capacity(n),
+        }
+    }
+}
+
+/// The direct path's delay (C10).
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Reference {
+    /// Absolute delays.
+    Absolute,
+    /// `τ₀` and its σ, fixed (the background's), and the baseline delay.
+    Fixed { tau0: Real, sigma0: Real, base: Real },
+    /// Found in each snapshot; the baseline delay.
+    PerSnapshot { base: Real },
+}
+
+/// One recorded link's static channel (module docs).
+#[derive(Debug, Clone, PartialEq)]
+pub struct LinkStatics {
+    /// The background (`background` mode).
+    pub background: Option<LinkBackground>,
+    /// The static clusters, in the output reference.
+    pub clusters: LinkCalibration,
+    /// The direct path's delay in the background's time base and its σ, s (`los` with a
+    /// background).
+    pub los_s: Option<(Real, Real)>,
+    /// Snapshots of the empty area used (0: recursive).
+    pub empty_snapshots: usize,
+    reference: Reference,
+}
+
+/// A band and the map of its recording's samples.
+pub type BandMap = (Band, ResponseMap);
+
+/// The baseline delay `‖t − r‖/c` of recorded link `link`, s (`baseline_s[link]`).
+fn check_link(baseline_s: &[Real], link: usize) -> Result<Real> {
+    baseline_s
+        .get(link)
+        .copied()
+        .ok_or(Error::IndexOutOfRange {
+            field: "links",
+            index: link,
+            len: baseline_s.len(),
+        })
+}
+
+/// The per-bin noise variance of recorded link `link` when the recording gives one.
+fn given_noise(rec: &Recording, map: &ResponseMap, link: usize) -> Option<Real> {
+    rec.noise_var
+        .as_ref()
+        .and_then(|v| v.get(link))
+        .map(|&v| map.noise_var_of_taps(v))
+}
+
+/// `τ − τ₀ + base`, the excess delay taken in `[−span/4, 3·span/4)`.
+fn relative(tau: Real, tau0: Real, base: Real, span: Real) -> Real {
+    let e = tau - tau0;
+    base + e - span * floor((e + 0.25 * span) / span)
+}
+
+/// The direct path among `paths` (the earliest within [`LOS_WITHIN_DB`] of the strongest).
+fn los_of(paths: &[PathEstimate]) -> Option<&PathEstimate> {
+    let strongest = paths.iter().map(|p| p.alpha.norm_sqr()).fold(0.0, Real::max);
+    if !(strongest > 0.0) {
+        return None;
+    }
+    let floor = strongest * db_to_linear(-LOS_WITHIN_DB);
+    paths
+        .iter()
+        .filter(|p| p.alpha.norm_sqr() >= floor)
+        .min_by(|a, b| a.delay_s.total_cmp(&b.delay_s))
+}
+
+/// The mean power per bin of `h`.
+fn mean_power(h: &[Complex]) -> Real {
+    h.iter().map(|v| v.norm_sqr()).sum::<Real>() / h.len().max(1) as Real
+}
+
+impl LinkStatics {
+    /// No statics: absolute delays, or (`los`) the direct path found in each snapshot.
+    pub fn none(reference: DelayReference, base: Real) -> LinkStatics {
+        LinkStatics {
+            background: None,
+            clusters: LinkCalibration::default(),
+            los_s: None,
+            empty_snapshots: 0,
+            reference: match reference {
+                DelayReference::Absolute => Reference::Absolute,
+                DelayReference::Los => Reference::PerSnapshot { base },
+            },
+        }
+    }
+
+    /// The statics of a background (`bg`, of `empty` snapshots; 0 = recursive, its clusters
+    /// limited to [`RECURSIVE_CLUSTER_DB`]) fitted by one C5 run on its mean.
+    fn of_background(
+        bg: LinkBackground,
+        band: &Band,
+        cfg: &FrontEndConfig,
+        empty: usize,
+        base: Real,
+    ) -> Result<LinkStatics> {
+        let mut est = Estimator::new(
+            band.clone(),
+            EstimatorConfig {
+                max_paths: BACKGROUND_MAX_PATHS.max(cfg.estimator.max_paths),
+                ..cfg.estimator
+            },
+        )?;
+        let nv = (bg.noise_var() > 0.0).then_some(bg.noise_var());
+        let fit = est.estimate(bg.mean(), nv, &[])?;
+        let los = los_of(&fit.paths).map(|p| (p.delay_s, p.sigma_s));
+        let reference = match (cfg.delay_reference, los) {
+            (DelayReference::Absolute, _) => Reference::Absolute,
+            (DelayReference::Los, Some((tau0, sigma0))) => Reference::Fixed { tau0, sigma0, base },
+            (DelayReference::Los, None) => {
+                return Err(Error::InvalidFile {
+                    field: "calibration".into(),
+                    reason: "delay_reference los: the background has no direct path (no path \
+                             above the estimator's threshold)"
+                        .into(),
+                })
+            }
+        };
+        let strongest = fit
+            .paths
+            .iter()
+            .map(|p| p.alpha.norm_sqr())
+            .fold(0.0, Real::max);
+        let keep = if empty == 0 {
+            strongest * db_to_linear(-RECURSIVE_CLUSTER_DB)
+        } else {
+            0.0
+        };
+        // A path whose copy in one snapshot is below the detection threshold never shows in a
+        // residual (its shadow cannot be detected): no cluster, and no gate ±many metres wide
+        // from its poorly known delay.
+        let gamma = est.threshold();
+        let snapshots = empty.max(1) as Real;
+        let bw = band.len() as Real * band.spacing_hz();
+        let span = band.unambiguous_s();
+        let mut clusters = Vec::new();
+        for p in fit
+            .paths
+            .iter()
+            .filter(|p| p.alpha.norm_sqr() >= keep && p.snr / snapshots >= gamma)
+        {
+            let mean = match reference {
+                Reference::Fixed { tau0, base, .. } => relative(p.delay_s, tau0, base, span),
+                _ => p.delay_s,
+            };
+            if !limits::DELAY_S.contains(mean) {
+                continue;
+            }
+            let amp = sqrt(p.alpha.norm_sqr());
+            clusters.push(StaticCluster {
+                mean_s: mean,
+                sigma_s: band
+                    .delay_bound_s(p.snr / snapshots)
+                    .max(BACKGROUND_SIGMA_FLOOR / bw),
+                count: empty.max(1),
+                snapshots: empty.max(1),
+                amplitude_db_mean: (amp > 0.0).then(|| 20.0 * log10(amp)),
+                amplitude_db_sigma: None,
+            });
+        }
+        Ok(LinkStatics {
+            background: Some(bg),
+            clusters: LinkCalibration::from_clusters(0, clusters)?,
+            los_s: match reference {
+                Reference::Fixed { tau0, sigma0, .. } => Some((tau0, sigma0)),
+                _ => None,
+            },
+            empty_snapshots: empty,
+            reference,
+        })
+    }
+
+    /// The statics of recorded link `link` from the empty-area recording `empty` (`None`: the
+    /// recursive background from the walk `rec`'s first snapshot; `clusters` mode needs
+    /// `empty`). `baseline_s[link]` is the link's baseline delay.
+    pub fn build(
+        empty: Option<(&Recording, &BandMap)>,
+        rec: &Recording,
+        band_map: &BandMap,
+        link: usize,
+        baseline_s: &[Real],
+        cfg: &FrontEndConfig,
+    ) -> Result<LinkStatics> {
+        let base = check_link(baseline_s, link)?;
+        let (band, map) = band_map;
+        match (cfg.statics, empty) {
+            (StaticMode::Background, Some((e, (eb, emap)))) => {
+                if eb.freq_hz != band.freq_hz || eb.response != band.response {
+                    return Err(Error::InvalidFile {
+                        field: "calibration".into(),
+                        reason: "its band (freq_hz, system response or taps) differs from the \
+                                 recording's: a background must be on the same bins"
+                            .into(),
+                    });
+                }
+                let mut hs = Vec::with_capacity(e.snapshot_count());
+                for s in 0..e.snapshot_count() {
+                    let mut h = Vec::new();
+                    emap.fill(e, s, link, &mut h)?;
+                    hs.push(h);
+                }
+                let nv = given_noise(e, emap, link).unwrap_or(0.0);
+                let (bg, _) =
+                    LinkBackground::from_snapshots(band, hs.iter().map(Vec::as_slice), nv, cfg.align())?;
+                LinkStatics::of_background(bg, band, cfg, e.snapshot_count(), base)
+            }
+            (StaticMode::Background, None) => {
+                let mut h = Vec::new();
+                map.fill(rec, 0, link, &mut h)?;
+                let nv = given_noise(rec, map, link).unwrap_or(0.0);
+                let bg = LinkBackground::new(band, &h, nv, cfg.align())?;
+                LinkStatics::of_background(bg, band, cfg, 0, base)
+            }
+            (StaticMode::Clusters, Some((e, ebm))) => {
+                let mut front = LinkFront::new(
+                    e,
+                    ebm,
+                    link,
+                    cfg,
+                    LinkStatics::none(cfg.delay_reference, base),
+                )?;
+                for _ in 0..e.snapshot_count() {
+                    front.step(e, &ebm.1)?;
+                }
+                let lists: Vec<Vec<DelayEstimate>> = front
+                    .out
+                    .paths
+                    .iter()
+                    .map(|l| l.iter().map(|t| t.estimate.delay_estimate()).collect())
+                    .collect();
+                let bw = band.len() as Real * band.spacing_hz();
+                let ccfg = AmplitudeClusterConfig::for_bandwidth(bw)?;
+                let mut statics = LinkStatics::none(cfg.delay_reference, base);
+                statics.clusters = LinkCalibration::from_estimates(link, &lists, &ccfg)?;
+                statics.empty_snapshots = e.snapshot_count();
+                Ok(statics)
+            }
+            (StaticMode::Clusters, None) => Err(Error::InvalidFile {
+                field: "calibration".into(),
+                reason: "statics clusters: needs a recording of the empty area (a calibration \
+                         recording, or a time range of the recording)"
+                    .into(),
+            }),
+        }
+    }
+}
+
+/// One recorded link's estimation in progress: the estimator, the path tracker, the statics,
+/// and what came out so far, snapshot after snapshot.
+#[derive(Debug, Clone)]
+pub struct LinkFront {
+    link: usize,
+    estimator: Estimator,
+    tracker: PathTracker,
+    statics: LinkStatics,
+    given: Option<Real>,
+    span: Real,
+    background_time_s: Real,
+    h: Vec<Complex>,
+    r: Vec<Complex>,
+    /// What came out.
+    pub out: LinkEstimates,
+}
+
+impl LinkFront {
+    /// The front end of recorded link `link` of `rec` with `statics` (from
+    /// [`LinkStatics::build`] or [`LinkStatics::none`]).
+    pub fn new(
+        rec: &Recording,
+        (band, map): &BandMap,
+        link: usize,
+        cfg: &FrontEndConfig,
+        statics: LinkStatics,
+    ) -> Result<LinkFront> {
+        Ok(LinkFront {
+            link,
+            estimator: Estimator::new(band.clone(), cfg.estimator)?,
+            tracker: PathTracker::new(cfg.paths)?,
+            given: given_noise(rec, map, link),
+            span: band.unambiguous_s(),
+            background_time_s: cfg.background_time_s,
+            statics,
+            h: Vec::new(),
+            r: Vec::new(),
+            out: LinkEstimates::with_capacity(rec.snapshot_count()),
+        })
+    }
+
+    /// Snapshots done.
+    pub fn done(&self) -> usize {
+        self.out.paths.len()
+    }
+
+    /// The statics (its background after the recursive updates so far).
+    pub fn statics(&self) -> &LinkStatics {
+        &self.statics
+    }
+
+    /// The statics and what came out.
+    pub fn finish(self) -> (LinkStatics, LinkEstimates) {
+        (self.statics, self.out)
+    }
+
+    /// Estimates the next snapshot of the link.
+    pub fn step(&mut self, rec: &Recording, map: &ResponseMap) -> Result<()> {
+        let s = self.out.paths.len();
+        let estimated = map.fill(rec, s, self.link, &mut self.h)?;
+        let nv = self.given.or(estimated);
+        let lambda = if s == 0 {
+            0.0
+        } else {
+            let dt = rec.t_s[s] - rec.t_s[s - 1];
+            Real::max(dt / self.background_time_s, 1.0 / (s + 1) as Real)
+        };
+        let recursive = self.statics.empty_snapshots == 0;
+        let span = self.span;
+        let LinkFront {
+            estimator,
+            tracker,
+            statics,
+            h,
+            r,
+            out,
+            ..
+        } = self;
+        let reference = statics.reference;
+        let mut used = 0.0;
+        let mut work = EstimateWork::default();
+        let mut align = None;
+        let tracked = tracker.step(rec.t_s[s], |seeds| {
+            let e = match statics.background.as_mut() {
+                Some(bg) => {
+                    // Seeds back in the background's time base.
+                    let seeds: Vec<Real> = match reference {
+                        Reference::Fixed { tau0, base, .. } => {
+                            seeds.iter().map(|t| t - base + tau0).collect()
+                        }
+                        _ => seeds.to_vec(),
+                    };
+                    let mut a = bg.align(h)?;
+                    bg.residual(h, &a, r)?;
+                    let power = mean_power(h) / a.gain.norm_sqr().max(Real::MIN_POSITIVE);
+                    let nvr = nv.map(|v| bg.residual_noise(v, &a));
+                    let mut e = estimator.estimate_floored(r, nvr, &seeds, power)?;
+                    if a != Alignment::NONE && !e.paths.is_empty() {
+                        let fit: Vec<(Real, Complex)> =
+                            e.paths.iter().map(|p| (p.delay_s, p.alpha)).collect();
+                        let first = e.work;
+                        a = bg.realign(h, &fit, &a)?;
+                        bg.residual(h, &a, r)?;
+                        let seeds: Vec<Real> = fit.iter().map(|f| f.0).collect();
+                        let nvr = nv.map(|v| bg.residual_noise(v, &a));
+                        e = estimator.estimate_floored(r, nvr, &seeds, power)?;
+                        e.work = merge_work(first, e.work);
+                    }
+                    if recursive && s > 0 {
+                        bg.update(lambda, nv.unwrap_or(0.0), &a);
+                    }
+                    align = Some(a);
+                    e
+                }
+                None => {
+                    let seeds: &[Real] = match reference {
+                        Reference::PerSnapshot { .. } => &[],
+                        _ => seeds,
+                    };
+                    estimator.estimate(h, nv, seeds)?
+                }
+            };
+            used = e.noise_var;
+            work = e.work;
+            Ok(in_reference(e, reference, span))
+        })?;
+        out.paths.push(tracked);
+        out.noise_var.push(used);
+        out.alignment.push(align);
+        out.work.push(work);
+        Ok(())
+    }
+}
+
+/// Both passes of a realigned snapshot.
+fn merge_work(a: EstimateWork, b: EstimateWork) -> EstimateWork {
+    EstimateWork {
+        passes: a.passes + b.passes,
+        sweeps: a.sweeps.max(b.sweeps),
+        newton: a.newton.max(b.newton),
+        sweeps_capped: a.sweeps_capped || b.sweeps_capped,
+        stop: b.stop,
+    }
+}
+
+/// A snapshot's estimate with its delays in `reference` (those `≤ 0` dropped).
+fn in_reference(mut e: SnapshotEstimate, reference: Reference, span: Real) -> SnapshotEstimate {
+    let (tau0, sigma0, base) = match reference {
+        Reference::Absolute => {
+            e.paths.retain(|p| p.delay_s > 0.0);
+            return e;
+        }
+        Reference::Fixed { tau0, sigma0, base } => (tau0, sigma0, base),
+        Reference::PerSnapshot { base } => match los_of(&e.paths) {
+            Some(p) => (p.delay_s, p.sigma_s, base),
+            None => {
+                e.paths.clear();
+                return e;
+            }
+        },
+    };
+    for p in &mut e.paths {
+        p.delay_s = relative(p.delay_s, tau0, base, span);
+        p.sigma_s = sqrt(p.sigma_s * p.sigma_s + sigma0 * sigma0);
+    }
+    e.paths.retain(|p| p.delay_s > 0.0);
+    e.paths.sort_by(|a, b| a.delay_s.total_cmp(&b.delay_s));
+    e
+}
+
+/// The baseline delays `‖t − r‖/c` of `rec`'s links on `model` (recording order).
+pub fn baselines(model: &crate::measure::Model, rec: &Recording) -> Result<Vec<Real>> {
+    let map = rec.link_map(model)?;
+    Ok(map
+        .iter()
+        .map(|&i| {
+            let l = &model.network.links[i];
+            let (t, r) = (
+                model.network.transmitters[l.tx],
+                model.network.receivers[l.rx],
+            );
+            sqrt((t - r).norm_squared()) / SPEED_OF_LIGHT
+        })
+        .collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn relative_delays_keep_the_excess_in_the_quarter_span_window() {
+        let span = 2e-6;
+        let base = 40e-9;
+        assert!((relative(130e-9, 100e-9, base, span) - 70e-9).abs() < 1e-18);
+        // 20 ns before the direct path: −20 ns of excess, not span − 20 ns.
+        assert!((relative(80e-9, 100e-9, base, span) - 20e-9).abs() < 1e-18);
+        // Wrapped: the direct path at 1990 ns, a path at 30 ns is 40 ns after it.
+        assert!((relative(30e-9, 1990e-9, base, span) - 80e-9).abs() < 1e-15);
+    }
+}
