@@ -223,7 +223,7 @@ pub const MAX_PATHS: usize = 64;
 /// every path by one Newton step; they stop earlier once no delay moves by more than 10⁻⁴/B
 /// (two to five sweeps on separated paths). A snapshot that reaches the bound keeps its paths
 /// and is counted (`EstimateWork::sweeps_capped`).
-pub const ESTIMATOR_SWEEPS: usize = 30;
+pub const ESTIMATOR_SWEEPS: usize = 6;
 
 /// Most Newton iterations of one new path of the snapshot estimator (C5), from the parabola
 /// through the periodogram's peak (quadratic convergence: two or three suffice).

@@ -8,15 +8,15 @@ use alloc::vec::Vec;
 
 use serde::Serialize;
 
+use crate::channel::Alignment;
 use crate::formats::CalibrationResult;
 use crate::math::{log10, Real};
 use crate::measure::Model;
 use crate::present::ErrorStats;
 use crate::scenario::Scenario;
-use crate::channel::Alignment;
 use crate::study::{
-    BoundCounts, ChannelRequest, ChannelStatics, CirTrackOutput, FrontEndConfig,
-    LinkStaticsInfo, RecordingEstimates,
+    BoundCounts, ChannelRequest, ChannelStatics, CirTrackOutput, FrontEndConfig, LinkStaticsInfo,
+    RecordingEstimates,
 };
 
 /// One path of `EST.json`.
@@ -152,7 +152,11 @@ pub fn estimates_doc<'a>(
         alignment: e
             .alignment
             .iter()
-            .map(|row| row.iter().map(|a| a.as_ref().map(AlignmentDoc::of)).collect())
+            .map(|row| {
+                row.iter()
+                    .map(|a| a.as_ref().map(AlignmentDoc::of))
+                    .collect()
+            })
             .collect(),
         max_paths: cfg.estimator.max_paths,
         p_fa: cfg.estimator.p_fa,

@@ -11,7 +11,7 @@ use rand_pcg::Pcg64;
 
 use super::*;
 use crate::channel::{Estimator, EstimatorConfig};
-use crate::math::{cos, sin};
+use crate::math::{cos, sin, sqrt};
 
 const N: usize = 241;
 const B: Real = 120e6;

@@ -47,16 +47,22 @@ use crate::channel::band::{cis, median};
 use crate::channel::fft::PaddedFft;
 use crate::channel::{Band, DelayEstimate};
 use crate::error::{limits, Error, Result};
-use crate::math::{db_to_linear, ln, round, sin, sqrt, Complex, Real, PI};
+use crate::math::{cos, db_to_linear, ln, round, sin, sqrt, Complex, Real, PI};
 
 mod linalg;
 
 /// Paths closer than this fraction of `1/B` are merged (their joint fit is ill-conditioned).
 pub const MERGE_FRACTION: Real = 0.25;
 /// Convergence of the refinement sweeps, in units of `1/B`.
-const SAGE_TOL: Real = 1e-4;
+const SAGE_TOL: Real = 1e-3;
+/// Refinement stops once a sweep raises the log-likelihood `‖r‖²/σ²` by less than this.
+const LL_TOL: Real = 0.05;
+/// Most paths refined jointly (more: cyclic sweeps on).
+const MAX_JOINT: usize = 3;
+/// Cyclic sweeps before the paths still moving are refined jointly.
+const CYCLIC_SWEEPS: usize = 1;
 /// Convergence of a new path's Newton iterations, in units of `1/B`.
-const NEWTON_TOL: Real = 1e-7;
+const NEWTON_TOL: Real = 1e-4;
 
 /// Settings of the snapshot estimator (C5 **[choice]**).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -247,6 +253,16 @@ impl Phasor {
             step: cis(2.0 * PI * df * tau),
         }
     }
+}
+
+/// Amplitudes by least squares at fixed delays ([`Estimator::project`]).
+struct Projection {
+    taus: Vec<Real>,
+    alpha: Vec<Complex>,
+    resid: Vec<Complex>,
+    cost: Real,
+    /// The basis columns, column-major (`k` columns of `n`).
+    basis: Vec<Complex>,
 }
 
 /// `c(τ)` and its first two derivatives `c'`, `c''` in `τ`.
@@ -459,8 +475,9 @@ impl Estimator {
                 self.median_noise().max(floor)
             }
         };
-        // Seeds first (C6): Newton from each prediction, kept if it passes the CFAR test.
-        for &seed in seeds {
+        // Seeds first (C6): Newton from each prediction (at most `max_paths` of them), kept if
+        // it passes the CFAR test; then one refinement of the seeded paths together.
+        for &seed in seeds.iter().take(self.cfg.max_paths) {
             if paths.len() >= self.cfg.max_paths || !(sigma2 > 0.0) {
                 break;
             }
@@ -473,8 +490,10 @@ impl Estimator {
                 let a = c / self.energy;
                 self.add_path(tau, -a);
                 paths.push((tau, a));
-                self.refine(h, &mut paths, &mut work);
             }
+        }
+        if !paths.is_empty() {
+            self.refine(h, &mut paths, 0, sigma2, &mut work);
         }
         // The greedy loop: each pass adds a path or stops, so at most `max_paths + 1` passes.
         for _ in 0..=self.cfg.max_paths {
@@ -512,7 +531,7 @@ impl Estimator {
             let a = m.c0 / self.energy;
             self.add_path(tau, -a);
             paths.push((tau, a));
-            self.refine(h, &mut paths, &mut work);
+            self.refine(h, &mut paths, before, sigma2, &mut work);
             if paths.len() <= before {
                 work.stop = Stop::Merged;
                 break;
@@ -574,6 +593,23 @@ impl Estimator {
         }
     }
 
+    /// The noise variance per bin of `h` as the estimator would estimate it before fitting a
+    /// path: `median |c_k|²/(Σ|P|² ln 2)` of its periodogram (biased up where paths crowd the
+    /// delay axis, as every first pass is).
+    pub fn noise_of(&mut self, h: &[Complex]) -> Result<Real> {
+        if h.len() != self.band.len() {
+            return Err(Error::LengthMismatch {
+                field: "response",
+                expected: self.band.len(),
+                found: h.len(),
+            });
+        }
+        self.resid.clear();
+        self.resid.extend_from_slice(h);
+        self.periodogram();
+        Ok(self.median_noise())
+    }
+
     /// The sub-cell offset (s) of the peak in `slot` ([`PaddedFft::parabola`]).
     fn parabola(&self, slot: u32) -> Real {
         self.fft.parabola(&self.scratch, slot) * self.span / self.fft.len() as Real
@@ -615,6 +651,23 @@ impl Estimator {
             ph *= ph0.step;
         }
         Moments { c0, c1, c2 }
+    }
+
+    /// `c(τ)` of the residual alone.
+    fn correlation(&self, tau: Real) -> Complex {
+        let ph0 = Phasor::at(self.fc[0], self.df, tau);
+        let mut ph = ph0.start;
+        let mut c0 = Complex::new(0.0, 0.0);
+        for i in 0..self.resid.len() {
+            let r = if self.flat {
+                self.resid[i]
+            } else {
+                self.band.response[i].conj() * self.resid[i]
+            };
+            c0 += r * ph;
+            ph *= ph0.step;
+        }
+        c0
     }
 
     /// `resid += a·P·e^{−j2π(f_n−f_c)τ}`.
@@ -696,29 +749,109 @@ impl Estimator {
         (folded, m, used)
     }
 
-    /// Cyclic refinement (one Newton step per path and sweep, at most
-    /// [`limits::ESTIMATOR_SWEEPS`] sweeps, until no delay moves by `SAGE_TOL/B`), merge of
-    /// close paths (then a joint LS of the amplitudes); leaves `resid = h − Ĥ`.
-    fn refine(&mut self, h: &[Complex], paths: &mut Vec<(Real, Complex)>, work: &mut EstimateWork) {
+    /// Refinement after new paths (`paths[new..]`): the new paths and the paths coupled to one
+    /// of them — within `2/B`, or so much stronger that their sidelobe there (`|α_j|/(πBΔ)`) is
+    /// a tenth of its amplitude (a weak path beside a strong one; other paths are moved by a
+    /// new one far below their own error) — cyclic sweeps (one Newton step per path and sweep)
+    /// while they converge fast; the paths still moving after [`CYCLIC_SWEEPS`] (strongly
+    /// coupled ones: closer than about `1/B`, where a Gauss–Seidel sweep converges slowly) are
+    /// refined jointly with their neighbours within `2/B` ([`Estimator::joint_refine`]:
+    /// Gauss–Newton with Levenberg damping, amplitudes by least squares, quadratic near the
+    /// optimum). At most [`limits::ESTIMATOR_SWEEPS`] sweeps and joint iterations together,
+    /// until no delay moves by `SAGE_TOL/B`, a sweep gains less than `LL_TOL` in log-likelihood
+    /// (`‖r‖²/σ²`) or two paths come closer than the merge separation;
+    /// then the merge of close paths (and a joint LS of the amplitudes); leaves `resid = h − Ĥ`.
+    fn refine(
+        &mut self,
+        h: &[Complex],
+        paths: &mut Vec<(Real, Complex)>,
+        new: usize,
+        sigma2: Real,
+        work: &mut EstimateWork,
+    ) {
         let n = self.band.len();
         let tol = SAGE_TOL / (self.df * n as Real);
+        // A sweep or joint step that lowers ‖r‖² by less than this changes the log-likelihood
+        // by less than LL_TOL: converged in what the data can tell, wherever the delays drift
+        // (diffuse scattering fitted by a few paths leaves such flat valleys).
+        let gain_tol = LL_TOL * sigma2;
         let max_step = 0.25 / (self.df * n as Real);
+        let near = 2.0 / (self.df * n as Real);
+        let bw = self.df * n as Real;
+        // Coupled to a new path: within 2/B, or strong enough that its sidelobe there (the
+        // Dirichlet envelope 1/(πBΔ) of its amplitude) is a tenth of the new path's amplitude.
+        let coupled = |i: usize, j: usize| {
+            let d = (paths[i].0 - paths[j].0).abs();
+            d < near || paths[i].1.norm() >= 0.1 * PI * bw * d * paths[j].1.norm()
+        };
+        let group: Vec<usize> = (0..paths.len())
+            .filter(|&i| i >= new || (new..paths.len()).any(|j| coupled(i, j)))
+            .collect();
         let mut sweeps = 0;
-        let mut converged = paths.len() < 2;
-        while !converged && sweeps < limits::ESTIMATOR_SWEEPS {
+        let mut converged = group.len() < 2;
+        let mut moves: Vec<Real> = vec![0.0; paths.len()];
+        while !converged && sweeps < CYCLIC_SWEEPS {
             sweeps += 1;
-            let mut moved: Real = 0.0;
-            for path in paths.iter_mut() {
-                let (t, a) = *path;
+            let mut gain = 0.0;
+            for &i in &group {
+                let (t, a) = paths[i];
                 let m = self.add_back(t, a);
                 let dt = m.newton_step(max_step);
-                let a2 = m.at(dt) / self.energy;
+                let c2 = m.at(dt);
+                let a2 = c2 / self.energy;
                 let t2 = fold(t + dt, self.win_start, self.span).min(self.win_end);
                 self.add_path(t2, -a2);
-                *path = (t2, a2);
-                moved = moved.max(dt.abs());
+                paths[i] = (t2, a2);
+                moves[i] = dt.abs();
+                // ‖r‖² falls by (|c(τ')|² − |c(τ)|²)/ΣP² when path i moves (its LS amplitude).
+                gain += (c2.norm_sqr() - m.c0.norm_sqr()) / self.energy;
             }
-            converged = moved < tol;
+            converged = group.iter().all(|&i| moves[i] < tol)
+                || gain.abs() < gain_tol
+                || self.crowded(paths);
+        }
+        if !converged {
+            // The paths still moving and their neighbours within 2/B: refined jointly when
+            // they are few (a resolvable pair or triple, where Gauss–Seidel crawls and
+            // Gauss–Newton converges in two or three steps), else by more cyclic sweeps (a dense
+            // cluster — diffuse scattering fitted by several paths — where joint steps are
+            // ill-conditioned and cost O(k²) kernels each).
+            let joint: Vec<usize> = group
+                .iter()
+                .copied()
+                .filter(|&i| {
+                    moves[i] >= tol
+                        || group
+                            .iter()
+                            .any(|&j| moves[j] >= tol && (paths[i].0 - paths[j].0).abs() < near)
+                })
+                .collect();
+            let budget = limits::ESTIMATOR_SWEEPS - sweeps;
+            if joint.len() <= MAX_JOINT {
+                let (iterations, ok) = self.joint_refine(paths, &joint, budget, tol, gain_tol);
+                sweeps += iterations;
+                converged = ok;
+            } else {
+                while !converged && sweeps < limits::ESTIMATOR_SWEEPS {
+                    sweeps += 1;
+                    let mut gain = 0.0;
+                    for &i in &group {
+                        let (t, a) = paths[i];
+                        let m = self.add_back(t, a);
+                        let dt = m.newton_step(max_step);
+                        let c2 = m.at(dt);
+                        let a2 = c2 / self.energy;
+                        let t2 = fold(t + dt, self.win_start, self.span).min(self.win_end);
+                        self.add_path(t2, -a2);
+                        paths[i] = (t2, a2);
+                        moves[i] = dt.abs();
+                        gain += (c2.norm_sqr() - m.c0.norm_sqr()) / self.energy;
+                    }
+                    converged = group.iter().all(|&i| moves[i] < tol)
+                        || gain.abs() < gain_tol
+                        || self.crowded(paths);
+                }
+            }
         }
         work.sweeps = work.sweeps.max(sweeps);
         work.sweeps_capped |= !converged;
@@ -743,6 +876,208 @@ impl Estimator {
         }
     }
 
+    /// Whether two paths are closer than the merge separation.
+    fn crowded(&self, paths: &[(Real, Complex)]) -> bool {
+        let sep = self.merge_sep();
+        (0..paths.len())
+            .any(|i| (i + 1..paths.len()).any(|j| (paths[i].0 - paths[j].0).abs() < sep))
+    }
+
+    /// Gauss–Newton with Levenberg damping on the delays of `paths[group]` (the other paths
+    /// fixed), their amplitudes by least squares at every trial (variable projection in
+    /// Kaufman's form): at most `budget` trials, until an accepted step moves no delay by
+    /// `tol`. Steps are clipped to `1/(4B)`. Returns the trials used and whether it converged;
+    /// leaves `resid = h − Ĥ` for the updated paths.
+    fn joint_refine(
+        &mut self,
+        paths: &mut [(Real, Complex)],
+        group: &[usize],
+        budget: usize,
+        tol: Real,
+        gain_tol: Real,
+    ) -> (usize, bool) {
+        let k = group.len();
+        if k == 0 {
+            return (0, true);
+        }
+        let n = self.band.len();
+        let max_step = 0.25 / (self.df * n as Real);
+        // The data the group explains: the residual with the group's paths added back.
+        for &g in group {
+            let (t, a) = paths[g];
+            self.add_path(t, a);
+        }
+        let y = self.resid.clone();
+        let mut taus: Vec<Real> = group.iter().map(|&g| paths[g].0).collect();
+        let mut fit = self.project(&y, &taus);
+        let mut lambda = 1e-6;
+        let (mut used, mut converged) = (0, false);
+        while used < budget {
+            used += 1;
+            let Some((grad, hess)) = self.gauss_newton_terms(&fit) else {
+                break;
+            };
+            let mut sys = hess.clone();
+            for i in 0..k {
+                sys[i * k + i] *= 1.0 + lambda;
+            }
+            let Some(inv) = linalg::inverse_sym(sys, k) else {
+                lambda *= 10.0;
+                continue;
+            };
+            let mut trial = taus.clone();
+            let mut moved: Real = 0.0;
+            for i in 0..k {
+                let d: Real = -(0..k).map(|j| inv[i * k + j] * grad[j]).sum::<Real>();
+                let d = if d.is_finite() {
+                    d.clamp(-max_step, max_step)
+                } else {
+                    0.0
+                };
+                trial[i] = fold(taus[i] + d, self.win_start, self.span).min(self.win_end);
+                moved = moved.max(d.abs());
+            }
+            let next = self.project(&y, &trial);
+            if next.cost <= fit.cost {
+                let gain = fit.cost - next.cost;
+                taus = trial;
+                fit = next;
+                lambda = (lambda * 0.1).max(1e-12);
+                // Converged, or two paths about to merge (the merge decides; their joint fit is
+                // degenerate and would drift on).
+                let sep = self.merge_sep();
+                let crowded = (0..k).any(|i| (i + 1..k).any(|j| (taus[i] - taus[j]).abs() < sep));
+                if moved < tol || gain < gain_tol || crowded {
+                    converged = true;
+                    break;
+                }
+            } else {
+                lambda *= 10.0;
+                if moved < tol {
+                    converged = true;
+                    break;
+                }
+            }
+        }
+        for (i, &g) in group.iter().enumerate() {
+            paths[g] = (taus[i], fit.alpha[i]);
+        }
+        self.resid.clear();
+        self.resid.extend_from_slice(&fit.resid);
+        (used, converged)
+    }
+
+    /// The least-squares amplitudes of paths at `taus` explaining `y`, the residual, its
+    /// energy, and the basis columns `a_i` (`P·e^{−j2π(f_n−f_c)τ_i}`).
+    fn project(&self, y: &[Complex], taus: &[Real]) -> Projection {
+        let (n, k) = (y.len(), taus.len());
+        let mut basis = Vec::with_capacity(n * k);
+        for &t in taus {
+            let ph0 = Phasor::at(self.fc[0], self.df, t);
+            let mut ph = ph0.start.conj();
+            let step = ph0.step.conj();
+            for i in 0..n {
+                basis.push(if self.flat {
+                    ph
+                } else {
+                    self.band.response[i] * ph
+                });
+                ph *= step;
+            }
+        }
+        let mut g = vec![Complex::new(0.0, 0.0); k * k];
+        let mut b = vec![Complex::new(0.0, 0.0); k];
+        for i in 0..k {
+            let ai = &basis[i * n..(i + 1) * n];
+            b[i] = ai.iter().zip(y).map(|(a, v)| a.conj() * v).sum();
+            g[i * k + i] = Complex::new(self.energy, 0.0);
+            for j in i + 1..k {
+                let s = self.gram(taus[j] - taus[i]);
+                g[i * k + j] = s;
+                g[j * k + i] = s.conj();
+            }
+        }
+        let alpha = linalg::solve_complex(&mut g, &mut b, k)
+            .unwrap_or_else(|| vec![Complex::new(0.0, 0.0); k]);
+        let mut resid = y.to_vec();
+        for (i, a) in alpha.iter().enumerate() {
+            for (r, v) in resid.iter_mut().zip(&basis[i * n..(i + 1) * n]) {
+                *r -= v * a;
+            }
+        }
+        let cost = resid.iter().map(|v| v.norm_sqr()).sum();
+        Projection {
+            taus: taus.to_vec(),
+            alpha,
+            resid,
+            cost,
+            basis,
+        }
+    }
+
+    /// The gradient and Gauss–Newton Hessian of `‖r‖²` in the delays at `fit` (amplitudes
+    /// held): `∂r/∂τ_i = −α_i·(−j2π(f_n−f_c))·a_i`. `None` if not finite.
+    fn gauss_newton_terms(&self, fit: &Projection) -> Option<(Vec<Real>, Vec<Real>)> {
+        let k = fit.alpha.len();
+        let n = fit.resid.len();
+        let tp = 2.0 * PI;
+        // dr_i[n] = j2π f_n α_i a_i[n]
+        let mut dr = Vec::with_capacity(n * k);
+        for i in 0..k {
+            let a = fit.alpha[i];
+            for (v, f) in fit.basis[i * n..(i + 1) * n].iter().zip(&self.fc) {
+                let x = v * a * (tp * f);
+                dr.push(Complex::new(-x.im, x.re));
+            }
+        }
+        let mut grad = vec![0.0; k];
+        let mut hess = vec![0.0; k * k];
+        // Kaufman's variable projection: the Jacobian projected off the amplitudes' span,
+        // J = (I − A G⁻¹Aᴴ)D, so JᴴJ = DᴴD − Bᴴ G⁻¹ B with G = AᴴA, B = AᴴD; every entry a
+        // kernel: (DᴴD)_ij = (2π)² conj(α_i) α_j S_2(τ_j − τ_i), B_ij = j2π α_j S_1(τ_j − τ_i),
+        // G_ij = S_0(τ_j − τ_i). Without the projection the steps of strongly coupled paths are
+        // far too short (amplitude and delay trade off within 1/B).
+        let taus = &fit.taus;
+        let mut g = vec![Complex::new(0.0, 0.0); k * k];
+        let mut bm = vec![Complex::new(0.0, 0.0); k * k];
+        let mut dd = vec![Complex::new(0.0, 0.0); k * k];
+        for i in 0..k {
+            for j in 0..k {
+                let (s0, s1, s2) = self.kernels(taus[j] - taus[i]);
+                g[i * k + j] = s0;
+                bm[i * k + j] = Complex::new(0.0, tp) * fit.alpha[j] * s1;
+                dd[i * k + j] = fit.alpha[i].conj() * fit.alpha[j] * s2 * (tp * tp);
+            }
+        }
+        // X = G⁻¹B, column by column.
+        let mut x = vec![Complex::new(0.0, 0.0); k * k];
+        for j in 0..k {
+            let mut gg = g.clone();
+            let mut col: Vec<Complex> = (0..k).map(|i| bm[i * k + j]).collect();
+            let sol = linalg::solve_complex(&mut gg, &mut col, k)?;
+            for i in 0..k {
+                x[i * k + j] = sol[i];
+            }
+        }
+        for i in 0..k {
+            let di = &dr[i * n..(i + 1) * n];
+            grad[i] = 2.0
+                * di.iter()
+                    .zip(&fit.resid)
+                    .map(|(d, r)| (r.conj() * d).re)
+                    .sum::<Real>();
+            for j in i..k {
+                // (Bᴴ X)_ij = Σ_m conj(B_mi) X_mj
+                let c: Complex = (0..k).map(|m| bm[m * k + i].conj() * x[m * k + j]).sum();
+                let h = 2.0 * (dd[i * k + j] - c).re;
+                hess[i * k + j] = h;
+                hess[j * k + i] = h;
+            }
+        }
+        (grad.iter().all(|v| v.is_finite()) && hess.iter().all(|v| v.is_finite()))
+            .then_some((grad, hess))
+    }
+
     /// Joint least squares of all amplitudes at fixed delays; `resid` ← `h − Ĥ`.
     fn joint_ls(&mut self, h: &[Complex], paths: &mut [(Real, Complex)]) {
         let k = paths.len();
@@ -756,7 +1091,7 @@ impl Estimator {
         self.resid.clear();
         self.resid.extend_from_slice(h);
         for i in 0..k {
-            b[i] = self.moments(paths[i].0).c0;
+            b[i] = self.correlation(paths[i].0);
             g[i * k + i] = Complex::new(self.energy, 0.0);
             for j in i + 1..k {
                 let s = self.gram(paths[j].0 - paths[i].0);
@@ -774,17 +1109,33 @@ impl Estimator {
         }
     }
 
-    /// `S_0(d) = Σ |P|² e^{−j2π(f_n−f_c)d}`: for a flat band on centred bins the real Dirichlet
-    /// kernel `sin(πNΔf d)/sin(πΔf d)`, else the sum.
+    /// `S_0(d) = Σ |P|² e^{−j2π(f_n−f_c)d}` ([`Estimator::kernels`]).
     fn gram(&self, d: Real) -> Complex {
-        let n = self.band.len();
-        if self.flat {
-            let den = sin(PI * self.df * d);
-            if den.abs() > 1e-9 {
-                return Complex::new(sin(PI * n as Real * self.df * d) / den, 0.0);
-            }
+        self.kernels(d).0
+    }
+
+    /// `S_a(d) = Σ |P|² (f_n−f_c)^a e^{−j2π(f_n−f_c)d}` for `a` = 0, 1, 2. For a flat band on
+    /// centred bins in closed form, `O(1)`: with `θ = πΔf·d` and the Dirichlet kernel
+    /// `D(θ) = sin(Nθ)/sin θ`, `S_0 = D`, `S_1 = j(Δf/2)·D'`, `S_2 = −(Δf²/4)·D''`,
+    /// `D' = (N cos Nθ sin θ − sin Nθ cos θ)/sin²θ`, `D'' = (1 − N²)D − 2 cot θ·D'`; the sums
+    /// where that cancels (`|Nθ| < 0.1` or `|sin θ| < 10⁻²`; tested against the sums).
+    fn kernels(&self, d: Real) -> (Complex, Complex, Complex) {
+        let n = self.band.len() as Real;
+        let th = PI * self.df * d;
+        let st = sin(th);
+        if self.flat && (n * th).abs() >= 0.1 && st.abs() >= 1e-2 {
+            let (sn, cn, ct) = (sin(n * th), cos(n * th), cos(th));
+            let dk = sn / st;
+            let d1 = (n * cn * st - sn * ct) / (st * st);
+            let d2 = (1.0 - n * n) * dk - 2.0 * (ct / st) * d1;
+            let df = self.df;
+            return (
+                Complex::new(dk, 0.0),
+                Complex::new(0.0, 0.5 * df * d1),
+                Complex::new(-0.25 * df * df * d2, 0.0),
+            );
         }
-        self.kernel(d, 0)
+        (self.kernel(d, 0), self.kernel(d, 1), self.kernel(d, 2))
     }
 
     /// `S_a(d) = Σ |P|² (f_n−f_c)^a e^{−j2π(f_n−f_c)d}` (`a` = 0, 1, 2).
@@ -807,7 +1158,7 @@ impl Estimator {
     /// `σ_τ` per path from the inverse of the joint Fisher matrix of C1 (parameters `τ_i`,
     /// `Re α_i`, `Im α_i`); C4 at the fitted SNR when it is singular.
     fn fisher_sigmas(&self, paths: &[(Real, Complex)], sigma2: Real) -> Vec<Real> {
-        let fim = fisher_matrix(&self.fc, &self.w, self.df, paths, sigma2);
+        let fim = fisher_with(paths, sigma2, |d| self.kernels(d));
         let k = paths.len();
         match linalg::inverse_sym(fim, 3 * k) {
             Some(inv) => (0..k)
@@ -842,6 +1193,31 @@ pub fn fisher_matrix(
     paths: &[(Real, Complex)],
     sigma2: Real,
 ) -> Vec<Real> {
+    let tp = 2.0 * PI;
+    fisher_with(paths, sigma2, |d| {
+        let mut ph = cis(-tp * fc[0] * d);
+        let step = cis(-tp * df * d);
+        let (mut s0, mut s1, mut s2) = (
+            Complex::new(0.0, 0.0),
+            Complex::new(0.0, 0.0),
+            Complex::new(0.0, 0.0),
+        );
+        for (wn, f) in w.iter().zip(fc) {
+            s0 += ph * *wn;
+            s1 += ph * (wn * f);
+            s2 += ph * (wn * f * f);
+            ph *= step;
+        }
+        (s0, s1, s2)
+    })
+}
+
+/// The Fisher matrix of [`fisher_matrix`] from the kernels `S_a(τ_l − τ_i)`, `a` = 0, 1, 2.
+fn fisher_with(
+    paths: &[(Real, Complex)],
+    sigma2: Real,
+    kernels: impl Fn(Real) -> (Complex, Complex, Complex),
+) -> Vec<Real> {
     let k = paths.len();
     let m = 3 * k;
     let mut out = vec![0.0; m * m];
@@ -850,19 +1226,7 @@ pub fn fisher_matrix(
     for i in 0..k {
         for l in 0..k {
             let d = paths[l].0 - paths[i].0;
-            let mut ph = cis(-tp * fc[0] * d);
-            let step = cis(-tp * df * d);
-            let (mut s0, mut s1, mut s2) = (
-                Complex::new(0.0, 0.0),
-                Complex::new(0.0, 0.0),
-                Complex::new(0.0, 0.0),
-            );
-            for (wn, f) in w.iter().zip(fc) {
-                s0 += ph * *wn;
-                s1 += ph * (wn * f);
-                s2 += ph * (wn * f * f);
-                ph *= step;
-            }
+            let (s0, s1, s2) = kernels(d);
             let (ai, al) = (paths[i].1, paths[l].1);
             // columns: d_τ = −j2πα f e, e, j e
             let dt_i = Complex::new(0.0, -tp) * ai; // times f

@@ -504,3 +504,27 @@ fn window_sets_grid() {
     assert_eq!(e.grid_cells(), 513); // cells 0 … 512 of 1024 over 2 µs
     assert!((full.threshold() - ln(1024.0 / 1e-3)).abs() < 1e-12);
 }
+
+/// The closed-form kernels `S_0, S_1, S_2` of a flat band equal the sums they replace, to
+/// 1e-9 of the largest of each, over separations from 0 to the unambiguous span.
+#[test]
+fn closed_form_kernels_equal_the_sums() {
+    let b = band();
+    let e = Estimator::new(b.clone(), EstimatorConfig::default()).unwrap();
+    let span = b.unambiguous_s();
+    let (m0, m1, m2) = (
+        e.kernel(0.0, 0).norm(),
+        e.kernel(0.3 / B, 1).norm().max(1.0),
+        e.kernel(0.0, 2).norm(),
+    );
+    for i in 0..4001 {
+        let d = -span + 2.0 * span * i as Real / 4000.0;
+        let (k0, k1, k2) = e.kernels(d);
+        assert!((k0 - e.kernel(d, 0)).norm() <= 1e-9 * m0, "S0 at {d}");
+        assert!(
+            (k1 - e.kernel(d, 1)).norm() <= 1e-9 * m1 * DF * N as Real,
+            "S1 at {d}"
+        );
+        assert!((k2 - e.kernel(d, 2)).norm() <= 1e-9 * m2, "S2 at {d}");
+    }
+}

@@ -288,7 +288,10 @@ impl Npy {
         match v {
             Some(0) => Ok(false),
             Some(1) => Ok(true),
-            Some(x) => Err(invalid(&self.name, format!("{x}: must be 0 (free-running) or 1 (a common clock)"))),
+            Some(x) => Err(invalid(
+                &self.name,
+                format!("{x}: must be 0 (free-running) or 1 (a common clock)"),
+            )),
             None => Err(self.wrong_dtype("bool or int")),
         }
     }

@@ -382,7 +382,12 @@ impl EstimationRun {
     /// Estimates up to `units` more link-snapshots of `rec` with `empty` (the recordings given
     /// to [`EstimationRun::new`]; a link's statics are built with its first snapshot); returns
     /// whether the estimation is complete.
-    pub fn run(&mut self, rec: &Recording, empty: Option<&Recording>, units: usize) -> Result<bool> {
+    pub fn run(
+        &mut self,
+        rec: &Recording,
+        empty: Option<&Recording>,
+        units: usize,
+    ) -> Result<bool> {
         let mut left = units;
         while left > 0 && !self.is_done() {
             let link = self.results.len();

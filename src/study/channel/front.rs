@@ -5,12 +5,14 @@
 //!
 //! **Statics** (per recorded link):
 //! - `background` with an empty-area recording: its coherent mean (C9 step 1); the static
-//!   clusters are the mean's own paths (one C5 fit at `S_bg` times the SNR, at most
-//!   [`BACKGROUND_MAX_PATHS`]) whose single-snapshot SNR (`SNR/S_bg`) passes the CFAR
-//!   threshold — a weaker path's shadow is never detected, and its poorly known delay would
-//!   gate metres of range — each with what a shadowed copy of that path measures in one
-//!   snapshot, `σ̄ = max(C4 at SNR/S_bg, 0.05/B)` (C4 alone: the joint Fisher bound of a dense
-//!   fit of diffuse multipath is metres wide where paths crowd within `1/B`).
+//!   clusters are the mean's own paths found by one C5 fit at the noise of *one* snapshot (at
+//!   most [`BACKGROUND_MAX_PATHS`]): exactly the paths whose shadowed copy a snapshot's residual
+//!   can show — a weaker path's shadow is never detected, and its poorly known delay would gate
+//!   metres of range — each with what such a copy measures in one snapshot,
+//!   `σ̄ = max(C4 at its single-snapshot SNR, 0.05/B)` (C4 alone: the joint Fisher bound of a
+//!   dense fit of diffuse multipath is metres wide where paths crowd within `1/B`). The noise
+//!   of one snapshot is the recording's `noise_var`, else the estimator's median estimate on
+//!   the first empty snapshot.
 //! - `background` without one (recursive, C9 step 1): the mean starts at the walk's first
 //!   snapshot; its clusters are that snapshot's paths within [`RECURSIVE_CLUSTER_DB`] of its
 //!   strongest (the shadowable ones: a person's echo is 30–40 dB below the direct path).
@@ -33,8 +35,8 @@
 use alloc::vec::Vec;
 
 use crate::channel::{
-    Alignment, Band, EstimateWork, Estimator, EstimatorConfig, LinkBackground,
-    PathEstimate, PathTracker, Recording, ResponseMap, SnapshotEstimate, TrackedPath,
+    Alignment, Band, EstimateWork, Estimator, EstimatorConfig, LinkBackground, PathEstimate,
+    PathTracker, Recording, ResponseMap, SnapshotEstimate, TrackedPath,
 };
 use crate::error::{limits, Error, Result};
 use crate::math::{db_to_linear, floor, log10, sqrt, Complex, Real, SPEED_OF_LIGHT};
@@ -81,7 +83,11 @@ enum Reference {
     /// Absolute delays.
     Absolute,
     /// `τ₀` and its σ, fixed (the background's), and the baseline delay.
-    Fixed { tau0: Real, sigma0: Real, base: Real },
+    Fixed {
+        tau0: Real,
+        sigma0: Real,
+        base: Real,
+    },
     /// Found in each snapshot; the baseline delay.
     PerSnapshot { base: Real },
 }
@@ -106,14 +112,11 @@ pub type BandMap = (Band, ResponseMap);
 
 /// The baseline delay `‖t − r‖/c` of recorded link `link`, s (`baseline_s[link]`).
 fn check_link(baseline_s: &[Real], link: usize) -> Result<Real> {
-    baseline_s
-        .get(link)
-        .copied()
-        .ok_or(Error::IndexOutOfRange {
-            field: "links",
-            index: link,
-            len: baseline_s.len(),
-        })
+    baseline_s.get(link).copied().ok_or(Error::IndexOutOfRange {
+        field: "links",
+        index: link,
+        len: baseline_s.len(),
+    })
 }
 
 /// The per-bin noise variance of recorded link `link` when the recording gives one.
@@ -132,7 +135,10 @@ fn relative(tau: Real, tau0: Real, base: Real, span: Real) -> Real {
 
 /// The direct path among `paths` (the earliest within [`LOS_WITHIN_DB`] of the strongest).
 fn los_of(paths: &[PathEstimate]) -> Option<&PathEstimate> {
-    let strongest = paths.iter().map(|p| p.alpha.norm_sqr()).fold(0.0, Real::max);
+    let strongest = paths
+        .iter()
+        .map(|p| p.alpha.norm_sqr())
+        .fold(0.0, Real::max);
     if !(strongest > 0.0) {
         return None;
     }
@@ -164,13 +170,16 @@ impl LinkStatics {
     }
 
     /// The statics of a background (`bg`, of `empty` snapshots; 0 = recursive, its clusters
-    /// limited to [`RECURSIVE_CLUSTER_DB`]) fitted by one C5 run on its mean.
+    /// limited to [`RECURSIVE_CLUSTER_DB`]) fitted by one C5 run on its mean at the noise of
+    /// one snapshot (`single_noise`, per bin): it finds exactly the paths whose shadowed copy
+    /// a snapshot's residual can show.
     fn of_background(
         bg: LinkBackground,
         band: &Band,
         cfg: &FrontEndConfig,
         empty: usize,
         base: Real,
+        single_noise: Real,
     ) -> Result<LinkStatics> {
         let mut est = Estimator::new(
             band.clone(),
@@ -179,7 +188,7 @@ impl LinkStatics {
                 ..cfg.estimator
             },
         )?;
-        let nv = (bg.noise_var() > 0.0).then_some(bg.noise_var());
+        let nv = (single_noise > 0.0).then_some(single_noise);
         let fit = est.estimate(bg.mean(), nv, &[])?;
         let los = los_of(&fit.paths).map(|p| (p.delay_s, p.sigma_s));
         let reference = match (cfg.delay_reference, los) {
@@ -204,19 +213,11 @@ impl LinkStatics {
         } else {
             0.0
         };
-        // A path whose copy in one snapshot is below the detection threshold never shows in a
-        // residual (its shadow cannot be detected): no cluster, and no gate ±many metres wide
-        // from its poorly known delay.
-        let gamma = est.threshold();
-        let snapshots = empty.max(1) as Real;
+
         let bw = band.len() as Real * band.spacing_hz();
         let span = band.unambiguous_s();
         let mut clusters = Vec::new();
-        for p in fit
-            .paths
-            .iter()
-            .filter(|p| p.alpha.norm_sqr() >= keep && p.snr / snapshots >= gamma)
-        {
+        for p in fit.paths.iter().filter(|p| p.alpha.norm_sqr() >= keep) {
             let mean = match reference {
                 Reference::Fixed { tau0, base, .. } => relative(p.delay_s, tau0, base, span),
                 _ => p.delay_s,
@@ -227,9 +228,7 @@ impl LinkStatics {
             let amp = sqrt(p.alpha.norm_sqr());
             clusters.push(StaticCluster {
                 mean_s: mean,
-                sigma_s: band
-                    .delay_bound_s(p.snr / snapshots)
-                    .max(BACKGROUND_SIGMA_FLOOR / bw),
+                sigma_s: band.delay_bound_s(p.snr).max(BACKGROUND_SIGMA_FLOOR / bw),
                 count: empty.max(1),
                 snapshots: empty.max(1),
                 amplitude_db_mean: (amp > 0.0).then(|| 20.0 * log10(amp)),
@@ -277,17 +276,29 @@ impl LinkStatics {
                     emap.fill(e, s, link, &mut h)?;
                     hs.push(h);
                 }
-                let nv = given_noise(e, emap, link).unwrap_or(0.0);
-                let (bg, _) =
-                    LinkBackground::from_snapshots(band, hs.iter().map(Vec::as_slice), nv, cfg.align())?;
-                LinkStatics::of_background(bg, band, cfg, e.snapshot_count(), base)
+                let nv = given_noise(e, emap, link);
+                let (bg, _) = LinkBackground::from_snapshots(
+                    band,
+                    hs.iter().map(Vec::as_slice),
+                    nv.unwrap_or(0.0),
+                    cfg.align(),
+                )?;
+                let single = match nv {
+                    Some(v) => v,
+                    None => Estimator::new(band.clone(), cfg.estimator)?.noise_of(&hs[0])?,
+                };
+                LinkStatics::of_background(bg, band, cfg, e.snapshot_count(), base, single)
             }
             (StaticMode::Background, None) => {
                 let mut h = Vec::new();
                 map.fill(rec, 0, link, &mut h)?;
-                let nv = given_noise(rec, map, link).unwrap_or(0.0);
-                let bg = LinkBackground::new(band, &h, nv, cfg.align())?;
-                LinkStatics::of_background(bg, band, cfg, 0, base)
+                let nv = given_noise(rec, map, link);
+                let bg = LinkBackground::new(band, &h, nv.unwrap_or(0.0), cfg.align())?;
+                let single = match nv {
+                    Some(v) => v,
+                    None => Estimator::new(band.clone(), cfg.estimator)?.noise_of(&h)?,
+                };
+                LinkStatics::of_background(bg, band, cfg, 0, base, single)
             }
             (StaticMode::Clusters, Some((e, ebm))) => {
                 let mut front = LinkFront::new(

@@ -49,8 +49,8 @@ pub use front::{
     RECURSIVE_CLUSTER_DB,
 };
 pub use request::{
-    ChannelRequest, DelayReference, DelaySigma, FrontEndConfig, StaticMode,
-    DEFAULT_PROCESS_NOISE, EXTENT_SIGMA_M,
+    ChannelRequest, DelayReference, DelaySigma, FrontEndConfig, StaticMode, DEFAULT_PROCESS_NOISE,
+    EXTENT_SIGMA_M,
 };
 pub use track::{cir_track, CirStart, CirTrackOutput, SegmentDoc};
 

@@ -8,12 +8,9 @@
 
 use alloc::string::{String, ToString};
 
-
 use serde::{Deserialize, Serialize};
 
-use crate::channel::{
-    AlignMode, EstimatorConfig, PathTrackerConfig, DEFAULT_BACKGROUND_TIME_S,
-};
+use crate::channel::{AlignMode, EstimatorConfig, PathTrackerConfig, DEFAULT_BACKGROUND_TIME_S};
 use crate::error::{limits, Error, Result};
 use crate::math::Real;
 use crate::track::gating::{AssociationRule, SegmentConfig};

@@ -104,9 +104,19 @@ impl CirTrackOutput {
 
     /// Snapshot `k`: the state and covariance, the links used, gating and association, the σ
     /// of each used delay.
-    fn set(&mut self, k: usize, x: &Vec4, p: &Mat4, links_used: usize, sel: &Selection, sig: &[Option<Real>]) {
+    fn set(
+        &mut self,
+        k: usize,
+        x: &Vec4,
+        p: &Mat4,
+        links_used: usize,
+        sel: &Selection,
+        sig: &[Option<Real>],
+    ) {
         self.states[k] = Some((*x).into());
-        self.covariances[k] = Some(core::array::from_fn(|i| core::array::from_fn(|j| p[(i, j)])));
+        self.covariances[k] = Some(core::array::from_fn(|i| {
+            core::array::from_fn(|j| p[(i, j)])
+        }));
         self.links_used[k] = links_used;
         self.delays_used_s[k] = sel.delays.clone();
         self.sigmas_used_s[k] = sig.to_vec();
@@ -206,7 +216,10 @@ pub fn cir_track(
                 for s in &steps {
                     out.record(s);
                 }
-                let p0 = steps.first().map(|s| s.covariance).unwrap_or_else(Mat4::zeros);
+                let p0 = steps
+                    .first()
+                    .map(|s| s.covariance)
+                    .unwrap_or_else(Mat4::zeros);
                 let doc = start_doc(&start, est.t_s[start.k], &p0);
                 if out.start.is_none() {
                     out.start = Some(doc.clone());

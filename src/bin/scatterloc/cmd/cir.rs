@@ -9,9 +9,8 @@ use scatterloc::formats::{CalibrationSnapshots, Measurements, Truth};
 use scatterloc::native::Parallel;
 use scatterloc::present::{estimates_doc, track_doc, track_errors};
 use scatterloc::study::{
-    cir_track as track_recording, delays_only, estimate_recording, ChannelRequest,
-    ChannelStatics, DelayReference, FrontEndConfig, RecordingEstimates, StaticMode,
-    DEFAULT_PROCESS_NOISE,
+    cir_track as track_recording, delays_only, estimate_recording, ChannelRequest, ChannelStatics,
+    DelayReference, FrontEndConfig, RecordingEstimates, StaticMode, DEFAULT_PROCESS_NOISE,
 };
 use scatterloc::track::ConstantVelocity;
 use scatterloc::{npz, Model, Scenario};
@@ -199,7 +198,11 @@ pub fn cir_estimate(args: &CirEstimateArgs) -> Result<(), CliError> {
     let cfg = req.front_end(rec.synchronized);
     let (statics, est) = estimate(&scenario, &model, &rec, empty.as_ref(), &cfg, threads)?;
     let mut files = OutputSet::new();
-    files.json("out", &args.out, &estimates_doc(&model, &est, &cfg, &statics))?;
+    files.json(
+        "out",
+        &args.out,
+        &estimates_doc(&model, &est, &cfg, &statics),
+    )?;
     let snaps = est.snapshots();
     if let Some(p) = &args.snapshots {
         let doc = CalibrationSnapshots {
