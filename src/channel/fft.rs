@@ -156,6 +156,11 @@ impl PaddedFft {
         self.m * self.r
     }
 
+    /// The output slot holding frequency index `k` (`k < L`).
+    pub(crate) fn slot_of(&self, k: usize) -> u32 {
+        self.slot_of[k]
+    }
+
     /// `natural[slot]`: the frequency index `k` held by output slot `slot`.
     pub(crate) fn natural(&self) -> &[u32] {
         &self.natural

@@ -20,11 +20,12 @@
 //!    a joint least-squares fit of all amplitudes (`K×K` Hermitian normal equations) after a
 //!    merge and at the end.
 //!
-//! The greedy loop adds one path per pass or stops: it stops at the CFAR test, at `M_max`
-//! paths ([`Stop::PathBudget`] when a peak above γ is left), or when the strongest residual
-//! peak is an existing path's misfit or merges into one ([`Stop::Merged`]) — so it runs at most
-//! `M_max + 1` passes whatever the data (a merge that keeps the count used to re-add the same
-//! peak forever).
+//! Each pass of the greedy loop adds a path, or finds the strongest peak left to be a fitted
+//! path's misfit (Newton slides onto it, or it merges into it; its cell is left out from then
+//! on), or stops: at the CFAR test, at `M_max` paths ([`Stop::PathBudget`] when a peak above γ
+//! is left), or after `M_max` misfits ([`Stop::Merged`]) — so it runs at most `2·M_max + 1`
+//! passes whatever the data (a merge that kept the count used to re-add the same peak
+//! forever).
 //!
 //! `σ̂²`: the caller's `noise_var` if given; else the median over the periodogram cells at the
 //! natural spacing `1/(MΔf)` (`M` the next power of two ≥ N: nearly independent cells) of the
@@ -162,7 +163,8 @@ pub enum Stop {
     Threshold,
     /// `M_max` paths and a residual peak still above the threshold: a bound was reached.
     PathBudget,
-    /// The strongest residual peak was an existing path's misfit, or merged into one.
+    /// More than `M_max` of the strongest peaks were fitted paths' misfits (slid onto one, or
+    /// merged into one).
     Merged,
 }
 
@@ -180,7 +182,7 @@ impl Stop {
 /// What one snapshot's estimation did, against the stated bounds of its loops.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct EstimateWork {
-    /// Greedy passes (periodograms), at most `M_max + 1` (plus one per seed tried).
+    /// Greedy passes (periodograms), at most `2·M_max + 1`.
     pub passes: usize,
     /// The most refinement sweeps after one new path (at most [`limits::ESTIMATOR_SWEEPS`]).
     pub sweeps: usize,
@@ -233,6 +235,8 @@ pub struct Estimator {
     /// Slots of the window's cells at the natural spacing (the median's cells).
     median_slots: Vec<u32>,
     gamma: Real,
+    /// Per slot: within the merge separation of a fitted path (not a new path's peak).
+    masked: Vec<bool>,
     scratch: Vec<Complex>,
     resid: Vec<Complex>,
     tmp: Vec<Complex>,
@@ -379,6 +383,7 @@ impl Estimator {
             powers: Vec::with_capacity(median_slots.len()),
             median_slots,
             gamma,
+            masked: vec![false; l],
             scratch: vec![Complex::new(0.0, 0.0); l],
             resid: vec![Complex::new(0.0, 0.0); n],
             tmp: vec![Complex::new(0.0, 0.0); n],
@@ -495,18 +500,31 @@ impl Estimator {
         if !paths.is_empty() {
             self.refine(h, &mut paths, 0, sigma2, &mut work);
         }
-        // The greedy loop: each pass adds a path or stops, so at most `max_paths + 1` passes.
-        for _ in 0..=self.cfg.max_paths {
-            self.periodogram();
-            work.passes += 1;
-            if noise_var.is_none() {
-                sigma2 = self.median_noise().max(floor);
+        // The greedy loop. Each pass adds a path, or finds that the strongest peak left is a
+        // misfit of a fitted path (Newton slides onto it, or the refinement merges it; its
+        // cell is then left out of later passes), or stops: at most `2·max_paths + 1` passes.
+        let mut misfits = 0;
+        let mut excluded: Vec<Real> = Vec::new();
+        let mut dirty = true;
+        for _ in 0..=2 * self.cfg.max_paths {
+            if dirty {
+                self.periodogram();
+                work.passes += 1;
+                if noise_var.is_none() {
+                    sigma2 = self.median_noise().max(floor);
+                }
             }
             if !(sigma2 > 0.0) {
                 break;
             }
+            // The strongest cell not within the merge separation of a fitted path or an
+            // excluded misfit (what is left there is that path's misfit, not a new path).
+            self.mask_paths(&paths, &excluded);
             let (mut best, mut slot, mut tk) = (0.0, 0u32, 0.0);
             for &(s, t) in &self.cells {
+                if self.masked[s as usize] {
+                    continue;
+                }
                 let v = self.scratch[s as usize].norm_sqr();
                 if v > best {
                     best = v;
@@ -523,16 +541,24 @@ impl Estimator {
             }
             let (tau, m, it) = self.newton(tk + self.parabola(slot));
             work.newton = work.newton.max(it);
-            if paths.iter().any(|p| (p.0 - tau).abs() < self.merge_sep()) {
-                work.stop = Stop::Merged; // the strongest residual peak is an existing path's misfit
-                break;
-            }
             let before = paths.len();
-            let a = m.c0 / self.energy;
-            self.add_path(tau, -a);
-            paths.push((tau, a));
-            self.refine(h, &mut paths, before, sigma2, &mut work);
-            if paths.len() <= before {
+            if paths.iter().any(|p| (p.0 - tau).abs() < self.merge_sep()) {
+                // Newton slid onto a fitted path: its misfit.
+                misfits += 1;
+                excluded.push(tk);
+                dirty = false;
+            } else {
+                let a = m.c0 / self.energy;
+                self.add_path(tau, -a);
+                paths.push((tau, a));
+                self.refine(h, &mut paths, before, sigma2, &mut work);
+                dirty = true;
+                if paths.len() <= before {
+                    misfits += 1;
+                    excluded.push(tau);
+                }
+            }
+            if misfits > self.cfg.max_paths {
                 work.stop = Stop::Merged;
                 break;
             }
@@ -608,6 +634,27 @@ impl Estimator {
         self.resid.extend_from_slice(h);
         self.periodogram();
         Ok(self.median_noise())
+    }
+
+    /// `masked[slot]` ← whether the slot's cell lies within the merge separation of a path or
+    /// of an excluded delay.
+    fn mask_paths(&mut self, paths: &[(Real, Complex)], excluded: &[Real]) {
+        for m in self.masked.iter_mut() {
+            *m = false;
+        }
+        let l = self.fft.len();
+        let cell = self.span / l as Real;
+        let reach = (self.merge_sep() / cell) as i64 + 1;
+        for tau in paths.iter().map(|p| p.0).chain(excluded.iter().copied()) {
+            let k0 = round(tau / cell) as i64;
+            for k in k0 - reach..=k0 + reach {
+                let t = k as Real * cell;
+                if (t - tau).abs() < self.merge_sep() {
+                    let slot = self.fft.slot_of(k.rem_euclid(l as i64) as usize);
+                    self.masked[slot as usize] = true;
+                }
+            }
+        }
     }
 
     /// The sub-cell offset (s) of the peak in `slot` ([`PaddedFft::parabola`]).

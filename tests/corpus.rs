@@ -1,0 +1,194 @@
+//! Recordings no one here wrote (issue 36 §6, spec C12 8): the ray-traced corpus of
+//! `tests/data/raytraced/` (NVIDIA Sionna RT; generator `scripts/raytrace/generate.py`) through
+//! the whole chain — recording → background → estimates → track with segments — against the
+//! truth and against a simple reference written in `corpus/reference.rs`, at the link budget's
+//! SNR and 10 dB lower, over three noise seeds each.
+//!
+//! The fixtures are noise-free (complex64, as the tracer wrote them); the thermal noise of C3
+//! (`σ_p² = N·k_B·T₀·B·F` per link, `truth.json`'s `noise_var_w`) is added here with a seeded
+//! generator, to the walk and to the empty area alike.
+
+#[path = "corpus/reference.rs"]
+mod reference;
+
+use rand::SeedableRng as _;
+use rand_distr::{Distribution, StandardNormal};
+use rand_pcg::Pcg64;
+use scatterloc::channel::Recording;
+use scatterloc::error::Cancel;
+use scatterloc::math::{Complex, Real};
+use scatterloc::study::{
+    cir_track, estimate_recording, ChannelRequest, CirTrackOutput, Sequential,
+};
+use scatterloc::{npz, Model, Scenario};
+
+/// One scene of the corpus.
+pub struct Scene {
+    pub name: &'static str,
+    pub scenario: Scenario,
+    pub model: Model,
+    pub walk: Recording,
+    pub empty: Recording,
+    pub states: Vec<[Real; 4]>,
+    pub noise_var_w: Vec<Real>,
+}
+
+/// Loads `tests/data/raytraced/<name>/`.
+pub fn scene(name: &'static str) -> Scene {
+    let dir = format!("{}/tests/data/raytraced/{name}", env!("CARGO_MANIFEST_DIR"));
+    let text = std::fs::read_to_string(format!("{dir}/scenario.json")).unwrap();
+    let scenario = Scenario::from_json(&text).unwrap();
+    let model = Model::new(&scenario).unwrap();
+    let read =
+        |f: &str| npz::read_recording(&std::fs::read(format!("{dir}/{f}")).unwrap()).unwrap();
+    let truth: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(format!("{dir}/truth.json")).unwrap())
+            .unwrap();
+    let states = serde_json::from_value(truth["states"].clone()).unwrap();
+    let noise_var_w = serde_json::from_value(truth["noise_var_w"].clone()).unwrap();
+    Scene {
+        name,
+        scenario,
+        model,
+        walk: read("walk.npz"),
+        empty: read("empty.npz"),
+        states,
+        noise_var_w,
+    }
+}
+
+/// `rec` with CN(0, σ_p²·10^(offset/10)) added per sample and `noise_var` set.
+pub fn noisy(rec: &Recording, noise_var_w: &[Real], offset_db: Real, seed: u64) -> Recording {
+    let mut out = rec.clone();
+    let nv: Vec<Real> = noise_var_w
+        .iter()
+        .map(|v| v * 10f64.powf(offset_db / 10.0))
+        .collect();
+    let mut rng = Pcg64::seed_from_u64(seed);
+    let per = rec.samples_per_link();
+    for (i, x) in out.samples.iter_mut().enumerate() {
+        let p = (i / per) % rec.link_count();
+        let s = (nv[p] / 2.0).sqrt();
+        let (a, b): (Real, Real) = (
+            StandardNormal.sample(&mut rng),
+            StandardNormal.sample(&mut rng),
+        );
+        *x += Complex::new(a * s, b * s);
+    }
+    out.noise_var = Some(nv);
+    out
+}
+
+/// Error statistics of a track against the truth.
+#[derive(Debug, Clone, Copy)]
+pub struct Stats {
+    pub median: Real,
+    pub p90: Real,
+    pub max: Real,
+    /// Snapshots after the start without a state, s.
+    pub lost_s: Real,
+    /// The start, s.
+    pub start_s: Real,
+}
+
+fn quantile(v: &mut [Real], q: Real) -> Real {
+    v.sort_by(|a, b| a.total_cmp(b));
+    let k = ((v.len() as Real - 1.0) * q).round() as usize;
+    v[k]
+}
+
+fn stats(t_s: &[Real], states: &[Option<[Real; 2]>], truth: &[[Real; 4]]) -> Stats {
+    let start = states
+        .iter()
+        .position(Option::is_some)
+        .unwrap_or(states.len());
+    let mut e: Vec<Real> = Vec::new();
+    let mut lost = 0;
+    for k in start..states.len() {
+        match states[k] {
+            Some(s) => e.push(((s[0] - truth[k][0]).powi(2) + (s[1] - truth[k][1]).powi(2)).sqrt()),
+            None => lost += 1,
+        }
+    }
+    let dt = (t_s[t_s.len() - 1] - t_s[0]) / (t_s.len() - 1) as Real;
+    if e.is_empty() {
+        return Stats {
+            median: Real::INFINITY,
+            p90: Real::INFINITY,
+            max: Real::INFINITY,
+            lost_s: lost as Real * dt,
+            start_s: Real::INFINITY,
+        };
+    }
+    Stats {
+        median: quantile(&mut e.clone(), 0.5),
+        p90: quantile(&mut e.clone(), 0.9),
+        max: e.iter().copied().fold(0.0, Real::max),
+        lost_s: lost as Real * dt,
+        start_s: t_s[start],
+    }
+}
+
+/// Ours on one noisy realisation.
+pub fn ours(
+    sc: &Scene,
+    walk: &Recording,
+    empty: &Recording,
+    req: &ChannelRequest,
+) -> CirTrackOutput {
+    let cfg = req.front_end(walk.synchronized);
+    let (statics, est) = estimate_recording(
+        &sc.model,
+        sc.scenario.radio.bandwidth_hz,
+        walk,
+        Some(empty),
+        &cfg,
+        &mut Sequential::new(),
+        &|_| {},
+    )
+    .unwrap();
+    cir_track(
+        req,
+        &sc.model,
+        &sc.scenario.area_m,
+        &statics.calibration,
+        &est,
+        Cancel::NEVER,
+    )
+    .unwrap()
+}
+
+#[test]
+#[ignore = "the whole corpus (12 recordings) through the chain: release, scripts/test.sh"]
+fn c12_8_ray_traced_walks() {
+    let req = ChannelRequest::default();
+    for name in ["open", "room"] {
+        let sc = scene(name);
+        for offset in [0.0, 10.0] {
+            for seed in [1u64, 2, 3] {
+                let walk = noisy(&sc.walk, &sc.noise_var_w, offset, seed);
+                let empty = noisy(&sc.empty, &sc.noise_var_w, offset, 100 + seed);
+                let track = ours(&sc, &walk, &empty, &req);
+                let mine: Vec<Option<[Real; 2]>> = track
+                    .states
+                    .iter()
+                    .map(|s| s.map(|s| [s[0], s[1]]))
+                    .collect();
+                let a = stats(&walk.t_s, &mine, &sc.states);
+                let r =
+                    reference::track(&sc.model, &walk, &empty, [sc.states[0][0], sc.states[0][1]]);
+                let rs: Vec<Option<[Real; 2]>> = r.into_iter().map(Some).collect();
+                let b = stats(&walk.t_s, &rs, &sc.states);
+                let segs: Vec<String> = track
+                    .segments
+                    .iter()
+                    .map(|s| format!("{}-{}:{}", s.first, s.last, s.end))
+                    .collect();
+                println!(
+                    "{name} -{offset} dB seed {seed}: ours median {:.3} p90 {:.3} max {:.3} start {:.1} s lost {:.1} s {segs:?} | ref median {:.3} p90 {:.3} max {:.3}",
+                    a.median, a.p90, a.max, a.start_s, a.lost_s, b.median, b.p90, b.max
+                );
+            }
+        }
+    }
+}
