@@ -28,9 +28,11 @@ use crate::measure::SNR_DISTANCE_FLOOR_M;
 use crate::measure::{noise_power_w, rng, standard_normal, unit_from, Model, Rng};
 use crate::scenario::Scenario;
 
+mod request;
 mod scene;
 mod walk;
 
+pub use request::{Simulated, SimulationRequest, DEFAULT_CALIBRATION_DURATION_S};
 pub use scene::{Body, ChannelScene, PointScatterer, Wall, DEFAULT_DT_S, DEFAULT_SUBCARRIERS};
 pub use walk::Walk;
 

@@ -3,7 +3,7 @@
 //! there) → [`scatterloc::study::estimate_recording`] and [`scatterloc::study::cir_track`],
 //! the simulator [`scatterloc::channel::simulate_recording`] → files written all or none.
 
-use scatterloc::channel::{simulate_recording, ChannelScene, Recording};
+use scatterloc::channel::{Recording, SimulationRequest};
 use scatterloc::error::{limits, Cancel};
 use scatterloc::formats::{CalibrationSnapshots, Measurements, Truth};
 use scatterloc::native::Parallel;
@@ -395,52 +395,33 @@ pub fn cir_simulate(args: &CirSimulateArgs) -> Result<(), CliError> {
     catch_ctrl_c();
     let scenario = read_scenario(&args.scenario)?;
     let model = model_of(&scenario)?;
-    let mut scene: ChannelScene = match &args.scene {
-        Some(p) => read_json_file("scene", p)?,
-        None => ChannelScene::hangar(),
+    let mut req = SimulationRequest {
+        scene: match &args.scene {
+            Some(p) => Some(read_json_file("scene", p)?),
+            None => None,
+        },
+        walk: args.walk.as_deref().map(parse_walk).transpose()?,
+        speed_mps: args.speed,
+        duration_s: args.duration,
+        dt_s: args.dt,
+        ..SimulationRequest::default()
     };
-    if let Some(w) = &args.walk {
-        scene.walk.waypoints_m = parse_walk(w)?;
+    if let Some(d) = args.calibration_duration {
+        req.calibration_duration_s = d;
     }
-    if let Some(v) = args.speed {
-        scene.walk.speed_mps = v;
+    if let Some(seed) = args.seed {
+        req.seed = seed;
     }
-    if let Some(d) = args.duration {
-        scene.duration_s = Some(d);
-    }
-    if let Some(dt) = args.dt {
-        scene.dt_s = dt;
-    }
-    let flag_of = |e: &scatterloc::Error| {
-        let t = e.to_string();
-        if t.contains("walk.waypoints") {
-            "--walk"
-        } else if t.contains("speed") {
-            "--speed"
-        } else if t.contains("duration") {
-            "--duration"
-        } else if t.contains("dt_s") {
-            "--dt"
-        } else {
-            "--scene"
-        }
+    // A core error names the request's field; the scene's own fields are --scene's.
+    let fail = |e: scatterloc::Error| {
+        CliError::usage(with_flag(&e).unwrap_or_else(|| format!("--scene: {e}")))
     };
-    scene
-        .validate()
-        .map_err(|e| CliError::usage(format!("{}: {e}", flag_of(&e))))?;
-    let mut empty = scene.clone();
-    empty.duration_s = Some(args.calibration_duration.unwrap_or(1.0));
-    empty
-        .validate()
-        .map_err(|e| CliError::usage(format!("--calibration-duration: {e}")))?;
-    let seed = args.seed.unwrap_or(1);
+    let (scene, _) = req.scenes().map_err(fail)?;
     let dir = args.out_dir.as_str();
     let created = prepare_out_dir_for(dir, &SIM_FILES)?;
     let written = (|| {
-        let fail = |e: scatterloc::Error| CliError::usage(format!("{}: {e}", flag_of(&e)));
-        let (rec, truth) =
-            simulate_recording(&scenario, &model, &scene, true, seed).map_err(fail)?;
-        let (cal, _) = simulate_recording(&scenario, &model, &empty, false, seed).map_err(fail)?;
+        let sim = req.run(&scenario, &model).map_err(fail)?;
+        let (rec, cal, truth) = (sim.recording, sim.calibration, sim.truth);
         let enc = |r: &Recording| {
             npz::write_recording(r).map_err(|e| CliError::output(format!("--out-dir: {e}")))
         };

@@ -5,7 +5,7 @@
 use scatterloc::Error;
 
 /// Core field → flag.
-const FLAGS: [(&str, &str); 41] = [
+const FLAGS: [(&str, &str); 45] = [
     // Tracking studies (`montecarlo`, `pcrlb`, `track`).
     ("runs", "--runs"),
     ("noise_runs", "--noise-runs"),
@@ -51,6 +51,11 @@ const FLAGS: [(&str, &str); 41] = [
     ("filter", "--filter"),
     ("seed", "--seed"),
     ("statics", "--statics"),
+    // The simulator (`cir simulate`).
+    ("walk", "--walk"),
+    ("speed_mps", "--speed"),
+    ("duration_s", "--duration"),
+    ("calibration_duration_s", "--calibration-duration"),
 ];
 
 /// The flag that sets core field `field`.
