@@ -53,7 +53,8 @@ use crate::math::{Mat4, Vec4};
 use crate::measure::{rng, Model};
 use crate::scenario::Area;
 use crate::track::gating::{
-    start_from_snapshot, AssociationRule, Calibration, Choice, GatedTracker, START_SPEED_SIGMA_MPS,
+    start_from_snapshot, AssociationRule, Calibration, Choice, GatedTracker, SegmentConfig,
+    SegmentEvent, SegmentSetup, SegmentTracker, START_SPEED_SIGMA_MPS,
 };
 use crate::track::{step_ns, UpdateSummary};
 use crate::track::{ConstantVelocity, Ekf, Filter, FilterKind, MeasurementNoise, Tracker};
@@ -174,7 +175,19 @@ pub fn track_measurements_in(req: &TrackRequest, cancel: Cancel) -> Result<Track
         }
         Steps::Raw(raw) => {
             let tracker = GatedTracker::new(filter, model, cal, motion, noise, req.rule)?;
-            gated(tracker, n, raw, m.dt_s, Every { cancel, every }, &mut out)?
+            let setup = SegmentSetup {
+                model,
+                calibration: cal,
+                area: req.area,
+                kind: req.filter,
+                process_noise: m.process_noise,
+                rule: req.rule,
+                estimate_sigmas: true,
+                gate_sigma_s: None,
+                segments: SegmentConfig::default(),
+            };
+            let held = SegmentTracker::holding(tracker, setup, 0.0);
+            gated(held, n, raw, m.dt_s, Every { cancel, every }, &mut out)?
         }
     }
     Ok(out)
@@ -281,10 +294,11 @@ fn plain(
     Ok(())
 }
 
-/// The raw form: every step (one list per each of `links` links) gated and associated by
-/// `tracker`, with what it chose.
+/// The raw form: every step (one list per each of `links` links) through the one gated loop
+/// of recordings and files, [`SegmentTracker`] (here holding the file's given start, loss
+/// detection off), with what it chose.
 fn gated(
-    mut tracker: GatedTracker<Tracker>,
+    mut tracker: SegmentTracker,
     links: usize,
     raw: &[RawStep],
     dt_s: f64,
@@ -292,18 +306,26 @@ fn gated(
     out: &mut TrackOutput,
 ) -> Result<()> {
     let (mut used, mut choices, mut removed) = (vec![], vec![], vec![]);
+    // A held track never restarts, so it never replays.
+    let replay = |_: usize| Err(Error::Cancelled);
     for (k, step) in raw.iter().enumerate() {
         at.check(k)?;
         let field = format!("raw_steps[{k}]");
         let estimates = Measurements::estimates(&field, step, links)?;
-        let s = tracker
-            .step(&estimates)
-            .map_err(|e| step_error(&field, e))?;
-        let f = &tracker.filter;
-        record(out, f.state(), f.covariance(), k, dt_s, &s.summary);
-        choices.push(names(&s.selection.choices));
-        used.push(s.selection.delays);
-        removed.push(s.selection.static_removed);
+        let t = (k + 1) as f64 * dt_s;
+        let SegmentEvent::Tracked(s) = tracker
+            .step(k, t, &estimates, &replay)
+            .map_err(|e| step_error(&field, e))?
+        else {
+            return Err(Error::InvalidFile {
+                field,
+                reason: "the track was not held".into(),
+            });
+        };
+        record(out, &s.state, &s.covariance, k, dt_s, &s.step.summary);
+        choices.push(names(&s.step.selection.choices));
+        used.push(s.step.selection.delays);
+        removed.push(s.step.selection.static_removed);
     }
     out.delays_used_s = Some(used);
     out.choices = Some(choices);

@@ -14,9 +14,10 @@
 //!   [`START_SPEED_SIGMA_MPS`]), unless it lies within 1 m of one already held (at most
 //!   [`SegmentConfig::max_hypotheses`]). Each hypothesis is gated and updated on the following
 //!   snapshots (the [`AssociationRule::Gated`] rule, 3σ); a snapshot is a hit when
-//!   ≥ `min_links` links associate. A hypothesis with `confirm_m` hits in the `confirm_n`
-//!   snapshots after its fix is **confirmed** (of several at once: most hits, then the lowest
-//!   summed NIS); one that cannot reach `confirm_m` any more, or leaves the area, is dropped.
+//!   ≥ `min_links` links associate. At the end of its window of `confirm_n` snapshots after
+//!   its fix, a hypothesis with `confirm_m` hits is **confirmed** (of several at once: most
+//!   hits, then the lowest NIS per associated link — C11's "best-confirmed"); one that cannot
+//!   reach `confirm_m` any more, or leaves the area, is dropped.
 //! - **Tracker**: the confirmed hypothesis starts the segment at its fix's snapshot: the chosen
 //!   filter (EKF, UKF or particle filter) starts at the fix and replays the snapshots since, so
 //!   the segment's states are that filter's.
@@ -264,6 +265,19 @@ struct Hypothesis<'a> {
     age: usize,
     hits: usize,
     nis: Real,
+    /// Links associated over the hits.
+    links: usize,
+}
+
+impl Hypothesis<'_> {
+    /// The summed NIS per associated link over the hits.
+    fn mean_nis(&self) -> Real {
+        if self.links == 0 {
+            Real::INFINITY
+        } else {
+            self.nis / self.links as Real
+        }
+    }
 }
 
 /// The track currently held.
@@ -557,6 +571,7 @@ impl<'a> SegmentTracker<'a> {
                 if s.summary.links_used >= cfg.min_links {
                     h.hits += 1;
                     h.nis += s.summary.nis;
+                    h.links += s.summary.links_used;
                 }
                 let reachable =
                     h.hits + (cfg.confirm_n - h.age.min(cfg.confirm_n)) >= cfg.confirm_m;
@@ -566,13 +581,18 @@ impl<'a> SegmentTracker<'a> {
             }
             self.hypotheses = kept;
         }
-        // Confirmation: the most hits, then the lowest summed NIS.
+        // Confirmation at the end of a hypothesis' window of N snapshots, with ≥ M hits; of
+        // several, the most hits, then the lowest NIS per associated link.
         let best = self
             .hypotheses
             .iter()
             .enumerate()
-            .filter(|(_, h)| h.hits >= cfg.confirm_m)
-            .min_by(|(_, a), (_, b)| b.hits.cmp(&a.hits).then(a.nis.total_cmp(&b.nis)))
+            .filter(|(_, h)| h.age >= cfg.confirm_n && h.hits >= cfg.confirm_m)
+            .min_by(|(_, a), (_, b)| {
+                b.hits
+                    .cmp(&a.hits)
+                    .then(a.mean_nis().total_cmp(&b.mean_nis()))
+            })
             .map(|(i, _)| i);
         if let Some(i) = best {
             let h = self.hypotheses.swap_remove(i);
@@ -859,6 +879,7 @@ impl<'a> SegmentTracker<'a> {
                 age: 0,
                 hits: 0,
                 nis: 0.0,
+                links: 0,
             });
         }
         Ok(())
