@@ -5,9 +5,10 @@
 //! One role per part (as Stone Soup's initiator, deleter and tracker):
 //! - **Initiator** (searching): per snapshot, each link's non-static candidates (E4), at most
 //!   [`SegmentConfig::candidates_per_link`] of the strongest; a backprojection over a grid of
-//!   the area (step [`SegmentConfig::grid_step_m`]; per node and link the nearest candidate's
-//!   normalised delay residual `d = |τ̂ − τ(node)|/√(σ̂² + (√2·step/c)²)`, capped at 3) picks the
-//!   nodes where ≥ [`SegmentConfig::min_links`] links agree; from the best local minima
+//!   the area (step [`SegmentConfig::grid_step_m`]; per node and link the best candidate by
+//!   `d² + 2·ln(A_max/A)`, `d = |τ̂ − τ(node)|/√(σ̂² + (√2·step/c)²)` the normalised delay
+//!   residual (within 3) and the second term a prior for the link's strongest candidate, the
+//!   score capped at 9) picks the nodes where ≥ [`SegmentConfig::min_links`] links agree; from the best local minima
 //!   (at most [`MAX_FIXES_PER_SNAPSHOT`]) Levenberg–Marquardt (E5) fixes the position with
 //!   those candidates, and a fix whose cost passes χ² at `1 − fix_tail_probability` with
 //!   `links − 2` degrees of freedom becomes a **hypothesis** (an EKF at the fix, velocity 0 ±
@@ -56,6 +57,11 @@ pub const MAX_START_GRID_NODES: usize = 1 << 16;
 pub const MAX_START_TABLE: usize = 1 << 22;
 /// A new hypothesis within this distance of a held one is the same one, m.
 const SAME_HYPOTHESIS_M: Real = 1.0;
+/// A hypothesis is confirmed only if its associated candidates are on average no weaker than
+/// this below each link's strongest non-static candidate, as `2·ln(A_max/A)` (4.6 = 10 dB): a
+/// person's direct echo is the strongest dynamic path on most links, and the consistent ghosts
+/// (the mirror image of the walker in a wall, from double bounces) are 10–20 dB weaker.
+pub const CONFIRM_PRIOR: Real = 4.6;
 /// Links that must associate for a snapshot to reset the miss clock of the loss test (one link's
 /// association is often a false alarm inside a widened gate; two at once rarely are).
 pub const MISS_LINKS: usize = 2;
@@ -267,9 +273,20 @@ struct Hypothesis<'a> {
     nis: Real,
     /// Links associated over the hits.
     links: usize,
+    /// `Σ 2·ln(A_max/A)` of the associated candidates over the hits (the strongest prior).
+    prior: Real,
 }
 
 impl Hypothesis<'_> {
+    /// The strongest prior per associated link over the hits.
+    fn mean_prior(&self) -> Real {
+        if self.links == 0 {
+            Real::INFINITY
+        } else {
+            self.prior / self.links as Real
+        }
+    }
+
     /// The summed NIS per associated link over the hits.
     fn mean_nis(&self) -> Real {
         if self.links == 0 {
@@ -560,6 +577,17 @@ impl<'a> SegmentTracker<'a> {
         replay: &dyn Fn(usize) -> Result<(Real, Vec<Vec<DelayEstimate>>)>,
     ) -> Result<SegmentEvent> {
         let cfg = self.cfg;
+        // Each link's strongest non-static amplitude (the prior of the hits).
+        let strongest: Vec<Real> = snapshot
+            .iter()
+            .enumerate()
+            .map(|(p, l)| {
+                l.iter()
+                    .filter(|e| !self.calibration.links[p].is_static(e.delay_s))
+                    .map(|e| e.amplitude)
+                    .fold(0.0, Real::max)
+            })
+            .collect();
         if let Some(dt) = dt {
             let motion = self.motion(dt)?;
             let (area, margin) = (self.area, cfg.area_margin_m);
@@ -572,6 +600,7 @@ impl<'a> SegmentTracker<'a> {
                     h.hits += 1;
                     h.nis += s.summary.nis;
                     h.links += s.summary.links_used;
+                    h.prior += prior_of(snapshot, &s.selection.delays, &strongest);
                 }
                 let reachable =
                     h.hits + (cfg.confirm_n - h.age.min(cfg.confirm_n)) >= cfg.confirm_m;
@@ -587,11 +616,13 @@ impl<'a> SegmentTracker<'a> {
             .hypotheses
             .iter()
             .enumerate()
-            .filter(|(_, h)| h.age >= cfg.confirm_n && h.hits >= cfg.confirm_m)
+            .filter(|(_, h)| {
+                h.age >= cfg.confirm_n && h.hits >= cfg.confirm_m && h.mean_prior() <= CONFIRM_PRIOR
+            })
             .min_by(|(_, a), (_, b)| {
-                b.hits
-                    .cmp(&a.hits)
-                    .then(a.mean_nis().total_cmp(&b.mean_nis()))
+                b.hits.cmp(&a.hits).then(
+                    (a.mean_nis() + a.mean_prior()).total_cmp(&(b.mean_nis() + b.mean_prior())),
+                )
             })
             .map(|(i, _)| i);
         if let Some(i) = best {
@@ -705,6 +736,25 @@ impl<'a> SegmentTracker<'a> {
         if cands.iter().filter(|c| !c.is_empty()).count() < cfg.min_links {
             return Ok(());
         }
+        // A prior for the strongest: a candidate A below the link's strongest costs
+        // 2·ln(A_max/A) (10 dB weaker ≈ a 2σ residual). A person's direct echo is the strongest
+        // dynamic path on most links; double bounces via walls and misfits are weaker, and
+        // their combinations can be as consistent as the truth for a few snapshots.
+        let prior: Vec<Vec<Real>> = cands
+            .iter()
+            .map(|c| {
+                let top = c.first().map_or(0.0, |e| e.amplitude);
+                c.iter()
+                    .map(|e| {
+                        if top > 0.0 && e.amplitude > 0.0 {
+                            2.0 * crate::math::ln(top / e.amplitude)
+                        } else {
+                            0.0
+                        }
+                    })
+                    .collect()
+            })
+            .collect();
         let tol = core::f64::consts::SQRT_2 * grid.step / SPEED_OF_LIGHT;
         let cap2 = BACKPROJECTION_CAP * BACKPROJECTION_CAP;
         let sig2 = |e: &DelayEstimate, p: usize, at: Vec2| {
@@ -725,18 +775,17 @@ impl<'a> SegmentTracker<'a> {
             let d = &grid.delays[i * n..(i + 1) * n];
             let (mut sum, mut agree) = (0.0, 0usize);
             for p in 0..n {
-                let mut best = cap2;
-                for e in &cands[p] {
+                let (mut best, mut fits) = (cap2, false);
+                for (e, pen) in cands[p].iter().zip(&prior[p]) {
                     let r = e.delay_s - d[p];
                     let v = r * r / (sig2(e, p, at) + tol * tol);
-                    if v < best {
-                        best = v;
+                    if v < cap2 {
+                        fits = true;
+                        best = best.min(v + pen);
                     }
                 }
-                if best < cap2 {
-                    agree += 1;
-                }
-                sum += best;
+                agree += usize::from(fits);
+                sum += best.min(cap2);
             }
             if agree >= cfg.min_links {
                 score[i] = sum;
@@ -779,12 +828,12 @@ impl<'a> SegmentTracker<'a> {
             let mut sigmas = vec![0.0; n];
             let mut chosen: Vec<Option<DelayEstimate>> = vec![None; n];
             for p in 0..n {
-                let mut best = (cap2, None);
-                for e in &cands[p] {
+                let mut best = (Real::INFINITY, None);
+                for (e, pen) in cands[p].iter().zip(&prior[p]) {
                     let r = e.delay_s - d[p];
                     let v = r * r / (sig2(e, p, at) + tol * tol);
-                    if v < best.0 {
-                        best = (v, Some(*e));
+                    if v < cap2 && v + pen < best.0 {
+                        best = (v + pen, Some(*e));
                     }
                 }
                 if let Some(e) = best.1 {
@@ -866,6 +915,29 @@ impl<'a> SegmentTracker<'a> {
                     .collect(),
                 sigmas: (0..n).map(|p| delays[p].map(|_| sigmas[p])).collect(),
             };
+            #[cfg(feature = "std")]
+            if std::env::var("SL_DEBUG").is_ok() {
+                std::eprintln!(
+                    "hyp k {k} at ({:.2}, {:.2}) cost {:.2} delays {:?} cands {:?}",
+                    report.position.x,
+                    report.position.y,
+                    report.cost,
+                    delays
+                        .iter()
+                        .map(|d| d.map(|d| (d * SPEED_OF_LIGHT * 100.0).round() / 100.0))
+                        .collect::<Vec<_>>(),
+                    cands
+                        .iter()
+                        .map(|c| c
+                            .iter()
+                            .map(|e| (
+                                (e.delay_s * SPEED_OF_LIGHT * 100.0).round() / 100.0,
+                                (20.0 * crate::math::log10(e.amplitude) * 10.0).round() / 10.0
+                            ))
+                            .collect::<Vec<_>>())
+                        .collect::<Vec<_>>()
+                );
+            }
             self.hypotheses.push(Hypothesis {
                 born: k,
                 fix: SegmentStart {
@@ -880,10 +952,28 @@ impl<'a> SegmentTracker<'a> {
                 hits: 0,
                 nis: 0.0,
                 links: 0,
+                prior: 0.0,
             });
         }
         Ok(())
     }
+}
+
+/// `Σ_p 2·ln(A_max,p/A_p)` over the links whose delay was taken (`delays[p]`), `A_p` the
+/// amplitude of that delay's estimate, `A_max,p` the link's strongest non-static one.
+fn prior_of(snapshot: &[Vec<DelayEstimate>], delays: &[Option<Real>], strongest: &[Real]) -> Real {
+    let mut sum = 0.0;
+    for (p, d) in delays.iter().enumerate() {
+        let Some(d) = d else { continue };
+        let a = snapshot[p]
+            .iter()
+            .find(|e| e.delay_s == *d)
+            .map_or(0.0, |e| e.amplitude);
+        if a > 0.0 && strongest[p] > a {
+            sum += 2.0 * crate::math::ln(strongest[p] / a);
+        }
+    }
+    sum
 }
 
 /// Whether the position of `x` lies outside `area` grown by `margin`.
