@@ -915,29 +915,6 @@ impl<'a> SegmentTracker<'a> {
                     .collect(),
                 sigmas: (0..n).map(|p| delays[p].map(|_| sigmas[p])).collect(),
             };
-            #[cfg(feature = "std")]
-            if std::env::var("SL_DEBUG").is_ok() {
-                std::eprintln!(
-                    "hyp k {k} at ({:.2}, {:.2}) cost {:.2} delays {:?} cands {:?}",
-                    report.position.x,
-                    report.position.y,
-                    report.cost,
-                    delays
-                        .iter()
-                        .map(|d| d.map(|d| (d * SPEED_OF_LIGHT * 100.0).round() / 100.0))
-                        .collect::<Vec<_>>(),
-                    cands
-                        .iter()
-                        .map(|c| c
-                            .iter()
-                            .map(|e| (
-                                (e.delay_s * SPEED_OF_LIGHT * 100.0).round() / 100.0,
-                                (20.0 * crate::math::log10(e.amplitude) * 10.0).round() / 10.0
-                            ))
-                            .collect::<Vec<_>>())
-                        .collect::<Vec<_>>()
-                );
-            }
             self.hypotheses.push(Hypothesis {
                 born: k,
                 fix: SegmentStart {
