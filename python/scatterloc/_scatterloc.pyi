@@ -55,6 +55,8 @@ _Progress = Optional[Callable[[int, int], object]]
 _Window = tuple[float, float, float, float]
 _ScenarioLike = Union["Scenario", str, Mapping[str, Any], "os.PathLike[str]"]
 _FilterName = Literal["ekf", "ukf", "pf"]
+_Statics = Literal["background", "clusters"]
+_DelayReference = Literal["absolute", "los"]
 
 class ScatterlocError(ValueError):
     """Bad input: ``field`` names the input at fault as the core names it (or is None),
@@ -460,6 +462,7 @@ class Recording:
         pulse: Optional[ArrayLike] = None,
         pulse_spacing_s: Optional[float] = None,
         noise_var: Optional[ArrayLike] = None,
+        synchronized: Optional[bool] = None,
     ) -> Recording: ...
     @property
     def t(self) -> _F64: ...
@@ -475,6 +478,8 @@ class Recording:
     def taps(self) -> Optional[tuple[float, float]]: ...
     @property
     def noise_var(self) -> Optional[_F64]: ...
+    @property
+    def synchronized(self) -> Optional[bool]: ...
     def between(self, t0: float, t1: float) -> Recording: ...
     def __len__(self) -> int: ...
 
@@ -488,9 +493,13 @@ def simulate_recording(
     speed: Optional[float] = None,
     duration: Optional[float] = None,
     dt: Optional[float] = None,
-    calibration_duration: float = 1.0,
-    seed: int = 1,
-) -> tuple[Recording, Recording, dict[str, Any]]: ...
+    calibration_duration: Optional[float] = None,
+    seed: Optional[int] = None,
+) -> tuple[Recording, Recording, dict[str, Any]]:
+    """``scatterloc cir simulate``: the walk's recording, the empty area's and the truth dict.
+    None takes the library's default (``channel::SimulationRequest``): ``scene`` the hangar,
+    ``walk``/``speed``/``duration``/``dt`` the scene's, ``calibration_duration`` 1 s,
+    ``seed`` 1."""
 
 @final
 class Paths:
@@ -539,11 +548,22 @@ def estimate_recording(
     scenario: _ScenarioLike,
     recording: Recording,
     *,
+    calibration: Optional[Recording] = None,
     max_paths: Optional[int] = None,
     pfa: Optional[float] = None,
+    statics: Optional[_Statics] = None,
+    delay_reference: Optional[_DelayReference] = None,
+    background_time: Optional[float] = None,
+    calibration_range: Optional[tuple[float, float]] = None,
     threads: int = 0,
     progress: _Progress = None,
-) -> Paths: ...
+) -> Paths:
+    """``scatterloc cir estimate``; ``to_dict()`` is its EST.json. None takes the library's
+    default (``study::ChannelRequest``): ``calibration`` the empty area's recording (None: a
+    recursive background), ``max_paths`` 12, ``pfa`` 1e-3, ``statics`` "background",
+    ``delay_reference`` from ``recording.synchronized`` (absolute unless False),
+    ``background_time`` 10 s, ``calibration_range`` (t0, t1) s of the recording as the empty
+    area instead of ``calibration``."""
 
 @final
 class ChannelTrack:
@@ -561,19 +581,21 @@ class ChannelTrack:
     def delays_used(self) -> _Masked: ...
     @property
     def error(self) -> Optional[_Masked]: ...
+    @property
+    def segments(self) -> list[dict[str, Any]]: ...
     def to_dict(self) -> dict[str, Any]: ...
 
 def cir_track(
     scenario: _ScenarioLike,
     recording: Recording,
-    calibration: Recording,
+    calibration: Optional[Recording] = None,
     *,
     truth: Optional[Union[Mapping[str, Any], _PathLike]] = None,
-    filter: _FilterName = "ekf",
-    process_noise: float = 1.0,
-    association: Literal["gated", "spec"] = "gated",
-    sigma: Literal["estimator", "budget"] = "estimator",
-    extent_sigma: float = 0.2,
+    filter: Optional[_FilterName] = None,
+    process_noise: Optional[float] = None,
+    association: Optional[Literal["gated", "spec"]] = None,
+    sigma: Optional[Literal["estimator", "budget"]] = None,
+    extent_sigma: Optional[float] = None,
     seed: Optional[int] = None,
     particles: Optional[int] = None,
     roughening: Optional[float] = None,
@@ -583,6 +605,16 @@ def cir_track(
     ukf_kappa: Optional[float] = None,
     max_paths: Optional[int] = None,
     pfa: Optional[float] = None,
+    statics: Optional[_Statics] = None,
+    delay_reference: Optional[_DelayReference] = None,
+    background_time: Optional[float] = None,
+    calibration_range: Optional[tuple[float, float]] = None,
     threads: int = 0,
     progress: _Progress = None,
-) -> ChannelTrack: ...
+) -> ChannelTrack:
+    """``scatterloc cir track``; ``to_dict()`` is its TRACK.json. The front-end keywords are
+    ``estimate_recording``'s; None takes the library's default (``study::ChannelRequest``):
+    ``filter`` "ekf", ``process_noise`` 1 m^2/s^3, ``association`` "gated", ``sigma``
+    "estimator", ``extent_sigma`` 0.2 m, ``seed`` 1 and ``particles`` 1000 (pf only),
+    ``ukf_alpha``/``ukf_beta``/``ukf_kappa`` (ukf only), ``roughening``/``bootstrap`` (pf
+    only)."""

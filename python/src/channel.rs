@@ -1,35 +1,32 @@
-//! The channel front end (spec `channel-estimation.md`, C1–C7): `Recording` (the `.npz` format
-//! of docs/recording.md, read and written by the library's `npz` edge), `simulate_recording`
-//! (`scatterloc cir simulate`), `estimate` (C5 + C6 on responses without a scenario),
-//! `estimate_recording` (`scatterloc cir estimate`) and `cir_track` (`scatterloc cir track`).
+//! The channel front end and its track (spec `channel-estimation.md`, C1–C11): `Recording` (the
+//! `.npz` format of docs/recording.md, read and written by the library's `npz` edge),
+//! `simulate_recording` (`scatterloc cir simulate`, the core's `SimulationRequest`), `estimate`
+//! (C5 + C6 on responses without a scenario), `estimate_recording` (`scatterloc cir estimate`)
+//! and `cir_track` (`scatterloc cir track`). The keywords fill the core's `ChannelRequest`
+//! (every default and check is there); this file only converts types.
+
+use std::borrow::Cow;
 
 use numpy::{Complex64, PyArray1, PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 
-use scatterloc::channel::{
-    simulate_recording as simulate, ChannelScene, Layout, Pulse, Recording, TrackedPath,
-};
+use scatterloc::channel::{ChannelScene, Layout, Pulse, Recording, SimulationRequest, TrackedPath};
 use scatterloc::error::{limits, Cancel};
 use scatterloc::formats::Truth;
 use scatterloc::native::Parallel;
 use scatterloc::npz;
 use scatterloc::present::{estimates_doc, track_doc, track_errors};
 use scatterloc::study::{
-    calibrate_estimates, cir_track as track_recording, estimate_link,
-    estimate_recording as estimate_all, CirTrackRequest, DelaySigma, FrontEndConfig,
-    RecordingEstimates, EXTENT_SIGMA_M,
+    cir_track as track_recording, estimate_link, estimate_recording as estimate_all,
+    ChannelRequest, ChannelStatics, DelayReference, DelaySigma, FrontEndConfig, RecordingEstimates,
+    StaticMode,
 };
-use scatterloc::track::gating::{AmplitudeClusterConfig, AssociationRule};
-use scatterloc::track::ConstantVelocity;
+use scatterloc::track::gating::AssociationRule;
 
 use crate::convert::{array, f64_array, masked, path_string, to_python, JsonDoc};
 use crate::errors::{arg_error, Core};
 use crate::run::run_job;
 use crate::scenario::scenario_arg;
-use crate::tracking::{one_filter, settings};
-
-// `cir_track`'s default `extent_sigma` is the library's (written as a number for Python).
-const _: () = assert!(EXTENT_SIGMA_M == 0.2);
 
 /// A complex argument as (shape, row-major values): complex128 read directly, anything else
 /// through `numpy.asarray(x, dtype=complex)`.
@@ -55,8 +52,9 @@ fn complex_arg(obj: &Bound<'_, PyAny>, field: &str) -> PyResult<(Vec<usize>, Vec
 /// A channel recording (docs/recording.md): per snapshot and link a channel frequency response
 /// (`cfr`, C1) at `freq_hz`, or a band-limited impulse response (`cir`, C2) of taps at
 /// `tap0_s + m·tap_spacing_s`; snapshot times `t` (s), links as (transmitter, receiver)
-/// indices into the scenario, and optionally the system response, the pulse and the noise
-/// variance per link. Amplitudes are √W at the receiver input (C3).
+/// indices into the scenario, and optionally the system response, the pulse, the noise
+/// variance per link and whether the links share the transmitter's clock (`synchronized`).
+/// Amplitudes are √W at the receiver input (C3).
 #[pyclass(module = "scatterloc", name = "Recording", frozen)]
 #[derive(Clone)]
 pub struct PyRecording {
@@ -68,12 +66,14 @@ impl PyRecording {
     /// A recording from arrays (checked as the reader checks a file): `t` (S,), `links` (P, 2)
     /// and exactly one of `cfr` (S, P, N) with `freq_hz` (N,) (and `system_response` (N,)) or
     /// `cir` (S, P, M) with `tap0_s`, `tap_spacing_s` (and `pulse` (K,) at `pulse_spacing_s`);
-    /// `noise_var` (P,), W.
+    /// `noise_var` (P,), W; `synchronized`: whether the receivers share the transmitter's
+    /// clock (None: unknown; `False` makes the front end read delays relative to each link's
+    /// direct path, C10).
     #[new]
     #[pyo3(signature = (
         t, links, *, cfr = None, freq_hz = None, system_response = None, cir = None,
         tap0_s = None, tap_spacing_s = None, pulse = None, pulse_spacing_s = None,
-        noise_var = None
+        noise_var = None, synchronized = None
     ))]
     #[allow(clippy::too_many_arguments)]
     fn new(
@@ -88,6 +88,7 @@ impl PyRecording {
         pulse: Option<&Bound<'_, PyAny>>,
         pulse_spacing_s: Option<f64>,
         noise_var: Option<&Bound<'_, PyAny>>,
+        synchronized: Option<bool>,
     ) -> PyResult<PyRecording> {
         let t_s = crate::convert::f64_vec(t, "t", None)?;
         let l = f64_array(links, "links")?;
@@ -178,6 +179,7 @@ impl PyRecording {
             noise_var: noise_var
                 .map(|v| crate::convert::f64_vec(v, "noise_var", None))
                 .transpose()?,
+            synchronized,
         };
         rec.validate().py()?;
         Ok(PyRecording { rec })
@@ -249,6 +251,13 @@ impl PyRecording {
             .as_ref()
             .map(|v| array(py, v.clone(), &[v.len()]))
             .transpose()
+    }
+
+    /// Whether the receivers share the transmitter's clock (the file's `synchronized`); None
+    /// when unknown.
+    #[getter]
+    fn synchronized(&self) -> Option<bool> {
+        self.rec.synchronized
     }
 
     /// The snapshots with `t0 ≤ t ≤ t1` as a recording of their own (e.g. a stretch of the
@@ -336,13 +345,16 @@ pub fn write_recording(
 /// LoS, walls with first- and second-order reflections, point scatterers, a walking person, with
 /// thermal noise from the link budget. `scene` is the scene dict (`scene.json` of the CLI;
 /// default the hangar of docs/reproduction.md); `walk` ((x, y) waypoints), `speed` (m/s),
-/// `duration` (s) and `dt` (s) override it. Returns `(recording, calibration, truth)`: the walk,
-/// `calibration_duration` seconds of the empty area (same seed, no person), and the truth as
-/// the CLI's `truth.json` dict.
+/// `duration` (s) and `dt` (s) override it. `calibration_duration`: the length of the empty
+/// area's recording, s (default 1); `seed` (default 1). Every keyword left at None takes the
+/// library's default (`channel::SimulationRequest`). Returns `(recording, calibration,
+/// truth)`: the walk, the empty area (same seed, no person), and the truth as the CLI's
+/// `truth.json` dict. Errors name the request's field (`walk`, `speed_mps`, `duration_s`,
+/// `dt_s`, `calibration_duration_s`) or the scene's own (`scene.…`).
 #[pyfunction]
 #[pyo3(signature = (
     scenario, *, scene = None, walk = None, speed = None, duration = None, dt = None,
-    calibration_duration = 1.0, seed = 1
+    calibration_duration = None, seed = None
 ))]
 #[allow(clippy::too_many_arguments)]
 pub fn simulate_recording<'py>(
@@ -353,47 +365,48 @@ pub fn simulate_recording<'py>(
     speed: Option<f64>,
     duration: Option<f64>,
     dt: Option<f64>,
-    calibration_duration: f64,
-    seed: u64,
+    calibration_duration: Option<f64>,
+    seed: Option<u64>,
 ) -> PyResult<(PyRecording, PyRecording, Bound<'py, PyAny>)> {
     let sc = scenario_arg(scenario)?;
-    let mut scene: ChannelScene = match scene {
-        Some(d) => {
-            scatterloc::scenario::parse_json(&crate::convert::to_json_text(d, "scene")?).py()?
-        }
-        None => ChannelScene::hangar(),
+    let scene: Option<ChannelScene> = match scene {
+        Some(d) => Some(
+            scatterloc::scenario::parse_json(&crate::convert::to_json_text(d, "scene")?).py()?,
+        ),
+        None => None,
     };
-    if let Some(w) = walk {
-        let (pts, lead) = crate::convert::points(w, "walk")?;
-        if lead.len() != 1 {
-            return Err(arg_error("walk", "expected waypoints of shape (K, 2)"));
+    let walk = match walk {
+        Some(w) => {
+            let (pts, lead) = crate::convert::points(w, "walk")?;
+            if lead.len() != 1 {
+                return Err(arg_error("walk", "expected waypoints of shape (K, 2)"));
+            }
+            Some(pts)
         }
-        scene.walk.waypoints_m = pts;
+        None => None,
+    };
+    let mut req = SimulationRequest {
+        scene,
+        walk,
+        speed_mps: speed,
+        duration_s: duration,
+        dt_s: dt,
+        ..SimulationRequest::default()
+    };
+    if let Some(d) = calibration_duration {
+        req.calibration_duration_s = d;
     }
-    if let Some(v) = speed {
-        scene.walk.speed_mps = v;
+    if let Some(s) = seed {
+        req.seed = s;
     }
-    if duration.is_some() {
-        scene.duration_s = duration;
-    }
-    if let Some(dt) = dt {
-        scene.dt_s = dt;
-    }
-    scene.validate().py()?;
-    let mut empty = scene.clone();
-    empty.duration_s = Some(calibration_duration);
-    empty.validate().py()?;
     let (s, m) = (sc.scenario(), sc.model());
-    let ((rec, truth), (cal, _)) = run_job(py, 2, None, |_| {
-        Ok((
-            simulate(s, m, &scene, true, seed)?,
-            simulate(s, m, &empty, false, seed)?,
-        ))
-    })?;
+    let sim = run_job(py, 1, None, |_| req.run(s, m))?;
     Ok((
-        PyRecording { rec },
-        PyRecording { rec: cal },
-        to_python(py, &truth)?,
+        PyRecording { rec: sim.recording },
+        PyRecording {
+            rec: sim.calibration,
+        },
+        to_python(py, &sim.truth)?,
     ))
 }
 
@@ -508,9 +521,79 @@ fn paths_object(
     })
 }
 
-/// The front end's settings from `max_paths` and `pfa` (the CLI's defaults: 12, 10⁻³).
-fn front_end(max_paths: Option<usize>, pfa: Option<f64>) -> PyResult<FrontEndConfig> {
-    FrontEndConfig::with_overrides(max_paths, pfa).py()
+/// The front end's keywords of `estimate_recording` and `cir_track` (None: the core's default).
+#[derive(Default)]
+struct FrontEndKw<'a> {
+    max_paths: Option<usize>,
+    pfa: Option<f64>,
+    statics: Option<&'a str>,
+    delay_reference: Option<&'a str>,
+    background_time: Option<f64>,
+    calibration_range: Option<[f64; 2]>,
+}
+
+/// The tracker's keywords of `cir_track` (None: the core's default).
+struct TrackKw<'a> {
+    filter: Option<&'a str>,
+    process_noise: Option<f64>,
+    association: Option<&'a str>,
+    sigma: Option<&'a str>,
+    extent_sigma: Option<f64>,
+    seed: Option<u64>,
+    particles: Option<usize>,
+    roughening: Option<f64>,
+    bootstrap: Option<bool>,
+    ukf: [Option<f64>; 3],
+}
+
+/// The core's [`ChannelRequest`] of the given keywords (the others at its defaults), checked
+/// by the core ([`ChannelRequest::check`]: errors name the request's field).
+fn request(fe: &FrontEndKw<'_>, track: Option<&TrackKw<'_>>) -> PyResult<ChannelRequest> {
+    let mut r = ChannelRequest::default();
+    if let Some(k) = fe.max_paths {
+        r.max_paths = k;
+    }
+    if let Some(p) = fe.pfa {
+        r.pfa = p;
+    }
+    if let Some(s) = fe.statics {
+        r.statics = StaticMode::named("statics", s).py()?;
+    }
+    if let Some(d) = fe.delay_reference {
+        r.delay_reference = Some(DelayReference::named("delay_reference", d).py()?);
+    }
+    if let Some(t) = fe.background_time {
+        r.background_time_s = t;
+    }
+    if fe.calibration_range.is_some() {
+        r.calibration_range_s = fe.calibration_range;
+    }
+    if let Some(t) = track {
+        if let Some(f) = t.filter {
+            r.filter = f.to_string();
+        }
+        [r.ukf_alpha, r.ukf_beta, r.ukf_kappa] = t.ukf;
+        r.particles = t.particles;
+        r.roughening = t.roughening;
+        if let Some(b) = t.bootstrap {
+            r.bootstrap = b;
+        }
+        r.seed = t.seed;
+        if let Some(q) = t.process_noise {
+            r.process_noise = q;
+        }
+        if let Some(a) = t.association {
+            r.association = AssociationRule::named("association", a).py()?;
+        }
+        if let Some(s) = t.sigma {
+            r.sigma = DelaySigma::named("sigma", s).py()?;
+        }
+        if let Some(x) = t.extent_sigma {
+            r.extent_sigma_m = x;
+        }
+    }
+    r.check().py()?;
+    Ok(r)
 }
 
 /// Every snapshot's paths (C5: greedy ML with SAGE refinement, joint amplitudes and a CFAR stop
@@ -544,7 +627,15 @@ pub fn estimate(
     pfa: Option<f64>,
     progress: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<Paths> {
-    let cfg = front_end(max_paths, pfa)?;
+    let cfg = request(
+        &FrontEndKw {
+            max_paths,
+            pfa,
+            ..FrontEndKw::default()
+        },
+        None,
+    )?
+    .front_end(None);
     let (shape, data) = complex_arg(response, "response")?;
     let (s, n) = match shape.as_slice() {
         [n] => (1, *n),
@@ -585,6 +676,7 @@ pub fn estimate(
             pulse,
             pulse_spacing_s,
             nv.as_ref(),
+            None,
         )
     };
     let rec = if is_cir {
@@ -608,25 +700,74 @@ pub fn estimate(
     paths_object(py, &rec.t_s, &per, noise, &[s], false, None)
 }
 
-/// The estimates of a recording on `scenario`'s links (`scatterloc cir estimate`): every
-/// recorded link's snapshots through C5 + C6 on `threads` workers (0 = all cores), without the
-/// GIL; Ctrl-C stops it; `progress(done, total)` counts link-snapshots. `to_dict()` is the
-/// CLI's `EST.json`.
+/// The recording of the empty area ([`ChannelRequest::empty_area`]): `calibration`, or the
+/// snapshots of `rec` in the request's `calibration_range_s`, or neither (None: a recursive
+/// background); not both.
+fn empty_area<'a>(
+    calibration: Option<&'a PyRecording>,
+    req: &ChannelRequest,
+    rec: &Recording,
+) -> PyResult<Option<Cow<'a, Recording>>> {
+    req.empty_area(calibration.map(|c| &c.rec), rec).py()
+}
+
+/// The estimates of a recording on `scenario`'s links (`scatterloc cir estimate`; spec C5, C6,
+/// C9/C7, C10): per recorded link its statics, then every snapshot estimated, on `threads`
+/// workers (0 = all cores), without the GIL; Ctrl-C stops it; `progress(done, total)` counts
+/// link-snapshots. Every keyword left at None takes the library's default
+/// (`study::ChannelRequest`, as the CLI's flags do):
+///
+/// - `calibration`: the recording of the empty area (`--calibration`); None: a recursive
+///   background of the walk itself (`statics="background"`; `"clusters"` needs one).
+/// - `max_paths` (default 12), `pfa` (default 1e-3): the estimator's path budget and
+///   false-alarm probability per snapshot (C5).
+/// - `statics`: `"background"` (default: the empty area's background subtracted, C9) or
+///   `"clusters"` (the empty area's path clusters only, C7).
+/// - `delay_reference`: `"absolute"` or `"los"` (relative to each link's direct path, C10);
+///   default from the recording's `synchronized` flag (absolute unless it is False).
+/// - `background_time`: the recursive background's time constant, s (default 10).
+/// - `calibration_range`: `(t0, t1)`, s: the recording's snapshots in it are the empty area
+///   (instead of `calibration`).
+///
+/// Errors (`ScatterlocError`) name the request's field (`statics`, `background_time_s`, …).
+/// `to_dict()` is the CLI's `EST.json` for the same inputs (with `alignment`, `front_end` and
+/// the static `calibration` clusters).
 #[pyfunction]
-#[pyo3(signature = (scenario, recording, *, max_paths = None, pfa = None, threads = 0, progress = None))]
+#[pyo3(signature = (
+    scenario, recording, *, calibration = None, max_paths = None, pfa = None, statics = None,
+    delay_reference = None, background_time = None, calibration_range = None, threads = 0,
+    progress = None
+))]
+#[allow(clippy::too_many_arguments)]
 pub fn estimate_recording(
     py: Python<'_>,
     scenario: &Bound<'_, PyAny>,
     recording: &PyRecording,
+    calibration: Option<&PyRecording>,
     max_paths: Option<usize>,
     pfa: Option<f64>,
+    statics: Option<&str>,
+    delay_reference: Option<&str>,
+    background_time: Option<f64>,
+    calibration_range: Option<[f64; 2]>,
     threads: usize,
     progress: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<Paths> {
     let sc = scenario_arg(scenario)?;
-    let cfg = front_end(max_paths, pfa)?;
-    let est = estimate_on(py, &sc, &recording.rec, &cfg, threads, progress)?;
-    let doc = JsonDoc::of(&estimates_doc(sc.model(), &est, &cfg))?;
+    let fe = FrontEndKw {
+        max_paths,
+        pfa,
+        statics,
+        delay_reference,
+        background_time,
+        calibration_range,
+    };
+    let req = request(&fe, None)?;
+    let rec = &recording.rec;
+    let empty = empty_area(calibration, &req, rec)?;
+    let cfg = req.front_end(rec.synchronized);
+    let (statics, est) = estimate_on(py, &sc, rec, empty.as_deref(), &cfg, threads, progress)?;
+    let doc = JsonDoc::of(&estimates_doc(sc.model(), &est, &cfg, &statics))?;
     let l = sc.model().link_count();
     let noise: Vec<f64> = est.noise_var.iter().flatten().copied().collect();
     paths_object(
@@ -645,17 +786,18 @@ fn estimate_on(
     py: Python<'_>,
     sc: &crate::scenario::PyScenario,
     rec: &Recording,
+    empty: Option<&Recording>,
     cfg: &FrontEndConfig,
     threads: usize,
     progress: Option<&Bound<'_, PyAny>>,
-) -> PyResult<RecordingEstimates> {
-    rec.link_map(sc.model()).py()?;
+) -> PyResult<(ChannelStatics, RecordingEstimates)> {
     let total = rec.snapshot_count() * rec.link_count();
     run_job(py, total, progress, |job| {
         estimate_all(
             sc.model(),
             sc.scenario().radio.bandwidth_hz,
             rec,
+            empty,
             cfg,
             &mut Parallel::new(threads, &job.cancel),
             &|k| job.add_done(k),
@@ -669,10 +811,10 @@ pub struct ChannelTrack {
     /// Snapshot times, s (S,).
     #[pyo3(get)]
     t: Py<PyAny>,
-    /// States [x, y, vx, vy], shape (S, 4), masked before the track starts.
+    /// States [x, y, vx, vy], shape (S, 4), masked outside the track's segments.
     #[pyo3(get)]
     states: Py<PyAny>,
-    /// Covariances (S, 4, 4), masked before the start.
+    /// Covariances (S, 4, 4), masked outside the segments.
     #[pyo3(get)]
     covariances: Py<PyAny>,
     /// Links used per snapshot (S,).
@@ -685,6 +827,12 @@ pub struct ChannelTrack {
     /// estimate; else None.
     #[pyo3(get)]
     error: Py<PyAny>,
+    /// The track's segments (C11) in time order, as `TRACK.json`'s `segments`: per segment a
+    /// dict with `first` and `last` (its first and last snapshot with a state), `t_first_s`,
+    /// `t_last_s`, `end` (why it ended: `innovation`, `misses`, `outside_area` or `end`),
+    /// `confirmed_at`, `hits` and `start` (the fix that started it).
+    #[pyo3(get)]
+    segments: Py<PyAny>,
     doc: JsonDoc,
 }
 
@@ -697,39 +845,54 @@ impl ChannelTrack {
 
     fn __repr__(&self, py: Python<'_>) -> String {
         format!(
-            "ChannelTrack(snapshots={})",
-            self.t.bind(py).len().unwrap_or(0)
+            "ChannelTrack(snapshots={}, segments={})",
+            self.t.bind(py).len().unwrap_or(0),
+            self.segments.bind(py).len().unwrap_or(0)
         )
     }
 }
 
-/// The whole chain from recordings to a track (`scatterloc cir track`): both recordings
-/// estimated (C5 + C6), the empty area's estimates clustered in (delay, amplitude) (C7), each
-/// snapshot gated (E4) and associated (`association`, default `"gated"`), the track started
-/// at the first snapshot whose links give an LM fix (§5) and filtered (`filter`, CV model with
-/// `process_noise` q̃, m²/s³). Each delay is weighted with the estimator's σ̂_τ widened by the
-/// scatterer's extent `extent_sigma` (m of path length), or with the link budget
-/// (`sigma="budget"`). `truth` (a dict as `truth.json`, or a path) adds the error statistics.
-/// `to_dict()` is the CLI's `TRACK.json`.
+/// The whole chain from a recording to a track (`scatterloc cir track`): the recording's
+/// estimates as `estimate_recording` makes them (the front-end keywords `calibration`,
+/// `max_paths`, `pfa`, `statics`, `delay_reference`, `background_time`, `calibration_range`
+/// are its own), then each snapshot gated against the static clusters (E4) and associated,
+/// through a tracker that starts the track by itself (an LM fix confirmed over snapshots),
+/// ends it when it is lost and starts it again (C11); states are masked between the segments.
+/// Every keyword left at None takes the library's default (`study::ChannelRequest`, as the
+/// CLI's flags do):
+///
+/// - `filter`: `"ekf"` (default), `"ukf"` or `"pf"`; with `ukf_alpha`, `ukf_beta`,
+///   `ukf_kappa` (ukf only), `particles` (default 1000), `roughening`, `bootstrap` and `seed`
+///   (default 1) (pf only).
+/// - `process_noise`: q̃ of the CV model, m²/s³ (default 1).
+/// - `association`: `"gated"` (default) or `"spec"`.
+/// - `sigma`: `"estimator"` (default: the estimator's σ̂_τ widened by the scatterer's extent
+///   `extent_sigma`, m of path length, default 0.2) or `"budget"` (the link budget's σ).
+///
+/// `truth` (a dict as `truth.json`, or a path) adds the error statistics. Work runs without
+/// the GIL on `threads` workers (0 = all cores); Ctrl-C stops it; `progress(done, total)`
+/// counts the estimated link-snapshots. Errors (`ScatterlocError`) name the request's field
+/// (`filter`, `extent_sigma_m`, …). `to_dict()` is the CLI's `TRACK.json`.
 #[pyfunction]
 #[pyo3(signature = (
-    scenario, recording, calibration, *, truth = None, filter = "ekf", process_noise = 1.0,
-    association = "gated", sigma = "estimator", extent_sigma = 0.2, seed = None,
+    scenario, recording, calibration = None, *, truth = None, filter = None,
+    process_noise = None, association = None, sigma = None, extent_sigma = None, seed = None,
     particles = None, roughening = None, bootstrap = None, ukf_alpha = None, ukf_beta = None,
-    ukf_kappa = None, max_paths = None, pfa = None, threads = 0, progress = None
+    ukf_kappa = None, max_paths = None, pfa = None, statics = None, delay_reference = None,
+    background_time = None, calibration_range = None, threads = 0, progress = None
 ))]
 #[allow(clippy::too_many_arguments)]
 pub fn cir_track(
     py: Python<'_>,
     scenario: &Bound<'_, PyAny>,
     recording: &PyRecording,
-    calibration: &PyRecording,
+    calibration: Option<&PyRecording>,
     truth: Option<&Bound<'_, PyAny>>,
-    filter: &str,
-    process_noise: f64,
-    association: &str,
-    sigma: &str,
-    extent_sigma: f64,
+    filter: Option<&str>,
+    process_noise: Option<f64>,
+    association: Option<&str>,
+    sigma: Option<&str>,
+    extent_sigma: Option<f64>,
     seed: Option<u64>,
     particles: Option<usize>,
     roughening: Option<f64>,
@@ -739,41 +902,36 @@ pub fn cir_track(
     ukf_kappa: Option<f64>,
     max_paths: Option<usize>,
     pfa: Option<f64>,
+    statics: Option<&str>,
+    delay_reference: Option<&str>,
+    background_time: Option<f64>,
+    calibration_range: Option<[f64; 2]>,
     threads: usize,
     progress: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<ChannelTrack> {
     let sc = scenario_arg(scenario)?;
-    let kind = one_filter(
-        &settings(
-            [ukf_alpha, ukf_beta, ukf_kappa],
-            particles,
-            roughening,
-            bootstrap,
-        ),
+    let fe = FrontEndKw {
+        max_paths,
+        pfa,
+        statics,
+        delay_reference,
+        background_time,
+        calibration_range,
+    };
+    let tk = TrackKw {
         filter,
+        process_noise,
+        association,
+        sigma,
+        extent_sigma,
         seed,
-    )?;
-    ConstantVelocity::validated(1.0, process_noise).py()?;
-    let rule = match association {
-        "gated" => AssociationRule::Gated,
-        "spec" => AssociationRule::Spec,
-        other => {
-            return Err(arg_error(
-                "association",
-                format!("'{other}' is not 'gated' or 'spec'"),
-            ))
-        }
+        particles,
+        roughening,
+        bootstrap,
+        ukf: [ukf_alpha, ukf_beta, ukf_kappa],
     };
-    let sigma = match sigma {
-        "estimator" => DelaySigma::Estimator,
-        "budget" => DelaySigma::LinkBudget,
-        other => {
-            return Err(arg_error(
-                "sigma",
-                format!("'{other}' is not 'estimator' or 'budget'"),
-            ))
-        }
-    };
+    let req = request(&fe, Some(&tk))?;
+    let rec = &recording.rec;
     let truth: Option<Truth> = match truth {
         None => None,
         Some(t) => {
@@ -783,31 +941,24 @@ pub fn cir_track(
                 crate::scenario::read_text(&path_string(t)?, "truth")?
             };
             let t = Truth::from_json(&text).py()?;
-            t.check_times(&recording.rec.t_s).py()?;
+            t.check_times(&rec.t_s).py()?;
             Some(t)
         }
     };
-    let cfg = front_end(max_paths, pfa)?;
+    let empty = empty_area(calibration, &req, rec)?;
+    let cfg = req.front_end(rec.synchronized);
     let (model, scen) = (sc.model(), sc.scenario());
-    let empty = estimate_on(py, &sc, &calibration.rec, &cfg, threads, None)?;
-    let ccfg = AmplitudeClusterConfig::for_bandwidth(scen.radio.bandwidth_hz).py()?;
-    let cal = calibrate_estimates(model, &empty, &ccfg).py()?;
-    let est = estimate_on(py, &sc, &recording.rec, &cfg, threads, progress)?;
-    let req = CirTrackRequest {
-        model,
-        area: &scen.area_m,
-        calibration: &cal,
-        estimates: &est,
-        filter: kind,
-        process_noise,
-        rule,
-        sigma,
-        extent_sigma_m: extent_sigma,
-        seed: seed.unwrap_or(1),
-    };
+    let (statics, est) = estimate_on(py, &sc, rec, empty.as_deref(), &cfg, threads, progress)?;
     let track = run_job(py, est.len(), None, |job| {
         let stop = || job.cancelled();
-        track_recording(&req, Cancel::when(&stop))
+        track_recording(
+            &req,
+            model,
+            &scen.area_m,
+            &statics.calibration,
+            &est,
+            Cancel::when(&stop),
+        )
     })?;
     let truth_states: Vec<Option<[f64; 4]>> = truth
         .as_ref()
@@ -815,15 +966,7 @@ pub fn cir_track(
         .unwrap_or_default();
     let view = track_errors(&track.t_s, &track.states, &truth_states).py()?;
     let stats = truth.as_ref().and(view.stats);
-    let doc = JsonDoc::of(&track_doc(
-        &track,
-        kind.name(),
-        process_noise,
-        sigma,
-        &cal,
-        empty.len(),
-        stats,
-    ))?;
+    let doc = JsonDoc::of(&track_doc(&track, &req, &cfg, &statics, &est, stats).py()?)?;
     let s = track.t_s.len();
     let l = model.link_count();
     let states: Vec<Option<f64>> = track
@@ -859,6 +1002,7 @@ pub fn cir_track(
         .unbind(),
         delays_used: masked(py, &used, &[s, l])?.unbind(),
         error,
+        segments: to_python(py, &track.segments)?.unbind(),
         doc,
     })
 }

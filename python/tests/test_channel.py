@@ -1,7 +1,9 @@
 """The channel front end against the CLI's `cir simulate`, `cir estimate` and `cir track` (bit for
-bit), `Recording` built from arrays and its checks, the `.npz` round trip through
+bit; with and without a recording of the empty area, every front-end and tracker setting),
+`Recording` built from arrays and its checks, the `.npz` round trip through
 `write_recording`/`read_recording` and `numpy.load` (docs/recording.md), `estimate` on one link
-against that link's entries of EST.json, and the dtypes and shapes of `Paths`."""
+against that link's entries of EST.json, the dtypes and shapes of `Paths`, the track's segments
+(C11) against its states, and errors named by the core's request fields."""
 
 from __future__ import annotations
 
@@ -62,13 +64,19 @@ def sim(request, tmp_path_factory) -> SimpleNamespace:
         "cir", "simulate", "--scenario", "s.json", "--out-dir", "sim", "--dt", DT,
         "--duration", DURATION, "--seed", str(seed),
     )
+    # Without --calibration: a recursive background of the walk itself.
     cli.run("cir", "estimate", "--scenario", "s.json", "--cir", "sim/recording.npz", "--out", "est.json")
+    cli.run(
+        "cir", "estimate", "--scenario", "s.json", "--cir", "sim/recording.npz",
+        "--calibration", "sim/calibration.npz", "--out", "est_cal.json",
+    )
     rec, cal, truth = sl.simulate_recording(s, dt=float(DT), duration=float(DURATION), seed=seed)
     progress: list[tuple[int, int]] = []
     paths = sl.estimate_recording(s, rec, progress=lambda d, t: progress.append((d, t)))
+    paths_cal = sl.estimate_recording(s, rec, calibration=cal)
     return SimpleNamespace(
         seed=seed, cli=cli, s=s, rec=rec, cal=cal, truth=truth, est=cli.file("est.json"),
-        paths=paths, progress=progress,
+        paths=paths, progress=progress, est_cal=cli.file("est_cal.json"), paths_cal=paths_cal,
     )
 
 
@@ -134,6 +142,21 @@ def test_recording_between():
     with pytest.raises(sl.ScatterlocError) as e:
         r.between(0.5, 0.2)
     assert e.value.field == "t"
+
+
+def test_recording_synchronized(tmp_path):
+    t, links, cfr, freq = small_cfr(S=6)
+    assert sl.Recording(t, links, cfr=cfr, freq_hz=freq).synchronized is None
+    for flag in (True, False):
+        r = sl.Recording(t, links, cfr=cfr, freq_hz=freq, synchronized=flag)
+        assert r.synchronized is flag
+        assert r.between(0.1, 0.3).synchronized is flag
+        p = tmp_path / f"s{flag}.npz"
+        sl.write_recording(p, r)
+        assert sl.read_recording(p).synchronized is flag
+        with np.load(p) as z:
+            assert "synchronized" in z.files
+            assert z["synchronized"].dtype == np.bool_ and bool(z["synchronized"]) is flag
 
 
 def test_recording_and_estimate_fortran_order():
@@ -325,12 +348,40 @@ def test_simulate_scene_and_walk_equal_cli(tmp_path):
     assert_bitwise(truth2, truth)
 
 
+@pytest.mark.parametrize(
+    "kw, field",
+    [
+        (dict(speed=-1.0), "speed_mps"),
+        (dict(dt=0.0), "dt_s"),
+        (dict(duration=-2.0), "duration_s"),
+        (dict(walk=[[0.0, 0.0]]), "walk"),
+        (dict(calibration_duration=-1.0), "calibration_duration_s"),
+    ],
+)
+def test_simulate_errors_name_the_request_field(kw, field):
+    s = sl.Scenario.preset("sensors2019")
+    with pytest.raises(sl.ScatterlocError) as e:
+        sl.simulate_recording(s, **kw)
+    assert e.value.field == field, str(e.value)
+
+
 # --------------------------------------------------------------------------------------------
 # estimate_recording vs `cir estimate`
 
 
 def test_estimate_recording_equals_cli(sim):
+    # calibration=None: the recursive background, as the CLI without --calibration.
     assert_bitwise(sim.paths.to_dict(), sim.est)
+    fe = sim.est["front_end"]
+    assert fe["statics"] == "background" and fe["delay_reference"] == "absolute"
+    assert [l["empty_snapshots"] for l in fe["links"]] == [0] * 4
+    assert len(sim.est["alignment"]) == 81 and "calibration" in sim.est
+    # With the empty area's recording, as --calibration.
+    assert_bitwise(sim.paths_cal.to_dict(), sim.est_cal)
+    fe = sim.est_cal["front_end"]
+    assert [l["empty_snapshots"] for l in fe["links"]] == [21] * 4
+    assert [l["background"] for l in fe["links"]] == [True] * 4
+    assert sim.est_cal["calibration"]["snapshot_count"] == 21
     prog = sim.progress
     total = 81 * 4
     assert prog and prog[-1] == (total, total)
@@ -342,16 +393,58 @@ def test_estimate_recording_equals_cli(sim):
     assert_bitwise(q.to_dict(), sim.est)
 
 
-def test_estimate_recording_settings_equal_cli(sim):
-    sim.cli.run(
-        "cir", "estimate", "--scenario", "s.json", "--cir", "sim/recording.npz", "--out",
-        "est4.json", "--max-paths", "4", "--pfa", "0.01",
-    )
-    doc = sim.cli.file("est4.json")
-    p = sl.estimate_recording(sim.s, sim.rec, max_paths=4, pfa=0.01)
+# (flags of `cir estimate`, keywords of `estimate_recording`; "CAL" = the empty area's recording)
+FRONT_END_SETTINGS = [
+    (("--max-paths", "4", "--pfa", "0.01"), dict(max_paths=4, pfa=0.01)),
+    (("--statics", "clusters", "--calibration", "sim/calibration.npz"), dict(statics="clusters", calibration="CAL")),
+    (("--statics", "background", "--calibration", "sim/calibration.npz"), dict(statics="background", calibration="CAL")),
+    (("--delay-reference", "los", "--background-time", "2"), dict(delay_reference="los", background_time=2.0)),
+    (("--delay-reference", "los", "--calibration", "sim/calibration.npz"), dict(delay_reference="los", calibration="CAL")),
+    (("--delay-reference", "absolute"), dict(delay_reference="absolute")),
+    (("--calibration-range", "0,0.5"), dict(calibration_range=(0.0, 0.5))),
+]
+
+
+def with_cal(sim, kw: dict) -> dict:
+    return {k: (sim.cal if v == "CAL" else v) for k, v in kw.items()}
+
+
+@pytest.mark.parametrize("flags, kw", FRONT_END_SETTINGS)
+def test_estimate_recording_settings_equal_cli(sim, flags, kw):
+    if sim.seed != 1 and "max_paths" not in kw:
+        pytest.skip("one seed is enough for the other settings")
+    out = "est" + "".join(c for c in "_".join(flags) if c.isalnum() or c == "_") + ".json"
+    sim.cli.run("cir", "estimate", "--scenario", "s.json", "--cir", "sim/recording.npz", "--out", out, *flags)
+    doc = sim.cli.file(out)
+    p = sl.estimate_recording(sim.s, sim.rec, **with_cal(sim, kw))
     assert_bitwise(p.to_dict(), doc)
-    assert doc["max_paths"] == 4 and doc["p_fa"] == 0.01
-    assert max(len(es) for per in doc["estimates"] for es in per) <= 4
+    fe = doc["front_end"]
+    if "max_paths" in kw:
+        assert doc["max_paths"] == 4 and doc["p_fa"] == 0.01
+        assert max(len(es) for per in doc["estimates"] for es in per) <= 4
+    assert fe["statics"] == kw.get("statics", "background")
+    assert fe["delay_reference"] == kw.get("delay_reference", "absolute")
+    assert fe["background_time_s"] == kw.get("background_time", 10.0)
+    if "calibration_range" in kw:
+        # 0 <= t <= 0.5 s: 11 snapshots of the walk are the empty area.
+        assert [l["empty_snapshots"] for l in fe["links"]] == [11] * 4
+
+
+def test_estimate_recording_unsynchronized_equals_cli(sim, tmp_path):
+    """A recording whose `synchronized` is False reads delays relative to the direct path (C10)
+    unless delay_reference says otherwise, in the package as in the CLI (the flag in the file)."""
+    if sim.seed != 1:
+        pytest.skip("one seed is enough")
+    r = sim.rec
+    un = sl.Recording(r.t, r.links, cfr=r.samples, freq_hz=r.freq_hz, noise_var=r.noise_var, synchronized=False)
+    sl.write_recording(sim.cli.cwd / "unsync.npz", un)
+    sim.cli.run("cir", "estimate", "--scenario", "s.json", "--cir", "unsync.npz", "--out", "est_unsync.json")
+    doc = sim.cli.file("est_unsync.json")
+    assert doc["front_end"]["delay_reference"] == "los"
+    assert_bitwise(sl.estimate_recording(sim.s, un).to_dict(), doc)
+    assert_bitwise(
+        sl.estimate_recording(sim.s, un, delay_reference="absolute").to_dict(), sim.est
+    )
 
 
 def test_paths_arrays(sim):
@@ -390,10 +483,17 @@ def test_paths_arrays(sim):
 
 
 def test_estimate_one_link_equals_est_json(sim):
+    """`estimate` on one link's responses is `cir estimate --statics clusters` (every full
+    response estimated, absolute delays) on that link."""
     rec = sim.rec
+    sim.cli.run(
+        "cir", "estimate", "--scenario", "s.json", "--cir", "sim/recording.npz", "--calibration",
+        "sim/calibration.npz", "--statics", "clusters", "--out", "est_clusters.json",
+    )
+    est = sim.cli.file("est_clusters.json")
     for l in range(4):
         p = sl.estimate(rec.samples[:, l, :], freq_hz=rec.freq_hz, t=rec.t, noise_var=rec.noise_var[l])
-        rows = est_rows(sim.est, l)
+        rows = est_rows(est, l)
         assert len(p) == len(rows) > 0
         assert p.link is None and p.to_dict() is None
         assert p.snapshot.tolist() == [s for s, _, _ in rows]
@@ -405,7 +505,7 @@ def test_estimate_one_link_equals_est_json(sim):
         amp = np.array([e["amplitude"] for _, _, e in rows])
         np.testing.assert_allclose(np.abs(p.amplitude), amp, rtol=1e-15, atol=0)
         assert p.noise_var.shape == (81,)
-        assert_same_bits(p.noise_var, np.array([e[l] for e in sim.est["noise_var"]]))
+        assert_same_bits(p.noise_var, np.array([e[l] for e in est["noise_var"]]))
         assert_same_bits(p.t, rec.t)
 
 
@@ -486,12 +586,38 @@ def test_estimate_errors():
 # cir_track vs `cir track`
 
 
-def track_cli(sim, out: str, *extra: str) -> dict:
-    sim.cli.run(
-        "cir", "track", "--scenario", "s.json", "--calibration", "sim/calibration.npz",
-        "--cir", "sim/recording.npz", "--out", out, *extra,
-    )
+def track_cli(sim, out: str, *extra: str, calibration: bool = True) -> dict:
+    cal = ("--calibration", "sim/calibration.npz") if calibration else ()
+    sim.cli.run("cir", "track", "--scenario", "s.json", *cal, "--cir", "sim/recording.npz", "--out", out, *extra)
     return sim.cli.file(out)
+
+
+def check_segments(t, doc: dict) -> None:
+    """`segments` is TRACK.json's, in time order, disjoint; states (and covariances) exist at
+    exactly the snapshots of a segment (masked between segments, C11)."""
+    assert isinstance(t.segments, list)
+    assert_bitwise(t.segments, doc["segments"])
+    S = len(doc["t_s"])
+    inside = np.zeros(S, dtype=bool)
+    prev_last = -1
+    for g in t.segments:
+        assert set(g) >= {"first", "last", "t_first_s", "t_last_s", "end", "confirmed_at", "hits", "start"}
+        assert prev_last < g["first"] <= g["confirmed_at"] <= g["last"] < S
+        assert g["t_first_s"] == doc["t_s"][g["first"]] and g["t_last_s"] == doc["t_s"][g["last"]]
+        assert g["start"]["snapshot"] == g["first"]
+        assert g["end"] in ("innovation", "misses", "outside_area", "end")
+        inside[g["first"] : g["last"] + 1] = True
+        prev_last = g["last"]
+    # Only the last segment can run to the recording's end.
+    assert all(g["end"] != "end" for g in t.segments[:-1])
+    has_state = [s is not None for s in doc["states"]]
+    assert has_state == inside.tolist()
+    assert (~np.ma.getmaskarray(t.states).any(axis=1) == inside).all()
+    assert (np.ma.getmaskarray(t.states).all(axis=1) == ~inside).all()
+    if t.segments:
+        assert doc["start"] == t.segments[0]["start"]
+    else:
+        assert doc["start"] is None
 
 
 def check_track_arrays(t, doc: dict) -> None:
@@ -516,6 +642,7 @@ def check_track_arrays(t, doc: dict) -> None:
     assert used == doc["delays_used_s"]
     # links_used counts the delays taken.
     assert (t.links_used == (~np.ma.getmaskarray(t.delays_used)).sum(axis=1)).all()
+    check_segments(t, doc)
 
 
 @pytest.mark.parametrize("with_truth", [True, False])
@@ -547,6 +674,43 @@ def test_cir_track_equals_cli(sim, with_truth):
     assert stats["median_m"] < 1.0
 
 
+@pytest.mark.parametrize("with_truth", [True, False])
+def test_cir_track_without_calibration_equals_cli(sim, with_truth):
+    """calibration=None: a recursive background of the walk itself, as the CLI without
+    --calibration."""
+    extra = ("--truth", "sim/truth.json") if with_truth else ()
+    doc = track_cli(sim, "track_rec.json", *extra, calibration=False)
+    t = sl.cir_track(sim.s, sim.rec, truth=sim.truth if with_truth else None)
+    assert_bitwise(t.to_dict(), doc)
+    check_track_arrays(t, doc)
+    assert [l["empty_snapshots"] for l in doc["front_end"]["links"]] == [0] * 4
+    if not with_truth:  # calibration given positionally as None
+        assert_bitwise(sl.cir_track(sim.s, sim.rec, None).to_dict(), doc)
+
+
+def test_cir_track_statics_clusters_equals_cli(sim):
+    doc = track_cli(sim, "track_clusters.json", "--truth", "sim/truth.json", "--statics", "clusters")
+    t = sl.cir_track(sim.s, sim.rec, sim.cal, truth=sim.truth, statics="clusters")
+    assert_bitwise(t.to_dict(), doc)
+    assert doc["front_end"]["statics"] == "clusters"
+    check_track_arrays(t, doc)
+
+
+def test_cir_track_front_end_settings_equal_cli(sim):
+    if sim.seed != 1:
+        pytest.skip("one seed is enough for the other settings")
+    doc = track_cli(
+        sim, "track_fe.json", "--delay-reference", "los", "--background-time", "3",
+        "--calibration-range", "0,0.6", "--max-paths", "6", "--pfa", "0.005", calibration=False,
+    )
+    t = sl.cir_track(
+        sim.s, sim.rec, delay_reference="los", background_time=3.0, calibration_range=[0.0, 0.6],
+        max_paths=6, pfa=0.005,
+    )
+    assert_bitwise(t.to_dict(), doc)
+    check_track_arrays(t, doc)
+
+
 def test_cir_track_ukf_equals_cli(sim):
     doc = track_cli(sim, "track_ukf.json", "--truth", "sim/truth.json", "--filter", "ukf")
     t = sl.cir_track(sim.s, sim.rec, sim.cal, truth=sim.cli.cwd / "sim" / "truth.json", filter="ukf")
@@ -566,6 +730,19 @@ def test_cir_track_from_files_equals_cli(sim):
         process_noise=0.5,
     )
     assert_bitwise(t.to_dict(), doc)
+    check_track_arrays(t, doc)
+    # The tracker's settings as the CLI's flags: pf with its own, extent_sigma.
+    doc = track_cli(
+        sim, "track_pf.json", "--filter", "pf", "--particles", "300", "--seed", "4",
+        "--extent-sigma-m", "0.3", "--process-noise", "2",
+    )
+    t = sl.cir_track(
+        sim.s, sim.rec, calibration=sim.cal, filter="pf", particles=300, seed=4,
+        extent_sigma=0.3, process_noise=2.0,
+    )
+    assert_bitwise(t.to_dict(), doc)
+    assert doc["filter"] == "pf" and doc["extent_sigma_m"] == 0.3
+    check_track_arrays(t, doc)
 
 
 @pytest.mark.parametrize(
@@ -578,14 +755,46 @@ def test_cir_track_from_files_equals_cli(sim):
         (dict(association="nearest"), "association"),
         (dict(sigma="fixed"), "sigma"),
         (dict(particles=100), "particles"),
+        (dict(statics="x"), "statics"),
+        (dict(delay_reference="relative"), "delay_reference"),
+        (dict(background_time=-1.0), "background_time_s"),
+        (dict(extent_sigma=-0.1), "extent_sigma_m"),
+        (dict(process_noise=-1.0), "process_noise"),
+        (dict(calibration_range=(0.0, 0.2)), "calibration_range_s"),
+        (dict(max_paths=0), "max_paths"),
     ],
 )
 def test_cir_track_errors(kw, field):
     s = sl.Scenario.preset("sensors2019")
-    t, _, cfr, freq = small_cfr(S=5, P=2, N=8)
-    links = np.array([[0, 0], [0, 1]])
-    rec = sl.Recording(t, links, cfr=cfr, freq_hz=freq)
+    rec = tiny_recording()
     with pytest.raises(sl.ScatterlocError) as e:
         sl.cir_track(s, rec, rec, **kw)
     assert e.value.field == field, str(e.value)
     assert str(e.value).startswith(field)
+
+
+def tiny_recording():
+    t, _, cfr, freq = small_cfr(S=5, P=2, N=8)
+    return sl.Recording(t, np.array([[0, 0], [0, 1]]), cfr=cfr, freq_hz=freq)
+
+
+@pytest.mark.parametrize(
+    "kw, field",
+    [
+        (dict(statics="x"), "statics"),
+        (dict(delay_reference="x"), "delay_reference"),
+        (dict(background_time=0.0), "background_time_s"),
+        (dict(calibration_range=(0.3, 0.1)), "calibration_range_s"),
+        (dict(calibration_range=(5.0, 6.0)), "calibration_range_s"),
+        # C7 alone needs the empty area (a calibration recording or a time range).
+        (dict(statics="clusters"), "calibration"),
+    ],
+)
+def test_estimate_recording_errors(kw, field):
+    s = sl.Scenario.preset("sensors2019")
+    rec = tiny_recording()
+    for call in (sl.estimate_recording, sl.cir_track):
+        with pytest.raises(sl.ScatterlocError) as e:
+            call(s, rec, **kw)
+        assert e.value.field == field, (call.__name__, str(e.value))
+        assert str(e.value).startswith(field)

@@ -6,11 +6,14 @@
 // `!(x > 0.0)` is meant: a NaN must fail these checks as well.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+use alloc::borrow::Cow;
 use alloc::string::{String, ToString};
 
 use serde::{Deserialize, Serialize};
 
-use crate::channel::{AlignMode, EstimatorConfig, PathTrackerConfig, DEFAULT_BACKGROUND_TIME_S};
+use crate::channel::{
+    AlignMode, EstimatorConfig, PathTrackerConfig, Recording, DEFAULT_BACKGROUND_TIME_S,
+};
 use crate::error::{limits, Error, Result};
 use crate::math::Real;
 use crate::track::gating::{AssociationRule, SegmentConfig};
@@ -310,16 +313,46 @@ impl ChannelRequest {
         Ok(kinds[0])
     }
 
+    /// The recording of the empty area: `file` (a calibration recording), or the snapshots of
+    /// `rec` in [`ChannelRequest::calibration_range_s`], or neither (`None`: a recursive
+    /// background). Errors: both given ([`Error::InvalidFile`] of `calibration_range_s`), a
+    /// range with no snapshot in it.
+    pub fn empty_area<'a>(
+        &self,
+        file: Option<&'a Recording>,
+        rec: &Recording,
+    ) -> Result<Option<Cow<'a, Recording>>> {
+        match (file, self.calibration_range_s) {
+            (Some(_), Some(_)) => Err(Error::InvalidFile {
+                field: "calibration_range_s".into(),
+                reason: "give a calibration recording or a time range of the recording, not both"
+                    .into(),
+            }),
+            (Some(f), None) => Ok(Some(Cow::Borrowed(f))),
+            (None, Some([a, b])) => rec
+                .between("calibration_range_s", a, b)
+                .map(|r| Some(Cow::Owned(r))),
+            (None, None) => Ok(None),
+        }
+    }
+
     /// The particle filter's seed (default 1).
     pub fn seed(&self) -> u64 {
         self.seed.unwrap_or(1)
     }
 
-    /// Checks every setting, naming the field at fault: the front end's ([`FrontEndConfig::
-    /// validate`]: `max_paths`, `p_fa`, `background_time_s`), the filter's
+    /// Checks every setting, naming the field at fault: `pfa`, the front end's
+    /// ([`FrontEndConfig::validate`]: `max_paths`, `background_time_s`), the filter's
     /// ([`ChannelRequest::filter_kind`]), `process_noise` (E7's range), `extent_sigma_m` (finite,
     /// ≥ 0), `calibration_range_s` (finite, `t0 ≤ t1`), the segments'.
     pub fn check(&self) -> Result<()> {
+        if !(self.pfa > 0.0 && self.pfa < 1.0) {
+            return Err(Error::OutOfRange {
+                field: "pfa".into(),
+                value: self.pfa,
+                allowed: "0 < pfa < 1",
+            });
+        }
         self.front_end(None).validate()?;
         self.filter_kind()?;
         ConstantVelocity::validated(1.0, self.process_noise)?;

@@ -71,9 +71,9 @@ pub struct SegmentDoc {
     pub first: usize,
     /// Its last snapshot with a state.
     pub last: usize,
-    /// Their times, s.
+    /// The time of its first snapshot, s.
     pub t_first_s: Real,
-    /// …
+    /// The time of its last snapshot, s.
     pub t_last_s: Real,
     /// Why it ended: `innovation`, `misses`, `outside_area` or `end` (the recording ended).
     pub end: &'static str,

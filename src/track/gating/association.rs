@@ -73,6 +73,18 @@ impl AssociationRule {
             AssociationRule::Gated => "gated",
         }
     }
+
+    /// The rule named `name` (`spec`, `gated`), else [`Error::InvalidFile`] of `field`.
+    pub fn named(field: &str, name: &str) -> Result<AssociationRule> {
+        match name {
+            "spec" => Ok(AssociationRule::Spec),
+            "gated" => Ok(AssociationRule::Gated),
+            _ => Err(Error::InvalidFile {
+                field: field.into(),
+                reason: format!("\"{}\" is not one of gated, spec", crate::error::Clip(name)),
+            }),
+        }
+    }
 }
 
 /// The association of one link's non-static candidates under `rule`: the index chosen (into

@@ -104,25 +104,21 @@ fn request(fe: &FrontEndArgs, track: Option<&CirTrackArgs>) -> Result<ChannelReq
 }
 
 /// The recording of the empty area: `--calibration CAL.npz`, or the snapshots of the recording
-/// in `--calibration-range` (`None`: neither, a recursive background).
+/// in `--calibration-range` (`None`: neither, a recursive background;
+/// [`ChannelRequest::empty_area`]).
 fn empty_area(
     path: Option<&str>,
     req: &ChannelRequest,
     rec: &Recording,
     model: &Model,
 ) -> Result<Option<Recording>, CliError> {
-    match (path, req.calibration_range_s) {
-        (Some(_), Some(_)) => Err(CliError::usage(
-            "--calibration-range: give a calibration recording or a time range of the recording, \
-             not both",
-        )),
-        (Some(p), None) => Ok(Some(read_recording("calibration", p, model)?)),
-        (None, Some([a, b])) => rec
-            .between("calibration_range_s", a, b)
-            .map(Some)
-            .map_err(|e| flag_error(&e)),
-        (None, None) => Ok(None),
-    }
+    let file = match path {
+        Some(p) => Some(read_recording("calibration", p, model)?),
+        None => None,
+    };
+    req.empty_area(file.as_ref(), rec)
+        .map(|c| c.map(std::borrow::Cow::into_owned))
+        .map_err(|e| flag_error(&e))
 }
 
 /// Statics and estimates of `rec` on `threads` threads under a progress bar (Ctrl-C: exit 130,

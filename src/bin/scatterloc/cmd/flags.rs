@@ -5,7 +5,7 @@
 use scatterloc::Error;
 
 /// Core field → flag.
-const FLAGS: [(&str, &str); 45] = [
+const FLAGS: [(&str, &str); 46] = [
     // Tracking studies (`montecarlo`, `pcrlb`, `track`).
     ("runs", "--runs"),
     ("noise_runs", "--noise-runs"),
@@ -45,6 +45,7 @@ const FLAGS: [(&str, &str); 45] = [
     // The channel front end and a recording's track (`cir`).
     ("max_paths", "--max-paths"),
     ("p_fa", "--pfa"),
+    ("pfa", "--pfa"),
     ("background_time_s", "--background-time"),
     ("calibration_range_s", "--calibration-range"),
     ("extent_sigma_m", "--extent-sigma-m"),
