@@ -25,8 +25,8 @@ pub use estimate::{
 pub use paths::{PathTracker, PathTrackerConfig, TrackedPath};
 pub use recording::{Layout, Pulse, Recording};
 pub use simulate::{
-    simulate_recording, Body, ChannelScene, ChannelTruth, PathKind, PointScatterer, Simulated,
-    SimulationRequest, TruePath, Walk, Wall, DEFAULT_CALIBRATION_DURATION_S, DEFAULT_DT_S,
-    DEFAULT_SUBCARRIERS,
+    simulate_recording, Body, ChannelScene, ChannelTruth, Clock, ClockState, PathKind,
+    PointScatterer, Simulated, SimulationRequest, TruePath, Walk, Wall,
+    DEFAULT_CALIBRATION_DURATION_S, DEFAULT_DT_S, DEFAULT_SUBCARRIERS,
 };
 pub use snapshot::{DelayEstimate, Snapshot};

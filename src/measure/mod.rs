@@ -18,4 +18,4 @@ pub use model::{
     noise_power_w, sigma_delay_from_snr, Model, DEFAULT_NOISE_FIGURE_DB, SNR_DISTANCE_FLOOR_M,
 };
 pub use pattern::{Beam, GainPolynomial, TxPattern, GAIN_POLYNOMIAL_TOLERANCE};
-pub use simulate::{noisy_delays, rng, standard_normal, Rng};
+pub use simulate::{noisy_delays, rng, standard_normal, uniform01, Rng};

@@ -29,6 +29,12 @@ pub fn standard_normal(rng: &mut Rng) -> Real {
     StandardNormal.sample(rng)
 }
 
+/// One uniform sample in `[0, 1)`.
+#[inline]
+pub fn uniform01(rng: &mut Rng) -> Real {
+    rand_distr::StandardUniform.sample(rng)
+}
+
 /// Noisy delays of every link for a scatterer at `r`, with `σ_p(r)` from the link budget, s.
 pub fn noisy_delays(model: &Model, r: Vec2, rng: &mut Rng) -> Vec<Real> {
     (0..model.link_count())

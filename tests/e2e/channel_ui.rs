@@ -8,6 +8,13 @@
 //! result texts), its line moves right on both charts, the save buttons produce the delay
 //! figure (SVG, PNG) and the track file (the TRACK.json text plus the newline the CLI writes),
 //! and the settings hook round-trips and refuses a bad value by name.
+//!
+//! Issue 36: a recording of a walk that leaves the area and comes back (simulated by the CLI),
+//! opened through the file inputs without an empty area's recording, is tracked with the
+//! background learnt from the recording (the CLI's `cir track` without `--calibration`, number
+//! for number) in two segments; the status line names them and the loss's reason, the error
+//! chart marks the gap and the loss, and in the gap the map draws no position and the first
+//! segment alone.
 
 use std::time::{Duration, Instant};
 
@@ -346,6 +353,12 @@ fn channel_view_simulate_run_stop_scrub_save() {
         d["wallMs"], d["workerMs"], d["timings"]
     );
     println!("status: {}", d["status"]);
+    let status = d["status"].as_str().unwrap();
+    assert!(status.contains("segment"), "{status}");
+    assert!(
+        status.contains("background from the empty area's recording"),
+        "{status}"
+    );
     let t_s = o.track["t_s"].as_array().unwrap();
     let states = o.track["states"].as_array().unwrap();
     assert_eq!(t_s.len() as u64, rec["snapshots"].as_u64().unwrap());
@@ -438,6 +451,9 @@ fn channel_view_simulate_run_stop_scrub_save() {
         ("p_fa", json!(0.001)),
         ("max_paths", json!(12)),
         ("extent_sigma_m", json!(0.2)),
+        ("statics", json!("background")),
+        ("delay_reference", json!("auto")),
+        ("background_time_s", json!(10)),
         ("calibration", json!("file")),
     ] {
         assert_eq!(s[k], v, "setting {k}: {s}");
@@ -459,4 +475,229 @@ fn channel_view_simulate_run_stop_scrub_save() {
         o.refused
     );
     assert_eq!(o.refused["same"], true);
+}
+
+/// What the two-segment run showed.
+struct Segments {
+    inputs: String,
+    done: Value,
+    track: Value,
+    gap: Value,
+    gap_info: String,
+    last: Value,
+    errors: Vec<String>,
+}
+
+async fn two_segments(
+    c: &Client,
+    port: u16,
+    rec: &str,
+    truth: &str,
+    expected: &Value,
+) -> Result<Segments, String> {
+    open_hash(c, port, "").await?;
+    settle(c).await?;
+    click(c, "mode-channel").await?;
+    settle(c).await?;
+    for (id, path) in [("chan-file", rec), ("chan-truth-file", truth)] {
+        c.find(Locator::Id(id))
+            .await
+            .map_err(|e| e.to_string())?
+            .send_keys(path)
+            .await
+            .map_err(|e| e.to_string())?;
+    }
+    wait_state(c, 60, "files", |s| {
+        s["recording"].is_object() && s["truth"].is_string()
+    })
+    .await?;
+    let inputs = js(
+        c,
+        "return document.getElementById('chan-inputs').textContent",
+    )
+    .await?
+    .as_str()
+    .unwrap_or_default()
+    .to_string();
+    click(c, "chan-run").await?;
+    let done = wait_state(c, 600, "run", |s| {
+        (s["runs"] == 1 || s["statusState"] == "error") && s["running"].is_null()
+    })
+    .await?;
+    let texts = js(c, "return window.channel.texts()").await?;
+    let track: Value = serde_json::from_str(texts["track"].as_str().unwrap_or("null"))
+        .map_err(|e| e.to_string())?;
+    // A snapshot in the first gap (after the first loss).
+    let segs = expected["segments"].as_array().cloned().unwrap_or_default();
+    let k = segs
+        .first()
+        .and_then(|g| g["last"].as_u64())
+        .map_or(0, |l| l + 2);
+    js(c, &format!("window.channel.seek({k})")).await?;
+    settle(c).await?;
+    let gap = state(c).await?;
+    let gap_info = js(c, "return document.getElementById('chan-info').textContent")
+        .await?
+        .as_str()
+        .unwrap_or_default()
+        .to_string();
+    keys(c, "chan-scrub", END).await?;
+    settle(c).await?;
+    let last = state(c).await?;
+    js(
+        c,
+        "document.getElementById('chan-figures').scrollIntoView()",
+    )
+    .await?;
+    if let Ok(png) = c.screenshot().await {
+        let _ = std::fs::write(
+            std::env::temp_dir().join("scatterloc-e2e-channel-segments.png"),
+            png,
+        );
+    }
+    Ok(Segments {
+        inputs,
+        done,
+        track,
+        gap,
+        gap_info,
+        last,
+        errors: console_errors(c).await?,
+    })
+}
+
+#[test]
+#[ignore = "needs chromium + chromedriver and www/pkg (wasm-pack build); run with --ignored"]
+fn channel_view_two_segments_without_calibration() {
+    use super::channel::{check, cli, compare, Diff, TRACK_TOL};
+    let dir = std::env::temp_dir().join(format!(
+        "scatterloc-e2e-channel-segments-{}",
+        std::process::id()
+    ));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let p = |n: &str| dir.join(n).to_string_lossy().into_owned();
+    std::fs::write(p("s.json"), cli(&["preset", "sensors2019"])).unwrap();
+    // Out along y = 4 m to x = 40 m (the area ends at x = 30 m) and back, then up: 23 s at 3 m/s.
+    cli(&[
+        "cir",
+        "simulate",
+        "--scenario",
+        &p("s.json"),
+        "--out-dir",
+        &p("sim"),
+        "--walk",
+        "10,4 40,4 10,4 10,14",
+        "--speed",
+        "3",
+        "--dt",
+        "0.05",
+        "--seed",
+        "1",
+    ]);
+    let (rec, truth) = (p("sim/recording.npz"), p("sim/truth.json"));
+    cli(&[
+        "cir",
+        "track",
+        "--scenario",
+        &p("s.json"),
+        "--cir",
+        &rec,
+        "--truth",
+        &truth,
+        "--out",
+        &p("track.json"),
+    ]);
+    let expected: Value = serde_json::from_slice(&std::fs::read(p("track.json")).unwrap()).unwrap();
+    let segs = expected["segments"].as_array().unwrap().clone();
+    let ends: Vec<&str> = segs.iter().map(|g| g["end"].as_str().unwrap()).collect();
+    println!("the CLI's segments: {ends:?}");
+    assert!(
+        segs.len() >= 2 && ends[0] != "end",
+        "the walk out of the area and back should give two segments, the first lost: {segs:?}"
+    );
+    let o = with_browser(async |c, port, _| two_segments(c, port, &rec, &truth, &expected).await);
+    let _ = std::fs::remove_dir_all(&dir);
+    assert!(o.errors.is_empty(), "console errors: {:?}", o.errors);
+    assert!(
+        o.inputs
+            .contains("the background is learnt from the recording itself"),
+        "{}",
+        o.inputs
+    );
+    // The page's TRACK.json is the CLI's.
+    let mut d = Diff::new(TRACK_TOL);
+    compare("TRACK", &o.track, &expected, &mut d);
+    check("TRACK.json of the walk out and back (page view)", &d);
+    // The status line: where the statics came from, the segments and each loss's reason.
+    let status = o.done["status"].as_str().unwrap();
+    println!("status: {status}");
+    assert!(
+        status.contains("no empty area: background learnt from the recording"),
+        "{status}"
+    );
+    assert!(
+        status.contains(&format!("{} segments: ", segs.len())),
+        "{status}"
+    );
+    let losses: Vec<&Value> = segs.iter().filter(|g| g["end"] != "end").collect();
+    assert_eq!(status.matches("(lost: ").count(), losses.len(), "{status}");
+    assert!(
+        status.contains(&format!("(lost: {})", ends[0].replace('_', " "))),
+        "{status}"
+    );
+    let st = &o.done["statics"];
+    assert_eq!(st["source"], "none", "{st}");
+    assert_eq!(st["statics"], "background", "{st}");
+    // The error chart: each loss a labelled line inside the plot, the gaps shaded, the starts.
+    let marks = &o.done["segmentMarks"];
+    let b = &o.done["errorBox"]["x_px"];
+    let (x0, x1) = (b[0].as_f64().unwrap(), b[1].as_f64().unwrap());
+    let drawn = marks["losses"].as_array().unwrap();
+    assert_eq!(drawn.len(), losses.len(), "{marks}");
+    for (m, g) in drawn.iter().zip(&losses) {
+        let x = m["x"].as_f64().unwrap();
+        assert!(x >= x0 - 0.5 && x <= x1 + 0.5, "loss at {x} outside {b}");
+        assert_eq!(m["end"], g["end"]);
+        assert_eq!(
+            m["label"].as_str().unwrap(),
+            format!("lost: {}", g["end"].as_str().unwrap().replace('_', " "))
+        );
+        // At the snapshot of the loss, the one after the segment's last.
+        let k = g["last"].as_u64().unwrap() as usize + 1;
+        assert_eq!(m["t_s"], expected["t_s"][k]);
+    }
+    let gaps = marks["gaps"].as_array().unwrap();
+    assert!(gaps.len() >= segs.len() - 1, "{marks}");
+    for w in gaps {
+        let (a, z) = (w[0].as_f64().unwrap(), w[1].as_f64().unwrap());
+        assert!(x0 - 0.5 <= a && a < z && z <= x1 + 0.5, "gap {w} in {b}");
+    }
+    assert_eq!(marks["starts"].as_array().unwrap().len(), segs.len());
+    assert_eq!(
+        o.done["segments"].as_array().unwrap().len(),
+        segs.len(),
+        "{}",
+        o.done["segments"]
+    );
+    // In the gap: no estimate, no ellipse, no link, the first segment alone.
+    let g = &o.gap["drawn"];
+    println!("in the gap: {g}; info {}", o.gap_info);
+    assert_eq!(g["estimate"], Value::Null, "{g}");
+    assert_eq!(g["sigma"], Value::Null, "{g}");
+    assert_eq!(g["segment"], Value::Null, "{g}");
+    assert_eq!(g["links"], json!([]), "{g}");
+    assert_eq!(g["track_runs"], 1, "{g}");
+    let first_len = segs[0]["last"].as_u64().unwrap() - segs[0]["first"].as_u64().unwrap() + 1;
+    assert_eq!(g["track_points"].as_u64(), Some(first_len), "{g}");
+    assert!(o.gap_info.contains("lost at"), "{}", o.gap_info);
+    // At the end: every segment, each its own line, together every state.
+    let l = &o.last["drawn"];
+    let states = expected["states"].as_array().unwrap();
+    assert_eq!(l["track_runs"].as_u64(), Some(segs.len() as u64), "{l}");
+    assert_eq!(
+        l["track_points"].as_u64(),
+        Some(states.iter().filter(|x| !x.is_null()).count() as u64),
+        "{l}"
+    );
 }

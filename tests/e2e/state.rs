@@ -228,6 +228,9 @@ const FIELDS: &[&str] = &[
     "channel.p_fa",
     "channel.max_paths",
     "channel.extent_sigma_m",
+    "channel.statics",
+    "channel.delay_reference",
+    "channel.background_time_s",
     "channel.calibration",
     "channel.empty_from_s",
     "channel.empty_to_s",
@@ -320,9 +323,14 @@ async fn set_everything(c: &Client) -> Result<(), String> {
         ("chan-pfa", "0.0001"),
         ("chan-max-paths", "9"),
         ("chan-extent", "0.3"),
+        ("chan-bg-time", "25"),
     ] {
         type_in(c, id, v).await?;
     }
+    // The statics and the delay reference (issue 36).
+    select(c, "chan-statics", "clusters").await?;
+    select(c, "chan-delay-ref", "los").await?;
+    quiet(c).await?;
     select(c, "chan-cal-source", "range").await?;
     quiet(c).await?;
     type_in(c, "chan-empty-from", "0.5").await?;

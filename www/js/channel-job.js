@@ -15,7 +15,9 @@
 //
 // `scenario` is the scenario JSON text; `recording`/`calibration` the .npz files' bytes
 // (Uint8Array or ArrayBuffer; copied to the worker, never transferred, so the caller keeps them);
-// `calibration: null` uses settings.calibration_range_s; `truth` the truth file's text or null.
+// `calibration: null` uses settings.calibration_range_s, or without one a background learnt from
+// the recording itself; `truth` the truth file's text or null; `settings` the core's
+// ChannelRequest as an object (its JSON field names: max_paths, pfa, statics, delay_reference, …).
 // Errors reject with an Error whose message is the core's named message.
 
 import { JobWorker } from './workers.js';

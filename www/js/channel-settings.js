@@ -7,8 +7,18 @@ import { clip, decimal } from './dom.js';
 
 /** The trackers of `cir track --filter`. */
 export const CHANNEL_FILTERS = ['ekf', 'ukf', 'pf'];
-/** Where the static paths come from: a recording of the empty area, or a time range of the recording. */
+/**
+ * Where the empty area comes from: a recording of it ('file'; optional: without one the
+ * background is learnt from the recording itself), or a time range of the recording.
+ */
 export const CALIBRATION_SOURCES = ['file', 'range'];
+/** How static paths are kept from the tracker (the core's StaticMode: `cir … --statics`). */
+export const CHANNEL_STATICS = ['background', 'clusters'];
+/**
+ * Which delays the tracker reads (the core's DelayReference, `--delay-reference`); 'auto' sends
+ * none: the recording's own `synchronized` flag decides (absolute without one).
+ */
+export const DELAY_REFERENCES = ['auto', 'absolute', 'los'];
 /** The playback speeds of the transport's <select>. */
 export const CHANNEL_SPEEDS = [0.25, 0.5, 1, 2, 4];
 
@@ -18,7 +28,9 @@ export const CHANNEL_SPEEDS = [0.25, 0.5, 1, 2, 4];
  * 0 < P_fa < 1, 1 … MAX_PATHS = 64 paths; PROCESS_NOISE: 0 < q ≤ 1e6 m²/s³; pf MAX_PARTICLES
  * = 1000000). Defaults are the command line's (cir.rs: q = 1, EXTENT_SIGMA_M = 0.2 m, EKF,
  * 1000 particles, seed 1; the estimator's 12 paths and P_fa = 10⁻³; the simulator's 1 s of
- * empty area at the start).
+ * empty area at the start; the core's ChannelRequest: statics 'background', the delay
+ * reference of the recording, a background time constant of 10 s within limits::
+ * BACKGROUND_TIME_S = 1e-3 … 1e6 s).
  */
 export const CHANNEL_FIELDS = [
   ['filter', 'choice', 'ekf', { values: CHANNEL_FILTERS }],
@@ -28,6 +40,9 @@ export const CHANNEL_FIELDS = [
   ['p_fa', 'number', 1e-3, { min: 0, max: 1, open: [true, true], allowed: '0 < P_fa < 1' }],
   ['max_paths', 'number', 12, { min: 1, max: 64, integer: true, allowed: 'an integer 1 … 64' }],
   ['extent_sigma_m', 'number', 0.2, { min: 0, max: 1000, allowed: '0 … 1000 m' }],
+  ['statics', 'choice', 'background', { values: CHANNEL_STATICS }],
+  ['delay_reference', 'choice', 'auto', { values: DELAY_REFERENCES }],
+  ['background_time_s', 'number', 10, { min: 1e-3, max: 1e6, allowed: '0.001 … 1000000 s' }],
   ['calibration', 'choice', 'file', { values: CALIBRATION_SOURCES }],
   ['empty_from_s', 'number', 0, { min: 0, max: 1e9, allowed: '0 … 1000000000 s' }],
   ['empty_to_s', 'number', 1, { min: 0, max: 1e9, allowed: '0 … 1000000000 s' }],

@@ -1,19 +1,20 @@
 // Channel-view worker (a module Web Worker, served by worker-loop.js; the page side is
 // channel-job.js on workers.js' JobWorker): simulates recordings and runs the core's channel job
-// (ChannelJob: read the files, estimate the calibration and the recording, calibrate, track, the
+// (ChannelJob: read the files, estimate every link's statics and paths, track in segments, the
 // delay figure) off the page's main thread, in SLICE_MS slices, so progress is reported and Stop
 // drops the job at its next pause.
 //
 // Jobs (besides worker-loop.js' own {type, gen}):
 //   {kind: 'run', scenario: text, recording: Uint8Array | ArrayBuffer (.npz bytes),
-//    calibration: Uint8Array | ArrayBuffer | null (.npz; null: settings.calibration_range_s),
-//    truth: text | null, settings: object (ChannelJob's settings, see src/edge/wasm/channel.rs)}
-//   {kind: 'simulate', scenario: text, settings: object (simulate_channel's settings)}
-// Progress (run only): {type: 'progress', gen, phase ('calibration' | 'estimate' | 'track' |
-//   'figure'), done, total}.
+//    calibration: Uint8Array | ArrayBuffer | null (.npz; null: settings.calibration_range_s,
+//    or without one a background learnt from the recording), truth: text | null, settings:
+//    object (the core's ChannelRequest, see src/edge/wasm/channel/job.rs)}
+//   {kind: 'simulate', scenario: text, settings: object (the core's SimulationRequest)}
+// Progress (run only): {type: 'progress', gen, phase ('estimate' | 'track' | 'figure'), done,
+//   total}.
 // Results:
 //   run:      {type: 'result', gen, ms, kind: 'run', summary: object, timings: {parse_ms,
-//              calibration_ms, estimate_ms, track_ms, figure_ms}, estimates: text (EST.json),
+//              estimate_ms, track_ms, figure_ms}, estimates: text (EST.json),
 //              track: text (TRACK.json), figure: text (the delay figure's data), errors: text
 //              (the error view)}
 //   simulate: {type: 'result', gen, ms, kind: 'simulate', recording: ArrayBuffer, calibration:

@@ -1,13 +1,17 @@
 // The channel view: from channel recordings to a track, in the browser. The user opens or drops
-// a recording (.npz) or simulates a walk through the scenario, adds the empty area (a recording
-// of it, or a time range of the same recording) and optionally the true path (truth.json as the
-// simulator writes it), sets the front end's and the tracker's options (the command line's `cir
-// estimate` / `cir track` options, with its defaults: channel-settings.js) and presses Run: the
-// estimation and tracking run in a Web Worker (channel-job.js) through the core's entry points,
-// with progress and Stop. The result is drawn by the core's chart code (ChannelFigures): the
-// delay figure of the chosen link ([S] Fig. 4) and the error over time, each with the time
-// cursor; the map shows the track up to the cursor, the iso-delay ellipses of the delays used,
-// the links used and the filter's 1σ (channel-draw.js). Files are read here with
+// a recording (.npz) or simulates a walk through the scenario, optionally adds the empty area (a
+// recording of it, or a time range of the same recording; without either the background is
+// learnt from the recording itself) and the true path (truth.json as the simulator writes it),
+// sets the front end's and the tracker's options (the command line's `cir estimate` / `cir
+// track` options, with its defaults: channel-settings.js; the worker hands them to the core as
+// its ChannelRequest) and presses Run: the estimation and tracking run in a Web Worker
+// (channel-job.js) through the core's entry points, with progress and Stop. The track comes in
+// segments (the tracker starts by itself, notices a loss, says why and starts again). The
+// result is drawn by the core's chart code (ChannelFigures): the delay figure of the chosen link
+// ([S] Fig. 4) and the error over time, each with the time cursor; over the error chart this
+// file marks the segments (the gaps shaded, each loss with its reason: channel-draw.js
+// drawSegments); the map shows the segments up to the cursor, the iso-delay ellipses of the
+// delays used, the links used and the filter's 1σ (channel-draw.js). Files are read here with
 // File.arrayBuffer() and go to the worker only: nothing leaves the machine.
 //
 // The state helpers call channelSettings() / applyChannelSettings(obj) (every setting, not the
@@ -15,7 +19,7 @@
 
 import { $, clip, clearError, errorText, fillKeyValues, fitCanvas, fixed, showError } from './dom.js';
 import { ChannelJobs, ChannelStopped } from './channel-job.js';
-import { drawChannel, drawCursor } from './channel-draw.js';
+import { drawChannel, drawCursor, drawSegments, lossName } from './channel-draw.js';
 import { CHANNEL_FIELDS, checkChannelSettings, defaultChannelSettings, parseChannelField } from './channel-settings.js';
 import { slug } from './export.js';
 
@@ -34,14 +38,26 @@ const INPUTS = [
   ['p_fa', 'chan-pfa', 'P_fa'],
   ['max_paths', 'chan-max-paths', 'max paths'],
   ['extent_sigma_m', 'chan-extent', 'extent σ'],
+  ['background_time_s', 'chan-bg-time', 'background τ'],
   ['empty_from_s', 'chan-empty-from', 'empty from'],
   ['empty_to_s', 'chan-empty-to', 'empty to'],
 ];
 /** The panel's choices: [setting key, select id]. */
-const CHOICES = [['filter', 'chan-filter'], ['calibration', 'chan-cal-source'], ['speed', 'chan-speed']];
+const CHOICES = [['filter', 'chan-filter'], ['calibration', 'chan-cal-source'], ['statics', 'chan-statics'],
+  ['delay_reference', 'chan-delay-ref'], ['speed', 'chan-speed']];
 /** The settings a run depends on (a change after a run says so). */
 const RUN_KEYS = ['filter', 'particles', 'seed', 'process_noise', 'p_fa', 'max_paths', 'extent_sigma_m',
-  'calibration', 'empty_from_s', 'empty_to_s'];
+  'statics', 'delay_reference', 'background_time_s', 'calibration', 'empty_from_s', 'empty_to_s'];
+
+/**
+ * The track's segments as the status line names them, e.g. "2 segments: 0.3–16.4 s (lost:
+ * innovation), 17.1–20.0 s" (TRACK.json's `segments`).
+ */
+export function segmentsText(segments) {
+  if (!segments || !segments.length) return 'no segment: the track never started (no fix was confirmed)';
+  const parts = segments.map((g) => `${fixed(g.t_first_s, 1)}–${fixed(g.t_last_s, 1)} s${g.end === 'end' ? '' : ` (lost: ${lossName(g.end)})`}`);
+  return `${segments.length} segment${segments.length === 1 ? '' : 's'}: ${parts.join(', ')}`;
+}
 
 let instance = null;
 
@@ -111,6 +127,7 @@ export class Channel {
     this.drawn = null; // what the map overlay drew last (drawChannel)
     this.delayBox = null; // the delay chart's plot box (cursor), backing pixels
     this.errorBox = null;
+    this.segmentMarks = null; // what drawSegments drew over the error chart
     this.cursorX = { delays: null, errors: null };
     this.overlays = new Map(); // step -> ChannelFigures.overlay(step)
     this.tickFn = (now) => this.tick(now);
@@ -161,6 +178,7 @@ export class Channel {
     $('chan-seed-wrap').hidden = !pf;
     const src = this.s.calibration;
     $('chan-cal-file-wrap').hidden = src !== 'file';
+    $('chan-cal-clear-wrap').hidden = src !== 'file';
     $('chan-empty-from-wrap').hidden = src !== 'range';
     $('chan-empty-to-wrap').hidden = src !== 'range';
     $('chan-filter-label').textContent = this.s.filter.toUpperCase();
@@ -196,6 +214,18 @@ export class Channel {
     $('chan-filter').addEventListener('change', () => {
       this.s = { ...this.s, filter: $('chan-filter').value };
       this.writePanel();
+      this.showStale();
+    });
+    for (const [key, id] of [['statics', 'chan-statics'], ['delay_reference', 'chan-delay-ref']]) {
+      $(id).addEventListener('change', () => {
+        this.s = { ...this.s, [key]: $(id).value };
+        this.showInputs();
+        this.showStale();
+      });
+    }
+    $('chan-cal-clear').addEventListener('click', () => {
+      this.cal = null;
+      this.showInputs();
       this.showStale();
     });
     $('chan-cal-source').addEventListener('change', () => {
@@ -340,12 +370,21 @@ export class Channel {
     const rows = [];
     const sum = (s) => `${s.snapshots} snapshots × ${s.links} links × ${s.samples_per_link} ${s.layout === 'cfr' ? 'frequencies' : 'taps'}, ${fixed(s.duration_s, 2)} s`;
     rows.push(['Recording', this.rec ? `${this.rec.name} · ${sum(this.rec.summary)}` : '—', '']);
-    if (this.s.calibration === 'file') rows.push(['Empty area', this.cal ? `${this.cal.name} · ${sum(this.cal.summary)}` : '— (open its recording)', '']);
+    if (this.s.calibration === 'file') rows.push(['Empty area', this.cal ? `${this.cal.name} · ${sum(this.cal.summary)}` : this.noEmptyText(), '']);
     else rows.push(['Empty area', `${fixed(this.s.empty_from_s, 3)} … ${fixed(this.s.empty_to_s, 3)} s of the recording`, '']);
     rows.push(['Truth', this.truth ? `${this.truth.name} · ${this.truth.data.t_s.length} states` : '— (optional)', '']);
     fillKeyValues($('chan-inputs'), rows);
     $('chan-truth-clear').disabled = !this.truth;
+    $('chan-cal-clear').disabled = !this.cal;
     this.showButtons();
+  }
+
+  /** The read-out of the empty area without its recording (the file is optional). */
+  noEmptyText() {
+    if (this.s.statics === 'clusters') {
+      return 'none — statics "clusters" needs one: open the empty area\'s recording, choose a time range, or use statics "background"';
+    }
+    return `none (optional) — the background is learnt from the recording itself (τ = ${fixed(this.s.background_time_s, 3)} s)`;
   }
 
   showButtons() {
@@ -373,9 +412,12 @@ export class Channel {
     const r = this.result.settings;
     const changed = RUN_KEYS.filter((k) => r[k] !== this.s[k]);
     const truthChanged = (this.truth ? this.truth.text : null) !== this.result.truthText;
+    const calNow = this.s.calibration === 'file' && this.cal ? this.cal.bytes : null;
+    const emptyChanged = this.s.calibration === 'file' && r.calibration === 'file' && calNow !== this.result.calibration;
     const el = $('chan-status');
-    if (changed.length || truthChanged) {
-      el.textContent = `${this.doneText()} · changed since: ${[...changed, ...(truthChanged ? ['truth'] : [])].join(', ')} (press Run)`;
+    if (changed.length || truthChanged || emptyChanged) {
+      const what = [...changed, ...(emptyChanged ? ['empty recording'] : []), ...(truthChanged ? ['truth'] : [])];
+      el.textContent = `${this.doneText()} · changed since: ${what.join(', ')} (press Run)`;
     } else {
       el.textContent = this.doneText();
     }
@@ -383,13 +425,17 @@ export class Channel {
 
   // ---------- jobs ----------
 
-  /** The job's settings (cir estimate / cir track options) from this.s. */
+  /**
+   * The job's settings from this.s: the core's ChannelRequest as JSON (its field names; the
+   * worker's ChannelJob parses it as such and the core checks it).
+   */
   jobSettings() {
     const s = this.s;
     const out = {
       max_paths: s.max_paths, pfa: s.p_fa, filter: s.filter, process_noise: s.process_noise,
-      extent_sigma_m: s.extent_sigma_m,
+      extent_sigma_m: s.extent_sigma_m, statics: s.statics, background_time_s: s.background_time_s,
     };
+    if (s.delay_reference !== 'auto') out.delay_reference = s.delay_reference;
     if (s.filter === 'pf') Object.assign(out, { particles: s.particles, seed: s.seed });
     if (s.calibration === 'range') out.calibration_range_s = [s.empty_from_s, s.empty_to_s];
     return out;
@@ -440,9 +486,6 @@ export class Channel {
         const v = parseChannelField(key, $(id).value, label);
         this.s = checkChannelSettings({ ...this.s, [key]: v });
       }
-      if (this.s.calibration === 'file' && !this.cal) {
-        throw new Error('Empty area: open the recording of the empty area, or choose a time range of this recording');
-      }
       settings = this.jobSettings();
     } catch (e) {
       this.fail(`Run: ${errorText(e)}`);
@@ -451,6 +494,7 @@ export class Channel {
     this.pause();
     const used = { ...this.s };
     const truthText = this.truth ? this.truth.text : null;
+    const calibration = this.s.calibration === 'file' && this.cal ? this.cal.bytes : null;
     const scenario = this.ctx.app.scenario_json();
     const nodes = this.ctx.app.nodes();
     const names = nodes.links.map(([k, l]) => `${nodes.transmitters[k].name} → ${nodes.receivers[l].name}`);
@@ -462,11 +506,11 @@ export class Channel {
     try {
       const r = await this.jobs.start({
         scenario, recording: this.rec.bytes,
-        calibration: this.s.calibration === 'file' ? this.cal.bytes : null,
+        calibration,
         truth: truthText,
       }, settings, (p) => this.onProgress(p));
       this.running = null;
-      this.receive(r, { settings: used, truthText, scenario, names });
+      this.receive(r, { settings: used, truthText, calibration, scenario, names });
     } catch (e) {
       this.running = null;
       this.bar(0, false);
@@ -488,8 +532,8 @@ export class Channel {
 
   onProgress(p) {
     this.progress = p;
-    const names = { calibration: 'Estimating the empty area', estimate: 'Estimating the paths', track: 'Tracking', figure: 'Drawing up the figures' };
-    const share = { calibration: [0, 0.3], estimate: [0.3, 0.95], track: [0.95, 0.98], figure: [0.98, 1] }[p.phase] || [0, 1];
+    const names = { estimate: 'Estimating the statics and paths', track: 'Tracking', figure: 'Drawing up the figures' };
+    const share = { estimate: [0, 0.95], track: [0.95, 0.98], figure: [0.98, 1] }[p.phase] || [0, 1];
     const f = p.total > 0 ? p.done / p.total : 0;
     this.bar(share[0] + f * (share[1] - share[0]), true);
     this.status(`${names[p.phase] || p.phase}… ${p.done} / ${p.total}`, 'running');
@@ -532,18 +576,35 @@ export class Channel {
     this.seek(Math.min(this.step, this.steps() - 1));
   }
 
-  /** The status line of the result shown: the measured times and the error statistics. */
+  /**
+   * The status line of the result shown: the measured times, where the statics came from, the
+   * segments (with each loss's reason) and the error statistics.
+   */
   doneText() {
     const r = this.result;
     if (!r) return '';
     const t = r.timings || {};
     const s = (ms) => `${fixed(ms / 1000, 2)} s`;
-    let text = `Done in ${s(r.wallMs)}: read ${s(t.parse_ms)}, empty area ${s(t.calibration_ms)}, `
-      + `paths ${s(t.estimate_ms)}, track ${s(t.track_ms)}, figures ${s(t.figure_ms)}`;
+    let text = `Done in ${s(r.wallMs)}: read ${s(t.parse_ms)}, statics and paths ${s(t.estimate_ms)}, `
+      + `track ${s(t.track_ms)}, figures ${s(t.figure_ms)} · ${this.staticsText()}`;
+    text += ` · ${segmentsText(r.track.segments)}`;
     const e = r.track.error;
     if (e) text += ` · error median ${fixed(e.median_m, 2)} m, 90 % ${fixed(e.p90_m, 2)} m`;
-    if (!r.track.start) text += ' · the track never started (no snapshot gave a fix)';
     return text;
+  }
+
+  /** Where the result's statics came from and which delays it tracked (ChannelJob.summary()). */
+  staticsText() {
+    const r = this.result;
+    const sum = r.summary || {};
+    const cal = sum.calibration || {};
+    const how = sum.statics === 'clusters' ? 'static clusters' : 'background';
+    let from;
+    if (cal.source === 'file') from = `${how} from the empty area's recording (${cal.snapshots} snapshots)`;
+    else if (cal.source === 'range') from = `${how} from ${fixed(r.settings.empty_from_s, 2)}–${fixed(r.settings.empty_to_s, 2)} s of the recording (${cal.snapshots} snapshots)`;
+    else from = `no empty area: background learnt from the recording (τ = ${fixed(r.settings.background_time_s, 3)} s)`;
+    const delays = sum.delay_reference === 'los' ? 'delays relative to the direct path' : 'absolute delays';
+    return `${from}, ${delays}`;
   }
 
   clearResult() {
@@ -640,14 +701,31 @@ export class Channel {
     const m2 = (p) => (p ? `${fixed(p[0], 3)}, ${fixed(p[1], 3)} m` : '—');
     const truth = this.truthAt(this.step);
     const e = ov.sigma_ellipse;
+    const seg = this.segmentAt(this.step);
     const rows = [
-      [`${(tr.filter || this.result.settings.filter).toUpperCase()} estimate`, ov.state ? m2(ov.state) : 'not started', 'fix'],
+      [`${(tr.filter || this.result.settings.filter).toUpperCase()} estimate`, ov.state ? m2(ov.state) : seg.text, 'fix'],
+      ['Segment', ov.segment === null || ov.segment === undefined ? '—'
+        : `${ov.segment + 1} of ${tr.segments.length} (${fixed(tr.segments[ov.segment].t_first_s, 2)}–${fixed(tr.segments[ov.segment].t_last_s, 2)} s)`, ''],
       ['1σ ellipse', e ? `${fixed(e.a, 3)} × ${fixed(e.b, 3)} m` : '—', 'fix'],
       ['Truth', m2(truth), ''],
       ['Error', ov.error_m === null || ov.error_m === undefined ? '—' : `${fixed(ov.error_m, 3)} m`, 'fix'],
       ['Links used', ov.links.length ? ov.links.map((l) => this.result.names[l.link] || `link ${l.link}`).join(', ') : 'none', ''],
     ];
     fillKeyValues($('chan-info'), rows);
+  }
+
+  /**
+   * What the track is doing at snapshot k outside its segments: {text} ("searching (not started
+   * yet)", "lost at 7.35 s (outside area) · searching", "ended").
+   */
+  segmentAt(k) {
+    const tr = this.result.track;
+    const segs = tr.segments || [];
+    const before = segs.filter((g) => g.last < k);
+    if (!before.length) return { text: segs.length ? 'searching (not started yet)' : 'never started' };
+    const g = before[before.length - 1];
+    const t = tr.t_s[Math.min(g.last + 1, tr.t_s.length - 1)];
+    return { text: g.end === 'end' ? 'ended' : `lost at ${fixed(t, 2)} s (${lossName(g.end)}) · searching` };
   }
 
   /** The true position at snapshot k ([x, y]) when a truth file of the run is at hand. */
@@ -690,12 +768,15 @@ export class Channel {
     }
     this.delayBox = null;
     this.errorBox = null;
+    this.segmentMarks = null;
     if (this.fig && this.active()) {
       try {
         const r = this.result;
         const link = this.s.link;
         this.delayBox = this.fig.draw_link_delays($('chan-delays'), link, 'Delays of one link', '');
         this.errorBox = this.fig.draw_error_time($('chan-errors'), 'Position error over time', '');
+        // The segments over the core's chart (gaps shaded, each loss and its reason).
+        this.segmentMarks = drawSegments($('chan-errors'), this.errorBox, r.track.segments || [], r.track.t_s);
       } catch (e) {
         showError(`Channel figures: ${errorText(e)}`);
         console.error(e);
@@ -784,6 +865,9 @@ export class Channel {
       cursorX: { ...this.cursorX },
       delayBox: this.delayBox,
       errorBox: this.errorBox,
+      segments: r ? (r.track.segments || []).map((g) => ({ first: g.first, last: g.last, t_first_s: g.t_first_s, t_last_s: g.t_last_s, end: g.end })) : null,
+      segmentMarks: this.segmentMarks,
+      statics: r ? { ...r.summary.calibration, statics: r.summary.statics, delay_reference: r.summary.delay_reference } : null,
       links: r ? r.names.slice() : [],
       timings: r ? r.timings : null,
       wallMs: r ? r.wallMs : null,

@@ -38,8 +38,12 @@
 //   window.channel           the channel view (channel.js): state() -> {running, progress, runs,
 //                            stopped, status, statusState, error, recording, calibration, truth,
 //                            steps, step, t_s, playing, drawn (what the map layer drew: {step,
-//                            estimate, sigma, links, truth, track_points}), cursorX, delayBox,
-//                            errorBox, links, timings, wallMs, workerMs, settings}; texts()
+//                            estimate, sigma, links, truth, track_points, track_runs, segment}),
+//                            cursorX, delayBox, errorBox, segments (TRACK.json's: {first, last,
+//                            t_first_s, t_last_s, end}), segmentMarks (drawn over the error
+//                            chart: {gaps, losses: [{x, t_s, end, label}], starts}), statics
+//                            ({source, snapshots, statics, delay_reference} of the result),
+//                            links, timings, wallMs, workerMs, settings}; texts()
 //                            (the result's TRACK.json, EST.json, figure and error texts, or null);
 //                            truthStates() (the truth file's states, or null);
 //                            seek(k); play(); pause(); settings() / applySettings(obj)

@@ -33,7 +33,9 @@ mod scene;
 mod walk;
 
 pub use request::{Simulated, SimulationRequest, DEFAULT_CALIBRATION_DURATION_S};
-pub use scene::{Body, ChannelScene, PointScatterer, Wall, DEFAULT_DT_S, DEFAULT_SUBCARRIERS};
+pub use scene::{
+    Body, ChannelScene, Clock, PointScatterer, Wall, DEFAULT_DT_S, DEFAULT_SUBCARRIERS,
+};
 pub use walk::Walk;
 
 #[cfg(test)]
@@ -47,6 +49,9 @@ const REANCHOR_BINS: usize = 32;
 const STREAM_NOISE: u64 = 0x25_01;
 const STREAM_NOISE_EMPTY: u64 = 0x25_02;
 const STREAM_BODY: u64 = 0x25_03;
+/// rng streams of the receivers' clocks (C10): the walk's and the empty area's.
+const STREAM_CLOCK: u64 = 0x36_01;
+const STREAM_CLOCK_EMPTY: u64 = 0x36_02;
 
 /// What a path of the truth is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -91,6 +96,21 @@ pub struct ChannelTruth {
     pub paths: Vec<Vec<Vec<TruePath>>>,
     /// Per snapshot, per link whether the walker shadows the LoS.
     pub shadowed: Vec<Vec<bool>>,
+    /// Per snapshot, per link what the receiver's clock did (C10; empty for a synchronised
+    /// sounder).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub clock: Vec<Vec<ClockState>>,
+}
+
+/// One snapshot of a link's receiver clock (C10): `H' = g·e^{jφ}·e^{−j2πf_nδ}·e^{jε_n}·H`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct ClockState {
+    /// Timing offset `δ`, s.
+    pub delay_s: f64,
+    /// Carrier phase `φ`, rad.
+    pub phase_rad: f64,
+    /// Gain `|g|`, dB.
+    pub gain_db: f64,
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -392,6 +412,48 @@ fn add_path(h: &mut [Complex], alpha: Complex, tau: Real, f0: Real, df: Real) {
     }
 }
 
+/// The receiver clock `c` on snapshot `s` of one link's response `h` (bins `f0 + n·df`): draws
+/// `δ` and `φ`, steps the AGC gain every `agc_every` snapshots, draws the phase noise, and
+/// applies `g·e^{jφ}·e^{−j2πf_nδ}·e^{jε_n}`. Returns what it applied.
+fn apply_clock(
+    c: &Clock,
+    s: usize,
+    gain_db: &mut Real,
+    r: &mut Rng,
+    h: &mut [Complex],
+    f0: Real,
+    df: Real,
+) -> ClockState {
+    let uniform = |r: &mut Rng| crate::measure::uniform01(r);
+    let delay = if c.timing_offset_s > 0.0 {
+        c.timing_offset_s * (2.0 * uniform(r) - 1.0)
+    } else {
+        0.0
+    };
+    let phase = if c.carrier_phase {
+        2.0 * PI * uniform(r)
+    } else {
+        0.0
+    };
+    if c.agc_step_db > 0.0 && s > 0 && s % c.agc_every == 0 {
+        *gain_db += c.agc_step_db * (2.0 * uniform(r) - 1.0);
+    }
+    let g = sqrt(db_to_linear(*gain_db));
+    for (n, v) in h.iter_mut().enumerate() {
+        let f = f0 + n as Real * df;
+        let mut rot = phase - 2.0 * PI * f * delay;
+        if c.phase_noise_rad > 0.0 {
+            rot += c.phase_noise_rad * standard_normal(r);
+        }
+        *v *= Complex::new(cos(rot), sin(rot)) * g;
+    }
+    ClockState {
+        delay_s: delay,
+        phase_rad: phase,
+        gain_db: *gain_db,
+    }
+}
+
 /// A unit-mean-power circular complex Gaussian draw.
 fn complex_normal(r: &mut Rng) -> Complex {
     let s = core::f64::consts::FRAC_1_SQRT_2;
@@ -491,6 +553,17 @@ fn synthesize(
     let mut body_rng = rng(seed, STREAM_BODY);
     let mut fluct = vec![Complex::new(0.0, 0.0); links.len() * k_centres];
 
+    let clock = scene.clock.as_ref();
+    let mut clock_rng = rng(
+        seed,
+        if with_person {
+            STREAM_CLOCK
+        } else {
+            STREAM_CLOCK_EMPTY
+        },
+    );
+    let mut gain_db = vec![0.0; links.len()];
+    let mut clock_truth: Vec<Vec<ClockState>> = Vec::new();
     let mut t_s = Vec::with_capacity(snapshots);
     let mut states = Vec::new();
     let mut truth_paths = Vec::with_capacity(snapshots);
@@ -575,6 +648,15 @@ fn synthesize(
                     }
                 }
             }
+            if let Some(c) = clock {
+                let st = apply_clock(c, s, &mut gain_db[p], &mut clock_rng, h, f0, df);
+                if p == 0 {
+                    clock_truth.push(Vec::with_capacity(links.len()));
+                }
+                if let Some(row) = clock_truth.last_mut() {
+                    row.push(st);
+                }
+            }
             for tp in &truth {
                 max_power[p] = Real::max(max_power[p], tp.power_w);
             }
@@ -617,13 +699,14 @@ fn synthesize(
         },
         samples,
         noise_var: Some(noise_var),
-        synchronized: None,
+        synchronized: clock.map(|c| !c.free_running()),
     };
     let truth = ChannelTruth {
         t_s,
         states,
         paths: truth_paths,
         shadowed,
+        clock: clock_truth,
     };
     Ok((recording, truth))
 }

@@ -117,6 +117,83 @@ pub struct ChannelScene {
     /// Body–wall double reflections.
     #[serde(default = "default_true")]
     pub double_reflections: bool,
+    /// Receivers without a common clock (C10): per-snapshot timing offsets, carrier phases,
+    /// AGC gain steps and phase noise (`None`: a synchronised sounder).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub clock: Option<Clock>,
+}
+
+/// What a receiver without the transmitter's clock does to each snapshot of a link (C10),
+/// every draw seeded: `H'[n] = g·e^{jφ}·e^{−j2πf_nδ}·e^{jε_n}·H[n]` before the thermal noise.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Clock {
+    /// Timing offset `δ` of each snapshot and link, uniform in `[−x, x]`, s (0: none).
+    pub timing_offset_s: f64,
+    /// A carrier phase `φ` of each snapshot and link, uniform in `[0, 2π)`.
+    pub carrier_phase: bool,
+    /// AGC: every [`Clock::agc_every`] snapshots the link's gain `|g|` steps by a uniform
+    /// `[−x, x]` dB, s (0: a fixed gain of 1).
+    pub agc_step_db: f64,
+    /// Snapshots between AGC steps (≥ 1).
+    pub agc_every: usize,
+    /// Phase noise `ε_n`, independent per bin and snapshot, Gaussian of this σ, rad (0: none).
+    pub phase_noise_rad: f64,
+}
+
+impl Default for Clock {
+    fn default() -> Self {
+        Clock {
+            timing_offset_s: 0.0,
+            carrier_phase: false,
+            agc_step_db: 0.0,
+            agc_every: 1,
+            phase_noise_rad: 0.0,
+        }
+    }
+}
+
+impl Clock {
+    /// Whether it makes delays relative (a timing offset or a carrier phase): the recording is
+    /// then not `synchronized`.
+    pub fn free_running(&self) -> bool {
+        self.timing_offset_s > 0.0 || self.carrier_phase
+    }
+
+    /// Checks the fields (`scene.clock.*`): offset 0 … 1 ms, AGC step 0 … 20 dB, `agc_every`
+    /// ≥ 1, phase noise 0 … π rad.
+    pub fn validate(&self) -> Result<()> {
+        let range = |field: &str, v: f64, hi: f64, allowed| {
+            if v.is_finite() && (0.0..=hi).contains(&v) {
+                Ok(())
+            } else {
+                Err(Error::OutOfRange {
+                    field: field.into(),
+                    value: v,
+                    allowed,
+                })
+            }
+        };
+        range(
+            "scene.clock.timing_offset_s",
+            self.timing_offset_s,
+            1e-3,
+            "0 to 1e-3 s",
+        )?;
+        range(
+            "scene.clock.agc_step_db",
+            self.agc_step_db,
+            20.0,
+            "0 to 20 dB",
+        )?;
+        range(
+            "scene.clock.phase_noise_rad",
+            self.phase_noise_rad,
+            core::f64::consts::PI,
+            "0 to π rad",
+        )?;
+        too_many("scene.clock.agc_every", self.agc_every, 1, usize::MAX)
+    }
 }
 
 fn check_point(field: &str, p: &[f64; 2]) -> Result<()> {
@@ -216,6 +293,9 @@ impl ChannelScene {
         if let Some(d) = self.dynamic_range_db {
             range("scene.dynamic_range_db", d, 0.0, 300.0, "0 to 300 dB")?;
         }
+        if let Some(c) = &self.clock {
+            c.validate()?;
+        }
         Ok(())
     }
 
@@ -258,6 +338,7 @@ impl ChannelScene {
             dynamic_range_db: None,
             second_order: true,
             double_reflections: true,
+            clock: None,
         }
     }
 }

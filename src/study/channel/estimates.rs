@@ -138,13 +138,23 @@ pub struct Prepared {
 }
 
 /// Checks `rec` (and `empty`) ([`Recording::validate`], their links on `model` — the same
-/// links in the same order — and their bands).
+/// links in the same order — and their bands), and that `cfg`'s statics have what they need
+/// (`clusters` an empty area: [`Error::InvalidFile`] of `calibration`).
 pub fn prepare(
     model: &Model,
     bandwidth_hz: Real,
     rec: &Recording,
     empty: Option<&Recording>,
+    cfg: &FrontEndConfig,
 ) -> Result<Prepared> {
+    if cfg.statics == super::StaticMode::Clusters && empty.is_none() {
+        return Err(Error::InvalidFile {
+            field: "calibration".into(),
+            reason: "statics clusters: needs a recording of the empty area (a calibration \
+                     recording, or a time range of the recording)"
+                .into(),
+        });
+    }
     rec.validate()?;
     let map = rec.link_map(model)?;
     let band = Band::of_recording(rec, bandwidth_hz)?;
@@ -280,7 +290,7 @@ pub fn estimate_recording(
     progress: &(dyn Fn(usize) + Sync),
 ) -> Result<(ChannelStatics, RecordingEstimates)> {
     cfg.validate()?;
-    let p = prepare(model, bandwidth_hz, rec, empty)?;
+    let p = prepare(model, bandwidth_hz, rec, empty, cfg)?;
     let mut results = Vec::with_capacity(p.links());
     driver.run(
         p.links(),
@@ -354,7 +364,7 @@ impl EstimationRun {
         cfg: &FrontEndConfig,
     ) -> Result<EstimationRun> {
         cfg.validate()?;
-        let prepared = prepare(model, bandwidth_hz, rec, empty)?;
+        let prepared = prepare(model, bandwidth_hz, rec, empty, cfg)?;
         Ok(EstimationRun {
             results: Vec::with_capacity(prepared.links()),
             prepared,

@@ -133,20 +133,27 @@ fn relative(tau: Real, tau0: Real, base: Real, span: Real) -> Real {
     base + e - span * floor((e + 0.25 * span) / span)
 }
 
-/// The direct path among `paths` (the earliest within [`LOS_WITHIN_DB`] of the strongest).
-fn los_of(paths: &[PathEstimate]) -> Option<&PathEstimate> {
-    let strongest = paths
+/// The direct path among `paths`: of the paths within [`LOS_WITHIN_DB`] of the strongest, the
+/// one furthest before the strongest, cyclically, by less than a quarter of the unambiguous
+/// span `span` (delays are known modulo it: a free-running receiver's direct path may sit just
+/// below the span's end while its echoes wrap to its start).
+fn los_of(paths: &[PathEstimate], span: Real) -> Option<&PathEstimate> {
+    let top = paths
         .iter()
-        .map(|p| p.alpha.norm_sqr())
-        .fold(0.0, Real::max);
+        .max_by(|a, b| a.alpha.norm_sqr().total_cmp(&b.alpha.norm_sqr()))?;
+    let strongest = top.alpha.norm_sqr();
     if !(strongest > 0.0) {
         return None;
     }
-    let floor = strongest * db_to_linear(-LOS_WITHIN_DB);
+    let within = strongest * db_to_linear(-LOS_WITHIN_DB);
+    let before = |p: &PathEstimate| {
+        let d = top.delay_s - p.delay_s;
+        d - span * floor(d / span)
+    };
     paths
         .iter()
-        .filter(|p| p.alpha.norm_sqr() >= floor)
-        .min_by(|a, b| a.delay_s.total_cmp(&b.delay_s))
+        .filter(|p| p.alpha.norm_sqr() >= within && before(p) < 0.25 * span)
+        .max_by(|a, b| before(a).total_cmp(&before(b)))
 }
 
 /// The mean power per bin of `h`.
@@ -190,7 +197,7 @@ impl LinkStatics {
         )?;
         let nv = (single_noise > 0.0).then_some(single_noise);
         let fit = est.estimate(bg.mean(), nv, &[])?;
-        let los = los_of(&fit.paths).map(|p| (p.delay_s, p.sigma_s));
+        let los = los_of(&fit.paths, band.unambiguous_s()).map(|p| (p.delay_s, p.sigma_s));
         let reference = match (cfg.delay_reference, los) {
             (DelayReference::Absolute, _) => Reference::Absolute,
             (DelayReference::Los, Some((tau0, sigma0))) => Reference::Fixed { tau0, sigma0, base },
@@ -487,7 +494,7 @@ fn in_reference(mut e: SnapshotEstimate, reference: Reference, span: Real) -> Sn
             return e;
         }
         Reference::Fixed { tau0, sigma0, base } => (tau0, sigma0, base),
-        Reference::PerSnapshot { base } => match los_of(&e.paths) {
+        Reference::PerSnapshot { base } => match los_of(&e.paths, span) {
             Some(p) => (p.delay_s, p.sigma_s, base),
             None => {
                 e.paths.clear();
@@ -523,6 +530,32 @@ pub fn baselines(model: &crate::measure::Model, rec: &Recording) -> Result<Vec<R
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn path(delay_s: Real, amp: Real) -> PathEstimate {
+        PathEstimate {
+            delay_s,
+            alpha: Complex::new(amp, 0.0),
+            sigma_s: 1e-11,
+            snr: 1e4,
+        }
+    }
+
+    /// The direct path is found cyclically: at 1990 ns of a 2 µs span, before echoes that
+    /// wrapped to 20–60 ns; a weaker earlier path within 20 dB wins, one 30 dB down does not.
+    #[test]
+    fn the_direct_path_is_found_across_the_wrap() {
+        let span = 2e-6;
+        let paths = [
+            path(20e-9, 0.3),
+            path(60e-9, 0.2),
+            path(1990e-9, 1.0),
+            path(1000e-9, 0.5),
+        ];
+        assert_eq!(los_of(&paths, span).unwrap().delay_s, 1990e-9);
+        let paths = [path(100e-9, 1.0), path(90e-9, 0.2), path(80e-9, 0.02)];
+        assert_eq!(los_of(&paths, span).unwrap().delay_s, 90e-9);
+        assert!(los_of(&[], span).is_none());
+    }
 
     #[test]
     fn relative_delays_keep_the_excess_in_the_quarter_span_window() {

@@ -198,23 +198,20 @@ impl ChannelJob {
         })?;
         let rec = read_page_recording("recording", recording, &model)?;
         check_particle_steps(&req, rec.t_s.len()).map_err(err)?;
-        let (empty, empty_source) = match (calibration, req.calibration_range_s) {
-            (Some(bytes), None) => (
-                Some(read_page_recording("calibration", &bytes, &model)?),
-                "file",
-            ),
-            (None, Some([a, b])) => (
-                Some(rec.between("calibration_range_s", a, b).map_err(err)?),
-                "range",
-            ),
-            (Some(_), Some(_)) => {
-                return Err(JsError::new(
-                    "calibration_range_s: give a calibration recording or a time range of the \
-                     recording, not both",
-                ))
-            }
-            (None, None) => (None, "none"),
+        let file = match calibration {
+            Some(bytes) => Some(read_page_recording("calibration", &bytes, &model)?),
+            None => None,
         };
+        // The core's rule: the file, or the range of the recording, or neither.
+        let empty_source = match (&file, req.calibration_range_s) {
+            (Some(_), _) => "file",
+            (None, Some(_)) => "range",
+            (None, None) => "none",
+        };
+        let empty = req
+            .empty_area(file.as_ref(), &rec)
+            .map_err(err)?
+            .map(alloc::borrow::Cow::into_owned);
         let truth = match truth_json {
             Some(text) => {
                 check_size("truth", text.len(), MAX_PAGE_TEXT_BYTES as u64).map_err(err)?;
@@ -227,7 +224,8 @@ impl ChannelJob {
         let bw = scenario.radio.bandwidth_hz;
         // The empty area's own checks first, so its problems are named as its.
         if let Some(e) = &empty {
-            prepare(&model, bw, e, None).map_err(named("calibration"))?;
+            prepare(&model, bw, e, None, &FrontEndConfig::default())
+                .map_err(named("calibration"))?;
         }
         let cfg = req.front_end(rec.synchronized);
         let run =
