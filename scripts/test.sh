@@ -57,6 +57,9 @@ step "full-size spec checks (release): check 10 at the paper step over seeds, ch
 # the release build and run about half of that.
 cargo test --release --test tracking --test mtl -- --ignored pcrlb:: check11:: sim:: 2>&1 | tee -a "$log"
 
+step "channel front end (release): C12 7 on 10⁴ random multipath snapshots, C12 8 on the ray-traced corpus against the reference"
+cargo test --release --test library --test corpus -- --ignored --nocapture c12_ 2>&1 | tee -a "$log"
+
 step "browser end-to-end (Debian chromium + chromedriver; prints the page's own map timing)"
 cargo test --test e2e -- --ignored --nocapture --test-threads=1 2>&1 | tee -a "$log"
 

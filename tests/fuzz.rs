@@ -34,6 +34,9 @@ use scatterloc::{Error, Model};
 mod check;
 #[path = "fuzz/docs.rs"]
 mod docs;
+#[allow(dead_code)]
+#[path = "common/multipath.rs"]
+mod multipath;
 #[path = "fuzz/mutate.rs"]
 mod mutate;
 #[path = "fuzz/parts.rs"]
@@ -1157,4 +1160,31 @@ fn fuzz_cli_output_targets() {
             what: format!("{:?} with {plant:?}, {writers} writer(s)", WRITERS[cmd].0),
         },
     );
+}
+
+// ------------------------------------------------------------------------------- channel responses
+
+/// Spec C12 7 in the fuzz suite: a random multipath response (`common/multipath.rs`: up to 64
+/// paths, spacings down to 0.1/B, amplitudes over 60 dB, noise-free to 0 dB SNR, or a stated
+/// `noise_var` of 1e-40) → the snapshot estimator with `max_paths` 1 … 64: finite paths within
+/// every stated bound of its loops, within the time budget.
+fn run_multipath(seed: u64, max_paths: usize) -> Verdict {
+    let b = multipath::band();
+    let mut est = multipath::estimator(&b, max_paths);
+    match multipath::run(&mut est, &b, seed) {
+        Ok(_) => Ok(Pass::Ok),
+        Err(m) => Err(fail(Class::NonFinite, m)),
+    }
+}
+
+#[test]
+fn fuzz_multipath_responses() {
+    let strategy = (any::<u64>(), 1usize..=64);
+    fuzz(file!(), "multipath", 60, KNOWN, strategy, |(seed, k)| {
+        let desc = format!("multipath seed {seed}, max_paths {k}");
+        Case {
+            verdict: guarded(&desc, || run_multipath(*seed, *k)),
+            what: desc,
+        }
+    });
 }

@@ -1,5 +1,6 @@
 //! The library's API across layers, one module per topic: one test per bad-input class
-//! (`bad_input`), the SIMD CRLB map kernel against its scalar reference (`map_kernel`), the
+//! (`bad_input`), the channel front end's loops within their bounds on random multipath
+//! (`bounds`, spec C12 7), the SIMD CRLB map kernel against its scalar reference (`map_kernel`), the
 //! planner's evidence (`planning`, `filters-and-planning.md` §3) and property tests of the core
 //! (`properties`, proptest; shrunk failures in `library/properties.proptest-regressions`) and the
 //! `.npz` recording format of docs/recording.md (`recording`, feature `npz`).
@@ -9,6 +10,9 @@ mod common;
 
 #[path = "library/bad_input.rs"]
 mod bad_input;
+
+#[path = "library/bounds.rs"]
+mod bounds;
 
 #[path = "library/map_kernel.rs"]
 mod map_kernel;

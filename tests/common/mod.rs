@@ -15,6 +15,7 @@
 #![allow(dead_code)]
 
 pub mod cli;
+pub mod multipath;
 pub mod tracking;
 
 use scatterloc::math::{Real, Vec2};
