@@ -22,6 +22,8 @@ pub use estimate::{
     fisher_matrix, EstimateWork, Estimator, EstimatorConfig, PathEstimate, SnapshotEstimate, Stop,
     MERGE_FRACTION,
 };
+/// The chirp-z delay profile (the delay figure's image, `present::delay_image`).
+pub(crate) use fft::ChirpZ;
 pub use paths::{PathTracker, PathTrackerConfig, TrackedPath};
 pub use recording::{Layout, Pulse, Recording};
 pub use simulate::{

@@ -3,16 +3,17 @@
 //! estimates coloured by amplitude, the static clusters, the true paths, all against time with
 //! delay shown as path length `c·τ`) and the track's position error ([`TrackErrorView`]: the
 //! error over time, its empirical CDF and [`ErrorStats`], \[S\] Figs. 5–6). The only maths here
-//! is the delay profile of C1 ([`delay_image`]) and order statistics; `chart::channel` draws
-//! these views.
+//! is the delay profile of C1 ([`delay_image`], a chirp-z transform per column) and order
+//! statistics; `chart::channel` draws these views.
 
 use alloc::string::String;
 use alloc::vec::Vec;
 
-use crate::channel::DelayEstimate;
+use crate::channel::{ChirpZ, DelayEstimate};
 use crate::error::limits::{DELAY_IMAGE_DR_DB, MAX_DELAY_IMAGE_COLS, MAX_DELAY_IMAGE_ROWS};
 use crate::error::{check_finite, check_len, Error, Result};
-use crate::math::{cos, log10, sin, sqrt, Complex, Real, PI, SPEED_OF_LIGHT};
+use crate::math::{log10, sqrt, Complex, Real, SPEED_OF_LIGHT};
+use crate::study::CirTrackOutput;
 use crate::track::gating::LinkCalibration;
 
 /// The delay profile of one link as an image: `db[j·cols + i]` is the power at range
@@ -92,8 +93,10 @@ fn column_snapshot(i: usize, cols: usize, s: usize) -> usize {
 /// the uniform frequencies `f_n = f_0 + n·Δf` (`freq_hz`), the power
 /// `p(τ) = |Σ_n H[n]·e^{j2πf_nτ}|² / N²` (the C5 periodogram with `P = 1`) at `τ = r/c` on
 /// `cfg.rows` ranges `r` evenly over `cfg.range_m` (cell centres), in dB re 1 W, clipped to the
-/// dynamic range. `|e^{j2πf_0τ}| = 1`, so the sum is evaluated as a polynomial in
-/// `z = e^{j2πΔfτ}` (Horner: one `sin`/`cos` per row, `N` complex multiply-adds per cell).
+/// dynamic range. `|e^{j2πf_0τ}| = 1`, and the rows are a uniform delay grid, so each column is
+/// one chirp-z transform (Bluestein: two FFTs of the power of two `L ≥ N + rows − 1`, `O(L log
+/// L)` instead of `N·rows` multiply-adds; exact up to rounding, within `1e-12·(Σ|H|)²/N²` of the
+/// direct sum, tested; the same bits natively and in wasm).
 /// More snapshots than `cfg.max_cols` are decimated (each column shows the snapshot at the
 /// middle of its share; no averaging). `response(s)` gives snapshot `s`'s `N` samples, `t_s` the
 /// snapshot times (ascending).
@@ -147,15 +150,11 @@ pub fn delay_image<'a>(
     let rows = cfg.rows;
     let dr = (hi - lo) / rows as Real;
     let r0 = lo + 0.5 * dr;
-    // z_j = e^{j2πΔf·τ_j}, one per row.
-    let z: Vec<Complex> = (0..rows)
-        .map(|j| {
-            let phase = 2.0 * PI * df * (r0 + j as Real * dr) / SPEED_OF_LIGHT;
-            Complex::new(cos(phase), sin(phase))
-        })
-        .collect();
+    let plan = ChirpZ::new(n, rows, df, r0 / SPEED_OF_LIGHT, dr / SPEED_OF_LIGHT);
     let norm = (n * n) as Real;
     let mut power = alloc::vec![0.0 as Real; rows * cols];
+    let mut column = alloc::vec![0.0 as Real; rows];
+    let mut work = Vec::with_capacity(plan.len());
     let mut times = Vec::with_capacity(cols);
     for i in 0..cols {
         let k = column_snapshot(i, cols, s);
@@ -168,12 +167,9 @@ pub fn delay_image<'a>(
                 field: alloc::format!("response of snapshot {k}"),
             });
         }
-        for (j, zj) in z.iter().enumerate() {
-            let mut acc = h[n - 1];
-            for hn in h[..n - 1].iter().rev() {
-                acc = acc * zj + hn;
-            }
-            let p = (acc.re * acc.re + acc.im * acc.im) / norm;
+        plan.power(h, &mut work, &mut column);
+        for (j, p) in column.iter().enumerate() {
+            let p = p / norm;
             // A sum of finite samples can still overflow: show it as the largest finite power.
             power[j * cols + i] = if p.is_finite() { p } else { Real::MAX };
         }
@@ -493,6 +489,95 @@ pub struct TrackErrorView {
     pub stats: Option<ErrorStats>,
     /// The first snapshot with a state (`None`: the track never starts).
     pub track_start: Option<usize>,
+    /// The track's segments (C11) in time order (empty: not given, and the figures mark none;
+    /// [`TrackErrorView::with_segments`]).
+    #[serde(default)]
+    pub segments: Vec<SegmentSpan>,
+}
+
+/// One segment of a track as the figures mark it (C11): its snapshots and times, why it ended,
+/// and when and where it was lost.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct SegmentSpan {
+    /// Its first snapshot.
+    pub first: usize,
+    /// Its last snapshot with a state.
+    pub last: usize,
+    /// The time of its first snapshot, s.
+    pub t_first_s: Real,
+    /// The time of its last snapshot, s.
+    pub t_last_s: Real,
+    /// Why it ended: `innovation`, `misses`, `outside_area` or `end` (the recording ended).
+    pub end: String,
+    /// When it was lost: the time of the snapshot after its last (of its last when there is
+    /// none), s (`None`: `end` is `end`).
+    pub lost_s: Option<Real>,
+    /// Where it was lost: its last estimated position, m (`None`: not lost, or no finite
+    /// position).
+    pub lost_m: Option<[Real; 2]>,
+}
+
+impl SegmentSpan {
+    /// Why it ended, in words: `innovation`, `misses`, `outside area`, `end of the recording`.
+    pub fn end_name(&self) -> String {
+        match self.end.as_str() {
+            "end" => "end of the recording".into(),
+            other => other.replace('_', " "),
+        }
+    }
+
+    /// The label of its loss, e.g. `lost: outside area` (`None`: it lasted to the end).
+    pub fn loss_label(&self) -> Option<String> {
+        self.lost_s
+            .map(|_| alloc::format!("lost: {}", self.end_name()))
+    }
+}
+
+impl TrackErrorView {
+    /// The view with the segments of `track` (the track it was made of: its `states` and
+    /// `segments`, C11): the map's track becomes one line per segment (none across a gap, nor
+    /// from one segment into the next), and the figures shade the time outside them and mark
+    /// each start and each loss. Errors: `track` not one entry per time of the view
+    /// (`LengthMismatch`); a segment outside the snapshots, ending before it starts or not after
+    /// the one before (`InvalidFile { field: "segments[i]" }`).
+    pub fn with_segments(mut self, track: &CirTrackOutput) -> Result<TrackErrorView> {
+        let n = self.t_s.len();
+        check_len("track states (one per t_s)", n, track.states.len())?;
+        let segments = &track.segments;
+        let mut next = 0;
+        let mut spans = Vec::with_capacity(segments.len());
+        let mut track_m = Vec::new();
+        for (i, g) in segments.iter().enumerate() {
+            if g.first < next || g.last < g.first || g.last >= n {
+                return Err(Error::InvalidFile {
+                    field: alloc::format!("segments[{i}]"),
+                    reason: alloc::format!(
+                        "snapshots {} … {} are not after the previous segment (from {next}) \
+                         within 0 … {}",
+                        g.first,
+                        g.last,
+                        n.saturating_sub(1)
+                    ),
+                });
+            }
+            next = g.last + 1;
+            let runs = runs(&track.states[g.first..=g.last]);
+            let lost = g.end != "end";
+            spans.push(SegmentSpan {
+                first: g.first,
+                last: g.last,
+                t_first_s: g.t_first_s,
+                t_last_s: g.t_last_s,
+                end: g.end.into(),
+                lost_s: lost.then(|| self.t_s[(g.last + 1).min(n - 1)]),
+                lost_m: runs.last().and_then(|r| r.last()).copied().filter(|_| lost),
+            });
+            track_m.extend(runs);
+        }
+        self.segments = spans;
+        self.track_m = track_m;
+        Ok(self)
+    }
 }
 
 /// Runs of consecutive finite positions.
@@ -513,7 +598,8 @@ fn runs(states: &[Option<[Real; 4]>]) -> Vec<Vec<[Real; 2]>> {
 }
 
 /// The view of a track: `states[s]` the filter's `[x, y, vx, vy]` at `t_s[s]` (`None` before
-/// the track starts), `truth[s]` the true state when known (an empty `truth`: none).
+/// the track starts), `truth[s]` the true state when known (an empty `truth`: none); no
+/// segments ([`TrackErrorView::with_segments`] adds a recording's).
 /// Errors: `states` or a non-empty `truth` not one per time (`LengthMismatch`).
 pub fn track_errors(
     t_s: &[Real],
@@ -548,6 +634,7 @@ pub fn track_errors(
         error_m,
         cdf,
         track_start: states.iter().position(Option::is_some),
+        segments: Vec::new(),
     })
 }
 

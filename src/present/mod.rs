@@ -29,7 +29,7 @@ pub use channel_files::{
 pub use channel_view::{
     delay_image, delay_points, quantile_pct, static_bands, suggest_range_m, track_errors,
     DelayFigure, DelayImage, DelayPoint, ErrorStats, ImageConfig, ImageFloor, LinkDelays,
-    StaticBand, TrackErrorView, TruthCurve,
+    SegmentSpan, StaticBand, TrackErrorView, TruthCurve,
 };
 pub use colormap::{
     colorbar_rgba, fill_rgba, render_rgba, viridis, LogScale, LINK_RGB, UNBOUNDED_RGB,

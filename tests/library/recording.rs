@@ -1,7 +1,8 @@
 //! The `.npz` recording format of docs/recording.md end to end: the documented numpy snippet is
 //! run with Debian's `/usr/bin/python3` (python3-numpy, installed by scripts/setup.sh), both files
-//! it writes (`np.savez` and `np.savez_compressed`) are read with `npz::read_recording`, and the
-//! committed int16 I/Q CIR fixture (scripts/make-recording-fixture.py) is read back value by value.
+//! it writes (`np.savez` and `np.savez_compressed`, with the optional `synchronized` flag) are
+//! read with `npz::read_recording`, and the committed int16 I/Q CIR fixture
+//! (scripts/make-recording-fixture.py) is read back value by value.
 
 use std::path::PathBuf;
 use std::process::Command;
@@ -102,6 +103,8 @@ fn documented_numpy_snippet_writes_a_valid_recording() {
     assert_eq!(a.samples.len(), 100 * 4 * 241);
     assert_eq!(a.t_s[99], 99.0 * 2.048e-3);
     assert_eq!(a.noise_var, Some(vec![1e-14; 4]));
+    // `synchronized=np.bool_(True)`: numpy's bool scalar, read as a common clock.
+    assert_eq!(a.synchronized, Some(true));
     let model = Model::new(&presets::sensors2019()).unwrap();
     assert_eq!(a.link_map(&model).unwrap(), vec![0, 1, 2, 3]);
     let Layout::Cfr {

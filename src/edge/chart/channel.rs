@@ -579,6 +579,18 @@ fn draw_track_map<DB: DrawingBackend>(
         });
     }
     draw_overlay(&mut chart, &overlay, font.nodes)?;
+    // Where each lost segment ended: a red ring.
+    let ring = (6.0 * s).round().max(3.0) as i32;
+    for p in view.segments.iter().filter_map(|g| g.lost_m) {
+        chart
+            .plotting_area()
+            .draw(&Circle::new(
+                (p[0], p[1]),
+                ring,
+                LOST_RGB.stroke_width((2.0 * s).round().max(1.0) as u32),
+            ))
+            .map_err(chart_err)?;
+    }
     draw_nodes(&mut chart, nodes, font.nodes)?;
     if nodes.is_empty() && !overlay.is_empty() {
         series_legend(
@@ -620,6 +632,68 @@ fn curve_chart<'a, DB: DrawingBackend>(
     Ok(chart)
 }
 
+/// Colour of a segment's loss (the map's ring, the error chart's dashed line).
+const LOST_RGB: RGBColor = RGBColor(200, 30, 30);
+
+/// The track's segments (C11) on the error-over-time chart `[t0, t1] × [0, top]`: the time
+/// outside every segment shaded grey (before the first, between two, after one lost at the
+/// end), at each loss a dashed red line labelled with its reason (`lost: innovation`), at each
+/// start a green tick on the time axis. Nothing without segments.
+fn draw_segment_marks<DB: DrawingBackend>(
+    chart: &Chart<'_, DB>,
+    view: &TrackErrorView,
+    t: [Real; 2],
+    top: Real,
+    font: &Fonts,
+    s: f64,
+) -> Result<(), ChartError> {
+    if view.segments.is_empty() {
+        return Ok(());
+    }
+    let plot = chart.plotting_area();
+    let shade = RGBColor(225, 225, 225).mix(0.6).filled();
+    let mut from = t[0];
+    for g in &view.segments {
+        if g.t_first_s > from {
+            plot.draw(&Rectangle::new([(from, 0.0), (g.t_first_s, top)], shade))
+                .map_err(chart_err)?;
+        }
+        from = g.lost_s.unwrap_or(g.t_last_s).max(g.t_last_s);
+    }
+    if view.segments.last().is_some_and(|g| g.lost_s.is_some()) && from < t[1] {
+        plot.draw(&Rectangle::new([(from, 0.0), (t[1], top)], shade))
+            .map_err(chart_err)?;
+    }
+    let width = (1.5 * s).round().max(1.0) as u32;
+    let tick = 0.04 * top;
+    let style = TextStyle::from(("sans-serif", font.ticks * 0.85).into_font())
+        .color(&LOST_RGB)
+        .pos(Pos::new(HPos::Right, VPos::Top));
+    for g in &view.segments {
+        plot.draw(&PathElement::new(
+            [(g.t_first_s, 0.0), (g.t_first_s, tick)],
+            RGBColor(20, 140, 40).stroke_width(2 * width),
+        ))
+        .map_err(chart_err)?;
+        let (Some(at), Some(label)) = (g.lost_s, g.loss_label()) else {
+            continue;
+        };
+        // A dashed line: 12 dashes over the height.
+        let dash = top / 24.0;
+        for k in 0..12 {
+            let y0 = 2.0 * k as Real * dash;
+            plot.draw(&PathElement::new(
+                [(at, y0), (at, y0 + dash)],
+                LOST_RGB.stroke_width(width),
+            ))
+            .map_err(chart_err)?;
+        }
+        plot.draw(&Text::new(label, (at, 0.97 * top), style.clone()))
+            .map_err(chart_err)?;
+    }
+    Ok(())
+}
+
 /// The largest error with room above it, m (1 m without errors).
 fn error_top(view: &TrackErrorView) -> Real {
     view.stats
@@ -651,6 +725,7 @@ fn draw_error_time<DB: DrawingBackend>(
         .iter()
         .zip(&view.error_m)
         .map(|(&t, e)| (t, e.unwrap_or(Real::NAN)));
+    draw_segment_marks(&chart, view, t, error_top(view), font, s)?;
     for part in segments(points, |t, e| t.is_finite() && e.is_finite()) {
         chart
             .plotting_area()

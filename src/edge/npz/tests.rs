@@ -350,3 +350,134 @@ fn a_smaller_cap_refuses_larger_files_and_members() {
         "{got}"
     );
 }
+
+/// The optional scalar `synchronized` (docs/recording.md): written as a numpy bool by
+/// `write_recording` and read back (`true`, `false`, absent); numpy's bool and 0/1 integers of
+/// any width are accepted; any other value, another dtype or a non-scalar is refused by name.
+#[test]
+fn synchronized_is_read_and_written() {
+    for sync in [Some(true), Some(false), None] {
+        for mut rec in [cfr(), cir(true)] {
+            rec.synchronized = sync;
+            let bytes = write_recording(&rec).unwrap();
+            assert_eq!(read_recording(&bytes).unwrap(), rec);
+            let member = members_of(&rec)
+                .into_iter()
+                .find(|(n, _)| n == "synchronized.npy");
+            match sync {
+                // numpy's bool scalar: `|b1`, shape (), one byte 0 or 1.
+                Some(s) => {
+                    let (_, d) = member.expect("synchronized.npy written");
+                    let a = npy::parse("synchronized", d).unwrap();
+                    assert_eq!(a.dtype.name(), "bool");
+                    assert!(a.shape.is_empty());
+                    assert_eq!(a.data, vec![u8::from(s)]);
+                }
+                None => assert!(member.is_none(), "absent when unknown"),
+            }
+        }
+    }
+    let rec = cfr();
+    let read = |descr: &str, shape: &[usize], data: &[u8]| {
+        read_recording(&replace(
+            &rec,
+            "synchronized",
+            Some(npy::write(descr, shape, data)),
+        ))
+        .map(|r| r.synchronized)
+    };
+    // bool, uint8, int8, int16, int32, int64 (both byte orders): 0 and 1.
+    for (descr, size, big) in [
+        ("|b1", 1, false),
+        ("|u1", 1, false),
+        ("|i1", 1, false),
+        ("<i2", 2, false),
+        ("<i4", 4, false),
+        ("<i8", 8, false),
+        (">i8", 8, true),
+    ] {
+        for v in [0u8, 1] {
+            let mut d = vec![0u8; size];
+            d[if big { size - 1 } else { 0 }] = v;
+            assert_eq!(read(descr, &[], &d).unwrap(), Some(v == 1), "{descr} {v}");
+        }
+    }
+    let err = |descr: &str, shape: &[usize], data: &[u8]| {
+        format!("{}", read(descr, shape, data).unwrap_err())
+    };
+    let must = "must be 0 (free-running) or 1 (a common clock)";
+    assert_eq!(
+        err("<i8", &[], &2i64.to_le_bytes()),
+        format!("synchronized: 2: {must}")
+    );
+    assert_eq!(
+        err("|i1", &[], &[0xff]),
+        format!("synchronized: -1: {must}")
+    );
+    assert_eq!(err("|u1", &[], &[2]), format!("synchronized: 2: {must}"));
+    assert_eq!(err("|b1", &[], &[2]), format!("synchronized: 2: {must}"));
+    assert_eq!(
+        err("<f8", &[], &1f64.to_le_bytes()),
+        "synchronized: wrong dtype float64, expected bool or int"
+    );
+    assert_eq!(
+        err("<c16", &[], &[0u8; 16]),
+        "synchronized: wrong dtype complex128, expected bool or int"
+    );
+    // Not a scalar: one per link, or a 1-element vector.
+    assert_eq!(
+        err("|b1", &[4], &[1; 4]),
+        "synchronized: wrong shape (4,), expected a scalar = ()"
+    );
+    assert_eq!(
+        err("|b1", &[1], &[1]),
+        "synchronized: wrong shape (1,), expected a scalar = ()"
+    );
+}
+
+/// A `descr` whose characters after the byte-order mark are several bytes long (`'<é'`: `é`
+/// is two bytes of UTF-8) used to panic slicing the string inside a character; the header
+/// parser compares bytes, so it and every other non-ASCII header is a named error.
+#[test]
+fn a_multi_byte_descr_is_a_named_error() {
+    let rec = cfr();
+    assert_eq!(
+        err(&replace(
+            &rec,
+            "t_s",
+            Some(npy::write("<é", &[3], &[0u8; 24]))
+        )),
+        "t_s: unsupported dtype descr '<é'"
+    );
+    for descr in ["<é8", "é<f8", "<fé", "é", "<f8é", "<\u{1F600}", "\u{1F600}"] {
+        let got = err(&replace(
+            &rec,
+            "t_s",
+            Some(npy::write(descr, &[3], &[0u8; 24])),
+        ));
+        assert!(got.starts_with("t_s: "), "{descr}: {got}");
+        assert!(
+            got.contains("descr") || got.contains("not a .npy"),
+            "{descr}: {got}"
+        );
+    }
+    // Non-ASCII elsewhere in the header: a key, the shape, fortran_order.
+    let header = |h: &str| {
+        let mut b = b"\x93NUMPY\x01\x00".to_vec();
+        let h = format!("{h}\n");
+        b.extend_from_slice(&(h.len() as u16).to_le_bytes());
+        b.extend_from_slice(h.as_bytes());
+        b.extend_from_slice(&[0u8; 24]);
+        b
+    };
+    for h in [
+        "{'déscr': '<f8', 'fortran_order': False, 'shape': (3,), }",
+        "{'descr': '<f8', 'fortran_order': Fålse, 'shape': (3,), }",
+        "{'descr': '<f8', 'fortran_order': False, 'shape': (3é,), }",
+        "{é'descr': '<f8', 'fortran_order': False, 'shape': (3,), }",
+        "{'descr': 'é', 'fortran_order': False, 'shape': (3,), }",
+    ] {
+        let got = err(&replace(&rec, "t_s", Some(header(h))));
+        assert!(got.starts_with("t_s: "), "{h}: {got}");
+    }
+}

@@ -1,4 +1,5 @@
 use super::*;
+use crate::math::{cos, sin, PI};
 use crate::track::gating::StaticCluster;
 
 /// `α·e^{−j2πf_nτ}` (C1 with `P = 1`, no noise) at `n` frequencies centred on 0, spacing `df`.
@@ -60,6 +61,93 @@ fn one_path_peaks_at_its_range_and_power() {
     // (1.5·c/(N·Δf) ≈ 3.73 m) away: the row at 33.75 m.
     let side = img.db[(120 + 15) * 5 + 2] - peak;
     assert!((side + 13.3).abs() < 0.5, "{side}");
+}
+
+/// The image by the direct sum (the Horner evaluation `delay_image` used before the chirp-z
+/// transform): powers per cell, row-major.
+fn direct_powers(f: &[Real], hs: &[Vec<Complex>], range_m: [Real; 2], rows: usize) -> Vec<Real> {
+    let n = f.len();
+    let df = (f[n - 1] - f[0]) / (n - 1) as Real;
+    let dr = (range_m[1] - range_m[0]) / rows as Real;
+    let cols = hs.len();
+    let z: Vec<Complex> = (0..rows)
+        .map(|j| {
+            let phase = 2.0 * PI * df * (range_m[0] + (j as Real + 0.5) * dr) / SPEED_OF_LIGHT;
+            Complex::new(cos(phase), sin(phase))
+        })
+        .collect();
+    let mut out = vec![0.0; rows * cols];
+    for (i, h) in hs.iter().enumerate() {
+        for (j, zj) in z.iter().enumerate() {
+            let mut acc = h[n - 1];
+            for hn in h[..n - 1].iter().rev() {
+                acc = acc * zj + hn;
+            }
+            out[j * cols + i] = acc.norm_sqr() / (n * n) as Real;
+        }
+    }
+    out
+}
+
+/// Four paths 6 to 46 dB above a noise floor, over ranges inside and beyond the unambiguous
+/// range: every value of the image equals the direct sum's, clipped the same way, to 1e-6 dB
+/// within 60 dB of the image's maximum (the chirp-z transform is exact up to rounding), and the
+/// powers to 1e-12 of the largest.
+#[test]
+fn image_equals_the_direct_sum() {
+    let n = 241;
+    let df = 0.5e6;
+    let f: Vec<Real> = (0..n).map(|k| 2.4e9 + k as Real * df).collect();
+    let t: Vec<Real> = (0..7).map(|k| k as Real * 0.1).collect();
+    let hs: Vec<Vec<Complex>> = t
+        .iter()
+        .enumerate()
+        .map(|(s, &ts)| {
+            let mut h = vec![Complex::new(0.0, 0.0); n];
+            for (r, a) in [
+                (12.0, 0.02),
+                (20.3, 0.01),
+                (25.0 + 9.0 * ts, 0.003),
+                (31.7, 1e-4),
+            ] {
+                let (_, p) = one_path(n, df, a, r);
+                h.iter_mut().zip(&p).for_each(|(x, y)| *x += y);
+            }
+            for (k, x) in h.iter_mut().enumerate() {
+                let u = ((k * 7919 + s * 104729) % 1000) as Real / 1000.0 - 0.5;
+                let v = ((k * 6007 + s * 7727) % 1000) as Real / 1000.0 - 0.5;
+                *x += Complex::new(1e-4 * u, 1e-4 * v);
+            }
+            h
+        })
+        .collect();
+    for (range_m, rows, floor) in [
+        ([5.0, 45.0], 300, ImageFloor::Global),
+        ([0.0, 60.0], 37, ImageFloor::Column),
+        ([-700.0, 1300.0], 300, ImageFloor::Global),
+        ([29.0, 29.5], 1, ImageFloor::Global),
+    ] {
+        let mut cfg = ImageConfig::new(range_m);
+        cfg.rows = rows;
+        cfg.floor = floor;
+        cfg.dynamic_range_db = 60.0;
+        let img = delay_image(&f, &t, |s| hs[s].as_slice(), &cfg).unwrap();
+        let direct = direct_powers(&f, &hs, range_m, rows);
+        let top = direct.iter().copied().fold(0.0, Real::max);
+        let want = to_db(direct.clone(), t.clone(), img.r0_m, img.dr_m, rows, &cfg);
+        for (k, (a, b)) in img.db.iter().zip(&want.db).enumerate() {
+            assert!((a - b).abs() < 1e-6, "{range_m:?} cell {k}: {a} vs {b} dB");
+        }
+        assert!((img.db_range[1] - want.db_range[1]).abs() < 1e-6);
+        // The powers themselves (before dB and clipping).
+        let mut again = cfg;
+        again.dynamic_range_db = DELAY_IMAGE_DR_DB.max;
+        let img = delay_image(&f, &t, |s| hs[s].as_slice(), &again).unwrap();
+        for (v, d) in img.db.iter().zip(&direct) {
+            let p = crate::math::db_to_linear(*v);
+            assert!((p - d).abs() <= 1e-12 * top, "{range_m:?}: {p} vs {d}");
+        }
+    }
 }
 
 #[test]
@@ -169,6 +257,105 @@ fn track_errors_before_the_start_and_without_a_start() {
     assert!(no_truth.stats.is_none() && no_truth.truth_m.is_empty());
     assert!(matches!(
         track_errors(&t, &states[..2], &truth),
+        Err(Error::LengthMismatch { .. })
+    ));
+}
+
+/// A track of `states` at `t` with `segments` `(first, last, end)` (the other fields empty).
+fn track_with(
+    t: &[Real],
+    states: &[Option<[Real; 4]>],
+    segments: &[(usize, usize, &'static str)],
+) -> CirTrackOutput {
+    use crate::study::{CirStart, SegmentDoc, TrackStart};
+    let fix = |k: usize| CirStart {
+        snapshot: k,
+        t_s: t.get(k).copied().unwrap_or(Real::NAN),
+        fix: TrackStart {
+            position_m: [0.0; 2],
+            covariance_m2: [[1.0, 0.0], [0.0, 1.0]],
+            termination: "converged",
+            links_used: 4,
+            delays_used_s: Vec::new(),
+            choices: Vec::new(),
+        },
+    };
+    CirTrackOutput {
+        t_s: t.to_vec(),
+        states: states.to_vec(),
+        covariances: vec![None; t.len()],
+        links_used: vec![0; t.len()],
+        delays_used_s: vec![Vec::new(); t.len()],
+        sigmas_used_s: vec![Vec::new(); t.len()],
+        choices: vec![Vec::new(); t.len()],
+        static_removed: vec![Vec::new(); t.len()],
+        start: segments.first().map(|g| fix(g.0)),
+        segments: segments
+            .iter()
+            .map(|&(first, last, end)| SegmentDoc {
+                first,
+                last,
+                t_first_s: t.get(first).copied().unwrap_or(Real::NAN),
+                t_last_s: t.get(last).copied().unwrap_or(Real::NAN),
+                end,
+                confirmed_at: first,
+                hits: 6,
+                start: fix(first),
+            })
+            .collect(),
+    }
+}
+
+/// Two segments (2…6 lost by innovation, 10…19 to the end): the map's track is one line per
+/// segment (none across the gap), the loss is at the snapshot after the first's last, where
+/// its last position was; errors stay as `track_errors` gave them. Overlapping, reversed or
+/// out-of-range segments and a track of another length are named errors.
+#[test]
+fn segments_split_the_track_and_mark_the_loss() {
+    let t: Vec<Real> = (0..20).map(|k| k as Real * 0.5).collect();
+    let truth: Vec<Option<[Real; 4]>> = t.iter().map(|&ts| Some([ts, 0.0, 2.0, 0.0])).collect();
+    let states: Vec<Option<[Real; 4]>> = (0..20)
+        .map(|k| (2..=6).contains(&k) || k >= 10)
+        .zip(&t)
+        .map(|(on, &ts)| on.then_some([ts, 0.3, 2.0, 0.0]))
+        .collect();
+    let plain = track_errors(&t, &states, &truth).unwrap();
+    let track = track_with(&t, &states, &[(2, 6, "innovation"), (10, 19, "end")]);
+    let view = plain.clone().with_segments(&track).unwrap();
+    assert_eq!(view.error_m, plain.error_m);
+    assert_eq!(view.stats, plain.stats);
+    assert_eq!(view.track_m.len(), 2);
+    assert_eq!(view.track_m[0].len(), 5);
+    assert_eq!(view.track_m[1].len(), 10);
+    assert_eq!(view.track_m[0][4], [3.0, 0.3]);
+    let lost = &view.segments[0];
+    assert_eq!((lost.first, lost.last), (2, 6));
+    assert_eq!(lost.lost_s, Some(3.5));
+    assert_eq!(lost.lost_m, Some([3.0, 0.3]));
+    assert_eq!(lost.loss_label().as_deref(), Some("lost: innovation"));
+    let last = &view.segments[1];
+    assert_eq!(
+        (last.lost_s, last.lost_m, last.loss_label()),
+        (None, None, None)
+    );
+    assert_eq!(last.end_name(), "end of the recording");
+    for bad in [
+        vec![(2, 6, "misses"), (5, 19, "end")],
+        vec![(6, 2, "misses")],
+        vec![(2, 20, "end")],
+    ] {
+        let err = plain
+            .clone()
+            .with_segments(&track_with(&t, &states, &bad))
+            .unwrap_err();
+        assert!(
+            matches!(&err, Error::InvalidFile { field, .. } if field.starts_with("segments[")),
+            "{bad:?}: {err:?}"
+        );
+    }
+    let short = track_with(&t[..10], &states[..10], &[]);
+    assert!(matches!(
+        plain.with_segments(&short),
         Err(Error::LengthMismatch { .. })
     ));
 }

@@ -315,7 +315,9 @@ pub fn cir_track(args: &CirTrackArgs) -> Result<(), CliError> {
         .map(|t| t.states.iter().map(|s| Some(*s)).collect())
         .unwrap_or_default();
     let view = track_errors(&track.t_s, &track.states, &truth_states)
-        .map_err(|e| CliError::usage(format!("--truth: {e}")))?;
+        .map_err(|e| CliError::usage(format!("--truth: {e}")))?
+        .with_segments(&track)
+        .map_err(|e| CliError::usage(format!("--cir {}: {e}", args.cir)))?;
     let error = truth.as_ref().and(view.stats);
     let doc = track_doc(&track, &req, &cfg, &statics, &est, error).map_err(|e| flag_error(&e))?;
     let mut files = OutputSet::new();

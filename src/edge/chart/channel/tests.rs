@@ -2,7 +2,8 @@ use super::*;
 use crate::channel::DelayEstimate;
 use crate::math::{cos, sin, Complex, PI, SPEED_OF_LIGHT};
 use crate::present::{
-    delay_image, delay_points, track_errors, DelayPoint, ImageConfig, StaticBand, TruthCurve,
+    delay_image, delay_points, track_errors, DelayPoint, ImageConfig, SegmentSpan, StaticBand,
+    TruthCurve,
 };
 
 /// The SVG of `draw` on a `size` canvas, and the same drawn into an RGB buffer (PNG backend).
@@ -258,4 +259,67 @@ fn track_figure_marks_the_90_percent_point() {
     let bare = track_errors(&t, &states, &[]).unwrap();
     let tx = texts(&draw(&bare));
     assert!(tx.iter().any(|t| t == "no truth") && tx.iter().any(|t| t == "track"));
+}
+
+/// A track lost once (innovation, at 3.5 s) and restarted: the error chart labels the loss,
+/// the map rings where it was lost; a track without segments has neither.
+#[test]
+fn track_figure_marks_losses() {
+    let t: Vec<Real> = (0..20).map(|k| k as Real * 0.5).collect();
+    let truth: Vec<Option<[Real; 4]>> = t.iter().map(|&ts| Some([ts, 2.0, 1.0, 0.0])).collect();
+    let states: Vec<Option<[Real; 4]>> = t
+        .iter()
+        .enumerate()
+        .map(|(k, &ts)| ((2..=6).contains(&k) || k >= 10).then_some([ts, 2.2, 1.0, 0.0]))
+        .collect();
+    let mut view = track_errors(&t, &states, &truth).unwrap();
+    let area = Area {
+        x: [-1.0, 12.0],
+        y: [-2.0, 6.0],
+    };
+    let opts = ChannelChartOptions {
+        title: "Track".into(),
+        subtitle: None,
+    };
+    let draw = |v: &TrackErrorView| {
+        let v = v.clone();
+        let n = nodes();
+        render(
+            track_errors_size(),
+            |r| draw_track_errors(r, &v, &n, &area, &opts),
+            |r| draw_track_errors(r, &v, &n, &area, &opts),
+        )
+    };
+    let before = draw(&view);
+    assert!(!texts(&before).iter().any(|t| t.starts_with("lost")));
+    view.segments = vec![
+        SegmentSpan {
+            first: 2,
+            last: 6,
+            t_first_s: 1.0,
+            t_last_s: 3.0,
+            end: "innovation".into(),
+            lost_s: Some(3.5),
+            lost_m: Some([3.0, 2.2]),
+        },
+        SegmentSpan {
+            first: 10,
+            last: 19,
+            t_first_s: 5.0,
+            t_last_s: 9.5,
+            end: "end".into(),
+            lost_s: None,
+            lost_m: None,
+        },
+    ];
+    let svg = draw(&view);
+    let tx = texts(&svg);
+    assert_eq!(
+        tx.iter().filter(|t| *t == "lost: innovation").count(),
+        1,
+        "{tx:?}"
+    );
+    assert_eq!(count(&svg, "circle"), count(&before, "circle") + 1);
+    // Shading before the first segment and in the gap: two more rectangles.
+    assert_eq!(count(&svg, "rect"), count(&before, "rect") + 2);
 }
