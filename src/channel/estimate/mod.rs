@@ -50,6 +50,7 @@ use crate::channel::{Band, DelayEstimate};
 use crate::error::{limits, Error, Result};
 use crate::math::{cos, db_to_linear, ln, round, sin, sqrt, Complex, Real, PI};
 
+mod kernels;
 mod linalg;
 
 /// Paths closer than this fraction of `1/B` are merged (their joint fit is ill-conditioned).
@@ -223,6 +224,8 @@ pub struct Estimator {
     flat: bool,
     /// `f_n − f_c` (centred for conditioning), Hz.
     fc: Vec<Real>,
+    /// `2π·(f_n − f_c)`, rad/s (the kernels' weights).
+    tw: Vec<Real>,
     /// `|P[n]|²`.
     w: Vec<Real>,
     energy: Real,
@@ -365,7 +368,8 @@ impl Estimator {
         }
         let gamma = ln(cells.len() as Real / cfg.p_fa);
         let fcen = 0.5 * (band.freq_hz[0] + band.freq_hz[n - 1]);
-        let fc = band.freq_hz.iter().map(|f| f - fcen).collect();
+        let fc: Vec<Real> = band.freq_hz.iter().map(|f| f - fcen).collect();
+        let tw = fc.iter().map(|f| 2.0 * PI * f).collect();
         let w = band.response.iter().map(|p| p.norm_sqr()).collect();
         let energy = band.response_energy();
         let flat = band.response.iter().all(|p| *p == Complex::new(1.0, 0.0));
@@ -373,6 +377,7 @@ impl Estimator {
             fft,
             flat,
             fc,
+            tw,
             w,
             energy,
             df,
@@ -676,6 +681,10 @@ impl Estimator {
     /// `c(τ)`, `c'(τ)`, `c''(τ)` of the residual (`c(τ) = Σ P*[n] r[n] e^{j2π(f_n−f_c)τ}`).
     fn moments(&self, tau: Real) -> Moments {
         let ph0 = Phasor::at(self.fc[0], self.df, tau);
+        if self.flat {
+            let (c0, c1, c2) = kernels::moments(&self.resid, &self.tw, ph0.start, ph0.step);
+            return Moments { c0, c1, c2 };
+        }
         let mut ph = ph0.start;
         let (mut c0, mut c1, mut c2) = (
             Complex::new(0.0, 0.0),
@@ -723,10 +732,7 @@ impl Estimator {
         let mut ph = ph0.start.conj() * a;
         let step = ph0.step.conj();
         if self.flat {
-            for r in self.resid.iter_mut() {
-                *r += ph;
-                ph *= step;
-            }
+            kernels::add_rotating(&mut self.resid, ph, step);
         } else {
             for (r, p) in self.resid.iter_mut().zip(&self.band.response) {
                 *r += p * ph;
@@ -739,6 +745,10 @@ impl Estimator {
     /// pass (a path added back before it is re-fitted).
     fn add_back(&mut self, tau: Real, a: Complex) -> Moments {
         let ph0 = Phasor::at(self.fc[0], self.df, tau);
+        if self.flat {
+            let (c0, c1, c2) = kernels::add_back(&mut self.resid, &self.tw, a, ph0.start, ph0.step);
+            return Moments { c0, c1, c2 };
+        }
         let mut ph = ph0.start;
         let (mut c0, mut c1, mut c2) = (
             Complex::new(0.0, 0.0),
