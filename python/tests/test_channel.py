@@ -605,7 +605,7 @@ def check_segments(t, doc: dict) -> None:
         assert prev_last < g["first"] <= g["confirmed_at"] <= g["last"] < S
         assert g["t_first_s"] == doc["t_s"][g["first"]] and g["t_last_s"] == doc["t_s"][g["last"]]
         assert g["start"]["snapshot"] == g["first"]
-        assert g["end"] in ("innovation", "misses", "outside_area", "end")
+        assert g["end"] in ("innovation", "misses", "outside_area", "filter", "end")
         inside[g["first"] : g["last"] + 1] = True
         prev_last = g["last"]
     # Only the last segment can run to the recording's end.

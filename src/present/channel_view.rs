@@ -507,7 +507,8 @@ pub struct SegmentSpan {
     pub t_first_s: Real,
     /// The time of its last snapshot, s.
     pub t_last_s: Real,
-    /// Why it ended: `innovation`, `misses`, `outside_area` or `end` (the recording ended).
+    /// Why it ended: `innovation`, `misses`, `outside_area`, `filter` (a numerical failure of
+    /// the filter) or `end` (the recording ended).
     pub end: String,
     /// When it was lost: the time of the snapshot after its last (of its last when there is
     /// none), s (`None`: `end` is `end`).

@@ -13,7 +13,7 @@ import { C, FULL, clipTo, cross, ellipsePath, linkColor, polyline } from './draw
 const TRUTH = 'rgba(255,255,255,0.9)';
 
 /** The reasons a segment ends (TRACK.json `segments[].end`) as the page names them. */
-const LOSS_NAMES = { innovation: 'innovation', misses: 'misses', outside_area: 'outside area', end: 'end of the recording' };
+const LOSS_NAMES = { innovation: 'innovation', misses: 'misses', outside_area: 'outside area', filter: 'filter failure', end: 'end of the recording' };
 
 /** A segment's `end` as text ("outside area"; an unknown one as written). */
 export function lossName(end) {

@@ -75,7 +75,8 @@ pub struct SegmentDoc {
     pub t_first_s: Real,
     /// The time of its last snapshot, s.
     pub t_last_s: Real,
-    /// Why it ended: `innovation`, `misses`, `outside_area` or `end` (the recording ended).
+    /// Why it ended: `innovation`, `misses`, `outside_area`, `filter` (a numerical failure of
+    /// the filter) or `end` (the recording ended).
     pub end: &'static str,
     /// The snapshot at which its hypothesis was confirmed.
     pub confirmed_at: usize,

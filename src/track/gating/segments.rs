@@ -196,17 +196,32 @@ pub enum EndReason {
     Misses,
     /// The state left the area by more than the margin.
     OutsideArea,
+    /// The filter failed numerically (its covariance stopped being positive definite, or the
+    /// particle filter degenerated): the segment ends where it last had a state, and the
+    /// search starts again.
+    Filter,
     /// The recording ended with the track held.
     End,
 }
 
+/// Whether `e` is a filter's numerical failure (a covariance not positive definite, a
+/// degenerate particle filter) rather than bad input: it ends a segment, it does not fail the
+/// run.
+fn numerical(e: &Error) -> bool {
+    matches!(
+        e,
+        Error::NotPositiveDefinite { .. } | Error::Degenerate { .. }
+    )
+}
+
 impl EndReason {
-    /// The name in `TRACK.json`: `innovation`, `misses`, `outside_area`, `end`.
+    /// The name in `TRACK.json`: `innovation`, `misses`, `outside_area`, `filter`, `end`.
     pub fn name(self) -> &'static str {
         match self {
             EndReason::Innovation => "innovation",
             EndReason::Misses => "misses",
             EndReason::OutsideArea => "outside_area",
+            EndReason::Filter => "filter",
             EndReason::End => "end",
         }
     }
@@ -517,7 +532,15 @@ impl<'a> SegmentTracker<'a> {
             return Ok(SegmentEvent::Searching { hypotheses: 0 });
         };
         held.tracker.set_motion(motion);
-        let step = held.tracker.step(snapshot)?;
+        let step = match held.tracker.step(snapshot) {
+            Ok(step) => step,
+            Err(e) if numerical(&e) => {
+                self.held = None;
+                self.hypotheses.clear();
+                return Ok(SegmentEvent::Lost(EndReason::Filter));
+            }
+            Err(e) => return Err(e),
+        };
         let f = &held.tracker.filter;
         let (state, covariance) = (*f.state(), *f.covariance());
         if !loss {
@@ -594,7 +617,12 @@ impl<'a> SegmentTracker<'a> {
             let mut kept = Vec::with_capacity(self.hypotheses.len());
             for mut h in core::mem::take(&mut self.hypotheses) {
                 h.tracker.set_motion(motion);
-                let s = h.tracker.step(snapshot)?;
+                // A hypothesis whose filter fails numerically is dropped.
+                let s = match h.tracker.step(snapshot) {
+                    Ok(s) => s,
+                    Err(e) if numerical(&e) => continue,
+                    Err(e) => return Err(e),
+                };
                 h.age += 1;
                 if s.summary.links_used >= cfg.min_links {
                     h.hits += 1;
@@ -682,7 +710,15 @@ impl<'a> SegmentTracker<'a> {
             let (tj, snap) = replay(j)?;
             tracker.set_motion(self.motion(tj - t_prev)?);
             t_prev = tj;
-            let s = tracker.step(&snap)?;
+            // A confirmed hypothesis whose filter fails numerically on the way to `k` is
+            // dropped: the search goes on.
+            let s = match tracker.step(&snap) {
+                Ok(s) => s,
+                Err(e) if numerical(&e) => {
+                    return Ok(SegmentEvent::Searching { hypotheses: 0 });
+                }
+                Err(e) => return Err(e),
+            };
             if s.summary.links_used > 0 {
                 if s.summary.links_used >= MISS_LINKS {
                     last_hit_t = tj;

@@ -343,7 +343,7 @@ impl ChannelJob {
     /// newline; `present::track_doc`): `{t_s, states: [[x, y, vx, vy] | null…] (null outside
     /// the segments), covariances, links_used, delays_used_s, sigmas_used_s, choices,
     /// static_removed, start: {…} | null, segments: [{first, last, t_first_s, t_last_s, end:
-    /// "innovation" | "misses" | "outside_area" | "end", confirmed_at, hits, start}…], filter,
+    /// "innovation" | "misses" | "outside_area" | "filter" | "end", confirmed_at, hits, start}…], filter,
     /// process_noise, sigma, association, extent_sigma_m, front_end, calibration, error?:
     /// {count, median_m, p90_m, max_m, rms_m, fraction_below_1m} (with a truth and a started
     /// track)}`. Throws before the `"track"` phase is done.

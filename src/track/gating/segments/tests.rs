@@ -254,3 +254,49 @@ fn settings_errors_are_named() {
     t.step(0, 1.0, &s, &replay).unwrap();
     assert!(t.step(1, 1.0, &s, &replay).is_err());
 }
+
+/// The most extreme valid input a held track can get — at snapshot 40 the echo alone on every
+/// link with σ = 10⁻¹⁵ s (the smallest `DELAY_SIGMA_S` allows), one fifth of a millimetre —
+/// ends the segment there (by `innovation`, or by `filter` had the filter failed numerically:
+/// none of EKF, UKF and PF does on this input, measured), never the run, and the search starts
+/// a new segment after it, for each filter.
+#[test]
+fn an_extreme_update_ends_the_segment_not_the_run() {
+    let w = walk();
+    let mut snaps = snapshots(&w, 90, 11, &truth, &|_| false);
+    for l in snaps[40].iter_mut() {
+        l.truncate(1);
+        l[0].sigma_s = Some(1e-15);
+    }
+    for kind in [
+        FilterKind::Ekf,
+        FilterKind::Ukf(crate::track::UkfParams::default()),
+        FilterKind::Pf(crate::track::PfConfig::default()),
+    ] {
+        let name = kind.name();
+        let mut t =
+            SegmentTracker::searching(SegmentSetup { kind, ..setup(&w) }, rng(1, 0)).unwrap();
+        let replay = |j: usize| Ok((j as Real * DT, snaps[j].clone()));
+        let mut events = Vec::new();
+        for (k, s) in snaps.iter().enumerate() {
+            match t.step(k, k as Real * DT, s, &replay).unwrap() {
+                SegmentEvent::Started { start, .. } => events.push((start.k, "started")),
+                SegmentEvent::Lost(r) => events.push((k, r.name())),
+                _ => {}
+            }
+        }
+        assert!(events.len() >= 3, "{name}: {events:?}");
+        assert!(
+            events[0].1 == "started" && events[0].0 < 15,
+            "{name}: {events:?}"
+        );
+        assert!(
+            events[1].0 == 40 && matches!(events[1].1, "innovation" | "filter"),
+            "{name}: {events:?}"
+        );
+        assert!(
+            events[2].1 == "started" && events[2].0 > 40,
+            "{name}: {events:?}"
+        );
+    }
+}
