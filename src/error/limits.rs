@@ -219,9 +219,10 @@ pub const RANGE_M: Range = Range {
 /// only costs time ([S] resolves fewer than 20 paths per link).
 pub const MAX_PATHS: usize = 64;
 
-/// Most refinement sweeps of the snapshot estimator (C5) after one new path: each sweep moves
-/// every path by one Newton step; they stop earlier once no delay moves by more than 10⁻⁴/B
-/// (two to five sweeps on separated paths). A snapshot that reaches the bound keeps its paths
+/// Most refinement steps of the snapshot estimator (C5) after one new path: a cyclic sweep
+/// (every coupled path by one Newton step) or a joint Gauss–Newton step of up to three coupled
+/// paths; they stop earlier once no delay moves by more than 10⁻³/B or a step gains less than
+/// 0.05 in log-likelihood. A snapshot that reaches the bound keeps its paths
 /// and is counted (`EstimateWork::sweeps_capped`).
 pub const ESTIMATOR_SWEEPS: usize = 6;
 

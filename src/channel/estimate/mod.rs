@@ -170,7 +170,8 @@ pub enum Stop {
 }
 
 impl Stop {
-    /// The name in `EST.json`: `threshold`, `path_budget`, `merged`.
+    /// Its name: `threshold`, `path_budget`, `merged` (EST.json counts the snapshots that
+    /// stopped at a bound in `front_end.bounds`).
     pub fn name(self) -> &'static str {
         match self {
             Stop::Threshold => "threshold",

@@ -1,5 +1,5 @@
-//! Flags of the channel front end `cir simulate|estimate|track` (issue 25; spec
-//! channel-estimation.md, C1–C8).
+//! Flags of the channel front end `cir simulate|estimate|track` (issues 25, 36; spec
+//! channel-estimation.md, C1–C11).
 
 use clap::{Args, Subcommand, ValueEnum};
 
@@ -18,22 +18,25 @@ pub enum CirCommand {
     /// Writes DIR/recording.npz (the walk), DIR/calibration.npz (the empty area), DIR/truth.json
     /// {t_s, states, paths} and DIR/scene.json (the scene used). Prints a JSON summary.
     Simulate(CirSimulateArgs),
-    /// Estimate every snapshot's paths of a recording (C5, C6).
+    /// Estimate every snapshot's paths of a recording (C5, C6, C9, C10).
     ///
-    /// Per link and snapshot: greedy ML with cyclic refinement and a CFAR stop, seeded by the
-    /// link's path tracks. --out EST.json: {t_s, links, estimates [snapshot][link] [{delay_s,
-    /// amplitude, sigma_s, snr_db, track, confirmed}], noise_var}. --snapshots and
-    /// --measurements also write the forms `calibrate --snapshots` and `track --measurements`
-    /// read.
+    /// The static channel is dealt with first (--statics: the empty area's background
+    /// subtracted at the signal level, C9, or its clusters gated, C7); then per link and
+    /// snapshot a bounded greedy ML with refinement and a CFAR stop, seeded by the link's path
+    /// tracks; delays absolute or relative to each link's direct path (--delay-reference, C10).
+    /// --out EST.json: {t_s, links, estimates [snapshot][link] [{delay_s, amplitude, sigma_s,
+    /// snr_db, track, confirmed}], noise_var, front_end (settings, bounds reached, alignment)}.
+    /// --snapshots and --measurements also write the forms `calibrate --snapshots` and `track
+    /// --measurements` read.
     Estimate(CirEstimateArgs),
-    /// Track a person through a recording: estimate, calibrate, gate, associate, filter.
+    /// Track a person through a recording: estimate, gate, start, filter, lose and restart.
     ///
-    /// Estimates both recordings (C5, C6), clusters the calibration recording's estimates in
-    /// (delay, amplitude) (C7), gates every snapshot of the walk (E4), associates (§4), starts
-    /// from the first snapshot whose links give an LM fix (§5) and filters (E7). --out
-    /// TRACK.json: {t_s, states (null before the start), covariances, links_used,
-    /// delays_used_s, sigmas_used_s, choices, static_removed, start, calibration, error (with
-    /// --truth)}.
+    /// Estimates the recording as `cir estimate` does, gates what is left of the static
+    /// channel (E4), associates (§4) and tracks in segments (C11): a start from hypotheses
+    /// confirmed over the following snapshots, a loss on innovations, misses or leaving the
+    /// area, then a new start. --out TRACK.json: {t_s, states (null outside segments),
+    /// covariances, links_used, delays_used_s, sigmas_used_s, choices, static_removed, start,
+    /// segments [{first, last, end, …}], front_end, calibration, error (with --truth)}.
     Track(CirTrackArgs),
 }
 
