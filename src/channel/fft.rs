@@ -203,11 +203,12 @@ impl PaddedFft {
         }
     }
 
-    /// In-place radix-2 decimation in frequency of size `M`, output in bit-reversed order.
+    /// In-place radix-2 decimation in frequency of size `M`, output in bit-reversed order. The
+    /// last two stages, whose twiddles are `1` and `j`, are done without multiplications.
     fn dif(&self, x: &mut [Complex]) {
         let mut span = self.m;
         let mut tw = 0;
-        while span >= 2 {
+        while span >= 8 {
             let half = span / 2;
             let w = &self.twiddles[tw..tw + half];
             for block in x.chunks_exact_mut(span) {
@@ -223,6 +224,27 @@ impl PaddedFft {
             }
             tw += half;
             span = half;
+        }
+        let add = |a: Complex, b: Complex| Complex::new(a.re + b.re, a.im + b.im);
+        let sub = |a: Complex, b: Complex| Complex::new(a.re - b.re, a.im - b.im);
+        if span == 4 {
+            // Twiddles 1 and e^{+jπ/2} = j.
+            for q in x.chunks_exact_mut(4) {
+                let (a0, a1, b0, b1) = (q[0], q[1], q[2], q[3]);
+                let (d0, d1) = (sub(a0, b0), sub(a1, b1));
+                q[0] = add(a0, b0);
+                q[1] = add(a1, b1);
+                q[2] = d0;
+                q[3] = Complex::new(-d1.im, d1.re);
+            }
+            span = 2;
+        }
+        if span == 2 {
+            for q in x.chunks_exact_mut(2) {
+                let (a, b) = (q[0], q[1]);
+                q[0] = add(a, b);
+                q[1] = sub(a, b);
+            }
         }
     }
 }

@@ -211,6 +211,92 @@ pub(super) fn add_back(
     (s0, s1, s2)
 }
 
+/// `Σ r_n·ph_n` with `ph_n = start·stepⁿ` (the correlation `c(τ)` alone).
+pub(super) fn correlation(r: &[Complex], start: Complex, step: Complex) -> Complex {
+    let n = r.len();
+    let (mut ph, step4) = chains(start, step);
+    let mut c0 = C4::ZERO;
+    let full = n / 4 * 4;
+    for rc in r[..full].chunks_exact(4) {
+        let x = C4::load(rc).mul(ph);
+        c0.re += x.re;
+        c0.im += x.im;
+        ph = ph.mul(step4);
+    }
+    let mut s0 = c0.sum();
+    for (l, v) in r[full..].iter().enumerate() {
+        s0 += v * ph.lane(l);
+    }
+    s0
+}
+
+/// Appends `ph·stepⁿ`, `n < count`, to `out`.
+pub(super) fn push_rotating(
+    out: &mut alloc::vec::Vec<Complex>,
+    count: usize,
+    ph: Complex,
+    step: Complex,
+) {
+    let (mut p, step4) = chains(ph, step);
+    let full = count / 4 * 4;
+    for _ in 0..full / 4 {
+        let (re, im) = (p.re.to_array(), p.im.to_array());
+        out.extend((0..4).map(|l| Complex::new(re[l], im[l])));
+        p = p.mul(step4);
+    }
+    out.extend((0..count - full).map(|l| p.lane(l)));
+}
+
+/// `Σ conj(a_n)·y_n` (four partial sums, added in lane order, then the tail).
+pub(super) fn dot_conj(a: &[Complex], y: &[Complex]) -> Complex {
+    let n = a.len().min(y.len());
+    let full = n / 4 * 4;
+    let mut acc = C4::ZERO;
+    for (ac, yc) in a[..full].chunks_exact(4).zip(y[..full].chunks_exact(4)) {
+        let x = C4::load(yc).mul_conj(C4::load(ac));
+        acc.re += x.re;
+        acc.im += x.im;
+    }
+    let mut s = acc.sum();
+    for (u, v) in a[full..n].iter().zip(&y[full..n]) {
+        s += u.conj() * v;
+    }
+    s
+}
+
+/// `Σ |v_n|²` (four partial sums, added in lane order, then the tail).
+pub(super) fn norm_sqr_sum(v: &[Complex]) -> Real {
+    let full = v.len() / 4 * 4;
+    let mut acc = f64x4::ZERO;
+    for c in v[..full].chunks_exact(4) {
+        let x = C4::load(c);
+        acc += x.re * x.re + x.im * x.im;
+    }
+    let a = acc.to_array();
+    let mut s = ((a[0] + a[1]) + a[2]) + a[3];
+    for x in &v[full..] {
+        s += x.norm_sqr();
+    }
+    s
+}
+
+/// `Σ Re(conj(r_n)·d_n)` (four partial sums, added in lane order, then the tail).
+pub(super) fn re_dot_conj(r: &[Complex], d: &[Complex]) -> Real {
+    let n = r.len().min(d.len());
+    let full = n / 4 * 4;
+    let mut acc = f64x4::ZERO;
+    for (rc, dc) in r[..full].chunks_exact(4).zip(d[..full].chunks_exact(4)) {
+        let (x, y) = (C4::load(rc), C4::load(dc));
+        acc += x.re * y.re + x.im * y.im;
+    }
+    let a = acc.to_array();
+    let mut s = ((a[0] + a[1]) + a[2]) + a[3];
+    for (x, y) in r[full..n].iter().zip(&d[full..n]) {
+        s += (x.conj() * y).re;
+    }
+    s
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -281,6 +367,23 @@ mod tests {
                 assert!((y[i] - x[i]).norm() <= 1e-12 * scale, "n {n} bin {i}");
             }
             assert!(close(b0, e0) && close(b1, e1) && close(b2, e2), "n {n}");
+            // correlation, push_rotating, dot_conj, norm_sqr_sum, re_dot_conj
+            assert!(close(correlation(&r, start, step), d0), "n {n}");
+            let mut cols = Vec::new();
+            push_rotating(&mut cols, n, start.conj(), step.conj());
+            assert_eq!(cols.len(), n);
+            for i in 0..n {
+                assert!((cols[i] - ph[i].conj()).norm() <= 1e-12, "n {n} bin {i}");
+            }
+            let dc: Complex = cols.iter().zip(&r).map(|(u, v)| u.conj() * v).sum();
+            assert!(close(dot_conj(&cols, &r), dc), "n {n}");
+            let ns: Real = r.iter().map(|v| v.norm_sqr()).sum();
+            assert!((norm_sqr_sum(&r) - ns).abs() <= 1e-12 * ns, "n {n}");
+            let rd: Real = r.iter().zip(&x).map(|(u, v)| (u.conj() * v).re).sum();
+            assert!(
+                (re_dot_conj(&r, &x) - rd).abs() <= 1e-12 * scale * scale,
+                "n {n}"
+            );
         }
     }
 }

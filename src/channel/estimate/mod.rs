@@ -229,6 +229,9 @@ pub struct Estimator {
     tw: Vec<Real>,
     /// `|P[n]|²`.
     w: Vec<Real>,
+    /// `S_a(0)`, `a` = 0, 1, 2 ([`Estimator::kernels`] at a zero delay difference: every
+    /// diagonal entry of the Gauss–Newton and Fisher matrices), computed once by the same sums.
+    kernels_at_zero: (Complex, Complex, Complex),
     energy: Real,
     df: Real,
     span: Real,
@@ -374,7 +377,7 @@ impl Estimator {
         let w = band.response.iter().map(|p| p.norm_sqr()).collect();
         let energy = band.response_energy();
         let flat = band.response.iter().all(|p| *p == Complex::new(1.0, 0.0));
-        Ok(Estimator {
+        let mut est = Estimator {
             fft,
             flat,
             fc,
@@ -395,7 +398,10 @@ impl Estimator {
             tmp: vec![Complex::new(0.0, 0.0); n],
             band,
             cfg,
-        })
+            kernels_at_zero: Default::default(),
+        };
+        est.kernels_at_zero = (est.kernel(0.0, 0), est.kernel(0.0, 1), est.kernel(0.0, 2));
+        Ok(est)
     }
 
     /// The band.
@@ -713,6 +719,9 @@ impl Estimator {
     /// `c(τ)` of the residual alone.
     fn correlation(&self, tau: Real) -> Complex {
         let ph0 = Phasor::at(self.fc[0], self.df, tau);
+        if self.flat {
+            return kernels::correlation(&self.resid, ph0.start, ph0.step);
+        }
         let mut ph = ph0.start;
         let mut c0 = Complex::new(0.0, 0.0);
         for i in 0..self.resid.len() {
@@ -1032,22 +1041,19 @@ impl Estimator {
         let mut basis = Vec::with_capacity(n * k);
         for &t in taus {
             let ph0 = Phasor::at(self.fc[0], self.df, t);
-            let mut ph = ph0.start.conj();
-            let step = ph0.step.conj();
-            for i in 0..n {
-                basis.push(if self.flat {
-                    ph
-                } else {
-                    self.band.response[i] * ph
-                });
-                ph *= step;
+            let from = basis.len();
+            kernels::push_rotating(&mut basis, n, ph0.start.conj(), ph0.step.conj());
+            if !self.flat {
+                for (v, p) in basis[from..].iter_mut().zip(&self.band.response) {
+                    *v *= p;
+                }
             }
         }
         let mut g = vec![Complex::new(0.0, 0.0); k * k];
         let mut b = vec![Complex::new(0.0, 0.0); k];
         for i in 0..k {
             let ai = &basis[i * n..(i + 1) * n];
-            b[i] = ai.iter().zip(y).map(|(a, v)| a.conj() * v).sum();
+            b[i] = kernels::dot_conj(ai, y);
             g[i * k + i] = Complex::new(self.energy, 0.0);
             for j in i + 1..k {
                 let s = self.gram(taus[j] - taus[i]);
@@ -1063,7 +1069,7 @@ impl Estimator {
                 *r -= v * a;
             }
         }
-        let cost = resid.iter().map(|v| v.norm_sqr()).sum();
+        let cost = kernels::norm_sqr_sum(&resid);
         Projection {
             taus: taus.to_vec(),
             alpha,
@@ -1119,11 +1125,7 @@ impl Estimator {
         }
         for i in 0..k {
             let di = &dr[i * n..(i + 1) * n];
-            grad[i] = 2.0
-                * di.iter()
-                    .zip(&fit.resid)
-                    .map(|(d, r)| (r.conj() * d).re)
-                    .sum::<Real>();
+            grad[i] = 2.0 * kernels::re_dot_conj(&fit.resid, di);
             for j in i..k {
                 // (Bᴴ X)_ij = Σ_m conj(B_mi) X_mj
                 let c: Complex = (0..k).map(|m| bm[m * k + i].conj() * x[m * k + j]).sum();
@@ -1178,6 +1180,9 @@ impl Estimator {
     /// `D' = (N cos Nθ sin θ − sin Nθ cos θ)/sin²θ`, `D'' = (1 − N²)D − 2 cot θ·D'`; the sums
     /// where that cancels (`|Nθ| < 0.1` or `|sin θ| < 10⁻²`; tested against the sums).
     fn kernels(&self, d: Real) -> (Complex, Complex, Complex) {
+        if d == 0.0 {
+            return self.kernels_at_zero;
+        }
         let n = self.band.len() as Real;
         let th = PI * self.df * d;
         let st = sin(th);
