@@ -18,6 +18,7 @@
 //! Run: `cargo bench --bench channel` (shorter: `-- --warm-up-time 1 --measurement-time 3`).
 
 use std::hint::black_box;
+use std::time::Instant;
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use rand::SeedableRng as _;
@@ -28,7 +29,7 @@ use scatterloc::channel::{Band, Estimator, EstimatorConfig, Layout, Recording};
 use scatterloc::error::Cancel;
 use scatterloc::math::{cos, sin, sqrt, Complex, Real, PI};
 use scatterloc::present::{delay_image, ImageConfig};
-use scatterloc::study::{cir_track, estimate_recording, ChannelRequest, Sequential};
+use scatterloc::study::{cir_track, estimate_recording, ChannelRequest, EstimationRun, Sequential};
 use scatterloc::{npz, Model, Scenario};
 
 const B: Real = 120e6;
@@ -128,6 +129,44 @@ fn raytraced(c: &mut Criterion) {
         .unwrap()
     };
     let (statics, est) = estimate();
+    // Per link-snapshot (the issue's median): every unit of the sliced run timed alone, the
+    // first of each link (its statics: the background fit) apart. Best of 5 per unit.
+    let mut per = vec![Real::INFINITY; walk.t_s.len() * walk.link_count()];
+    for _ in 0..5 {
+        let mut run = EstimationRun::new(&model, bw, &walk, Some(&empty), &cfg).unwrap();
+        for t in per.iter_mut().take(run.total()) {
+            let t0 = Instant::now();
+            run.run(&walk, Some(&empty), 1).unwrap();
+            *t = t.min(t0.elapsed().as_secs_f64() * 1e6);
+        }
+    }
+    let s = walk.t_s.len();
+    let mut steps: Vec<Real> = per
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| i % s != 0)
+        .map(|(_, t)| *t)
+        .collect();
+    steps.sort_by(Real::total_cmp);
+    let q = |p: Real| steps[((steps.len() - 1) as Real * p).round() as usize];
+    println!(
+        "raytraced_open per link-snapshot (best of 5, {} units): median {:.1} µs, 90 % {:.1} µs, \
+         max {:.1} µs, mean {:.1} µs",
+        steps.len(),
+        q(0.5),
+        q(0.9),
+        steps[steps.len() - 1],
+        steps.iter().sum::<Real>() / steps.len() as Real
+    );
+    let works: Vec<_> = est.work.iter().flatten().collect();
+    let paths: usize = est.paths.iter().flatten().map(Vec::len).sum();
+    println!(
+        "raytraced_open: {} link-snapshots, {:.2} periodogram passes and {:.2} paths each on \
+         average",
+        works.len(),
+        works.iter().map(|w| w.passes).sum::<usize>() as Real / works.len() as Real,
+        paths as Real / works.len() as Real
+    );
     let mut g = c.benchmark_group("raytraced_open");
     g.sample_size(10);
     g.bench_function("estimate", |b| b.iter(|| black_box(estimate())));
