@@ -849,7 +849,8 @@ impl Estimator {
         // Dirichlet envelope 1/(πBΔ) of its amplitude) is a tenth of the new path's amplitude.
         let coupled = |i: usize, j: usize| {
             let d = (paths[i].0 - paths[j].0).abs();
-            d < near || paths[i].1.norm() >= 0.1 * PI * bw * d * paths[j].1.norm()
+            d < near
+                || sqrt(paths[i].1.norm_sqr()) >= 0.1 * PI * bw * d * sqrt(paths[j].1.norm_sqr())
         };
         let group: Vec<usize> = (0..paths.len())
             .filter(|&i| i >= new || (new..paths.len()).any(|j| coupled(i, j)))
