@@ -186,7 +186,7 @@ pub fn track_measurements_in(req: &TrackRequest, cancel: Cancel) -> Result<Track
                 gate_sigma_s: None,
                 segments: SegmentConfig::default(),
             };
-            let held = SegmentTracker::holding(tracker, setup, 0.0);
+            let held = SegmentTracker::holding(tracker, setup, 0.0).with_interval(m.dt_s);
             gated(held, n, raw, m.dt_s, Every { cancel, every }, &mut out)?
         }
     }

@@ -383,6 +383,9 @@ pub struct SegmentTracker<'a> {
     hypotheses: Vec<Hypothesis<'a>>,
     held: Option<Held<'a>>,
     last_t: Option<Real>,
+    /// A fixed snapshot interval: the motion model's `Δt` exactly, not the difference of two
+    /// times ([`SegmentTracker::with_interval`]).
+    interval: Option<Real>,
     /// The index of the last snapshot seen.
     k: Option<usize>,
 }
@@ -434,6 +437,7 @@ impl<'a> SegmentTracker<'a> {
             hypotheses: Vec::new(),
             held: None,
             last_t: None,
+            interval: None,
             k: None,
         })
     }
@@ -465,8 +469,17 @@ impl<'a> SegmentTracker<'a> {
                 last_hit_t: t0_s,
             }),
             last_t: Some(t0_s),
+            interval: None,
             k: None,
         }
+    }
+
+    /// Snapshots at the fixed interval `dt_s` (a measurement file's `dt_s`): the motion model
+    /// takes `dt_s` itself, so a track equals the plain filter's to the bit (the difference of
+    /// two times `(k + 1)·dt − k·dt` rounds differently). The times must still increase.
+    pub fn with_interval(mut self, dt_s: Real) -> Self {
+        self.interval = Some(dt_s);
+        self
     }
 
     /// Whether a track is held.
@@ -504,7 +517,7 @@ impl<'a> SegmentTracker<'a> {
                         allowed: "after the previous snapshot's time",
                     });
                 }
-                Some(dt)
+                Some(self.interval.unwrap_or(dt))
             }
             None => None,
         };
