@@ -101,6 +101,29 @@ fn chains(start: Complex, step: Complex) -> (C4, C4) {
     )
 }
 
+/// Adds four bins' terms `x`, `j·w·x` and `−w²·x` (`w` the bins' `2π(f_n − f_c)`) to the
+/// moments' partial sums `c0, c1, c2`.
+#[inline(always)]
+fn accumulate(x: C4, w: &[Real], [c0, c1, c2]: [&mut C4; 3]) {
+    let f = f64x4::new([w[0], w[1], w[2], w[3]]);
+    c0.re += x.re;
+    c0.im += x.im;
+    let (xr, xi) = (x.re * f, x.im * f);
+    c1.re -= xi;
+    c1.im += xr;
+    c2.re -= xr * f;
+    c2.im -= xi * f;
+}
+
+/// [`accumulate`] for one bin (the tail past the last multiple of four).
+#[inline(always)]
+fn accumulate_one(x: Complex, w: Real, [s0, s1, s2]: [&mut Complex; 3]) {
+    *s0 += x;
+    let xf = x * w;
+    *s1 += Complex::new(-xf.im, xf.re);
+    *s2 -= xf * w;
+}
+
 /// The moments of the residual `r` at the phasors `ph_n = start·stepⁿ` with angular bin
 /// frequencies `tw[n] = 2π(f_n − f_c)`: `c0 = Σ r_n ph_n`, `c1 = Σ j·tw_n·r_n ph_n` and
 /// `c2 = −Σ tw_n²·r_n ph_n` (`c(τ)`, `c'(τ)`, `c''(τ)` of C5 up to the sign convention of the
@@ -116,25 +139,12 @@ pub(super) fn moments(
     let (mut c0, mut c1, mut c2) = (C4::ZERO, C4::ZERO, C4::ZERO);
     let full = n / 4 * 4;
     for (rc, wc) in r[..full].chunks_exact(4).zip(tw[..full].chunks_exact(4)) {
-        let x = C4::load(rc).mul(ph);
-        let f = f64x4::new([wc[0], wc[1], wc[2], wc[3]]);
-        c0.re += x.re;
-        c0.im += x.im;
-        let (xr, xi) = (x.re * f, x.im * f);
-        c1.re -= xi;
-        c1.im += xr;
-        c2.re -= xr * f;
-        c2.im -= xi * f;
+        accumulate(C4::load(rc).mul(ph), wc, [&mut c0, &mut c1, &mut c2]);
         ph = ph.mul(step4);
     }
     let (mut s0, mut s1, mut s2) = (c0.sum(), c1.sum(), c2.sum());
     for (l, i) in (full..n).enumerate() {
-        let x = r[i] * ph.lane(l);
-        let f = tw[i];
-        s0 += x;
-        let xf = x * f;
-        s1 += Complex::new(-xf.im, xf.re);
-        s2 -= xf * f;
+        accumulate_one(r[i] * ph.lane(l), tw[i], [&mut s0, &mut s1, &mut s2]);
     }
     (s0, s1, s2)
 }
@@ -186,27 +196,14 @@ pub(super) fn add_back(
             im: old.im + pa.im,
         };
         v.store(rc);
-        let x = v.mul(ph);
-        let f = f64x4::new([wc[0], wc[1], wc[2], wc[3]]);
-        c0.re += x.re;
-        c0.im += x.im;
-        let (xr, xi) = (x.re * f, x.im * f);
-        c1.re -= xi;
-        c1.im += xr;
-        c2.re -= xr * f;
-        c2.im -= xi * f;
+        accumulate(v.mul(ph), wc, [&mut c0, &mut c1, &mut c2]);
         ph = ph.mul(step4);
     }
     let (mut s0, mut s1, mut s2) = (c0.sum(), c1.sum(), c2.sum());
     for (l, i) in (full..n).enumerate() {
         let p = ph.lane(l);
         r[i] += a * p.conj();
-        let x = r[i] * p;
-        let f = tw[i];
-        s0 += x;
-        let xf = x * f;
-        s1 += Complex::new(-xf.im, xf.re);
-        s2 -= xf * f;
+        accumulate_one(r[i] * p, tw[i], [&mut s0, &mut s1, &mut s2]);
     }
     (s0, s1, s2)
 }

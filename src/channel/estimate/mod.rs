@@ -860,20 +860,7 @@ impl Estimator {
         let mut moves: Vec<Real> = vec![0.0; paths.len()];
         while !converged && sweeps < CYCLIC_SWEEPS {
             sweeps += 1;
-            let mut gain = 0.0;
-            for &i in &group {
-                let (t, a) = paths[i];
-                let m = self.add_back(t, a);
-                let dt = m.newton_step(max_step);
-                let c2 = m.at(dt);
-                let a2 = c2 / self.energy;
-                let t2 = fold(t + dt, self.win_start, self.span).min(self.win_end);
-                self.add_path(t2, -a2);
-                paths[i] = (t2, a2);
-                moves[i] = dt.abs();
-                // ‖r‖² falls by (|c(τ')|² − |c(τ)|²)/ΣP² when path i moves (its LS amplitude).
-                gain += (c2.norm_sqr() - m.c0.norm_sqr()) / self.energy;
-            }
+            let gain = self.sweep(paths, &group, &mut moves, max_step);
             converged = group.iter().all(|&i| moves[i] < tol)
                 || gain.abs() < gain_tol
                 || self.crowded(paths);
@@ -902,19 +889,7 @@ impl Estimator {
             } else {
                 while !converged && sweeps < limits::ESTIMATOR_SWEEPS {
                     sweeps += 1;
-                    let mut gain = 0.0;
-                    for &i in &group {
-                        let (t, a) = paths[i];
-                        let m = self.add_back(t, a);
-                        let dt = m.newton_step(max_step);
-                        let c2 = m.at(dt);
-                        let a2 = c2 / self.energy;
-                        let t2 = fold(t + dt, self.win_start, self.span).min(self.win_end);
-                        self.add_path(t2, -a2);
-                        paths[i] = (t2, a2);
-                        moves[i] = dt.abs();
-                        gain += (c2.norm_sqr() - m.c0.norm_sqr()) / self.energy;
-                    }
+                    let gain = self.sweep(paths, &group, &mut moves, max_step);
                     converged = group.iter().all(|&i| moves[i] < tol)
                         || gain.abs() < gain_tol
                         || self.crowded(paths);
@@ -942,6 +917,32 @@ impl Estimator {
         if paths.len() < before {
             self.joint_ls(h, paths);
         }
+    }
+
+    /// One cyclic sweep: each path of `group` in turn added back, moved by one Newton step
+    /// (clipped to `max_step`) and taken out again with its least-squares amplitude; `moves[i]`
+    /// its step. Returns the fall of `‖r‖²`: `(|c(τ')|² − |c(τ)|²)/ΣP²` summed over the moves.
+    fn sweep(
+        &mut self,
+        paths: &mut [(Real, Complex)],
+        group: &[usize],
+        moves: &mut [Real],
+        max_step: Real,
+    ) -> Real {
+        let mut gain = 0.0;
+        for &i in group {
+            let (t, a) = paths[i];
+            let m = self.add_back(t, a);
+            let dt = m.newton_step(max_step);
+            let c2 = m.at(dt);
+            let a2 = c2 / self.energy;
+            let t2 = fold(t + dt, self.win_start, self.span).min(self.win_end);
+            self.add_path(t2, -a2);
+            paths[i] = (t2, a2);
+            moves[i] = dt.abs();
+            gain += (c2.norm_sqr() - m.c0.norm_sqr()) / self.energy;
+        }
+        gain
     }
 
     /// Whether two paths are closer than the merge separation.
