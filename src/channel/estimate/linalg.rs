@@ -98,3 +98,33 @@ pub(crate) fn inverse_sym(mut a: Vec<Real>, m: usize) -> Option<Vec<Real>> {
         None
     }
 }
+
+/// The inverse of the symmetric positive (semi)definite `m×m` matrix `a` (row-major) after
+/// Jacobi scaling (`D^{-1/2} a D^{-1/2}`, `D` its diagonal), so that parameters of very
+/// different units (a delay in seconds beside an amplitude) do not fall under
+/// [`inverse_sym`]'s tolerance, which is relative to the largest diagonal entry; `None` if a
+/// diagonal entry is not positive or the scaled matrix is singular.
+pub(crate) fn inverse_spd_scaled(mut a: Vec<Real>, m: usize) -> Option<Vec<Real>> {
+    let s: Vec<Real> = (0..m)
+        .map(|i| {
+            let d = a[i * m + i];
+            if d > 0.0 && d.is_finite() {
+                Some(1.0 / crate::math::sqrt(d))
+            } else {
+                None
+            }
+        })
+        .collect::<Option<Vec<Real>>>()?;
+    for r in 0..m {
+        for c in 0..m {
+            a[r * m + c] *= s[r] * s[c];
+        }
+    }
+    let mut inv = inverse_sym(a, m)?;
+    for r in 0..m {
+        for c in 0..m {
+            inv[r * m + c] *= s[r] * s[c];
+        }
+    }
+    Some(inv)
+}

@@ -53,6 +53,7 @@ use crate::math::{cos, db_to_linear, ln, round, sin, sqrt, Complex, Real, PI};
 mod kernels;
 mod linalg;
 
+
 /// Paths closer than this fraction of `1/B` are merged (their joint fit is ill-conditioned).
 pub const MERGE_FRACTION: Real = 0.25;
 /// Convergence of the refinement sweeps, in units of `1/B`.
@@ -1225,7 +1226,7 @@ impl Estimator {
     fn fisher_sigmas(&self, paths: &[(Real, Complex)], sigma2: Real) -> Vec<Real> {
         let fim = fisher_with(paths, sigma2, |d| self.kernels(d));
         let k = paths.len();
-        match linalg::inverse_sym(fim, 3 * k) {
+        match linalg::inverse_spd_scaled(fim, 3 * k) {
             Some(inv) => (0..k)
                 .map(|i| {
                     let v = inv[(3 * i) * 3 * k + 3 * i];

@@ -528,3 +528,37 @@ fn closed_form_kernels_equal_the_sums() {
         assert!((k2 - e.kernel(d, 2)).norm() <= 1e-9 * m2, "S2 at {d}");
     }
 }
+
+/// The units of a recording do not matter: Wi-Fi CSI comes in raw integer units (amplitudes of
+/// tens to thousands), a sounder in √W (10⁻⁶). Scaling a response and its noise by `s` scales
+/// the amplitudes by `s` and leaves every delay and its σ from the joint Fisher matrix as they
+/// are — which the joint bound of two coupled paths must show (the Fisher matrix mixes
+/// `|α|²·f²` with `1`: unscaled, its inversion's tolerance called amplitudes of order one
+/// singular and fell back to C4).
+#[test]
+fn estimates_do_not_depend_on_the_recording_units() {
+    let b = band();
+    let mut rng = Pcg64::seed_from_u64(11);
+    let paths = [
+        (100e-9, Complex::new(3e-5, 1e-5)),
+        (107e-9, Complex::new(-1e-5, 2e-5)),
+    ];
+    let var = 1e-13;
+    let h = response(&b, &paths, var, &mut rng);
+    let want = joint_bounds(&b, &paths, var);
+    for scale in [1.0, 1e3, 1e6, 1e9] {
+        let hs: Vec<Complex> = h.iter().map(|v| v * scale).collect();
+        let mut est = Estimator::new(b.clone(), EstimatorConfig::default()).unwrap();
+        let e = est.estimate(&hs, Some(var * scale * scale), &[]).unwrap();
+        assert_eq!(e.paths.len(), 2, "scale {scale}: {:?}", e.paths);
+        for (p, w) in e.paths.iter().zip(&want) {
+            // The fitted paths sit within a few σ of the truth: their joint bound is within
+            // a few per cent of the bound at the true parameters.
+            assert!(
+                (p.sigma_s / w - 1.0).abs() < 0.1,
+                "scale {scale}: σ {} s against the joint bound {w} s",
+                p.sigma_s
+            );
+        }
+    }
+}
