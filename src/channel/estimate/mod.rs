@@ -53,7 +53,6 @@ use crate::math::{cos, db_to_linear, ln, round, sin, sqrt, Complex, Real, PI};
 mod kernels;
 mod linalg;
 
-
 /// Paths closer than this fraction of `1/B` are merged (their joint fit is ill-conditioned).
 pub const MERGE_FRACTION: Real = 0.25;
 /// Convergence of the refinement sweeps, in units of `1/B`.
