@@ -335,12 +335,80 @@ fn c12_9_receivers_without_a_common_clock() {
             n >= sync.truth.states.len() * 8 / 10,
             "{n} common snapshots"
         );
-        // MISSED: C12 9 asks for 10 %; measured 1.20, 1.05, 1.48 over the three seeds
-        // (docs/reproduction.md). The alignment fits gain and timing to the whole background,
-        // so the residual is the echo minus its projection on it: where the echo overlaps the
-        // direct path, a copy of the direct path at the echo's level. The same degradation
-        // shows on the synchronised recording run with `delay_reference = los`. Asserted:
-        // within 50 %.
-        assert!(eb <= 1.5 * ea, "seed {seed}: {eb} vs {ea}");
+        // MISSED: C12 9 asks for 10 %; measured 1.18, 0.93, 1.00 over these three seeds, a
+        // median of 1.12 over seeds 1–12 (docs/reproduction.md). The joint alignment
+        // (`LinkBackground::joint_align`) took the median from 1.43; what is left are starts
+        // that differ and episodes where the echo overlaps the direct path. Asserted: within
+        // 30 %.
+        assert!(eb <= 1.3 * ea, "seed {seed}: {eb} vs {ea}");
     }
+}
+
+/// C12 9 over twelve seeds (release; `scripts/test.sh`): the ratio of the free-running RMSE to
+/// the synchronised one per seed, as in [`c12_9_receivers_without_a_common_clock`]. Measured
+/// (2026-12-06): the middle pair 1.08 and 1.17 (median 1.12), 6 of 12 within 10 % (with the
+/// alignment made separately and the paths held fixed: 1.38 and 1.48, 1 of 12). Asserted: the
+/// upper of the middle pair within 20 %.
+#[test]
+#[ignore = "24 simulated recordings through the chain: release, scripts/test.sh"]
+fn c12_9_over_twelve_seeds() {
+    use scatterloc::channel::{ChannelScene, Clock, SimulationRequest};
+    use scatterloc::scenario::presets;
+    let scenario = presets::preset("sensors2019").unwrap();
+    let model = Model::new(&scenario).unwrap();
+    let req = ChannelRequest::default();
+    let mut ratios = Vec::new();
+    for seed in 1u64..=12 {
+        let mut scene = ChannelScene::hangar();
+        scene.duration_s = Some(10.0);
+        scene.dt_s = 0.05;
+        let run = |clock: Option<Clock>| {
+            let mut s = scene.clone();
+            s.clock = clock;
+            let sim = SimulationRequest {
+                scene: Some(s),
+                seed,
+                ..SimulationRequest::default()
+            }
+            .run(&scenario, &model)
+            .unwrap();
+            let cfg = req.front_end(sim.recording.synchronized);
+            let (statics, est) = estimate_recording(
+                &model,
+                scenario.radio.bandwidth_hz,
+                &sim.recording,
+                Some(&sim.calibration),
+                &cfg,
+                &mut Sequential::new(),
+                &|_| {},
+            )
+            .unwrap();
+            let t = cir_track(
+                &req,
+                &model,
+                &scenario.area_m,
+                &statics.calibration,
+                &est,
+                Cancel::NEVER,
+            )
+            .unwrap();
+            (t, sim.truth.states)
+        };
+        let (a, truth) = run(None);
+        let (b, _) = run(Some(Clock {
+            timing_offset_s: 100e-9,
+            carrier_phase: true,
+            ..Clock::default()
+        }));
+        let (ea, eb, _) = paired_rmse(&a, &b, &truth);
+        println!(
+            "C12.9 seed {seed}: synchronised {ea:.3} m, free-running {eb:.3} m, ratio {:.3}",
+            eb / ea
+        );
+        ratios.push(eb / ea);
+    }
+    let within = ratios.iter().filter(|r| **r <= 1.1).count();
+    let median = quantile(&mut ratios, 0.5);
+    println!("C12.9 over 12 seeds: median ratio {median:.3}, {within} of 12 within 10 %");
+    assert!(median <= 1.2, "median {median}");
 }

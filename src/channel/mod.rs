@@ -16,7 +16,9 @@ mod recording;
 mod simulate;
 mod snapshot;
 
-pub use background::{AlignMode, Alignment, LinkBackground, DEFAULT_BACKGROUND_TIME_S};
+pub use background::{
+    AlignMode, Alignment, JointAlignment, LinkBackground, DEFAULT_BACKGROUND_TIME_S,
+};
 pub use band::{Band, ResponseMap};
 pub use estimate::{
     fisher_matrix, EstimateWork, Estimator, EstimatorConfig, PathEstimate, SnapshotEstimate, Stop,

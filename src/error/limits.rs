@@ -230,6 +230,15 @@ pub const ESTIMATOR_SWEEPS: usize = 6;
 /// through the periodogram's peak (quadratic convergence: two or three suffice).
 pub const NEWTON_ITERATIONS: usize = 8;
 
+/// Most Levenberg–Marquardt iterations of a snapshot's joint alignment (C9 step 2 with the
+/// dynamic paths, C10): started from the separate alignment and the first fit, it converges in
+/// three to six; one that reaches the bound keeps its best point.
+pub const JOINT_ALIGN_ITERATIONS: usize = 16;
+
+/// Most dynamic paths refined together with a snapshot's alignment (the strongest first; the
+/// others stay in the residual).
+pub const JOINT_ALIGN_PATHS: usize = 8;
+
 /// The estimator's dynamic range (C5), dB: the noise variance is never taken below the
 /// response's mean bin power this far down. 20 dB is a coarse receiver; 300 dB is beyond the
 /// rounding of float64 samples.

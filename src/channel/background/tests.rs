@@ -253,12 +253,12 @@ fn leak(fc: &[Real], r: &[Complex], nv: Real, paths: &[(Real, Complex)]) -> Real
 
 /// Receivers without a common clock (C10): an offset over ±100 ns and a random complex gain.
 /// The first alignment, made with the echo present, is biased and leaks the static paths into
-/// the residual above the noise (here 1.4–1.5 noise units of excess energy); realigned with the
-/// echo's estimate taken out, the residual without the echo is at the noise level (its energy
+/// the residual above the noise (here 1.4–1.5 noise units of excess energy); aligned jointly
+/// with the echo's estimate, the residual without the echo is at the noise level (its energy
 /// within 10 % of `N·σ_r²`; 25 snapshots of each of 3 seeds), and the echo is at its delay in
 /// the background's time base.
 #[test]
-fn realignment_removes_the_dynamic_bias() {
+fn joint_alignment_removes_the_dynamic_bias() {
     let b = band();
     let st = statics();
     let var = 1e-14;
@@ -304,7 +304,10 @@ fn realignment_removes_the_dynamic_bias() {
                 .into_iter()
                 .collect();
             first += leak(&bg.fc, &r, bg.residual_noise(var, &a), &strongest);
-            let a2 = bg.realign(&h, &strongest, &a).unwrap();
+            let a2 = bg
+                .joint_align(&h, &strongest, &a, limits::JOINT_ALIGN_ITERATIONS)
+                .unwrap()
+                .alignment;
             bg.residual(&h, &a2, &mut r).unwrap();
             let e2 = est
                 .estimate(&r, Some(bg.residual_noise(var, &a2)), &[strongest[0].0])
@@ -325,10 +328,105 @@ fn realignment_removes_the_dynamic_bias() {
         }
         let (first, second) = (first / 25.0, second / 25.0);
         std::println!(
-            "seed {seed}: residual energy / N·σ² first {first:.2}, realigned {second:.3}"
+            "seed {seed}: residual energy / N·σ² first {first:.2}, jointly aligned {second:.3}"
         );
         // The mean over 25 × 241 bins has a standard error of about 1/√6025 = 0.013.
         assert!(first > 1.5, "seed {seed}: {first}");
         assert!((second - 1.0).abs() < 0.1, "seed {seed}: {second}");
     }
+}
+
+/// The case the joint alignment is for: an echo 30 dB below a strong direct path and 0.4/B
+/// from it (a person near the line between transmitter and receiver), an offset over ±100 ns
+/// and a random gain per snapshot. The separate alignment's timing error is the echo's pull;
+/// on 3 seeds × 20 snapshots the joint one's RMS is below a fifth of it (measured: 0.29 ps
+/// against 2.18 ps, 0.65 mm of path length; what is left comes from the paths of the first fit
+/// that are not the echo, which the joint model carries along).
+#[test]
+fn joint_alignment_with_an_echo_on_the_direct_path() {
+    let b = band();
+    let mut st = statics();
+    st[0].1 *= 1000.0; // the direct path at 20 ns, 40 dB above the next static path
+    let echo = (20e-9 + 0.4 / B, st[0].1 * Complex::new(0.0, 0.0316));
+    let mut with = st.clone();
+    with.push(echo);
+    let var = 1e-13;
+    let mut est = Estimator::new(b.clone(), EstimatorConfig::default()).unwrap();
+    let h0 = response(
+        &b,
+        &st,
+        0.0,
+        Complex::new(1.0, 0.0),
+        0.0,
+        &mut Pcg64::seed_from_u64(0),
+    );
+    let mut bg = LinkBackground::new(&b, &h0, 0.0, AlignMode::Coarse).unwrap();
+    let (mut sep, mut joint, mut n) = (0.0, 0.0, 0.0);
+    for seed in [21u64, 22, 23] {
+        let mut rng = Pcg64::seed_from_u64(seed);
+        for _ in 0..20 {
+            let d: Real = Uniform::new(-100e-9, 100e-9).unwrap().sample(&mut rng);
+            let ph: Real = Uniform::new(0.0, 2.0 * PI).unwrap().sample(&mut rng);
+            let g = Complex::new(cos(ph), sin(ph)) * 0.5;
+            let h = response(&b, &with, d, g, var, &mut rng);
+            let a = bg.align(&h).unwrap();
+            let mut r = Vec::new();
+            bg.residual(&h, &a, &mut r).unwrap();
+            let e = est
+                .estimate(&r, Some(bg.residual_noise(var, &a)), &[])
+                .unwrap();
+            let fit: Vec<(Real, Complex)> = e.paths.iter().map(|p| (p.delay_s, p.alpha)).collect();
+            let j = bg
+                .joint_align(&h, &fit, &a, limits::JOINT_ALIGN_ITERATIONS)
+                .unwrap();
+            assert!(j.iterations <= limits::JOINT_ALIGN_ITERATIONS);
+            sep += (a.delay_s - d).powi(2);
+            joint += (j.alignment.delay_s - d).powi(2);
+            n += 1.0;
+        }
+    }
+    let (sep, joint) = (sqrt(sep / n), sqrt(joint / n));
+    std::println!("δ RMS: separate {sep:.3e} s, joint {joint:.3e} s");
+    assert!(joint < 0.2 * sep, "joint {joint} vs separate {sep}");
+}
+
+/// The joint alignment's loop stops at its bound: with one iteration allowed it makes one and
+/// keeps its best point (finite, not worse than the start); with none it returns the start;
+/// without paths, with alignment off or against an empty background it changes nothing.
+#[test]
+fn joint_alignment_stops_at_its_bound() {
+    let b = band();
+    let st = statics();
+    let mut rng = Pcg64::seed_from_u64(5);
+    let h0 = response(&b, &st, 0.0, Complex::new(1.0, 0.0), 0.0, &mut rng);
+    let mut bg = LinkBackground::new(&b, &h0, 0.0, AlignMode::Coarse).unwrap();
+    let mut with = st.clone();
+    with.push((151e-9, Complex::new(3e-6, 0.0)));
+    let h = response(&b, &with, 13e-9, Complex::new(0.8, 0.3), 1e-14, &mut rng);
+    let a = bg.align(&h).unwrap();
+    // A poor starting path: the loop has work to do.
+    let paths = [(150.5e-9, Complex::new(1e-6, 1e-6))];
+    let one = bg.joint_align(&h, &paths, &a, 1).unwrap();
+    assert_eq!(one.iterations, 1);
+    assert!(!one.converged);
+    assert!(one.alignment.delay_s.is_finite() && one.paths.iter().all(|p| p.0.is_finite()));
+    let full = bg
+        .joint_align(&h, &paths, &a, limits::JOINT_ALIGN_ITERATIONS)
+        .unwrap();
+    assert!(full.converged, "{} iterations", full.iterations);
+    assert!(
+        (full.paths[0].0 - 151e-9).abs() < 0.01 / B,
+        "{:?}",
+        full.paths
+    );
+    let zero = bg.joint_align(&h, &paths, &a, 0).unwrap();
+    assert_eq!((zero.iterations, zero.alignment.delay_s), (0, a.delay_s));
+    let none = bg.joint_align(&h, &[], &a, 8).unwrap();
+    assert_eq!((none.iterations, none.alignment), (0, a));
+    let mut off = LinkBackground::new(&b, &h0, 0.0, AlignMode::Off).unwrap();
+    assert_eq!(off.joint_align(&h, &paths, &a, 8).unwrap().iterations, 0);
+    let mut empty =
+        LinkBackground::new(&b, &vec![Complex::new(0.0, 0.0); N], 0.0, AlignMode::Coarse).unwrap();
+    assert_eq!(empty.joint_align(&h, &paths, &a, 8).unwrap().iterations, 0);
+    assert!(bg.joint_align(&h[..5], &paths, &a, 8).is_err());
 }

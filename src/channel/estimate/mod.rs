@@ -52,6 +52,7 @@ use crate::math::{cos, db_to_linear, ln, round, sin, sqrt, Complex, Real, PI};
 
 mod kernels;
 mod linalg;
+pub(crate) use linalg::{inverse_spd_scaled, solve_complex};
 
 /// Paths closer than this fraction of `1/B` are merged (their joint fit is ill-conditioned).
 pub const MERGE_FRACTION: Real = 0.25;

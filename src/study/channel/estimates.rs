@@ -45,7 +45,7 @@ pub struct BoundCounts {
     /// … whose refinement reached its sweep bound without converging.
     pub sweeps: usize,
     /// The most greedy passes of one link-snapshot (bound: `max_paths + 1` per pass, plus
-    /// one per seed tried; twice that when realigned).
+    /// one per seed tried; twice that when aligned).
     pub max_passes: usize,
 }
 

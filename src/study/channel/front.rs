@@ -24,10 +24,11 @@
 //! `[−span/4, 3·span/4)` of the unambiguous span) with `σ² + σ₀²`; a result `≤ 0` is dropped.
 //! A snapshot whose direct path is not found (`clusters`) gives that link no delay.
 //!
-//! **Realignment**: when snapshots are aligned (`los`), the first alignment is made with the
-//! dynamic part present and is biased by it; the residual's paths are taken out, the snapshot
-//! realigned from there ([`LinkBackground::realign`]) and the residual estimated again, seeded
-//! by the first pass.
+//! **Joint alignment**: when snapshots are aligned (`los`), the first alignment is made with
+//! the dynamic part present and leaves the residual as that part minus its projection on the
+//! background; `δ`, `g` and the strongest paths of the first fit are then refined together
+//! ([`LinkBackground::joint_align`]) and the residual estimated again, seeded by the refined
+//! delays.
 
 // `!(x > 0.0)` is meant: a NaN must fail these checks as well.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
@@ -62,7 +63,7 @@ pub struct LinkEstimates {
     pub noise_var: Vec<Real>,
     /// The alignment to the background (`background` mode).
     pub alignment: Vec<Option<Alignment>>,
-    /// What each snapshot's estimation did against its bounds (both passes when realigned).
+    /// What each snapshot's estimation did against its bounds (both passes when aligned).
     pub work: Vec<EstimateWork>,
 }
 
@@ -442,9 +443,10 @@ impl LinkFront {
                         let fit: Vec<(Real, Complex)> =
                             e.paths.iter().map(|p| (p.delay_s, p.alpha)).collect();
                         let first = e.work;
-                        a = bg.realign(h, &fit, &a)?;
+                        let joint = bg.joint_align(h, &fit, &a, limits::JOINT_ALIGN_ITERATIONS)?;
+                        a = joint.alignment;
                         bg.residual(h, &a, r)?;
-                        let seeds: Vec<Real> = fit.iter().map(|f| f.0).collect();
+                        let seeds: Vec<Real> = joint.paths.iter().map(|f| f.0).collect();
                         let nvr = nv.map(|v| bg.residual_noise(v, &a));
                         e = estimator.estimate_floored(r, nvr, &seeds, power)?;
                         e.work = merge_work(first, e.work);
@@ -475,7 +477,7 @@ impl LinkFront {
     }
 }
 
-/// Both passes of a realigned snapshot.
+/// Both passes of an aligned snapshot.
 fn merge_work(a: EstimateWork, b: EstimateWork) -> EstimateWork {
     EstimateWork {
         passes: a.passes + b.passes,
