@@ -288,11 +288,11 @@ impl LinkBackground {
         let mut d = a.delay_s;
         let mut taus: Vec<Real> = ps.iter().map(|p| p.0).collect();
         // The linear parameters (g, β) by least squares at the starting delays.
-        let Some(lin) = self.linear_fit(h, d, &taus) else {
+        let Some(mut lin) = self.linear_fit(h, d, &taus) else {
             return Ok(unchanged);
         };
-        let mut lin = lin;
         let mut model = vec![Complex::new(0.0, 0.0); n];
+        let mut trial = vec![Complex::new(0.0, 0.0); n];
         let mut cost = self.joint_cost(h, d, &taus, &lin, &mut model);
         // Parameters: δ, τ_1..τ_k, Re g, Im g, Re β_1, Im β_1, …
         let m = 3 + 3 * k;
@@ -307,13 +307,7 @@ impl LinkBackground {
             iterations += 1;
             // Columns (order δ, τ_1..τ_k, Re g, Im g, Re β_i, Im β_i …) at the current point;
             // `model` holds the model there.
-            let s0 = cis(-tp * self.fc[0] * d);
-            let ds = cis(-tp * self.df * d);
-            let mut phs: Vec<(Complex, Complex)> = taus
-                .iter()
-                .map(|&t| (cis(-tp * self.fc[0] * t), cis(-tp * self.df * t)))
-                .collect();
-            let mut sh = s0;
+            let (mut sh, ds, mut phs) = self.phasors(d, &taus);
             for i in 0..n {
                 let f = self.fc[i];
                 let w = Complex::new(0.0, -tp * f);
@@ -368,14 +362,13 @@ impl LinkBackground {
                 for q in 0..k {
                     ll[1 + q] += Complex::new(step[3 + k + 2 * q], step[4 + k + 2 * q]);
                 }
-                let mut trial = vec![Complex::new(0.0, 0.0); n];
                 let c_new = self.joint_cost(h, d + dd, &tt, &ll, &mut trial);
                 if c_new.is_finite() && c_new < cost {
                     let rel = (cost - c_new) / cost.max(Real::MIN_POSITIVE);
                     d += dd;
                     taus = tt;
                     lin = ll;
-                    model = trial;
+                    core::mem::swap(&mut model, &mut trial);
                     cost = c_new;
                     lambda = (lambda * 0.1).max(1e-12);
                     improved = true;
@@ -420,14 +413,8 @@ impl LinkBackground {
     fn linear_fit(&self, h: &[Complex], d: Real, taus: &[Real]) -> Option<Vec<Complex>> {
         let k = taus.len() + 1;
         let n = self.fc.len();
-        let tp = 2.0 * PI;
         let mut cols = vec![Complex::new(0.0, 0.0); k * n];
-        let mut sh = cis(-tp * self.fc[0] * d);
-        let ds = cis(-tp * self.df * d);
-        let mut phs: Vec<(Complex, Complex)> = taus
-            .iter()
-            .map(|&t| (cis(-tp * self.fc[0] * t), cis(-tp * self.df * t)))
-            .collect();
+        let (mut sh, ds, mut phs) = self.phasors(d, taus);
         for i in 0..n {
             cols[i] = sh * self.mean[i];
             for (q, ph) in phs.iter_mut().enumerate() {
@@ -449,6 +436,16 @@ impl LinkBackground {
         crate::channel::estimate::solve_complex(&mut g, &mut b, k)
     }
 
+    /// The phasors of the joint model at the first bin and their steps per bin: the shift
+    /// `e^{−j2πf_0δ}` and its step `e^{−j2πΔfδ}`, and per delay `τ_i` the pair
+    /// `(e^{−j2πf_0τ_i}, e^{−j2πΔfτ_i})`.
+    fn phasors(&self, d: Real, taus: &[Real]) -> (Complex, Complex, Vec<(Complex, Complex)>) {
+        let tp = 2.0 * PI;
+        let at = |t: Real| (cis(-tp * self.fc[0] * t), cis(-tp * self.df * t));
+        let (sh, ds) = at(d);
+        (sh, ds, taus.iter().map(|&t| at(t)).collect())
+    }
+
     /// `‖h − model‖²` of the joint model at `(δ, τ, (g, β))`, the model written to `out`.
     fn joint_cost(
         &self,
@@ -458,13 +455,7 @@ impl LinkBackground {
         lin: &[Complex],
         out: &mut [Complex],
     ) -> Real {
-        let tp = 2.0 * PI;
-        let mut sh = cis(-tp * self.fc[0] * d);
-        let ds = cis(-tp * self.df * d);
-        let mut phs: Vec<(Complex, Complex)> = taus
-            .iter()
-            .map(|&t| (cis(-tp * self.fc[0] * t), cis(-tp * self.df * t)))
-            .collect();
+        let (mut sh, ds, mut phs) = self.phasors(d, taus);
         let mut cost = 0.0;
         for (i, o) in out.iter_mut().enumerate() {
             let mut v = lin[0] * self.mean[i];

@@ -251,6 +251,22 @@ fn leak(fc: &[Real], r: &[Complex], nv: Real, paths: &[(Real, Complex)]) -> Real
     e / (r.len() as Real * nv)
 }
 
+/// A snapshot of a receiver without the transmitter's clock: `paths` with a timing offset
+/// uniform over ±100 ns and a gain of modulus `gain` and uniform phase, noise `var`. Returns the
+/// offset and the response.
+fn free_running(
+    b: &Band,
+    paths: &[(Real, Complex)],
+    gain: Real,
+    var: Real,
+    rng: &mut Pcg64,
+) -> (Real, Vec<Complex>) {
+    let d: Real = Uniform::new(-100e-9, 100e-9).unwrap().sample(rng);
+    let ph: Real = Uniform::new(0.0, 2.0 * PI).unwrap().sample(rng);
+    let g = Complex::new(cos(ph), sin(ph)) * gain;
+    (d, response(b, paths, d, g, var, rng))
+}
+
 /// Receivers without a common clock (C10): an offset over ±100 ns and a random complex gain.
 /// The first alignment, made with the echo present, is biased and leaks the static paths into
 /// the residual above the noise (here 1.4–1.5 noise units of excess energy); aligned jointly
@@ -287,10 +303,7 @@ fn joint_alignment_removes_the_dynamic_bias() {
         let (mut first, mut second) = (0.0, 0.0);
         let mut r = Vec::new();
         for _ in 0..25 {
-            let d: Real = Uniform::new(-100e-9, 100e-9).unwrap().sample(&mut rng);
-            let ph: Real = Uniform::new(0.0, 2.0 * PI).unwrap().sample(&mut rng);
-            let g = Complex::new(cos(ph), sin(ph)) * 2.0;
-            let h = response(&b, &with, d, g, var, &mut rng);
+            let (_, h) = free_running(&b, &with, 2.0, var, &mut rng);
             let a = bg.align(&h).unwrap();
             bg.residual(&h, &a, &mut r).unwrap();
             let e1 = est
@@ -365,10 +378,7 @@ fn joint_alignment_with_an_echo_on_the_direct_path() {
     for seed in [21u64, 22, 23] {
         let mut rng = Pcg64::seed_from_u64(seed);
         for _ in 0..20 {
-            let d: Real = Uniform::new(-100e-9, 100e-9).unwrap().sample(&mut rng);
-            let ph: Real = Uniform::new(0.0, 2.0 * PI).unwrap().sample(&mut rng);
-            let g = Complex::new(cos(ph), sin(ph)) * 0.5;
-            let h = response(&b, &with, d, g, var, &mut rng);
+            let (d, h) = free_running(&b, &with, 0.5, var, &mut rng);
             let a = bg.align(&h).unwrap();
             let mut r = Vec::new();
             bg.residual(&h, &a, &mut r).unwrap();
