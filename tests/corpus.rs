@@ -131,10 +131,22 @@ fn stats(t_s: &[Real], states: &[Option<[Real; 2]>], truth: &[[Real; 4]]) -> Sta
 
 /// Ours on one noisy realisation.
 fn ours(sc: &Scene, walk: &Recording, empty: &Recording, req: &ChannelRequest) -> CirTrackOutput {
+    chain(&sc.model, &sc.scenario, walk, empty, req).2
+}
+
+/// The chain with `req`'s settings on `walk` and its empty area: the delay reference it chose,
+/// each link's direct-path σ (C10's σ_τ₀), the track.
+fn chain(
+    model: &Model,
+    scenario: &Scenario,
+    walk: &Recording,
+    empty: &Recording,
+    req: &ChannelRequest,
+) -> (&'static str, Vec<Option<Real>>, CirTrackOutput) {
     let cfg = req.front_end(walk.synchronized);
     let (statics, est) = estimate_recording(
-        &sc.model,
-        sc.scenario.radio.bandwidth_hz,
+        model,
+        scenario.radio.bandwidth_hz,
         walk,
         Some(empty),
         &cfg,
@@ -142,15 +154,22 @@ fn ours(sc: &Scene, walk: &Recording, empty: &Recording, req: &ChannelRequest) -
         &|_| {},
     )
     .unwrap();
-    cir_track(
+    let los = statics
+        .links
+        .iter()
+        .flatten()
+        .map(|l| l.los_sigma_s)
+        .collect();
+    let t = cir_track(
         req,
-        &sc.model,
-        &sc.scenario.area_m,
+        model,
+        &scenario.area_m,
         &statics.calibration,
         &est,
         Cancel::NEVER,
     )
-    .unwrap()
+    .unwrap();
+    (cfg.delay_reference.name(), los, t)
 }
 
 /// Spec C12 8 on the whole corpus (2 scenes × the link budget's SNR and 10 dB lower × seeds
@@ -288,39 +307,18 @@ impl Hangar {
         .unwrap()
     }
 
-    /// The chain on `sim` with the defaults: the delay reference it chose, each link's direct
-    /// path σ (C10's σ_τ₀), the track.
+    /// The chain on `sim` with the defaults ([`chain`]).
     fn track(
         &self,
         sim: &scatterloc::channel::Simulated,
     ) -> (&'static str, Vec<Option<Real>>, CirTrackOutput) {
-        let cfg = self.req.front_end(sim.recording.synchronized);
-        let (statics, est) = estimate_recording(
+        chain(
             &self.model,
-            self.scenario.radio.bandwidth_hz,
+            &self.scenario,
             &sim.recording,
-            Some(&sim.calibration),
-            &cfg,
-            &mut Sequential::new(),
-            &|_| {},
-        )
-        .unwrap();
-        let los = statics
-            .links
-            .iter()
-            .flatten()
-            .map(|l| l.los_sigma_s)
-            .collect();
-        let t = cir_track(
+            &sim.calibration,
             &self.req,
-            &self.model,
-            &self.scenario.area_m,
-            &statics.calibration,
-            &est,
-            Cancel::NEVER,
         )
-        .unwrap();
-        (cfg.delay_reference.name(), los, t)
     }
 }
 
@@ -394,4 +392,44 @@ fn c12_9_over_twelve_seeds() {
     let median = quantile(&mut ratios, 0.5);
     println!("C12.9 over 12 seeds: median ratio {median:.3}, {within} of 12 within 10 %");
     assert!(median <= 1.2, "median {median}");
+}
+
+/// C10's front end on a recording no one here wrote: the ray-traced open area (seeds 1–3 at the
+/// link budget's SNR), once as recorded (one clock) and once declared `synchronized = false`, so
+/// that every snapshot is aligned to the background (`LinkBackground::joint_align`) and delays
+/// are taken relative to the direct path. Measured (2026-12-06): RMSE ratio to the one-clock
+/// run 1.20, 1.26, 1.32 (C12 9's 10 % MISSED here too); the los track's median 0.24–0.25 m, 90 %
+/// 0.297–0.312 m, max 0.40–1.17 m, one segment each. With the realignment this replaced (paths
+/// held fixed) and before the Fisher scaling fix, the same run on `walk-noisy.npz` followed a
+/// ghost: median 7.0 m, 90 % 12.0 m. Asserted (a guard against that): the ratio within 50 % and
+/// the 90 % point within 0.35 m.
+#[test]
+#[ignore = "the open area's recordings through the chain twice: release, scripts/test.sh"]
+fn c12_9_los_on_the_ray_traced_open_area() {
+    let req = ChannelRequest::default();
+    let sc = scene("open");
+    for seed in [1u64, 2, 3] {
+        let walk = noisy(&sc.walk, &sc.noise_var_w, 0.0, seed);
+        let empty = noisy(&sc.empty, &sc.noise_var_w, 0.0, 100 + seed);
+        let (ra, _, a) = chain(&sc.model, &sc.scenario, &walk, &empty, &req);
+        let (mut wf, mut ef) = (walk.clone(), empty.clone());
+        wf.synchronized = Some(false);
+        ef.synchronized = Some(false);
+        let (rb, _, b) = chain(&sc.model, &sc.scenario, &wf, &ef, &req);
+        assert_eq!((ra, rb), ("absolute", "los"));
+        let (ea, eb, n) = paired_rmse(&a, &b, &sc.states);
+        let los: Vec<Option<[Real; 2]>> =
+            b.states.iter().map(|s| s.map(|s| [s[0], s[1]])).collect();
+        let st = stats(&wf.t_s, &los, &sc.states);
+        println!(
+            "C12.9 open seed {seed}: RMSE one clock {ea:.3} m, los {eb:.3} m over {n} snapshots, ratio {:.3}; los median {:.3} p90 {:.3} max {:.3} segments {}",
+            eb / ea,
+            st.median,
+            st.p90,
+            st.max,
+            b.segments.len()
+        );
+        assert!(eb <= 1.5 * ea, "seed {seed}: {eb} vs {ea}");
+        assert!(st.p90 <= 0.35, "seed {seed}: 90 % {}", st.p90);
+    }
 }
