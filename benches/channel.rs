@@ -105,7 +105,13 @@ fn noisy(rec: &Recording, noise_var_w: &[Real], seed: u64) -> Recording {
 }
 
 fn raytraced(c: &mut Criterion) {
-    let dir = format!("{}/tests/data/raytraced/open", env!("CARGO_MANIFEST_DIR"));
+    raytraced_fixture(c, "open");
+    raytraced_fixture(c, "room");
+}
+
+/// The front end, the tracker and the delay figure on one ray-traced fixture.
+fn raytraced_fixture(c: &mut Criterion, name: &str) {
+    let dir = format!("{}/tests/data/raytraced/{name}", env!("CARGO_MANIFEST_DIR"));
     let read = |f: &str| std::fs::read(format!("{dir}/{f}")).expect("fixture");
     let scenario = Scenario::from_json(&String::from_utf8(read("scenario.json")).unwrap()).unwrap();
     let model = Model::new(&scenario).unwrap();
@@ -150,7 +156,7 @@ fn raytraced(c: &mut Criterion) {
     steps.sort_by(Real::total_cmp);
     let q = |p: Real| steps[((steps.len() - 1) as Real * p).round() as usize];
     println!(
-        "raytraced_open per link-snapshot (best of 5, {} units): median {:.1} µs, 90 % {:.1} µs, \
+        "raytraced_{name} per link-snapshot (best of 5, {} units): median {:.1} µs, 90 % {:.1} µs, \
          max {:.1} µs, mean {:.1} µs",
         steps.len(),
         q(0.5),
@@ -161,13 +167,13 @@ fn raytraced(c: &mut Criterion) {
     let works: Vec<_> = est.work.iter().flatten().collect();
     let paths: usize = est.paths.iter().flatten().map(Vec::len).sum();
     println!(
-        "raytraced_open: {} link-snapshots, {:.2} periodogram passes and {:.2} paths each on \
+        "raytraced_{name}: {} link-snapshots, {:.2} periodogram passes and {:.2} paths each on \
          average",
         works.len(),
         works.iter().map(|w| w.passes).sum::<usize>() as Real / works.len() as Real,
         paths as Real / works.len() as Real
     );
-    let mut g = c.benchmark_group("raytraced_open");
+    let mut g = c.benchmark_group(format!("raytraced_{name}"));
     g.sample_size(10);
     g.bench_function("estimate", |b| b.iter(|| black_box(estimate())));
     g.bench_function("track", |b| {

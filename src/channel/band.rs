@@ -24,7 +24,7 @@ use alloc::vec::Vec;
 use crate::channel::fft::Fft;
 use crate::channel::{Layout, Recording};
 use crate::error::{Error, Result};
-use crate::math::{cos, ln, sin, Complex, Real, PI};
+use crate::math::{ln, sincos, Complex, Real, PI};
 
 /// Relative tolerance of "uniformly spaced" for `f_n` (a float64 grid written by numpy as
 /// `f0 + n·Δf` is uniform to ~1e-12 relative).
@@ -37,6 +37,10 @@ pub struct Band {
     pub freq_hz: Vec<Real>,
     /// The system response `P[n]` (all ones for a calibrated sounder).
     pub response: Vec<Complex>,
+    /// Where the delays this band observes start, s: `H[n]` is periodic in delay with period
+    /// `1/Δf`, and a recording sees one period, `[origin, origin + 1/Δf)` — tap 0 of a CIR
+    /// (`tap0_s`), 0 for a CFR ([`Band::new`]). The estimator's default search window.
+    pub delay_origin_s: Real,
 }
 
 impl Band {
@@ -99,7 +103,11 @@ impl Band {
                 });
             }
         }
-        let band = Band { freq_hz, response };
+        let band = Band {
+            freq_hz,
+            response,
+            delay_origin_s: 0.0,
+        };
         if !(band.response_energy() > 0.0) {
             return Err(Error::InvalidFile {
                 field: "system_response".into(),
@@ -291,7 +299,12 @@ impl Band {
                     .iter()
                     .map(|&f| cis(-2.0 * PI * f * t0) * (b * dt))
                     .collect();
-                let band = Band::new(freq, resp)?;
+                // The taps see `[t0, t0 + MΔt)`: delays are searched there (issue 37 item 3:
+                // searched in `[0, MΔt)` they came out one window early).
+                let band = Band {
+                    delay_origin_s: t0,
+                    ..Band::new(freq, resp)?
+                };
                 let fft = if m.is_power_of_two() {
                     Some(Fft::new(m))
                 } else {
@@ -318,7 +331,8 @@ impl Band {
 
 /// `e^{jx}`.
 pub(crate) fn cis(x: Real) -> Complex {
-    Complex::new(cos(x), sin(x))
+    let (s, c) = sincos(x);
+    Complex::new(c, s)
 }
 
 /// The map from a recording's samples of one link and snapshot to `H[n]` of its [`Band`]

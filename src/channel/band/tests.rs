@@ -9,7 +9,7 @@ use rand_pcg::Pcg64;
 
 use super::*;
 use crate::channel::Pulse;
-use crate::math::sqrt;
+use crate::math::{sin, sqrt};
 
 fn one() -> Complex {
     Complex::new(1.0, 0.0)

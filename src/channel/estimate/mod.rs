@@ -48,7 +48,7 @@ use crate::channel::band::{cis, median};
 use crate::channel::fft::PaddedFft;
 use crate::channel::{Band, DelayEstimate};
 use crate::error::{limits, Error, Result};
-use crate::math::{cos, db_to_linear, ln, round, sin, sqrt, Complex, Real, PI};
+use crate::math::{db_to_linear, ln, round, sincos, sqrt, Complex, Real, PI};
 
 mod kernels;
 mod linalg;
@@ -76,8 +76,9 @@ pub struct EstimatorConfig {
     pub p_fa: Real,
     /// Delay-grid oversampling of the periodogram (4 … 64).
     pub oversample: usize,
-    /// Search window `[start, end]` of absolute delays, s (`None`: the whole unambiguous span
-    /// `[0, 1/Δf)`); at most `1/Δf` wide.
+    /// Search window `[start, end]` of absolute delays, s (`None`: the band's whole
+    /// unambiguous span `[o, o + 1/Δf)`, `o` its [`Band::delay_origin_s`]: tap 0 of a CIR, 0
+    /// for a CFR); at most `1/Δf` wide.
     pub window_s: Option<(Real, Real)>,
     /// The noise variance is never taken below the response's mean bin power this far down,
     /// dB ([`limits::ESTIMATOR_DYNAMIC_RANGE_DB`]; default 120): the rounding floor of a
@@ -329,7 +330,7 @@ impl Estimator {
         let df = band.spacing_hz();
         let span = 1.0 / df;
         let (ws, we) = match cfg.window_s {
-            None => (0.0, span),
+            None => (band.delay_origin_s, band.delay_origin_s + span),
             Some((a, b)) => {
                 if !(a.is_finite() && b.is_finite()) {
                     return Err(Error::NonFinite {
@@ -1188,9 +1189,9 @@ impl Estimator {
         }
         let n = self.band.len() as Real;
         let th = PI * self.df * d;
-        let st = sin(th);
+        let (st, ct) = sincos(th);
         if self.flat && (n * th).abs() >= 0.1 && st.abs() >= 1e-2 {
-            let (sn, cn, ct) = (sin(n * th), cos(n * th), cos(th));
+            let (sn, cn) = sincos(n * th);
             let dk = sn / st;
             let d1 = (n * cn * st - sn * ct) / (st * st);
             let d2 = (1.0 - n * n) * dk - 2.0 * (ct / st) * d1;
@@ -1222,29 +1223,29 @@ impl Estimator {
     }
 
     /// `σ_τ` per path from the inverse of the joint Fisher matrix of C1 (parameters `τ_i`,
-    /// `Re α_i`, `Im α_i`); C4 at the fitted SNR when it is singular.
+    /// `Re α_i`, `Im α_i`; only its delay diagonal, from the Schur complement of the
+    /// amplitudes); C4 at the fitted SNR when it is singular.
     fn fisher_sigmas(&self, paths: &[(Real, Complex)], sigma2: Real) -> Vec<Real> {
         let fim = fisher_with(paths, sigma2, |d| self.kernels(d));
         let k = paths.len();
-        match linalg::inverse_spd_scaled(fim, 3 * k) {
-            Some(inv) => (0..k)
-                .map(|i| {
-                    let v = inv[(3 * i) * 3 * k + 3 * i];
+        let delays: Vec<usize> = (0..k).map(|i| 3 * i).collect();
+        let c4 = |p: &(Real, Complex)| {
+            self.band
+                .delay_bound_s(self.energy * p.1.norm_sqr() / sigma2)
+        };
+        match linalg::inverse_diagonal_spd(&fim, 3 * k, &delays) {
+            Some(var) => var
+                .iter()
+                .zip(paths)
+                .map(|(&v, p)| {
                     if v > 0.0 && v.is_finite() {
                         sqrt(v)
                     } else {
-                        self.band
-                            .delay_bound_s(self.energy * paths[i].1.norm_sqr() / sigma2)
+                        c4(p)
                     }
                 })
                 .collect(),
-            None => paths
-                .iter()
-                .map(|p| {
-                    self.band
-                        .delay_bound_s(self.energy * p.1.norm_sqr() / sigma2)
-                })
-                .collect(),
+            None => paths.iter().map(c4).collect(),
         }
     }
 }

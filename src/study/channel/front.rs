@@ -270,11 +270,11 @@ impl LinkStatics {
         let (band, map) = band_map;
         match (cfg.statics, empty) {
             (StaticMode::Background, Some((e, (eb, emap)))) => {
-                if eb.freq_hz != band.freq_hz || eb.response != band.response {
+                if eb != band {
                     return Err(Error::InvalidFile {
                         field: "calibration".into(),
-                        reason: "its band (freq_hz, system response or taps) differs from the \
-                                 recording's: a background must be on the same bins"
+                        reason: "its band (freq_hz, system response, taps or tap0_s) differs \
+                                 from the recording's: a background must be on the same bins"
                             .into(),
                     });
                 }
