@@ -248,6 +248,12 @@ pub const ESTIMATOR_DYNAMIC_RANGE_DB: Range = Range {
     allowed: "20 to 300 dB",
 };
 
+/// The largest magnitude of a response sample the estimator takes (either part, any unit):
+/// `10¹⁰⁰`. Its sums of squares over up to [`MAX_PERIODOGRAM`] cells stay finite (a response
+/// of `10³⁰⁰` gave an infinite noise variance, issue 37 item 7); float32 recordings end at
+/// `3.4·10³⁸`, raw integer CSI at `2³¹`. A given noise variance is capped at its square.
+pub const MAX_SAMPLE_MAGNITUDE: f64 = 1e100;
+
 /// The recursive background's time constant `τ_bg` (C9), s: 1 ms (a few snapshots at [S]'s
 /// rate) to 10⁶ s (a background that never forgets).
 pub const BACKGROUND_TIME_S: Range = Range {

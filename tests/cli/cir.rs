@@ -14,10 +14,12 @@ use std::process::Command;
 
 use serde_json::{json, Value};
 
-use crate::common::cli::{fails, interrupted, ok_json, ok_json_line, read_json, TempDir, BIN};
+use crate::common::cli::{
+    fails, fails_output, interrupted, ok_json, ok_json_line, read_json, TempDir, BIN,
+};
 
 /// Writes the sensors2019 scenario into `dir`; returns its path.
-fn scenario(dir: &TempDir) -> String {
+pub(crate) fn scenario(dir: &TempDir) -> String {
     dir.write_text(
         "s.json",
         &String::from_utf8(
@@ -68,7 +70,7 @@ fn simulate_into(
 
 /// Simulates `seconds` of the hangar walk at `dt` into `dir` (plus a scenario file), with
 /// 0.4 s of the empty area.
-fn simulate(dir: &TempDir, seconds: &str, dt: &str, seed: &str) -> (String, String) {
+pub(crate) fn simulate(dir: &TempDir, seconds: &str, dt: &str, seed: &str) -> (String, String) {
     let scenario = scenario(dir);
     let out = simulate_into(dir, &scenario, "sim", None, [seconds, dt, "0.4", seed]);
     (scenario, out)
@@ -770,4 +772,40 @@ fn ctrl_c_stops_cir_track_and_writes_nothing() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(130), "{err}");
     assert!(!std::path::Path::new(&track).exists());
+}
+
+/// Issue 37 item 6: a recording whose members each declare 10⁹ bytes (under the 1.06·10⁹ cap)
+/// but hold a few kB, read under a 1.5 GB address-space limit: a named error at the first
+/// member (exit 2), not an abort. Before, the reader reserved every member's declared size
+/// up front and the second reservation aborted the process (exit 134).
+#[test]
+fn declared_sizes_are_not_reserved_up_front() {
+    let dir = TempDir::new();
+    let (scenario, sim) = simulate(&dir, "0.1", "0.02", "5");
+    let mut z = std::fs::read(format!("{sim}/recording.npz")).unwrap();
+    let size = 1_000_000_000u32.to_le_bytes();
+    let mut patched = 0;
+    for i in 0..z.len().saturating_sub(30) {
+        match &z[i..i + 4] {
+            b"PK\x03\x04" => z[i + 22..i + 26].copy_from_slice(&size),
+            b"PK\x01\x02" => z[i + 24..i + 28].copy_from_slice(&size),
+            _ => continue,
+        }
+        patched += 1;
+    }
+    assert!(patched >= 8, "{patched} headers");
+    let rec = dir.path("forged.npz");
+    std::fs::write(&rec, &z).unwrap();
+    let out = dir.path("o.json");
+    let script = format!(
+        "ulimit -v 1500000 && exec '{BIN}' cir estimate --threads 1 --scenario '{scenario}' \
+         --cir '{rec}' --out '{out}'"
+    );
+    let run = Command::new("bash").args(["-c", &script]).output().unwrap();
+    fails_output(
+        &[&script],
+        &run,
+        &["--cir", "fewer than its declared 1000000000"],
+    );
+    assert!(!std::path::Path::new(&out).exists());
 }

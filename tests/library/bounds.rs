@@ -102,3 +102,109 @@ fn the_sweep_bound_is_reached_on_an_unresolvable_cluster() {
     }
     assert!(capped > 0, "the sweep bound was never reached");
 }
+
+/// A cancel callback that counts how often it is asked and asks to stop from its `at`-th call
+/// (`usize::MAX`: never).
+fn counting(at: usize) -> (std::sync::atomic::AtomicUsize, usize) {
+    (std::sync::atomic::AtomicUsize::new(0), at)
+}
+
+/// Issue 37 item 1: cancellation is asked inside a snapshot's work, not only between
+/// snapshots — before every pass of the greedy loop — so a long fit (64 paths on a wide band
+/// take seconds) ends at once with `Cancelled`. Deterministic: the callback asks to stop at its
+/// third call, and the estimate ends right there.
+#[test]
+fn cancellation_is_asked_inside_a_snapshot() {
+    use scatterloc::error::{Cancel, Error};
+    use std::sync::atomic::Ordering;
+    let b = band();
+    let paths: Vec<(f64, Complex)> = (0..30)
+        .map(|i| (40e-9 + i as f64 * 6.0 / B, Complex::new(1e-5, 0.0)))
+        .collect();
+    let d = Draw {
+        paths,
+        noise_var: 1e-14,
+        given: true,
+    };
+    let h = response(&b, &d, 1);
+    let power = h.iter().map(|v| v.norm_sqr()).sum::<f64>() / h.len() as f64;
+    for at in [1, 3, 10, usize::MAX] {
+        let (n, at) = counting(at);
+        let stop = || n.fetch_add(1, Ordering::SeqCst) + 1 >= at;
+        let mut e = estimator(&b, limits::MAX_PATHS);
+        let got = e.estimate_floored(&h, Some(d.noise_var), &[], power, Cancel::when(&stop));
+        let asked = n.load(Ordering::SeqCst);
+        if at == usize::MAX {
+            let got = got.unwrap();
+            assert!(got.paths.len() >= 30);
+            // Once per greedy pass: at least once per path added.
+            assert!(asked > 30, "asked {asked} times in one snapshot");
+        } else {
+            assert!(matches!(got, Err(Error::Cancelled)), "{got:?}");
+            assert_eq!(asked, at);
+        }
+    }
+}
+
+/// Issue 37 items 1 and 18: the statics of a link (the background of a long empty-area
+/// recording, aligned snapshot by snapshot, then fitted) ask the cancel callback per empty
+/// snapshot, not only once the whole calibration is done (a 4-snapshot calibration at 16 384
+/// bins took 4 s to honour Ctrl-C).
+#[test]
+fn cancellation_is_asked_while_the_statics_are_built() {
+    use scatterloc::channel::{Band, Layout, Recording};
+    use scatterloc::error::{Cancel, Error};
+    use scatterloc::study::{FrontEndConfig, LinkStatics};
+    use std::sync::atomic::Ordering;
+    let b = band();
+    let d = Draw {
+        paths: vec![
+            (40e-9, Complex::new(1e-3, 0.0)),
+            (90e-9, Complex::new(0.0, 3e-4)),
+        ],
+        noise_var: 1e-12,
+        given: true,
+    };
+    let recording = |snapshots: u64| {
+        let mut samples = Vec::new();
+        for s in 0..snapshots {
+            samples.extend(response(&b, &d, s));
+        }
+        Recording {
+            t_s: (0..snapshots).map(|s| s as f64 * 0.01).collect(),
+            links: vec![[0, 0]],
+            layout: Layout::Cfr {
+                freq_hz: b.freq_hz.clone(),
+                system_response: None,
+            },
+            samples,
+            noise_var: Some(vec![d.noise_var]),
+            synchronized: None,
+        }
+    };
+    let (empty, walk) = (recording(8), recording(1));
+    let bm = Band::of_recording(&walk, B).unwrap();
+    let ebm = Band::of_recording(&empty, B).unwrap();
+    let cfg = FrontEndConfig::default();
+    for at in [1, 3, 8, usize::MAX] {
+        let (n, at) = counting(at);
+        let stop = || n.fetch_add(1, Ordering::SeqCst) + 1 >= at;
+        let got = LinkStatics::build(
+            Some((&empty, &ebm)),
+            &walk,
+            &bm,
+            0,
+            &[10e-9],
+            &cfg,
+            Cancel::when(&stop),
+        );
+        let asked = n.load(Ordering::SeqCst);
+        if at == usize::MAX {
+            assert!(got.is_ok(), "{:?}", got.err());
+            assert!(asked >= 8, "asked {asked} times");
+        } else {
+            assert!(matches!(got, Err(Error::Cancelled)), "{:?}", got.err());
+            assert_eq!(asked, at);
+        }
+    }
+}

@@ -47,7 +47,7 @@ use alloc::vec::Vec;
 use crate::channel::band::{cis, median};
 use crate::channel::fft::PaddedFft;
 use crate::channel::{Band, DelayEstimate};
-use crate::error::{limits, Error, Result};
+use crate::error::{limits, Cancel, Error, Result};
 use crate::math::{db_to_linear, ln, round, sincos, sqrt, Complex, Real, PI};
 
 mod kernels;
@@ -438,18 +438,22 @@ impl Estimator {
         seeds: &[Real],
     ) -> Result<SnapshotEstimate> {
         let power = h.iter().map(|v| v.norm_sqr()).sum::<Real>() / h.len().max(1) as Real;
-        self.estimate_floored(h, noise_var, seeds, power)
+        self.estimate_floored(h, noise_var, seeds, power, Cancel::NEVER)
     }
 
     /// [`Estimator::estimate`] with the floor measured from `reference_power` (W per bin)
     /// instead of `h`'s own: a residual after the background (C9) is floored at the full
-    /// response's power, where its rounding and alignment errors come from.
+    /// response's power, where its rounding and alignment errors come from. `cancel` is asked
+    /// before every pass of the greedy loop (a pass is at most one refinement: well under a
+    /// second at the largest band and path budget), so a long fit ends with
+    /// [`Error::Cancelled`] (issue 37 item 1).
     pub fn estimate_floored(
         &mut self,
         h: &[Complex],
         noise_var: Option<Real>,
         seeds: &[Real],
         reference_power: Real,
+        cancel: Cancel,
     ) -> Result<SnapshotEstimate> {
         let n = self.band.len();
         if h.len() != n {
@@ -464,11 +468,29 @@ impl Estimator {
                 field: "response".into(),
             });
         }
+        let peak = h
+            .iter()
+            .map(|v| v.re.abs().max(v.im.abs()))
+            .fold(0.0, Real::max);
+        if peak > limits::MAX_SAMPLE_MAGNITUDE {
+            return Err(Error::OutOfRange {
+                field: "response".into(),
+                value: peak,
+                allowed: "samples of magnitude at most 1e100 (their powers must stay finite)",
+            });
+        }
         if let Some(v) = noise_var {
             if !(v > 0.0 && v.is_finite()) {
                 return Err(Error::NotPositive {
                     field: "noise_var".into(),
                     value: v,
+                });
+            }
+            if v > limits::MAX_SAMPLE_MAGNITUDE * limits::MAX_SAMPLE_MAGNITUDE {
+                return Err(Error::OutOfRange {
+                    field: "noise_var".into(),
+                    value: v,
+                    allowed: "at most 1e200 (the square of the largest sample magnitude)",
                 });
             }
         }
@@ -512,6 +534,7 @@ impl Estimator {
             }
         }
         if !paths.is_empty() {
+            cancel.check()?;
             self.refine(h, &mut paths, 0, sigma2, &mut work);
         }
         // The greedy loop. Each pass adds a path, or finds that the strongest peak left is a
@@ -521,6 +544,7 @@ impl Estimator {
         let mut excluded: Vec<Real> = Vec::new();
         let mut dirty = true;
         for _ in 0..=2 * self.cfg.max_paths {
+            cancel.check()?;
             if dirty {
                 self.periodogram();
                 work.passes += 1;
@@ -603,7 +627,22 @@ impl Estimator {
                     snr,
                 }
             })
-            .collect();
+            .collect::<Vec<PathEstimate>>();
+        // Every number out finite (issue 37 item 7), or a named error: the input caps above
+        // keep the sums finite, so this is a guard, not a path taken.
+        let finite = |c: Complex| c.re.is_finite() && c.im.is_finite();
+        if !sigma2.is_finite()
+            || out.iter().any(|p| {
+                !(p.delay_s.is_finite()
+                    && finite(p.alpha)
+                    && p.sigma_s.is_finite()
+                    && p.snr.is_finite())
+            })
+        {
+            return Err(Error::NonFinite {
+                field: "estimate (noise variance or a path)".into(),
+            });
+        }
         Ok(SnapshotEstimate {
             paths: out,
             noise_var: sigma2,

@@ -510,6 +510,36 @@ fn config_and_input_errors() {
     assert!(e.estimate(&h, Some(0.0), &[]).is_err());
     h[3] = Complex::new(Real::NAN, 0.0);
     assert!(e.estimate(&h, None, &[]).is_err());
+    // Issue 37 item 7: samples whose powers overflow gave `noise_var = inf` and exit 0.
+    let mut rng = Pcg64::seed_from_u64(7);
+    let paths = [
+        (50e-9, Complex::new(1.0, 0.0)),
+        (90e-9, Complex::new(0.0, 0.3)),
+    ];
+    let clean = response(&b, &paths, 1e-3, &mut rng);
+    for scale in [1e-100, 1e-30, 1.0, 1e30, 5e99] {
+        let x: Vec<Complex> = clean.iter().map(|v| v * scale).collect();
+        let got = e.estimate(&x, None, &[]).unwrap();
+        assert!(got.noise_var.is_finite() && got.noise_var > 0.0, "{scale}");
+        assert_eq!(got.paths.len(), 2, "{scale}");
+        assert!(got
+            .paths
+            .iter()
+            .all(|p| p.sigma_s.is_finite() && p.snr.is_finite()));
+    }
+    for scale in [1e100, 1e300] {
+        let x: Vec<Complex> = clean.iter().map(|v| v * scale).collect();
+        let got = e.estimate(&x, None, &[]).unwrap_err().to_string();
+        assert!(
+            got.starts_with("response: ") && got.contains("1e100"),
+            "{got}"
+        );
+    }
+    assert!(e
+        .estimate(&clean, Some(1e201), &[])
+        .unwrap_err()
+        .to_string()
+        .starts_with("noise_var: "));
 }
 
 /// A seed is refined from its prediction and kept when it passes the CFAR test; a seed where

@@ -32,6 +32,7 @@ fn members(bytes: &[u8], cap: u64) -> Result<BTreeMap<&'static str, Npy>> {
     }
     let mut zip = zip::ZipArchive::new(Cursor::new(bytes))
         .map_err(|e| invalid("npz", format!("not a zip archive (.npz): {e}")))?;
+    refuse_duplicates(bytes, zip.offset() + zip.central_directory_start())?;
     let mut out = BTreeMap::new();
     let mut budget = cap;
     for k in 0..zip.len() {
@@ -53,7 +54,9 @@ fn members(bytes: &[u8], cap: u64) -> Result<BTreeMap<&'static str, Npy>> {
         if declared > budget {
             return Err(too_big(name, declared, cap));
         }
-        let mut data = Vec::with_capacity(declared as usize);
+        // Grown with what actually inflates (a 2 KB file may declare gigabytes: reserving
+        // them up front aborts under an address-space limit).
+        let mut data = Vec::with_capacity(declared.min(INITIAL_RESERVE) as usize);
         (&mut f)
             .take(declared + 1)
             .read_to_end(&mut data)
@@ -67,10 +70,51 @@ fn members(bytes: &[u8], cap: u64) -> Result<BTreeMap<&'static str, Npy>> {
                 ),
             ));
         }
+        if (data.len() as u64) < declared {
+            return Err(invalid(
+                name,
+                format!(
+                    "the member inflates to {} bytes, fewer than its declared {declared} (a \
+                     truncated or corrupt archive)",
+                    data.len()
+                ),
+            ));
+        }
         budget -= data.len() as u64;
         out.insert(name, npy::parse(name, data)?);
     }
     Ok(out)
+}
+
+/// The most a member's buffer reserves before inflating (1 MiB); it grows from there.
+const INITIAL_RESERVE: u64 = 1 << 20;
+
+/// Refuses an archive whose central directory (from `start`) names a member twice: the zip
+/// reader keys members by name and would keep one of them silently. The walk reads the
+/// fixed 46-byte headers (`PK\x01\x02`, name, extra and comment lengths at 28, 30, 32) and
+/// advances at least 46 bytes per record, so it ends within `bytes.len()/46` records.
+fn refuse_duplicates(bytes: &[u8], start: u64) -> Result<()> {
+    let u16_at = |p: usize| u16::from_le_bytes([bytes[p], bytes[p + 1]]) as usize;
+    let mut names: Vec<&[u8]> = Vec::new();
+    let mut p = usize::try_from(start).unwrap_or(usize::MAX);
+    while p.checked_add(46).is_some_and(|e| e <= bytes.len())
+        && bytes[p..p + 4] == [0x50, 0x4b, 0x01, 0x02]
+    {
+        let (n, m, k) = (u16_at(p + 28), u16_at(p + 30), u16_at(p + 32));
+        let Some(name) = bytes.get(p + 46..p + 46 + n) else {
+            break;
+        };
+        if names.contains(&name) {
+            let text = alloc::string::String::from_utf8_lossy(name);
+            return Err(invalid(
+                &crate::error::Clip(&text).to_string(),
+                "the member appears twice in the archive".into(),
+            ));
+        }
+        names.push(name);
+        p += 46 + n + m + k;
+    }
+    Ok(())
 }
 
 fn missing(name: &str, why: &str) -> Error {

@@ -481,3 +481,60 @@ fn a_multi_byte_descr_is_a_named_error() {
         assert!(got.starts_with("t_s: "), "{h}: {got}");
     }
 }
+
+/// Issue 37 item 15: a member named twice in the central directory (the zip reader keys
+/// members by name and kept one silently) is refused by name; the bytes are patched after
+/// writing, since a zip writer refuses duplicate names.
+#[test]
+fn duplicate_members_are_refused() {
+    let rec = cfr();
+    let mut m = members_of(&rec);
+    let t = m.iter().find(|(n, _)| n == "t_s.npy").unwrap().1.clone();
+    m.push(("u_s.npy".into(), t));
+    let mut z = rezip(&m);
+    assert!(read_recording(&z).is_err_and(|e| e.to_string().contains("u_s")));
+    let at: Vec<usize> = z
+        .windows(7)
+        .enumerate()
+        .filter(|(_, w)| w == b"u_s.npy")
+        .map(|(i, _)| i)
+        .collect();
+    assert_eq!(at.len(), 2, "a local and a central header");
+    for i in at {
+        z[i..i + 3].copy_from_slice(b"t_s");
+    }
+    assert_eq!(err(&z), "t_s.npy: the member appears twice in the archive");
+}
+
+/// Issue 37 item 6: a member declaring more than it inflates to is refused by name (a
+/// truncated or forged archive), and its declared size is not reserved up front (a 2 KB file
+/// declaring gigabytes aborted under an address-space limit; `tests/cli/cir.rs` runs one
+/// under `ulimit -v`).
+#[test]
+fn a_member_declaring_more_than_it_holds_is_refused() {
+    let mut z = zip_of(&[("cfr.npy", vec![0u8; 1000])], true);
+    set_declared_size(&mut z, 1_000_000_000);
+    assert_eq!(
+        err(&z),
+        "cfr: the member inflates to 1000 bytes, fewer than its declared 1000000000 (a \
+         truncated or corrupt archive)"
+    );
+}
+
+/// Issue 37 item 16: a long member name is clipped in the error, as elsewhere (the
+/// longest a zip can hold, 64 KB, of one-byte, two-byte and control characters).
+#[test]
+fn a_long_member_name_is_clipped_in_the_error() {
+    for unit in ["x", "é", "\n\u{1b}[2J"] {
+        let name = format!("{}.npy", unit.repeat(60_000 / unit.len()));
+        let z = zip_of(&[(name.as_str(), vec![0u8; 10])], false);
+        let got = err(&z);
+        assert!(
+            got.contains("unknown array"),
+            "{}",
+            &got[..200.min(got.len())]
+        );
+        assert!(got.len() < 1000, "{} bytes", got.len());
+        assert!(!got.contains('\u{1b}'), "control characters escaped");
+    }
+}

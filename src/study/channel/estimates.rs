@@ -189,12 +189,13 @@ impl Prepared {
         empty: Option<&Recording>,
         link: usize,
         cfg: &FrontEndConfig,
+        cancel: Cancel,
     ) -> Result<LinkFront> {
         let e = match (empty, &self.empty_band) {
             (Some(e), Some(b)) => Some((e, b)),
             _ => None,
         };
-        let statics = LinkStatics::build(e, rec, &self.band, link, &self.baseline_s, cfg)?;
+        let statics = LinkStatics::build(e, rec, &self.band, link, &self.baseline_s, cfg, cancel)?;
         LinkFront::new(rec, &self.band, link, cfg, statics)
     }
 
@@ -214,7 +215,7 @@ fn link_run(
     cancel: Cancel,
     progress: &(dyn Fn(usize) + Sync),
 ) -> Result<(LinkStatics, LinkEstimates)> {
-    let mut front = p.link(rec, empty, link, cfg)?;
+    let mut front = p.link(rec, empty, link, cfg, cancel)?;
     // Cancel and progress every 64 snapshots (well under 0.1 s of work).
     const EVERY: usize = 64;
     for s in 0..rec.t_s.len() {
@@ -224,7 +225,7 @@ fn link_run(
                 progress(EVERY);
             }
         }
-        front.step(rec, &p.band.1)?;
+        front.step(rec, &p.band.1, cancel)?;
     }
     let len = rec.t_s.len();
     progress(len - EVERY * (len.saturating_sub(1) / EVERY));
@@ -332,7 +333,7 @@ pub fn estimate_link(
                 progress(64);
             }
         }
-        front.step(rec, &band.1)?;
+        front.step(rec, &band.1, cancel)?;
     }
     let len = rec.t_s.len();
     progress(len - 64 * (len.saturating_sub(1) / 64));
@@ -402,10 +403,14 @@ impl EstimationRun {
         while left > 0 && !self.is_done() {
             let link = self.results.len();
             if self.current.is_none() {
-                self.current = Some(self.prepared.link(rec, empty, link, &self.cfg)?);
+                self.current =
+                    Some(
+                        self.prepared
+                            .link(rec, empty, link, &self.cfg, Cancel::NEVER)?,
+                    );
             }
             if let Some(front) = self.current.as_mut() {
-                front.step(rec, &self.prepared.band.1)?;
+                front.step(rec, &self.prepared.band.1, Cancel::NEVER)?;
                 left -= 1;
                 if front.done() == self.snapshots {
                     let front = self.current.take().ok_or(Error::Cancelled)?;

@@ -39,7 +39,7 @@ use crate::channel::{
     Alignment, Band, EstimateWork, Estimator, EstimatorConfig, LinkBackground, PathEstimate,
     PathTracker, Recording, ResponseMap, SnapshotEstimate, TrackedPath,
 };
-use crate::error::{limits, Error, Result};
+use crate::error::{limits, Cancel, Error, Result};
 use crate::math::{db_to_linear, floor, log10, sqrt, Complex, Real, SPEED_OF_LIGHT};
 use crate::study::channel::{DelayReference, FrontEndConfig, StaticMode};
 use crate::track::gating::{AmplitudeClusterConfig, DelayEstimate, LinkCalibration, StaticCluster};
@@ -188,6 +188,7 @@ impl LinkStatics {
         empty: usize,
         base: Real,
         single_noise: Real,
+        cancel: Cancel,
     ) -> Result<LinkStatics> {
         let mut est = Estimator::new(
             band.clone(),
@@ -197,7 +198,7 @@ impl LinkStatics {
             },
         )?;
         let nv = (single_noise > 0.0).then_some(single_noise);
-        let fit = est.estimate(bg.mean(), nv, &[])?;
+        let fit = est.estimate_floored(bg.mean(), nv, &[], mean_power(bg.mean()), cancel)?;
         let los = los_of(&fit.paths, band.unambiguous_s()).map(|p| (p.delay_s, p.sigma_s));
         let reference = match (cfg.delay_reference, los) {
             (DelayReference::Absolute, _) => Reference::Absolute,
@@ -265,6 +266,7 @@ impl LinkStatics {
         link: usize,
         baseline_s: &[Real],
         cfg: &FrontEndConfig,
+        cancel: Cancel,
     ) -> Result<LinkStatics> {
         let base = check_link(baseline_s, link)?;
         let (band, map) = band_map;
@@ -280,22 +282,27 @@ impl LinkStatics {
                 }
                 let mut hs = Vec::with_capacity(e.snapshot_count());
                 for s in 0..e.snapshot_count() {
+                    cancel.check()?;
                     let mut h = Vec::new();
                     emap.fill(e, s, link, &mut h)?;
                     hs.push(h);
                 }
                 let nv = given_noise(e, emap, link);
+                // Asked between the snapshots the background aligns (a long empty recording).
                 let (bg, _) = LinkBackground::from_snapshots(
                     band,
-                    hs.iter().map(Vec::as_slice),
+                    hs.iter()
+                        .map(Vec::as_slice)
+                        .take_while(|_| !cancel.requested()),
                     nv.unwrap_or(0.0),
                     cfg.align(),
                 )?;
+                cancel.check()?;
                 let single = match nv {
                     Some(v) => v,
                     None => Estimator::new(band.clone(), cfg.estimator)?.noise_of(&hs[0])?,
                 };
-                LinkStatics::of_background(bg, band, cfg, e.snapshot_count(), base, single)
+                LinkStatics::of_background(bg, band, cfg, e.snapshot_count(), base, single, cancel)
             }
             (StaticMode::Background, None) => {
                 let mut h = Vec::new();
@@ -306,7 +313,7 @@ impl LinkStatics {
                     Some(v) => v,
                     None => Estimator::new(band.clone(), cfg.estimator)?.noise_of(&h)?,
                 };
-                LinkStatics::of_background(bg, band, cfg, 0, base, single)
+                LinkStatics::of_background(bg, band, cfg, 0, base, single, cancel)
             }
             (StaticMode::Clusters, Some((e, ebm))) => {
                 let mut front = LinkFront::new(
@@ -317,7 +324,7 @@ impl LinkStatics {
                     LinkStatics::none(cfg.delay_reference, base),
                 )?;
                 for _ in 0..e.snapshot_count() {
-                    front.step(e, &ebm.1)?;
+                    front.step(e, &ebm.1, cancel)?;
                 }
                 let lists: Vec<Vec<DelayEstimate>> = front
                     .out
@@ -398,8 +405,9 @@ impl LinkFront {
         (self.statics, self.out)
     }
 
-    /// Estimates the next snapshot of the link.
-    pub fn step(&mut self, rec: &Recording, map: &ResponseMap) -> Result<()> {
+    /// Estimates the next snapshot of the link; `cancel` is asked inside the estimator
+    /// ([`Estimator::estimate_floored`]).
+    pub fn step(&mut self, rec: &Recording, map: &ResponseMap, cancel: Cancel) -> Result<()> {
         let s = self.out.paths.len();
         let estimated = map.fill(rec, s, self.link, &mut self.h)?;
         let nv = self.given.or(estimated);
@@ -438,7 +446,7 @@ impl LinkFront {
                     bg.residual(h, &a, r)?;
                     let power = mean_power(h) / a.gain.norm_sqr().max(Real::MIN_POSITIVE);
                     let nvr = nv.map(|v| bg.residual_noise(v, &a));
-                    let mut e = estimator.estimate_floored(r, nvr, &seeds, power)?;
+                    let mut e = estimator.estimate_floored(r, nvr, &seeds, power, cancel)?;
                     if a != Alignment::NONE && !e.paths.is_empty() {
                         let fit: Vec<(Real, Complex)> =
                             e.paths.iter().map(|p| (p.delay_s, p.alpha)).collect();
@@ -448,7 +456,7 @@ impl LinkFront {
                         bg.residual(h, &a, r)?;
                         let seeds: Vec<Real> = joint.paths.iter().map(|f| f.0).collect();
                         let nvr = nv.map(|v| bg.residual_noise(v, &a));
-                        e = estimator.estimate_floored(r, nvr, &seeds, power)?;
+                        e = estimator.estimate_floored(r, nvr, &seeds, power, cancel)?;
                         e.work = merge_work(first, e.work);
                     }
                     if recursive && s > 0 {
@@ -462,7 +470,7 @@ impl LinkFront {
                         Reference::PerSnapshot { .. } => &[],
                         _ => seeds,
                     };
-                    estimator.estimate(h, nv, seeds)?
+                    estimator.estimate_floored(h, nv, seeds, mean_power(h), cancel)?
                 }
             };
             used = e.noise_var;
