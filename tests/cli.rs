@@ -1,8 +1,8 @@
 //! End-to-end tests of the `scatterloc` binary, one module per command family: presets, CRLB,
 //! maps, locate, help and completions (`basics`), tracking studies (`tracking`, `montecarlo`,
 //! `filters`), the gating pipeline (`gating`), the planner (`plan`), the multi-target commands
-//! (`mtl`), sharded studies and `merge` (`scale_out`), bounded, named bad input (`hardening`),
-//! and the outputs of a fixed set of commands pinned to those of the binary before issue 23
+//! (`mtl`), sharded studies and `merge` (`scale_out`), bounded, named bad input (`hardening`;
+//! issue 37's command-line items in `hardening3`), and the outputs of a fixed set of commands pinned to those of the binary before issue 23
 //! (`pinned`), and the output writer's guarantees: atomic, never through a link, a FIFO or a
 //! device, all-or-nothing, checked stdout (`outputs`, issue 24). Every module checks the "exit 2 + one stderr line naming the field" contract.
 #![cfg(not(target_arch = "wasm32"))]
@@ -28,6 +28,9 @@ mod gating;
 
 #[path = "cli/hardening.rs"]
 mod hardening;
+
+#[path = "cli/hardening3.rs"]
+mod hardening3;
 
 #[path = "cli/montecarlo.rs"]
 mod montecarlo;

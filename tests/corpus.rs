@@ -303,7 +303,7 @@ impl Hangar {
             seed,
             ..SimulationRequest::default()
         }
-        .run(&self.scenario, &self.model)
+        .run(&self.scenario, &self.model, Cancel::NEVER)
         .unwrap()
     }
 

@@ -1,6 +1,7 @@
 //! Native timings for the package's benchmark (`python/bench/bench.py`, docs/benchmarks.md):
 //! the same kernels timed inside Rust, in the same process and run as the Python calls they are
-//! compared with, so "Python overhead" is measured, not guessed. Not part of the public API.
+//! compared with, so "Python overhead" is measured, not guessed; and `panic`, the tests' probe of
+//! the binding's panic guard ([`crate::run::guarded`]). Not part of the public API.
 
 use std::time::Instant;
 
@@ -81,8 +82,24 @@ fn locate_seconds(
     Ok(best)
 }
 
-/// Registers the timings in `m` (`scatterloc._scatterloc._bench`).
+/// Panics with `message` inside core work run as every call runs it: on a worker thread
+/// (`worker=True`, [`crate::run::run_job`]) or on the calling thread
+/// ([`crate::run::run_quick`]). The tests check that it raises `ScatterlocError` (kind
+/// `"Panic"`), not `PanicException`.
+#[pyfunction]
+#[pyo3(signature = (message, worker = false))]
+fn panic(py: Python<'_>, message: &str, worker: bool) -> PyResult<()> {
+    let work = || -> scatterloc::Result<()> { panic!("{message}") };
+    if worker {
+        crate::run::run_job(py, 1, None, |_| work())
+    } else {
+        crate::run::run_quick(py, work)
+    }
+}
+
+/// Registers the timings (and the panic probe) in `m` (`scatterloc._scatterloc._bench`).
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(panic, m)?)?;
     m.add_function(wrap_pyfunction!(crlb_map_seconds, m)?)?;
     m.add_function(wrap_pyfunction!(locate_seconds, m)?)?;
     Ok(())

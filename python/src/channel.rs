@@ -7,7 +7,10 @@
 
 use std::borrow::Cow;
 
-use numpy::{Complex64, PyArray1, PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
+use numpy::{
+    Complex64, PyArray1, PyArrayDescrMethods, PyArrayDyn, PyArrayMethods, PyUntypedArray,
+    PyUntypedArrayMethods,
+};
 use pyo3::prelude::*;
 
 use scatterloc::channel::{ChannelScene, Layout, Pulse, Recording, SimulationRequest, TrackedPath};
@@ -23,30 +26,116 @@ use scatterloc::study::{
 };
 use scatterloc::track::gating::AssociationRule;
 
-use crate::convert::{array, f64_array, masked, path_string, to_python, JsonDoc};
+use crate::convert::{
+    array, asarray, dtype_name, f64_array, masked, path_string, to_python, too_many, JsonDoc, Len,
+};
 use crate::errors::{arg_error, Core};
-use crate::run::run_job;
+use crate::run::{check_threads, run_job, run_quick};
 use crate::scenario::scenario_arg;
 
-/// A complex argument as (shape, row-major values): complex128 read directly, anything else
-/// through `numpy.asarray(x, dtype=complex)`.
-fn complex_arg(obj: &Bound<'_, PyAny>, field: &str) -> PyResult<(Vec<usize>, Vec<Complex64>)> {
+/// The dtypes a sample array may have: the `.npz` reader's (docs/recording.md), so an array
+/// `Recording` takes is one the reader takes from a file and the other way round.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum SampleDtypes {
+    /// complex64 or complex128 (`cfr`, `system_response`, `pulse`, `estimate`'s `response`).
+    Complex,
+    /// Those, or int16/int32 (I, Q) pairs on a last axis of length 2 (`cir`).
+    ComplexOrIq,
+}
+
+/// A complex sample argument as (shape, row-major values), under the reader's dtype rule
+/// ([`SampleDtypes`]; any other dtype — real, int8, float16, complex256, object — is refused
+/// by name, never converted). A list or other non-array goes through `numpy.asarray(x)` and
+/// its dtype is checked the same way (a list of complex numbers is complex128). `check` sees
+/// the shape (for I/Q pairs without their last axis) before anything is copied or converted:
+/// it checks the shape and the size caps, so a broadcast view of 10¹⁰ samples is refused
+/// without being copied.
+fn complex_arg(
+    obj: &Bound<'_, PyAny>,
+    field: &str,
+    dtypes: SampleDtypes,
+    check: impl FnOnce(&[usize]) -> PyResult<()>,
+) -> PyResult<(Vec<usize>, Vec<Complex64>)> {
     let py = obj.py();
-    let a = match obj.cast::<PyArrayDyn<Complex64>>() {
-        Ok(a) => a.clone(),
+    let converted;
+    let a = match crate::convert::ndarray(obj) {
+        Some(a) => a,
+        None => {
+            converted = asarray(py)?
+                .call1((obj,))
+                .map_err(|e| arg_error(field, format!("not an array of complex numbers ({e})")))?;
+            converted
+                .cast::<PyUntypedArray>()
+                .map_err(|_| arg_error(field, "not an array of complex numbers"))?
+        }
+    };
+    let (kind, size) = (a.dtype().kind(), a.dtype().itemsize());
+    let shape = a.shape().to_vec();
+    let complex = kind == b'c' && (size == 8 || size == 16);
+    let iq = dtypes == SampleDtypes::ComplexOrIq && kind == b'i' && (size == 2 || size == 4);
+    if !complex && !iq {
+        let expected = match dtypes {
+            SampleDtypes::Complex => "complex64 or complex128",
+            SampleDtypes::ComplexOrIq => "complex64, complex128, or int16/int32 (I, Q)",
+        };
+        return Err(arg_error(
+            field,
+            format!("wrong dtype {}, expected {expected}", dtype_name(a)),
+        ));
+    }
+    let kwargs = pyo3::types::PyDict::new(py);
+    if iq {
+        let logical = match shape.split_last() {
+            Some((2, lead)) => lead.to_vec(),
+            _ => {
+                return Err(arg_error(
+                    field,
+                    format!(
+                        "int16/int32 samples are (I, Q) pairs on a last axis of length 2, \
+                         got shape {shape:?}"
+                    ),
+                ))
+            }
+        };
+        check(&logical)?;
+        // Exact: every int32 is a float64.
+        kwargs.set_item("dtype", "float64")?;
+        let f = asarray(py)?
+            .call((a,), Some(&kwargs))?
+            .cast_into::<PyArrayDyn<f64>>()
+            .map_err(|_| arg_error(field, "not an array of (I, Q) pairs"))?;
+        let v = crate::convert::logical_order(&f)
+            .chunks_exact(2)
+            .map(|q| Complex64::new(q[0], q[1]))
+            .collect();
+        return Ok((logical, v));
+    }
+    check(&shape)?;
+    let c = match a.cast::<PyArrayDyn<Complex64>>() {
+        Ok(c) => c.clone(),
+        // complex64, or complex128 of the other byte order: converted exactly.
         Err(_) => {
-            let kwargs = pyo3::types::PyDict::new(py);
             kwargs.set_item("dtype", "complex128")?;
-            let np = py.import("numpy")?;
-            np.getattr("asarray")?
-                .call((obj,), Some(&kwargs))
-                .map_err(|e| arg_error(field, format!("not an array of complex numbers ({e})")))?
+            asarray(py)?
+                .call((a,), Some(&kwargs))?
                 .cast_into::<PyArrayDyn<Complex64>>()
                 .map_err(|_| arg_error(field, "not an array of complex numbers"))?
         }
     };
-    let shape = a.shape().to_vec();
-    Ok((shape, crate::convert::logical_order(&a)))
+    Ok((shape, crate::convert::logical_order(&c)))
+}
+
+/// A 1-D complex argument of at most `max` samples (`system_response`, `pulse`).
+fn complex_vec(obj: &Bound<'_, PyAny>, field: &str, max: usize) -> PyResult<Vec<Complex64>> {
+    let check = |shape: &[usize]| match shape {
+        [n] if *n <= max => Ok(()),
+        [n] => Err(too_many(field, *n, max, "samples")),
+        _ => Err(arg_error(
+            field,
+            format!("expected a 1-D array, got shape {shape:?}"),
+        )),
+    };
+    Ok(complex_arg(obj, field, SampleDtypes::Complex, check)?.1)
 }
 
 /// A channel recording (docs/recording.md): per snapshot and link a channel frequency response
@@ -66,6 +155,9 @@ impl PyRecording {
     /// A recording from arrays (checked as the reader checks a file): `t` (S,), `links` (P, 2)
     /// and exactly one of `cfr` (S, P, N) with `freq_hz` (N,) (and `system_response` (N,)) or
     /// `cir` (S, P, M) with `tap0_s`, `tap_spacing_s` (and `pulse` (K,) at `pulse_spacing_s`);
+    /// the samples in the reader's dtypes — complex64 or complex128, for `cir` also int16/int32
+    /// (I, Q) pairs (S, P, M, 2) — any other dtype refused by name; sizes checked against the
+    /// reader's caps before anything is copied;
     /// `noise_var` (P,), W; `synchronized`: whether the receivers share the transmitter's
     /// clock (None: unknown; `False` makes the front end read delays relative to each link's
     /// direct path, C10).
@@ -90,8 +182,8 @@ impl PyRecording {
         noise_var: Option<&Bound<'_, PyAny>>,
         synchronized: Option<bool>,
     ) -> PyResult<PyRecording> {
-        let t_s = crate::convert::f64_vec(t, "t", None)?;
-        let l = f64_array(links, "links")?;
+        let t_s = crate::convert::f64_vec(t, "t", Len::AtMost(limits::MAX_SNAPSHOTS))?;
+        let l = f64_array(links, "links", 2 * limits::MAX_LINKS)?;
         if l.shape.len() != 2 || l.shape[1] != 2 {
             return Err(arg_error(
                 "links",
@@ -122,14 +214,19 @@ impl PyRecording {
                     }
                 }
                 let f = freq_hz.ok_or_else(|| arg_error("freq_hz", "required with cfr"))?;
-                let (shape, data) = complex_arg(h, "cfr")?;
-                check_samples("cfr", &shape, t_s.len(), links.len())?;
+                let (_, data) = complex_arg(h, "cfr", SampleDtypes::Complex, |shape| {
+                    check_samples("cfr", shape, t_s.len(), links.len())
+                })?;
                 let sys = system_response
-                    .map(|p| complex_arg(p, "system_response").map(|v| v.1))
+                    .map(|p| complex_vec(p, "system_response", limits::MAX_BINS_PER_LINK))
                     .transpose()?;
                 (
                     Layout::Cfr {
-                        freq_hz: crate::convert::f64_vec(f, "freq_hz", None)?,
+                        freq_hz: crate::convert::f64_vec(
+                            f,
+                            "freq_hz",
+                            Len::AtMost(limits::MAX_BINS_PER_LINK),
+                        )?,
                         system_response: sys,
                     },
                     data,
@@ -144,12 +241,13 @@ impl PyRecording {
                         return Err(arg_error(f, "only for a cfr recording"));
                     }
                 }
-                let (shape, data) = complex_arg(h, "cir")?;
-                check_samples("cir", &shape, t_s.len(), links.len())?;
+                let (_, data) = complex_arg(h, "cir", SampleDtypes::ComplexOrIq, |shape| {
+                    check_samples("cir", shape, t_s.len(), links.len())
+                })?;
                 let pulse = match pulse {
                     Some(p) => {
                         let mut p = Pulse {
-                            samples: complex_arg(p, "pulse")?.1,
+                            samples: complex_vec(p, "pulse", limits::MAX_PULSE_SAMPLES)?,
                             spacing_s: pulse_spacing_s.ok_or_else(|| {
                                 arg_error("pulse_spacing_s", "required with pulse")
                             })?,
@@ -177,7 +275,7 @@ impl PyRecording {
             layout,
             samples,
             noise_var: noise_var
-                .map(|v| crate::convert::f64_vec(v, "noise_var", None))
+                .map(|v| crate::convert::f64_vec(v, "noise_var", Len::AtMost(limits::MAX_LINKS)))
                 .transpose()?,
             synchronized,
         };
@@ -284,10 +382,22 @@ impl PyRecording {
     }
 }
 
-/// `shape` must be (S, P, N) for `s` snapshots and `p` links.
+/// `shape` must be (S, P, N) for `s` snapshots and `p` links, with S·P·N within the reader's
+/// cap ([`limits::MAX_RECORDING_SAMPLES`]); checked before the samples are copied.
 fn check_samples(field: &str, shape: &[usize], s: usize, p: usize) -> PyResult<()> {
     match shape {
-        [a, b, _] if *a == s && *b == p => Ok(()),
+        [a, b, _] if *a == s && *b == p => {
+            let n = crate::convert::count(shape);
+            if n > limits::MAX_RECORDING_SAMPLES {
+                return Err(too_many(
+                    field,
+                    n,
+                    limits::MAX_RECORDING_SAMPLES,
+                    "complex samples",
+                ));
+            }
+            Ok(())
+        }
         _ => Err(arg_error(
             field,
             format!("expected shape ({s}, {p}, N) (snapshots, links, samples), got {shape:?}"),
@@ -310,12 +420,14 @@ pub fn read_recording(py: Python<'_>, path: &Bound<'_, PyAny>) -> PyResult<PyRec
             format!("'{p}' is larger than {} bytes", limits::MAX_RECORDING_BYTES),
         ));
     }
-    let rec = py.detach(|| npz::read_recording(&bytes)).py()?;
+    let rec = run_quick(py, || npz::read_recording(&bytes))?;
     Ok(PyRecording { rec })
 }
 
-/// Writes `recording` to `path` as `.npz` (docs/recording.md; `numpy.load` reads it), through a
-/// temporary file renamed into place.
+/// Writes `recording` to `path` as `.npz` (docs/recording.md; `numpy.load` reads it),
+/// atomically as the CLI writes its outputs: into an exclusive temporary with a random name in
+/// the target's directory, synced, then renamed into place (`crate::output`). A symbolic link,
+/// a directory or another special file at `path` is refused by name.
 #[pyfunction]
 pub fn write_recording(
     py: Python<'_>,
@@ -323,22 +435,8 @@ pub fn write_recording(
     recording: &PyRecording,
 ) -> PyResult<()> {
     let p = std::path::PathBuf::from(path_string(path)?);
-    let bytes = py.detach(|| npz::write_recording(&recording.rec)).py()?;
-    let dir = p
-        .parent()
-        .filter(|d| !d.as_os_str().is_empty())
-        .unwrap_or(std::path::Path::new("."));
-    let name = p
-        .file_name()
-        .ok_or_else(|| arg_error("path", "not a file name"))?
-        .to_string_lossy()
-        .into_owned();
-    let tmp = dir.join(format!(".{name}.{}.tmp", std::process::id()));
-    std::fs::write(&tmp, &bytes)?;
-    std::fs::rename(&tmp, &p).inspect_err(|_| {
-        let _ = std::fs::remove_file(&tmp);
-    })?;
-    Ok(())
+    let bytes = run_quick(py, || npz::write_recording(&recording.rec))?;
+    crate::output::write_file(py, "path", &p, &bytes)
 }
 
 /// Signal-level recordings of a walk through a scene (C1, C3; `scatterloc cir simulate`): the
@@ -377,7 +475,7 @@ pub fn simulate_recording<'py>(
     };
     let walk = match walk {
         Some(w) => {
-            let (pts, lead) = crate::convert::points(w, "walk")?;
+            let (pts, lead) = crate::convert::points(w, "walk", limits::MAX_WAYPOINTS)?;
             if lead.len() != 1 {
                 return Err(arg_error("walk", "expected waypoints of shape (K, 2)"));
             }
@@ -400,7 +498,10 @@ pub fn simulate_recording<'py>(
         req.seed = s;
     }
     let (s, m) = (sc.scenario(), sc.model());
-    let sim = run_job(py, 1, None, |_| req.run(s, m))?;
+    let sim = run_job(py, 1, None, |job| {
+        let stop = || job.cancelled();
+        req.run(s, m, Cancel::when(&stop))
+    })?;
     Ok((
         PyRecording { rec: sim.recording },
         PyRecording {
@@ -636,19 +737,31 @@ pub fn estimate(
         None,
     )?
     .front_end(None);
-    let (shape, data) = complex_arg(response, "response")?;
-    let (s, n) = match shape.as_slice() {
-        [n] => (1, *n),
-        [s, n] => (*s, *n),
-        other => {
-            return Err(arg_error(
-                "response",
-                format!("expected shape (N,) or (S, N), got {other:?}"),
-            ))
-        }
+    let dims = |shape: &[usize]| match shape {
+        [n] => Ok((1, *n)),
+        [s, n] => Ok((*s, *n)),
+        other => Err(arg_error(
+            "response",
+            format!("expected shape (N,) or (S, N), got {other:?}"),
+        )),
     };
+    let check = |shape: &[usize]| {
+        dims(shape)?;
+        let n = crate::convert::count(shape);
+        if n > limits::MAX_RECORDING_SAMPLES {
+            return Err(too_many(
+                "response",
+                n,
+                limits::MAX_RECORDING_SAMPLES,
+                "complex samples",
+            ));
+        }
+        Ok(())
+    };
+    let (shape, data) = complex_arg(response, "response", SampleDtypes::Complex, check)?;
+    let (s, n) = dims(&shape)?;
     let t_s = match t {
-        Some(t) => crate::convert::f64_vec(t, "t", Some(s))?,
+        Some(t) => crate::convert::f64_vec(t, "t", Len::Exactly(s))?,
         None => (0..s).map(|k| k as f64).collect(),
     };
     let is_cir = tap0_s.is_some() || tap_spacing_s.is_some();
@@ -753,6 +866,7 @@ pub fn estimate_recording(
     threads: usize,
     progress: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<Paths> {
+    check_threads(threads)?;
     let sc = scenario_arg(scenario)?;
     let fe = FrontEndKw {
         max_paths,
@@ -909,6 +1023,7 @@ pub fn cir_track(
     threads: usize,
     progress: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<ChannelTrack> {
+    check_threads(threads)?;
     let sc = scenario_arg(scenario)?;
     let fe = FrontEndKw {
         max_paths,

@@ -1,7 +1,9 @@
 //! The core's [`scatterloc::Error`] as Python exceptions: every bad input is a
 //! `scatterloc.ScatterlocError` (a `ValueError`) carrying the core's field name (`field`) and
 //! the error's kind (`kind`, the core variant's name); a cancelled run is the
-//! `KeyboardInterrupt` that cancelled it.
+//! `KeyboardInterrupt` that cancelled it; a panic inside the library (a bug, caught by
+//! [`crate::run::guarded`]) is a `ScatterlocError` of kind `"Panic"`, never
+//! `pyo3_runtime.PanicException`.
 
 use pyo3::exceptions::{PyKeyboardInterrupt, PyValueError};
 use pyo3::prelude::*;
@@ -34,6 +36,20 @@ pub fn core_error(e: Error) -> PyErr {
         return PyKeyboardInterrupt::new_err("cancelled");
     }
     Python::attach(|py| error_with(py, e.to_string(), e.field(), e.kind()))
+}
+
+/// A panic inside the library (a bug) with its `message`: a [`ScatterlocError`] of kind
+/// `"Panic"` (no `field`), so `except ValueError` / `except Exception` catch it as any other
+/// error of the package.
+pub fn panic_error(message: &str) -> PyErr {
+    Python::attach(|py| {
+        error_with(
+            py,
+            format!("internal error (a bug in scatterloc, please report it): {message}"),
+            None,
+            "Panic",
+        )
+    })
 }
 
 /// A bad argument of the binding itself (a wrong shape, an unknown option), named `field`.

@@ -5,7 +5,9 @@
 //!
 //! - `errors`: the core's `Error` as `ScatterlocError` (a `ValueError` with `field` and `kind`).
 //! - `convert`: arrays in and out, documents as the dicts the CLI's JSON parses to.
-//! - `run`: long work on a worker thread without the GIL, Ctrl-C and progress.
+//! - `run`: long work on a worker thread without the GIL, Ctrl-C and progress; the one guard
+//!   that turns a panic into a `ScatterlocError` (kind `"Panic"`); the `threads` cap.
+//! - `output`: the one atomic file writer (`write_recording`, `Scenario.save`), as the CLI's.
 //! - `scenario`: `Scenario` (the core's `present::Session`).
 //! - `snapshot`: `crlb`, `crlb_map`, `locate`.
 //! - `tracking`: `track`, `calibrate` and the filter settings.
@@ -24,6 +26,7 @@ mod channel;
 mod convert;
 mod errors;
 mod mtl;
+mod output;
 mod planning;
 mod run;
 mod scenario;

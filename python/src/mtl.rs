@@ -196,7 +196,7 @@ pub fn mtl_locate(
         }
     };
     let nodes = |obj: &Bound<'_, PyAny>, field: &str| -> PyResult<Vec<[f64; 2]>> {
-        let (p, lead) = crate::convert::points(obj, field)?;
+        let (p, lead) = crate::convert::points(obj, field, scatterloc::error::limits::MAX_NODES)?;
         if lead.len() != 1 {
             return Err(arg_error(field, "expected node positions of shape (N, 2)"));
         }

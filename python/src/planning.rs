@@ -112,7 +112,11 @@ pub fn plan(
             polys
                 .iter()
                 .enumerate()
-                .map(|(i, p)| crate::convert::points(p, &format!("allowed[{i}]")).map(|v| v.0))
+                .map(|(i, p)| {
+                    let field = format!("allowed[{i}]");
+                    crate::convert::points(p, &field, scatterloc::plan::MAX_POLYGON_VERTICES)
+                        .map(|v| v.0)
+                })
                 .collect::<PyResult<_>>()?
         }
     };

@@ -11,7 +11,7 @@ use scatterloc::present::Session;
 use scatterloc::scenario::{presets, Area};
 use scatterloc::{Scenario, Vec2};
 
-use crate::convert::{array, path_string, point, points, to_json_text, to_python};
+use crate::convert::{array, path_string, point, to_json_text, to_python};
 use crate::errors::{arg_error, Core};
 
 /// Largest scenario file read, bytes (the CLI's input cap, docs/cli.md "Size caps").
@@ -151,11 +151,13 @@ impl PyScenario {
         self.scenario().to_json()
     }
 
-    /// Writes the scenario as JSON to `path` (every command and the page load it).
-    fn save(&self, path: &Bound<'_, PyAny>) -> PyResult<()> {
-        let p = path_string(path)?;
-        std::fs::write(p, self.scenario().to_json() + "\n")?;
-        Ok(())
+    /// Writes the scenario as JSON to `path` (every command and the page load it), atomically
+    /// as `write_recording` writes (a synced temporary renamed into place: a failed save leaves
+    /// the old file whole and nothing new).
+    fn save(&self, py: Python<'_>, path: &Bound<'_, PyAny>) -> PyResult<()> {
+        let p = std::path::PathBuf::from(path_string(path)?);
+        let text = self.scenario().to_json() + "\n";
+        crate::output::write_file(py, "path", &p, text.as_bytes())
     }
 
     /// A copy (edits of one do not change the other).
@@ -328,9 +330,9 @@ impl PyScenario {
         py: Python<'py>,
         points: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let (pts, mut shape) = crate::convert::points(points, "points")?;
         let net = &self.model().network;
         let l = net.link_count();
+        let (pts, mut shape) = crate::convert::eval_points(points, "points", l)?;
         let mut out = Vec::with_capacity(pts.len() * l * 2);
         for p in &pts {
             let r = Vec2::new(p[0], p[1]);
@@ -456,8 +458,8 @@ impl PyScenario {
         points_obj: &Bound<'py, PyAny>,
         f: impl Fn(usize, Vec2) -> f64,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let (pts, mut shape) = points(points_obj, "points")?;
         let l = self.model().link_count();
+        let (pts, mut shape) = crate::convert::eval_points(points_obj, "points", l)?;
         let mut out = Vec::with_capacity(pts.len() * l);
         for p in &pts {
             let r = Vec2::new(p[0], p[1]);

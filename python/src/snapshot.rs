@@ -111,9 +111,9 @@ pub fn crlb<'py>(
     points: &Bound<'py, PyAny>,
 ) -> PyResult<Crlb> {
     let sc = scenario_arg(scenario)?;
-    let (at, lead) = crate::convert::points(points, "points")?;
     let model = sc.model();
     let l = model.link_count();
+    let (at, lead) = crate::convert::eval_points(points, "points", l)?;
     let n = at.len();
     let (mut sx, mut sy, mut rmse) = (
         Vec::with_capacity(n),
@@ -282,12 +282,7 @@ pub fn crlb_map(
         None => sc.scenario().area_m,
     };
     let grid = Grid::new(area, nx, ny).py()?;
-    if threads > 1024 {
-        return Err(arg_error(
-            "threads",
-            format!("{threads} is above 1024 (0 = all cores)"),
-        ));
-    }
+    crate::run::check_threads(threads)?;
     let model = sc.model();
     let cells = grid.len();
     // Small maps (a few ms) run on this thread with the GIL released; large ones on a worker
@@ -449,7 +444,7 @@ pub fn locate(
     };
     let model = sc.model();
     let n = model.link_count();
-    let d = f64_array(delays, "delays")?;
+    let d = f64_array(delays, "delays", scatterloc::error::limits::MAX_LINKS)?;
     if d.shape.len() != 1 || d.data.len() != n {
         return Err(arg_error(
             "delays",
@@ -478,11 +473,14 @@ pub fn locate(
     };
     let area = &sc.scenario().area_m;
     let rep = if initial.is_some() {
-        lm_locate(&model.network, &m, &LmConfig::default(), initial, area).py()?
+        // A few µs: on this thread with the GIL, through the panic guard all core calls take.
+        crate::run::guarded(|| lm_locate(&model.network, &m, &LmConfig::default(), initial, area))
+            .map_err(PyErr::from)?
     } else {
         // The grid-search start costs ~0.1 ms: without the GIL.
-        py.detach(|| lm_locate(&model.network, &m, &LmConfig::default(), None, area))
-            .py()?
+        crate::run::run_quick(py, || {
+            lm_locate(&model.network, &m, &LmConfig::default(), None, area)
+        })?
     };
     Ok(Fix {
         doc: FixDoc::from(&rep),
@@ -494,7 +492,11 @@ pub fn sigma_arg(sigma: &Bound<'_, PyAny>, links: usize) -> PyResult<Vec<f64>> {
     let s = if let Ok(v) = sigma.extract::<f64>() {
         Sigma::One(v)
     } else {
-        Sigma::PerLink(crate::convert::f64_vec(sigma, "sigma", None)?)
+        Sigma::PerLink(crate::convert::f64_vec(
+            sigma,
+            "sigma",
+            crate::convert::Len::AtMost(scatterloc::error::limits::MAX_LINKS),
+        )?)
     };
     s.per_link(links).py()
 }

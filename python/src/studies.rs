@@ -15,7 +15,7 @@ use scatterloc::Error;
 
 use crate::convert::{array, JsonDoc};
 use crate::errors::{arg_error, Core};
-use crate::run::run_job;
+use crate::run::{check_threads, run_job};
 use crate::scenario::scenario_arg;
 use crate::tracking::{cpu_cap, settings};
 
@@ -386,17 +386,6 @@ pub fn montecarlo(
         curves,
         doc: body(&only)?,
     })
-}
-
-/// `threads` checked (0 = all cores, at most 256 as the CLI).
-fn check_threads(threads: usize) -> PyResult<()> {
-    if threads > 256 {
-        return Err(arg_error(
-            "threads",
-            format!("{threads} is outside the allowed range 0..=256 (0 = all cores)"),
-        ));
-    }
-    Ok(())
 }
 
 /// The posterior CRLB alone (spec §8, E9): at the noise-free path (`nominal=True`, spec check 9,

@@ -172,7 +172,7 @@ fn raw_step(obj: &Bound<'_, PyAny>, field: &str, links: usize) -> PyResult<RawSt
         .enumerate()
         .map(|(p, l)| {
             let f = format!("{field}[{p}]");
-            let a = f64_array(l, &f)?;
+            let a = f64_array(l, &f, crate::convert::MAX_VALUES)?;
             match a.shape.as_slice() {
                 [0] | [0, _] => Ok(Vec::new()),
                 [_, 2] => Ok(a
@@ -394,7 +394,7 @@ pub fn track(
         let q = process_noise
             .ok_or_else(|| arg_error("process_noise", "required with delays or raw estimates"))?;
         let initial_state = initial_state
-            .map(|s| crate::convert::f64_vec(s, "initial_state", Some(4)))
+            .map(|s| crate::convert::f64_vec(s, "initial_state", crate::convert::Len::Exactly(4)))
             .transpose()?
             .map(|v| [v[0], v[1], v[2], v[3]]);
         let initial_covariance = initial_covariance
@@ -404,7 +404,11 @@ pub fn track(
             None => None,
             Some(s) => Some(match s.extract::<f64>() {
                 Ok(v) => Sigma::One(v),
-                Err(_) => Sigma::PerLink(crate::convert::f64_vec(s, "sigma", None)?),
+                Err(_) => Sigma::PerLink(crate::convert::f64_vec(
+                    s,
+                    "sigma",
+                    crate::convert::Len::AtMost(scatterloc::error::limits::MAX_LINKS),
+                )?),
             }),
         };
         let is_array = measurements.cast::<numpy::PyUntypedArray>().is_ok();
@@ -423,7 +427,7 @@ pub fn track(
                 .is_none_or(|s| s.extract::<Vec<f64>>().is_ok())
         };
         let (steps, raw_steps) = if plain {
-            let a = f64_array(measurements, "measurements")?;
+            let a = f64_array(measurements, "measurements", crate::convert::MAX_VALUES)?;
             let rows = match a.shape.as_slice() {
                 [_, l] if *l == n => a.data.chunks_exact(n).count(),
                 [0] => 0,

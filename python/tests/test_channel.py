@@ -209,7 +209,7 @@ def test_recording_errors_name_the_array(change, field):
         (dict(tap_spacing_s=1e-9), "tap0_s"),
         (dict(tap0_s=0.0), "tap_spacing_s"),
         (dict(tap0_s=0.0, tap_spacing_s=1e-9, freq_hz=np.arange(8.0)), "freq_hz"),
-        (dict(tap0_s=0.0, tap_spacing_s=1e-9, pulse=[0.5, 1, 0.5]), "pulse_spacing_s"),
+        (dict(tap0_s=0.0, tap_spacing_s=1e-9, pulse=[0.5, 1 + 0j, 0.5]), "pulse_spacing_s"),
         (dict(tap0_s=0.0, tap_spacing_s=-1e-9), "tap_spacing_s"),
     ],
 )

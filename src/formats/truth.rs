@@ -6,7 +6,7 @@ use alloc::vec::Vec;
 
 use serde::{Deserialize, Serialize};
 
-use crate::error::{Error, Result};
+use crate::error::{limits, Error, Result};
 use crate::scenario::parse_json;
 
 /// The true states at the track's times. `resolved` is written by `simulate-walk` and optional
@@ -23,6 +23,10 @@ use crate::scenario::parse_json;
 /// // The track's times must be the truth's.
 /// let e = t.check_times(&[0.1, 0.3]).unwrap_err();
 /// assert_eq!(e.to_string(), "t_s[1]: 0.2 but the track's step is at 0.3 s");
+/// // Positions are coordinates (±1e7 m), velocities within ±1e6 m/s.
+/// let far = Truth::from_json(r#"{"t_s": [0.1], "states": [[1e100, 0, 1, 0]]}"#).unwrap();
+/// let e = far.check_times(&[0.1]).unwrap_err();
+/// assert_eq!(e.to_string(), "states[0][0]: 1e100 is out of range (-1e7 to 1e7 m)");
 /// ```
 #[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
 pub struct Truth {
@@ -42,7 +46,10 @@ impl Truth {
     }
 
     /// Checks that the times are the track's `t_s` (to 1e-9 relative) and every state is
-    /// finite ([`Error::InvalidFile`] of `t_s`, [`Error::NonFinite`] of `states[k]`).
+    /// finite, its position within [`limits::COORDINATE_M`] and its velocity within
+    /// [`limits::VELOCITY_M_S`], as a tracker's states ([`Error::InvalidFile`] of `t_s`,
+    /// [`Error::NonFinite`] of `states[k]`, [`Error::OutOfRange`] of `states[k][i]`; issue 37:
+    /// states at 1e100 m gave a median error of 1e100 m, at 1e160 m none).
     pub fn check_times(&self, t_s: &[f64]) -> Result<()> {
         let n = t_s.len();
         if self.t_s.len() != n || self.states.len() != n {
@@ -71,6 +78,19 @@ impl Truth {
             return Err(Error::NonFinite {
                 field: format!("states[{k}]"),
             });
+        }
+        let ranges = [
+            limits::COORDINATE_M,
+            limits::COORDINATE_M,
+            limits::VELOCITY_M_S,
+            limits::VELOCITY_M_S,
+        ];
+        for (k, s) in self.states.iter().enumerate() {
+            for (i, (v, range)) in s.iter().zip(&ranges).enumerate() {
+                if !range.contains(*v) {
+                    range.check(&format!("states[{k}][{i}]"), *v)?;
+                }
+            }
         }
         Ok(())
     }

@@ -20,7 +20,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::channel::{Layout, Recording};
 use crate::error::limits::MAX_CHANNEL_SAMPLES;
-use crate::error::{check_len, Error, Result};
+use crate::error::{check_len, limits, Cancel, Error, Result};
 use crate::math::{
     cos, db_to_linear, dbm_to_watt, sin, sqrt, Complex, Real, Vec2, PI, SPEED_OF_LIGHT,
 };
@@ -462,6 +462,49 @@ fn complex_normal(r: &mut Rng) -> Complex {
     Complex::new(re * s, im * s)
 }
 
+/// The simulator's caps on the truth's path entries and on its work
+/// ([`limits::MAX_TRUTH_PATHS`], [`limits::MAX_SIMULATION_WORK`]), named as `scene.duration_s`
+/// (the request names it `duration_s`).
+struct Budget {
+    snapshots: usize,
+    bins: usize,
+}
+
+impl Budget {
+    /// `entries` path entries in the first `done` snapshots.
+    fn check(&self, entries: usize, done: usize) -> Result<()> {
+        if entries <= limits::MAX_TRUTH_PATHS {
+            return Ok(());
+        }
+        Err(Error::InvalidFile {
+            field: "scene.duration_s".into(),
+            reason: alloc::format!(
+                "the truth would hold more than {} true paths (already {entries} in {done} of {} \
+                 snapshots): fewer scatterers, walls or links, or a shorter duration",
+                limits::MAX_TRUTH_PATHS,
+                self.snapshots
+            ),
+        })
+    }
+
+    /// `work` path × bin products in the first `done` snapshots.
+    fn check_work(&self, work: u64, done: usize) -> Result<()> {
+        if work <= limits::MAX_SIMULATION_WORK {
+            return Ok(());
+        }
+        Err(Error::InvalidFile {
+            field: "scene.duration_s".into(),
+            reason: alloc::format!(
+                "more than {} path × subcarrier products ({work} in {done} of {} snapshots of \
+                 {} subcarriers): fewer scatterers or subcarriers, or a shorter duration",
+                limits::MAX_SIMULATION_WORK,
+                self.snapshots,
+                self.bins
+            ),
+        })
+    }
+}
+
 /// Simulates a recording of `scene` on `model`'s links (compiled from `scenario`), with the
 /// walker (`with_person`) or of the empty area (the calibration recording, its own noise
 /// stream), seeded by `seed`. Layout C1 (`Cfr`, no system response), `noise_var` per link.
@@ -476,11 +519,19 @@ pub fn simulate_recording(
     with_person: bool,
     seed: u64,
 ) -> Result<(Recording, ChannelTruth)> {
-    synthesize(scenario, model, scene, with_person, seed, true)
+    synthesize(
+        scenario,
+        model,
+        scene,
+        with_person,
+        seed,
+        true,
+        Cancel::NEVER,
+    )
 }
 
 /// [`simulate_recording`], optionally without the additive noise (`noise_var` then still
-/// gives the σ² the noisy version would use).
+/// gives the σ² the noisy version would use); `cancel` is asked once per snapshot.
 fn synthesize(
     scenario: &Scenario,
     model: &Model,
@@ -488,6 +539,7 @@ fn synthesize(
     with_person: bool,
     seed: u64,
     add_noise: bool,
+    cancel: Cancel,
 ) -> Result<(Recording, ChannelTruth)> {
     scene.validate()?;
     check_len(
@@ -543,6 +595,22 @@ fn synthesize(
         .iter()
         .map(|lb| static_rays(lb, &lines, scene))
         .collect();
+    // The truth and the work grow with every path of every link and snapshot: refused by
+    // name before anything is computed when the static paths alone exceed a cap, and as
+    // soon as the walker's paths make them exceed it (issue 37 item 4).
+    let static_count: usize = statics.iter().map(Vec::len).sum();
+    let budget = Budget {
+        snapshots,
+        bins: n_bins,
+    };
+    budget.check(snapshots.saturating_mul(static_count), snapshots)?;
+    budget.check_work(
+        (snapshots as u64)
+            .saturating_mul(static_count as u64)
+            .saturating_mul(n_bins as u64),
+        snapshots,
+    )?;
+    let (mut entries, mut work) = (0usize, 0u64);
 
     let body = &scene.body;
     let k_centres = body.centres;
@@ -573,6 +641,7 @@ fn synthesize(
     let mut scratch = Vec::new();
 
     for s in 0..snapshots {
+        cancel.check()?;
         let t = s as Real * scene.dt_s;
         t_s.push(t);
         let walker = with_person.then(|| path.state_and_heading(t));
@@ -660,6 +729,11 @@ fn synthesize(
             for tp in &truth {
                 max_power[p] = Real::max(max_power[p], tp.power_w);
             }
+            let rays = statics[p].len() + (1 + k_centres) * scratch.len().max(1);
+            entries = entries.saturating_add(truth.len());
+            work = work.saturating_add((rays as u64).saturating_mul(n_bins as u64));
+            budget.check(entries, s + 1)?;
+            budget.check_work(work, s + 1)?;
             snap_paths.push(truth);
             snap_shadow.push(los_shadowed);
         }

@@ -4,9 +4,9 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::{simulate_recording, ChannelScene, ChannelTruth};
+use super::{ChannelScene, ChannelTruth};
 use crate::channel::Recording;
-use crate::error::{Error, Result};
+use crate::error::{Cancel, Error, Result};
 use crate::measure::Model;
 use crate::scenario::Scenario;
 
@@ -110,18 +110,25 @@ impl SimulationRequest {
         }
     }
 
-    /// Simulates both recordings on `model` (of `scenario`). Errors: [`SimulationRequest::
-    /// scenes`]'s, the simulator's (its sample cap names `duration_s`, or
-    /// `calibration_duration_s` for the empty area).
-    pub fn run(&self, scenario: &Scenario, model: &Model) -> Result<Simulated> {
+    /// Simulates both recordings on `model` (of `scenario`); `cancel` is asked once per
+    /// snapshot. Errors: [`SimulationRequest::scenes`]'s, the simulator's (its caps on
+    /// samples, truth and work name `duration_s`, or `calibration_duration_s` for the empty
+    /// area), [`Error::Cancelled`].
+    pub fn run(&self, scenario: &Scenario, model: &Model, cancel: Cancel) -> Result<Simulated> {
         let (scene, empty) = self.scenes()?;
-        let (recording, truth) = simulate_recording(scenario, model, &scene, true, self.seed)
-            .map_err(|e| self.attribute(e))?;
-        let (calibration, _) = simulate_recording(scenario, model, &empty, false, self.seed)
-            .map_err(|e| Error::InvalidFile {
+        let (recording, truth) =
+            super::synthesize(scenario, model, &scene, true, self.seed, true, cancel)
+                .map_err(|e| self.attribute(e))?;
+        let (calibration, _) = super::synthesize(
+            scenario, model, &empty, false, self.seed, true, cancel,
+        )
+        .map_err(|e| match e {
+            Error::Cancelled => e,
+            _ => Error::InvalidFile {
                 field: "calibration_duration_s".into(),
                 reason: strip_field(&e),
-            })?;
+            },
+        })?;
         Ok(Simulated {
             recording,
             calibration,

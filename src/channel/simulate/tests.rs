@@ -36,7 +36,7 @@ fn rel(a: Real, b: Real) -> Real {
 #[test]
 fn los_power_is_friis_in_every_bin() {
     let (sc, m) = setup();
-    let (rec, truth) = synthesize(&sc, &m, &bare_scene(), false, 1, false).unwrap();
+    let (rec, truth) = synthesize(&sc, &m, &bare_scene(), false, 1, false, Cancel::NEVER).unwrap();
     let lambda = SPEED_OF_LIGHT / sc.radio.carrier_hz;
     for p in 0..m.link_count() {
         let (tx, rx) = m.network.link_nodes(p);
@@ -61,7 +61,7 @@ fn phases_follow_the_delay_across_the_band() {
     // H[n+1]/H[n] = e^{−j2πΔfτ} for a single path, through the re-anchoring points.
     let (sc, m) = setup();
     let scene = bare_scene();
-    let (rec, truth) = synthesize(&sc, &m, &scene, false, 1, false).unwrap();
+    let (rec, truth) = synthesize(&sc, &m, &scene, false, 1, false, Cancel::NEVER).unwrap();
     let df = sc.radio.bandwidth_hz / scene.subcarriers as Real;
     let tau = truth.paths[0][1][0].delay_s;
     let step = cis_neg(df * tau);
@@ -88,7 +88,7 @@ fn scatterer_power_over_noise_is_the_model_snr() {
             position_m: [r.x, r.y],
             rcs_m2: rcs,
         }];
-        let (_, truth) = synthesize(&sc, &m, &scene, false, 1, false).unwrap();
+        let (_, truth) = synthesize(&sc, &m, &scene, false, 1, false, Cancel::NEVER).unwrap();
         for p in 0..m.link_count() {
             let sp = truth.paths[0][p]
                 .iter()
@@ -113,7 +113,7 @@ fn processing_gain_enters_through_the_noise() {
         position_m: [r.x, r.y],
         rcs_m2: 1.0,
     }];
-    let (rec, truth) = synthesize(&sc, &m, &scene, false, 1, false).unwrap();
+    let (rec, truth) = synthesize(&sc, &m, &scene, false, 1, false, Cancel::NEVER).unwrap();
     let nv = rec.noise_var.as_ref().unwrap();
     for (p, &nvp) in nv.iter().enumerate() {
         let sp = truth.paths[0][p][1];
@@ -126,7 +126,7 @@ fn processing_gain_enters_through_the_noise() {
 #[test]
 fn walker_truth_power_is_the_model_received_power() {
     let (sc, m) = setup();
-    let (_, truth) = synthesize(&sc, &m, &bare_scene(), true, 3, false).unwrap();
+    let (_, truth) = synthesize(&sc, &m, &bare_scene(), true, 3, false, Cancel::NEVER).unwrap();
     for (s, st) in truth.states.iter().enumerate() {
         let r = Vec2::new(st[0], st[1]);
         for p in 0..m.link_count() {
@@ -150,7 +150,7 @@ fn wall_delay_is_the_image_method() {
         b_m: [30.0, c],
         gamma: -0.6,
     }];
-    let (_, truth) = synthesize(&sc, &m, &scene, false, 1, false).unwrap();
+    let (_, truth) = synthesize(&sc, &m, &scene, false, 1, false, Cancel::NEVER).unwrap();
     let lambda = SPEED_OF_LIGHT / sc.radio.carrier_hz;
     for p in 0..m.link_count() {
         let (tx, rx) = m.network.link_nodes(p);
@@ -172,7 +172,7 @@ fn wall_delay_is_the_image_method() {
     }
     // A wall too short to hold the reflection point gives no path.
     scene.walls[0].a_m = [28.0, c];
-    let (_, truth) = synthesize(&sc, &m, &scene, false, 1, false).unwrap();
+    let (_, truth) = synthesize(&sc, &m, &scene, false, 1, false, Cancel::NEVER).unwrap();
     assert!(truth.paths[0][0].iter().all(|t| t.kind != PathKind::Wall));
 }
 
@@ -194,7 +194,7 @@ fn second_order_between_two_parallel_walls() {
             gamma: 0.5,
         },
     ];
-    let (_, truth) = synthesize(&sc, &m, &scene, false, 1, false).unwrap();
+    let (_, truth) = synthesize(&sc, &m, &scene, false, 1, false, Cancel::NEVER).unwrap();
     for p in 0..m.link_count() {
         let (tx, rx) = m.network.link_nodes(p);
         // Tx in the top wall: 48 − y; then in the bottom: −18 − (48 − y) = y − 66.
@@ -235,7 +235,7 @@ fn shadowing_exactly_when_the_walker_is_on_the_los() {
     };
     scene.dt_s = 0.04;
     scene.duration_s = Some(4.0);
-    let (_, truth) = synthesize(&sc, &m, &scene, true, 1, false).unwrap();
+    let (_, truth) = synthesize(&sc, &m, &scene, true, 1, false, Cancel::NEVER).unwrap();
     let (tx, rx) = m.network.link_nodes(0);
     let lambda = SPEED_OF_LIGHT / sc.radio.carrier_hz;
     let k = lambda / (4.0 * PI * dist(tx, rx));
@@ -267,8 +267,10 @@ fn noise_variance_is_n_times_pn() {
     let want = scene.subcarriers as Real * m.noise_power_w;
     for seed in [1, 2, 3] {
         for with_person in [false, true] {
-            let (clean, _) = synthesize(&sc, &m, &scene, with_person, seed, false).unwrap();
-            let (noisy, _) = synthesize(&sc, &m, &scene, with_person, seed, true).unwrap();
+            let (clean, _) =
+                synthesize(&sc, &m, &scene, with_person, seed, false, Cancel::NEVER).unwrap();
+            let (noisy, _) =
+                synthesize(&sc, &m, &scene, with_person, seed, true, Cancel::NEVER).unwrap();
             let nv = noisy.noise_var.as_ref().unwrap();
             for (p, &nvp) in nv.iter().enumerate() {
                 assert!(rel(nvp, want) < 1e-15);
@@ -300,7 +302,7 @@ fn dynamic_range_raises_the_noise_floor() {
     let (sc, m) = setup();
     let mut scene = bare_scene();
     scene.dynamic_range_db = Some(30.0);
-    let (rec, truth) = synthesize(&sc, &m, &scene, true, 1, false).unwrap();
+    let (rec, truth) = synthesize(&sc, &m, &scene, true, 1, false, Cancel::NEVER).unwrap();
     let nv = rec.noise_var.as_ref().unwrap();
     for p in 0..m.link_count() {
         let strongest = truth
@@ -326,8 +328,8 @@ fn deterministic_per_seed() {
     assert_eq!(a.1.states, c.1.states);
     // The calibration recording draws its noise from another stream.
     let (e, te) = simulate_recording(&sc, &m, &scene, false, 7).unwrap();
-    let (ec, _) = synthesize(&sc, &m, &scene, false, 7, false).unwrap();
-    let (pc, _) = synthesize(&sc, &m, &scene, true, 7, false).unwrap();
+    let (ec, _) = synthesize(&sc, &m, &scene, false, 7, false, Cancel::NEVER).unwrap();
+    let (pc, _) = synthesize(&sc, &m, &scene, true, 7, false, Cancel::NEVER).unwrap();
     let noise_e: Vec<Complex> = e
         .samples
         .iter()
@@ -356,8 +358,8 @@ fn body_fluctuation_has_unit_mean_power_and_the_set_correlation() {
     scene.body.correlation = 0.5;
     scene.duration_s = Some(4000.0 * DEFAULT_DT_S);
     scene.subcarriers = 2;
-    let (with, truth) = synthesize(&sc, &m, &scene, true, 11, false).unwrap();
-    let (without, _) = synthesize(&sc, &m, &scene, false, 11, false).unwrap();
+    let (with, truth) = synthesize(&sc, &m, &scene, true, 11, false, Cancel::NEVER).unwrap();
+    let (without, _) = synthesize(&sc, &m, &scene, false, 11, false, Cancel::NEVER).unwrap();
     // Link 2 (Rx (−6, −8)): the walk along y = 4 never shadows its LoS.
     let p = 2;
     let g: Vec<Complex> = (0..with.snapshot_count())
@@ -555,7 +557,7 @@ fn body_wall_delays_are_the_image_method() {
         b_m: [30.0, c],
         gamma: -0.6,
     }];
-    let (_, truth) = synthesize(&sc, &m, &scene, true, 1, false).unwrap();
+    let (_, truth) = synthesize(&sc, &m, &scene, true, 1, false, Cancel::NEVER).unwrap();
     let st = truth.states[3];
     let r = Vec2::new(st[0], st[1]);
     let mirror = |p: Vec2| Vec2::new(p.x, 2.0 * c - p.y);
@@ -603,4 +605,75 @@ fn full_hangar_recording() {
         .all(|z| z.re.is_finite() && z.im.is_finite()));
     // The walk crosses LoS paths somewhere: some snapshot is shadowed.
     assert!(truth.shadowed.iter().flatten().any(|&s| s));
+}
+
+/// Issue 37 item 4: a scene of 4096 scatterers grew the truth by every static path of every
+/// link and snapshot (a 278 MB `truth.json` in 2 s of walk, 3 GB of memory in 11 s). Refused
+/// by name before anything is computed when the static paths alone exceed a cap (the truth's
+/// path entries, or the path × subcarrier work); a shorter walk of the same scene is
+/// simulated.
+#[test]
+fn the_truth_and_the_work_are_capped_by_name() {
+    let (sc, m) = setup();
+    let mut scene = bare_scene();
+    scene.subcarriers = 16;
+    scene.scatterers = (0..4096)
+        .map(|i| PointScatterer {
+            position_m: [1.0 + (i % 64) as Real * 0.25, 1.0 + (i / 64) as Real * 0.1],
+            rcs_m2: 0.01,
+        })
+        .collect();
+    scene.dt_s = 0.004;
+    let refused =
+        |scene: &ChannelScene| match synthesize(&sc, &m, scene, true, 1, true, Cancel::NEVER) {
+            Ok(_) => panic!("accepted"),
+            Err(e) => e.to_string(),
+        };
+    // 501 snapshots × 4 links × ≥ 4097 paths: refused before the first snapshot.
+    scene.duration_s = Some(2.0);
+    let text = refused(&scene);
+    assert!(
+        text.starts_with("scene.duration_s: the truth would hold more than 1048576 true paths"),
+        "{text}"
+    );
+    assert!(text.contains("in 501 of 501 snapshots"), "{text}");
+    // 40 snapshots fit (≈ 655 000 paths).
+    scene.duration_s = Some(39.0 * 0.004);
+    let (_, truth) = synthesize(&sc, &m, &scene, true, 1, true, Cancel::NEVER).unwrap();
+    let entries: usize = truth.paths.iter().flatten().map(Vec::len).sum();
+    assert!(
+        entries > 600_000 && entries <= limits::MAX_TRUTH_PATHS,
+        "{entries}"
+    );
+    // The work: 600 scatterers on 32 768 subcarriers for 400 snapshots (52·10⁶ samples, under
+    // their cap; 0.96·10⁶ paths, under the truth's) is 3.2·10¹⁰ path × bin products > 2³⁴.
+    scene.scatterers.truncate(600);
+    scene.subcarriers = 32_768;
+    scene.duration_s = Some(399.0 * 0.004);
+    let text = refused(&scene);
+    assert!(
+        text.starts_with("scene.duration_s: more than 17179869184 path × subcarrier products"),
+        "{text}"
+    );
+}
+
+/// Issue 37 item 13: the simulator asks its cancel callback once per snapshot (Ctrl-C took
+/// effect only after the whole simulation).
+#[test]
+fn the_simulator_asks_to_cancel_per_snapshot() {
+    use core::sync::atomic::{AtomicUsize, Ordering};
+    let (sc, m) = setup();
+    let scene = bare_scene();
+    for at in [1, 4, usize::MAX] {
+        let n = AtomicUsize::new(0);
+        let stop = || n.fetch_add(1, Ordering::SeqCst) + 1 >= at;
+        let got = synthesize(&sc, &m, &scene, true, 1, true, Cancel::when(&stop));
+        let asked = n.load(Ordering::SeqCst);
+        if at == usize::MAX {
+            assert_eq!(asked, got.unwrap().0.t_s.len());
+        } else {
+            assert!(matches!(got, Err(Error::Cancelled)));
+            assert_eq!(asked, at);
+        }
+    }
 }

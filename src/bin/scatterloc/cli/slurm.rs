@@ -14,8 +14,9 @@ pub enum SlurmCommand {
     /// submits `--array=0-(N-1)` of `shards.sbatch NAME N STUDY...` and a merge job with
     /// `--dependency=afterok` on it, both with DIR as their working directory and this binary as
     /// SCATTERLOC. The study (after `--`) is `montecarlo …` or `mtl roc …` without --shard,
-    /// --shards, --json, --out and --threads (set here); it is checked before anything is
-    /// submitted. Prints the job ids and where the parts, the logs and the result will be.
+    /// --shards, --json, --out and --threads (set here); it is checked as each shard checks it
+    /// (a relative --scenario is DIR's) before anything is written or submitted. Prints the job
+    /// ids and where the parts, the logs and the result will be.
     Submit(SubmitArgs),
 }
 

@@ -17,8 +17,8 @@ use scatterloc::{npz, Model, Scenario};
 
 use super::flags::with_flag;
 use super::gating::{prepare_out_dir_for, walk_file};
-use super::io::{emit_summary, model_of, read_bytes, read_json_file, read_scenario};
-use super::output::{check_writable, Format, OutputSet};
+use super::io::{emit_summary, model_of, one_stdin, read_bytes, read_json_file, read_scenario};
+use super::output::{check_distinct, check_writable, Format, OutputSet};
 use super::study::{catch_ctrl_c, interrupted, run_with_counter, threads};
 use crate::cli::{
     Association, CirEstimateArgs, CirSimulateArgs, CirTrackArgs, FrontEndArgs, ReferenceName,
@@ -166,15 +166,23 @@ fn output(flag: &str, path: &str, allowed: &[Format]) -> Result<Format, CliError
 /// [--snapshots F] [--measurements F]`.
 pub fn cir_estimate(args: &CirEstimateArgs) -> Result<(), CliError> {
     catch_ctrl_c();
+    one_stdin(&[
+        ("scenario", Some(&args.scenario)),
+        ("cir", Some(&args.cir)),
+        ("calibration", args.calibration.as_deref()),
+    ])?;
     output("out", &args.out, &[Format::Json])?;
+    let mut outputs = vec![("out", args.out.as_str())];
     for (flag, p) in [
         ("snapshots", &args.snapshots),
         ("measurements", &args.measurements),
     ] {
         if let Some(p) = p {
             output(flag, p, &[Format::Json])?;
+            outputs.push((flag, p));
         }
     }
+    check_distinct(&outputs)?;
     let q = args.process_noise.unwrap_or(DEFAULT_PROCESS_NOISE);
     if args.process_noise.is_some() && args.measurements.is_none() {
         return Err(CliError::usage(
@@ -265,6 +273,12 @@ fn uniform_dt(t_s: &[f64], q: f64) -> Result<(f64, f64), CliError> {
 /// `scatterloc cir track --scenario S --cir REC.npz --out TRACK.json [--calibration CAL.npz]`.
 pub fn cir_track(args: &CirTrackArgs) -> Result<(), CliError> {
     catch_ctrl_c();
+    one_stdin(&[
+        ("scenario", Some(&args.scenario)),
+        ("cir", Some(&args.cir)),
+        ("calibration", args.calibration.as_deref()),
+        ("truth", args.truth.as_deref()),
+    ])?;
     output("out", &args.out, &[Format::Json])?;
     let figure = match &args.figure {
         Some(p) => Some((
@@ -280,6 +294,11 @@ pub fn cir_track(args: &CirTrackArgs) -> Result<(), CliError> {
         )),
         None => None,
     };
+    let figures = [("figure", figure), ("delays-figure", delays_figure)];
+    let outputs: Vec<(&str, &str)> = std::iter::once(("out", args.out.as_str()))
+        .chain(figures.iter().filter_map(|(f, o)| o.map(|(p, _)| (*f, p))))
+        .collect();
+    check_distinct(&outputs)?;
     let req = request(&args.front_end, Some(args))?;
     let (threads, _) = threads(args.front_end.threads)?;
     let scenario = read_scenario(&args.scenario)?;
@@ -391,6 +410,10 @@ fn parse_walk(text: &str) -> Result<Vec<[f64; 2]>, CliError> {
 /// [--duration S] [--dt T] [--calibration-duration S] [--seed N]`.
 pub fn cir_simulate(args: &CirSimulateArgs) -> Result<(), CliError> {
     catch_ctrl_c();
+    one_stdin(&[
+        ("scenario", Some(&args.scenario)),
+        ("scene", args.scene.as_deref()),
+    ])?;
     let scenario = read_scenario(&args.scenario)?;
     let model = model_of(&scenario)?;
     let mut req = SimulationRequest {
@@ -418,7 +441,15 @@ pub fn cir_simulate(args: &CirSimulateArgs) -> Result<(), CliError> {
     let dir = args.out_dir.as_str();
     let created = prepare_out_dir_for(dir, &SIM_FILES)?;
     let written = (|| {
-        let sim = req.run(&scenario, &model).map_err(fail)?;
+        // Ctrl-C is asked once per snapshot (issue 37 item 13: it took effect only after the
+        // whole simulation).
+        let stop = interrupted;
+        let sim = req
+            .run(&scenario, &model, Cancel::when(&stop))
+            .map_err(|e| match e {
+                scatterloc::Error::Cancelled => super::study::cancelled(),
+                e => fail(e),
+            })?;
         let (rec, cal, truth) = (sim.recording, sim.calibration, sim.truth);
         let enc = |r: &Recording| {
             npz::write_recording(r).map_err(|e| CliError::output(format!("--out-dir: {e}")))

@@ -11,7 +11,7 @@ use scatterloc::track::paper_initial_covariance;
 use scatterloc::track::ConstantVelocity;
 use scatterloc::{measure, Model};
 
-use super::io::{emit_json, model_of, read_json_file, read_scenario};
+use super::io::{emit_json, model_of, one_stdin, read_json_file, read_scenario};
 use super::output::{check_writable, write_json_file, Format, OutputSet};
 use super::study::{checked_steps, flag_error};
 use crate::cli::{CalibrateArgs, SimulateWalkArgs, WalkStart};
@@ -27,6 +27,10 @@ pub fn read_calibration(path: &str, model: &Model) -> Result<Calibration, CliErr
 /// `scatterloc calibrate --scenario S --snapshots C [--gap-s G] [--min-fraction F]
 /// [--sigma-floor-s S] [--out OUT.json]`.
 pub fn calibrate(args: &CalibrateArgs) -> Result<(), CliError> {
+    one_stdin(&[
+        ("scenario", Some(&args.scenario)),
+        ("snapshots", Some(&args.snapshots)),
+    ])?;
     // The extension rule of every other output flag (issue 24: `--out cal.txt` wrote JSON).
     if let Some(p) = args.out.as_deref() {
         check_writable("out", p)?;

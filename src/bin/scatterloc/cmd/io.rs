@@ -39,6 +39,25 @@ pub fn emit_json<T: Serialize>(v: &T) -> Result<(), CliError> {
     emit(&text)
 }
 
+/// Refuses more than one of a command's `inputs` (flag, path if given) on standard input (`-`):
+/// it can be read only once, so the second would read nothing (issue 37). Checked before
+/// anything is read; the error names the flags.
+pub fn one_stdin(inputs: &[(&str, Option<&str>)]) -> Result<(), CliError> {
+    let on_stdin: Vec<String> = inputs
+        .iter()
+        .filter(|(_, path)| *path == Some("-"))
+        .map(|(flag, _)| format!("--{flag}"))
+        .collect();
+    if on_stdin.len() > 1 {
+        return Err(CliError::usage(format!(
+            "{}: more than one input is '-', but standard input can be read only once; give \
+             all but one of them as files",
+            on_stdin.join(" / ")
+        )));
+    }
+    Ok(())
+}
+
 /// Reads a file (or stdin for `-`) named by `--flag`, at most [`limits::MAX_INPUT_BYTES`]
 /// (a larger input, or an endless one such as `/dev/zero`, is refused after reading one byte
 /// past the cap). A leading UTF-8 byte-order mark is dropped (editors on some systems write

@@ -45,19 +45,48 @@ fn chart_options(study: &MonteCarloStudy) -> TrackingChartOptions {
     }
 }
 
-/// `scatterloc montecarlo`.
-pub fn montecarlo(args: &MontecarloArgs) -> Result<(), CliError> {
+/// The study of `montecarlo`'s flags, checked (errors name the flags).
+fn study_of(args: &MontecarloArgs) -> Result<MonteCarloStudy, CliError> {
     let track = parse_study(&args.study)?;
     let runs = args.runs.unwrap_or(5000);
     let noise_runs = args.noise_runs.unwrap_or(50);
-    let (seed, (threads, used)) = (args.seed.unwrap_or(1), threads(args.threads)?);
     let names = match &args.filters {
         Some(list) => list.0.clone(),
         None => vec![FilterName::Ekf],
     };
     let kinds = filter_kinds(&names, &args.settings, "--filters")?;
-    let study = MonteCarloStudy::new(track, runs, noise_runs, seed, args.oracle_noise, &kinds)
+    let seed = args.seed.unwrap_or(1);
+    MonteCarloStudy::new(track, runs, noise_runs, seed, args.oracle_noise, &kinds)
+        .map_err(flag_error)
+}
+
+/// What each of `shards` shards of `args` (on `threads` threads each) checks before its run,
+/// without running it (`slurm submit`, issue 37): the study's flags, and the predicted CPU time
+/// of the costliest shard against `--max-cpu-hours`.
+pub fn check_shards(args: &MontecarloArgs, shards: usize, threads: usize) -> Result<(), CliError> {
+    let study = study_of(args)?;
+    let links = study.track.model.link_count();
+    let runs = (0..study.track.trajectories.len())
+        .map(|k| study.filter_study(k))
+        .collect::<Result<Vec<_>, _>>()
         .map_err(flag_error)?;
+    let cost = |chunks: &std::ops::Range<usize>| -> f64 {
+        runs.iter().map(|r| r.predicted_cpu_s(links, chunks)).sum()
+    };
+    let costliest = (0..shards)
+        .filter_map(|i| Shard::new(i, shards))
+        .map(|s| s.range(study.chunk_count()))
+        .max_by(|a, b| cost(a).total_cmp(&cost(b)));
+    match costliest {
+        Some(chunks) => check_study_cost(&study, &chunks, threads, args.max_cpu_hours).map(drop),
+        None => Ok(()),
+    }
+}
+
+/// `scatterloc montecarlo`.
+pub fn montecarlo(args: &MontecarloArgs) -> Result<(), CliError> {
+    let study = study_of(args)?;
+    let (threads, used) = threads(args.threads)?;
     let shard = shard::resolve(&args.shard)?;
     let chunks = match shard {
         Some(s) => s.range(study.chunk_count()),

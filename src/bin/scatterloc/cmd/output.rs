@@ -11,7 +11,7 @@
 //!   old file or the whole new one, never a torn one;
 //! - a command with several outputs stages all of them in an [`OutputSet`] set and renames them
 //!   only when every one was written; on any failure the temporaries are removed and nothing new
-//!   is left.
+//!   is left. Two outputs naming one file are refused ([`check_distinct`]).
 
 use std::fs::{File, Permissions};
 use std::io::{BufWriter, Write};
@@ -167,10 +167,43 @@ pub fn check_writable(flag: &str, path: &str) -> Result<(), CliError> {
     temporary_for(flag, path).map(drop)
 }
 
+/// The file `path` names, to compare outputs: its directory made canonical (`.`, `..` and links
+/// resolved) joined with its file name; the path as given when the directory cannot be resolved
+/// (its own check then fails by name).
+fn file_identity(path: &str) -> PathBuf {
+    let p = Path::new(path);
+    match (std::fs::canonicalize(directory_of(path)), p.file_name()) {
+        (Ok(dir), Some(name)) => dir.join(name),
+        _ => p.to_path_buf(),
+    }
+}
+
+/// Two output flags naming one file: exit status 2 naming both (one output would be lost).
+fn same_file(first: &str, flag: &str, path: &str) -> CliError {
+    CliError::usage(format!(
+        "--{first} / --{flag}: both name the file '{path}'; give each output a path of its own"
+    ))
+}
+
+/// Refuses, naming both flags, two of `outputs` (flag, path) that name one file (`--out a.json
+/// --snapshots ./a.json`): the second would replace the first (issue 37). [`OutputSet`] refuses
+/// the same when staging; commands call this with their other checks, before their work.
+pub fn check_distinct(outputs: &[(&str, &str)]) -> Result<(), CliError> {
+    let ids: Vec<PathBuf> = outputs.iter().map(|(_, p)| file_identity(p)).collect();
+    for (i, (flag, path)) in outputs.iter().enumerate() {
+        if let Some(j) = ids[..i].iter().position(|id| *id == ids[i]) {
+            return Err(same_file(outputs[j].0, flag, path));
+        }
+    }
+    Ok(())
+}
+
 /// One staged output: its temporary, and where it goes.
 struct Staged {
     flag: String,
     path: String,
+    /// The file it names ([`file_identity`]).
+    identity: PathBuf,
     tmp: NamedTempFile,
 }
 
@@ -193,7 +226,9 @@ impl OutputSet {
         self.staged.is_empty()
     }
 
-    /// A new temporary for `path` (checked), filled by `write`, flushed and synced to disk.
+    /// A new temporary for `path` (checked), filled by `write`, flushed and synced to disk. A
+    /// path naming a file already staged (`same.json`, `./same.json`) is refused naming both
+    /// flags ([`check_distinct`]).
     fn stage(
         &mut self,
         flag: &str,
@@ -201,6 +236,10 @@ impl OutputSet {
         write: impl FnOnce(&mut BufWriter<&File>) -> Result<(), CliError>,
     ) -> Result<(), CliError> {
         target_kind(flag, path)?;
+        let identity = file_identity(path);
+        if let Some(s) = self.staged.iter().find(|s| s.identity == identity) {
+            return Err(same_file(&s.flag, flag, path));
+        }
         let tmp = temporary_for(flag, path)?;
         {
             let mut w = BufWriter::new(tmp.as_file());
@@ -213,6 +252,7 @@ impl OutputSet {
         self.staged.push(Staged {
             flag: flag.to_string(),
             path: path.to_string(),
+            identity,
             tmp,
         });
         Ok(())

@@ -18,7 +18,7 @@ use scatterloc::plan::{Polygon, MAX_PLAN_GRID, MIN_PLAN_GRID};
 use scatterloc::present::{run_plan_with, PlanJson, PlanRequest, DEFAULT_PLAN_BUDGET};
 use scatterloc::{Error, Model, Scenario};
 
-use super::io::{emit_summary, read_json_file};
+use super::io::{emit_summary, one_stdin, read_json_file};
 use super::output::{check_writable, Figure, Format, OutputSet};
 use super::study::{cancelled, interrupted, load_layout, run_with_bar};
 use crate::cli::PlanArgs;
@@ -37,6 +37,10 @@ pub fn plan(args: &PlanArgs) -> Result<(), CliError> {
         Some(p) => Some((p, Format::of("figure", p, &[Format::Svg, Format::Png])?)),
         None => None,
     };
+    one_stdin(&[
+        ("scenario", args.scenario.as_deref()),
+        ("allowed", args.allowed.as_deref()),
+    ])?;
     let (_, scenario) = load_layout(args.preset.as_deref(), args.scenario.as_deref())?;
     let allowed: Vec<Polygon> = match args.allowed.as_deref() {
         Some(path) => read_json_file("allowed", path)?,

@@ -7,7 +7,7 @@ use scatterloc::localize::{locate as lm_locate, DelayMeasurements, LmConfig};
 use scatterloc::present::{CrlbDoc, FixDoc};
 use scatterloc::{scenario::presets, Vec2};
 
-use super::io::{emit, emit_json, model_of, read_json_file, read_scenario};
+use super::io::{emit, emit_json, model_of, one_stdin, read_json_file, read_scenario};
 use crate::cli::{CrlbArgs, LocateArgs, PresetArgs};
 use crate::failure::CliError;
 
@@ -42,6 +42,7 @@ struct DelaysFile {
 /// `scatterloc locate --scenario S --delays D`.
 pub fn locate(args: &LocateArgs) -> Result<(), CliError> {
     let dpath = args.delays.as_str();
+    one_stdin(&[("scenario", Some(&args.scenario)), ("delays", Some(dpath))])?;
     let s = read_scenario(&args.scenario)?;
     let bad = |m: String| CliError::usage(format!("--delays {dpath}: {m}"));
     let d: DelaysFile = read_json_file("delays", dpath)?;

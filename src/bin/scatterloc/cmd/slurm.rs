@@ -1,8 +1,10 @@
 //! `scatterloc slurm submit` (issue 28): a sharded study as a Slurm job array plus a merge job
 //! that depends on it, submitted with the scripts of docs/scale-out.md — the same files
 //! (`docs/slurm/*.sbatch`, compiled in), written to DIR/slurm/ so a user can read and re-run
-//! them. The study is checked (parsed as the CLI parses it) before anything is submitted.
+//! them. The study is checked before anything is written or submitted: parsed as the CLI parses
+//! it, then with the checks each shard makes before its run (issue 37).
 
+use std::path::Path;
 use std::process::Command;
 
 use serde_json::json;
@@ -11,6 +13,7 @@ use scatterloc::math::MAX_SHARDS;
 
 use super::io::emit_summary;
 use super::output::{Format, OutputSet};
+use super::{montecarlo, mtl};
 use crate::cli::{self, MtlCommand, SubmitArgs};
 use crate::failure::CliError;
 
@@ -19,14 +22,24 @@ const SHARDS_SCRIPT: &str = include_str!("../../../../docs/slurm/shards.sbatch")
 /// The merge script of docs/scale-out.md.
 const MERGE_SCRIPT: &str = include_str!("../../../../docs/slurm/merge.sbatch");
 
-/// The study's default name and the flags this command sets itself (refused in the study).
-fn check_study(study: &[String]) -> Result<&'static str, CliError> {
+/// Checks the study after `--` as its `shards` tasks of `threads` threads each, working in
+/// `dir`, would check it before their runs, and returns its default name. Refused (exit 2,
+/// naming the flag): what the CLI would not parse, the flags this command sets itself, and
+/// what every shard would refuse (issue 37: `--runs 0`, a missing `--scenario`, a shard over
+/// `--max-cpu-hours`, …), which was submitted as N failing tasks and a merge job pending
+/// forever.
+fn check_study(
+    study: &[String],
+    dir: &Path,
+    shards: usize,
+    threads: usize,
+) -> Result<&'static str, CliError> {
     let bad = |m: String| CliError::usage(format!("slurm submit: the study after --: {m}"));
     let argv = std::iter::once("scatterloc".to_string()).chain(study.iter().cloned());
     let matches = cli::command()
         .try_get_matches_from(argv)
         .map_err(|e| bad(e.to_string().lines().next().unwrap_or("").to_string()))?;
-    let parsed = <cli::Cli as clap::FromArgMatches>::from_arg_matches(&matches)
+    let mut parsed = <cli::Cli as clap::FromArgMatches>::from_arg_matches(&matches)
         .map_err(|e| bad(e.to_string()))?;
     let given = |shard: &cli::ShardArgs, json: bool, out: bool, threads: bool| {
         [
@@ -73,12 +86,88 @@ fn check_study(study: &[String]) -> Result<&'static str, CliError> {
             "{flag} is set by slurm submit (--json/--out of the merged result go before --)"
         )));
     }
+    // What each shard checks before its run (`bad`: the study's flags are named as they are).
+    match &mut parsed.command {
+        cli::Command::Montecarlo(a) => {
+            as_the_tasks_read(&mut a.study.scenario, dir).map_err(|e| bad(e.message))?;
+            montecarlo::check_shards(a, shards, threads).map_err(|e| bad(e.message))?;
+        }
+        cli::Command::Mtl {
+            command: MtlCommand::Roc(a),
+        } => {
+            mtl::roc_config_of(a).map_err(|e| bad(e.message))?;
+        }
+        _ => {}
+    }
     Ok(name)
 }
 
-/// Runs `sbatch --parsable ARGS` and returns the job id (`123` of `123;cluster`).
-fn sbatch(args: &[String]) -> Result<String, String> {
+/// `--scenario` of a study as its tasks read it: a relative path is DIR's (their working
+/// directory, not this command's); standard input is refused (batch jobs have none).
+fn as_the_tasks_read(scenario: &mut Option<String>, dir: &Path) -> Result<(), CliError> {
+    match scenario.as_deref() {
+        Some("-") => Err(CliError::usage(
+            "--scenario: '-' (standard input) is not there for batch jobs; give the scenario \
+             as a file",
+        )),
+        Some(p) if Path::new(p).is_relative() => {
+            *scenario = Some(dir.join(p).display().to_string());
+            Ok(())
+        }
+        _ => Ok(()),
+    }
+}
+
+/// Refuses part files `DIR/parts/NAME-?????.json` left by an earlier run (issue 37): the merge
+/// job reads every file of that pattern, so it would add them to the new ones or refuse the set.
+fn check_no_parts(dir: &Path, name: &str) -> Result<(), CliError> {
+    let parts = dir.join("parts");
+    let entries = match std::fs::read_dir(&parts) {
+        Ok(entries) => entries,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(()),
+        Err(e) => {
+            return Err(CliError::usage(format!(
+                "--dir: cannot read {}: {e}",
+                parts.display()
+            )))
+        }
+    };
+    let is_part = |file: &str| {
+        file.strip_prefix(name)
+            .and_then(|f| f.strip_prefix('-'))
+            .and_then(|f| f.strip_suffix(".json"))
+            .is_some_and(|index| index.chars().count() == 5)
+    };
+    let mut stale: Vec<String> = entries
+        .filter_map(|e| e.ok())
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|f| is_part(f))
+        .collect();
+    stale.sort();
+    match stale.first() {
+        None => Ok(()),
+        Some(first) => Err(CliError::usage(format!(
+            "--dir: {} already holds {} part file(s) of '{name}' from an earlier run ({first}{}), \
+             which the merge job would read with the new ones; remove them, or use another \
+             --dir or --name",
+            parts.display(),
+            stale.len(),
+            if stale.len() > 1 { ", …" } else { "" }
+        ))),
+    }
+}
+
+/// `text` quoted for a POSIX shell: in single quotes, each `'` in it as `'\''`.
+fn shell_quote(text: &str) -> String {
+    format!("'{}'", text.replace('\'', r"'\''"))
+}
+
+/// Runs `sbatch --parsable ARGS` with `SCATTERLOC=exe` in its environment (exported to the
+/// job by `--export=ALL`; inside `--export=…,SCATTERLOC=PATH` a comma of the path would split
+/// it) and returns the job id (`123` of `123;cluster`).
+fn sbatch(args: &[String], exe: &Path) -> Result<String, String> {
     let out = Command::new("sbatch")
+        .env("SCATTERLOC", exe)
         .arg("--parsable")
         .args(args)
         .output()
@@ -106,7 +195,21 @@ pub fn slurm_submit(args: &SubmitArgs) -> Result<(), CliError> {
             "--shards: {n} is outside the allowed range 1..={MAX_SHARDS}"
         )));
     }
-    let study_name = check_study(&args.study)?;
+    let cpus = args.cpus_per_task.unwrap_or(2);
+    if !(1..=256).contains(&cpus) {
+        return Err(CliError::usage(format!(
+            "--cpus-per-task: {cpus} is outside the allowed range 1..=256"
+        )));
+    }
+    let dir = std::path::absolute(args.dir.as_deref().unwrap_or("."))
+        .map_err(|e| CliError::usage(format!("--dir: {e}")))?;
+    if !dir.is_dir() {
+        return Err(CliError::usage(format!(
+            "--dir: '{}' is not a directory",
+            dir.display()
+        )));
+    }
+    let study_name = check_study(&args.study, &dir, n, cpus)?;
     let name = args.name.clone().unwrap_or_else(|| study_name.to_string());
     if name.is_empty()
         || name.len() > 64
@@ -125,20 +228,7 @@ pub fn slurm_submit(args: &SubmitArgs) -> Result<(), CliError> {
     if let Some(out) = &args.out {
         Format::of("out", out, &[Format::Svg, Format::Png])?;
     }
-    let cpus = args.cpus_per_task.unwrap_or(2);
-    if !(1..=256).contains(&cpus) {
-        return Err(CliError::usage(format!(
-            "--cpus-per-task: {cpus} is outside the allowed range 1..=256"
-        )));
-    }
-    let dir = std::path::absolute(args.dir.as_deref().unwrap_or("."))
-        .map_err(|e| CliError::usage(format!("--dir: {e}")))?;
-    if !dir.is_dir() {
-        return Err(CliError::usage(format!(
-            "--dir: '{}' is not a directory",
-            dir.display()
-        )));
-    }
+    check_no_parts(&dir, &name)?;
     let dir_s = dir.display().to_string();
     let exe = std::env::current_exe()
         .map_err(|e| CliError::output(format!("the path of this binary: {e}")))?;
@@ -163,7 +253,7 @@ pub fn slurm_submit(args: &SubmitArgs) -> Result<(), CliError> {
     // The docs' scripts, as files a user can read and re-run.
     let scripts = dir.join("slurm");
     std::fs::create_dir_all(&scripts)
-        .map_err(|e| CliError::output(format!("--dir: creating {}: {e}", scripts.display())))?;
+        .map_err(|e| CliError::usage(format!("--dir: cannot create {}: {e}", scripts.display())))?;
     let shards_path = scripts.join("shards.sbatch").display().to_string();
     let merge_path = scripts.join("merge.sbatch").display().to_string();
     let mut files = OutputSet::new();
@@ -171,8 +261,7 @@ pub fn slurm_submit(args: &SubmitArgs) -> Result<(), CliError> {
     files.bytes("dir", &merge_path, MERGE_SCRIPT.as_bytes())?;
     files.commit()?;
 
-    let export = format!("--export=ALL,SCATTERLOC={}", exe.display());
-    let mut common = vec![format!("--chdir={dir_s}"), export];
+    let mut common = vec![format!("--chdir={dir_s}"), "--export=ALL".to_string()];
     if let Some(p) = &args.partition {
         common.push(format!("--partition={p}"));
     }
@@ -190,7 +279,7 @@ pub fn slurm_submit(args: &SubmitArgs) -> Result<(), CliError> {
     array.push(name.clone());
     array.push(n.to_string());
     array.extend(args.study.iter().cloned());
-    let shards_job = sbatch(&array).map_err(CliError::output)?;
+    let shards_job = sbatch(&array, &exe).map_err(CliError::output)?;
 
     let mut merge = common;
     merge.push(format!("--dependency=afterok:{shards_job}"));
@@ -203,13 +292,14 @@ pub fn slurm_submit(args: &SubmitArgs) -> Result<(), CliError> {
         merge.push("--out".into());
         merge.push(out.clone());
     }
-    let merge_job = sbatch(&merge).map_err(|e| {
+    let merge_job = sbatch(&merge, &exe).map_err(|e| {
         CliError::output(format!(
             "the array job {shards_job} was submitted, the merge job was not: {e}; submit it \
-             with `sbatch {}` (or cancel the array: scancel {shards_job})",
+             with `SCATTERLOC={} sbatch {}` (or cancel the array: scancel {shards_job})",
+            shell_quote(&exe.display().to_string()),
             merge
                 .iter()
-                .map(|a| format!("'{a}'"))
+                .map(|a| shell_quote(a))
                 .collect::<Vec<_>>()
                 .join(" ")
         ))

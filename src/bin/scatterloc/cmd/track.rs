@@ -15,7 +15,7 @@ use scatterloc::track::gating::AssociationRule;
 
 use super::filters::filter_kinds;
 use super::gating::read_calibration;
-use super::io::{emit, model_of, read_json_file, read_scenario};
+use super::io::{emit, model_of, one_stdin, read_json_file, read_scenario};
 use super::output::{check_writable, Format};
 use super::study::{cost_refused, run_with_bar};
 use super::track_fig::{read_truth, write_track_figure, TrackSeries};
@@ -25,6 +25,12 @@ use crate::failure::CliError;
 /// `scatterloc track --scenario S --measurements M [--calibration C] [--association R]`.
 pub fn track(args: &TrackArgs) -> Result<(), CliError> {
     let mpath = args.measurements.as_str();
+    one_stdin(&[
+        ("scenario", Some(&args.scenario)),
+        ("measurements", Some(mpath)),
+        ("calibration", args.calibration.as_deref()),
+        ("truth", args.truth.as_deref()),
+    ])?;
     let figure = match args.out.as_deref() {
         Some(p) => {
             let f = Format::of("out", p, &[Format::Svg, Format::Png])?;

@@ -12,7 +12,7 @@ use crate::channel::{ChannelScene, Recording, SimulationRequest};
 use crate::edge::wasm::base::err;
 use crate::edge::wasm::json::to_json;
 use crate::error::limits::{MAX_PAGE_RECORDING_BYTES, MAX_PAGE_TEXT_BYTES};
-use crate::error::Error;
+use crate::error::{Cancel, Error};
 use crate::npz;
 
 /// The files of `cir simulate` for one scenario and simulation request.
@@ -81,7 +81,8 @@ pub fn simulate_channel(
     let (scene, empty) = req.scenes().map_err(err)?;
     check_simulated_size("duration_s", &scene, model.link_count())?;
     check_simulated_size("calibration_duration_s", &empty, model.link_count())?;
-    let sim = req.run(&scenario, &model).map_err(err)?;
+    // The page's worker is ended by terminating it: nothing to ask here.
+    let sim = req.run(&scenario, &model, Cancel::NEVER).map_err(err)?;
     let enc = |r: &Recording| {
         npz::write_recording(r).map_err(|e| JsError::new(&alloc::format!("recording: {e}")))
     };

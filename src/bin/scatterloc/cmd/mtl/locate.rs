@@ -7,6 +7,11 @@ use super::*;
 pub fn mtl_locate(args: &MtlLocateArgs) -> Result<(), CliError> {
     let net_path = args.network.as_str();
     let ranges_path = args.ranges.as_str();
+    one_stdin(&[
+        ("network", Some(net_path)),
+        ("ranges", Some(ranges_path)),
+        ("table", args.table.as_deref()),
+    ])?;
     let spec = model_spec(args)?;
     let cfg = mtl_config(args);
     let out_path = match args.out.as_deref() {

@@ -26,7 +26,7 @@ use scatterloc::native::run_experiment_range;
 use scatterloc::Error;
 
 use super::flags::with_flag;
-use super::io::{emit, emit_summary, read_input};
+use super::io::{emit, emit_summary, one_stdin, read_input};
 use super::output::{check_writable, write_json_file, Figure, Format, OutputSet};
 use super::shard;
 use super::study::{cancelled, run_with_bar, threads};
@@ -39,7 +39,7 @@ mod roc;
 mod table2;
 
 pub use locate::mtl_locate;
-pub use roc::{merge_roc, mtl_roc};
+pub use roc::{merge_roc, mtl_roc, roc_config_of};
 pub use table2::mtl_table2;
 
 /// A core error as a CLI error: the field replaced by its flag when a flag sets it, else

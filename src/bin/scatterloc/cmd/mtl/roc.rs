@@ -236,21 +236,28 @@ fn result_outputs<'a>(
     Ok((figure, json))
 }
 
-/// `scatterloc mtl roc`.
-pub fn mtl_roc(args: &RocArgs) -> Result<(), CliError> {
+/// The validated experiment of `mtl roc`'s flags (errors name the flags); `slurm submit`
+/// checks a study with it before submitting (issue 37).
+pub fn roc_config_of(args: &RocArgs) -> Result<ExperimentConfig, CliError> {
     let experiment = match args.experiment {
         RocExperiment::Va => Experiment::Va,
         RocExperiment::Vb => Experiment::Vb,
         RocExperiment::Vc => Experiment::Vc,
     };
-    let cfg = roc_config(&RocFlags {
+    roc_config(&RocFlags {
         experiment,
         realisations: args.realizations,
         seed: args.seed.unwrap_or(1),
         exact: args.exact,
         empirical: args.empirical,
         max_candidates: args.max_candidates,
-    })?;
+    })
+}
+
+/// `scatterloc mtl roc`.
+pub fn mtl_roc(args: &RocArgs) -> Result<(), CliError> {
+    let cfg = roc_config_of(args)?;
+    let experiment = cfg.experiment;
     let (threads, used) = threads(args.threads)?;
     if let Some(shard) = shard::resolve(&args.shard)? {
         let path = shard::part_path(args.json.as_deref(), args.out.as_deref())?;
