@@ -19,7 +19,7 @@ use super::overlay::{
 };
 use super::panel::{check_area, draw_axes, draw_nodes, legend_entry, rgb, Chart, ChartNode};
 use super::{chart_err, register_fonts, ChartError, CURVE_PALETTE};
-use crate::math::Real;
+use crate::math::{round, Real};
 use crate::present::{linear_ticks, viridis, DelayFigure, DelayImage, LinkDelays, TrackErrorView};
 use crate::scenario::Area;
 
@@ -146,6 +146,129 @@ pub fn draw_delays_boxes<DB: DrawingBackend>(
     fig: &DelayFigure,
     opts: &ChannelChartOptions,
 ) -> Result<Vec<PlotBox>, ChartError> {
+    draw_delays_with(root, fig, opts, true)
+}
+
+/// The delay figure as SVG text of `size` px with each link's image embedded as ONE PNG at
+/// its plot's pixel resolution ([`super::raster`], a `data:` URI) under the vector layers,
+/// instead of one rectangle per run of grey: the file no longer grows by ≈ 48 kB per snapshot
+/// up to the image's 600 columns (28 MB for 1528 snapshots, issue 37 item 11); what still
+/// grows with the snapshots is one circle per estimate.
+pub fn delays_svg(
+    size: (u32, u32),
+    fig: &DelayFigure,
+    opts: &ChannelChartOptions,
+) -> Result<String, ChartError> {
+    let mut svg = String::new();
+    let boxes = {
+        let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
+        let boxes = draw_delays_with(&root, fig, opts, false)?;
+        root.present().map_err(chart_err)?;
+        boxes
+    };
+    let mut images = Vec::new();
+    if let Some(g) = image_range(&fig.links) {
+        for (link, b) in fig.links.iter().zip(&boxes) {
+            let Some(img) = &link.image else {
+                continue;
+            };
+            let (w, h) = (b.x_px[1] - b.x_px[0], b.y_px[1] - b.y_px[0]);
+            if w <= 0 || h <= 0 {
+                continue;
+            }
+            let rgb = image_rgb(
+                img,
+                g,
+                b.t_range_s,
+                axis(link.range_m),
+                (w as usize, h as usize),
+            );
+            let png = super::raster::encode_png(w as usize, h as usize, &rgb).ok_or_else(|| {
+                ChartError(format!("{}: the image could not be encoded", link.name))
+            })?;
+            images.push(((b.x_px[0], b.y_px[0], w, h), png));
+        }
+    }
+    super::raster::embed_pngs(&svg, &images)
+        .ok_or_else(|| ChartError("the figure has no element to put the images under".into()))
+}
+
+/// The image `img` as RGB pixels of a `w × h` plot spanning `[t0, t1] × [r0, r1]` (row 0 at
+/// `r1`, the top): each pixel's centre takes the grey of the column and row it falls in (the
+/// columns' edges of [`draw_image`]), white outside the image.
+fn image_rgb(
+    img: &DelayImage,
+    [lo, hi]: [Real; 2],
+    [t0, t1]: [Real; 2],
+    [r0, r1]: [Real; 2],
+    (w, h): (usize, usize),
+) -> Vec<u8> {
+    let mut rgb = alloc::vec![255u8; 3 * w * h];
+    let cols = img.cols();
+    if cols == 0 || img.rows == 0 {
+        return rgb;
+    }
+    let edges = column_edges(img, t1 - t0);
+    let col_of: Vec<Option<usize>> = (0..w)
+        .map(|x| {
+            let t = t0 + (x as Real + 0.5) / w as Real * (t1 - t0);
+            let i = edges.partition_point(|&e| e <= t);
+            (i >= 1 && i <= cols).then(|| i - 1)
+        })
+        .collect();
+    for y in 0..h {
+        let r = r1 - (y as Real + 0.5) / h as Real * (r1 - r0);
+        let j = round((r - img.r0_m) / img.dr_m);
+        if !(j >= 0.0 && j < img.rows as Real) {
+            continue;
+        }
+        let j = j as usize;
+        for (x, c) in col_of.iter().enumerate() {
+            if let Some(i) = c {
+                let RGBColor(v, _, _) = grey(img.db[j * cols + i], lo, hi);
+                rgb[3 * (y * w + x)..3 * (y * w + x) + 3].fill(v);
+            }
+        }
+    }
+    rgb
+}
+
+/// The `cols + 1` time edges of the image's columns: half-way between neighbouring columns'
+/// times, half a spacing beyond the first and last (`span/2` for a single column).
+fn column_edges(img: &DelayImage, span: Real) -> Vec<Real> {
+    let t = &img.t_s;
+    let cols = t.len();
+    let half = if cols > 1 {
+        0.5 * (t[1] - t[0])
+    } else {
+        0.5 * span
+    };
+    (0..=cols)
+        .map(|i| {
+            if i == 0 {
+                t[0] - half
+            } else if i == cols {
+                t[cols - 1]
+                    + if cols > 1 {
+                        0.5 * (t[cols - 1] - t[cols - 2])
+                    } else {
+                        half
+                    }
+            } else {
+                0.5 * (t[i - 1] + t[i])
+            }
+        })
+        .collect()
+}
+
+/// [`draw_delays_boxes`], the images' cells drawn only when `cells` (else the caller puts each
+/// image under its plot).
+fn draw_delays_with<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    fig: &DelayFigure,
+    opts: &ChannelChartOptions,
+    cells: bool,
+) -> Result<Vec<PlotBox>, ChartError> {
     register_fonts();
     for l in &fig.links {
         if let Some(img) = &l.image {
@@ -188,7 +311,15 @@ pub fn draw_delays_boxes<DB: DrawingBackend>(
     let areas = panels.split_evenly((nrows, ncols));
     let mut boxes = Vec::with_capacity(fig.links.len());
     for (k, (area, link)) in areas.iter().zip(&fig.links).enumerate() {
-        boxes.push(draw_link(area, fig, link, grey_range, k == 0, &font, s)?);
+        boxes.push(draw_link(
+            area,
+            fig,
+            link,
+            grey_range.filter(|_| cells),
+            k == 0,
+            &font,
+            s,
+        )?);
     }
     let (bar_a, bar_g) = bars.split_horizontally(bars_w / 2);
     let bar_h = (bh as f64 * 0.8) as u32;
@@ -365,26 +496,8 @@ fn draw_image<DB: DrawingBackend>(
     if cols == 0 || img.rows == 0 {
         return Ok(());
     }
-    let t = &img.t_s;
-    let half = if cols > 1 {
-        0.5 * (t[1] - t[0])
-    } else {
-        0.5 * (t1 - t0)
-    };
-    let edge = |i: usize| -> Real {
-        if i == 0 {
-            t[0] - half
-        } else if i == cols {
-            t[cols - 1]
-                + if cols > 1 {
-                    0.5 * (t[cols - 1] - t[cols - 2])
-                } else {
-                    half
-                }
-        } else {
-            0.5 * (t[i - 1] + t[i])
-        }
-    };
+    let edges = column_edges(img, t1 - t0);
+    let edge = |i: usize| edges[i];
     let clamp_t = |v: Real| v.clamp(t0, t1);
     let row_edge = |j: usize| (img.r0_m + (j as Real - 0.5) * img.dr_m).clamp(r0, r1);
     let mut cells = Vec::new();

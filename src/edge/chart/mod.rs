@@ -22,7 +22,7 @@ mod scene;
 mod tracking;
 
 pub use channel::{
-    delays_size, draw_delays, draw_track_errors, track_errors_size, ChannelChartOptions,
+    delays_size, delays_svg, draw_delays, draw_track_errors, track_errors_size, ChannelChartOptions,
 };
 pub use channel::{draw_delays_boxes, draw_error_time_chart, error_time_size, PlotBox};
 pub(crate) use layout::{axis_label, chart_err};
@@ -36,7 +36,7 @@ pub use panel::{check_area, ChartNode, MapData, NodeKind};
 pub use plan::{
     draw_plan_maps, plan_caption, plan_chart_size, PlanChartOptions, PlanPanel, PlanPath,
 };
-pub use raster::{base64, encode_png, map_rgb, PNG_DATA_URI, PNG_SIGNATURE};
+pub use raster::{base64, embed_pngs, encode_png, map_rgb, PNG_DATA_URI, PNG_SIGNATURE};
 pub use roc::{
     curve_chart_size, draw_curves, CurveChartOptions, CurveSeries, LineKind, Marker, CURVE_PALETTE,
 };

@@ -99,19 +99,26 @@ pub type PlotPixels = (i32, i32, i32, i32);
 /// after the figure's white background (its first element), so every vector layer stays on top.
 /// `None` if the SVG has no first element to insert after.
 pub fn embed_png(svg: &str, plot: PlotPixels, png: &[u8]) -> Option<String> {
+    embed_pngs(svg, &[(plot, png.to_vec())])
+}
+
+/// [`embed_png`] for several images (the delay figure's panels), in order.
+pub fn embed_pngs(svg: &str, images: &[(PlotPixels, Vec<u8>)]) -> Option<String> {
     let open = svg.find("<svg")?;
     let first = open + svg[open..].find('>')? + 1;
     let first_el = first + svg[first..].find('<')?;
     let after = first_el + svg[first_el..].find("/>")? + 2;
-    let (x, y, w, h) = plot;
-    let image = alloc::format!(
-        "\n<image x=\"{x}\" y=\"{y}\" width=\"{w}\" height=\"{h}\" preserveAspectRatio=\"none\" \
-         style=\"image-rendering:pixelated\" href=\"{PNG_DATA_URI}{}\"/>",
-        base64(png)
-    );
-    let mut out = String::with_capacity(svg.len() + image.len());
+    let mut out =
+        String::with_capacity(svg.len() + images.iter().map(|i| i.1.len() * 2).sum::<usize>());
     out.push_str(&svg[..after]);
-    out.push_str(&image);
+    for ((x, y, w, h), png) in images {
+        out.push_str(&alloc::format!(
+            "\n<image x=\"{x}\" y=\"{y}\" width=\"{w}\" height=\"{h}\" \
+             preserveAspectRatio=\"none\" style=\"image-rendering:pixelated\" \
+             href=\"{PNG_DATA_URI}{}\"/>",
+            base64(png)
+        ));
+    }
     out.push_str(&svg[after..]);
     Some(out)
 }

@@ -309,7 +309,8 @@ impl ChannelFigures {
     }
 
     /// The delay figure as SVG text of `width × height` px (0, 0: the CLI's size; else each
-    /// 200 … 8000). Throws `delays_svg: …`.
+    /// 200 … 8000), its images embedded as PNGs (`chart::delays_svg`, as the CLI's). Throws
+    /// `delays_svg: …`.
     pub fn delays_svg(
         &self,
         width: u32,
@@ -320,9 +321,9 @@ impl ChannelFigures {
         let size = chart_size(delays_size(self.figure.links.len()), width, height)
             .map_err(named("delays_svg"))?;
         let opts = chart_options(title, subtitle);
-        to_svg("delays_svg", size, |root| {
-            draw_delays(root, &self.figure, &opts)
-        })
+        // The images as one PNG per panel, as the CLI writes it (issue 37 item 11).
+        crate::chart::delays_svg(size, &self.figure, &opts)
+            .map_err(|e| JsError::new(&format!("delays_svg: {e}")))
     }
 
     /// Draws the track figure (`chart::draw_track_errors`, as `cir track --figure`: the track on

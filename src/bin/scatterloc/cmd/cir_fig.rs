@@ -7,7 +7,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use scatterloc::channel::{Band, Recording};
 use scatterloc::chart::{
-    delays_size, draw_delays, draw_track_errors, scenario_nodes, track_errors_size,
+    delays_size, delays_svg, draw_delays, draw_track_errors, scenario_nodes, track_errors_size,
     ChannelChartOptions, ChartError,
 };
 use scatterloc::formats::Truth;
@@ -27,6 +27,11 @@ struct Delays {
 impl Figure for Delays {
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), ChartError> {
         draw_delays(root, &self.fig, &self.opts)
+    }
+
+    /// The images as one PNG per panel inside the SVG (issue 37 item 11).
+    fn svg(&self, size: (u32, u32)) -> Option<Result<String, ChartError>> {
+        Some(delays_svg(size, &self.fig, &self.opts))
     }
 }
 

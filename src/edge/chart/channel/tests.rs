@@ -323,3 +323,86 @@ fn track_figure_marks_losses() {
     // Shading before the first segment and in the gap: two more rectangles.
     assert_eq!(count(&svg, "rect"), count(&before, "rect") + 2);
 }
+
+/// Issue 37 item 11: the SVG the CLI and the page write holds each link's image as ONE
+/// embedded PNG (at its plot's pixel size, under the vector layers), not one rectangle per run
+/// of grey, so the file stops growing with the imaged columns. Checked against the cells the
+/// vector figure draws: the PNG's pixel under the middle of each image column and row is the
+/// grey of that cell (an independent lookup: time → nearest column, range → nearest row).
+#[test]
+fn the_svg_embeds_each_image_as_one_png() {
+    let fig = figure();
+    let opts = ChannelChartOptions::default();
+    let size = delays_size(4);
+    let svg = delays_svg(size, &fig, &opts).unwrap();
+    let doc = roxmltree::Document::parse(&svg).expect("well-formed SVG");
+    let images: Vec<_> = doc
+        .descendants()
+        .filter(|n| n.has_tag_name("image"))
+        .collect();
+    assert_eq!(images.len(), 1, "only link 0 has an image");
+    let vector = render(
+        size,
+        |r| draw_delays(r, &fig, &opts),
+        |r| draw_delays(r, &fig, &opts),
+    );
+    // The cells are gone (the other rectangles — colour bars, bands, frames — stay); the
+    // circles and texts stay.
+    let cells = count(&vector, "rect") - count(&svg, "rect");
+    assert!(cells > 1000, "{cells} cells");
+    assert_eq!(count(&svg, "circle"), count(&vector, "circle"));
+    assert_eq!(texts(&svg), texts(&vector));
+    // The image's pixels, as given to the PNG encoder (tested on its own in `raster`).
+    let boxes = {
+        let mut s = String::new();
+        let root = SVGBackend::with_string(&mut s, size).into_drawing_area();
+        draw_delays_boxes(&root, &fig, &opts).unwrap()
+    };
+    let b = boxes[0];
+    let (w, h) = ((b.x_px[1] - b.x_px[0]) as usize, (b.y_px[1] - b.y_px[0]) as usize);
+    let attr = |k: &str| images[0].attribute(k).unwrap().parse::<i32>().unwrap();
+    assert_eq!(
+        (attr("x"), attr("y"), attr("width"), attr("height")),
+        (b.x_px[0], b.y_px[0], w as i32, h as i32)
+    );
+    let img = fig.links[0].image.as_ref().unwrap();
+    let g = image_range(&fig.links).unwrap();
+    let range = axis(fig.links[0].range_m);
+    let rgb = image_rgb(img, g, b.t_range_s, range, (w, h));
+    let [t0, t1] = b.t_range_s;
+    let mut checked = 0;
+    for (i, &tc) in img.t_s.iter().enumerate() {
+        let x = ((tc - t0) / (t1 - t0) * w as Real) as usize;
+        if x >= w {
+            continue;
+        }
+        for j in 0..img.rows {
+            let r = img.r0_m + j as Real * img.dr_m;
+            if !(range[0]..range[1]).contains(&r) {
+                continue;
+            }
+            let y = ((range[1] - r) / (range[1] - range[0]) * h as Real) as usize;
+            if y >= h {
+                continue;
+            }
+            // Only pixels whose centre lies in the cell (not on a boundary).
+            let tx = t0 + (x as Real + 0.5) / w as Real * (t1 - t0);
+            let ry = range[1] - (y as Real + 0.5) / h as Real * (range[1] - range[0]);
+            let nearest_col = img
+                .t_s
+                .iter()
+                .enumerate()
+                .min_by(|a, b| (a.1 - tx).abs().total_cmp(&(b.1 - tx).abs()))
+                .unwrap()
+                .0;
+            let nearest_row = ((ry - img.r0_m) / img.dr_m).round() as usize;
+            if nearest_col != i || nearest_row != j {
+                continue;
+            }
+            let RGBColor(want, _, _) = grey(img.db[j * img.cols() + i], g[0], g[1]);
+            assert_eq!(rgb[3 * (y * w + x)], want, "column {i}, row {j}");
+            checked += 1;
+        }
+    }
+    assert!(checked > 500, "{checked} pixels checked");
+}
