@@ -334,12 +334,22 @@ impl OutputSet {
     /// renamed). A new target is created without replacing anything (`persist_noclobber`), an
     /// existing regular file is replaced atomically (`rename`, which never follows a link). If a
     /// rename still fails, the files this commit created are removed again.
+    ///
+    /// Across processes too (issue 37 item 9: concurrent runs into one directory left a mixed
+    /// set): the targets' directories are locked (an exclusive `flock` on each directory, in a
+    /// fixed order) while the set is renamed, so commits over the same files take turns and
+    /// each leaves a whole set, the last one winning. A directory that cannot be opened or
+    /// locked is renamed into without the lock (as before).
     pub fn commit(self) -> Result<(), CliError> {
         for s in &self.staged {
             target_kind(&s.flag, &s.path)?;
         }
+        let _locks = lock_directories(self.staged.iter().map(|s| s.identity.as_path()));
         let mut created: Vec<String> = Vec::new();
-        for s in self.staged {
+        for (k, s) in self.staged.into_iter().enumerate() {
+            if k > 0 {
+                test_pause();
+            }
             match persist(s.tmp, &s.flag, &s.path) {
                 Ok(Existing::Nothing) => created.push(s.path),
                 Ok(Existing::File) => {}
@@ -352,6 +362,28 @@ impl OutputSet {
             }
         }
         Ok(())
+    }
+}
+
+/// The directories of `files` (deduplicated, sorted: every process takes them in the same
+/// order), each opened and locked exclusively; the locks hold until the files are dropped.
+fn lock_directories<'a>(files: impl Iterator<Item = &'a Path>) -> Vec<File> {
+    let dirs: std::collections::BTreeSet<&Path> = files.filter_map(Path::parent).collect();
+    dirs.into_iter()
+        .filter_map(|d| File::open(d).ok().filter(|f| f.lock().is_ok()))
+        .collect()
+}
+
+/// Debug builds only: sleeps `SCATTERLOC_TEST_COMMIT_PAUSE_MS` between two renames of a set,
+/// so a test can make two commits overlap (`tests/cli/outputs.rs`).
+fn test_pause() {
+    if cfg!(debug_assertions) {
+        if let Some(ms) = std::env::var("SCATTERLOC_TEST_COMMIT_PAUSE_MS")
+            .ok()
+            .and_then(|v| v.parse::<u64>().ok())
+        {
+            std::thread::sleep(std::time::Duration::from_millis(ms.min(10_000)));
+        }
     }
 }
 
