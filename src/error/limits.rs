@@ -144,6 +144,15 @@ pub const C_SIGMA_M: Range = Range {
     allowed: "1e-3 to 1e3 m",
 };
 
+/// The person's extent `σ_e` that widens the delays of a channel track (`extent_sigma_m`):
+/// 0 to 1 km — beyond, a delay says nothing about a position (1e300 was accepted and gave no
+/// track, issue 37 item 8).
+pub const PERSON_EXTENT_M: Range = Range {
+    min: 0.0,
+    max: 1e3,
+    allowed: "0 to 1e3 m",
+};
+
 /// Largest number of links of a scenario. The CRLB map costs links × cells: at 4096 links a
 /// 256² map takes 0.46 s on the 2-core reference machine and the grid-search start of `locate`
 /// 0.10 s; 1000 × 1000 nodes (10⁶ links) took about 2 minutes per map.

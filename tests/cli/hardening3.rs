@@ -496,3 +496,68 @@ fn two_inputs_on_standard_input_are_refused() {
     child.stdin.take().unwrap().write_all(&text).unwrap();
     assert!(child.wait_with_output().unwrap().status.success());
 }
+
+/// Item 8: errors name the recording's array and file, and the flag at fault: a recording
+/// scaled by 10³⁰⁰ (item 7: it gave `"noise_var": null` and exit 0) fails as `--cir PATH: cfr:`
+/// (it said `noise_var`, the estimator's argument); `--statics clusters` without an empty area
+/// as `--calibration: …` once (it said `--calibration: calibration: …`); `--extent-sigma-m
+/// 1e300` by its flag (it was accepted and gave no track).
+#[test]
+fn errors_name_the_recordings_array_file_and_flag() {
+    let dir = TempDir::new();
+    let (scenario, sim) = simulate(&dir, "0.2", "0.02", "5");
+    let rec = format!("{sim}/recording.npz");
+    let mut r = scatterloc::npz::read_recording(&std::fs::read(&rec).unwrap()).unwrap();
+    for v in r.samples.iter_mut() {
+        *v *= 1e300;
+    }
+    let huge = dir.path("huge.npz");
+    std::fs::write(&huge, scatterloc::npz::write_recording(&r).unwrap()).unwrap();
+    let out = dir.path("o.json");
+    let line = fails(
+        &[
+            "cir",
+            "estimate",
+            "--scenario",
+            &scenario,
+            "--cir",
+            &huge,
+            "--out",
+            &out,
+        ],
+        &[&format!("--cir {huge}: cfr: "), "1e100"],
+    );
+    assert!(!line.contains("noise_var"), "{line}");
+    let line = fails(
+        &[
+            "cir",
+            "estimate",
+            "--scenario",
+            &scenario,
+            "--cir",
+            &rec,
+            "--out",
+            &out,
+            "--statics",
+            "clusters",
+        ],
+        &["--calibration: statics clusters"],
+    );
+    assert!(!line.contains("calibration: calibration"), "{line}");
+    fails(
+        &[
+            "cir",
+            "track",
+            "--scenario",
+            &scenario,
+            "--cir",
+            &rec,
+            "--out",
+            &out,
+            "--extent-sigma-m",
+            "1e300",
+        ],
+        &["--extent-sigma-m", "0 to 1e3 m"],
+    );
+    assert!(!Path::new(&out).exists());
+}

@@ -343,7 +343,7 @@ impl ChannelRequest {
 
     /// Checks every setting, naming the field at fault: `pfa`, the front end's
     /// ([`FrontEndConfig::validate`]: `max_paths`, `background_time_s`), the filter's
-    /// ([`ChannelRequest::filter_kind`]), `process_noise` (E7's range), `extent_sigma_m` (finite,
+    /// ([`ChannelRequest::filter_kind`]), `process_noise` (E7's range), `extent_sigma_m` (0 … 1 km,
     /// ≥ 0), `calibration_range_s` (finite, `t0 ≤ t1`), the segments'.
     pub fn check(&self) -> Result<()> {
         if !(self.pfa > 0.0 && self.pfa < 1.0) {
@@ -356,11 +356,11 @@ impl ChannelRequest {
         self.front_end(None).validate()?;
         self.filter_kind()?;
         ConstantVelocity::validated(1.0, self.process_noise)?;
-        if !(self.extent_sigma_m.is_finite() && self.extent_sigma_m >= 0.0) {
+        if !limits::PERSON_EXTENT_M.contains(self.extent_sigma_m) {
             return Err(Error::OutOfRange {
                 field: "extent_sigma_m".into(),
                 value: self.extent_sigma_m,
-                allowed: "0 … finite m",
+                allowed: limits::PERSON_EXTENT_M.allowed,
             });
         }
         if let Some([a, b]) = self.calibration_range_s {

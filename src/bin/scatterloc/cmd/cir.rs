@@ -122,7 +122,9 @@ fn empty_area(
 }
 
 /// Statics and estimates of `rec` on `threads` threads under a progress bar (Ctrl-C: exit 130,
-/// nothing written).
+/// nothing written). An error names the file it comes from (`files`: the `--cir` path and the
+/// `--calibration` path, if any): `--cir PATH: …`, `--calibration PATH: …` (issue 37 item 8:
+/// the flag alone, and `--calibration: calibration: …` twice).
 fn estimate(
     scenario: &Scenario,
     model: &Model,
@@ -130,6 +132,7 @@ fn estimate(
     empty: Option<&Recording>,
     cfg: &FrontEndConfig,
     threads: usize,
+    files: (&str, Option<&str>),
 ) -> Result<(ChannelStatics, RecordingEstimates), CliError> {
     let total = rec.t_s.len() * rec.links.len();
     let (res, _) = run_with_counter(total, "snapshots", "cir", |cancel, bar| {
@@ -146,12 +149,25 @@ fn estimate(
     })?;
     res.map_err(|e| {
         let text = with_flag(&e).unwrap_or_else(|| e.to_string());
-        let flag = if text.starts_with("calibration") {
-            "--calibration"
-        } else {
-            "--cir"
+        if text.starts_with("--") {
+            return CliError::usage(text);
+        }
+        // The estimator's input is the recording's array.
+        let text = match text.strip_prefix("response: ") {
+            Some(rest) => format!("{}: {rest}", rec.layout.array()),
+            None => text,
         };
-        CliError::usage(format!("{flag}: {text}"))
+        let message = match text.strip_prefix("calibration") {
+            Some(rest) => {
+                let rest = rest.strip_prefix(": ").unwrap_or(rest);
+                match files.1 {
+                    Some(path) => format!("--calibration {path}: {rest}"),
+                    None => format!("--calibration: {rest}"),
+                }
+            }
+            None => format!("--cir {}: {text}", files.0),
+        };
+        CliError::usage(message)
     })
 }
 
@@ -200,7 +216,15 @@ pub fn cir_estimate(args: &CirEstimateArgs) -> Result<(), CliError> {
         None => None,
     };
     let cfg = req.front_end(rec.synchronized);
-    let (statics, est) = estimate(&scenario, &model, &rec, empty.as_ref(), &cfg, threads)?;
+    let (statics, est) = estimate(
+        &scenario,
+        &model,
+        &rec,
+        empty.as_ref(),
+        &cfg,
+        threads,
+        (&args.cir, args.calibration.as_deref()),
+    )?;
     let mut files = OutputSet::new();
     files.json(
         "out",
@@ -315,7 +339,15 @@ pub fn cir_track(args: &CirTrackArgs) -> Result<(), CliError> {
         None => None,
     };
     let cfg = req.front_end(rec.synchronized);
-    let (statics, est) = estimate(&scenario, &model, &rec, empty.as_ref(), &cfg, threads)?;
+    let (statics, est) = estimate(
+        &scenario,
+        &model,
+        &rec,
+        empty.as_ref(),
+        &cfg,
+        threads,
+        (&args.cir, args.calibration.as_deref()),
+    )?;
     let (res, _) = run_with_counter(est.len(), "snapshots", "track", |cancel, _| {
         let stop = || cancel.load(std::sync::atomic::Ordering::Relaxed);
         track_recording(
