@@ -63,7 +63,7 @@ impl Pulse {
     /// `pulse` when K is even (no middle sample) or `p(0) = 0` or not finite.
     pub fn normalise(&mut self) -> Result<()> {
         let k = self.samples.len();
-        if k % 2 == 0 {
+        if k.is_multiple_of(2) {
             return Err(invalid(
                 "pulse",
                 format!("{k} samples: an odd count is required (the middle one is t = 0)"),
@@ -287,7 +287,7 @@ impl Recording {
                     check_pulse(p)?;
                 }
                 let rows = s_count * p_count;
-                if self.samples.len() % rows != 0 {
+                if !self.samples.len().is_multiple_of(rows) {
                     return Err(invalid(
                         "cir",
                         format!(
@@ -436,7 +436,7 @@ fn check_pulse(p: &Pulse) -> Result<()> {
     if let Some(i) = p.samples.iter().position(|z| !finite_c(z)) {
         return Err(invalid("pulse", format!("pulse[{i}] is not finite")));
     }
-    if k % 2 == 0 {
+    if k.is_multiple_of(2) {
         return Err(invalid(
             "pulse",
             format!("{k} samples: an odd count is required (the middle one is t = 0)"),

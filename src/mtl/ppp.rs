@@ -240,7 +240,7 @@ impl NodeAreas {
         loop {
             let extra = (self.union[unblocked | t] - al).max(0.0);
             let term = exp(-lambda * extra);
-            if t.count_ones() % 2 == 0 {
+            if t.count_ones().is_multiple_of(2) {
                 sum += term;
             } else {
                 sum -= term;

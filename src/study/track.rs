@@ -259,7 +259,7 @@ struct Every<'a> {
 impl Every<'_> {
     /// [`Error::Cancelled`] at step `k` when it is a checking step and the caller asks.
     fn check(&self, k: usize) -> Result<()> {
-        if k % self.every.max(1) == 0 {
+        if k.is_multiple_of(self.every.max(1)) {
             self.cancel.check()
         } else {
             Ok(())

@@ -357,7 +357,7 @@ impl Estimator {
             let t = fold(k as Real * cell, ws, span);
             if cfg.window_s.is_none() || t <= we {
                 cells.push((slot as u32, t));
-                if k % stride == 0 {
+                if k.is_multiple_of(stride) {
                     median_slots.push(slot as u32);
                 }
             }

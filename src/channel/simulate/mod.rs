@@ -435,7 +435,7 @@ fn apply_clock(
     } else {
         0.0
     };
-    if c.agc_step_db > 0.0 && s > 0 && s % c.agc_every == 0 {
+    if c.agc_step_db > 0.0 && s > 0 && s.is_multiple_of(c.agc_every) {
         *gain_db += c.agc_step_db * (2.0 * uniform(r) - 1.0);
     }
     let g = sqrt(db_to_linear(*gain_db));

@@ -10,7 +10,7 @@ pub fn chi_square_upper_tail(k: usize, x: Real) -> Real {
         return 1.0;
     }
     let e = exp(-0.5 * x);
-    if k % 2 == 0 {
+    if k.is_multiple_of(2) {
         let (mut term, mut sum) = (1.0, 0.0);
         for j in 0..k / 2 {
             if j > 0 {
