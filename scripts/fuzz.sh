@@ -12,7 +12,8 @@
 #   --collect    fail nothing; print every distinct failure with a short case (for triage)
 #   KIND         run only these kinds: scenario page_edits mtl_scene network_ranges
 #                empirical_table calibration ekf cli_delays cli_measurements cli_raw_steps
-#                cli_calibration_file cli_snapshots cli_mtl (test names without `fuzz_`)
+#                cli_calibration_file cli_snapshots cli_mtl noise_free_responses cir_windows
+#                npz_reservations simulator_truth (test names without `fuzz_`)
 #
 # Budgets: an in-process case over 5 s fails (SCATTERLOC_FUZZ_BUDGET_S), one over 120 s stops
 # the run (SCATTERLOC_FUZZ_HARD_S); a CLI case is killed after 15 s (SCATTERLOC_FUZZ_CLI_S) and
@@ -32,7 +33,7 @@ while [ $# -gt 0 ]; do
     --threads) threads=$2; shift 2 ;;
     --strict) export SCATTERLOC_FUZZ_STRICT=1; shift ;;
     --collect) export SCATTERLOC_FUZZ_COLLECT=1; shift ;;
-    -h|--help) sed -n '2,22p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,21p' "$0"; exit 0 ;;
     -*) echo "fuzz.sh: unknown option $1" >&2; exit 2 ;;
     *) filters+=("fuzz_$1"); shift ;;
   esac

@@ -60,6 +60,11 @@ cargo test --release --test tracking --test mtl -- --ignored pcrlb:: check11:: s
 step "channel front end (release): C12 7 on 10⁴ random multipath snapshots, C12 8 on the ray-traced corpus against the reference"
 cargo test --release --test library --test corpus -- --ignored --nocapture c12_ 2>&1 | tee -a "$log"
 
+step "fuzz: the issue-37 kinds, 10⁴ cases each (release): noise-free responses, CIR windows, .npz reservations, simulator truth"
+# The other kinds run at full size in scripts/fuzz.sh; these four stay cheap (about 1 ms a case).
+SCATTERLOC_FUZZ_CASES=10000 cargo test --release --test fuzz -- --nocapture \
+  fuzz_noise_free_responses fuzz_cir_windows fuzz_npz_reservations fuzz_simulator_truth 2>&1 | tee -a "$log"
+
 step "browser end-to-end (Debian chromium + chromedriver; prints the page's own map timing)"
 cargo test --test e2e -- --ignored --nocapture --test-threads=1 2>&1 | tee -a "$log"
 

@@ -6,7 +6,9 @@
 //!   wall time is measured against [`in_process_budget`], and a watchdog thread ends the whole
 //!   test process (exit 3, naming the case) if one case runs past [`hard_limit`] — so a blow-up
 //!   is a loud failure, never a hung CI job. Memory is bounded from outside (`scripts/fuzz.sh`
-//!   runs the test binary under `prlimit --as`).
+//!   runs the test binary under `prlimit --as`); a kind whose input declares sizes also checks
+//!   the process's peak address space around each case ([`vm_peak_bytes`]), which counts a
+//!   reservation whether or not a limit is set.
 //! - CLI cases run the built binary under `prlimit --as` ([`cli_memory_bytes`]) and are killed
 //!   after [`cli_time_limit`]; exit 0 must print JSON whose every `null` is documented, exit 2
 //!   one `error: …` line naming a flag; 101 (panic), 134/SIGABRT (abort, out of memory), other
@@ -618,4 +620,22 @@ pub fn run_child(kind: &str, test_name: &str, dir: &CaseDir, text: &str) -> Verd
             Err(fail(class, detail))
         }
     }
+}
+
+// ------------------------------------------------------------------------------- memory
+
+/// The process's peak virtual memory size (`VmPeak` of `/proc/self/status`), bytes; `None`
+/// where it cannot be read. A case whose call raises it by much reserved that much (an
+/// allocation need not be touched to count), whatever the memory limit.
+pub fn vm_peak_bytes() -> Option<u64> {
+    let s = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = s.lines().find(|l| l.starts_with("VmPeak:"))?;
+    let kb: u64 = line
+        .trim_start_matches("VmPeak:")
+        .trim()
+        .trim_end_matches("kB")
+        .trim()
+        .parse()
+        .ok()?;
+    Some(kb << 10)
 }

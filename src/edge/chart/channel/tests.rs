@@ -359,7 +359,10 @@ fn the_svg_embeds_each_image_as_one_png() {
         draw_delays_boxes(&root, &fig, &opts).unwrap()
     };
     let b = boxes[0];
-    let (w, h) = ((b.x_px[1] - b.x_px[0]) as usize, (b.y_px[1] - b.y_px[0]) as usize);
+    let (w, h) = (
+        (b.x_px[1] - b.x_px[0]) as usize,
+        (b.y_px[1] - b.y_px[0]) as usize,
+    );
     let attr = |k: &str| images[0].attribute(k).unwrap().parse::<i32>().unwrap();
     assert_eq!(
         (attr("x"), attr("y"), attr("width"), attr("height")),
