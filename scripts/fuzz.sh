@@ -19,6 +19,7 @@
 # the run (SCATTERLOC_FUZZ_HARD_S); a CLI case is killed after 15 s (SCATTERLOC_FUZZ_CLI_S) and
 # runs under `prlimit --as` of 2048 MB (SCATTERLOC_FUZZ_CLI_MB); the test process itself runs
 # under `prlimit --as` of FUZZ_MEM_MB (default 8192) MB.
+# The Python kind is python/tests/test_fuzz.py (run by scripts/python.sh; SCATTERLOC_FUZZ_CASES scales it).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 export PATH="$HOME/.cargo/bin:$PATH"
