@@ -201,6 +201,23 @@ def test_estimate_capped_before_copying():
     assert str(e.value) == f"t: expected 3 values, got {HUGE}"
 
 
+def test_estimate_of_huge_samples_is_a_named_error():
+    """Item 22 (item 7's twin): samples scaled by 1e300 returned `noise_var == inf` and no
+    error; now the estimator refuses samples above 1e100 by name, and below that every number
+    out is finite."""
+    freq = (np.arange(64) - 31.5) * 1.875e6
+    h = np.exp(-2j * np.pi * freq * 50e-9) + 0.3j * np.exp(-2j * np.pi * freq * 90e-9)
+    h = np.tile(h, (2, 1))
+    for scale in (1e-30, 1.0, 1e30, 5e99 / 1.3):
+        p = sl.estimate(h * scale, freq_hz=freq)
+        assert np.all(np.isfinite(np.asarray(p.noise_var, dtype=float)))
+        assert np.all(np.isfinite(np.asarray(p.delay, dtype=float)))
+    for scale in (1e101, 1e300):
+        with pytest.raises(sl.ScatterlocError) as e:
+            sl.estimate(h * scale, freq_hz=freq)
+        assert "1e100" in str(e.value)
+
+
 @pytest.mark.parametrize("n", [10**8, HUGE])
 def test_crlb_points_capped_before_copying(n):
     s = sl.Scenario.preset("sensors2019")  # 4 links: at most 2048^2 / 4 points
