@@ -809,3 +809,114 @@ fn declared_sizes_are_not_reserved_up_front() {
     );
     assert!(!std::path::Path::new(&out).exists());
 }
+
+/// Position NEES `eᵀP⁻¹e` of every snapshot of `t` (TRACK.json) with a state within 2 m of the
+/// truth `truth` (truth.json); and how many states were farther (a ghost, not a covariance
+/// question).
+fn position_nees(t: &Value, truth: &Value) -> (Vec<f64>, usize) {
+    let (mut nees, mut ghosts) = (Vec::new(), 0);
+    for (k, x) in t["states"].as_array().unwrap().iter().enumerate() {
+        if x.is_null() {
+            continue;
+        }
+        let at = |v: &Value, i: usize| v[i].as_f64().unwrap();
+        let truth_k = &truth["states"][k];
+        let (dx, dy) = (at(x, 0) - at(truth_k, 0), at(x, 1) - at(truth_k, 1));
+        if dx.hypot(dy) > 2.0 {
+            ghosts += 1;
+            continue;
+        }
+        let p = &t["covariances"][k];
+        let (a, b, c, d) = (at(&p[0], 0), at(&p[0], 1), at(&p[1], 0), at(&p[1], 1));
+        let det = a * d - b * c;
+        assert!(
+            det > 0.0,
+            "snapshot {k}: position covariance not positive definite: {p}"
+        );
+        nees.push((d * dx * dx - (b + c) * dx * dy + a * dy * dy) / det);
+    }
+    (nees, ghosts)
+}
+
+/// The integrated autocorrelation time of `x` in samples (Sokal's self-consistent window
+/// `M ≥ 5τ`), at least 1: `n/τ` of its samples count as independent.
+fn integrated_autocorrelation_time(x: &[f64]) -> f64 {
+    let n = x.len();
+    let mean = x.iter().sum::<f64>() / n as f64;
+    let var = x.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / n as f64;
+    let mut tau = 1.0;
+    for lag in 1..n {
+        let r: f64 = (0..n - lag)
+            .map(|i| (x[i] - mean) * (x[i + lag] - mean))
+            .sum::<f64>()
+            / (n as f64 * var);
+        tau += 2.0 * r;
+        if lag as f64 >= 5.0 * tau {
+            break;
+        }
+    }
+    tau.max(1.0)
+}
+
+/// Issue 38 §11: the reported covariance of a channel track is consistent with its error. On
+/// 15 s of the hangar walk at 50 ms (the page's Simulate) with the empty area's recording and
+/// the default estimator σ widened by the 0.2 m body extent, seeds 1–12: each seed's mean
+/// position NEES (2 degrees of freedom) against its two-sided 95 % band
+/// `χ²_{2n}(0.025 | 0.975)/n` with `n = N/τ` independent samples (`τ` the NEES series'
+/// integrated autocorrelation time: the extent's offset holds over several snapshots); at most 2
+/// of 12 seeds outside (with 12 consistent seeds, 3 or more outside has probability 2 %).
+/// Ghost states (> 2 m from the truth: an association failure, not a covariance question) are
+/// left out and counted: at most 1 % of the states.
+///
+/// Measured (release CLI, 2026-12-06): without the extent's consider term (the filter's own
+/// covariance) the seeds' means were 5.1–6.5, every seed outside its band; with it 1.35–2.10
+/// (pooled 1.77: conservative, the term takes the offset as constant where the simulated body
+/// decorrelates with ρ = 0.9 per snapshot), seed 12 (1.35) below its band [1.43, 2.66], the
+/// others inside; seed 9 starts on a ghost 20 m away for 12 snapshots (0.3 % of the states).
+#[test]
+fn track_nees_is_in_its_band_over_seeds() {
+    let dir = TempDir::new();
+    let scenario = scenario(&dir);
+    let wilson_hilferty =
+        |k: f64, z: f64| k * (1.0 - 2.0 / (9.0 * k) + z * (2.0 / (9.0 * k)).sqrt()).powi(3);
+    let (mut outside, mut ghosts, mut states) = (Vec::new(), 0, 0);
+    for seed in 1..=12 {
+        let name = format!("sim{seed}");
+        let sim = simulate_into(
+            &dir,
+            &scenario,
+            &name,
+            None,
+            ["15", "0.05", "1", &seed.to_string()],
+        );
+        let cal = format!("{sim}/calibration.npz");
+        let (_, t) = track(&dir, &scenario, &sim, &["--calibration", &cal]);
+        let truth = read_json(&format!("{sim}/truth.json"));
+        let (nees, g) = position_nees(&t, &truth);
+        ghosts += g;
+        states += nees.len() + g;
+        assert!(
+            nees.len() > 200,
+            "seed {seed}: the track holds {} of 301 snapshots",
+            nees.len()
+        );
+        let mean = nees.iter().sum::<f64>() / nees.len() as f64;
+        let n = nees.len() as f64 / integrated_autocorrelation_time(&nees);
+        let band = (
+            wilson_hilferty(2.0 * n, -1.959_964) / n,
+            wilson_hilferty(2.0 * n, 1.959_964) / n,
+        );
+        eprintln!(
+            "seed {seed}: mean NEES {mean:.2}, {n:.0} independent, band [{:.2}, {:.2}], ghosts {g}",
+            band.0, band.1
+        );
+        if !(band.0..=band.1).contains(&mean) {
+            outside.push((seed, mean, band));
+        }
+    }
+    assert!(
+        outside.len() <= 2,
+        "seeds outside their 95 % band: {outside:?}"
+    );
+    assert!(ghosts * 100 <= states, "{ghosts} ghost states of {states}");
+}

@@ -15,7 +15,7 @@ use serde::Serialize;
 
 use crate::channel::{DelayEstimate, Snapshot};
 use crate::error::{check_every, Cancel, Result};
-use crate::math::{sqrt, Mat4, Real, Vec4, SPEED_OF_LIGHT};
+use crate::math::{sqrt, Mat2, Mat4, Real, Vec4, SPEED_OF_LIGHT};
 use crate::measure::{rng, Model};
 use crate::scenario::Area;
 use crate::study::channel::{ChannelRequest, DelaySigma, RecordingEstimates};
@@ -33,7 +33,9 @@ pub struct CirTrackOutput {
     pub t_s: Vec<Real>,
     /// The estimates `[x, y, vx, vy]` after each snapshot's update (`null` outside segments).
     pub states: Vec<Option<[Real; 4]>>,
-    /// Their covariances (`null` outside segments).
+    /// Their covariances (`null` outside segments): the filter's, plus, with the estimator's σ
+    /// and a body extent `σ_e > 0`, the extent's consider term in the position block
+    /// ([`extent_floor`]).
     pub covariances: Vec<Option<[[Real; 4]; 4]>>,
     /// Links used per snapshot.
     pub links_used: Vec<usize>,
@@ -136,6 +138,17 @@ impl CirTrackOutput {
         );
     }
 
+    /// Adds the consider term `floor` (m²) to the position block of snapshot `k`'s covariance.
+    fn add_floor(&mut self, k: usize, floor: &Mat2) {
+        if let Some(c) = self.covariances[k].as_mut() {
+            for (i, row) in c.iter_mut().take(2).enumerate() {
+                for (j, v) in row.iter_mut().take(2).enumerate() {
+                    *v += floor[(i, j)];
+                }
+            }
+        }
+    }
+
     /// Whether snapshot `k` has a state.
     pub fn has_state(&self, k: usize) -> bool {
         self.states.get(k).is_some_and(Option::is_some)
@@ -168,6 +181,46 @@ fn widened(est: &RecordingEstimates, k: usize, extent_s: Option<Real>) -> Snapsh
         }
     }
     s
+}
+
+/// The body extent's share of the position covariance that filtering cannot average away
+/// (issue 38 §11): `σ_e²·(JᵀJ)⁻¹`, `J` the rows (E3, s/m) of the links whose delay was used at
+/// state `x`, `extent_s = σ_e/c`. `None` with fewer than two links or a singular `JᵀJ` (the
+/// caller keeps the segment's previous term).
+///
+/// The delay a person's echo shows is that of the body's scattering centre, which wanders over
+/// the body (its extent `σ_e`) slowly against the snapshot rate: the error it adds is an offset
+/// per link held over many snapshots, not white noise. The filter weights each delay with
+/// `σ̂² + σ_e²` as if the errors were independent from snapshot to snapshot and so averages the
+/// offset down; an offset held still passes through a filter in steady state as through a
+/// least-squares fix, with covariance `σ_e²·(JᵀJ)⁻¹`. Added to the filter's position
+/// covariance as a consider term (the filter's own covariance, its gates and its NIS are
+/// unchanged), it makes the reported 1σ consistent with the error: on the simulated walk the
+/// mean NEES of a track was 5.1–6.5 without it (2 is consistent), 1.5–2.1 with it
+/// (`tests/cli/cir.rs`, `track_nees_is_in_its_band_over_seeds`).
+pub fn extent_floor(
+    model: &Model,
+    x: &Vec4,
+    used: &[Option<Real>],
+    extent_s: Real,
+) -> Option<Mat2> {
+    let at = crate::math::Vec2::new(x[0], x[1]);
+    let mut info = Mat2::zeros();
+    let mut rows = 0;
+    for (p, d) in used.iter().enumerate() {
+        if d.is_none() || p >= model.link_count() {
+            continue;
+        }
+        let j = model.network.jacobian_row(p, at);
+        info += j * j.transpose();
+        rows += 1;
+    }
+    if rows < 2 {
+        return None;
+    }
+    let inv = info.try_inverse()?;
+    let floor = inv * (extent_s * extent_s);
+    floor.iter().all(|v| v.is_finite()).then_some(floor)
 }
 
 /// Tracks a recording's estimates (module docs) with the request's tracker settings; asks
@@ -206,6 +259,21 @@ pub fn cir_track(
         Ok((est.t_s[j], widened(est, j, extent_s)))
     };
     let mut open: Option<SegmentDoc> = None;
+    // The extent's consider term ([`extent_floor`]): the last one of the segment where a
+    // snapshot used fewer than two links (the offset is still there).
+    let consider = extent_s.filter(|e| *e > 0.0);
+    let mut floor: Option<Mat2> = None;
+    let record = |out: &mut CirTrackOutput, s: &SegmentStep, floor: &mut Option<Mat2>| {
+        out.record(s);
+        if let Some(e) = consider {
+            if let Some(f) = extent_floor(model, &s.state, &s.step.selection.delays, e) {
+                *floor = Some(f);
+            }
+            if let Some(f) = floor.as_ref() {
+                out.add_floor(s.k, f);
+            }
+        }
+    };
     for k in 0..est.len() {
         if k % every == 0 {
             cancel.check()?;
@@ -214,8 +282,15 @@ pub fn cir_track(
         match tracker.step(k, est.t_s[k], &snap, &replay)? {
             SegmentEvent::Searching { .. } => {}
             SegmentEvent::Started { start, steps } => {
-                for s in &steps {
-                    out.record(s);
+                // The fix's own covariance (one snapshot, nothing averaged) holds the extent
+                // already; the filtered snapshots after it get the consider term.
+                floor = None;
+                for (i, s) in steps.iter().enumerate() {
+                    if i == 0 {
+                        out.record(s);
+                    } else {
+                        record(&mut out, s, &mut floor);
+                    }
                 }
                 let p0 = steps
                     .first()
@@ -237,7 +312,7 @@ pub fn cir_track(
                 });
             }
             SegmentEvent::Tracked(s) => {
-                out.record(&s);
+                record(&mut out, &s, &mut floor);
                 if let Some(seg) = open.as_mut() {
                     seg.last = k;
                     seg.t_last_s = est.t_s[k];
@@ -255,4 +330,48 @@ pub fn cir_track(
         out.segments.push(seg);
     }
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scenario::presets;
+
+    /// `σ_e²·(JᵀJ)⁻¹` against the closed-form 2 × 2 inverse of the information from E3's rows
+    /// (unit vectors to the Tx and Rx, over c); `None` below two links and on collinear rows.
+    #[test]
+    fn extent_floor_is_the_least_squares_covariance_of_an_offset() {
+        let model = Model::new(&presets::preset("sensors2019").unwrap()).unwrap();
+        let net = &model.network;
+        let x = Vec4::new(3.0, 5.0, 1.0, 0.0);
+        let at = crate::math::Vec2::new(3.0, 5.0);
+        let e = 0.2 / SPEED_OF_LIGHT;
+        let used = [Some(1e-7), None, Some(1e-7), Some(1e-7)];
+        let (mut a, mut b, mut d) = (0.0, 0.0, 0.0);
+        for p in [0, 2, 3] {
+            let (tx, rx) = net.link_nodes(p);
+            let u = |n: crate::math::Vec2| {
+                let v = at - n;
+                v / v.norm()
+            };
+            let g = (u(tx) + u(rx)) / SPEED_OF_LIGHT;
+            a += g.x * g.x;
+            b += g.x * g.y;
+            d += g.y * g.y;
+        }
+        let det = a * d - b * b;
+        let f = extent_floor(&model, &x, &used, e).unwrap();
+        let want = [
+            [d / det * e * e, -b / det * e * e],
+            [-b / det * e * e, a / det * e * e],
+        ];
+        for i in 0..2 {
+            for j in 0..2 {
+                let rel = (f[(i, j)] - want[i][j]).abs() / want[0][0].abs();
+                assert!(rel < 1e-12, "({i}, {j}): {} vs {}", f[(i, j)], want[i][j]);
+            }
+        }
+        assert!(extent_floor(&model, &x, &[Some(1e-7), None, None, None], e).is_none());
+        assert!(extent_floor(&model, &x, &[None; 4], e).is_none());
+    }
 }
