@@ -14,6 +14,10 @@ mod common;
 #[path = "common/svg.rs"]
 mod svg;
 
+/// A channel track's NEES against its truth (issue 38 §11), shared with the page tests.
+#[path = "common/nees.rs"]
+mod nees;
+
 #[path = "cli/basics.rs"]
 mod basics;
 

@@ -17,6 +17,7 @@ use serde_json::{json, Value};
 use crate::common::cli::{
     fails, fails_output, interrupted, ok_json, ok_json_line, read_json, TempDir, BIN,
 };
+use crate::nees::position_nees;
 
 /// Writes the sensors2019 scenario into `dir`; returns its path.
 pub(crate) fn scenario(dir: &TempDir) -> String {
@@ -810,54 +811,6 @@ fn declared_sizes_are_not_reserved_up_front() {
     assert!(!std::path::Path::new(&out).exists());
 }
 
-/// Position NEES `eᵀP⁻¹e` of every snapshot of `t` (TRACK.json) with a state within 2 m of the
-/// truth `truth` (truth.json); and how many states were farther (a ghost, not a covariance
-/// question).
-fn position_nees(t: &Value, truth: &Value) -> (Vec<f64>, usize) {
-    let (mut nees, mut ghosts) = (Vec::new(), 0);
-    for (k, x) in t["states"].as_array().unwrap().iter().enumerate() {
-        if x.is_null() {
-            continue;
-        }
-        let at = |v: &Value, i: usize| v[i].as_f64().unwrap();
-        let truth_k = &truth["states"][k];
-        let (dx, dy) = (at(x, 0) - at(truth_k, 0), at(x, 1) - at(truth_k, 1));
-        if dx.hypot(dy) > 2.0 {
-            ghosts += 1;
-            continue;
-        }
-        let p = &t["covariances"][k];
-        let (a, b, c, d) = (at(&p[0], 0), at(&p[0], 1), at(&p[1], 0), at(&p[1], 1));
-        let det = a * d - b * c;
-        assert!(
-            det > 0.0,
-            "snapshot {k}: position covariance not positive definite: {p}"
-        );
-        nees.push((d * dx * dx - (b + c) * dx * dy + a * dy * dy) / det);
-    }
-    (nees, ghosts)
-}
-
-/// The integrated autocorrelation time of `x` in samples (Sokal's self-consistent window
-/// `M ≥ 5τ`), at least 1: `n/τ` of its samples count as independent.
-fn integrated_autocorrelation_time(x: &[f64]) -> f64 {
-    let n = x.len();
-    let mean = x.iter().sum::<f64>() / n as f64;
-    let var = x.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / n as f64;
-    let mut tau = 1.0;
-    for lag in 1..n {
-        let r: f64 = (0..n - lag)
-            .map(|i| (x[i] - mean) * (x[i + lag] - mean))
-            .sum::<f64>()
-            / (n as f64 * var);
-        tau += 2.0 * r;
-        if lag as f64 >= 5.0 * tau {
-            break;
-        }
-    }
-    tau.max(1.0)
-}
-
 /// Issue 38 §11: the reported covariance of a channel track is consistent with its error. On
 /// 15 s of the hangar walk at 50 ms (the page's Simulate) with the empty area's recording and
 /// the default estimator σ widened by the 0.2 m body extent, seeds 1–12: each seed's mean
@@ -877,8 +830,6 @@ fn integrated_autocorrelation_time(x: &[f64]) -> f64 {
 fn track_nees_is_in_its_band_over_seeds() {
     let dir = TempDir::new();
     let scenario = scenario(&dir);
-    let wilson_hilferty =
-        |k: f64, z: f64| k * (1.0 - 2.0 / (9.0 * k) + z * (2.0 / (9.0 * k)).sqrt()).powi(3);
     let (mut outside, mut ghosts, mut states) = (Vec::new(), 0, 0);
     for seed in 1..=12 {
         let name = format!("sim{seed}");
@@ -892,26 +843,20 @@ fn track_nees_is_in_its_band_over_seeds() {
         let cal = format!("{sim}/calibration.npz");
         let (_, t) = track(&dir, &scenario, &sim, &["--calibration", &cal]);
         let truth = read_json(&format!("{sim}/truth.json"));
-        let (nees, g) = position_nees(&t, &truth);
-        ghosts += g;
-        states += nees.len() + g;
+        let n = position_nees(&t, &truth);
+        ghosts += n.ghosts;
+        states += n.samples + n.ghosts;
         assert!(
-            nees.len() > 200,
-            "seed {seed}: the track holds {} of 301 snapshots",
-            nees.len()
-        );
-        let mean = nees.iter().sum::<f64>() / nees.len() as f64;
-        let n = nees.len() as f64 / integrated_autocorrelation_time(&nees);
-        let band = (
-            wilson_hilferty(2.0 * n, -1.959_964) / n,
-            wilson_hilferty(2.0 * n, 1.959_964) / n,
+            n.samples > 200,
+            "seed {seed}: the track holds {} of 301 snapshots near the truth",
+            n.samples
         );
         eprintln!(
-            "seed {seed}: mean NEES {mean:.2}, {n:.0} independent, band [{:.2}, {:.2}], ghosts {g}",
-            band.0, band.1
+            "seed {seed}: mean NEES {:.2} of {} states ({:.0} independent), band [{:.2}, {:.2}], {} ghost states",
+            n.mean, n.samples, n.independent, n.band.0, n.band.1, n.ghosts
         );
-        if !(band.0..=band.1).contains(&mean) {
-            outside.push((seed, mean, band));
+        if !n.inside() {
+            outside.push((seed, n.mean, n.band));
         }
     }
     assert!(

@@ -78,7 +78,7 @@ fn recording_value(r: &scatterloc::channel::Recording) -> Value {
     })
 }
 
-fn base64(bytes: &[u8]) -> String {
+pub(super) fn base64(bytes: &[u8]) -> String {
     const A: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
     let mut s = String::with_capacity(bytes.len().div_ceil(3) * 4);
     for c in bytes.chunks(3) {
@@ -296,7 +296,7 @@ pub(super) fn check(what: &str, d: &Diff) {
 /// `window.__ch`); the outcome lands in `window.__chOut` ({state: 'done', r} or {state:
 /// 'error', message, stopped}). `files` are (recording, calibration) as base64 or a script
 /// expression, so a test can hand over a file built in the page.
-async fn start_job(
+pub(super) async fn start_job(
     c: &Client,
     scenario: &str,
     recording_b64: &str,
@@ -339,7 +339,7 @@ async fn start_job(
 }
 
 /// Waits for the job's outcome (`window.__chOut` once not running).
-async fn outcome(c: &Client, within: Duration) -> Result<Value, String> {
+pub(super) async fn outcome(c: &Client, within: Duration) -> Result<Value, String> {
     let t0 = Instant::now();
     loop {
         let o = js(
