@@ -109,6 +109,34 @@ pub(crate) mod screenshot;
 #[path = "e2e/pictures.rs"]
 mod pictures;
 
+/// Issue 38 §6, §7, §9: channel results marked stale, the delays picture, checks at open.
+#[cfg(test)]
+#[path = "e2e/page_channel.rs"]
+mod page_channel;
+/// Issue 38 §1, §3, §5: state round trip from every view, undo history untouched by the
+/// channel cursor and Play, help covers every view and its links resolve.
+#[cfg(test)]
+#[path = "e2e/page_state.rs"]
+mod page_state;
+/// Issue 38 §4: every view in both themes (axe-core contrast, insets, status colours).
+#[cfg(test)]
+#[path = "e2e/page_theme.rs"]
+mod page_theme;
+/// Issue 38 §2, §8, §10: the tracking map equals its figure after every panel change, the Monte
+/// Carlo chart and status agree, overlays readable.
+#[cfg(test)]
+#[path = "e2e/page_tracking.rs"]
+mod page_tracking;
+
+/// A channel track's NEES against its truth (issue 38 §11), shared with the CLI tests.
+#[cfg(test)]
+#[path = "common/nees.rs"]
+mod nees;
+/// Issue 38 §11: the page's channel track is consistent with its error (NEES band, 4 seeds).
+#[cfg(test)]
+#[path = "e2e/page_nees.rs"]
+mod page_nees;
+
 /// One browser at a time (2-core machines).
 static SERIAL: Mutex<()> = Mutex::new(());
 
@@ -125,10 +153,15 @@ fn content_type(path: &Path) -> &'static str {
         "json" => "application/json",
         "png" => "image/png",
         "svg" => "image/svg+xml",
+        // The docs (Help's links): shown by the browser, not downloaded (scripts/serve.py).
+        "md" => "text/plain; charset=utf-8",
         _ => "application/octet-stream",
     }
 }
 
+/// Answers one request with the layout of `scripts/serve.py`: `root` (`www/`) is the site, and
+/// `/docs/…` and `/README.md` are the repository's (its parent's), for the Help dialog's links.
+/// A path containing `..` or a backslash is refused (404).
 fn serve_one(mut stream: TcpStream, root: &Path) {
     let mut line = String::new();
     let mut reader = BufReader::new(match stream.try_clone() {
@@ -150,10 +183,21 @@ fn serve_one(mut stream: TcpStream, root: &Path) {
     } else {
         path.trim_start_matches('/')
     };
-    let file = root.join(rel);
-    let (status, ctype, body) = match std::fs::read(&file) {
-        Ok(b) if !rel.contains("..") => ("200 OK", content_type(&file), b),
-        _ => ("404 Not Found", "text/plain", b"not found".to_vec()),
+    let repo = root.parent().unwrap_or(root);
+    let file = if rel == "README.md" || rel.starts_with("docs/") {
+        repo.join(rel)
+    } else {
+        root.join(rel)
+    };
+    let refused = rel.contains("..") || rel.contains('\\');
+    let read = if refused {
+        None
+    } else {
+        std::fs::read(&file).ok()
+    };
+    let (status, ctype, body) = match read {
+        Some(b) => ("200 OK", content_type(&file), b),
+        None => ("404 Not Found", "text/plain", b"not found".to_vec()),
     };
     let head = format!(
         "HTTP/1.1 {status}\r\nContent-Type: {ctype}\r\nContent-Length: {}\r\nCache-Control: no-store\r\nConnection: close\r\n\r\n",

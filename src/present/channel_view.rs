@@ -30,11 +30,32 @@ pub struct DelayImage {
     /// Number of rows.
     pub rows: usize,
     /// `rows × cols` values, row-major, dB re 1 W (`10·log10(p/N²)`: a lone path of amplitude
-    /// `|α|` √W peaks at `20·log10|α|`), each within `db_range`.
+    /// `|α|` √W peaks at `20·log10|α|`), each within `db_range`. Serialised to 0.01 dB (the
+    /// figure shows 32 grey levels over 40 dB): the page's worker sends this text to the page,
+    /// a third of the full digits' size (issue 38 item 9).
+    #[serde(serialize_with = "serialize_centi_db")]
     pub db: Vec<Real>,
     /// `[lo, hi]`, dB: `hi` the largest value, `lo = hi − dynamic range` (values below are
     /// clipped to `lo`).
     pub db_range: [Real; 2],
+}
+
+/// `db` with each value rounded to 0.01 dB (non-finite values as they are).
+fn serialize_centi_db<S: serde::Serializer>(
+    db: &[Real],
+    s: S,
+) -> core::result::Result<S::Ok, S::Error> {
+    use serde::ser::SerializeSeq;
+    let mut seq = s.serialize_seq(Some(db.len()))?;
+    for &v in db {
+        let r = if v.is_finite() {
+            crate::math::round(v * 100.0) / 100.0
+        } else {
+            v
+        };
+        seq.serialize_element(&if r.is_finite() { r } else { v })?;
+    }
+    seq.end()
 }
 
 impl DelayImage {
@@ -379,19 +400,42 @@ pub fn static_bands(cal: &LinkCalibration) -> Vec<StaticBand> {
         .collect()
 }
 
-/// A range axis `[lo, hi]` (m) holding the estimates, the bands and the true paths with a 5 %
-/// margin (at least 1 m), starting no lower than 0 and ending no higher than `max_m` (e.g. the
-/// unambiguous range `c/Δf` of a recording; pass `Real::INFINITY` for none). `[0, 10]` when
-/// there is nothing to show.
+/// The estimates a range axis must hold, robust to outliers: the 1st to 99th percentile of
+/// their path lengths widened by a quarter of that span on each side; estimates beyond are
+/// outliers (drawn clipped at the axis' edge and marked). `None` without an estimate.
+pub fn robust_estimate_span_m(estimates: &[DelayPoint]) -> Option<[Real; 2]> {
+    let mut r: Vec<Real> = estimates
+        .iter()
+        .map(|e| e.range_m)
+        .filter(|v| v.is_finite())
+        .collect();
+    if r.is_empty() {
+        return None;
+    }
+    r.sort_by(Real::total_cmp);
+    let (p1, p99) = (quantile_pct(&r, 1), quantile_pct(&r, 99));
+    let pad = 0.25 * (p99 - p1);
+    let (lo, hi) = (p1 - pad, p99 + pad);
+    // The extreme estimates inside the widened span (so the axis ends at data, not at a pad).
+    let first = r.iter().copied().find(|&v| v >= lo).unwrap_or(p1);
+    let last = r.iter().rev().copied().find(|&v| v <= hi).unwrap_or(p99);
+    Some([first, last])
+}
+
+/// A range axis `[lo, hi]` (m) holding the bands, the true paths and the estimates (those
+/// within [`robust_estimate_span_m`]: one stray estimate does not stretch the axis, issue 38
+/// item 7) with a 5 % margin (at least 1 m), starting no lower than 0 and ending no higher than
+/// `max_m` (e.g. the unambiguous range `c/Δf` of a recording; pass `Real::INFINITY` for none).
+/// `[0, 10]` when there is nothing to show.
 pub fn suggest_range_m(
     estimates: &[DelayPoint],
     statics: &[StaticBand],
     truth: &[TruthCurve],
     max_m: Real,
 ) -> [Real; 2] {
-    let values = estimates
-        .iter()
-        .map(|e| e.range_m)
+    let values = robust_estimate_span_m(estimates)
+        .into_iter()
+        .flatten()
         .chain(
             statics
                 .iter()

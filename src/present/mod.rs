@@ -21,7 +21,7 @@ mod snapshot_docs;
 mod ticks;
 mod track_view;
 
-pub use channel_figure::delay_figure;
+pub use channel_figure::{delay_figure, delay_figure_link};
 pub use channel_files::{
     estimates_doc, link_names, track_doc, AlignmentDoc, EstimatesDoc, FrontEndDoc, PathDoc,
     TrackDoc,

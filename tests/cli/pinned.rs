@@ -13,7 +13,11 @@
 //! (its curves and the multi-filter legend with the failed counts), the map SVG embeds the map
 //! as one PNG image, and the transcendental functions are the `libm` crate's on every platform
 //! (last-bit changes: the PF's NEES at 1.4e-12 relative, the exact sums' expansions of the part
-//! files). Issue 24 had made part files format version 2 (a digest of their sums).
+//! files). Issue 24 had made part files format version 2 (a digest of their sums). Issue 38
+//! changed two figures on purpose (only their entries were replaced): the filters' curves of
+//! `montecarlo-filters` and `montecarlo-merge` differ in line style (EKF solid, UKF dotted, PF
+//! dashed), and the merged figure's legend is drawn smaller so that it fits its panel (it was
+//! cut at the plot's left edge).
 //!
 //! To regenerate the reference with another binary (only when an output is meant to change):
 //! `SCATTERLOC_PIN_WRITE=/path/to/scatterloc cargo test --test cli pinned::`.

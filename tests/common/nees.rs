@@ -71,7 +71,7 @@ pub fn integrated_autocorrelation_time(x: &[f64]) -> f64 {
     let n = x.len();
     let mean = x.iter().sum::<f64>() / n as f64;
     let var = x.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / n as f64;
-    if !(var > 0.0) {
+    if var.is_nan() || var <= 0.0 {
         return 1.0;
     }
     let mut tau = 1.0;

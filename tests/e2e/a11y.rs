@@ -24,7 +24,7 @@ const RIGHT: char = '\u{E014}';
 const DELETE: char = '\u{E017}';
 
 /// The pinned axe-core script (scripts/setup.sh). Missing is a failure, never a skip.
-fn axe_source() -> String {
+pub(super) fn axe_source() -> String {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(".tools/axe-core/axe.min.js");
     std::fs::read_to_string(&path).unwrap_or_else(|e| {
         panic!(
@@ -37,7 +37,7 @@ fn axe_source() -> String {
 /// Runs axe on the whole document with **every** rule it has enabled (`axe.getRules()`, the
 /// experimental ones such as `label-content-name-mismatch` included); returns its violations as
 /// `[{id, impact, help, nodes: [{target, summary}]}]` and the number of rules run.
-async fn axe_violations(c: &Client, axe: &str) -> Result<(Vec<Value>, usize), String> {
+pub(super) async fn axe_violations(c: &Client, axe: &str) -> Result<(Vec<Value>, usize), String> {
     if js(c, "return typeof window.axe").await? != "object" {
         c.execute(axe, vec![])
             .await

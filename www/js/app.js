@@ -1,8 +1,9 @@
 // The page: loads the wasm core, owns the state, the refresh loop (one redraw per animation frame
-// at most) and the mode switch between the three views: snapshot (map.js, with the Plan panel of
-// plan.js), tracking (tracking.js) and multi-target (mtl.js); reads its options, and a shared
-// scenario, from the URL hash and writes them back for "Copy link" (share.js). All numbers come
-// from the core; JavaScript routes events and draws. Loaded by main.js.
+// at most) and the mode switch between the four views (VIEWS): snapshot (map.js, with the Plan
+// panel of plan.js), tracking (tracking.js), multi-target (mtl.js) and channel (channel.js);
+// reads its options, and a shared scenario, from the URL hash and writes them back for "Copy
+// link" (share.js). All numbers come from the core; JavaScript routes events and draws. Loaded
+// by main.js.
 
 import init, * as wasm from '../pkg/scatterloc.js';
 import { $, clip, decimal, decimalIn, errorText, showError } from './dom.js';
@@ -20,12 +21,16 @@ import { Plan } from './plan.js';
 import { FigureExport } from './export.js';
 import { Zoomer } from './zoom.js';
 import { setLinkColors } from './draw.js';
-import { Channel, applyChannelSettings, channelSettings } from './channel.js';
+import { CHANNEL_TRANSIENT, Channel, applyChannelSettings, channelSettings, checkChannelState } from './channel.js';
 import { homeWithNodes } from './outside.js';
 import { attachHelp } from './help.js';
 import { attachTheme } from './theme.js';
 
-const MODES = ['snapshot', 'tracking', 'mtl', 'channel'];
+/**
+ * The page's views, one list: each has its top-bar button `mode-<view>`, is a value of the URL
+ * option `mode` and of the page state's `mode` (state.js), and has its entry in Help's Views.
+ */
+const VIEWS = ['snapshot', 'tracking', 'mtl', 'channel'];
 
 /**
  * Every option the page reads from the URL hash (anything else is named in the banner as unknown):
@@ -107,7 +112,7 @@ function hashOptions(presets) {
   const scenarioKeys = ['z', 'scenario'].filter((k) => h.has(k) && !bad.has(k));
   if (scenarioKeys.length > 1) report('scenario', 'z and scenario: both given (one scenario at most)');
   const opts = {
-    mode: oneOf('mode', MODES) ?? 'snapshot',
+    mode: oneOf('mode', VIEWS) ?? 'snapshot',
     track: oneOf('track', [...$('track-kind').options].map((o) => o.value)),
     step: read('step', (t) => decimalIn(t, 'step', { min: stepRange[0], max: stepRange[1], integer: true })),
     play: oneOf('play', ['0', '1']) === '1',
@@ -285,13 +290,16 @@ export async function start() {
   const zoom = new Zoomer(ctx, mtl, (p) => (st.mode === 'mtl' ? !!mtl.hit(p) : !!hitNode(view, st.nodes, p)));
   ctx.zoom = zoom;
   zoom.cancelPress.push(() => mtl.cancelPress());
-  /** Snapshot view (click to place a target), tracking (animated filter track + Monte Carlo) or multi-target. */
+  /**
+   * Snapshot view (click to place a target), tracking (animated filter track + Monte Carlo),
+   * multi-target or channel (recordings to a track).
+   */
   const setMode = (mode) => {
-    st.mode = MODES.includes(mode) ? mode : 'snapshot';
+    st.mode = VIEWS.includes(mode) ? mode : 'snapshot';
     document.body.classList.toggle('mode-tracking', st.mode === 'tracking');
     document.body.classList.toggle('mode-mtl', st.mode === 'mtl');
     document.body.classList.toggle('mode-channel', st.mode === 'channel');
-    for (const m of MODES) $(`mode-${m}`).setAttribute('aria-pressed', String(st.mode === m));
+    for (const m of VIEWS) $(`mode-${m}`).setAttribute('aria-pressed', String(st.mode === m));
     tracking.setActive(st.mode === 'tracking');
     mtl.setActive(st.mode === 'mtl');
     channel.setActive(st.mode === 'channel');
@@ -304,7 +312,7 @@ export async function start() {
     pointer.showHint();
     changed({ draw: true });
   };
-  for (const m of MODES) $(`mode-${m}`).addEventListener('click', () => setMode(m));
+  for (const m of VIEWS) $(`mode-${m}`).addEventListener('click', () => setMode(m));
   $('preset').value = shared ? '' : preset;
   const pointer = attachPointer(ctx);
   attachKeyboard(ctx, mtl);
@@ -358,10 +366,14 @@ export async function start() {
   setMode(opts.mode);
   // The page state (state.js): saved and opened as a file, carried by the link, undo/redo. The
   // channel view's settings (not its recordings) and the colour lock are sections of it; a state
-  // file written before they existed still opens (optional).
-  registerSection('channel', { get: channelSettings, apply: applyChannelSettings, optional: true });
+  // file written before they existed still opens (optional). The channel view's cursor and
+  // playback speed are not edits (transient: undo leaves them be), as the tracking view's.
+  registerSection('channel', {
+    get: channelSettings, apply: applyChannelSettings, check: checkChannelState, optional: true,
+    transient: CHANNEL_TRANSIENT,
+  });
   registerSection('colours', { get: () => map.lock.get(), apply: (v) => map.lock.set(v), optional: true });
-  const pageState = attachState({ app, wasm, st, view, panel, tracking, mtl, plan, zoom, ctx, setMode });
+  const pageState = attachState({ app, wasm, st, view, panel, tracking, mtl, plan, zoom, ctx, setMode, views: VIEWS, homeFor: setHomeFor });
   if (opts.state) {
     const [key, value] = opts.state;
     try {
@@ -383,6 +395,7 @@ export async function start() {
     window: view.zoomed() ? Array.from(view.area) : null,
     scenario: app.scenario_json(),
     state: pageState.linkState(),
+    checkState: (text) => pageState.checkLink(text), // the read-back: the link's state restores
   });
   $('share-copy').addEventListener('click', () => copyLink(link, () => panel.exportJson()));
   $('share-close').addEventListener('click', () => { $('share').hidden = true; });

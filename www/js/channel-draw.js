@@ -12,6 +12,13 @@ import { C, FULL, clipTo, cross, ellipsePath, linkColor, polyline } from './draw
 
 const TRUTH = 'rgba(255,255,255,0.9)';
 
+/**
+ * The time cursor's colour over the charts: a magenta none of the charts' own marks use (the
+ * truth is vermillion, the estimates blue, the statics grey, a loss red, a start green); the
+ * legend under the delay chart shows it (index.html, .sym.chan-cursor).
+ */
+export const CURSOR_COLOR = 'rgb(190, 0, 140)';
+
 /** The reasons a segment ends (TRACK.json `segments[].end`) as the page names them. */
 const LOSS_NAMES = { innovation: 'innovation', misses: 'misses', outside_area: 'outside area', filter: 'filter failure', end: 'end of the recording' };
 
@@ -30,14 +37,16 @@ function halo(ctx, view, points, width) {
 
 /**
  * Draws the layer. `d` = {overlay (ChannelFigures.overlay(k)), truth: [[x, y] | null per
- * snapshot] | null, step, nodes (App.nodes())}. Returns what was drawn, for the hooks:
- * {step, estimate: [x, y] | null, sigma: ellipse | null, links: [link index…], truth: [x, y] |
- * null, track_points (positions drawn), track_runs (segments drawn, each its own line),
- * segment (the overlay's segment index | null)}.
+ * snapshot] | null, step, nodes (App.nodes()), stale (the result's inputs changed since the
+ * run: its track, 1σ and estimate are drawn faded and the track dashed)}. Returns what was
+ * drawn, for the hooks: {step, estimate: [x, y] | null, sigma: ellipse | null, links: [link
+ * index…], truth: [x, y] | null, track_points (positions drawn), track_runs (segments drawn,
+ * each its own line), segment (the overlay's segment index | null), stale}.
  */
 export function drawChannel(ctx, view, d) {
   const ov = d.overlay;
-  const drawn = { step: d.step, estimate: null, sigma: null, links: [], truth: null, track_points: 0, track_runs: 0, segment: null };
+  const stale = !!d.stale;
+  const drawn = { step: d.step, estimate: null, sigma: null, links: [], truth: null, track_points: 0, track_runs: 0, segment: null, stale };
   clipTo(ctx, view.rect);
   ctx.lineJoin = 'round';
   // The true path: whole and dashed, the part walked so far brighter.
@@ -96,13 +105,17 @@ export function drawChannel(ctx, view, d) {
     const runs = ov.track_m || [];
     drawn.segment = ov.segment ?? null;
     drawn.track_runs = runs.length;
+    // A stale result (computed with other nodes or settings): faded, the track dashed.
+    if (stale) ctx.globalAlpha = 0.45;
     runs.forEach((run, i) => {
       drawn.track_points += run.length;
       if (run.length > 1) {
+        if (stale) ctx.setLineDash([6, 5]);
         halo(ctx, view, run, 4.5);
         ctx.strokeStyle = C.fix;
         ctx.lineWidth = 2;
         polyline(ctx, view, run, false); ctx.stroke();
+        ctx.setLineDash([]);
       }
       // A segment that has ended by now: a ring where it was lost.
       if (i !== ov.segment && run.length) {
@@ -125,6 +138,7 @@ export function drawChannel(ctx, view, d) {
       ctx.lineWidth = 1.5; ctx.strokeStyle = '#1b1f27'; ctx.stroke();
       drawn.estimate = [ov.state[0], ov.state[1]];
     }
+    ctx.globalAlpha = 1;
   }
   const t = d.truth && d.truth[d.step];
   if (t) {
@@ -138,7 +152,7 @@ export function drawChannel(ctx, view, d) {
 }
 
 /**
- * The time cursor over a chart drawn by the core: a vertical line at time `t_s` inside `box`
+ * The time cursor over a chart drawn by the core: a vertical line in CURSOR_COLOR at time `t_s` inside `box`
  * ({x_px: [left, right], y_px: [top, bottom], t_range_s: [t0, t1]}, the canvas' backing
  * pixels) on the transparent canvas `cursor` laid over the chart (same backing size). Returns
  * the line's x (backing pixels) or null when nothing is drawn.
@@ -160,7 +174,7 @@ export function drawCursor(cursor, box, t_s, width, height) {
   if (!(x >= x0 - 0.5 && x <= x1 + 0.5)) return null;
   const dpr = window.devicePixelRatio || 1;
   ctx.lineWidth = Math.max(1, 2 * dpr);
-  ctx.strokeStyle = 'rgba(213, 94, 0, 0.9)';
+  ctx.strokeStyle = CURSOR_COLOR;
   ctx.beginPath();
   ctx.moveTo(Math.round(x) + 0.5, y0);
   ctx.lineTo(Math.round(x) + 0.5, y1);

@@ -10,8 +10,8 @@
 //    or without one a background learnt from the recording), truth: text | null, settings:
 //    object (the core's ChannelRequest, see src/edge/wasm/channel/job.rs)}
 //   {kind: 'simulate', scenario: text, settings: object (the core's SimulationRequest)}
-// Progress (run only): {type: 'progress', gen, phase ('estimate' | 'track' | 'figure'), done,
-//   total}.
+// Progress (run only): {type: 'progress', gen, phase ('estimate' | 'track' | 'figure' |
+//   'results': the texts being written), done, total}.
 // Results:
 //   run:      {type: 'result', gen, ms, kind: 'run', summary: object, timings: {parse_ms,
 //              estimate_ms, track_ms, figure_ms}, estimates: text (EST.json),
@@ -41,6 +41,8 @@ async function run(m, { progress, pause }) {
       progress({ phase: p.phase, done: p.done, total: p.total });
       await pause(); // throws when superseded or stopped
     }
+    // Writing the texts (the figure's is megabytes) takes a while: say so first.
+    progress({ phase: 'results', done: 0, total: 1 });
     return {
       value: {
         kind: 'run',

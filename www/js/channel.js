@@ -15,7 +15,8 @@
 // File.arrayBuffer() and go to the worker only: nothing leaves the machine.
 //
 // The state helpers call channelSettings() / applyChannelSettings(obj) (every setting, not the
-// recording).
+// recording), checkChannelState(obj) before applying, and leave CHANNEL_TRANSIENT (the cursor's
+// snapshot, the playback speed) out of the undo history.
 
 import { $, clip, clearError, errorText, fillKeyValues, fitCanvas, fixed, showError } from './dom.js';
 import { ChannelJobs, ChannelStopped } from './channel-job.js';
@@ -48,6 +49,45 @@ const CHOICES = [['filter', 'chan-filter'], ['calibration', 'chan-cal-source'], 
 /** The settings a run depends on (a change after a run says so). */
 const RUN_KEYS = ['filter', 'particles', 'seed', 'process_noise', 'p_fa', 'max_paths', 'extent_sigma_m',
   'statics', 'delay_reference', 'background_time_s', 'calibration', 'empty_from_s', 'empty_to_s'];
+/** The run's settings as the status line names them when they change. */
+const RUN_LABELS = {
+  filter: 'filter', particles: 'particles', seed: 'seed', process_noise: 'q', p_fa: 'P_fa', max_paths: 'max paths',
+  extent_sigma_m: 'extent σ', statics: 'statics', delay_reference: 'delays', background_time_s: 'background τ',
+  calibration: 'empty area', empty_from_s: 'empty from', empty_to_s: 'empty to',
+};
+
+/**
+ * What changed between two scenario JSON texts, named for the status line: each node moved
+ * ("Rx2 moved"), added or removed, and any other change as "scenario changed (radio)" by its
+ * top-level key. Empty when the texts are equal.
+ */
+export function scenarioChanges(before, now) {
+  if (before === now) return [];
+  let a;
+  let b;
+  try {
+    a = JSON.parse(before);
+    b = JSON.parse(now);
+  } catch {
+    return ['scenario changed'];
+  }
+  const out = [];
+  for (const kind of ['transmitters', 'receivers']) {
+    const was = a[kind] || [];
+    const is = b[kind] || [];
+    for (let i = 0; i < Math.max(was.length, is.length); i++) {
+      const [p, q] = [was[i], is[i]];
+      if (!p) out.push(`${q.name} added`);
+      else if (!q) out.push(`${p.name} removed`);
+      else if (p.position_m[0] !== q.position_m[0] || p.position_m[1] !== q.position_m[1]) out.push(`${q.name} moved`);
+      else if (JSON.stringify(p) !== JSON.stringify(q)) out.push(`${q.name} changed`);
+    }
+  }
+  const keys = [...new Set([...Object.keys(a), ...Object.keys(b)])]
+    .filter((k) => k !== 'transmitters' && k !== 'receivers' && JSON.stringify(a[k]) !== JSON.stringify(b[k]));
+  if (keys.length) out.push(`scenario changed (${keys.join(', ')})`);
+  return out.length ? out : ['scenario changed'];
+}
 
 /**
  * The track's segments as the status line names them, e.g. "2 segments: 0.3–16.4 s (lost:
@@ -59,7 +99,54 @@ export function segmentsText(segments) {
   return `${segments.length} segment${segments.length === 1 ? '' : 's'}: ${parts.join(', ')}`;
 }
 
+/**
+ * The phases of a run in order: [phase, name in the status line, share of the progress bar].
+ * The worker reports estimate (link-snapshots), track, figure (links) and results (its texts
+ * being written); the page load (reading them into ChannelFigures) and draw (the charts). The
+ * shares are the measured split of a 1528-snapshot, 4-link recording (issue 38 item 9, see
+ * docs/page.md; the --dev build: reading and estimates 3.6 s, track 0.2 s, figure 0.3 s,
+ * results 1.3 s, reading them 0.5 s, charts 0.8 s): before, the bar sat at 95 % with the last
+ * estimate count while the rest took as long again.
+ */
+const RUN_PHASES = [
+  ['estimate', 'Estimating the statics and paths', 0.55],
+  ['track', 'Tracking', 0.04],
+  ['figure', 'Drawing up the delay figure', 0.06],
+  ['results', 'Handing the results to the page', 0.18],
+  ['load', 'Reading the results', 0.07],
+  ['draw', 'Drawing the charts', 0.1],
+];
+
+/** The worker's phase times of a result (ms): parse, estimate, track, figure. */
+function sumTimings(t) {
+  return (t.parse_ms || 0) + (t.estimate_ms || 0) + (t.track_ms || 0) + (t.figure_ms || 0);
+}
+
+/** Resolves after the next frame was painted (a status set before it shows). */
+function nextPaint() {
+  return new Promise((resolve) => requestAnimationFrame(() => setTimeout(resolve, 0)));
+}
+
 let instance = null;
+
+/**
+ * The settings that are not edits: the time cursor's snapshot and the playback speed. They are
+ * saved and linked, but stepping the cursor, Play and a new speed add no undo step, and an undo
+ * leaves them where they are (state.js `transient`; the tracking view's step and speed alike).
+ */
+export const CHANNEL_TRANSIENT = ['step', 'speed'];
+
+/**
+ * Checks the page state's channel section strictly (checkChannelSettings) before anything is
+ * applied; throws an Error naming the field as `state.channel.<key>: …`.
+ */
+export function checkChannelState(obj) {
+  try {
+    checkChannelSettings(obj);
+  } catch (e) {
+    throw new Error(errorText(e).replace(/^channel settings?(?: (\w+))?:/, (_, k) => (k ? `state.channel.${k}:` : 'state.channel:')));
+  }
+}
 
 /** Every setting of the channel view as a plain JSON object (not the recording itself). */
 export function channelSettings() {
@@ -130,6 +217,8 @@ export class Channel {
     this.segmentMarks = null; // what drawSegments drew over the error chart
     this.cursorX = { delays: null, errors: null };
     this.overlays = new Map(); // step -> ChannelFigures.overlay(step)
+    this.stale = []; // what changed since the result shown (staleReasons)
+    this.progressLog = []; // every progress report of the last run: {phase, done, total, bar}
     this.tickFn = (now) => this.tick(now);
     instance = this;
     this.bind();
@@ -203,6 +292,7 @@ export class Channel {
       el.classList.add('invalid');
       showError(errorText(e));
     }
+    this.showInputs();
   }
 
   bind() {
@@ -211,6 +301,8 @@ export class Channel {
       $(id).setAttribute('autocomplete', 'off');
       $(id).addEventListener('change', () => this.editInput(key, id, label));
     }
+    // The "Empty area" line follows its from/to fields as they are typed.
+    for (const id of ['chan-empty-from', 'chan-empty-to']) $(id).addEventListener('input', () => this.showInputs());
     $('chan-filter').addEventListener('change', () => {
       this.s = { ...this.s, filter: $('chan-filter').value };
       this.writePanel();
@@ -255,8 +347,9 @@ export class Channel {
     $('chan-stop').addEventListener('click', () => this.stop());
     $('chan-play').addEventListener('click', () => (this.playing ? this.pause() : this.play()));
     $('chan-scrub').addEventListener('input', () => {
+      const n = Number($('chan-scrub').value); // before pause() redraws the transport (and the slider)
       this.pause();
-      this.seek(Number($('chan-scrub').value));
+      this.seek(n);
     });
     $('chan-save').addEventListener('click', () => this.save($('chan-save-what').value));
     // Drop files onto the map or the channel panel.
@@ -306,25 +399,59 @@ export class Channel {
     if (json[0]) await this.openTruth(json[0]);
   }
 
-  /** Reads and checks a recording (the core's reader, named errors); it replaces the one open. */
+  /**
+   * A recording's bytes read and checked as the job checks them at Run (the core's reader, its
+   * links against the scenario's: channel_recording_summary). Returns the summary {snapshots,
+   * links, layout, samples_per_link, duration_s, t_s}; throws the core's named error.
+   */
+  readRecording(bytes) {
+    return this.wasm.channel_recording_summary(this.ctx.app.scenario_json(), bytes);
+  }
+
+  /**
+   * The open truth file checked against the recording's times (the core's check at Run,
+   * check_channel_truth); throws naming both files. Nothing without both.
+   */
+  checkTruth(truth, rec) {
+    if (!truth || !rec) return;
+    try {
+      this.wasm.check_channel_truth(truth.text, new Float64Array(rec.summary.t_s));
+    } catch (e) {
+      throw new Error(`truth file ${clip(truth.name)} does not fit the recording ${clip(rec.name)} (${rec.summary.snapshots} snapshots): ${errorText(e)}`);
+    }
+  }
+
+  /**
+   * Reads and checks a recording (the core's reader and its links against the scenario's, named
+   * errors) and replaces the one open. A result shown stays, marked stale. A truth file open
+   * that does not fit the new recording is dropped, and the banner says so.
+   */
   async openRecording(file) {
     try {
       const bytes = await readBytes(file, MAX_RECORDING_FILE_BYTES, 'recording');
-      const summary = this.wasm.read_recording_summary(bytes);
+      const summary = this.readRecording(bytes);
       this.rec = { name: file.name, bytes, summary };
-      this.clearResult();
+      if (!this.result) this.clearResult();
       this.ok();
+      try {
+        this.checkTruth(this.truth, this.rec);
+      } catch (e) {
+        this.truth = null;
+        this.fail(`Recording ${clip(file.name)} opened; its ${errorText(e)} — the truth file was dropped (open the one of this recording)`);
+      }
     } catch (e) {
       this.fail(`Recording ${clip(file.name)}: ${errorText(e)}`);
     }
     this.showInputs();
+    this.showStale();
+    this.redraw();
   }
 
   /** Reads and checks the empty area's recording; the calibration source becomes "recording". */
   async openCalibration(file) {
     try {
       const bytes = await readBytes(file, MAX_RECORDING_FILE_BYTES, 'empty-area recording');
-      const summary = this.wasm.read_recording_summary(bytes);
+      const summary = this.readRecording(bytes);
       this.cal = { name: file.name, bytes, summary };
       this.s = { ...this.s, calibration: 'file' };
       this.writePanel();
@@ -336,14 +463,19 @@ export class Channel {
     this.showStale();
   }
 
-  /** Reads and checks a truth file (its times are checked against the recording's by the core at Run). */
+  /**
+   * Reads and checks a truth file: its form here, its times against the open recording's by the
+   * core's check (as at Run), so a file of another length is refused at open, naming both.
+   */
   async openTruth(file) {
     try {
       if (file.size > MAX_TRUTH_FILE_BYTES) {
         throw new Error(`${file.size} bytes, more than the ${MAX_TRUTH_FILE_BYTES} bytes the page reads`);
       }
       const text = await file.text();
-      this.truth = { name: file.name, text, data: parseTruth(text, file.name) };
+      const truth = { name: file.name, text, data: parseTruth(text, file.name) };
+      this.checkTruth(truth, this.rec);
+      this.truth = truth;
       this.ok();
     } catch (e) {
       this.fail(e.message.startsWith('truth file') ? errorText(e) : `Truth file ${clip(file.name)}: ${errorText(e)}`);
@@ -371,12 +503,34 @@ export class Channel {
     const sum = (s) => `${s.snapshots} snapshots × ${s.links} links × ${s.samples_per_link} ${s.layout === 'cfr' ? 'frequencies' : 'taps'}, ${fixed(s.duration_s, 2)} s`;
     rows.push(['Recording', this.rec ? `${this.rec.name} · ${sum(this.rec.summary)}` : '—', '']);
     if (this.s.calibration === 'file') rows.push(['Empty area', this.cal ? `${this.cal.name} · ${sum(this.cal.summary)}` : this.noEmptyText(), '']);
-    else rows.push(['Empty area', `${fixed(this.s.empty_from_s, 3)} … ${fixed(this.s.empty_to_s, 3)} s of the recording`, '']);
+    else rows.push(['Empty area', this.emptyRangeText(), '']);
     rows.push(['Truth', this.truth ? `${this.truth.name} · ${this.truth.data.t_s.length} states` : '— (optional)', '']);
     fillKeyValues($('chan-inputs'), rows);
     $('chan-truth-clear').disabled = !this.truth;
     $('chan-cal-clear').disabled = !this.cal;
     this.showButtons();
+  }
+
+  /**
+   * The "Empty area" line of a time range: the from/to fields as they stand (also while typed,
+   * before Enter), with the recording's snapshots inside, or what is wrong with them.
+   */
+  emptyRangeText() {
+    const field = (key, id, label) => {
+      try {
+        return { v: parseChannelField(key, $(id).value, label) };
+      } catch (e) {
+        return { error: errorText(e) };
+      }
+    };
+    const from = field('empty_from_s', 'chan-empty-from', 'from');
+    const to = field('empty_to_s', 'chan-empty-to', 'to');
+    if (from.error || to.error) return from.error || to.error;
+    const range = `${fixed(from.v, 3)} … ${fixed(to.v, 3)} s`;
+    if (!(to.v > from.v)) return `${range}: "to" must be after "from"`;
+    if (!this.rec) return `${range} of the recording`;
+    const n = this.rec.summary.t_s.filter((t) => t >= from.v && t <= to.v).length;
+    return `${range} of the recording (${n ? `${n} snapshot${n === 1 ? '' : 's'}` : 'no snapshot: choose times of the recording'})`;
   }
 
   /** The read-out of the empty area without its recording (the file is optional). */
@@ -406,21 +560,49 @@ export class Channel {
     el.dataset.state = state;
   }
 
-  /** Says so when the settings or inputs differ from those of the result shown. */
-  showStale() {
-    if (!this.result || this.running) return;
-    const r = this.result.settings;
-    const changed = RUN_KEYS.filter((k) => r[k] !== this.s[k]);
-    const truthChanged = (this.truth ? this.truth.text : null) !== this.result.truthText;
+  /**
+   * What differs now from the inputs of the result shown, each named for the status line
+   * ("Rx2 moved", "P_fa changed", "recording walk.npz opened", …); empty when it is current or
+   * there is none (issue 38 item 6: any change that invalidates a result marks it stale).
+   */
+  staleReasons() {
+    const r = this.result;
+    if (!r) return [];
+    const out = [];
+    if (this.rec && this.rec !== r.rec) out.push(`recording ${clip(this.rec.name)} opened`);
+    out.push(...scenarioChanges(r.scenario, this.ctx.app.scenario_json()));
+    for (const k of RUN_KEYS) if (r.settings[k] !== this.s[k]) out.push(`${RUN_LABELS[k] || k} changed`);
     const calNow = this.s.calibration === 'file' && this.cal ? this.cal.bytes : null;
-    const emptyChanged = this.s.calibration === 'file' && r.calibration === 'file' && calNow !== this.result.calibration;
-    const el = $('chan-status');
-    if (changed.length || truthChanged || emptyChanged) {
-      const what = [...changed, ...(emptyChanged ? ['empty recording'] : []), ...(truthChanged ? ['truth'] : [])];
-      el.textContent = `${this.doneText()} · changed since: ${what.join(', ')} (press Run)`;
-    } else {
-      el.textContent = this.doneText();
+    if (this.s.calibration === 'file' && r.settings.calibration === 'file' && calNow !== r.calibration) {
+      out.push(calNow ? `empty recording ${clip(this.cal.name)} opened` : 'empty recording removed');
     }
+    const truthNow = this.truth ? this.truth.text : null;
+    if (truthNow !== r.truthText) out.push(truthNow ? `truth ${clip(this.truth.name)} opened` : 'truth removed');
+    return out;
+  }
+
+  /**
+   * Marks the result stale when its inputs changed (staleReasons): the status line names the
+   * changes ("stale: Rx2 moved · …", state "stale"), the map draws the track faded and dashed
+   * and the charts faded, until Run again. Redraws the map when the mark comes or goes (not
+   * when called from the map's own drawing: `fromDraw`).
+   */
+  showStale(fromDraw = false) {
+    if (!this.result || this.running) return;
+    const reasons = this.staleReasons();
+    const was = this.stale.join('\n');
+    const same = was === reasons.join('\n');
+    this.stale = reasons;
+    // From the map's drawing only a change of the reasons rewrites the status line (a file's
+    // error stays until then).
+    if (fromDraw && same) return;
+    $('chan-figures').classList.toggle('stale', reasons.length > 0);
+    if (reasons.length) {
+      this.status(`stale: ${reasons.join(', ')} (press Run) · ${this.doneText()}`, 'stale');
+    } else {
+      this.status(this.doneText(), 'done');
+    }
+    if (!fromDraw && !same) this.redraw();
   }
 
   // ---------- jobs ----------
@@ -452,8 +634,8 @@ export class Channel {
     const t0 = performance.now();
     try {
       const r = await this.jobs.simulate(this.ctx.app.scenario_json(), SIMULATE_SETTINGS);
-      const summary = this.wasm.read_recording_summary(r.recording);
-      const calSummary = this.wasm.read_recording_summary(r.calibration);
+      const summary = this.readRecording(r.recording);
+      const calSummary = this.readRecording(r.calibration);
       this.rec = { name: 'simulated walk', bytes: r.recording, summary };
       this.cal = { name: 'simulated empty area', bytes: r.calibration, summary: calSummary };
       this.truth = { name: 'simulated truth', text: r.truth, data: parseTruth(r.truth, 'simulated truth') };
@@ -498,19 +680,23 @@ export class Channel {
     const scenario = this.ctx.app.scenario_json();
     const nodes = this.ctx.app.nodes();
     const names = nodes.links.map(([k, l]) => `${nodes.transmitters[k].name} → ${nodes.receivers[l].name}`);
+    const rec = this.rec;
     this.running = 'run';
     this.progress = null;
+    this.progressLog = [];
     this.showButtons();
     this.bar(0, true);
     this.status('Reading the recording…', 'running');
+    const t0 = performance.now();
     try {
       const r = await this.jobs.start({
-        scenario, recording: this.rec.bytes,
+        scenario, recording: rec.bytes,
         calibration,
         truth: truthText,
       }, settings, (p) => this.onProgress(p));
+      await this.receive(r, { settings: used, truthText, calibration, scenario, names, rec }, t0);
       this.running = null;
-      this.receive(r, { settings: used, truthText, calibration, scenario, names });
+      this.showStale();
     } catch (e) {
       this.running = null;
       this.bar(0, false);
@@ -530,13 +716,22 @@ export class Channel {
     this.jobs.stop();
   }
 
+  /**
+   * A progress report {phase, done, total} of the worker (estimate, track, figure, results) or
+   * of the page (load, draw): the bar at the phase's start (its share in RUN_PHASES) plus its
+   * part done, the status line the phase's name and count. Kept in progressLog (with the bar).
+   */
   onProgress(p) {
     this.progress = p;
-    const names = { estimate: 'Estimating the statics and paths', track: 'Tracking', figure: 'Drawing up the figures' };
-    const share = { estimate: [0, 0.95], track: [0.95, 0.98], figure: [0.98, 1] }[p.phase] || [0, 1];
-    const f = p.total > 0 ? p.done / p.total : 0;
-    this.bar(share[0] + f * (share[1] - share[0]), true);
-    this.status(`${names[p.phase] || p.phase}… ${p.done} / ${p.total}`, 'running');
+    const k = RUN_PHASES.findIndex(([phase]) => phase === p.phase);
+    const start = RUN_PHASES.slice(0, Math.max(k, 0)).reduce((a, [, , share]) => a + share, 0);
+    const share = k >= 0 ? RUN_PHASES[k][2] : 0;
+    const f = p.total > 0 ? Math.min(1, p.done / p.total) : 0;
+    const bar = start + f * share;
+    this.bar(bar, true);
+    this.progressLog.push({ phase: p.phase, done: p.done, total: p.total, bar });
+    const name = k >= 0 ? RUN_PHASES[k][1] : p.phase;
+    this.status(`${name}…${p.total > 1 ? ` ${p.done} / ${p.total}` : ''}`, 'running');
   }
 
   bar(f, running) {
@@ -545,35 +740,52 @@ export class Channel {
     b.classList.toggle('running', running);
   }
 
-  /** A finished run: the figures (ChannelFigures), the link choice, the cursor at the start. */
-  receive(r, meta) {
+  /**
+   * A finished run (started at `t0`, performance.now()): the figures (ChannelFigures, read from
+   * the worker's texts), the link choice, the charts, the cursor at the start. The reading and
+   * the drawing block the page, so each is reported first (progress 'load', 'draw') and a
+   * frame is let through to show it; their times are the result's page_ms.
+   */
+  async receive(r, meta, t0) {
     let fig;
+    this.onProgress({ phase: 'load', done: 0, total: 1 });
+    await nextPaint();
+    const tLoad = performance.now();
     try {
       fig = new this.wasm.ChannelFigures(meta.scenario, r.figure, r.errors, r.track);
     } catch (e) {
       this.fail(`Run: ${errorText(e)}`);
       return;
     }
+    const loadMs = performance.now() - tLoad;
+    this.onProgress({ phase: 'draw', done: 0, total: 1 });
+    await nextPaint();
+    const tDraw = performance.now();
     if (this.fig) this.fig.free();
     this.fig = fig;
     this.overlays.clear();
     this.runs += 1;
     this.result = {
       track: JSON.parse(r.track), texts: { track: r.track, figure: r.figure, errors: r.errors, estimates: r.estimates },
-      timings: r.timings, summary: r.summary, ms: r.ms, wallMs: r.wallMs, ...meta,
+      timings: { ...r.timings, results_ms: r.ms - sumTimings(r.timings), load_ms: loadMs }, summary: r.summary, ms: r.ms,
+      workerWallMs: r.wallMs, wallMs: r.wallMs, ...meta,
     };
+    this.stale = [];
+    $('chan-figures').classList.remove('stale');
     const sel = $('chan-link');
     sel.replaceChildren(...meta.names.map((n, i) => new Option(n, String(i))));
     if (this.s.link >= meta.names.length) this.s = { ...this.s, link: 0 };
     sel.value = String(this.s.link);
     $('chan-scrub').max = String(this.steps() - 1);
-    this.bar(1, false);
     this.errorText = null;
     clearError();
-    this.status(this.doneText(), 'done');
     this.showButtons();
     this.drawCharts();
     this.seek(Math.min(this.step, this.steps() - 1));
+    this.result.timings.draw_ms = performance.now() - tDraw;
+    this.result.wallMs = performance.now() - t0;
+    this.bar(1, false);
+    this.status(this.doneText(), 'done');
   }
 
   /**
@@ -586,7 +798,7 @@ export class Channel {
     const t = r.timings || {};
     const s = (ms) => `${fixed(ms / 1000, 2)} s`;
     let text = `Done in ${s(r.wallMs)}: read ${s(t.parse_ms)}, statics and paths ${s(t.estimate_ms)}, `
-      + `track ${s(t.track_ms)}, figures ${s(t.figure_ms)} · ${this.staticsText()}`;
+      + `track ${s(t.track_ms)}, figures ${s(t.figure_ms)}, results and charts ${s((r.wallMs - sumTimings(t)))} · ${this.staticsText()}`;
     text += ` · ${segmentsText(r.track.segments)}`;
     const e = r.track.error;
     if (e) text += ` · error median ${fixed(e.median_m, 2)} m, 90 % ${fixed(e.p90_m, 2)} m`;
@@ -612,6 +824,8 @@ export class Channel {
     if (this.fig) this.fig.free();
     this.fig = null;
     this.result = null;
+    this.stale = [];
+    $('chan-figures').classList.remove('stale');
     this.overlays.clear();
     this.step = 0;
     this.drawn = null;
@@ -753,9 +967,12 @@ export class Channel {
       this.drawn = null;
       return;
     }
+    // A node moved (or the scenario changed) since the run: say so before drawing it stale.
+    this.showStale(true);
     const truth = this.truthAt(0) ? this.truth.data.states.map((s) => [s[0], s[1]]) : null;
     this.drawn = drawChannel(ctx, view, {
       overlay: this.overlay(this.step), truth, step: this.step, nodes: this.ctx.st.nodes,
+      stale: this.stale.length > 0,
     });
   }
 
@@ -853,6 +1070,8 @@ export class Channel {
       stopped: this.stopped,
       status: $('chan-status').textContent,
       statusState: $('chan-status').dataset.state,
+      stale: this.stale.slice(),
+      progressLog: this.progressLog.map((p) => ({ ...p })),
       error: this.errorText,
       recording: this.rec ? { name: this.rec.name, ...this.rec.summary } : null,
       calibration: this.cal ? { name: this.cal.name, ...this.cal.summary } : null,

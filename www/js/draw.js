@@ -16,6 +16,18 @@ export const C = {
   focus: '#ffd166',
   iso: 'rgba(255,255,255,0.62)',
   baseline: 'rgba(255,255,255,0.28)',
+  // The dark casing under the main map's iso-delay ellipses, so a yellow or green link reads on
+  // the map's yellow-green end too (map.js drawTargetMain; the same in both themes).
+  mapCasing: 'rgba(10,12,18,0.85)',
+  // The zoom inset's own colours (map.js drawInset), per theme: see applyThemeColors.
+  insetBg: '#0d1017',
+  insetText: '#c9d2e0',
+  insetHalo: 'rgba(10,12,18,0.85)',
+  insetTruth: '#ffffff',
+  insetCasing: 'transparent',
+  insetCrlb: '#5cc8ff',
+  insetFix: '#ffa94d',
+  insetFixFill: 'rgba(255,169,77,0.25)',
 };
 /** The links' colours, from the core (present::LINK_RGB, as the figures'): set by setLinkColors. */
 let LINK_COLORS = ['#ffffff'];
@@ -65,11 +77,65 @@ export function cross(ctx, p, r, color, width) {
   ctx.stroke();
 }
 
-export function haloText(ctx, text, x, y) {
+/** `text` at (x, y) in the current fill over a 3 px halo (dark by default; the inset passes its theme's). */
+export function haloText(ctx, text, x, y, halo = 'rgba(10,12,18,0.85)') {
   ctx.lineWidth = 3;
-  ctx.strokeStyle = 'rgba(10,12,18,0.85)';
+  ctx.strokeStyle = halo;
   ctx.strokeText(text, x, y);
   ctx.fillText(text, x, y);
+}
+
+/** True if boxes `a` and `b` ({x, y, w, h}) overlap. */
+export function boxesOverlap(a, b) {
+  return a.x < b.x + b.w && b.x < a.x + a.w && a.y < b.y + b.h && b.y < a.y + a.h;
+}
+
+/**
+ * Draws `text` (the context's font and fill, with haloText's halo) at the first of `spots`
+ * ([dx, dy, textAlign, textBaseline] from the anchor pixel `p`) whose box lies inside `rect` and
+ * overlaps none of the boxes `taken`; failing that, at the first spot moved up or down by whole
+ * label heights that does; failing that, at the first spot moved inside `rect`. Returns the box
+ * drawn {x, y, w, h} (CSS px, halo included) and adds it to `taken`.
+ */
+export function placeLabel(ctx, text, p, rect, taken, spots) {
+  const halo = 1.5;
+  const boxAt = ([dx, dy, align, baseline], shift = 0) => {
+    ctx.textAlign = align;
+    ctx.textBaseline = baseline;
+    const m = ctx.measureText(text);
+    const x = p.x + dx;
+    const y = p.y + dy + shift;
+    return {
+      x: x - m.actualBoundingBoxLeft - halo, y: y - m.actualBoundingBoxAscent - halo,
+      w: m.actualBoundingBoxLeft + m.actualBoundingBoxRight + 2 * halo,
+      h: m.actualBoundingBoxAscent + m.actualBoundingBoxDescent + 2 * halo,
+      at: { x, y, align, baseline },
+    };
+  };
+  const inside = (b) => b.x >= rect.x && b.y >= rect.y && b.x + b.w <= rect.x + rect.w && b.y + b.h <= rect.y + rect.h;
+  const free = (b) => inside(b) && !taken.some((t) => boxesOverlap(b, t));
+  let best = spots.map((s) => boxAt(s)).find(free);
+  if (!best) {
+    const step = boxAt(spots[0]).h + 1;
+    for (let k = 1; k <= 8 && !best; k++) {
+      for (const sign of [1, -1]) {
+        best = spots.map((s) => boxAt(s, sign * k * step)).find(free);
+        if (best) break;
+      }
+    }
+  }
+  if (!best) {
+    const b = boxAt(spots[0]);
+    const dx = Math.min(Math.max(b.x, rect.x), rect.x + rect.w - b.w) - b.x;
+    const dy = Math.min(Math.max(b.y, rect.y), rect.y + rect.h - b.h) - b.y;
+    best = { ...b, x: b.x + dx, y: b.y + dy, at: { ...b.at, x: b.at.x + dx, y: b.at.y + dy } };
+  }
+  ctx.textAlign = best.at.align;
+  ctx.textBaseline = best.at.baseline;
+  haloText(ctx, text, best.at.x, best.at.y);
+  const box = { x: best.x, y: best.y, w: best.w, h: best.h };
+  taken.push(box);
+  return box;
 }
 
 /** Grid, tick labels (from the core's `axis_ticks`), axis titles and the frame of the plot rectangle. */
@@ -202,13 +268,17 @@ export function drawNodes(ctx, view, receivers, transmitters, sel) {
 /**
  * The canvas colours of the theme (theme.js): the plot's background, frame, axis text, muted
  * text and grid from the CSS variables --plot-bg, --plot-frame, --plot-text, --plot-muted and
- * --plot-grid (style.css, per theme) into C. The map, its overlays and the markers keep their
- * colours in both themes (they are drawn over the map's dark-to-bright scale).
+ * --plot-grid (style.css, per theme) into C; the zoom inset's background, text, halo, truth
+ * cross and link casing from --inset-*, its CRLB and fix from the page's --crlb, --fix and
+ * --ekf-fill. The map, its overlays and the markers keep their colours in both themes (they are
+ * drawn over the map's dark-to-bright scale).
  */
 export function applyThemeColors() {
   const css = getComputedStyle(document.documentElement);
   for (const [key, name] of [['bg', '--plot-bg'], ['frame', '--plot-frame'], ['text', '--plot-text'],
-    ['muted', '--plot-muted'], ['grid', '--plot-grid']]) {
+    ['muted', '--plot-muted'], ['grid', '--plot-grid'], ['insetBg', '--inset-bg'], ['insetText', '--inset-text'],
+    ['insetHalo', '--inset-halo'], ['insetTruth', '--inset-truth'], ['insetCasing', '--inset-casing'],
+    ['insetCrlb', '--crlb'], ['insetFix', '--fix'], ['insetFixFill', '--ekf-fill']]) {
     const v = css.getPropertyValue(name).trim();
     if (v) C[key] = v;
   }

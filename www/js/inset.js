@@ -165,10 +165,18 @@ export class InsetControls {
     Object.assign(head.style, { left: `${box.x}px`, top: `${box.y}px`, width: `${box.size}px`, height: `${HEAD_PX}px` });
   }
 
-  /** For the hooks: {closed, moved, box: {x, y, size} | null}. */
+  /**
+   * For the hooks: {closed, moved, box: {x, y, size} | null, colors: {bg, title, halo} | null}
+   * (the CSS colours the last frame drew the inset's background, title and title halo in).
+   */
   state() {
     const b = this.box;
-    return { closed: this.closed, moved: !!this.pos, box: b ? { x: b.x, y: b.y, size: b.size } : null };
+    return {
+      closed: this.closed,
+      moved: !!this.pos,
+      box: b ? { x: b.x, y: b.y, size: b.size } : null,
+      colors: b && b.colors ? { ...b.colors } : null,
+    };
   }
 }
 

@@ -353,14 +353,25 @@ function drawNetwork(ctx, view, n, selected) {
   drawNodes(ctx, view, n.receivers, n.transmitters, selected);
 }
 
-/** Each link's curve `key` ('outline': closed, 'arc': open) in its plot colour at `alpha`. */
-function linkCurves(ctx, tr, links, key, alpha) {
+/**
+ * Each link's curve `key` ('outline': closed, 'arc': open) in its plot colour at `alpha`, over a
+ * `casing` line `casingPx` px wider (a CSS colour; none when null or transparent).
+ */
+function linkCurves(ctx, tr, links, key, alpha, casing = null, casingPx = 2) {
   const closed = key === 'outline';
+  const cased = casing && casing !== 'transparent';
+  const width = ctx.lineWidth;
   links.forEach((l, i) => {
     if (l[key].length < (closed ? 3 : 2)) return;
+    polyline(ctx, tr, l[key], closed);
+    if (cased) {
+      ctx.globalAlpha = 1;
+      ctx.strokeStyle = casing; ctx.lineWidth = width + casingPx;
+      ctx.stroke();
+      ctx.lineWidth = width;
+    }
     ctx.strokeStyle = linkColor(i);
     ctx.globalAlpha = alpha;
-    polyline(ctx, tr, l[key], closed);
     ctx.stroke();
   });
   ctx.globalAlpha = 1;
@@ -369,8 +380,8 @@ function linkCurves(ctx, tr, links, key, alpha) {
 /** Iso-delay ellipses and markers of the simulated snapshot in the main view. */
 function drawTargetMain(ctx, view, fix) {
   clipTo(ctx, view.rect);
-  ctx.lineWidth = 1;
-  linkCurves(ctx, view, fix.links, 'outline', 0.7);
+  ctx.lineWidth = 1.25;
+  linkCurves(ctx, view, fix.links, 'outline', 0.9, C.mapCasing, 3.5);
   ctx.restore();
   const t = view.toPixel(fix.truth.x, fix.truth.y);
   cross(ctx, t, 6, '#0d1017', 4);
@@ -401,47 +412,48 @@ function drawInset(ctx, view, fix, w, title, avoid, controls) {
   ctx.setLineDash([]);
   ctx.save();
   ctx.shadowColor = 'rgba(0,0,0,0.5)'; ctx.shadowBlur = 12;
-  ctx.fillStyle = 'rgba(13,16,23,0.94)';
+  // The inset's colours follow the theme (C.inset*, style.css --inset-*: draw.js applyThemeColors).
+  ctx.fillStyle = C.insetBg;
   ctx.fillRect(box.x, box.y, size, size);
   ctx.restore();
   clipTo(ctx, { x: box.x, y: box.y, w: size, h: size });
   ctx.lineWidth = 1.25;
   // The core hands over only the arc near the target, so no path is millions of pixels wide.
-  linkCurves(ctx, z, fix.links, 'arc', 0.85);
+  linkCurves(ctx, z, fix.links, 'arc', 0.85, C.insetCasing);
   const c = z.toPixel(fix.truth.x, fix.truth.y);
   if (fix.crlb.ellipse) {
-    ctx.setLineDash([5, 4]); ctx.lineWidth = 2; ctx.strokeStyle = C.crlb;
+    ctx.setLineDash([5, 4]); ctx.lineWidth = 2; ctx.strokeStyle = C.insetCrlb;
     ellipsePath(ctx, z, fix.crlb.ellipse); ctx.stroke();
     ctx.setLineDash([]);
   }
   if (fix.fix) {
     const f = z.toPixel(fix.fix.x, fix.fix.y);
     if (fix.fix.ellipse) {
-      ctx.lineWidth = 2; ctx.strokeStyle = C.fix;
+      ctx.lineWidth = 2; ctx.strokeStyle = C.insetFix;
       ellipsePath(ctx, z, fix.fix.ellipse); ctx.stroke();
-      ctx.fillStyle = 'rgba(255,169,77,0.12)'; ctx.fill();
+      ctx.fillStyle = C.insetFixFill; ctx.fill();
     }
-    ctx.beginPath(); ctx.arc(f.x, f.y, 3.5, 0, FULL); ctx.fillStyle = C.fix; ctx.fill();
+    ctx.beginPath(); ctx.arc(f.x, f.y, 3.5, 0, FULL); ctx.fillStyle = C.insetFix; ctx.fill();
   }
-  cross(ctx, c, 5, '#ffffff', 2);
+  cross(ctx, c, 5, C.insetTruth, 2);
   // Scale bar.
   const bar = w.scale_bar(fix.view_radius_m * 0.8);
   if (bar) {
     const len = z.len(bar.length_m);
     const y = box.y + size - 14;
-    ctx.strokeStyle = '#fff'; ctx.lineWidth = 2;
+    ctx.strokeStyle = C.insetText; ctx.lineWidth = 2;
     ctx.beginPath();
     ctx.moveTo(box.x + 12, y - 4); ctx.lineTo(box.x + 12, y); ctx.lineTo(box.x + 12 + len, y); ctx.lineTo(box.x + 12 + len, y - 4);
     ctx.stroke();
-    ctx.font = FONT; ctx.fillStyle = '#fff'; ctx.textAlign = 'left'; ctx.textBaseline = 'bottom';
-    haloText(ctx, bar.label, box.x + 16 + len, y + 4);
+    ctx.font = FONT; ctx.fillStyle = C.insetText; ctx.textAlign = 'left'; ctx.textBaseline = 'bottom';
+    haloText(ctx, bar.label, box.x + 16 + len, y + 4, C.insetHalo);
   }
-  ctx.font = FONT_B; ctx.fillStyle = C.text; ctx.textAlign = 'left'; ctx.textBaseline = 'top';
-  haloText(ctx, title, box.x + 8, box.y + 7);
+  ctx.font = FONT_B; ctx.fillStyle = C.insetText; ctx.textAlign = 'left'; ctx.textBaseline = 'top';
+  haloText(ctx, title, box.x + 8, box.y + 7, C.insetHalo);
   ctx.restore();
   ctx.strokeStyle = C.frame; ctx.lineWidth = 1;
   ctx.strokeRect(box.x + 0.5, box.y + 0.5, size, size);
-  return { x: box.x, y: box.y, size };
+  return { x: box.x, y: box.y, size, colors: { bg: C.insetBg, title: C.insetText, halo: C.insetHalo } };
 }
 
 /**

@@ -1,7 +1,9 @@
 // The page side of the browser Monte Carlo: a job worker (workers.js; mc-worker.js) runs the
 // study in slices; a newer generation supersedes a running study (every drag restarts it), which
-// the worker drops at its next slice. Shows the progress bar, the status line and the plotters
-// chart (drawn by the wasm core on #track-chart).
+// the worker drops at its next slice; Stop ends it, its partial result staying on the chart. Shows
+// the progress bar, the status line (with the time left, from the measured chunk rate), the status
+// bar's read-out and the plotters chart (drawn by the wasm core on #track-chart), all from one
+// state of one study: a new study clears the chart at once, so no old curve sits under its status.
 
 import { $, errorText, fitCanvas, fixed } from './dom.js';
 import { JobWorker } from './workers.js';
@@ -14,7 +16,7 @@ export class MonteCarlo {
   constructor(wasm, module, onError) {
     this.wasm = wasm;
     this.onError = onError;
-    this.state = 'idle'; // 'running' | 'done' | 'error' | 'idle'
+    this.state = 'idle'; // 'running' | 'done' | 'stopped' | 'error' | 'idle'
     this.params = null;
     this.result = null; // last result JSON text (partial while running)
     this.done = 0;
@@ -25,6 +27,9 @@ export class MonteCarlo {
     this.coldStart = false;
     this.series = 0;
     this.caption = '';
+    this.elapsedMs = null; // time from start to the last report, ms
+    this.etaMs = null; // time left estimated at the last report, ms (null before the first)
+    $('mc-stop').addEventListener('click', () => this.stop());
     this.worker = new JobWorker(new URL('./mc-worker.js', import.meta.url), module, {
       staleMs: Infinity, // the worker drops a stale study at its next slice …
       graceMs: 250, // … or is terminated when that takes longer (one long chunk; issue 24)
@@ -56,8 +61,22 @@ export class MonteCarlo {
     this.result = null;
     this.done = 0;
     this.total = 0; // known from the worker's first report
+    this.elapsedMs = null;
+    this.etaMs = null;
     this.t0 = performance.now();
     this.worker.post(params);
+    this.drawChart(); // the new study's empty chart at once
+    this.show();
+  }
+
+  /** Stop: ends the running study; its partial result stays (chart and figure labelled partial). */
+  stop() {
+    if (this.state !== 'running') return;
+    this.superseded += 1;
+    this.worker.cancel();
+    this.state = 'stopped';
+    this.etaMs = null;
+    this.drawChart();
     this.show();
   }
 
@@ -75,9 +94,13 @@ export class MonteCarlo {
     this.done = m.done;
     this.total = m.total;
     this.result = m.result;
+    this.elapsedMs = performance.now() - this.t0;
+    // The time left at the rate measured so far (chunks are of one size).
+    this.etaMs = m.done > 0 ? (this.elapsedMs * (m.total - m.done)) / m.done : null;
     if (m.type === 'result') {
       this.state = 'done';
-      this.ms = performance.now() - this.t0;
+      this.ms = this.elapsedMs;
+      this.etaMs = null;
       this.computeMs = m.ms;
     }
     this.drawChart();
@@ -105,8 +128,11 @@ export class MonteCarlo {
       this.onError(`Chart: ${errorText(e)}`);
       console.error(e);
     }
-    canvas.dataset.series = String(this.series);
-    canvas.dataset.generation = String(this.gen);
+    // The study drawn: its generation and chunk counts, as the status line's.
+    Object.assign(canvas.dataset, {
+      series: String(this.series), generation: String(this.gen), state: this.state,
+      done: String(this.done), total: String(this.total), title: t.title, subtitle: t.subtitle,
+    });
   }
 
   /** The chart's {title, subtitle, caption} (the canvas and the SVG of "Save figure" share them). */
@@ -115,7 +141,8 @@ export class MonteCarlo {
     const r = this.result ? JSON.parse(this.result) : null;
     let sub = p ? `${p.trajectories * p.noise_runs} runs × ${p.steps} steps, T = ${p.dt_s} s` : '';
     if (r) sub += ` · ${failedRuns(r)}`;
-    if (this.state === 'running') sub += ` · running, ${this.done}/${this.total} chunks`;
+    if (this.state === 'running') sub += ` · ${this.progressText()}`;
+    if (this.state === 'stopped') sub += ` · ${this.stoppedText()}`;
     const names = p && p.filters ? p.filters.toUpperCase().split(',').join(', ') : 'EKF';
     // A study still running (or stopped) labels its figure, the canvas and a saved file alike.
     const partial = r && !r.done ? partialRuns(r, names.includes(',')) : '';
@@ -123,19 +150,43 @@ export class MonteCarlo {
     return { title, subtitle: sub, caption: this.caption, partial };
   }
 
-  /** Progress bar and status line (numbers and labels from the result). */
+  /** A running study's progress: "starting…" before the first report, then "running 55/1251 chunks". */
+  progressText() {
+    return this.total ? `running ${this.done}/${this.total} chunks` : 'starting…';
+  }
+
+  /** A stopped study's progress: "stopped at 55/1251 chunks". */
+  stoppedText() {
+    return this.total ? `stopped at ${this.done}/${this.total} chunks` : 'stopped before its first report';
+  }
+
+  /** The time left of a running study, "about 12 s left" (from the measured chunk rate), or ''. */
+  etaText() {
+    if (this.state !== 'running' || this.etaMs === null) return '';
+    const s = Math.round(this.etaMs / 1000);
+    return `about ${s < 60 ? `${s} s` : `${Math.floor(s / 60)} min ${s % 60} s`} left`;
+  }
+
+  /**
+   * Progress bar, status line, Stop and the status bar's read-out (numbers and labels from the
+   * result), all of the current study.
+   */
   show() {
     const el = $('mc-status');
     Object.assign(el.dataset, {
       state: this.state, generation: String(this.gen), done: String(this.done),
       total: String(this.total), ms: this.ms === null ? '' : String(this.ms),
+      eta: this.etaMs === null ? '' : String(this.etaMs),
     });
     $('mc-bar').style.width = `${this.total ? (100 * this.done) / this.total : 0}%`;
     $('mc-bar').classList.toggle('running', this.state === 'running');
+    $('mc-stop').disabled = this.state !== 'running';
     const p = this.params;
     const size = p ? `${p.trajectories * p.noise_runs} runs × ${p.steps} steps` : '';
+    const eta = this.etaText();
     let text = size;
-    if (this.state === 'running') text = `${size} · running ${this.done}/${this.total} chunks…`;
+    if (this.state === 'running') text = `${size} · ${this.progressText()}${eta ? ` · ${eta}` : ''}`;
+    if (this.state === 'stopped') text = `${size} · ${this.stoppedText()} (the chart shows the runs done)`;
     const r = this.result ? JSON.parse(this.result) : null;
     if (this.state === 'done' && r) {
       const n = r.t_s.length - 1;
@@ -152,9 +203,19 @@ export class MonteCarlo {
     if (this.state === 'error') text = `${size} · failed`;
     el.textContent = text;
     el.title = FAILED_MEANING;
+    // The status bar: the same study, never the time of an earlier one under this one's size.
     const ms = $('mc-ms');
-    ms.textContent = this.ms === null ? 'MC –' : `MC ${size}: ${fixed(this.ms, 0)} ms`;
-    ms.dataset.ms = this.ms === null ? '' : String(this.ms);
+    const bar = {
+      running: `MC ${size}: ${this.progressText()}${eta ? `, ${eta}` : ''}`,
+      done: `MC ${size}: ${fixed(this.ms, 0)} ms`,
+      stopped: `MC ${size}: ${this.stoppedText()}`,
+      error: `MC ${size}: failed`,
+    }[this.state];
+    ms.textContent = bar || 'MC –';
+    Object.assign(ms.dataset, {
+      ms: this.state === 'done' ? String(this.ms) : '', generation: String(this.gen), state: this.state,
+      done: String(this.done), total: String(this.total),
+    });
   }
 }
 

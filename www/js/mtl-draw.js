@@ -3,7 +3,7 @@
 // through the view transform. Markers of the scene (nodes, targets, discs) are drawn from the
 // scene itself so they follow a drag at once.
 
-import { C, FONT_B, FULL, clipTo, cross, drawAxes, drawNodes, drawScaleBar, ellipsePath, focusRing, haloText, isSelected, linkColor, plotFocus, ring } from './draw.js';
+import { C, FONT_B, FULL, clipTo, cross, drawAxes, drawNodes, drawScaleBar, ellipsePath, focusRing, isSelected, linkColor, placeLabel, plotFocus, ring } from './draw.js';
 
 const DISC = 'rgba(150,160,178,0.55)';
 const BLOCKED = '#ff4d4f';
@@ -81,19 +81,31 @@ function candidates(ctx, view, v) {
   }
 }
 
-function detections(ctx, view, v) {
+/** Where a detection's label may go around its ring ([dx, dy, align, baseline]), first choice first. */
+const DET_SPOTS = [[-12, -8, 'right', 'bottom'], [12, -8, 'left', 'bottom'], [-12, 8, 'right', 'top'],
+  [12, 8, 'left', 'top'], [0, -13, 'center', 'bottom'], [0, 13, 'center', 'top']];
+/** Where a target's label may go beside its cross. */
+const TARGET_SPOTS = [[9, 6, 'left', 'top'], [9, -6, 'left', 'bottom'], [-9, 6, 'right', 'top'], [-9, -6, 'right', 'bottom']];
+
+/**
+ * The detections: a ring each, then their labels (#1, #2 FA, …) placed clear of one another
+ * (placeLabel) inside `rect`; each label's box goes to `labels` ({text, kind, box}).
+ */
+function detections(ctx, view, v, rect, taken, labels) {
   ctx.font = FONT_B;
-  ctx.textBaseline = 'bottom';
-  v.detected.forEach((d, i) => {
+  const at = v.detected.map((d) => {
     const p = view.toPixel(d.x[0], d.x[1]);
     const color = d.hit ? DET : FA;
     ctx.beginPath(); ctx.arc(p.x, p.y, 10, 0, FULL);
     ctx.lineWidth = 4; ctx.strokeStyle = 'rgba(10,12,18,0.7)'; ctx.stroke();
     ctx.lineWidth = 2.25; ctx.strokeStyle = color; ctx.stroke();
     dot(ctx, p, 2.5, color);
-    ctx.fillStyle = color;
-    ctx.textAlign = 'right';
-    haloText(ctx, `#${i + 1}${d.hit ? '' : ' FA'}`, p.x - 12, p.y - 8);
+    return { p, color };
+  });
+  v.detected.forEach((d, i) => {
+    const text = `#${i + 1}${d.hit ? '' : ' FA'}`;
+    ctx.fillStyle = at[i].color;
+    labels.push({ text, kind: 'detection', box: placeLabel(ctx, text, at[i].p, rect, taken, DET_SPOTS) });
   });
 }
 
@@ -111,24 +123,29 @@ function discs(ctx, view, scene, sel) {
   });
 }
 
-function targets(ctx, view, scene, v, sel) {
-  ctx.font = FONT_B;
-  ctx.textAlign = 'left';
-  ctx.textBaseline = 'top';
-  scene.targets.forEach((q, k) => {
+/** The targets' crosses, then their labels (clear of the detections' and one another's, as there). */
+function targets(ctx, view, scene, v, sel, rect, taken, labels) {
+  const at = scene.targets.map((q, k) => {
     const p = view.toPixel(q[0], q[1]);
     if (isSelected(sel, 'target', k)) ring(ctx, p, 12);
     cross(ctx, p, 7, '#0d1017', 5);
     cross(ctx, p, 7, '#ffffff', 2.25);
+    return p;
+  });
+  ctx.font = FONT_B;
+  ctx.fillStyle = '#ffffff';
+  scene.targets.forEach((q, k) => {
     const t = v && v.targets[k];
-    ctx.fillStyle = '#ffffff';
-    haloText(ctx, t ? `T${k + 1} · ${t.dp_trps.length} DP` : `T${k + 1}`, p.x + 9, p.y + 6);
+    const text = t ? `T${k + 1} · ${t.dp_trps.length} DP` : `T${k + 1}`;
+    labels.push({ text, kind: 'target', box: placeLabel(ctx, text, at[k], rect, taken, TARGET_SPOTS) });
   });
 }
 
 /**
  * The whole canvas: `scene` (markers, current), `v` (the core's last view or null), `sel` (the
- * selected object), `w` (the wasm module, for axis ticks).
+ * selected object), `w` (the wasm module, for axis ticks). The labels of the detections and
+ * targets drawn go to `view.drawn.labels` ([{text, kind: 'detection' | 'target', box: {x, y, w,
+ * h} CSS px}]).
  */
 export function drawMtl(view, scene, v, sel, w) {
   const ctx = view.context();
@@ -150,8 +167,13 @@ export function drawMtl(view, scene, v, sel, w) {
   if (v) candidates(ctx, view, v);
   ctx.restore();
   if (zoomed) clipTo(ctx, r);
-  if (v) detections(ctx, view, v);
-  targets(ctx, view, scene, v, sel);
+  // Labels stay inside the plot when zoomed (it clips), else inside the canvas.
+  const room = zoomed ? r : { x: 0, y: 0, w: view.width, h: view.height };
+  const taken = [];
+  const labels = [];
+  if (v) detections(ctx, view, v, room, taken, labels);
+  targets(ctx, view, scene, v, sel, room, taken, labels);
+  view.drawn.labels = labels;
   const named = (prefix) => (q, i) => ({ x: q[0], y: q[1], name: `${prefix}${i + 1}` });
   drawNodes(ctx, view, scene.receivers.map(named('Rx')), scene.transmitters.map(named('Tx')), sel);
   if (zoomed) ctx.restore();

@@ -399,6 +399,7 @@ export class Mtl {
       error: this.workerError,
       busyMs: this.job.busyMs(),
       restarts: this.job.restarts,
+      labels: (this.view.drawn.labels || []).map((l) => ({ ...l, box: { ...l.box } })),
     };
   }
 

@@ -113,9 +113,11 @@ function tooLarge(what) {
  * writes it reads (issue 24): a scenario over MAX_BYTES of compact JSON, or whose link the
  * reader would refuse (decodeScenario, run here on the link's own text), throws `tooLarge`
  * instead of giving a link. `state` (JSON text, or null): the rest of the page state (state.js
- * linkState), carried as `zstate=` (deflated) or `state=` (base64url), read back by decodeState.
+ * linkState), carried as `zstate=` (deflated) or `state=` (base64url), read back by decodeState
+ * and then judged whole by `checkState(text)` (state.js checkLink: every section's check, as the
+ * opened page restores it), so no link is given for a state that would not restore.
  */
-export async function viewLink({ mode, res, target, roi, window, scenario, state = null }) {
+export async function viewLink({ mode, res, target, roi, window, scenario, state = null, checkState = null }) {
   const parts = [`mode=${mode}`];
   if (res) parts.push(`res=${res}`);
   if (window) parts.push(`view=${window.join(',')}`);
@@ -127,8 +129,16 @@ export async function viewLink({ mode, res, target, roi, window, scenario, state
     if (size > MAX_BYTES) throw tooLarge(`the page state is ${size} bytes of JSON`);
     const [k, v] = await encodeScenario(state);
     const key = k === 'z' ? 'zstate' : 'state';
-    if ((await decodeState(key, v)) !== JSON.stringify(JSON.parse(state))) {
+    const back = await decodeState(key, v);
+    if (back !== JSON.stringify(JSON.parse(state))) {
       throw new Error(`the ${key}= text does not read back as the page state`);
+    }
+    if (checkState) {
+      try {
+        checkState(back);
+      } catch (e) {
+        throw new Error(`the page state would not restore from the link (${e && e.message ? e.message : e})`);
+      }
     }
     parts.push(`${key}=${v}`);
   }

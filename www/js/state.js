@@ -14,12 +14,14 @@
 // input event) the state is compared with the newest snapshot and, if it differs, pushed. A
 // gesture is one step: nothing is recorded while a pointer is down, a key is held, a trajectory
 // is drawn or a plan runs (its glides), so a drag, a held arrow key, a slider's slide or an
-// Optimize each become one snapshot when they end.
+// Optimize each become one snapshot when they end. A section's `transient` fields (a time
+// cursor, a playback speed) are saved and linked but are not edits: the history leaves them out,
+// and an undo keeps them as they are.
 //
-// The channel view plugs in with one line (the integrator adds it in app.js once
-// www/js/channel.js exists, after attachState):
-//   registerSection('channel', { get: channelSettings, apply: applyChannelSettings, optional: true });
+// The views a state may name (its `mode`) are the page's own list (app.js VIEWS, handed to
+// attachState), so a state saved in any view, the channel view included, restores.
 
+import { homeWithNodes } from './outside.js';
 import { $, clip, decimal, decimalIn, errorText, showError, clearError } from './dom.js';
 import { MAX_BYTES } from './share.js';
 import { View } from './view.js';
@@ -37,18 +39,21 @@ export const MAX_STATE_BYTES = MAX_BYTES;
 export const HISTORY_MAX = 200;
 /** While a gesture or a plan is going on, the history looks again this often, ms. */
 const RETRY_MS = 60;
-const MODES = ['snapshot', 'tracking', 'mtl'];
 
 const sections = [];
 
 /**
  * Registers a section of the state: `name` (its key in the state object) and {get, apply,
  * check?, history = true (undo covers it), optional = false (a state without it is accepted and
- * leaves it as it is)}. Sections are applied in the order registered.
+ * leaves it as it is), transient = [] (fields of its object value that are not edits, such as a
+ * time cursor: saved and linked, left out of the undo history)}. Sections are applied in the
+ * order registered.
  */
-export function registerSection(name, { get, apply, check = null, history = true, optional = false }) {
+export function registerSection(name, {
+  get, apply, check = null, history = true, optional = false, transient = [],
+}) {
   if (sections.some((s) => s.name === name)) throw new Error(`state section ${name}: registered twice`);
-  sections.push({ name, get, apply, check, history, optional });
+  sections.push({ name, get, apply, check, history, optional, transient });
 }
 
 // ---------- strict readers (each throws naming the path) ----------
@@ -131,12 +136,12 @@ export function captureState(names = null) {
 }
 
 /**
- * Restores a state object (a file's, a link's or a snapshot of the history): checks everything,
- * then applies the sections that differ. `names`: only these sections (the rest may be absent);
- * `pending`: facts known beforehand (a link's scenario). Throws a named Error and changes
- * nothing on a bad field.
+ * Checks a state object as restoreState would before applying anything (the envelope, the
+ * sections present, every section's check) and returns the sections to apply, in order. Throws
+ * a named Error (`state.<section>.<field>: …`) on the first bad field. `names`, `pending`: as
+ * for restoreState.
  */
-export function restoreState(obj, { names = null, pending = {} } = {}) {
+export function checkState(obj, { names = null, pending = {} } = {}) {
   if (!isObject(obj)) throw new Error(`state: ${shown(obj)} is not a JSON object`);
   if (obj.format !== STATE_FORMAT) throw new Error(`state.format: ${shown(obj.format)} is not "${STATE_FORMAT}"`);
   if (obj.version !== STATE_VERSION) {
@@ -156,6 +161,17 @@ export function restoreState(obj, { names = null, pending = {} } = {}) {
     list.push(s);
   }
   for (const s of list) if (s.check) s.check(obj[s.name], pending);
+  return list;
+}
+
+/**
+ * Restores a state object (a file's, a link's or a snapshot of the history): checks everything
+ * (checkState), then applies the sections that differ. `names`: only these sections (the rest
+ * may be absent); `pending`: facts known beforehand (a link's scenario). Throws a named Error
+ * and changes nothing on a bad field.
+ */
+export function restoreState(obj, { names = null, pending = {} } = {}) {
+  const list = checkState(obj, { names, pending });
   const done = [];
   try {
     for (const s of list) {
@@ -178,11 +194,13 @@ export function restoreState(obj, { names = null, pending = {} } = {}) {
  * Registers the page's sections, the history, the buttons (Undo, Redo, Save state, Open state),
  * the keyboard shortcuts and the confirmation before a scenario switch.
  * @param {object} p - {app, wasm, st, view, panel, tracking, mtl, plan, zoom, changed (ctx.changed's
- *   holder: the ctx object), setMode}
- * @returns the state model: {capture, restore, linkState, openLink, save, undo, redo, history, dirty}
+ *   holder: the ctx object), setMode, views (the page's views, app.js VIEWS: what `mode` may be),
+ *   homeFor (app.js setHomeFor: sets the map's home to the area widened to its nodes)}
+ * @returns the state model: {capture, restore, linkState, openLink, checkLink, save, undo, redo,
+ *   history, dirty}
  */
 export function attachState(p) {
-  const { app, wasm, st, view, panel, tracking, mtl, plan, zoom, ctx, setMode } = p;
+  const { app, wasm, st, view, panel, tracking, mtl, plan, zoom, ctx, setMode, views, homeFor } = p;
   const changed = (f) => ctx.changed(f);
 
   registerSection('scenario', {
@@ -196,6 +214,7 @@ export function attachState(p) {
       try {
         scratch.set_scenario_json(JSON.stringify(v.json));
         pending.area = Array.from(scratch.area());
+        pending.home = homeWithNodes(pending.area, scratch.nodes()).home;
       } catch (e) {
         throw new Error(`state.scenario.json: ${errorText(e)}`);
       } finally {
@@ -207,7 +226,7 @@ export function attachState(p) {
         plan.cancel('state restored');
         const text = JSON.stringify(v.json);
         if (app.scenario_json() !== text) app.set_scenario_json(text);
-        view.setHome(app.area());
+        homeFor();
         st.nodes = app.nodes();
         changed({ all: true });
       }
@@ -281,6 +300,7 @@ export function attachState(p) {
     ['runs', 'mc-runs'], ['speed', 'track-speed']];
   const stepRange = JSON.parse(wasm.track_field_ranges()).step;
   registerSection('tracking', {
+    transient: ['speed'], // the playback speed, like the step (the view section's): not an edit
     get: () => {
       const o = { kind: tracking.kind, drawn: { ...tracking.drawn } };
       for (const [k, id] of TRACK) o[k] = k === 'filter' ? $(id).value : Number($(id).value);
@@ -353,13 +373,14 @@ export function attachState(p) {
     }),
     check: (v, pending) => {
       fields(v, 'state.view', ['map', 'mtl', 'plan_open', 'step']);
-      if (v.map !== null) checkWindow(v.map, 'state.view.map', pending.area ?? Array.from(app.area()));
+      const home = pending.home ?? homeWithNodes(Array.from(app.area()), app.nodes()).home;
+      if (v.map !== null) checkWindow(v.map, 'state.view.map', home);
       if (v.mtl !== null) checkWindow(v.mtl, 'state.view.mtl', mtlHome(pending.region ?? mtl.scene.region));
       flag(v.plan_open, 'state.view.plan_open');
       number(v.step, 'state.view.step', { min: stepRange[0], max: stepRange[1], integer: true });
     },
     apply: (v) => {
-      view.setHome(app.area());
+      homeFor();
       if (v.map) view.setWindow(v.map); else view.reset();
       mtl.view.setHome(mtlHome(mtl.scene.region));
       if (v.mtl) mtl.view.setWindow(v.mtl); else mtl.view.reset();
@@ -375,7 +396,7 @@ export function attachState(p) {
     history: false,
     get: () => st.mode,
     check: (v) => {
-      if (!MODES.includes(v)) throw new Error(`state.mode: ${shown(v)} is not one of ${MODES.join(', ')}`);
+      if (!views.includes(v)) throw new Error(`state.mode: ${shown(v)} is not one of ${views.join(', ')}`);
     },
     apply: (v) => setMode(v),
   });
@@ -415,9 +436,18 @@ class StateModel {
 
   historyNames() { return sections.filter((s) => s.history).map((s) => s.name); }
 
+  /** The history's snapshot of the page now: the history sections, without their transient fields. */
   docText() {
     const o = {};
-    for (const s of sections) if (s.history) o[s.name] = s.get();
+    for (const s of sections) {
+      if (!s.history) continue;
+      const v = s.get();
+      if (s.transient.length && isObject(v)) {
+        o[s.name] = Object.fromEntries(Object.entries(v).filter(([k]) => !s.transient.includes(k)));
+      } else {
+        o[s.name] = v;
+      }
+    }
     return JSON.stringify(o);
   }
 
@@ -508,6 +538,10 @@ class StateModel {
     this.check(true);
     if (i < 0 || i >= this.entries.length || i === this.index) return false;
     const obj = { format: STATE_FORMAT, version: STATE_VERSION, ...JSON.parse(this.entries[i]) };
+    // The transient fields (a cursor, a speed) stay as they are now (in get()'s order of fields).
+    for (const s of sections) {
+      if (s.history && s.transient.length && isObject(obj[s.name])) obj[s.name] = { ...s.get(), ...obj[s.name] };
+    }
     this.restoring = true;
     try {
       restoreState(obj, { names: this.historyNames() });
@@ -750,6 +784,15 @@ class StateModel {
     const s = captureState();
     s.scenario = { ...s.scenario, json: null };
     return JSON.stringify(s);
+  }
+
+  /**
+   * Copy link's read-back of its own state part (`text`, decoded from the link as the opened page
+   * will decode it): throws the named Error the opened page would give unless every section
+   * passes the checks a restore makes first (checkState, with the link's own scenario option).
+   */
+  checkLink(text) {
+    checkState(JSON.parse(text), { pending: { linkScenario: true } });
   }
 
   /** A link's state (its JSON text, the scenario given by the link's scenario option): null or the message. */

@@ -3,7 +3,7 @@
 // the arrow of a drawn trajectory. The current step's markers, iso-delay ellipses and the zoom
 // inset are drawn by draw.js from the snapshot-shaped frame.
 
-import { C, FONT_B, FULL, clipTo, ellipsePath, haloText, polyline } from './draw.js';
+import { C, FONT_B, FULL, clipTo, ellipsePath, placeLabel, polyline } from './draw.js';
 
 const TRUTH = 'rgba(255,255,255,0.9)';
 const EKF = C.fix;
@@ -32,7 +32,10 @@ function arrow(ctx, a, b, size) {
   ctx.fill();
 }
 
-/** The drawn trajectory's prior mean: start ring and arrow to the point reached at the end. */
+/**
+ * The drawn trajectory's prior mean: start ring and arrow to the point reached at the end, its
+ * label kept inside the plot (placeLabel). Returns the label's box {x, y, w, h} (CSS px) or null.
+ */
 function drawArrow(ctx, view, d) {
   const a = view.toPixel(d.x0, d.y0);
   const b = view.toPixel(d.x1, d.y1);
@@ -42,19 +45,23 @@ function drawArrow(ctx, view, d) {
   ctx.setLineDash([]);
   arrow(ctx, a, b, 11);
   ctx.beginPath(); ctx.arc(a.x, a.y, 5, 0, FULL); ctx.stroke();
+  if (!d.label) return null;
   ctx.font = FONT_B;
-  ctx.textAlign = 'left';
-  ctx.textBaseline = 'bottom';
-  if (d.label) haloText(ctx, d.label, b.x + 8, b.y - 6);
+  // Above right of the arrow's head, else where it fits inside the plot.
+  return placeLabel(ctx, d.label, b, view.rect, [], [[8, -6, 'left', 'bottom'], [-8, -6, 'right', 'bottom'],
+    [8, 8, 'left', 'top'], [-8, 8, 'right', 'top']]);
 }
 
 /**
  * The track layers. `tr` = {data (Track.data()), step, magnify, drawn: {x0, y0, x1, y1, label} | null}.
  * Ellipses every `stride` steps up to the current one are drawn faintly, the current one bold.
+ * Returns what was drawn, for the hooks: {filter, step, truth (the whole path, m), track (the
+ * estimates drawn, m), label (the drawn trajectory's label box, CSS px) | null}.
  */
 export function drawTrack(ctx, view, tr) {
   clipTo(ctx, view.rect);
   const d = tr.data;
+  const out = { filter: d ? d.filter : null, step: null, truth: [], track: [], label: null };
   if (d) {
     const step = Math.min(tr.step, d.truth.length - 1);
     // Truth: the whole path dashed, the part already travelled brighter, on a dark halo.
@@ -80,6 +87,7 @@ export function drawTrack(ctx, view, tr) {
     }
     // The filter's track up to now.
     const track = d.estimates.slice(0, step + 1);
+    Object.assign(out, { step, truth: d.truth.map((p) => [p[0], p[1]]), track: track.map((p) => [p[0], p[1]]) });
     halo(ctx, view, track, 4.5);
     ctx.strokeStyle = EKF;
     ctx.lineWidth = 2;
@@ -91,6 +99,7 @@ export function drawTrack(ctx, view, tr) {
       ctx.lineWidth = 2; ctx.strokeStyle = EKF; ctx.stroke();
     }
   }
-  if (tr.drawn) drawArrow(ctx, view, tr.drawn);
+  if (tr.drawn) out.label = drawArrow(ctx, view, tr.drawn);
   ctx.restore();
+  return out;
 }

@@ -39,7 +39,7 @@ export class Tracking {
       if (v !== null && v !== undefined && v !== '') $(id).value = String(v);
     }
     if (opts.filters) for (const f of FILTERS) $(`mc-${f}`).checked = opts.filters.includes(f);
-    const rerun = () => this.rerun();
+    const rerun = () => this.panelChanged();
     $('track-kind').addEventListener('change', () => { this.kind = $('track-kind').value; rerun(); });
     $('track-dt').addEventListener('change', rerun);
     $('track-seed').addEventListener('change', rerun);
@@ -50,7 +50,12 @@ export class Tracking {
     $('mc-restart').addEventListener('click', () => this.startMc());
     $('track-ex').addEventListener('change', () => this.redraw());
     $('track-play').addEventListener('click', () => (this.playing ? this.pause() : this.play()));
-    $('track-scrub').addEventListener('input', () => { this.pause(); this.seek(Number($('track-scrub').value)); });
+    // The slider's new value is read before pause() redraws the transport (it resets the slider).
+    $('track-scrub').addEventListener('input', () => {
+      const n = Number($('track-scrub').value);
+      this.pause();
+      this.seek(n);
+    });
     this.tickFn = (now) => this.tick(now);
     this.startStep = opts.step;
   }
@@ -80,7 +85,20 @@ export class Tracking {
     return on.length ? on : ['ekf'];
   }
 
-  /** Re-simulates the track (keeping the step) and restarts the Monte Carlo. */
+  /**
+   * A change in the panel (scenario, T, seed, filter, particles): re-simulates and redraws every
+   * layer that shows the run (the map's truth and track, the inset and its title, the legend),
+   * as Play or the slider would, and restarts the Monte Carlo.
+   */
+  panelChanged() {
+    this.rerun();
+    this.redraw();
+  }
+
+  /**
+   * Re-simulates the track (keeping the step) and restarts the Monte Carlo; the caller redraws
+   * (app.js's refresh draws next, panelChanged asks for a frame).
+   */
   rerun() {
     if (!this.active()) return;
     try {
@@ -204,7 +222,7 @@ export class Tracking {
       const v = this.p && this.p.kind === 'custom' ? this.p : null;
       drawn = { ...this.drawn, label: v ? `v̄ = (${fixed(v.vx, 2)}, ${fixed(v.vy, 2)}) m/s` : '' };
     }
-    drawTrack(ctx, view, { data: this.data, step: this.step, magnify, drawn });
+    this.layer = drawTrack(ctx, view, { data: this.data, step: this.step, magnify, drawn });
   }
 
   /** Points the zoom inset should not hide, weighted: the truth path, a drawn arrow, the nodes. */
@@ -256,7 +274,9 @@ export class Tracking {
       t_s: f ? f.t_s : null, truth: f ? [f.truth.x, f.truth.y] : null, estimate: f ? [f.fix.x, f.fix.y] : null,
       mcState: mc.state, mcGeneration: mc.gen, mcRuns: mc.params ? mc.params.trajectories * mc.params.noise_runs : 0,
       mcMs: mc.ms, mcComputeMs: mc.computeMs, mcDone: mc.done, mcTotal: mc.total,
+      mcElapsedMs: mc.elapsedMs, mcEtaMs: mc.etaMs,
       mcSuperseded: mc.superseded, chartSeries: mc.series, drawn: { ...this.drawn },
+      layer: this.layer || null,
     };
   }
 }

@@ -1,6 +1,7 @@
 //! The channel front end's figures (issue 25 §4): [`draw_delays`], \[S\] Fig. 4 per link (the
-//! response's delay profile as a grey image, the path estimates coloured by amplitude, the
-//! static clusters as grey bands, the true paths dashed, path length against time), and
+//! response's delay profile as a grey image with its one colour bar, the path estimates as blue
+//! dots, grey inside a static cluster, the static clusters as grey bands, the true paths dashed
+//! on top, path length against time on a range axis robust to outliers), and
 //! [`draw_track_errors`], \[S\] Figs. 5–6 (the track on the map, the position error over time
 //! and its empirical CDF with the 90 % point). Both draw a [`crate::present`] view on any
 //! plotters [`DrawingBackend`].
@@ -17,10 +18,12 @@ use super::layout::{font_scale, frame_plot, segments, series_legend, titled_body
 use super::overlay::{
     draw_overlay, MapOverlay, OverlayLine, OverlayMark, OverlayMarkKind, OverlayPath,
 };
-use super::panel::{check_area, draw_axes, draw_nodes, legend_entry, rgb, Chart, ChartNode};
+use super::panel::{check_area, draw_axes, draw_nodes, legend_entry, Chart, ChartNode};
 use super::{chart_err, register_fonts, ChartError, CURVE_PALETTE};
-use crate::math::{round, Real};
-use crate::present::{linear_ticks, viridis, DelayFigure, DelayImage, LinkDelays, TrackErrorView};
+use crate::math::{round, sqrt, Real};
+use crate::present::{
+    linear_ticks, DelayFigure, DelayImage, LinkDelays, StaticBand, TrackErrorView,
+};
 use crate::scenario::Area;
 
 /// Colour of the true paths (the figures' red).
@@ -92,16 +95,6 @@ fn grey(v: Real, lo: Real, hi: Real) -> RGBColor {
     RGBColor(g, g, g)
 }
 
-/// The viridis colour of amplitude `v` on `range`.
-fn amplitude_rgb(v: Real, range: [Real; 2]) -> RGBColor {
-    let f = if range[1] > range[0] {
-        (v - range[0]) / (range[1] - range[0])
-    } else {
-        0.5
-    };
-    rgb(viridis(f))
-}
-
 /// A text centred in the plotting area of `chart` (e.g. `no track`).
 fn centred_note<DB: DrawingBackend>(
     chart: &Chart<'_, DB>,
@@ -129,9 +122,14 @@ fn axis(r: [Real; 2]) -> [Real; 2] {
 }
 
 /// Draws the delay figure onto `root` (filled white first): the title band, one panel per link
-/// (two columns from two links on) on the figure's time axis, and on the right the colour bars of
-/// the estimates' amplitude (viridis) and of the image (grey, one scale for every link). A link
-/// without estimates says so; a figure without links says `no links`. Does not call `present()`.
+/// (two columns from two links on) on the figure's time axis, and on the right ONE colour bar,
+/// the image's (grey, one scale for every link). In each panel, bottom to top: the response's
+/// delay profile (grey), the static clusters (grey bands), the estimates (blue dots; grey
+/// inside a static cluster's ±3σ, as the tracker gates them: E4), the estimates beyond the
+/// axis as triangles at its edge (the axis is robust to outliers:
+/// [`crate::present::suggest_range_m`]), the truth (vermillion dashes over a white halo, so it
+/// shows over the estimates). A link without estimates says so; a figure without links says
+/// `no links`. Does not call `present()`.
 pub fn draw_delays<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     fig: &DelayFigure,
@@ -146,14 +144,49 @@ pub fn draw_delays_boxes<DB: DrawingBackend>(
     fig: &DelayFigure,
     opts: &ChannelChartOptions,
 ) -> Result<Vec<PlotBox>, ChartError> {
-    draw_delays_with(root, fig, opts, true)
+    draw_delays_with(root, fig, opts, Layers::Vector, true)
 }
 
-/// The delay figure as SVG text of `size` px with each link's image embedded as ONE PNG at
-/// its plot's pixel resolution ([`super::raster`], a `data:` URI) under the vector layers,
-/// instead of one rectangle per run of grey: the file no longer grows by ≈ 48 kB per snapshot
-/// up to the image's 600 columns (28 MB for 1528 snapshots, issue 37 item 11); what still
-/// grows with the snapshots is one circle per estimate.
+/// As [`draw_delays_boxes`] without the legend in the first panel (the page shows its own,
+/// with the time cursor it draws over the chart).
+pub fn draw_delays_panels<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    fig: &DelayFigure,
+    opts: &ChannelChartOptions,
+) -> Result<Vec<PlotBox>, ChartError> {
+    draw_delays_with(root, fig, opts, Layers::Vector, false)
+}
+
+/// Colour of the estimates.
+const ESTIMATE_RGB: RGBColor = CURVE_PALETTE[0];
+/// Colour of the estimates inside a static cluster's ±3σ (the static paths).
+const STATIC_ESTIMATE_RGB: RGBColor = RGBColor(150, 150, 150);
+/// Opacity of the static bands over the image.
+const STATIC_BAND_ALPHA: f64 = 0.3;
+
+/// How the image, the bands and the estimates of a panel are drawn.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Layers {
+    /// As plotters elements (a canvas, a PNG, the vector figure of the tests).
+    Vector,
+    /// Not at all: the caller puts them under the panel as one raster image ([`delays_svg`]).
+    Raster,
+}
+
+/// Whether an estimate at `range_m` lies inside one of `statics` (a static cluster's ±3σ,
+/// where the tracker gates it away: E4).
+fn in_static_band(statics: &[StaticBand], range_m: Real) -> bool {
+    statics
+        .iter()
+        .any(|b| (range_m - b.mean_m).abs() <= b.halfwidth_m)
+}
+
+/// The delay figure as SVG text of `size` px with each link's image, static bands and
+/// estimates as ONE embedded PNG per panel at its plot's pixel resolution ([`super::raster`],
+/// a `data:` URI) under the vector layers (axes, truth, clipped estimates' marks, legend,
+/// colour bar, text): the file's size depends on the figure's pixels, not on the snapshots or
+/// the estimates (a 1528-snapshot recording with 45 000 estimates: 4.4 MB as circles, issue 38
+/// item 7; the images alone were 28 MB as rectangles, issue 37 item 11).
 pub fn delays_svg(
     size: (u32, u32),
     fig: &DelayFigure,
@@ -162,35 +195,142 @@ pub fn delays_svg(
     let mut svg = String::new();
     let boxes = {
         let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
-        let boxes = draw_delays_with(&root, fig, opts, false)?;
+        let boxes = draw_delays_with(&root, fig, opts, Layers::Raster, true)?;
         root.present().map_err(chart_err)?;
         boxes
     };
+    let grey_range = image_range(&fig.links);
+    let font_s = delays_scale(size, fig.links.len());
     let mut images = Vec::new();
-    if let Some(g) = image_range(&fig.links) {
-        for (link, b) in fig.links.iter().zip(&boxes) {
-            let Some(img) = &link.image else {
-                continue;
-            };
-            let (w, h) = (b.x_px[1] - b.x_px[0], b.y_px[1] - b.y_px[0]);
-            if w <= 0 || h <= 0 {
-                continue;
-            }
-            let rgb = image_rgb(
-                img,
-                g,
-                b.t_range_s,
-                axis(link.range_m),
-                (w as usize, h as usize),
-            );
-            let png = super::raster::encode_png(w as usize, h as usize, &rgb).ok_or_else(|| {
-                ChartError(format!("{}: the image could not be encoded", link.name))
-            })?;
-            images.push(((b.x_px[0], b.y_px[0], w, h), png));
+    for (link, b) in fig.links.iter().zip(&boxes) {
+        if link.image.is_none() && link.estimates.is_empty() && link.statics.is_empty() {
+            continue;
         }
+        let (w, h) = (b.x_px[1] - b.x_px[0], b.y_px[1] - b.y_px[0]);
+        if w <= 0 || h <= 0 {
+            continue;
+        }
+        let (w, h) = (w as usize, h as usize);
+        let range = axis(link.range_m);
+        let mut rgb = match (&link.image, grey_range) {
+            (Some(img), Some(g)) => image_rgb(img, g, b.t_range_s, range, (w, h)),
+            _ => alloc::vec![255u8; 3 * w * h],
+        };
+        raster_bands(&mut rgb, (w, h), &link.statics, range);
+        raster_estimates(
+            &mut rgb,
+            (w, h),
+            link,
+            b.t_range_s,
+            range,
+            estimate_radius(font_s),
+        );
+        let png = super::raster::encode_png(w, h, &rgb)
+            .ok_or_else(|| ChartError(format!("{}: the image could not be encoded", link.name)))?;
+        images.push(((b.x_px[0], b.y_px[0], w as i32, h as i32), png));
     }
     super::raster::embed_pngs(&svg, &images)
         .ok_or_else(|| ChartError("the figure has no element to put the images under".into()))
+}
+
+/// The static bands over `rgb` (a `w × h` plot spanning `[r0, r1]`, row 0 at `r1`), as the
+/// vector panel draws them: each band's rows blended with its grey at
+/// [`STATIC_BAND_ALPHA`], its mean a one-pixel grey line.
+fn raster_bands(
+    rgb: &mut [u8],
+    (w, h): (usize, usize),
+    statics: &[StaticBand],
+    [r0, r1]: [Real; 2],
+) {
+    let row_of = |r: Real| (r1 - r) / (r1 - r0) * h as Real;
+    let RGBColor(sr, sg, sb) = STATIC_RGB;
+    for band in statics {
+        let (lo, hi) = (
+            (band.mean_m - band.halfwidth_m).max(r0),
+            (band.mean_m + band.halfwidth_m).min(r1),
+        );
+        if lo.partial_cmp(&hi) != Some(core::cmp::Ordering::Less) {
+            continue;
+        }
+        let (y0, y1) = (
+            round(row_of(hi)) as usize,
+            (round(row_of(lo)) as usize).min(h),
+        );
+        for y in y0..y1 {
+            for px in rgb[3 * y * w..3 * (y + 1) * w].chunks_exact_mut(3) {
+                for (c, s) in px.iter_mut().zip([sr, sg, sb]) {
+                    *c = blend(*c, s, STATIC_BAND_ALPHA);
+                }
+            }
+        }
+        if (r0..=r1).contains(&band.mean_m) {
+            let y = (row_of(band.mean_m) as usize).min(h - 1);
+            for px in rgb[3 * y * w..3 * (y + 1) * w].chunks_exact_mut(3) {
+                px.copy_from_slice(&[sr, sg, sb]);
+            }
+        }
+    }
+}
+
+/// `a` blended towards `b` by `alpha` (0: `a`, 1: `b`).
+fn blend(a: u8, b: u8, alpha: Real) -> u8 {
+    round(a as Real + (b as Real - a as Real) * alpha.clamp(0.0, 1.0)) as u8
+}
+
+/// The estimates inside the axes as discs of `radius` px over `rgb` (a `w × h` plot spanning
+/// `[t0, t1] × [r0, r1]`, row 0 at `r1`), each pixel covered in proportion to its distance from
+/// the disc's edge (anti-aliased), blue or, inside a static band, grey.
+fn raster_estimates(
+    rgb: &mut [u8],
+    (w, h): (usize, usize),
+    link: &LinkDelays,
+    [t0, t1]: [Real; 2],
+    [r0, r1]: [Real; 2],
+    radius: i32,
+) {
+    let rad = radius as Real;
+    for e in &link.estimates {
+        if !((t0..=t1).contains(&e.t_s) && (r0..=r1).contains(&e.range_m)) {
+            continue;
+        }
+        let cx = (e.t_s - t0) / (t1 - t0) * w as Real;
+        let cy = (r1 - e.range_m) / (r1 - r0) * h as Real;
+        let RGBColor(r, g, b) = estimate_rgb(&link.statics, e.range_m);
+        let (x0, x1) = (
+            (cx - rad - 1.0).max(0.0) as usize,
+            ((cx + rad + 1.0) as usize).min(w),
+        );
+        let (y0, y1) = (
+            (cy - rad - 1.0).max(0.0) as usize,
+            ((cy + rad + 1.0) as usize).min(h),
+        );
+        for y in y0..y1 {
+            for x in x0..x1 {
+                let (dx, dy) = (x as Real + 0.5 - cx, y as Real + 0.5 - cy);
+                let cover = (rad + 0.5 - sqrt(dx * dx + dy * dy)).clamp(0.0, 1.0);
+                if cover > 0.0 {
+                    let px = &mut rgb[3 * (y * w + x)..3 * (y * w + x) + 3];
+                    for (c, v) in px.iter_mut().zip([r, g, b]) {
+                        *c = blend(*c, v, cover);
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// The colour of an estimate at `range_m`: grey inside a static band, else blue.
+fn estimate_rgb(statics: &[StaticBand], range_m: Real) -> RGBColor {
+    if in_static_band(statics, range_m) {
+        STATIC_ESTIMATE_RGB
+    } else {
+        ESTIMATE_RGB
+    }
+}
+
+/// The radius of an estimate's dot at font scale `s`, px.
+fn estimate_radius(s: f64) -> i32 {
+    (2.6 * s).round().max(1.0) as i32
 }
 
 /// The image `img` as RGB pixels of a `w × h` plot spanning `[t0, t1] × [r0, r1]` (row 0 at
@@ -261,13 +401,24 @@ fn column_edges(img: &DelayImage, span: Real) -> Vec<Real> {
         .collect()
 }
 
-/// [`draw_delays_boxes`], the images' cells drawn only when `cells` (else the caller puts each
-/// image under its plot).
+/// The font scale of the delay figure of `links` panels on a `w × h` figure.
+fn delays_scale((w, h): (u32, u32), links: usize) -> f64 {
+    let ncols = if links > 1 { 2 } else { 1 };
+    let nrows = links.div_ceil(ncols).max(1);
+    (w as f64 / ncols as f64 / 640.0)
+        .min(h as f64 / nrows as f64 / 380.0)
+        .clamp(0.5, 4.0)
+        .min(font_scale(w, h))
+}
+
+/// [`draw_delays_boxes`], the images, bands and estimates drawn as `layers` says, the legend in
+/// the first panel when `legend`.
 fn draw_delays_with<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     fig: &DelayFigure,
     opts: &ChannelChartOptions,
-    cells: bool,
+    layers: Layers,
+    legend: bool,
 ) -> Result<Vec<PlotBox>, ChartError> {
     register_fonts();
     for l in &fig.links {
@@ -287,16 +438,16 @@ fn draw_delays_with<DB: DrawingBackend>(
     let n = fig.links.len();
     let ncols = if n > 1 { 2 } else { 1 };
     let nrows = n.div_ceil(ncols).max(1);
-    let s = (w as f64 / ncols as f64 / 640.0)
-        .min(h as f64 / nrows as f64 / 380.0)
-        .clamp(0.5, 4.0)
-        .min(font_scale(w, h));
+    let s = delays_scale((w, h), n);
     let (font, body) = titled_body(root, s, &opts.title, opts.subtitle.as_deref())?;
     let (bw, bh) = body.dim_in_pixel();
-    let bars_w =
-        ((2.0 * (24.0 + 16.0) * s + 2.0 * (3.0 * font.ticks + 1.4 * font.axis)) as u32).min(bw / 3);
-    let (panels, bars) = body.split_horizontally(bw.saturating_sub(bars_w));
     let grey_range = image_range(&fig.links);
+    let bars_w = if grey_range.is_some() {
+        (((24.0 + 16.0) * s + 3.0 * font.ticks + 1.4 * font.axis) as u32).min(bw / 4)
+    } else {
+        0
+    };
+    let (panels, bar) = body.split_horizontally(bw.saturating_sub(bars_w));
     if n == 0 {
         let style = TextStyle::from(("sans-serif", font.axis).into_font())
             .pos(Pos::new(HPos::Center, VPos::Center));
@@ -315,30 +466,18 @@ fn draw_delays_with<DB: DrawingBackend>(
             area,
             fig,
             link,
-            grey_range.filter(|_| cells),
-            k == 0,
+            grey_range,
+            layers,
+            legend && k == 0,
             &font,
             s,
         )?);
     }
-    let (bar_a, bar_g) = bars.split_horizontally(bars_w / 2);
-    let bar_h = (bh as f64 * 0.8) as u32;
-    let shrink = |a: &DrawingArea<DB, Shift>| {
-        a.clone()
-            .shrink((0, (bh - bar_h) as i32 / 2), (bars_w / 2, bar_h))
-    };
-    if let Some(r) = fig.amplitude_db_range {
-        draw_db_bar(
-            &shrink(&bar_a),
-            r,
-            |v| amplitude_rgb(v, r),
-            "estimate amplitude 20·log₁₀|α| (dB)",
-            &font,
-        )?;
-    }
     if let Some(r) = grey_range {
+        let bar_h = (bh as f64 * 0.8) as u32;
+        let bar = bar.shrink((0, (bh - bar_h) as i32 / 2), (bars_w, bar_h));
         draw_db_bar(
-            &shrink(&bar_g),
+            &bar,
             r,
             |v| grey(v, r[0], r[1]),
             "response power (dB)",
@@ -362,11 +501,13 @@ fn image_range(links: &[LinkDelays]) -> Option<[Real; 2]> {
 }
 
 /// One link's panel.
+#[allow(clippy::too_many_arguments)]
 fn draw_link<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     fig: &DelayFigure,
     link: &LinkDelays,
     grey_range: Option<[Real; 2]>,
+    layers: Layers,
     legend: bool,
     font: &Fonts,
     s: f64,
@@ -387,7 +528,8 @@ fn draw_link<DB: DrawingBackend>(
         [8, 7],
         None,
     )?;
-    if let (Some(img), Some(g)) = (&link.image, grey_range) {
+    let vector = layers == Layers::Vector;
+    if let (Some(img), Some(g), true) = (&link.image, grey_range, vector) {
         draw_image(&mut chart, img, g, [t0, t1, r0, r1])?;
     }
     for (k, b) in link.statics.iter().enumerate() {
@@ -398,19 +540,21 @@ fn draw_link<DB: DrawingBackend>(
         if lo.partial_cmp(&hi) != Some(core::cmp::Ordering::Less) {
             continue;
         }
-        chart
-            .draw_series([Rectangle::new(
-                [(t0, lo), (t1, hi)],
-                STATIC_RGB.mix(0.3).filled(),
-            )])
-            .map_err(chart_err)?;
-        if (r0..=r1).contains(&b.mean_m) {
+        if vector {
             chart
-                .draw_series([PathElement::new(
-                    [(t0, b.mean_m), (t1, b.mean_m)],
-                    STATIC_RGB.stroke_width(1),
+                .draw_series([Rectangle::new(
+                    [(t0, lo), (t1, hi)],
+                    STATIC_RGB.mix(STATIC_BAND_ALPHA).filled(),
                 )])
                 .map_err(chart_err)?;
+            if (r0..=r1).contains(&b.mean_m) {
+                chart
+                    .draw_series([PathElement::new(
+                        [(t0, b.mean_m), (t1, b.mean_m)],
+                        STATIC_RGB.stroke_width(1),
+                    )])
+                    .map_err(chart_err)?;
+            }
         }
         if legend && k == 0 {
             let sz = (6.0 * s) as i32;
@@ -422,17 +566,76 @@ fn draw_link<DB: DrawingBackend>(
             })?;
         }
     }
+    // The estimates: inside the axes as dots, beyond it (outliers the robust axis leaves out)
+    // as triangles at its edge, one per few pixels of time.
+    let radius = estimate_radius(s);
+    let inside = |e: &&crate::present::DelayPoint| {
+        (t0..=t1).contains(&e.t_s) && (r0..=r1).contains(&e.range_m)
+    };
+    if vector {
+        chart
+            .draw_series(link.estimates.iter().filter(inside).map(|e| {
+                Circle::new(
+                    (e.t_s, e.range_m),
+                    radius,
+                    estimate_rgb(&link.statics, e.range_m).filled(),
+                )
+            }))
+            .map_err(chart_err)?;
+    }
+    if legend && !link.estimates.is_empty() {
+        legend_entry(&mut chart, "estimate", move |(x, y)| {
+            Circle::new((x, y), radius + 1, ESTIMATE_RGB.filled())
+        })?;
+        if link
+            .estimates
+            .iter()
+            .any(|e| in_static_band(&link.statics, e.range_m))
+        {
+            legend_entry(&mut chart, "estimate in a static cluster", move |(x, y)| {
+                Circle::new((x, y), radius + 1, STATIC_ESTIMATE_RGB.filled())
+            })?;
+        }
+    }
+    let off = draw_clipped(&chart, link, [t0, t1], [r0, r1], radius + 1)?;
+    if off > 0 {
+        let style = TextStyle::from(("sans-serif", font.ticks * 0.8).into_font())
+            .color(&ESTIMATE_RGB)
+            .pos(Pos::new(HPos::Left, VPos::Top));
+        let pad = (6.0 * s) as i32;
+        let label = format!(
+            "{off} estimate{} off the axis (triangles at its edge)",
+            if off == 1 { "" } else { "s" }
+        );
+        chart
+            .plotting_area()
+            .strip_coord_spec()
+            .draw_text(&label, &style, (pad, pad + (font.ticks * 0.9) as i32))
+            .map_err(chart_err)?;
+    }
+    // The truth on top: a white halo under vermillion dashes.
     let width = (2.0 * s).round().max(1.0) as u32;
     let (dash, gap) = ((8.0 * s) as u32, (5.0 * s) as u32);
     let mut kinds: Vec<&str> = Vec::new();
     for c in &link.truth {
-        let style = if c.primary {
-            TRUTH_RGB.stroke_width(width)
+        let (style, halo) = if c.primary {
+            (
+                TRUTH_RGB.stroke_width(width),
+                WHITE
+                    .mix(0.85)
+                    .stroke_width(width + 2 * (s.round().max(1.0) as u32)),
+            )
         } else {
-            TRUTH_RGB.mix(0.45).stroke_width(width.div_ceil(2))
+            (
+                TRUTH_RGB.mix(0.45).stroke_width(width.div_ceil(2)),
+                WHITE.mix(0.6).stroke_width(width.div_ceil(2) + 2),
+            )
         };
         let inside = |t: Real, r: Real| t.is_finite() && r.is_finite() && (r0..=r1).contains(&r);
         for part in segments(c.points.iter().copied(), inside) {
+            chart
+                .draw_series(LineSeries::new(part.iter().copied(), halo))
+                .map_err(chart_err)?;
             chart
                 .draw_series(DashedLineSeries::new(part, dash, gap, style))
                 .map_err(chart_err)?;
@@ -443,28 +646,6 @@ fn draw_link<DB: DrawingBackend>(
                 EmptyElement::at((x, y))
                     + PathElement::new([(-12, 0), (-3, 0)], style)
                     + PathElement::new([(3, 0), (12, 0)], style)
-            })?;
-        }
-    }
-    let radius = (2.6 * s).round().max(1.0) as i32;
-    if let Some(range) = fig.amplitude_db_range {
-        let visible = link
-            .estimates
-            .iter()
-            .filter(|e| (t0..=t1).contains(&e.t_s) && (r0..=r1).contains(&e.range_m));
-        chart
-            .draw_series(visible.map(|e| {
-                Circle::new(
-                    (e.t_s, e.range_m),
-                    radius,
-                    amplitude_rgb(e.amplitude_db, range).filled(),
-                )
-            }))
-            .map_err(chart_err)?;
-        if legend && !link.estimates.is_empty() {
-            let c = amplitude_rgb(range[1], range);
-            legend_entry(&mut chart, "estimate (colour: amplitude)", move |(x, y)| {
-                Circle::new((x, y), radius + 1, c.filled())
             })?;
         }
     }
@@ -482,6 +663,48 @@ fn draw_link<DB: DrawingBackend>(
     }
     frame_plot(&chart)?;
     Ok(PlotBox::of(&chart, [t0, t1]))
+}
+
+/// The estimates of `link` beyond the range axis `[r0, r1]` (within the time axis) as
+/// triangles of `size` px at its edge (pointing up at the top, down at the bottom), one per
+/// 3 px of time and edge; returns how many estimates are beyond.
+fn draw_clipped<DB: DrawingBackend>(
+    chart: &Chart<'_, DB>,
+    link: &LinkDelays,
+    [t0, t1]: [Real; 2],
+    [r0, r1]: [Real; 2],
+    size: i32,
+) -> Result<usize, ChartError> {
+    let (w, _) = chart.plotting_area().dim_in_pixel();
+    let mut seen: Vec<(bool, i64)> = Vec::new();
+    let mut off = 0;
+    for e in &link.estimates {
+        if !(t0..=t1).contains(&e.t_s) || (r0..=r1).contains(&e.range_m) || !e.range_m.is_finite() {
+            continue;
+        }
+        off += 1;
+        let up = e.range_m > r1;
+        let bucket = ((e.t_s - t0) / (t1 - t0) * w as Real / 3.0) as i64;
+        if seen.contains(&(up, bucket)) {
+            continue;
+        }
+        seen.push((up, bucket));
+        // The tip on the edge, pointing out of the plot, the base inside.
+        let (edge, base) = if up {
+            (r1, size + size / 2)
+        } else {
+            (r0, -(size + size / 2))
+        };
+        let tri = alloc::vec![(0, 0), (-size, base), (size, base)];
+        chart
+            .plotting_area()
+            .draw(
+                &(EmptyElement::at((e.t_s, edge))
+                    + Polygon::new(tri, estimate_rgb(&link.statics, e.range_m).filled())),
+            )
+            .map_err(chart_err)?;
+    }
+    Ok(off)
 }
 
 /// The image in data coordinates: per column (from the middle between its time and its

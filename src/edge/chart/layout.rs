@@ -189,7 +189,8 @@ pub(crate) fn titled_body<DB: DrawingBackend>(
     Ok((font, body))
 }
 
-/// Title and subtitle, centred in the band.
+/// Title and subtitle, centred in the band; a line wider than the figure less its padding is
+/// drawn smaller, to fit ([`fitting_size`]), so no text is cut at the edges.
 pub(crate) fn draw_titles<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     font: &Fonts,
@@ -198,19 +199,40 @@ pub(crate) fn draw_titles<DB: DrawingBackend>(
     subtitle: Option<&str>,
 ) -> Result<(), ChartError> {
     let (w, _) = root.dim_in_pixel();
+    let room = w as f64 - 2.0 * band.pad;
     let centre = Pos::new(HPos::Center, VPos::Top);
-    let style = TextStyle::from(("sans-serif", font.title).into_font()).pos(centre);
+    let size = fitting_size(root, title, font.title, room);
+    let style = TextStyle::from(("sans-serif", size).into_font()).pos(centre);
     root.draw_text(title, &style, (w as i32 / 2, band.title_y))
         .map_err(chart_err)?;
     if let Some(sub) = subtitle {
         let grey = RGBColor(70, 70, 70);
-        let style = TextStyle::from(("sans-serif", font.subtitle).into_font())
+        let size = fitting_size(root, sub, font.subtitle, room);
+        let style = TextStyle::from(("sans-serif", size).into_font())
             .color(&grey)
             .pos(centre);
         root.draw_text(sub, &style, (w as i32 / 2, band.subtitle_y))
             .map_err(chart_err)?;
     }
     Ok(())
+}
+
+/// The font size, px, at which `text` (sans-serif) is at most `room` px wide on `root`: `size`
+/// when it fits, else `size` scaled down to fit (the backend's own text measure).
+pub(crate) fn fitting_size<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    text: &str,
+    size: f64,
+    room: f64,
+) -> f64 {
+    let wide = root
+        .estimate_text_size(text, &("sans-serif", size).into_text_style(root))
+        .map_or(0, |(tw, _)| tw) as f64;
+    if wide > room && room > 0.0 {
+        size * room / wide
+    } else {
+        size
+    }
 }
 
 /// The series legend of `chart`: a white box (opacity `background`) with a black border at

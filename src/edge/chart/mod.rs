@@ -24,7 +24,9 @@ mod tracking;
 pub use channel::{
     delays_size, delays_svg, draw_delays, draw_track_errors, track_errors_size, ChannelChartOptions,
 };
-pub use channel::{draw_delays_boxes, draw_error_time_chart, error_time_size, PlotBox};
+pub use channel::{
+    draw_delays_boxes, draw_delays_panels, draw_error_time_chart, error_time_size, PlotBox,
+};
 pub(crate) use layout::{axis_label, chart_err};
 pub use layout::{register_fonts, suggested_size, ChartError};
 pub use map::{

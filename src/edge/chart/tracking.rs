@@ -7,9 +7,12 @@ use alloc::string::String;
 use alloc::vec::Vec;
 
 use plotters::coord::Shift;
+use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 
-use super::layout::{font_scale, frame_plot, segments, series_legend, titled_body, Fonts};
+use super::layout::{
+    fitting_size, font_scale, frame_plot, segments, series_legend, titled_body, Fonts,
+};
 use super::{axis_label, chart_err, register_fonts, ChartError, CURVE_PALETTE};
 use crate::math::Real;
 use crate::present::colorbar_ticks;
@@ -26,6 +29,15 @@ const CURVE_RGB: [RGBColor; 4] = [
     CURVE_PALETTE[4],
     CURVE_PALETTE[3],
 ];
+/// Line styles of the RMSE curves, in curve order as [`CURVE_RGB`]: `None` solid, else `(dash,
+/// gap)` px at scale 1 — EKF solid, UKF dotted, PF long dashes (the bound's dashes are 9, 5), so
+/// the curves differ without colour too (on the canvas, in the SVG and in the legend).
+const CURVE_DASH: [Option<(f64, f64)>; 4] =
+    [None, Some((2.5, 3.5)), Some((16.0, 5.0)), Some((6.0, 3.0))];
+/// The legend label of the PCRLB curve.
+const PCRLB_LABEL: &str = "posterior CRLB  ε_PCRLB";
+/// Length of a legend's line sample, px.
+const LEGEND_LINE_PX: i32 = 24;
 
 /// One named RMSE curve of a [`FiltersPanel`].
 #[derive(Debug, Clone, Copy)]
@@ -43,7 +55,7 @@ pub struct FiltersPanel<'a> {
     pub title: &'a str,
     /// Times `t_n`, s (ascending).
     pub t_s: &'a [Real],
-    /// The RMSE curves, solid, in distinct colours (the first in the EKF's blue).
+    /// The RMSE curves, in distinct colours and line styles (the first solid in the EKF's blue).
     pub curves: &'a [FilterCurve<'a>],
     /// `ε_PCRLB(t_n)`, m, one per time (empty: not drawn; `None`: a gap).
     pub rmse_pcrlb_m: &'a [Option<Real>],
@@ -104,8 +116,9 @@ fn y_range(panels: &[FiltersPanel]) -> (Real, Real) {
 
 /// Draws the tracking figure onto `root` (filled white first): the title band, then one panel
 /// per entry of `panels` side by side with a shared y range, each with one or more trackers'
-/// labelled RMSE curves (labels: [`crate::study::curve_label`]), each solid in its own colour
-/// (the first in the EKF's blue) with its label in the legend, next to the dashed PCRLB — \[S\]
+/// labelled RMSE curves (labels: [`crate::study::curve_label`]), each in its own colour and line
+/// style ([`CURVE_DASH`]: the first solid in the EKF's blue) with its label and a sample of its
+/// line in the legend, next to the dashed PCRLB — \[S\]
 /// Fig. 3 with the EKF alone. The one entry point of the CLI's and the page's tracking charts.
 /// Returns the shared y range `(lo, hi)`, m. Does not call `present()`.
 pub fn draw_tracking_filters<DB: DrawingBackend>(
@@ -179,13 +192,7 @@ fn draw_panel<DB: DrawingBackend>(
         .with_light_points(minor.iter().map(|t| t.value));
     // The caption shrinks to the panel's width (long failure notes of several filters).
     let (w, _) = area.dim_in_pixel();
-    let mut caption_size = font.axis * 1.1;
-    let wide = area
-        .estimate_text_size(p.title, &("sans-serif", caption_size).into_text_style(area))
-        .map_or(0, |(tw, _)| tw);
-    if wide as f64 > 0.96 * w as f64 {
-        caption_size *= 0.96 * w as f64 / wide as f64;
-    }
+    let caption_size = fitting_size(area, p.title, font.axis * 1.1, 0.96 * w as f64);
     let mut chart = ChartBuilder::on(area)
         .caption(p.title, ("sans-serif", caption_size).into_font())
         .margin_top((6.0 * s) as u32)
@@ -224,18 +231,28 @@ fn draw_panel<DB: DrawingBackend>(
     let drawable = |t: Real, v: Real| t.is_finite() && v.is_finite() && v > 0.0;
     for (c, curve) in p.curves.iter().enumerate() {
         let style = CURVE_RGB[c % CURVE_RGB.len()].stroke_width(width);
+        let dash = CURVE_DASH[c % CURVE_DASH.len()].map(|(d, g)| {
+            (
+                ((d * s).round() as u32).max(1),
+                ((g * s).round() as u32).max(1),
+            )
+        });
         let parts = segments(
             p.t_s.iter().copied().zip(curve.rmse_m.iter().copied()),
             drawable,
         );
         for (k, part) in parts.into_iter().enumerate() {
-            let series = chart
-                .draw_series(LineSeries::new(part, style))
-                .map_err(chart_err)?;
+            let series = match dash {
+                None => chart.draw_series(LineSeries::new(part, style)),
+                Some((d, g)) => chart.draw_series(DashedLineSeries::new(part, d, g, style)),
+            }
+            .map_err(chart_err)?;
             if k == 0 {
-                series
-                    .label(curve.label)
-                    .legend(move |(x, y)| PathElement::new([(x, y), (x + 24, y)], style));
+                // The legend's sample in the curve's own line style.
+                series.label(curve.label).legend(move |(x, y)| {
+                    let (d, g) = dash.unwrap_or((LEGEND_LINE_PX as u32, 0));
+                    DashedPathElement::new([(x, y), (x + LEGEND_LINE_PX, y)], d, g, style)
+                });
             }
         }
     }
@@ -246,13 +263,11 @@ fn draw_panel<DB: DrawingBackend>(
             .draw_series(DashedLineSeries::new(part, dash, gap, pcrlb))
             .map_err(chart_err)?;
         if k == 0 {
-            series
-                .label("posterior CRLB  ε_PCRLB")
-                .legend(move |(x, y)| {
-                    EmptyElement::at((x, y))
-                        + PathElement::new([(0, 0), (10, 0)], pcrlb)
-                        + PathElement::new([(14, 0), (24, 0)], pcrlb)
-                });
+            series.label(PCRLB_LABEL).legend(move |(x, y)| {
+                EmptyElement::at((x, y))
+                    + PathElement::new([(0, 0), (10, 0)], pcrlb)
+                    + PathElement::new([(14, 0), (24, 0)], pcrlb)
+            });
         }
     }
     if let Some(note) = p.legend_note {
@@ -262,11 +277,25 @@ fn draw_panel<DB: DrawingBackend>(
             .label(note)
             .legend(|(x, y)| EmptyElement::at((x, y)));
     }
+    // The legend fits the plot's width (a narrow canvas, long failure notes): its font shrinks
+    // so the widest row, its line sample (plotters' 30 px), its margins and plotters' 5 px from
+    // the plot's edge fit, so no sample is cut at the plot's left edge.
+    let margin = 8.0 * s;
+    let (plot_w, _) = chart.plotting_area().dim_in_pixel();
+    let room = plot_w as f64 - 30.0 - 2.0 * margin - 10.0;
+    let legend_font = p
+        .curves
+        .iter()
+        .map(|c| c.label)
+        .chain([PCRLB_LABEL])
+        .chain(p.legend_note)
+        .map(|label| fitting_size(area, label, font.ticks * 0.95, room))
+        .fold(font.ticks * 0.95, f64::min);
     series_legend(
         &mut chart,
         SeriesLabelPosition::UpperRight,
-        font.ticks * 0.95,
-        8.0 * s,
+        legend_font,
+        margin,
         0.9,
     )?;
     frame_plot(&chart)

@@ -37,10 +37,13 @@ use web_sys::HtmlCanvasElement;
 mod cursor;
 /// `ChannelJob`: the chain from a recording to its track, in slices.
 mod job;
+/// The checks at open: a recording's links, a truth file's times.
+mod open;
 /// `simulate_channel`: the simulation use case.
 mod simulate;
 
 pub use job::ChannelJob;
+pub use open::{channel_recording_summary, check_channel_truth};
 pub use simulate::{simulate_channel, SimulatedChannel};
 
 use super::base::err;

@@ -48,7 +48,8 @@ fn drawable(v: &Option<f64>) -> bool {
     v.is_some_and(|v| v.is_finite() && v > 0.0)
 }
 
-/// Draws each tracker's RMSE (solid, one colour per filter, in the order EKF, UKF, PF, each
+/// Draws each tracker's RMSE (one colour and line style per filter — EKF solid, UKF dotted, PF
+/// long dashes —, in the order EKF, UKF, PF, each
 /// labelled with its failed runs, the legend's last row saying what failed means; a result
 /// without `filters` draws `rmse_ekf_m` as the EKF's) and ε_PCRLB(t) (dashed) from
 /// `result_json` (a Monte Carlo result; `""` draws empty axes) onto `canvas` at its pixel size,

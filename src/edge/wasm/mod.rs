@@ -34,7 +34,10 @@ mod tracking;
 pub use app::App;
 pub use base::{check_point, check_rect, preset_json, preset_names, start};
 use base::{err, point, window};
-pub use channel::{simulate_channel, ChannelFigures, ChannelJob, SimulatedChannel};
+pub use channel::{
+    channel_recording_summary, check_channel_truth, simulate_channel, ChannelFigures, ChannelJob,
+    SimulatedChannel,
+};
 pub use chart::draw_tracking_chart;
 pub use export::{mtl_scene_svg, tracking_chart_svg, MAX_FIGURE_PX, MAX_FIGURE_RES};
 pub use montecarlo::MonteCarloJob;

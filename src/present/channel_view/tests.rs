@@ -359,3 +359,35 @@ fn segments_split_the_track_and_mark_the_loss() {
         Err(Error::LengthMismatch { .. })
     ));
 }
+
+/// Issue 38 item 7: one stray estimate (370 m among a thousand within 10–50 m) does not stretch
+/// the range axis; a cluster of estimates at the edge of the bulk is kept.
+#[test]
+fn the_range_axis_is_robust_to_outliers() {
+    let mut p: Vec<DelayPoint> = (0..1000)
+        .map(|k| DelayPoint {
+            t_s: k as Real * 0.05,
+            range_m: 10.0 + 40.0 * (k % 100) as Real / 99.0,
+            amplitude_db: -80.0,
+        })
+        .collect();
+    let clean = suggest_range_m(&p, &[], &[], Real::INFINITY);
+    assert!(
+        (clean[0] - 8.0).abs() < 1e-9 && (clean[1] - 52.0).abs() < 1e-9,
+        "{clean:?}"
+    );
+    p.push(DelayPoint {
+        t_s: 3.0,
+        range_m: 370.0,
+        amplitude_db: -90.0,
+    });
+    assert_eq!(suggest_range_m(&p, &[], &[], Real::INFINITY), clean);
+    // A truth beyond the estimates still widens it (the truth is never an outlier).
+    let truth = [TruthCurve {
+        kind: "person".into(),
+        primary: true,
+        points: vec![(0.0, 70.0)],
+    }];
+    let r = suggest_range_m(&p, &[], &truth, Real::INFINITY);
+    assert!((r[1] - 73.0).abs() < 1e-9, "{r:?}");
+}

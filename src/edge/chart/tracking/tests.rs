@@ -121,3 +121,70 @@ fn legend_names_failed_runs_and_what_failed_means() {
     assert!(at("PF RMSE (3/192 failed)") < at("failed = filter broke down"));
     assert!(at("posterior CRLB") < at("failed = filter broke down"));
 }
+
+/// Issue 38 §8: the filters' curves differ in line style as well as colour (EKF one solid
+/// polyline, UKF and PF many dashes of different lengths), their legend samples too, and a title
+/// wider than the figure is drawn smaller to fit.
+#[test]
+fn curves_differ_in_dash_pattern_and_long_titles_fit() {
+    let t: Vec<Real> = (0..=50).map(|k| k as Real * 0.2).collect();
+    let ekf: Vec<Real> = t.iter().map(|t| 0.4 / (1.0 + t)).collect();
+    let ukf: Vec<Real> = ekf.iter().map(|v| v * 1.1).collect();
+    let pf: Vec<Real> = ekf.iter().map(|v| v * 1.3).collect();
+    let pcrlb: Vec<Option<Real>> = ekf.iter().map(|v| Some(v * 0.8)).collect();
+    let curves = [
+        FilterCurve {
+            label: "EKF RMSE",
+            rmse_m: &ekf,
+        },
+        FilterCurve {
+            label: "UKF RMSE",
+            rmse_m: &ukf,
+        },
+        FilterCurve {
+            label: "PF RMSE",
+            rmse_m: &pf,
+        },
+    ];
+    let panel = FiltersPanel {
+        title: "Scenario I",
+        t_s: &t,
+        curves: &curves,
+        rmse_pcrlb_m: &pcrlb,
+        legend_note: None,
+    };
+    let title = "Position RMSE: EKF, UKF, PF vs posterior CRLB (partial: EKF 200 of 200, UKF 200 of 200, PF 16 of 192 runs)";
+    let opts = TrackingChartOptions {
+        title: title.into(),
+        subtitle: None,
+    };
+    let svg = svg_of(|root| draw_tracking_filters(root, &[panel], &opts));
+    // Polylines per curve colour, and their mean number of points.
+    let lines = |c: RGBColor| {
+        let rgb = format!("stroke=\"#{:02X}{:02X}{:02X}\"", c.0, c.1, c.2);
+        svg.lines()
+            .filter(|l| l.contains("<polyline") && l.contains(&rgb))
+            .count()
+    };
+    let (e, u, p) = (
+        lines(CURVE_RGB[0]),
+        lines(CURVE_RGB[1]),
+        lines(CURVE_RGB[2]),
+    );
+    // EKF: the curve and its legend sample; UKF (dotted) more dashes than PF (long dashes).
+    assert_eq!(e, 2, "{svg}");
+    assert!(u > p && p > 5, "UKF {u}, PF {p} dashes");
+    // The title at 32 px would be ~1500 px wide: drawn smaller than 32 px.
+    let lines: Vec<&str> = svg.lines().collect();
+    let at = lines
+        .iter()
+        .position(|l| l.contains("partial: EKF"))
+        .expect("the title");
+    let size = lines[at - 1]
+        .split("font-size=\"")
+        .nth(1)
+        .and_then(|s| s.split('"').next())
+        .and_then(|s| s.parse::<f64>().ok())
+        .unwrap_or_else(|| panic!("title font size in {}", lines[at - 1]));
+    assert!(size < 30.0, "title font {size}");
+}

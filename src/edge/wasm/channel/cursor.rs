@@ -1,6 +1,6 @@
 //! The channel view's charts with a time cursor: [`ChannelFigures::draw_link_delays`] (one
 //! link's panel of the delay figure) and [`ChannelFigures::draw_error_time`] (the error over
-//! time of the track figure) draw through the CLI's chart code (`chart::draw_delays_boxes`,
+//! time of the track figure) draw through the CLI's chart code (`chart::draw_delays_panels`,
 //! `chart::draw_error_time_chart`) and return where the plotting area lies on the canvas and
 //! the time it spans, so the page draws its time cursor over them without redrawing the chart.
 
@@ -11,7 +11,7 @@ use wasm_bindgen::prelude::*;
 use web_sys::HtmlCanvasElement;
 
 use super::{chart_options, on_canvas, ChannelFigures};
-use crate::chart::{draw_delays_boxes, draw_error_time_chart, PlotBox};
+use crate::chart::{draw_delays_panels, draw_error_time_chart, PlotBox};
 use crate::edge::wasm::base::err;
 use crate::edge::wasm::json::to_js;
 use crate::error::Error;
@@ -39,8 +39,9 @@ impl From<PlotBox> for PlotBoxJs {
 #[wasm_bindgen]
 impl ChannelFigures {
     /// Draws the panel of link `link` (0 … links − 1) of the delay figure alone on `canvas` at
-    /// its pixel size (`chart::draw_delays_boxes` on a figure of that link, with the whole
-    /// figure's time axis and amplitude scale) with `title` and `subtitle` (`""`: none), and
+    /// its pixel size (`chart::draw_delays_panels` on a figure of that link, with the whole
+    /// figure's time axis; no legend in the panel: the page shows its own, with the time
+    /// cursor) with `title` and `subtitle` (`""`: none), and
     /// returns its plot box `{x_px, y_px, t_range_s}` (canvas pixels). Throws on `link` out of
     /// range or a drawing failure (`draw_link_delays: …`).
     pub fn draw_link_delays(
@@ -67,7 +68,7 @@ impl ChannelFigures {
         let opts = chart_options(title, subtitle);
         let mut plot = None;
         on_canvas("draw_link_delays", canvas, |root| {
-            plot = draw_delays_boxes(root, &fig, &opts)?.first().copied();
+            plot = draw_delays_panels(root, &fig, &opts)?.first().copied();
             Ok(())
         })?;
         to_js(&plot.map(PlotBoxJs::from))

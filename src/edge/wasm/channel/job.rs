@@ -12,6 +12,7 @@ use serde::Serialize;
 use wasm_bindgen::prelude::*;
 
 use super::{check_size, named, now_ms, scenario_and_model, MAX_CHANNEL_PARTICLE_STEPS};
+use crate::channel::ResponseMap;
 use crate::channel::{Band, Recording};
 use crate::edge::wasm::base::err;
 use crate::edge::wasm::json::{to_js, to_json};
@@ -19,7 +20,8 @@ use crate::error::limits::{MAX_PAGE_RECORDING_BYTES, MAX_PAGE_TEXT_BYTES};
 use crate::error::{Cancel, Error};
 use crate::formats::Truth;
 use crate::present::{
-    delay_figure, estimates_doc, link_names, track_doc, track_errors, DelayFigure, TrackErrorView,
+    delay_figure_link, estimates_doc, link_names, track_doc, track_errors, DelayFigure, LinkDelays,
+    TrackErrorView,
 };
 use crate::study::{
     cir_track, prepare, ChannelRequest, ChannelStatics, CirTrackOutput, EstimationRun,
@@ -153,6 +155,10 @@ pub struct ChannelJob {
     track: Option<CirTrackOutput>,
     view: Option<TrackErrorView>,
     figure: Option<DelayFigure>,
+    /// The delay figure's panels made so far (one per unit of the `"figure"` phase) and the
+    /// recording's band they are made from.
+    panels: Vec<LinkDelays>,
+    band: Option<(Band, ResponseMap)>,
     timings: TimingsJs,
 }
 
@@ -250,13 +256,17 @@ impl ChannelJob {
             track: None,
             view: None,
             figure: None,
+            panels: Vec::new(),
+            band: None,
             timings,
         })
     }
 
     /// Runs work for about `budget_ms` ms (at least one unit: a few snapshots of one link while
-    /// estimating, a link's statics with its first snapshot; the track and the figure are one
-    /// unit each) and returns the progress (as [`ChannelJob::progress`]). Throws the core's
+    /// estimating, a link's statics with its first snapshot; the track is one unit, the figure
+    /// one unit per link), returning early when a phase ends (so the next phase's progress is
+    /// reported before its first unit runs, issue 38 item 9), and returns the progress (as
+    /// [`ChannelJob::progress`]). Throws the core's
     /// named error of the phase (prefixed by `recording`, `track` or `figure`; the empty
     /// area's as `calibration…`); after an error the job is spent.
     pub fn step(&mut self, budget_ms: f64) -> Result<JsValue, JsError> {
@@ -271,7 +281,7 @@ impl ChannelJob {
                 Phase::Figure => self.timings.figure_ms += spent,
                 Phase::Done => {}
             }
-            if self.phase == Phase::Done || now_ms() - start >= budget_ms {
+            if self.phase != phase || now_ms() - start >= budget_ms {
                 break;
             }
         }
@@ -280,11 +290,13 @@ impl ChannelJob {
 
     /// The progress `{phase, done, total, finished}`: `phase` is `"estimate"` (the statics and
     /// paths of every link; `done`/`total` count link-snapshots), `"track"` (0 of 1),
-    /// `"figure"` (0 of 1) or `"done"` (1 of 1); `finished` is true once every result is there.
+    /// `"figure"` (`done` of `total` links' panels) or `"done"` (1 of 1); `finished` is true
+    /// once every result is there.
     pub fn progress(&self) -> Result<JsValue, JsError> {
         let (done, total) = match (&self.run, self.phase) {
             (Some(r), _) => (r.done(), r.total()),
             (None, Phase::Done) => (1, 1),
+            (None, Phase::Figure) => (self.panels.len(), self.model.link_count().max(1)),
             (None, _) => (0, 1),
         };
         to_js(&ProgressJs {
@@ -438,20 +450,32 @@ impl ChannelJob {
                     (Some(s), Some(e)) => (s, e),
                     _ => return Err(pending("step")),
                 };
-                let bw = self.scenario.radio.bandwidth_hz;
-                let band = Band::of_recording(&self.rec, bw).map_err(named("figure"))?;
-                let fig = delay_figure(
-                    &self.model,
-                    &self.rec,
-                    &band,
-                    est,
-                    Some(&st.calibration),
-                    self.truth.as_ref().map(|t| t.states.as_slice()),
-                    &link_names(&self.scenario, &self.model),
-                )
-                .map_err(named("figure"))?;
-                self.figure = Some(fig);
-                self.phase = Phase::Done;
+                if self.band.is_none() {
+                    let bw = self.scenario.radio.bandwidth_hz;
+                    self.band = Some(Band::of_recording(&self.rec, bw).map_err(named("figure"))?);
+                }
+                let band = self.band.as_ref().ok_or_else(|| pending("step"))?;
+                let p = self.panels.len();
+                if p < self.model.link_count() {
+                    let panel = delay_figure_link(
+                        &self.model,
+                        &self.rec,
+                        band,
+                        est,
+                        Some(&st.calibration),
+                        self.truth.as_ref().map(|t| t.states.as_slice()),
+                        &link_names(&self.scenario, &self.model),
+                        p,
+                    )
+                    .map_err(named("figure"))?;
+                    self.panels.push(panel);
+                }
+                if self.panels.len() >= self.model.link_count() {
+                    let panels = core::mem::take(&mut self.panels);
+                    self.figure = Some(DelayFigure::new(&self.rec.t_s, panels));
+                    self.band = None;
+                    self.phase = Phase::Done;
+                }
             }
             Phase::Done => {}
         }
