@@ -112,14 +112,14 @@ struct Views {
 }
 
 /// A fresh load of the page with `hash`, settled.
-async fn reopen(c: &Client, port: u16, hash: &str) -> Result<(), String> {
+pub(super) async fn reopen(c: &Client, port: u16, hash: &str) -> Result<(), String> {
     c.goto("about:blank").await.map_err(|e| e.to_string())?;
     open_hash(c, port, hash).await?;
     settle(c).await
 }
 
 /// Polls `script` (returning a value) until `done` holds, at most `secs` seconds.
-async fn poll(
+pub(super) async fn poll(
     c: &Client,
     script: &str,
     secs: u64,
@@ -140,7 +140,7 @@ async fn poll(
 }
 
 /// Switches the theme (the page's hook, as the toggle does) and waits for the redraw.
-async fn set_theme(c: &Client, theme: &str) -> Result<(), String> {
+pub(super) async fn set_theme(c: &Client, theme: &str) -> Result<(), String> {
     js(c, &format!("window.theme.set('{theme}')")).await?;
     if js(c, "return document.documentElement.dataset.theme").await? != theme {
         return Err(format!("theme {theme} not applied"));

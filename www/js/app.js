@@ -235,7 +235,7 @@ export async function start() {
       st.fix = tr ? tracking.frame : st.snap;
       st.overlay = tr ? (c, v) => tracking.overlay(c, v)
         : plan.showsRoi() ? (c, v) => plan.overlay(c, v) : null;
-      st.insetTitle = tr ? `${tracking.filterName()} zoom · true scale` : 'target zoom';
+      st.insetTitle = tr ? `${tracking.filterName()} zoom 1:1` : 'target zoom';
       st.insetAvoid = tr ? tracking.avoidPoints() : map.avoidPoints();
       if (st.mode === 'channel') {
         // The channel view (channel.js): its track layer, no snapshot target.

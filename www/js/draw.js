@@ -19,6 +19,21 @@ export const C = {
   // The dark casing under the main map's iso-delay ellipses, so a yellow or green link reads on
   // the map's yellow-green end too (map.js drawTargetMain; the same in both themes).
   mapCasing: 'rgba(10,12,18,0.85)',
+  // The multi-target view's colours (mtl-draw.js), per theme, the same CSS variables as its legend
+  // (#legend-mtl): see applyThemeColors.
+  halo: 'rgba(10,12,18,0.85)',
+  casing: 'transparent',
+  marker: '#ffffff',
+  regionEdge: 'rgba(92,200,255,0.6)',
+  discFill: 'rgba(150,160,178,0.55)',
+  discEdge: '#c9d2e0',
+  blocked: '#ff4d4f',
+  los: 'rgba(255,255,255,0.35)',
+  seed: 'rgba(200,210,225,0.8)',
+  hyp: '#ffd166',
+  hypRej: 'rgba(160,170,185,0.8)',
+  fa: '#ff8fb0',
+  det: '#ffa94d',
   // The zoom inset's own colours (map.js drawInset), per theme: see applyThemeColors.
   insetBg: '#0d1017',
   insetText: '#c9d2e0',
@@ -85,6 +100,17 @@ export function haloText(ctx, text, x, y, halo = 'rgba(10,12,18,0.85)') {
   ctx.fillText(text, x, y);
 }
 
+/**
+ * `text` cut at the end with '…' so that it is at most `maxW` px wide in the context's font
+ * (`text` itself when it fits).
+ */
+export function fitText(ctx, text, maxW) {
+  if (ctx.measureText(text).width <= maxW) return text;
+  let n = text.length;
+  while (n > 0 && ctx.measureText(`${text.slice(0, n).trimEnd()}…`).width > maxW) n--;
+  return `${text.slice(0, n).trimEnd()}…`;
+}
+
 /** True if boxes `a` and `b` ({x, y, w, h}) overlap. */
 export function boxesOverlap(a, b) {
   return a.x < b.x + b.w && b.x < a.x + a.w && a.y < b.y + b.h && b.y < a.y + a.h;
@@ -95,9 +121,9 @@ export function boxesOverlap(a, b) {
  * ([dx, dy, textAlign, textBaseline] from the anchor pixel `p`) whose box lies inside `rect` and
  * overlaps none of the boxes `taken`; failing that, at the first spot moved up or down by whole
  * label heights that does; failing that, at the first spot moved inside `rect`. Returns the box
- * drawn {x, y, w, h} (CSS px, halo included) and adds it to `taken`.
+ * drawn {x, y, w, h} (CSS px, halo included) and adds it to `taken`. `haloColor`: haloText's.
  */
-export function placeLabel(ctx, text, p, rect, taken, spots) {
+export function placeLabel(ctx, text, p, rect, taken, spots, haloColor = undefined) {
   const halo = 1.5;
   const boxAt = ([dx, dy, align, baseline], shift = 0) => {
     ctx.textAlign = align;
@@ -132,7 +158,7 @@ export function placeLabel(ctx, text, p, rect, taken, spots) {
   }
   ctx.textAlign = best.at.align;
   ctx.textBaseline = best.at.baseline;
-  haloText(ctx, text, best.at.x, best.at.y);
+  haloText(ctx, text, best.at.x, best.at.y, haloColor);
   const box = { x: best.x, y: best.y, w: best.w, h: best.h };
   taken.push(box);
   return box;
@@ -268,7 +294,9 @@ export function drawNodes(ctx, view, receivers, transmitters, sel) {
 /**
  * The canvas colours of the theme (theme.js): the plot's background, frame, axis text, muted
  * text and grid from the CSS variables --plot-bg, --plot-frame, --plot-text, --plot-muted and
- * --plot-grid (style.css, per theme) into C; the zoom inset's background, text, halo, truth
+ * --plot-grid (style.css, per theme) into C; the multi-target view's label halo, link casing
+ * and markers from --plot-halo, --plot-casing and the variables its legend's symbols use; the
+ * zoom inset's background, text, halo, truth
  * cross and link casing from --inset-*, its CRLB and fix from the page's --crlb, --fix and
  * --ekf-fill. The map, its overlays and the markers keep their colours in both themes (they are
  * drawn over the map's dark-to-bright scale).
@@ -278,7 +306,10 @@ export function applyThemeColors() {
   for (const [key, name] of [['bg', '--plot-bg'], ['frame', '--plot-frame'], ['text', '--plot-text'],
     ['muted', '--plot-muted'], ['grid', '--plot-grid'], ['insetBg', '--inset-bg'], ['insetText', '--inset-text'],
     ['insetHalo', '--inset-halo'], ['insetTruth', '--inset-truth'], ['insetCasing', '--inset-casing'],
-    ['insetCrlb', '--crlb'], ['insetFix', '--fix'], ['insetFixFill', '--ekf-fill']]) {
+    ['insetCrlb', '--crlb'], ['insetFix', '--fix'], ['insetFixFill', '--ekf-fill'],
+    ['halo', '--plot-halo'], ['casing', '--plot-casing'], ['marker', '--marker'], ['regionEdge', '--region-edge'],
+    ['discFill', '--disc-fill'], ['discEdge', '--disc-edge'], ['blocked', '--blocked'], ['los', '--los'],
+    ['seed', '--seed'], ['hyp', '--hyp'], ['hypRej', '--hyp-rej'], ['fa', '--fa'], ['det', '--fix']]) {
     const v = css.getPropertyValue(name).trim();
     if (v) C[key] = v;
   }

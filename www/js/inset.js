@@ -15,6 +15,8 @@ const MIN_SIZE = 80;
 export const HEAD_PX = 24;
 /** Keyboard move of the inset, CSS px (Shift: ×5). */
 const KEY_STEP = 10;
+/** The × button's width (CSS px; style.css .inset-close) while it is not laid out. */
+const CLOSE_PX = 24;
 
 /**
  * The box {x, y, size} (CSS px) of an inset of side `size` inside the plot rectangle `r` that
@@ -155,7 +157,15 @@ export class InsetControls {
     };
   }
 
-  /** After a frame: the controls over the box drawn (or hidden when none; "Show" when closed). */
+  /** The width (CSS px) the title of an inset of side `size` may take: left of the × with a gap. */
+  titleRoom(size) {
+    return size - 8 - (this.closeButton.offsetWidth || CLOSE_PX) - 6;
+  }
+
+  /**
+   * After a frame: the controls over the box drawn (or hidden when none; "Show" when closed);
+   * the header's name and tooltip carry the inset's full title (cut on the canvas if long).
+   */
   shown(box, hasTarget) {
     this.box = box;
     const head = this.head;
@@ -163,11 +173,15 @@ export class InsetControls {
     this.openButton.hidden = !(this.closed && hasTarget);
     if (!box) return;
     Object.assign(head.style, { left: `${box.x}px`, top: `${box.y}px`, width: `${box.size}px`, height: `${HEAD_PX}px` });
+    const name = box.title ? `${box.title.full}: m` : 'M';
+    this.grip.setAttribute('aria-label', `${name}ove the zoom inset: drag it, or use the arrow keys`);
+    this.grip.title = `${box.title ? `${box.title.full}: d` : 'D'}rag to move the zoom inset (arrow keys: 10 px, Shift: 50 px)`;
   }
 
   /**
-   * For the hooks: {closed, moved, box: {x, y, size} | null, colors: {bg, title, halo} | null}
-   * (the CSS colours the last frame drew the inset's background, title and title halo in).
+   * For the hooks: {closed, moved, box: {x, y, size} | null, colors: {bg, title, halo} | null,
+   * title: {text, full, box: {x, y, w, h}} | null} (the CSS colours the last frame drew the
+   * inset's background, title and title halo in; the title drawn, cut or not, and its ink box).
    */
   state() {
     const b = this.box;
@@ -176,6 +190,7 @@ export class InsetControls {
       moved: !!this.pos,
       box: b ? { x: b.x, y: b.y, size: b.size } : null,
       colors: b && b.colors ? { ...b.colors } : null,
+      title: b && b.title ? { ...b.title, box: { ...b.title.box } } : null,
     };
   }
 }

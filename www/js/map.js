@@ -14,7 +14,7 @@
 import { $, fixed, showError } from './dom.js';
 import { Zoom } from './view.js';
 import { JobWorker } from './workers.js';
-import { C, FONT, FONT_B, FULL, clipTo, cross, drawAxes, drawNodes, drawScaleBar, ellipsePath, haloText, linkColor, polyline } from './draw.js';
+import { C, FONT, FONT_B, FULL, clipTo, cross, drawAxes, drawNodes, drawScaleBar, ellipsePath, fitText, haloText, linkColor, polyline } from './draw.js';
 import { ColourLock } from './colour-lock.js';
 import { HARD, InsetControls, chooseBox } from './inset.js';
 
@@ -448,12 +448,20 @@ function drawInset(ctx, view, fix, w, title, avoid, controls) {
     ctx.font = FONT; ctx.fillStyle = C.insetText; ctx.textAlign = 'left'; ctx.textBaseline = 'bottom';
     haloText(ctx, bar.label, box.x + 16 + len, y + 4, C.insetHalo);
   }
+  // The title stays left of the × (inset.js): cut with '…' if it is too long, the full text is
+  // the header's tooltip and accessible name then.
   ctx.font = FONT_B; ctx.fillStyle = C.insetText; ctx.textAlign = 'left'; ctx.textBaseline = 'top';
-  haloText(ctx, title, box.x + 8, box.y + 7, C.insetHalo);
+  const room = controls ? controls.titleRoom(size) : size - 16;
+  const shown = fitText(ctx, title, room);
+  haloText(ctx, shown, box.x + 8, box.y + 7, C.insetHalo);
+  const m = ctx.measureText(shown);
+  const titleBox = { x: box.x + 8 - m.actualBoundingBoxLeft, y: box.y + 7 - m.actualBoundingBoxAscent,
+    w: m.actualBoundingBoxLeft + m.actualBoundingBoxRight, h: m.actualBoundingBoxAscent + m.actualBoundingBoxDescent };
   ctx.restore();
   ctx.strokeStyle = C.frame; ctx.lineWidth = 1;
   ctx.strokeRect(box.x + 0.5, box.y + 0.5, size, size);
-  return { x: box.x, y: box.y, size, colors: { bg: C.insetBg, title: C.insetText, halo: C.insetHalo } };
+  return { x: box.x, y: box.y, size, colors: { bg: C.insetBg, title: C.insetText, halo: C.insetHalo },
+    title: { text: shown, full: title, box: titleBox } };
 }
 
 /**

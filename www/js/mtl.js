@@ -378,7 +378,7 @@ export class Mtl {
     drawMtl(this.view, this.scene, this.result, this.selected, this.wasm);
   }
 
-  /** Test and console hook: the scene, the last view's essentials and the timing. */
+  /** Test and console hook: the scene, the last view's essentials, the colours drawn with (mtlColors) and the timing. */
   state() {
     const v = this.result;
     return {
@@ -400,6 +400,7 @@ export class Mtl {
       busyMs: this.job.busyMs(),
       restarts: this.job.restarts,
       labels: (this.view.drawn.labels || []).map((l) => ({ ...l, box: { ...l.box } })),
+      colors: this.view.drawn.colors ? { ...this.view.drawn.colors } : null,
     };
   }
 
