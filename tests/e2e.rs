@@ -132,15 +132,15 @@ mod page_tracking;
 #[cfg(test)]
 #[path = "common/nees.rs"]
 mod nees;
-/// Issue 38 §11: the page's channel track is consistent with its error (NEES band, 4 seeds).
-#[cfg(test)]
-#[path = "e2e/page_nees.rs"]
-mod page_nees;
 /// Issue 38, a first-time user's look: the multi-target view in its theme's colours, the zoom
 /// inset's title clear of its ×, the channel panel without sideways scrolling.
 #[cfg(test)]
 #[path = "e2e/page_look.rs"]
 mod page_look;
+/// Issue 38 §11: the page's channel track is consistent with its error (NEES band, 4 seeds).
+#[cfg(test)]
+#[path = "e2e/page_nees.rs"]
+mod page_nees;
 
 /// One browser at a time (2-core machines).
 static SERIAL: Mutex<()> = Mutex::new(());

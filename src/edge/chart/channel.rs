@@ -599,19 +599,27 @@ fn draw_link<DB: DrawingBackend>(
     }
     let off = draw_clipped(&chart, link, [t0, t1], [r0, r1], radius + 1)?;
     if off > 0 {
+        // Bottom left: the first panel's legend sits upper right and can span the width.
         let style = TextStyle::from(("sans-serif", font.ticks * 0.8).into_font())
             .color(&ESTIMATE_RGB)
-            .pos(Pos::new(HPos::Left, VPos::Top));
+            .pos(Pos::new(HPos::Left, VPos::Bottom));
         let pad = (6.0 * s) as i32;
-        let label = format!(
-            "{off} estimate{} off the axis (triangles at its edge)",
-            if off == 1 { "" } else { "s" }
-        );
-        chart
-            .plotting_area()
-            .strip_coord_spec()
-            .draw_text(&label, &style, (pad, pad + (font.ticks * 0.9) as i32))
-            .map_err(chart_err)?;
+        let label = format!("{off} off the axis (marked at its edge)");
+        let area = chart.plotting_area().strip_coord_spec();
+        let (_, h) = area.dim_in_pixel();
+        // On a white box: the response image beneath can be dark.
+        let (w_text, h_text) = area.estimate_text_size(&label, &style).map_err(chart_err)?;
+        let (x, y) = (pad, h as i32 - pad);
+        let m = (2.0 * s) as i32;
+        area.draw(&Rectangle::new(
+            [
+                (x - m, y - h_text as i32 - m),
+                (x + w_text as i32 + m, y + m),
+            ],
+            WHITE.mix(0.85).filled(),
+        ))
+        .map_err(chart_err)?;
+        area.draw_text(&label, &style, (x, y)).map_err(chart_err)?;
     }
     // The truth on top: a white halo under vermillion dashes.
     let width = (2.0 * s).round().max(1.0) as u32;

@@ -595,7 +595,7 @@ fn the_svg_of_a_long_recording_stays_small() {
     );
     let tx = texts(&svg);
     // Each link's outlier: counted in its panel, one triangle at the top edge.
-    let note = "1 estimate off the axis (triangles at its edge)";
+    let note = "1 off the axis (marked at its edge)";
     assert_eq!(tx.iter().filter(|t| *t == note).count(), 4, "{tx:?}");
     assert_eq!(
         doc.descendants()
