@@ -29,17 +29,17 @@ const HOME: &str = "\u{E011}";
 const END: &str = "\u{E010}";
 const RIGHT: &str = "\u{E014}";
 
-async fn click(c: &Client, id: &str) -> Result<(), String> {
+pub(super) async fn click(c: &Client, id: &str) -> Result<(), String> {
     let e = c.find(Locator::Id(id)).await.map_err(|e| e.to_string())?;
     e.click().await.map_err(|e| format!("click {id}: {e}"))
 }
 
-async fn state(c: &Client) -> Result<Value, String> {
+pub(super) async fn state(c: &Client) -> Result<Value, String> {
     js(c, "return window.channel.state()").await
 }
 
 /// Polls the channel state until `done` holds (at most `secs`), failing fast on a console error.
-async fn wait_state(
+pub(super) async fn wait_state(
     c: &Client,
     secs: u64,
     what: &str,
@@ -81,7 +81,7 @@ async fn dismiss(c: &Client) -> Result<(), String> {
 }
 
 /// Keys typed into element `id` (it gets the focus).
-async fn keys(c: &Client, id: &str, k: &str) -> Result<(), String> {
+pub(super) async fn keys(c: &Client, id: &str, k: &str) -> Result<(), String> {
     let e = c.find(Locator::Id(id)).await.map_err(|e| e.to_string())?;
     e.send_keys(k)
         .await

@@ -21,6 +21,7 @@ use fantoccini::{Client, Locator};
 use serde_json::Value;
 
 use super::channel::cli;
+use super::channel_ui::{keys, state, wait_state};
 use super::mtl::banner;
 use super::{console_errors, drag_on_plot, js, open_hash, settle, with_browser};
 
@@ -67,34 +68,6 @@ fn preset(dir: &Path) {
     std::fs::write(dir.join("s.json"), s).unwrap();
 }
 
-async fn state(c: &Client) -> Result<Value, String> {
-    js(c, "return window.channel.state()").await
-}
-
-/// Polls the channel state until `done` holds (at most `secs`), failing fast on a console error.
-async fn wait_state(
-    c: &Client,
-    secs: u64,
-    what: &str,
-    done: impl Fn(&Value) -> bool,
-) -> Result<Value, String> {
-    let t0 = Instant::now();
-    loop {
-        let s = state(c).await?;
-        if done(&s) {
-            return Ok(s);
-        }
-        let errors = console_errors(c).await?;
-        if !errors.is_empty() {
-            return Err(format!("{what}: console errors {errors:?}; state {s}"));
-        }
-        if t0.elapsed() > Duration::from_secs(secs) {
-            return Err(format!("{what}: not after {secs} s; state {s}"));
-        }
-        tokio::time::sleep(Duration::from_millis(50)).await;
-    }
-}
-
 /// Chooses `path` in the file input `id` (chromedriver types the path, as a user picks it) and
 /// waits until the view has read it (`key` of the state names it, or the banner shows).
 async fn choose(c: &Client, id: &str, path: &Path, key: &str) -> Result<String, String> {
@@ -129,14 +102,6 @@ async fn choose(c: &Client, id: &str, path: &Path, key: &str) -> Result<String, 
 async fn run(c: &Client, n: u64) -> Result<Value, String> {
     js(c, "document.getElementById('chan-run').click()").await?;
     wait_state(c, 600, "run", |s| s["runs"] == n && s["running"].is_null()).await
-}
-
-/// Keys typed into element `id` (it gets the focus).
-async fn keys(c: &Client, id: &str, k: &str) -> Result<(), String> {
-    let e = c.find(Locator::Id(id)).await.map_err(|e| e.to_string())?;
-    e.send_keys(k)
-        .await
-        .map_err(|e| format!("keys to {id}: {e}"))
 }
 
 /// What the stale checks read after each change.

@@ -21,49 +21,19 @@ use std::time::{Duration, Instant};
 use fantoccini::{Client, Locator};
 use serde_json::{json, Value};
 
+use super::channel_ui::{click, keys};
 use super::hardening::session;
 use super::mtl::{banner, wait_view};
 use super::plan::open_url;
+use super::state::{select, type_in};
 use super::*;
 
-const ENTER: char = '\u{E007}';
-const CONTROL: char = '\u{E009}';
-const NULL_KEY: char = '\u{E000}';
 const HOME: &str = "\u{E011}";
 const END: &str = "\u{E010}";
 const RIGHT: &str = "\u{E014}";
 
 /// The page's views, as their mode buttons `mode-<view>` name them.
 const VIEWS: [&str; 4] = ["snapshot", "tracking", "mtl", "channel"];
-
-async fn click(c: &Client, id: &str) -> Result<(), String> {
-    let e = c.find(Locator::Id(id)).await.map_err(|e| e.to_string())?;
-    e.click().await.map_err(|e| format!("click {id}: {e}"))
-}
-
-async fn select(c: &Client, id: &str, value: &str) -> Result<(), String> {
-    let e = c.find(Locator::Id(id)).await.map_err(|e| e.to_string())?;
-    e.select_by_value(value)
-        .await
-        .map_err(|e| format!("select {id} = {value}: {e}"))
-}
-
-/// Types `text` over the whole content of input `id` (Ctrl+A, the text, Enter).
-async fn type_in(c: &Client, id: &str, text: &str) -> Result<(), String> {
-    let e = c.find(Locator::Id(id)).await.map_err(|e| e.to_string())?;
-    e.click().await.map_err(|e| format!("click {id}: {e}"))?;
-    e.send_keys(&format!("{CONTROL}a{NULL_KEY}{text}{ENTER}"))
-        .await
-        .map_err(|e| format!("type into {id}: {e}"))
-}
-
-/// Keys sent to element `id` (it gets the focus).
-async fn keys(c: &Client, id: &str, k: &str) -> Result<(), String> {
-    let e = c.find(Locator::Id(id)).await.map_err(|e| e.to_string())?;
-    e.send_keys(k)
-        .await
-        .map_err(|e| format!("keys to {id}: {e}"))
-}
 
 /// The page is idle and the undo history has looked at the last change.
 async fn quiet(c: &Client) -> Result<(), String> {

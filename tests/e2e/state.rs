@@ -28,7 +28,7 @@ async fn click(c: &Client, id: &str) -> Result<(), String> {
     e.click().await.map_err(|e| format!("click {id}: {e}"))
 }
 
-async fn select(c: &Client, id: &str, value: &str) -> Result<(), String> {
+pub(super) async fn select(c: &Client, id: &str, value: &str) -> Result<(), String> {
     let e = c.find(Locator::Id(id)).await.map_err(|e| e.to_string())?;
     e.select_by_value(value)
         .await
@@ -36,7 +36,7 @@ async fn select(c: &Client, id: &str, value: &str) -> Result<(), String> {
 }
 
 /// Types `text` over the whole content of input `id` (Ctrl+A, the text, Enter).
-async fn type_in(c: &Client, id: &str, text: &str) -> Result<(), String> {
+pub(super) async fn type_in(c: &Client, id: &str, text: &str) -> Result<(), String> {
     let e = c.find(Locator::Id(id)).await.map_err(|e| e.to_string())?;
     e.click().await.map_err(|e| format!("click {id}: {e}"))?;
     e.send_keys(&format!("{CONTROL}a{NULL_KEY}{text}{ENTER}"))
