@@ -1,6 +1,6 @@
 //! The invariants of a Monte Carlo part's sums (issue 24): what [`crate::track::StudySums`]
 //! of a shard's chunks can hold, checked by [`crate::study::MonteCarloStudy::merge`] before
-//! they are added. The list is in the module documentation of [`crate::study::PartSet`].
+//! they are added. The list is in the documentation of [`crate::study::PartSet`].
 
 use alloc::format;
 use alloc::string::String;

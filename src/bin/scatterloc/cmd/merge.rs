@@ -1,5 +1,5 @@
 //! `scatterloc merge`: the part files of a sharded study into the result of the unsharded run.
-//! The files are read here, one at a time (each at most 256 MiB); the library checks them as
+//! The files are read one at a time (each at most 256 MiB, `parts`); the library checks them as
 //! one set ([`scatterloc::study::PartSet::read`]: format version, one study, every shard
 //! exactly once) before anything is written, then the study's merge reads each part's sums
 //! again and checks them against their digest and the study (issue 24; the list is in
@@ -8,34 +8,10 @@
 //! (`montecarlo`, `mtl roc`) then writes its usual outputs.
 
 use scatterloc::study::PartSet;
-use scatterloc::Error;
 
-use super::io::read_input_named;
+use super::parts::PartReader;
 use crate::cli::MergeArgs;
 use crate::failure::CliError;
-
-/// Reads the part files of `merge`, one at a time (its errors as the library's, exit status
-/// 2); stdin (`-`) is read once and kept, as it cannot be read again.
-#[derive(Default)]
-pub struct PartReader {
-    stdin: Option<String>,
-}
-
-impl PartReader {
-    /// The text of part file `path`.
-    pub fn load(&mut self, path: &str) -> Result<String, Error> {
-        let read = |p: &str| {
-            read_input_named("merge: PART", p).map_err(|e| Error::PartSet { what: e.message })
-        };
-        if path != "-" {
-            return read(path);
-        }
-        if self.stdin.is_none() {
-            self.stdin = Some(read(path)?);
-        }
-        Ok(self.stdin.clone().unwrap_or_default())
-    }
-}
 
 /// `scatterloc merge`.
 pub fn merge(args: &MergeArgs) -> Result<(), CliError> {

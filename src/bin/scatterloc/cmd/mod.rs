@@ -1,10 +1,11 @@
 //! The commands of `scatterloc`, one file per family: the single-snapshot commands (`preset`,
 //! `crlb`, `locate` in `scenario`, `crlb-map` in `crlb_map`), tracking (`track` with its figure
-//! in `track_fig`), the channel front end (`cir simulate|estimate|track` in `cir`), gating (`calibrate`, `simulate-walk`), the tracking studies (`montecarlo`,
-//! `pcrlb`, sharing `study` and `report`), network planning (`plan`), the multi-target commands (`mtl`), and scale-out:
-//! one shard of a study (`--shard`, its part file in `shard`), `merge`, and a sharded study
-//! submitted to Slurm (`slurm submit`). Each takes its
-//! parsed flags from `crate::cli`, reads its inputs (`io`), calls the library and writes JSON to
+//! in `track_fig`), the channel front end (`cir simulate|estimate|track` in `cir`), gating
+//! (`calibrate`, `simulate-walk`), the tracking studies (`montecarlo`, `pcrlb`, sharing `study`
+//! and `report`), network planning (`plan`), the multi-target commands (`mtl`), and scale-out:
+//! one shard of a study (`--shard`, its part file in `shard`), `merge` (the part files read by
+//! `parts`), and a sharded study submitted to Slurm (`slurm submit`). Each takes its parsed
+//! flags from `crate::cli`, reads its inputs (`io`), calls the library and writes JSON to
 //! stdout and files atomically (`output`).
 
 mod cir;
@@ -18,6 +19,7 @@ mod merge;
 mod montecarlo;
 mod mtl;
 mod output;
+mod parts;
 mod plan;
 mod report;
 mod scenario;

@@ -15,6 +15,7 @@ use scatterloc::study::{
 use scatterloc::track::{nominal_pcrlb_rmse, paper_initial_covariance};
 
 use super::filters::filter_kinds;
+use super::parts::PartReader;
 use super::report::Outputs;
 use super::shard;
 use super::study::{
@@ -173,7 +174,7 @@ fn run_shard(
 /// shard added exactly ([`MonteCarloStudy::merge`]), then the outputs of the unsharded run.
 pub fn merge_parts(
     set: &PartSet,
-    mut reader: super::merge::PartReader,
+    mut reader: PartReader,
     json: &str,
     out: Option<&str>,
 ) -> Result<(), CliError> {

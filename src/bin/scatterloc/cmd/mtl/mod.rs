@@ -28,6 +28,7 @@ use scatterloc::Error;
 use super::flags::with_flag;
 use super::io::{emit, emit_summary, one_stdin, read_input};
 use super::output::{check_writable, write_json_file, Figure, Format, OutputSet};
+use super::parts::PartReader;
 use super::shard;
 use super::study::{cancelled, run_with_bar, threads};
 use crate::cli::{MtlLocateArgs, MtlModel, RocArgs, RocExperiment, Table2Args};

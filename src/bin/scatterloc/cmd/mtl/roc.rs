@@ -295,7 +295,7 @@ pub fn mtl_roc(args: &RocArgs) -> Result<(), CliError> {
 /// shard added exactly ([`RocStudy::merge`]), then the outputs of the unsharded run.
 pub fn merge_roc(
     set: &PartSet,
-    mut reader: super::super::merge::PartReader,
+    mut reader: PartReader,
     json: &str,
     out: Option<&str>,
 ) -> Result<(), CliError> {
