@@ -24,7 +24,7 @@ use scatterloc::track::{
 use scatterloc::track::{
     run_chunk, run_filter_chunk, run_truth_chunk, FilterKind, MonteCarloConfig, CHUNK_TRAJECTORIES,
 };
-use scatterloc::track::{Ekf, MeasurementNoise, ParticleFilter, PfConfig, Ukf, UkfParams};
+use scatterloc::track::{Ekf, Filter, MeasurementNoise, ParticleFilter, PfConfig, Ukf, UkfParams};
 use scatterloc::{measure, scenario::presets, Model};
 
 const SEED: u64 = 2019;

@@ -13,7 +13,7 @@ use common::sensors_model;
 use common::tracking::mesh;
 use scatterloc::math::{Real, Vec2, Vec4};
 use scatterloc::track::{paper_initial_covariance, TrackScenario, TruthSampler};
-use scatterloc::track::{ConstantVelocity, Ekf, MeasurementNoise, PAPER_INTENSITY};
+use scatterloc::track::{ConstantVelocity, Ekf, Filter, MeasurementNoise, PAPER_INTENSITY};
 use scatterloc::{measure, Model};
 
 #[global_allocator]

@@ -35,7 +35,7 @@ use scatterloc::present::{mtl_view, MtlScene};
 use scatterloc::present::{simulate_snapshot, Session};
 use scatterloc::scenario::{parse_json, presets, Area, Scenario};
 use scatterloc::track::gating::{Calibration, ClusterConfig};
-use scatterloc::track::{ConstantVelocity, Ekf, MeasurementNoise};
+use scatterloc::track::{ConstantVelocity, Ekf, Filter, MeasurementNoise};
 use scatterloc::{Error, Model};
 
 #[path = "fuzz/check.rs"]

@@ -1,11 +1,13 @@
-//! The channel front end (spec `channel-estimation.md`, C1–C7): from channel recordings to the
+//! The channel front end (spec `channel-estimation.md`, C1–C10): from channel recordings to the
 //! delay estimates that gating and the trackers read. A [`Recording`] holds per snapshot and link
 //! a channel frequency response (C1) or a band-limited impulse response (C2); [`Band`] is its
-//! frequency-domain view; the [`Estimator`] finds each snapshot's paths (C5: greedy ML with
-//! cyclic refinement and a CFAR stop), the [`PathTracker`] follows them over snapshots (C6); the
-//! signal-level [`simulate`](simulate_recording) makes recordings of a scene (walls, point
-//! scatterers, a walking person). Its output, per snapshot and link a list of
-//! [`DelayEstimate`]s (a [`Snapshot`]), is what `track::gating` reads, whatever filter runs.
+//! frequency-domain view; the [`LinkBackground`] removes the static channel, each snapshot
+//! aligned to it (C9, receivers without a common clock: C10); the [`Estimator`] finds each
+//! snapshot's paths (C5: greedy ML with cyclic refinement and a CFAR stop), the [`PathTracker`]
+//! follows them over snapshots (C6); the signal-level [`simulate`](simulate_recording) makes
+//! recordings of a scene (walls, point scatterers, a walking person, receiver clocks). Its
+//! output, per snapshot and link a list of [`DelayEstimate`]s (a [`Snapshot`]), is what
+//! `track::gating` reads, whatever filter runs (EKF, UKF or particle filter).
 
 mod background;
 mod band;

@@ -95,3 +95,36 @@ fn bad_files_are_named_errors() {
         "states[0]: not a finite number"
     );
 }
+
+/// The channel simulator's truth (`cir simulate`'s `truth.json`: `channel::ChannelTruth`) reads
+/// as a [`Truth`] (`track --truth`): its `t_s` and `states`, its other keys ignored.
+#[test]
+fn channel_truth_reads_as_truth() {
+    use crate::channel::{ChannelTruth, ClockState, PathKind, TruePath};
+    let truth = ChannelTruth {
+        t_s: vec![0.0, 0.1],
+        states: vec![[1.0, 2.0, 0.5, 0.0], [1.05, 2.0, 0.5, 0.0]],
+        paths: vec![
+            vec![vec![TruePath {
+                kind: PathKind::Body,
+                delay_s: 1e-7,
+                power_w: 1e-12,
+            }]];
+            2
+        ],
+        shadowed: vec![vec![true]; 2],
+        clock: vec![
+            vec![ClockState {
+                delay_s: 1e-9,
+                phase_rad: 0.5,
+                gain_db: 0.0,
+            }];
+            2
+        ],
+    };
+    let t = Truth::from_json(&serde_json::to_string(&truth).unwrap()).unwrap();
+    assert_eq!(t.t_s, truth.t_s);
+    assert_eq!(t.states, truth.states);
+    assert!(t.resolved.is_empty());
+    t.check_times(&truth.t_s).unwrap();
+}

@@ -31,10 +31,10 @@
 use alloc::vec::Vec;
 
 use crate::error::{check_len, limits, Error, Result};
-use crate::math::{sqrt, Mat4, Real, Vec2, Vec4, SPEED_OF_LIGHT};
+use crate::math::{sqrt, Mat4, Real, Vec4, SPEED_OF_LIGHT};
 use crate::measure::Model;
 use crate::track::shared::{
-    check_covariance, check_state, check_update, link_sigmas, predict_gaussian, spd_quadratic_form,
+    check_covariance, check_state, check_update, link_sigmas, predict_gaussian,
 };
 use crate::track::{ConstantVelocity, Filter, MeasurementNoise, PredictedDelay, UpdateSummary};
 
@@ -73,17 +73,6 @@ impl Ekf {
         Ok(Ekf { state, covariance })
     }
 
-    /// Position part of the state, m.
-    pub fn position(&self) -> Vec2 {
-        Vec2::new(self.state[0], self.state[1])
-    }
-
-    /// Predict: `x̂⁻ = A x̂`, `P⁻ = A P Aᵀ + Q` (S16, E7).
-    #[inline]
-    pub fn predict(&mut self, motion: &ConstantVelocity) {
-        predict_gaussian(&mut self.state, &mut self.covariance, motion);
-    }
-
     /// Update with delays `z` (s, one per link in scenario link order, `None` = missing; no link
     /// = nothing to do) by the batch Joseph-form update (S17, module docs). On error the filter
     /// is left unchanged. `P` is taken as symmetric (its upper triangle is read).
@@ -117,24 +106,26 @@ impl Ekf {
         );
         summary
     }
+}
 
-    /// Predict then update (one filter step, [`Filter::step`]); on error the filter is left as
-    /// before the step.
-    pub fn step(
-        &mut self,
-        motion: &ConstantVelocity,
-        model: &Model,
-        z: &[Option<Real>],
-        noise: MeasurementNoise,
-    ) -> Result<UpdateSummary> {
-        Filter::step(self, motion, model, z, noise)
+/// The EKF behind the filter seam: its own predict (S16, E7), predicted delays from the
+/// Jacobian (E3) and update (S17).
+impl Filter for Ekf {
+    fn name(&self) -> &'static str {
+        "ekf"
+    }
+
+    /// Predict: `x̂⁻ = A x̂`, `P⁻ = A P Aᵀ + Q` (S16, E7).
+    #[inline]
+    fn predict(&mut self, motion: &ConstantVelocity) {
+        predict_gaussian(&mut self.state, &mut self.covariance, motion);
     }
 
     /// The predicted measurement of every link at the current state (call after
-    /// [`Ekf::predict`]): `h_p(r̂⁻)` (E1) and `√S_pp`, `S_pp = J_p P_rr J_pᵀ + σ_p²` from the
+    /// [`Filter::predict`]): `h_p(r̂⁻)` (E1) and `√S_pp`, `S_pp = J_p P_rr J_pᵀ + σ_p²` from the
     /// Jacobian (E3), with `σ_p` from `noise`. A `σ_p` that is not finite and `> 0` is
     /// [`Error::InvalidSigma`]; `Fixed` noise of the wrong length is [`Error::LengthMismatch`].
-    pub fn predicted_delays(
+    fn predicted_delays(
         &self,
         model: &Model,
         noise: MeasurementNoise,
@@ -154,33 +145,6 @@ impl Ekf {
                 }
             })
             .collect())
-    }
-
-    /// Normalised estimation error squared `(x̂ − x)ᵀ P⁻¹ (x̂ − x)` against a true state;
-    /// `None` if `P` is not positive definite. `P` is taken as symmetric (a 4 × 4 `LDLᵀ`
-    /// factorisation of its lower triangle; all pivots must be positive).
-    pub fn nees(&self, truth: &Vec4) -> Option<Real> {
-        spd_quadratic_form(&self.covariance, &(self.state - truth))
-    }
-}
-
-/// The EKF behind the filter seam: its own predict (S16, E7), predicted delays from the
-/// Jacobian (E3) and update (S17).
-impl Filter for Ekf {
-    fn name(&self) -> &'static str {
-        "ekf"
-    }
-
-    fn predict(&mut self, motion: &ConstantVelocity) {
-        Ekf::predict(self, motion)
-    }
-
-    fn predicted_delays(
-        &self,
-        model: &Model,
-        noise: MeasurementNoise,
-    ) -> Result<Vec<PredictedDelay>> {
-        Ekf::predicted_delays(self, model, noise)
     }
 
     fn update(

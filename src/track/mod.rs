@@ -1,10 +1,11 @@
 //! Tracking a moving scatterer: the white-noise-acceleration motion model (E7), the EKF with the
 //! Joseph-form update (spec §6, S16–S17), the UKF and the bootstrap particle filter
-//! (`filters-and-planning.md` §1–2) behind one seam ([`Filter`], driven through [`Tracker`]) with
-//! their shared helpers in one private module (`shared`), the posterior CRLB recursion (E9, §8), the trajectories
-//! of \[S\] Fig. 2b and the Monte Carlo prior (§9.4–9.5), one simulated run for display, and the
-//! Monte Carlo study of the tracker against its bound, chunked so that any driver (sequential,
-//! `native`, the page's worker) gives the same result.
+//! (`filters-and-planning.md` §1–2) behind one seam ([`Filter`], driven through [`Tracker`];
+//! the trait is their API) with their shared helpers in one private module (`shared`), the
+//! posterior CRLB recursion (E9, §8), the trajectories of \[S\] Fig. 2b and the Monte Carlo
+//! prior (§9.4–9.5), one simulated run for display, the raw-estimate front end (`gating`: spec
+//! §4, C7, C11), and the Monte Carlo study of the tracker against its bound, chunked so that any
+//! driver (sequential, `native`, the page's worker) gives the same result.
 
 mod cost;
 mod ekf;

@@ -37,11 +37,11 @@ use alloc::vec::Vec;
 use rand::Rng as _;
 
 use crate::error::{Error, Result};
-use crate::math::{exp, ln, sqrt, Mat4, Real, Vec2, Vec4, SPEED_OF_LIGHT};
+use crate::math::{exp, ln, sqrt, Mat4, Real, Vec4, SPEED_OF_LIGHT};
 use crate::measure::{Model, Rng};
 use crate::track::shared::{
     check_covariance, check_state, check_update, first_input_error, link_sigmas, predict_gaussian,
-    rolled_back, spd_quadratic_form, Ldl4, NO_UPDATE,
+    rolled_back, Ldl4, NO_UPDATE,
 };
 use crate::track::trajectory::normal4;
 use crate::track::{
@@ -202,34 +202,6 @@ impl ParticleFilter {
         &self.log_weights
     }
 
-    /// Position part of the estimate, m.
-    pub fn position(&self) -> Vec2 {
-        Vec2::new(self.state[0], self.state[1])
-    }
-
-    /// Predict: every particle `x ← A x + w`, `w ~ 𝒩(0, Q)` (E7); the estimate follows.
-    pub fn predict(&mut self, motion: &ConstantVelocity) {
-        // `Q`'s Cholesky factor is block-diagonal per axis: [[l11, 0], [l21, l22]] on (x, vx)
-        // and on (y, vy).
-        let lq = motion.process_noise_factor();
-        let (l11, l21, l22) = (lq[(0, 0)], lq[(2, 0)], lq[(2, 2)]);
-        let t = motion.dt_s;
-        for x in self.particles.iter_mut() {
-            let w = normal4(&mut self.rng);
-            let (px, py, vx, vy) = (x[0], x[1], x[2], x[3]);
-            *x = Vec4::new(
-                px + t * vx + l11 * w[0],
-                py + t * vy + l11 * w[1],
-                vx + l21 * w[0] + l22 * w[2],
-                vy + l21 * w[1] + l22 * w[3],
-            );
-        }
-        if let Some((m, p)) = self.gaussian.as_mut() {
-            predict_gaussian(m, p, motion);
-        }
-        self.estimate();
-    }
-
     /// Update with delays `z` (s, one per link, `None` = missing): weights, estimate, and
     /// resampling when the effective sample size falls below `N/2`. No link: nothing to do. On
     /// error the filter is unchanged.
@@ -350,71 +322,6 @@ impl ParticleFilter {
             f.predict(motion);
             f.update(model, z, noise)
         })
-    }
-
-    /// Normalised estimation error squared of the estimate against a true state (`None` if the
-    /// covariance is not positive definite, e.g. after collapsing onto one particle).
-    pub fn nees(&self, truth: &Vec4) -> Option<Real> {
-        spd_quadratic_form(&self.covariance, &(self.state - truth))
-    }
-
-    /// The predicted measurement of every link from the weighted particles (spec §2):
-    /// `ẑ_p = Σ w_j h_p(x_j)` and `√S_pp`, `S_pp = Σ w_j (h_p(x_j) − ẑ_p)² + σ_p²` (weights
-    /// normalised), both s, with `σ_p` from `noise` at the weighted mean (as the update's). Two
-    /// passes over the particles (mean, then spread); no state change.
-    pub fn predicted_delays(
-        &self,
-        model: &Model,
-        noise: MeasurementNoise,
-    ) -> Result<Vec<PredictedDelay>> {
-        let sigmas = link_sigmas(model, noise, self.position())?;
-        let net = &model.network;
-        let links = sigmas.len();
-        let ntx = net.transmitters.len();
-        let mut d = vec![0.0; ntx + net.receivers.len()];
-        // The particle's range on every link (E1: the sum of its two node distances), m.
-        let mut ranges = |x: &Vec4, out: &mut [Real]| {
-            for (k, node) in net.transmitters.iter().chain(&net.receivers).enumerate() {
-                let (dx, dy) = (x[0] - node.x, x[1] - node.y);
-                d[k] = sqrt(dx * dx + dy * dy);
-            }
-            for (o, l) in out.iter_mut().zip(&net.links) {
-                *o = d[l.tx] + d[ntx + l.rx];
-            }
-        };
-        let total: Real = self.weights.iter().sum();
-        let mut h = vec![0.0; links];
-        let mut mean = vec![0.0; links];
-        for (x, w) in self.particles.iter().zip(&self.weights) {
-            ranges(x, &mut h);
-            for (m, hk) in mean.iter_mut().zip(&h) {
-                *m += w * hk;
-            }
-        }
-        mean.iter_mut().for_each(|m| *m /= total);
-        let mut var = vec![0.0; links];
-        for (x, w) in self.particles.iter().zip(&self.weights) {
-            ranges(x, &mut h);
-            for ((v, hk), m) in var.iter_mut().zip(&h).zip(&mean) {
-                *v += w * (hk - m) * (hk - m);
-            }
-        }
-        mean.iter()
-            .zip(&var)
-            .zip(&sigmas)
-            .map(|((m, v), sigma)| {
-                let s = v / (total * SPEED_OF_LIGHT * SPEED_OF_LIGHT) + sigma * sigma;
-                if !(s > 0.0 && s.is_finite() && m.is_finite()) {
-                    return Err(Error::Degenerate {
-                        field: "pf.predicted_delays".into(),
-                    });
-                }
-                Ok(PredictedDelay {
-                    delay_s: m / SPEED_OF_LIGHT,
-                    innovation_sigma_s: sqrt(s),
-                })
-            })
-            .collect()
     }
 
     /// The regularised filter's first-update proposal (module docs): `N` particles drawn from
@@ -631,16 +538,86 @@ impl Filter for ParticleFilter {
         "pf"
     }
 
+    /// Predict: every particle `x ← A x + w`, `w ~ 𝒩(0, Q)` (E7); the estimate follows.
     fn predict(&mut self, motion: &ConstantVelocity) {
-        ParticleFilter::predict(self, motion)
+        // `Q`'s Cholesky factor is block-diagonal per axis: [[l11, 0], [l21, l22]] on (x, vx)
+        // and on (y, vy).
+        let lq = motion.process_noise_factor();
+        let (l11, l21, l22) = (lq[(0, 0)], lq[(2, 0)], lq[(2, 2)]);
+        let t = motion.dt_s;
+        for x in self.particles.iter_mut() {
+            let w = normal4(&mut self.rng);
+            let (px, py, vx, vy) = (x[0], x[1], x[2], x[3]);
+            *x = Vec4::new(
+                px + t * vx + l11 * w[0],
+                py + t * vy + l11 * w[1],
+                vx + l21 * w[0] + l22 * w[2],
+                vy + l21 * w[1] + l22 * w[3],
+            );
+        }
+        if let Some((m, p)) = self.gaussian.as_mut() {
+            predict_gaussian(m, p, motion);
+        }
+        self.estimate();
     }
 
+    /// The predicted measurement of every link from the weighted particles (spec §2):
+    /// `ẑ_p = Σ w_j h_p(x_j)` and `√S_pp`, `S_pp = Σ w_j (h_p(x_j) − ẑ_p)² + σ_p²` (weights
+    /// normalised), both s, with `σ_p` from `noise` at the weighted mean (as the update's). Two
+    /// passes over the particles (mean, then spread); no state change.
     fn predicted_delays(
         &self,
         model: &Model,
         noise: MeasurementNoise,
     ) -> Result<Vec<PredictedDelay>> {
-        ParticleFilter::predicted_delays(self, model, noise)
+        let sigmas = link_sigmas(model, noise, self.position())?;
+        let net = &model.network;
+        let links = sigmas.len();
+        let ntx = net.transmitters.len();
+        let mut d = vec![0.0; ntx + net.receivers.len()];
+        // The particle's range on every link (E1: the sum of its two node distances), m.
+        let mut ranges = |x: &Vec4, out: &mut [Real]| {
+            for (k, node) in net.transmitters.iter().chain(&net.receivers).enumerate() {
+                let (dx, dy) = (x[0] - node.x, x[1] - node.y);
+                d[k] = sqrt(dx * dx + dy * dy);
+            }
+            for (o, l) in out.iter_mut().zip(&net.links) {
+                *o = d[l.tx] + d[ntx + l.rx];
+            }
+        };
+        let total: Real = self.weights.iter().sum();
+        let mut h = vec![0.0; links];
+        let mut mean = vec![0.0; links];
+        for (x, w) in self.particles.iter().zip(&self.weights) {
+            ranges(x, &mut h);
+            for (m, hk) in mean.iter_mut().zip(&h) {
+                *m += w * hk;
+            }
+        }
+        mean.iter_mut().for_each(|m| *m /= total);
+        let mut var = vec![0.0; links];
+        for (x, w) in self.particles.iter().zip(&self.weights) {
+            ranges(x, &mut h);
+            for ((v, hk), m) in var.iter_mut().zip(&h).zip(&mean) {
+                *v += w * (hk - m) * (hk - m);
+            }
+        }
+        mean.iter()
+            .zip(&var)
+            .zip(&sigmas)
+            .map(|((m, v), sigma)| {
+                let s = v / (total * SPEED_OF_LIGHT * SPEED_OF_LIGHT) + sigma * sigma;
+                if !(s > 0.0 && s.is_finite() && m.is_finite()) {
+                    return Err(Error::Degenerate {
+                        field: "pf.predicted_delays".into(),
+                    });
+                }
+                Ok(PredictedDelay {
+                    delay_s: m / SPEED_OF_LIGHT,
+                    innovation_sigma_s: sqrt(s),
+                })
+            })
+            .collect()
     }
 
     fn update(

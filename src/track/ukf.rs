@@ -43,7 +43,7 @@ use crate::measure::Model;
 use crate::track::ekf::link_information;
 use crate::track::shared::{
     check_covariance, check_state, check_update, first_input_error, link_sigmas, predict_gaussian,
-    spd_quadratic_form, Ldl4, NO_UPDATE,
+    Ldl4, NO_UPDATE,
 };
 use crate::track::{ConstantVelocity, Filter, MeasurementNoise, PredictedDelay, UpdateSummary};
 
@@ -169,55 +169,6 @@ impl Ukf {
         })
     }
 
-    /// Position part of the state, m.
-    pub fn position(&self) -> Vec2 {
-        Vec2::new(self.state[0], self.state[1])
-    }
-
-    /// Predict: the unscented transform of the linear CV model, `A x̂`, `A P Aᵀ + Q` (E7).
-    pub fn predict(&mut self, motion: &ConstantVelocity) {
-        predict_gaussian(&mut self.state, &mut self.covariance, motion);
-    }
-
-    /// Update with delays `z` (s, one per link, `None` = missing) by the unscented transform of
-    /// `h` around `(x̂⁻, P⁻)` (spec §1, evaluated as in the module docs). No link: nothing to
-    /// do. On error the filter is unchanged.
-    pub fn update(
-        &mut self,
-        model: &Model,
-        z: &[Option<Real>],
-        noise: MeasurementNoise,
-    ) -> Result<UpdateSummary> {
-        let m = check_update(model, z, noise)?;
-        if m == 0 {
-            return Ok(NO_UPDATE);
-        }
-        // Up to 8 links on the stack (no allocation), more on the heap; the same code.
-        let (x, p) = if m <= 4 {
-            self.updated(
-                model,
-                z,
-                noise,
-                &mut Scratch::new(m, &mut [0.0; scratch_len(4)]),
-            )?
-        } else if m <= 8 {
-            self.updated(
-                model,
-                z,
-                noise,
-                &mut Scratch::new(m, &mut [0.0; scratch_len(8)]),
-            )?
-        } else {
-            let mut buf = vec![0.0; scratch_len(m)];
-            self.updated(model, z, noise, &mut Scratch::new(m, &mut buf))?
-        };
-        (self.state, self.covariance) = (x.0, p);
-        Ok(UpdateSummary {
-            nis: x.1,
-            links_used: m,
-        })
-    }
-
     /// The updated `(x̂, NIS)` and `P` for the `m ≥ 1` links present (module docs).
     #[inline(always)]
     fn updated(
@@ -305,17 +256,18 @@ impl Ukf {
         }
         Ok(((state, nis), covariance))
     }
+}
 
-    /// Predict then update (one filter step, [`Filter::step`]); on error the filter is left as
-    /// before the step.
-    pub fn step(
-        &mut self,
-        motion: &ConstantVelocity,
-        model: &Model,
-        z: &[Option<Real>],
-        noise: MeasurementNoise,
-    ) -> Result<UpdateSummary> {
-        Filter::step(self, motion, model, z, noise)
+/// The UKF behind the filter seam: predict (E7), predicted delays from its sigma points and the
+/// unscented update (spec §1).
+impl Filter for Ukf {
+    fn name(&self) -> &'static str {
+        "ukf"
+    }
+
+    /// Predict: the unscented transform of the linear CV model, `A x̂`, `A P Aᵀ + Q` (E7).
+    fn predict(&mut self, motion: &ConstantVelocity) {
+        predict_gaussian(&mut self.state, &mut self.covariance, motion);
     }
 
     /// The predicted measurement of every link from the sigma points of `(x̂⁻, P⁻)` (spec §1):
@@ -324,7 +276,7 @@ impl Ukf {
     /// points off `χ₀`'s position are evaluated: with `d_k = h_p(χ_k) − h_p(χ₀)`,
     /// `δ = ẑ_p − h_p(χ₀) = Wᵢ Σ d_k` and `S_pp = Wᵢ Σ d_k² + (β − α²) δ² + σ_p²`. A `P⁻` or an
     /// `S_pp` that is not positive is [`Error::NotPositiveDefinite`].
-    pub fn predicted_delays(
+    fn predicted_delays(
         &self,
         model: &Model,
         noise: MeasurementNoise,
@@ -365,39 +317,43 @@ impl Ukf {
             .collect()
     }
 
-    /// Normalised estimation error squared against a true state (`None` if `P` is not positive
-    /// definite).
-    pub fn nees(&self, truth: &Vec4) -> Option<Real> {
-        spd_quadratic_form(&self.covariance, &(self.state - truth))
-    }
-}
-
-/// The UKF behind the filter seam: predict (E7), predicted delays from its sigma points and the
-/// unscented update (spec §1).
-impl Filter for Ukf {
-    fn name(&self) -> &'static str {
-        "ukf"
-    }
-
-    fn predict(&mut self, motion: &ConstantVelocity) {
-        Ukf::predict(self, motion)
-    }
-
-    fn predicted_delays(
-        &self,
-        model: &Model,
-        noise: MeasurementNoise,
-    ) -> Result<Vec<PredictedDelay>> {
-        Ukf::predicted_delays(self, model, noise)
-    }
-
+    /// Update with delays `z` (s, one per link, `None` = missing) by the unscented transform of
+    /// `h` around `(x̂⁻, P⁻)` (spec §1, evaluated as in the module docs). No link: nothing to
+    /// do. On error the filter is unchanged.
     fn update(
         &mut self,
         model: &Model,
         z: &[Option<Real>],
         noise: MeasurementNoise,
     ) -> Result<UpdateSummary> {
-        Ukf::update(self, model, z, noise)
+        let m = check_update(model, z, noise)?;
+        if m == 0 {
+            return Ok(NO_UPDATE);
+        }
+        // Up to 8 links on the stack (no allocation), more on the heap; the same code.
+        let (x, p) = if m <= 4 {
+            self.updated(
+                model,
+                z,
+                noise,
+                &mut Scratch::new(m, &mut [0.0; scratch_len(4)]),
+            )?
+        } else if m <= 8 {
+            self.updated(
+                model,
+                z,
+                noise,
+                &mut Scratch::new(m, &mut [0.0; scratch_len(8)]),
+            )?
+        } else {
+            let mut buf = vec![0.0; scratch_len(m)];
+            self.updated(model, z, noise, &mut Scratch::new(m, &mut buf))?
+        };
+        (self.state, self.covariance) = (x.0, p);
+        Ok(UpdateSummary {
+            nis: x.1,
+            links_used: m,
+        })
     }
 
     fn state(&self) -> &Vec4 {

@@ -14,7 +14,7 @@ use common::tracking::{covariance_close, fast_motion};
 use scatterloc::math::{Mat4, Real, Vec2, Vec4, SPEED_OF_LIGHT};
 use scatterloc::track::ConstantVelocity;
 use scatterloc::track::{paper_initial_covariance, TrackScenario, TruthSampler};
-use scatterloc::track::{Ekf, MeasurementNoise, UpdateSummary};
+use scatterloc::track::{Ekf, Filter, MeasurementNoise, UpdateSummary};
 use scatterloc::{measure, Error, Model};
 
 /// The reference: one textbook batch update in the delay domain with `nalgebra::DMatrix`,

@@ -14,7 +14,7 @@ use scatterloc::math::{Real, Vec2};
 use scatterloc::native::run_parallel;
 use scatterloc::track::pcrlb_rmse;
 use scatterloc::track::{run_pcrlb_sequential, run_sequential, MonteCarloConfig};
-use scatterloc::track::{Ekf, MeasurementNoise, TrackScenario, TruthSampler};
+use scatterloc::track::{Ekf, Filter, MeasurementNoise, TrackScenario, TruthSampler};
 use scatterloc::{localize, measure, Mat2};
 
 /// 1 thread, 2 threads and the sequential driver give bitwise equal curves (3 chunks, the last

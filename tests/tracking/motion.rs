@@ -9,7 +9,7 @@ use common::rel_close;
 use common::tracking::covariance_close;
 use scatterloc::math::{Mat4, Vec4};
 use scatterloc::track::ConstantVelocity;
-use scatterloc::track::{Ekf, PAPER_INTENSITY, PAPER_STEP_S};
+use scatterloc::track::{Ekf, Filter, PAPER_INTENSITY, PAPER_STEP_S};
 
 /// `A(T₁)A(T₂) = A(T₁+T₂)` (exactly: the only non-trivial entries are `T₁ + T₂`), and `Q` is the
 /// discretisation of continuous white-noise acceleration, so

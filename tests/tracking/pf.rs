@@ -12,7 +12,7 @@ use scatterloc::math::{Mat4, Real, Vec2, Vec4};
 use scatterloc::measure::{self, rng};
 use scatterloc::track::{paper_initial_covariance, TrackScenario, TruthSampler};
 use scatterloc::track::{
-    ConstantVelocity, Ekf, MeasurementNoise, ParticleFilter, PfConfig, Ukf, UkfParams,
+    ConstantVelocity, Ekf, Filter, MeasurementNoise, ParticleFilter, PfConfig, Ukf, UkfParams,
 };
 use scatterloc::{Error, Model};
 

@@ -13,7 +13,7 @@ use common::sensors_model as model;
 use common::tracking::{fast_motion, mesh};
 use scatterloc::math::{Mat4, Real, Vec2, Vec4, SPEED_OF_LIGHT};
 use scatterloc::track::{paper_initial_covariance, TrackScenario, TruthSampler};
-use scatterloc::track::{ConstantVelocity, Ekf, MeasurementNoise, Ukf, UkfParams};
+use scatterloc::track::{ConstantVelocity, Ekf, Filter, MeasurementNoise, Ukf, UkfParams};
 use scatterloc::{measure, Error, Model};
 
 /// One reference UKF step (spec §1), with `σ_p` from the link budget at the predicted position.

@@ -14,8 +14,10 @@ use rand_distr::{Distribution, StandardNormal, Uniform};
 use rand_pcg::Pcg64;
 
 use super::*;
-use crate::channel::{Layout, Recording};
-use crate::math::{cos, sin, SPEED_OF_LIGHT};
+use crate::channel::band::cis;
+use crate::channel::{Band, Layout, Recording};
+use crate::error::{limits, Error};
+use crate::math::{cos, ln, round, sin, sqrt, Complex, Real, PI, SPEED_OF_LIGHT};
 
 const N: usize = 241;
 const B: Real = 120e6;

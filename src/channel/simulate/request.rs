@@ -4,6 +4,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use super::synthesize::synthesize;
 use super::{ChannelScene, ChannelTruth};
 use crate::channel::Recording;
 use crate::error::{Cancel, Error, Result};
@@ -116,19 +117,16 @@ impl SimulationRequest {
     /// area), [`Error::Cancelled`].
     pub fn run(&self, scenario: &Scenario, model: &Model, cancel: Cancel) -> Result<Simulated> {
         let (scene, empty) = self.scenes()?;
-        let (recording, truth) =
-            super::synthesize(scenario, model, &scene, true, self.seed, true, cancel)
-                .map_err(|e| self.attribute(e))?;
-        let (calibration, _) = super::synthesize(
-            scenario, model, &empty, false, self.seed, true, cancel,
-        )
-        .map_err(|e| match e {
-            Error::Cancelled => e,
-            _ => Error::InvalidFile {
-                field: "calibration_duration_s".into(),
-                reason: strip_field(&e),
-            },
-        })?;
+        let (recording, truth) = synthesize(scenario, model, &scene, true, self.seed, true, cancel)
+            .map_err(|e| self.attribute(e))?;
+        let (calibration, _) = synthesize(scenario, model, &empty, false, self.seed, true, cancel)
+            .map_err(|e| match e {
+                Error::Cancelled => e,
+                _ => Error::InvalidFile {
+                    field: "calibration_duration_s".into(),
+                    reason: strip_field(&e),
+                },
+            })?;
         Ok(Simulated {
             recording,
             calibration,

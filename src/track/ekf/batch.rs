@@ -8,6 +8,7 @@ use crate::error::{Error, Result};
 use crate::math::{Mat4, Real, Vec2, Vec4};
 use crate::measure::Model;
 use crate::track::shared::{finite_probe, first_input_error, positive_finite, NO_UPDATE};
+use crate::track::Filter;
 
 /// The EKF update of `L` independent filters against the same model and noise option, each
 /// with its own delays `z[j]` (lengths checked by the caller); `active[j] = false` skips filter

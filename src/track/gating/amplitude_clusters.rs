@@ -12,10 +12,11 @@
 //! 4. per kept cluster: the mean and sample σ of the delay (σ floored at `sigma_floor_s`) and
 //!    the mean and sample σ of the amplitude in dB.
 //!
-//! The kept clusters are the static clusters of E4 (ascending in mean delay), so
-//! [`LinkCalibration::is_static`] gates with them exactly as with the delay-only ones. An
-//! estimate with amplitude `0` (no dB value) is skipped; a non-finite or negative amplitude is
-//! an error.
+//! The steps run on the skeleton the delay-only clusterer shares (`clustering.rs`: sizes, sort,
+//! gap splits, the snapshot fraction, the statistics). The kept clusters are the static
+//! clusters of E4 (ascending in mean delay), so [`LinkCalibration::is_static`] gates with them
+//! exactly as with the delay-only ones. An estimate with amplitude `0` (no dB value) is
+//! skipped; a non-finite or negative amplitude is an error.
 
 use alloc::format;
 use alloc::vec::Vec;
@@ -23,9 +24,7 @@ use alloc::vec::Vec;
 use crate::channel::DelayEstimate;
 use crate::error::{limits, Error, Result};
 use crate::math::{log10, Real};
-use crate::track::gating::calibration::{
-    check_sizes, cluster_of, distinct_snapshots, gap_groups, mean_sigma,
-};
+use crate::track::gating::clustering::{cluster_link, cluster_network, Entry};
 use crate::track::gating::{Calibration, ClusterConfig, LinkCalibration};
 
 /// Settings of the delay-and-amplitude clusterer (C7 **\[choice\]**, module docs).
@@ -76,14 +75,6 @@ impl AmplitudeClusterConfig {
     }
 }
 
-/// One calibration estimate: delay, snapshot index, amplitude in dB.
-#[derive(Debug, Clone, Copy)]
-struct Entry {
-    delay_s: Real,
-    snapshot: usize,
-    amplitude_db: Real,
-}
-
 impl LinkCalibration {
     /// Clusters link `link`'s calibration estimates (`snapshots[k]` = its list in snapshot `k`)
     /// by delay and amplitude (module docs). Errors: no snapshots or too many (`SizeLimit`), a
@@ -103,64 +94,22 @@ impl LinkCalibration {
         cfg: &AmplitudeClusterConfig,
     ) -> Result<LinkCalibration> {
         cfg.validate()?;
-        let count = lists.len();
-        let total: usize = lists.clone().map(<[DelayEstimate]>::len).sum();
-        check_sizes(count, total)?;
-        let mut entries = Vec::with_capacity(total);
-        for (k, list) in lists.enumerate() {
-            for (i, e) in list.iter().enumerate() {
-                limits::DELAY_S
-                    .check(&format!("calibration[{k}][{link}][{i}].delay_s"), e.delay_s)?;
-                if !(e.amplitude.is_finite() && e.amplitude >= 0.0) {
-                    return Err(Error::OutOfRange {
-                        field: format!("calibration[{k}][{link}][{i}].amplitude"),
-                        value: e.amplitude,
-                        allowed: "finite and ≥ 0",
-                    });
-                }
-                if e.amplitude > 0.0 {
-                    entries.push(Entry {
-                        delay_s: e.delay_s,
-                        snapshot: k,
-                        amplitude_db: 20.0 * log10(e.amplitude),
-                    });
-                }
+        let delay = cfg.delay_config();
+        cluster_link(lists, &delay, Some(cfg.amplitude_gap_db), |k, i, e| {
+            limits::DELAY_S.check(&format!("calibration[{k}][{link}][{i}].delay_s"), e.delay_s)?;
+            if !(e.amplitude.is_finite() && e.amplitude >= 0.0) {
+                return Err(Error::OutOfRange {
+                    field: format!("calibration[{k}][{link}][{i}].amplitude"),
+                    value: e.amplitude,
+                    allowed: "finite and ≥ 0",
+                });
             }
-        }
-        let by_delay = |a: &Entry, b: &Entry| {
-            a.delay_s
-                .total_cmp(&b.delay_s)
-                .then(a.snapshot.cmp(&b.snapshot))
-                .then(a.amplitude_db.total_cmp(&b.amplitude_db))
-        };
-        entries.sort_by(by_delay);
-        let needed = cfg.min_fraction * count as Real;
-        let mut clusters = Vec::new();
-        let (mut seen, mut members) = (Vec::new(), Vec::new());
-        for group in gap_groups(&entries, |e| e.delay_s, cfg.gap_s) {
-            let group = &mut entries[group];
-            group.sort_by(|a, b| {
-                a.amplitude_db
-                    .total_cmp(&b.amplitude_db)
-                    .then(by_delay(a, b))
-            });
-            for sub in gap_groups(group, |e| e.amplitude_db, cfg.amplitude_gap_db) {
-                let sub = &group[sub];
-                let snapshots = distinct_snapshots(sub.iter().map(|e| e.snapshot), &mut seen);
-                if (snapshots as Real) < needed {
-                    continue;
-                }
-                members.clear();
-                members.extend(sub.iter().map(|e| (e.delay_s, e.snapshot)));
-                let mut c = cluster_of(&members, snapshots, cfg.sigma_floor_s);
-                let (mean, sigma) = mean_sigma(sub.iter().map(|e| e.amplitude_db));
-                c.amplitude_db_mean = Some(mean);
-                c.amplitude_db_sigma = Some(sigma);
-                clusters.push(c);
-            }
-        }
-        clusters.sort_by(|a, b| a.mean_s.total_cmp(&b.mean_s));
-        Ok(LinkCalibration { clusters })
+            Ok((e.amplitude > 0.0).then(|| Entry {
+                delay_s: e.delay_s,
+                snapshot: k,
+                amplitude_db: Some(20.0 * log10(e.amplitude)),
+            }))
+        })
     }
 }
 
@@ -174,23 +123,9 @@ impl Calibration {
         links: usize,
         cfg: &AmplitudeClusterConfig,
     ) -> Result<Calibration> {
-        if let Some(s) = snapshots.iter().find(|s| s.len() != links) {
-            return Err(Error::LengthMismatch {
-                field: "calibration snapshot",
-                expected: links,
-                found: s.len(),
-            });
-        }
-        let links = (0..links)
-            .map(|p| {
-                LinkCalibration::from_estimate_lists(
-                    p,
-                    snapshots.iter().map(|s| s[p].as_slice()),
-                    cfg,
-                )
-            })
-            .collect::<Result<Vec<_>>>()?;
-        Ok(Calibration { links })
+        cluster_network(snapshots, links, |p| {
+            LinkCalibration::from_estimate_lists(p, snapshots.iter().map(|s| s[p].as_slice()), cfg)
+        })
     }
 }
 

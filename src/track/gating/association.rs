@@ -3,9 +3,9 @@
 //! and the remaining candidates are associated to the one mobile scatterer (S6, I7).
 //!
 //! Association rule (spec §4 **\[choice\]**): if one candidate remains take it; if several remain,
-//! take the one nearest the EKF-predicted delay when its normalised innovation
+//! take the one nearest the filter's predicted delay when its normalised innovation
 //! `|τ̂ − h_p(r̂⁻)|/√S_pp` is ≤ 3, else (in particular with no track yet) the one of largest
-//! amplitude. A link with no candidate is absent from `τ̂` at that time (the EKF skips its row).
+//! amplitude. A link with no candidate is absent from `τ̂` at that time (the filter skips it).
 //! That rule assumes the papers' unique scatterer: a lone false alarm is taken however far from
 //! the prediction, which derails the track. [`AssociationRule::Gated`] is the clutter-safe
 //! variant: with a track only a candidate inside the innovation gate is taken.
@@ -132,7 +132,7 @@ fn argmin(c: &[DelayEstimate], key: impl Fn(&DelayEstimate) -> Real) -> usize {
 /// One snapshot after gating and association.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Selection {
-    /// Per link the associated delay (s), `None` = absent: the EKF's measurement vector.
+    /// Per link the associated delay (s), `None` = absent: the filter's measurement vector.
     pub delays: Vec<Option<Real>>,
     /// Per link how it was chosen.
     pub choices: Vec<Choice>,

@@ -16,7 +16,8 @@
 //! most snapshots and then gates the echo as well; calibrate with a detection threshold that
 //! keeps them sparse, or cluster by amplitude too: the papers use X-means on (amplitude, delay);
 //! [`crate::track::gating::AmplitudeClusterConfig`] with [`Calibration::from_estimates`] is the
-//! deterministic alternative (C7) behind the same [`LinkCalibration`].
+//! deterministic alternative (C7) behind the same [`LinkCalibration`]; both run on the skeleton
+//! of `clustering.rs`.
 
 use alloc::format;
 use alloc::vec::Vec;
@@ -24,7 +25,8 @@ use alloc::vec::Vec;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{check_len, limits, Error, Result};
-use crate::math::{sqrt, Real};
+use crate::math::Real;
+use crate::track::gating::clustering::{cluster_link, cluster_network, Entry};
 
 /// The gate's half-width in cluster standard deviations (E4).
 pub const GATE_SIGMAS: Real = 3.0;
@@ -146,29 +148,14 @@ impl LinkCalibration {
         cfg: &ClusterConfig,
     ) -> Result<LinkCalibration> {
         cfg.validate()?;
-        let count = lists.len();
-        let total: usize = lists.clone().map(<[Real]>::len).sum();
-        check_sizes(count, total)?;
-        // (delay, snapshot index), sorted by delay.
-        let mut delays = Vec::with_capacity(total);
-        for (k, snapshot) in lists.enumerate() {
-            for (i, &d) in snapshot.iter().enumerate() {
-                limits::DELAY_S.check(&format!("calibration[{k}][{link}][{i}]"), d)?;
-                delays.push((d, k));
-            }
-        }
-        delays.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-        let needed = cfg.min_fraction * count as Real;
-        let mut clusters = Vec::new();
-        let mut seen = Vec::new();
-        for group in gap_groups(&delays, |m| m.0, cfg.gap_s) {
-            let members = &delays[group];
-            let snapshots = distinct_snapshots(members.iter().map(|m| m.1), &mut seen);
-            if snapshots as Real >= needed {
-                clusters.push(cluster_of(members, snapshots, cfg.sigma_floor_s));
-            }
-        }
-        Ok(LinkCalibration { clusters })
+        cluster_link(lists, cfg, None, |k, i, &d| {
+            limits::DELAY_S.check(&format!("calibration[{k}][{link}][{i}]"), d)?;
+            Ok(Some(Entry {
+                delay_s: d,
+                snapshot: k,
+                amplitude_db: None,
+            }))
+        })
     }
 
     /// A link calibration from given clusters (e.g. read back from JSON): every mean finite and
@@ -196,85 +183,6 @@ impl LinkCalibration {
     }
 }
 
-/// The snapshot-count and total-size caps of one link's calibration: `1 ≤ count ≤`
-/// [`MAX_CALIBRATION_SNAPSHOTS`] snapshots, at most [`MAX_CALIBRATION_DELAYS`] delays.
-pub(super) fn check_sizes(count: usize, total: usize) -> Result<()> {
-    if count == 0 || count > MAX_CALIBRATION_SNAPSHOTS {
-        return Err(Error::SizeLimit {
-            field: "calibration snapshots per link",
-            value: count,
-            min: 1,
-            max: MAX_CALIBRATION_SNAPSHOTS,
-        });
-    }
-    if total > MAX_CALIBRATION_DELAYS {
-        return Err(Error::SizeLimit {
-            field: "calibration delays per link",
-            value: total,
-            min: 0,
-            max: MAX_CALIBRATION_DELAYS,
-        });
-    }
-    Ok(())
-}
-
-/// The index ranges of `sorted` (ascending in `key`) split where consecutive keys differ by
-/// more than `gap`.
-pub(super) fn gap_groups<T>(
-    sorted: &[T],
-    key: impl Fn(&T) -> Real,
-    gap: Real,
-) -> Vec<core::ops::Range<usize>> {
-    let mut groups = Vec::new();
-    let mut start = 0;
-    for end in 1..=sorted.len() {
-        if end == sorted.len() || key(&sorted[end]) - key(&sorted[end - 1]) > gap {
-            groups.push(start..end);
-            start = end;
-        }
-    }
-    groups
-}
-
-/// Number of distinct snapshot indices in `ids` (`scratch` is reused storage).
-pub(super) fn distinct_snapshots(
-    ids: impl Iterator<Item = usize>,
-    scratch: &mut Vec<usize>,
-) -> usize {
-    scratch.clear();
-    scratch.extend(ids);
-    scratch.sort_unstable();
-    scratch.dedup();
-    scratch.len()
-}
-
-/// Mean and sample standard deviation (`n − 1`; 0 for one value) of `values` (non-empty).
-pub(super) fn mean_sigma(values: impl Iterator<Item = Real> + Clone) -> (Real, Real) {
-    let n = values.clone().count() as Real;
-    let mean = values.clone().sum::<Real>() / n;
-    let ss: Real = values.map(|v| (v - mean) * (v - mean)).sum();
-    let sigma = if n > 1.0 { sqrt(ss / (n - 1.0)) } else { 0.0 };
-    (mean, sigma)
-}
-
-/// Mean and sample standard deviation (`n − 1`; 0 for one member) floored at `floor` of
-/// `(delay, snapshot)` members seen in `snapshots` distinct snapshots.
-pub(super) fn cluster_of(
-    members: &[(Real, usize)],
-    snapshots: usize,
-    floor: Real,
-) -> StaticCluster {
-    let (mean, sigma) = mean_sigma(members.iter().map(|m| m.0));
-    StaticCluster {
-        mean_s: mean,
-        sigma_s: sigma.max(floor),
-        count: members.len(),
-        snapshots,
-        amplitude_db_mean: None,
-        amplitude_db_sigma: None,
-    }
-}
-
 /// The calibration of every link of a scenario, in scenario link order.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Calibration {
@@ -291,17 +199,9 @@ impl Calibration {
         links: usize,
         cfg: &ClusterConfig,
     ) -> Result<Calibration> {
-        if let Some(s) = snapshots.iter().find(|s| s.len() != links) {
-            return Err(Error::LengthMismatch {
-                field: "calibration snapshot",
-                expected: links,
-                found: s.len(),
-            });
-        }
-        let links = (0..links)
-            .map(|p| LinkCalibration::from_lists(p, snapshots.iter().map(|s| s[p].as_slice()), cfg))
-            .collect::<Result<Vec<_>>>()?;
-        Ok(Calibration { links })
+        cluster_network(snapshots, links, |p| {
+            LinkCalibration::from_lists(p, snapshots.iter().map(|s| s[p].as_slice()), cfg)
+        })
     }
 
     /// Number of links calibrated.

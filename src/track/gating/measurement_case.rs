@@ -70,7 +70,7 @@ impl LoopPath {
         )
     }
 
-    /// The states at `dt_s, 2·dt_s, …, steps·dt_s` (the EKF's update times).
+    /// The states at `dt_s, 2·dt_s, …, steps·dt_s` (the filter's update times).
     pub fn states(&self, dt_s: Real, steps: usize) -> Vec<Vec4> {
         (1..=steps)
             .map(|k| self.state_at(k as Real * dt_s))

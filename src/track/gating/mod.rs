@@ -1,15 +1,19 @@
 //! The raw-estimate front end of the tracker (spec §4): the calibration stage (static clusters
-//! per link), 3σ gating of static estimates (E4), association of the remaining estimates to the
-//! scatterer, the gated tracker that feeds the EKF, the simulated output of the per-snapshot
+//! per link, delay-only or by delay and amplitude (C7) on one shared skeleton), 3σ gating of
+//! static estimates (E4), association of the remaining estimates to the scatterer, the gated
+//! tracker that feeds any filter (EKF, UKF or particle filter, through the `Filter` seam), its
+//! start, loss and restart in segments (C11), the simulated output of the per-snapshot
 //! estimator, and the synthetic stand-in of the measurement case (spec §9.6).
 
 mod amplitude_clusters;
 mod association;
 mod calibration;
+mod clustering;
 mod gated_track;
 mod measurement_case;
 mod raw_snapshot;
 mod segments;
+mod walk_sim;
 
 pub use amplitude_clusters::AmplitudeClusterConfig;
 pub use association::{
@@ -29,3 +33,4 @@ pub use segments::{
     EndReason, SegmentConfig, SegmentEvent, SegmentSetup, SegmentStart, SegmentStep,
     SegmentTracker, MAX_FIXES_PER_SNAPSHOT, MAX_START_GRID_NODES, MAX_START_TABLE, MISS_LINKS,
 };
+pub use walk_sim::{WalkRequest, WalkSimulation, WalkSnapshot};

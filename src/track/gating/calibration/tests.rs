@@ -1,4 +1,5 @@
 use super::*;
+use crate::math::sqrt;
 use alloc::vec;
 
 const B: Real = 120e6;

@@ -8,10 +8,13 @@ use alloc::vec::Vec;
 
 use rand_distr::{Distribution, StandardNormal, Uniform};
 
+use super::loss::outside;
 use super::*;
-use crate::measure::rng;
-use crate::scenario::presets;
-use crate::track::gating::LinkCalibration;
+use crate::math::{sqrt, Real, Vec2, Vec4, SPEED_OF_LIGHT};
+use crate::measure::{rng, Model};
+use crate::scenario::{presets, Area};
+use crate::track::gating::{AssociationRule, Calibration, DelayEstimate, LinkCalibration};
+use crate::track::FilterKind;
 
 const DT: Real = 0.1;
 
