@@ -187,6 +187,16 @@ pub fn check_name(field: &str, name: &str) -> Result<()> {
 /// same size when written.
 pub const MAX_INPUT_BYTES: u64 = 256 << 20;
 
+/// Most calibration snapshots of the empty area a simulated §9.6 walk draws
+/// ([`crate::track::gating::WalkRequest`]): 100 000 (200 s of [S]'s snapshots; the clusterer
+/// needs tens).
+pub const MAX_WALK_CALIBRATION_SNAPSHOTS: usize = 100_000;
+
+/// Largest expected number of estimates a simulated §9.6 walk writes
+/// ([`crate::track::gating::WalkRequest`]): at most 46 bytes each (a `[delay, amplitude]` pair
+/// with a comma), so each of its files stays below [`MAX_INPUT_BYTES`] and can be read back.
+pub const MAX_WALK_ESTIMATES: f64 = 5e6;
+
 /// The tracker's time step `Δt`: 1 µs to 1 h.
 pub const DT_S: Range = Range {
     min: 1e-6,

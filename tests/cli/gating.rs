@@ -528,3 +528,33 @@ fn raw_steps_tracked_with_every_filter() {
         );
     }
 }
+
+/// `simulate-walk --help` states the core's defaults ([`WalkRequest::default`]) and range
+/// (`limits::MAX_WALK_CALIBRATION_SNAPSHOTS`): the CLI holds none of its own.
+#[test]
+fn simulate_walk_help_states_the_core_defaults() {
+    use scatterloc::error::limits::MAX_WALK_CALIBRATION_SNAPSHOTS;
+    use scatterloc::track::gating::WalkRequest;
+    let out = common::cli::run(&["simulate-walk", "--help"]);
+    let text = String::from_utf8(out.stdout).unwrap();
+    let text = text.split_whitespace().collect::<Vec<_>>().join(" ");
+    let d = WalkRequest::default();
+    for want in [
+        format!("[default: {}, one loop]", d.duration_s),
+        format!("Step T between snapshots, s [default: {}]", d.dt_s),
+        format!("Random seed [default: {}]", d.seed),
+        format!(
+            "1..={MAX_WALK_CALIBRATION_SNAPSHOTS} [default: {}]",
+            d.calibration_snapshots
+        ),
+        format!("per link and snapshot [default: {}]", d.false_alarms),
+        format!("m^2/s^3 [default: {}]", d.process_noise),
+        "[default: snapshot]".to_string(),
+    ] {
+        assert!(
+            text.contains(&want),
+            "simulate-walk --help lacks {want}: {text}"
+        );
+    }
+    assert!(!d.start_from_truth);
+}

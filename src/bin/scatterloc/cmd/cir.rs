@@ -15,7 +15,7 @@ use scatterloc::study::{
 use scatterloc::track::ConstantVelocity;
 use scatterloc::{npz, Model, Scenario};
 
-use super::flags::with_flag;
+use super::flags::{at_flag, in_file, renamed, with_flag};
 use super::gating::{prepare_out_dir_for, walk_file};
 use super::io::{emit_summary, model_of, one_stdin, read_bytes, read_json_file, read_scenario};
 use super::output::{check_distinct, check_writable, Format, OutputSet};
@@ -29,10 +29,9 @@ use crate::failure::CliError;
 /// Reads the recording `--flag PATH` (.npz, docs/recording.md), checked against `model`.
 fn read_recording(flag: &str, path: &str, model: &Model) -> Result<Recording, CliError> {
     let bytes = read_bytes(flag, path, limits::MAX_RECORDING_BYTES)?;
-    let bad = |e: &dyn std::fmt::Display| CliError::usage(format!("--{flag} {path}: {e}"));
     // The reader validates what it read (`Recording::validate`); the links against the scenario.
-    let rec = npz::read_recording(&bytes).map_err(|e| bad(&e))?;
-    rec.link_map(model).map_err(|e| bad(&e))?;
+    let rec = npz::read_recording(&bytes).map_err(|e| in_file(flag, path, e))?;
+    rec.link_map(model).map_err(|e| in_file(flag, path, e))?;
     Ok(rec)
 }
 
@@ -148,26 +147,20 @@ fn estimate(
         )
     })?;
     res.map_err(|e| {
-        let text = with_flag(&e).unwrap_or_else(|| e.to_string());
-        if text.starts_with("--") {
+        if let Some(text) = with_flag(&e) {
             return CliError::usage(text);
         }
-        // The estimator's input is the recording's array.
-        let text = match text.strip_prefix("response: ") {
-            Some(rest) => format!("{}: {rest}", rec.layout.array()),
-            None => text,
+        // The empty area's problems name `calibration…` (the core's field): its file's.
+        let calibration = match files.1 {
+            Some(path) => format!("--calibration {path}"),
+            None => "--calibration".to_string(),
         };
-        let message = match text.strip_prefix("calibration") {
-            Some(rest) => {
-                let rest = rest.strip_prefix(": ").unwrap_or(rest);
-                match files.1 {
-                    Some(path) => format!("--calibration {path}: {rest}"),
-                    None => format!("--calibration: {rest}"),
-                }
-            }
-            None => format!("--cir {}: {text}", files.0),
-        };
-        CliError::usage(message)
+        if let Some(text) = renamed(&e, "calibration", &calibration) {
+            return CliError::usage(text);
+        }
+        // The estimator's input `response` is the recording's array.
+        let text = renamed(&e, "response", rec.layout.array()).unwrap_or_else(|| e.to_string());
+        in_file("cir", files.0, text)
     })
 }
 
@@ -289,8 +282,14 @@ fn uniform_dt(t_s: &[f64], q: f64) -> Result<(f64, f64), CliError> {
             t_s[k] - t_s[k - 1]
         )));
     }
-    ConstantVelocity::validated(dt, q)
-        .map_err(|e| CliError::usage(format!("--process-noise: {e}")))?;
+    // `q` is the flag's; the step is the recording's.
+    ConstantVelocity::validated(dt, q).map_err(|e| match e.field() {
+        Some("dt_s") => at_flag(
+            "measurements",
+            format_args!("the recording's mean step {e}"),
+        ),
+        _ => flag_error(&e),
+    })?;
     Ok((dt, q))
 }
 
@@ -333,7 +332,7 @@ pub fn cir_track(args: &CirTrackArgs) -> Result<(), CliError> {
         Some(p) => {
             let t: Truth = read_json_file("truth", p)?;
             t.check_times(&rec.t_s)
-                .map_err(|e| CliError::usage(format!("--truth {p}: {e}")))?;
+                .map_err(|e| in_file("truth", p, e))?;
             Some(t)
         }
         None => None,
@@ -359,16 +358,16 @@ pub fn cir_track(args: &CirTrackArgs) -> Result<(), CliError> {
             Cancel::when(&stop),
         )
     })?;
-    let track = res.map_err(|e| CliError::usage(format!("--cir {}: {e}", args.cir)))?;
+    let track = res.map_err(|e| in_file("cir", &args.cir, e))?;
     // The error view (per snapshot, its statistics and CDF) once, for TRACK.json and --figure.
     let truth_states: Vec<Option<[f64; 4]>> = truth
         .as_ref()
         .map(|t| t.states.iter().map(|s| Some(*s)).collect())
         .unwrap_or_default();
     let view = track_errors(&track.t_s, &track.states, &truth_states)
-        .map_err(|e| CliError::usage(format!("--truth: {e}")))?
+        .map_err(|e| at_flag("truth", e))?
         .with_segments(&track)
-        .map_err(|e| CliError::usage(format!("--cir {}: {e}", args.cir)))?;
+        .map_err(|e| in_file("cir", &args.cir, e))?;
     let error = truth.as_ref().and(view.stats);
     let doc = track_doc(&track, &req, &cfg, &statics, &est, error).map_err(|e| flag_error(&e))?;
     let mut files = OutputSet::new();
@@ -414,7 +413,7 @@ const SIM_FILES: [&str; 4] = [
 
 /// Parses `--walk "x,y x,y ..."` (at least two points).
 fn parse_walk(text: &str) -> Result<Vec<[f64; 2]>, CliError> {
-    let bad = |why: String| CliError::usage(format!("--walk: {why}"));
+    let bad = |why: String| at_flag("walk", why);
     let pts = text
         .split_whitespace()
         .enumerate()
@@ -466,9 +465,8 @@ pub fn cir_simulate(args: &CirSimulateArgs) -> Result<(), CliError> {
         req.seed = seed;
     }
     // A core error names the request's field; the scene's own fields are --scene's.
-    let fail = |e: scatterloc::Error| {
-        CliError::usage(with_flag(&e).unwrap_or_else(|| format!("--scene: {e}")))
-    };
+    let fail =
+        |e: scatterloc::Error| with_flag(&e).map_or_else(|| at_flag("scene", e), CliError::usage);
     let (scene, _) = req.scenes().map_err(fail)?;
     let dir = args.out_dir.as_str();
     let created = prepare_out_dir_for(dir, &SIM_FILES)?;

@@ -16,6 +16,7 @@ use scatterloc::study::{CirTrackOutput, RecordingEstimates};
 use scatterloc::track::gating::Calibration;
 use scatterloc::{Model, Scenario};
 
+use super::flags::at_flag;
 use super::output::{Figure, Format, OutputSet};
 use crate::failure::CliError;
 
@@ -61,7 +62,7 @@ pub fn stage_delays_figure(
     calibration: &Calibration,
     truth: Option<&Truth>,
 ) -> Result<(), CliError> {
-    let fail = |e: &dyn std::fmt::Display| CliError::usage(format!("--delays-figure: {e}"));
+    let fail = |e: &dyn std::fmt::Display| at_flag("delays-figure", e);
     let band = Band::of_recording(rec, scenario.radio.bandwidth_hz).map_err(|e| fail(&e))?;
     let fig = delay_figure(
         model,

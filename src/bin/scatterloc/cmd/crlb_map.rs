@@ -14,9 +14,10 @@ use scatterloc::chart::{ChartError, ChartNode, ChartOptions, MapData, MapOverlay
 use scatterloc::localize::Grid;
 use scatterloc::native::{crlb_map_parallel, fast_path};
 use scatterloc::scenario::Area;
-use scatterloc::{Error, Model, Scenario};
+use scatterloc::{Error, Scenario};
 
-use super::io::{emit_summary, read_scenario};
+use super::flags::at_flag;
+use super::io::{emit_summary, model_of, read_scenario};
 use super::output::{check_writable, write_figure, write_json_file, Figure, Format};
 use crate::cli::CrlbMapArgs;
 use crate::failure::CliError;
@@ -69,10 +70,10 @@ pub fn crlb_map(args: &CrlbMapArgs) -> Result<(), CliError> {
     let area = area_of(args, &s)?;
     let grid = grid_of(args, area)?;
     if format != Format::Json {
-        check_area(&area).map_err(|e| CliError::usage(format!("--x-min .. --y-max: {e}")))?;
+        check_area(&area).map_err(|e| at_flag("x-min .. --y-max", e))?;
     }
     let size = figure_size(args, &area)?;
-    let model = Model::new(&s).map_err(|e| CliError::usage(format!("--scenario: {e}")))?;
+    let model = model_of(&s)?;
     // Before the work: a FIFO, link or device at --out is refused now (issue 24).
     check_writable("out", out)?;
 

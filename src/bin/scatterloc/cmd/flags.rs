@@ -1,11 +1,16 @@
 //! The one map from the core's field names to the CLI's flags: a core error that names a field
 //! a flag sets ([`scatterloc::Error::field`]) is reported with the flag in its place, so every
-//! command's messages name what the user typed.
+//! command's messages name what the user typed; and the one form of an error about the file a
+//! flag named ([`in_file`], [`at_flag`]).
+
+use std::fmt::Display;
 
 use scatterloc::Error;
 
+use crate::failure::CliError;
+
 /// Core field → flag.
-const FLAGS: [(&str, &str); 46] = [
+const FLAGS: [(&str, &str); 59] = [
     // Tracking studies (`montecarlo`, `pcrlb`, `track`).
     ("runs", "--runs"),
     ("noise_runs", "--noise-runs"),
@@ -57,6 +62,25 @@ const FLAGS: [(&str, &str); 46] = [
     ("speed_mps", "--speed"),
     ("duration_s", "--duration"),
     ("calibration_duration_s", "--calibration-duration"),
+    // The planner (`plan`; `allowed` names its file there).
+    ("roi", "--roi"),
+    ("bounds", "--bounds"),
+    ("move", "--move"),
+    ("min_spacing", "--min-spacing"),
+    ("objective", "--objective"),
+    ("grid", "--grid"),
+    ("budget", "--budget"),
+    // The clusterer (`calibrate`).
+    ("calibration.gap_s", "--gap-s"),
+    ("calibration.min_fraction", "--min-fraction"),
+    ("calibration.sigma_floor_s", "--sigma-floor-s"),
+    // The §9.6 walk (`simulate-walk`).
+    ("calibration_snapshots", "--calibration-snapshots"),
+    ("false_alarms", "--false-alarms"),
+    (
+        "walk_estimates",
+        "--duration/--dt/--false-alarms/--calibration-snapshots",
+    ),
 ];
 
 /// The flag that sets core field `field`.
@@ -73,4 +97,28 @@ pub fn with_flag(e: &Error) -> Option<String> {
     let field = e.field()?;
     let flag = flag_of(field)?;
     Some(e.to_string().replacen(field, flag, 1))
+}
+
+/// A usage error about the file `--flag PATH` named: `--flag PATH: e`.
+pub fn in_file(flag: &str, path: &str, e: impl Display) -> CliError {
+    CliError::usage(format!("--{flag} {path}: {e}"))
+}
+
+/// A usage error about what `--flag` gave (a file read before, a value): `--flag: e`.
+pub fn at_flag(flag: &str, e: impl Display) -> CliError {
+    CliError::usage(format!("--{flag}: {e}"))
+}
+
+/// `e`'s message with the leading `prefix` of its field replaced by `by` (field `calibration`,
+/// `calibration: no direct path`, `by` = `--calibration CAL.npz` → `--calibration CAL.npz: no
+/// direct path`; field `response`, `by` = `cir` → `cir: …`); `None` when `e` names no field
+/// that starts with `prefix`. `Display` starts with the field ([`Error::field`]).
+pub fn renamed(e: &Error, prefix: &str, by: &str) -> Option<String> {
+    e.field()?.strip_prefix(prefix)?;
+    let text = e.to_string();
+    let after = text.get(prefix.len()..)?;
+    Some(match after.strip_prefix(": ") {
+        Some(reason) => format!("{by}: {reason}"),
+        None => format!("{by}{after}"),
+    })
 }

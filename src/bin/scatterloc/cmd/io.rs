@@ -10,6 +10,7 @@ use scatterloc::error::limits;
 use scatterloc::scenario::parse_json;
 use scatterloc::{Model, Scenario};
 
+use super::flags::{at_flag, in_file};
 use crate::failure::CliError;
 
 /// `text` and a newline.
@@ -110,12 +111,12 @@ fn read_capped(what: &str, path: &str, cap: u64, kind: &str) -> Result<Vec<u8>, 
 /// Reads and validates the scenario file `path` of `--scenario`.
 pub fn read_scenario(path: &str) -> Result<Scenario, CliError> {
     let text = read_input("scenario", path)?;
-    Scenario::from_json(&text).map_err(|e| CliError::usage(format!("--scenario {path}: {e}")))
+    Scenario::from_json(&text).map_err(|e| in_file("scenario", path, e))
 }
 
 /// The model of a validated scenario.
 pub fn model_of(s: &Scenario) -> Result<Model, CliError> {
-    Model::new(s).map_err(|e| CliError::usage(format!("--scenario: {e}")))
+    Model::new(s).map_err(|e| at_flag("scenario", e))
 }
 
 /// Reads and parses the JSON file named by `--flag` (errors: `--flag PATH: field: problem`).

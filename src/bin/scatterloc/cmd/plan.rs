@@ -16,9 +16,10 @@ use scatterloc::native::crlb_map_exact;
 use scatterloc::native::crlb_map_parallel;
 use scatterloc::plan::{Polygon, MAX_PLAN_GRID, MIN_PLAN_GRID};
 use scatterloc::present::{run_plan_with, PlanJson, PlanRequest, DEFAULT_PLAN_BUDGET};
-use scatterloc::{Error, Model, Scenario};
+use scatterloc::{Error, Scenario};
 
-use super::io::{emit_summary, one_stdin, read_json_file};
+use super::flags::{at_flag, flag_of};
+use super::io::{emit_summary, model_of, one_stdin, read_json_file};
 use super::output::{check_writable, Figure, Format, OutputSet};
 use super::study::{cancelled, interrupted, load_layout, run_with_bar};
 use crate::cli::PlanArgs;
@@ -69,8 +70,7 @@ pub fn plan(args: &PlanArgs) -> Result<(), CliError> {
     // The objective is parsed here so that a bad one is reported before any file is touched.
     let config = request.config().map_err(errors)?;
     if let Some((path, _)) = figure {
-        check_area(&scenario.area_m)
-            .map_err(|e| CliError::usage(format!("--figure: area_m: {e}")))?;
+        check_area(&scenario.area_m).map_err(|e| at_flag("figure", format_args!("area_m: {e}")))?;
         check_writable("figure", path)?;
     }
     check_writable("out", out)?;
@@ -128,7 +128,7 @@ pub fn plan(args: &PlanArgs) -> Result<(), CliError> {
 /// A core error of the plan as the flag that caused it: `--roi: …`, `--move: …`,
 /// `--min-spacing: …`, `--objective: …`, `--allowed FILE: …`; Ctrl-C as exit status 130.
 fn plan_error(e: Error, args: &PlanArgs) -> CliError {
-    let field = match &e {
+    match &e {
         Error::Cancelled => return cancelled(),
         Error::OutOfRange { field, value, .. } if field == "objective" && value.is_nan() => {
             return CliError::usage(format!(
@@ -136,36 +136,28 @@ fn plan_error(e: Error, args: &PlanArgs) -> CliError {
                 args.objective
             ))
         }
-        Error::SizeLimit { field, .. } | Error::InvertedArea { field, .. } => field.to_string(),
-        Error::NonFinite { field }
-        | Error::NotPositive { field, .. }
-        | Error::OutOfRange { field, .. }
-        | Error::UnknownNode { field, .. }
-        | Error::Infeasible { field, .. } => field.clone(),
-        _ => String::new(),
-    };
+        _ => {}
+    }
+    let field = e.field().unwrap_or_default().to_string();
     let base = field
         .split(['.', '[', ' '])
         .next()
         .unwrap_or_default()
         .to_string();
     let flag = match base.as_str() {
-        "roi" => "--roi".to_string(),
-        "bounds" => "--bounds".to_string(),
-        "move" => "--move".to_string(),
         // No feasible layout found: the spacing, the polygons and the bounds together.
         "min_spacing" if args.allowed.is_some() && matches!(e, Error::Infeasible { .. }) => {
             "--min-spacing / --allowed".to_string()
         }
-        "min_spacing" => "--min-spacing".to_string(),
-        "objective" => "--objective".to_string(),
-        "grid" => "--grid".to_string(),
-        "budget" => "--budget".to_string(),
         "allowed" => match &args.allowed {
             Some(path) => format!("--allowed {path}"),
             None => "--allowed".to_string(),
         },
-        _ => return CliError::usage(format!("--scenario: {e}")),
+        // The request's fields by the one table; any other field is the scenario's.
+        b => match flag_of(b) {
+            Some(flag) => flag.to_string(),
+            None => return at_flag("scenario", e),
+        },
     };
     let text = e.to_string();
     // `roi: …` becomes `--roi: …`; a longer path (`roi.x`, `allowed[2]`) is kept after the flag.
@@ -206,9 +198,9 @@ struct PlanMaps {
 impl PlanMaps {
     fn compute(before: &Scenario, after: &Scenario) -> Result<PlanMaps, CliError> {
         let grid = Grid::new(before.area_m, FIGURE_GRID, FIGURE_GRID)
-            .map_err(|e| CliError::usage(format!("--figure: area_m: {e}")))?;
+            .map_err(|e| at_flag("figure", format_args!("area_m: {e}")))?;
         let map = |s: &Scenario| -> Result<Vec<f64>, CliError> {
-            let model = Model::new(s).map_err(|e| CliError::usage(format!("--scenario: {e}")))?;
+            let model = model_of(s)?;
             let mut values = vec![0.0; grid.len()];
             crlb_map_parallel(&model, &grid, &mut values, 0)
                 .map_err(|e| CliError::output(format!("--figure: {e}")))?;

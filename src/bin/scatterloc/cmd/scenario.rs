@@ -7,6 +7,7 @@ use scatterloc::localize::{locate as lm_locate, DelayMeasurements, LmConfig};
 use scatterloc::present::{CrlbDoc, FixDoc};
 use scatterloc::{scenario::presets, Vec2};
 
+use super::flags::{at_flag, in_file};
 use super::io::{emit, emit_json, model_of, one_stdin, read_json_file, read_scenario};
 use crate::cli::{CrlbArgs, LocateArgs, PresetArgs};
 use crate::failure::CliError;
@@ -21,8 +22,7 @@ pub fn preset(args: &PresetArgs) -> Result<(), CliError> {
 pub fn crlb(args: &CrlbArgs) -> Result<(), CliError> {
     let s = read_scenario(&args.scenario)?;
     let model = model_of(&s)?;
-    let doc = CrlbDoc::at(&s, &model, args.at)
-        .map_err(|e| CliError::usage(format!("--scenario: {e}")))?;
+    let doc = CrlbDoc::at(&s, &model, args.at).map_err(|e| at_flag("scenario", e))?;
     emit_json(&doc)
 }
 
@@ -44,7 +44,7 @@ pub fn locate(args: &LocateArgs) -> Result<(), CliError> {
     let dpath = args.delays.as_str();
     one_stdin(&[("scenario", Some(&args.scenario)), ("delays", Some(dpath))])?;
     let s = read_scenario(&args.scenario)?;
-    let bad = |m: String| CliError::usage(format!("--delays {dpath}: {m}"));
+    let bad = |m: String| in_file("delays", dpath, m);
     let d: DelaysFile = read_json_file("delays", dpath)?;
     let model = model_of(&s)?;
     let sigmas = d

@@ -11,6 +11,7 @@ use serde_json::json;
 
 use scatterloc::math::MAX_SHARDS;
 
+use super::flags::at_flag;
 use super::io::emit_summary;
 use super::output::{Format, OutputSet};
 use super::{montecarlo, mtl};
@@ -201,8 +202,8 @@ pub fn slurm_submit(args: &SubmitArgs) -> Result<(), CliError> {
             "--cpus-per-task: {cpus} is outside the allowed range 1..=256"
         )));
     }
-    let dir = std::path::absolute(args.dir.as_deref().unwrap_or("."))
-        .map_err(|e| CliError::usage(format!("--dir: {e}")))?;
+    let dir =
+        std::path::absolute(args.dir.as_deref().unwrap_or(".")).map_err(|e| at_flag("dir", e))?;
     if !dir.is_dir() {
         return Err(CliError::usage(format!(
             "--dir: '{}' is not a directory",

@@ -21,7 +21,7 @@ use scatterloc::track::{
 use scatterloc::track::{MonteCarloConfig, MAX_STEPS};
 use scatterloc::{scenario::presets, Error, Model, Scenario};
 
-use super::flags::with_flag;
+use super::flags::{at_flag, with_flag};
 use super::io::read_scenario;
 use crate::cli::{StudyArgs, Trajectory};
 use crate::failure::CliError;
@@ -85,7 +85,7 @@ pub fn load_layout(
         }
         (p, None) => {
             let name = p.unwrap_or("sensors2019");
-            let s = presets::preset(name).map_err(|e| CliError::usage(format!("--preset: {e}")))?;
+            let s = presets::preset(name).map_err(|e| at_flag("preset", e))?;
             Ok((name.to_string(), s))
         }
     }
@@ -99,8 +99,7 @@ pub fn new_study(
     motion: ConstantVelocity,
     steps: usize,
 ) -> Result<Study, CliError> {
-    Study::new(layout, scenario, trajectories, motion, steps)
-        .map_err(|e| CliError::usage(format!("--scenario: {e}")))
+    Study::new(layout, scenario, trajectories, motion, steps).map_err(|e| at_flag("scenario", e))
 }
 
 /// `--threads` (default 0 = all cores) and the number of threads that means.

@@ -14,6 +14,7 @@ use scatterloc::study::{track_cpu_s, track_measurements_in, TrackRequest};
 use scatterloc::track::gating::AssociationRule;
 
 use super::filters::filter_kinds;
+use super::flags::in_file;
 use super::gating::read_calibration;
 use super::io::{emit, model_of, one_stdin, read_json_file, read_scenario};
 use super::output::{check_writable, Format};
@@ -53,7 +54,7 @@ pub fn track(args: &TrackArgs) -> Result<(), CliError> {
     }
     let scenario = read_scenario(&args.scenario)?;
     let m: Measurements = read_json_file("measurements", mpath)?;
-    let bad = |e: &dyn std::fmt::Display| CliError::usage(format!("--measurements {mpath}: {e}"));
+    let bad = |e: &dyn std::fmt::Display| in_file("measurements", mpath, e);
     let model = model_of(&scenario)?;
     let n = model.link_count();
     let rule = match args.association {

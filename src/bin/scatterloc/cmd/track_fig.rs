@@ -10,6 +10,7 @@ use scatterloc::chart::{
 };
 use scatterloc::formats::Truth;
 
+use super::flags::in_file;
 use super::io::read_json_file;
 use super::output::{write_figure, Figure, Format};
 use crate::failure::CliError;
@@ -44,7 +45,7 @@ pub fn read_truth(path: &str, t_s: &[f64]) -> Result<Truth, CliError> {
     let truth: Truth = read_json_file("truth", path)?;
     truth
         .check_times(t_s)
-        .map_err(|e| CliError::usage(format!("--truth {path}: {e}")))?;
+        .map_err(|e| in_file("truth", path, e))?;
     Ok(truth)
 }
 

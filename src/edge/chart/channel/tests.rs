@@ -1,10 +1,21 @@
+use alloc::string::String;
+use alloc::vec::Vec;
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+use super::delays::{grey, image_range, ESTIMATE_RGB, STATIC_ESTIMATE_RGB};
+use super::delays_svg::image_rgb;
+use super::shared::axis;
 use super::*;
 use crate::channel::DelayEstimate;
-use crate::math::{cos, sin, Complex, PI, SPEED_OF_LIGHT};
+use crate::edge::chart::{ChartError, ChartNode};
+use crate::math::{cos, sin, Complex, Real, PI, SPEED_OF_LIGHT};
 use crate::present::{
-    delay_image, delay_points, track_errors, DelayPoint, ImageConfig, SegmentSpan, StaticBand,
-    TruthCurve,
+    delay_image, delay_points, track_errors, DelayFigure, DelayPoint, ImageConfig, LinkDelays,
+    SegmentSpan, StaticBand, TrackErrorView, TruthCurve,
 };
+use crate::scenario::Area;
 
 /// The SVG of `draw` on a `size` canvas, and the same drawn into an RGB buffer (PNG backend).
 fn render(
