@@ -66,6 +66,12 @@ fn sensors() -> App {
     ok(App::from_preset("sensors2019"))
 }
 
+/// `App.compute_map_in`'s settings object (JSON text, as the page's `JSON.stringify`: a
+/// non-finite number is `null`) of window `w` on an `nx × ny` grid.
+fn map_window(w: [f64; 4], nx: usize, ny: usize) -> String {
+    serde_json::json!({ "window": w, "nx": nx, "ny": ny }).to_string()
+}
+
 /// Spec §0 check 7: layout L4 CRLB RMSE at four points, within 0.1 %.
 #[wasm_bindgen_test]
 fn spec_check_7_l4_crlb_rmse() {
@@ -174,7 +180,7 @@ fn map_of_a_window_is_the_core_map_of_that_window() {
         [-7.5, 30.0, -10.0, 26.0],
     ] {
         let out = Float64Array::new_with_length((nx * ny) as u32);
-        ok(app.compute_map_in(w[0], w[1], w[2], w[3], nx, ny, &out));
+        ok(app.compute_map_in(&map_window(w, nx, ny), &out));
         let grid = Grid::new(
             Area {
                 x: [w[0], w[1]],
@@ -207,32 +213,170 @@ fn map_of_a_window_is_the_core_map_of_that_window() {
         Float64Array::new_with_length(64),
     );
     ok(app.compute_map(8, 8, &a));
-    ok(app.compute_map_in(-7.5, 30.0, -10.0, 26.0, 8, 8, &b));
+    ok(app.compute_map_in(&map_window([-7.5, 30.0, -10.0, 26.0], 8, 8), &b));
     assert_eq!(a.to_vec(), b.to_vec());
     let buf = Float64Array::new_with_length(64);
     for (m, field) in [
         (
-            err(app.compute_map_in(1.0, 1.0, 0.0, 1.0, 8, 8, &buf)),
+            err(app.compute_map_in(&map_window([1.0, 1.0, 0.0, 1.0], 8, 8), &buf)),
             "window.x",
         ),
         (
-            err(app.compute_map_in(0.0, 1.0, f64::NAN, 1.0, 8, 8, &buf)),
+            err(app.compute_map_in(&map_window([0.0, 1.0, f64::NAN, 1.0], 8, 8), &buf)),
+            "settings: invalid JSON: window[2]",
+        ),
+        (
+            err(app.compute_map_in(&map_window([0.0, 1.0, 2.0, 1.0], 8, 8), &buf)),
             "window.y",
         ),
         (
-            err(app.compute_map_in(0.0, 1.0, 2.0, 1.0, 8, 8, &buf)),
-            "window.y",
+            err(app.compute_map_in(&map_window([0.0, f64::INFINITY, 0.0, 1.0], 8, 8), &buf)),
+            "settings: invalid JSON: window[1]",
         ),
         (
-            err(app.compute_map_in(0.0, f64::INFINITY, 0.0, 1.0, 8, 8, &buf)),
-            "window.x",
-        ),
-        (
-            err(app.compute_map_in(0.0, 1.0, 0.0, 1.0, 1, 8, &buf)),
+            err(app.compute_map_in(&map_window([0.0, 1.0, 0.0, 1.0], 1, 8), &buf)),
             "nx",
         ),
     ] {
         assert!(m.contains(field), "message {m:?} should name {field}");
+    }
+}
+
+/// Issue 39: the bindings that took many positional numbers take one settings object (JSON text,
+/// read into a serde struct): an unknown, missing or mistyped field is an exception naming the
+/// field (never a trap, never a silent default), for each of `App.compute_map_in`,
+/// `App.simulate_track`, `MonteCarloJob` and `map_data_text`.
+#[wasm_bindgen_test]
+fn settings_objects_name_a_bad_field() {
+    use serde_json::{json, Value};
+    /// `base` with `key` set to `value` (`None` removes it; a `.` goes one level down).
+    fn with(base: &Value, key: &str, value: Option<Value>) -> String {
+        let mut v = base.clone();
+        let (obj, key) = match key.split_once('.') {
+            Some((outer, inner)) => (&mut v[outer], inner),
+            None => (&mut v, key),
+        };
+        let obj = obj.as_object_mut().unwrap();
+        match value {
+            Some(value) => obj.insert(key.into(), value),
+            None => obj.remove(key),
+        };
+        v.to_string()
+    }
+    let cases = [
+        ("extra", Some(json!(1)), "unknown field `extra`"),
+        ("nx", None, "missing field `nx`"),
+        ("nx", Some(json!(-1)), "nx: invalid value"),
+        ("nx", Some(json!(8.5)), "nx: invalid type"),
+        ("window", Some(json!([0, 1, 0])), "window: invalid length 3"),
+        (
+            "window",
+            Some(json!([0, 1, 0, "1"])),
+            "window[3]: invalid type",
+        ),
+    ];
+    let app = sensors();
+    let buf = Float64Array::new_with_length(64);
+    let map = json!({ "window": [0.0, 1.0, 0.0, 1.0], "nx": 8, "ny": 8 });
+    ok(app.compute_map_in(&map.to_string(), &buf));
+    for (key, value, want) in cases.clone() {
+        let m = err(app.compute_map_in(&with(&map, key, value), &buf));
+        assert!(
+            m.starts_with("settings: invalid JSON: ") && m.contains(want),
+            "{key}: {m}"
+        );
+    }
+    assert!(
+        err(app.compute_map_in("[0, 1, 0, 1, 8, 8]", &buf)).starts_with("settings: invalid JSON")
+    );
+    assert!(err(app.compute_map_in("", &buf)).starts_with("settings: invalid JSON"));
+
+    let mut data = map.clone();
+    data["scenario"] = json!("L4");
+    data["format"] = json!("csv");
+    let values = vec![1.0; 64];
+    assert!(ok(wasm::map_data_text(&values, &data.to_string())).starts_with("x_m,y_m,rmse_m\n"));
+    for (key, value, want) in cases {
+        let m = err(wasm::map_data_text(&values, &with(&data, key, value)));
+        assert!(
+            m.starts_with("map_data_text: invalid JSON: ") && m.contains(want),
+            "{key}: {m}"
+        );
+    }
+    let m = err(wasm::map_data_text(
+        &values,
+        &with(&data, "format", Some(json!(1))),
+    ));
+    assert!(m.contains("format: invalid type"), "{m}");
+
+    let trajectory = json!({ "kind": "II", "x0_m": 0, "y0_m": 0, "vx_mps": 0, "vy_mps": 0 });
+    let track = json!({
+        "trajectory": trajectory, "dt_s": 0.1, "steps": 10, "seed": 7, "filter": "ekf",
+        "particles": 1000,
+    });
+    ok(app.simulate_track(&track.to_string()));
+    let scenario = ok(wasm::preset_json("sensors2019"));
+    let study = json!({
+        "trajectory": trajectory, "dt_s": 0.1, "steps": 10, "trajectories": 16,
+        "noise_runs": 1, "seed": 7,
+    });
+    ok(wasm::MonteCarloJob::new(&scenario, &study.to_string()));
+    for (key, value, want) in [
+        ("x0", Some(json!(1)), "unknown field `x0`"),
+        ("steps", None, "missing field `steps`"),
+        (
+            "dt_s",
+            Some(Value::from(f64::NAN)),
+            "dt_s: invalid type: null",
+        ),
+        ("dt_s", Some(json!("0.1")), "dt_s: invalid type: string"),
+        ("steps", Some(json!(-1)), "steps: invalid value"),
+        ("seed", Some(json!(1u64 << 32)), "seed: invalid value"),
+        (
+            "trajectory.x0",
+            Some(json!(0)),
+            "trajectory.x0: unknown field `x0`",
+        ),
+        (
+            "trajectory.vy_mps",
+            None,
+            "trajectory: missing field `vy_mps`",
+        ),
+        (
+            "trajectory.kind",
+            Some(json!(2)),
+            "trajectory.kind: invalid type",
+        ),
+    ] {
+        let m = err(app.simulate_track(&with(&track, key, value.clone())));
+        assert!(
+            m.starts_with("settings: invalid JSON: ") && m.contains(want),
+            "track {key}: {m}"
+        );
+        let m = err(wasm::MonteCarloJob::new(&scenario, &with(&study, key, value)).map(|_| ()));
+        assert!(
+            m.starts_with("settings: invalid JSON: ") && m.contains(want),
+            "study {key}: {m}"
+        );
+    }
+    for (key, value, want) in [
+        ("filter", Some(json!(["ekf"])), "filter: invalid type"),
+        ("particles", Some(json!(1.5)), "particles: invalid type"),
+        (
+            "trajectories",
+            Some(json!(1)),
+            "unknown field `trajectories`",
+        ),
+    ] {
+        let m = err(app.simulate_track(&with(&track, key, value)));
+        assert!(m.contains(want), "track {key}: {m}");
+    }
+    for (key, value, want) in [
+        ("noise_runs", Some(json!("1")), "noise_runs: invalid type"),
+        ("filter", Some(json!("ekf")), "unknown field `filter`"),
+    ] {
+        let m = err(wasm::MonteCarloJob::new(&scenario, &with(&study, key, value)).map(|_| ()));
+        assert!(m.contains(want), "study {key}: {m}");
     }
 }
 

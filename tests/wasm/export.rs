@@ -106,7 +106,15 @@ fn map_svg_draws_the_target_snapshot_and_window() {
 #[wasm_bindgen_test]
 fn track_map_svg_draws_the_track() {
     let app = sensors();
-    let track = ok(app.simulate_track("II", 0.0, 0.0, 0.0, 0.0, 0.1, 50, 7, "ukf", 1000));
+    let settings = serde_json::json!({
+        "trajectory": { "kind": "II", "x0_m": 0, "y0_m": 0, "vx_mps": 0, "vy_mps": 0 },
+        "dt_s": 0.1,
+        "steps": 50,
+        "seed": 7,
+        "filter": "ukf",
+        "particles": 1000,
+    });
+    let track = ok(app.simulate_track(&settings.to_string()));
     let texts = svg_texts(
         "figure",
         &ok(track.map_svg(1000, 0, 30, 100.0, r#"{"res": 32}"#)),

@@ -3,7 +3,7 @@
 //! plotters chart on a canvas. Bad input throws the core's message.
 
 use js_sys::{Array, Function, JSON};
-use serde_json::Value;
+use serde_json::{json, Value};
 use wasm_bindgen::{JsCast, JsValue};
 use wasm_bindgen_test::*;
 
@@ -14,6 +14,42 @@ use scatterloc::wasm::{self, MonteCarloJob};
 use scatterloc::{scenario::presets, Model};
 
 use super::{err, get, num, ok, sensors};
+
+/// The `trajectory` of a settings object: `kind` with the prior mean `[x0, y0, vx, vy]` (m,
+/// m/s; `custom` only).
+fn trajectory(kind: &str, [x0, y0, vx, vy]: [f64; 4]) -> Value {
+    json!({ "kind": kind, "x0_m": x0, "y0_m": y0, "vx_mps": vx, "vy_mps": vy })
+}
+
+/// `App.simulate_track`'s settings object (JSON text): trajectory II, T = 0.1 s, 100 steps,
+/// seed 7, the EKF (1000 particles if `pf`), with the fields of `set` instead.
+fn track_settings(set: Value) -> String {
+    let mut v = json!({
+        "trajectory": trajectory("II", [0.0; 4]),
+        "dt_s": 0.1,
+        "steps": 100,
+        "seed": 7,
+        "filter": "ekf",
+        "particles": 1000,
+    });
+    for (key, x) in set.as_object().unwrap() {
+        v[key] = x.clone();
+    }
+    v.to_string()
+}
+
+/// `MonteCarloJob`'s settings object (JSON text) of trajectory `kind`, seed 11.
+fn study(kind: &str, dt_s: f64, steps: usize, trajectories: usize, noise_runs: usize) -> String {
+    json!({
+        "trajectory": trajectory(kind, [0.0; 4]),
+        "dt_s": dt_s,
+        "steps": steps,
+        "trajectories": trajectories,
+        "noise_runs": noise_runs,
+        "seed": 11,
+    })
+    .to_string()
+}
 
 fn len(v: &JsValue) -> u32 {
     Array::from(v).length()
@@ -28,7 +64,7 @@ fn stringify(v: &JsValue) -> String {
 #[wasm_bindgen_test]
 fn simulate_track_is_deterministic_and_complete() {
     let app = sensors();
-    let track = ok(app.simulate_track("II", 0.0, 0.0, 0.0, 0.0, 0.1, 100, 7, "ekf", 1000));
+    let track = ok(app.simulate_track(&track_settings(json!({}))));
     assert_eq!(track.entries(), 101);
     let d = ok(track.data());
     for key in [
@@ -65,9 +101,9 @@ fn simulate_track_is_deterministic_and_complete() {
     assert!((sig.get(0).as_f64().unwrap() - 0.2_f64.sqrt()).abs() < 1e-12);
     assert!(sig.get(100).as_f64().unwrap() < 0.05);
 
-    let again = ok(app.simulate_track("II", 0.0, 0.0, 0.0, 0.0, 0.1, 100, 7, "ekf", 1000));
+    let again = ok(app.simulate_track(&track_settings(json!({}))));
     assert_eq!(stringify(&ok(again.data())), stringify(&d));
-    let other = ok(app.simulate_track("II", 0.0, 0.0, 0.0, 0.0, 0.1, 100, 8, "ekf", 1000));
+    let other = ok(app.simulate_track(&track_settings(json!({ "seed": 8 }))));
     assert_ne!(stringify(&ok(other.data())), stringify(&d));
 
     // A frame is snapshot-shaped: links with ellipse, outline and arc; the estimate as `fix`.
@@ -94,7 +130,12 @@ fn custom_track_starts_where_drawn() {
     let app = sensors();
     let v = ok(wasm::drag_velocity(2.0, 3.0, 12.0, -2.0, 10.0));
     assert_eq!(v, vec![1.0, -0.5]);
-    let t = ok(app.simulate_track("custom", 2.0, 3.0, v[0], v[1], 0.05, 40, 1, "ekf", 1000));
+    let t = ok(app.simulate_track(&track_settings(json!({
+        "trajectory": trajectory("custom", [2.0, 3.0, v[0], v[1]]),
+        "dt_s": 0.05,
+        "steps": 40,
+        "seed": 1,
+    }))));
     assert_eq!(t.entries(), 41);
     let e = Array::from(&Array::from(&get(&ok(t.data()), "estimates")).get(0));
     let e: Vec<f64> = e.iter().map(|x| x.as_f64().unwrap()).collect();
@@ -108,12 +149,23 @@ fn custom_track_starts_where_drawn() {
 fn tracking_errors_are_exceptions() {
     let app = sensors();
     let sim = |kind: &str, vx: f64, dt: f64, steps: usize| {
-        app.simulate_track(kind, 1.0, 2.0, vx, 0.5, dt, steps, 1, "ekf", 1000)
-            .map(|_| ())
+        app.simulate_track(&track_settings(json!({
+            "trajectory": trajectory(kind, [1.0, 2.0, vx, 0.5]),
+            "dt_s": dt,
+            "steps": steps,
+            "seed": 1,
+        })))
+        .map(|_| ())
     };
     let filter = |name: &str, particles: usize, steps: usize| {
-        app.simulate_track("I", 0.0, 0.0, 0.0, 0.0, 0.1, steps, 1, name, particles)
-            .map(|_| ())
+        app.simulate_track(&track_settings(json!({
+            "trajectory": trajectory("I", [0.0; 4]),
+            "steps": steps,
+            "seed": 1,
+            "filter": name,
+            "particles": particles,
+        })))
+        .map(|_| ())
     };
     for (m, field) in [
         (err(sim("IV", 1.0, 0.1, 100)), "trajectory \"IV\""),
@@ -148,19 +200,7 @@ fn job(
     noise: usize,
 ) -> Result<MonteCarloJob, wasm_bindgen::JsError> {
     let scenario = ok(wasm::preset_json("sensors2019"));
-    MonteCarloJob::new(
-        &scenario,
-        kind,
-        0.0,
-        0.0,
-        0.0,
-        0.0,
-        0.1,
-        steps,
-        trajectories,
-        noise,
-        11,
-    )
+    MonteCarloJob::new(&scenario, &study(kind, 0.1, steps, trajectories, noise))
 }
 
 /// The native model and study of [`job`]`("II", …)`.
@@ -232,24 +272,13 @@ fn monte_carlo_job_rejects_bad_input() {
         (e(job("I", 100, 20_000_000, 1)), "runs"),
         (e(job("V", 100, 10, 1)), "trajectory"),
         (
-            e(MonteCarloJob::new(
-                "{", "I", 0.0, 0.0, 0.0, 0.0, 0.1, 10, 1, 1, 1,
-            )),
+            e(MonteCarloJob::new("{", &study("I", 0.1, 10, 1, 1))),
             "invalid JSON",
         ),
         (
             e(MonteCarloJob::new(
                 &ok(wasm::preset_json("sensors2019")),
-                "I",
-                0.0,
-                0.0,
-                0.0,
-                0.0,
-                -0.1,
-                10,
-                1,
-                1,
-                1,
+                &study("I", -0.1, 10, 1, 1),
             )),
             "dt_s",
         ),
@@ -328,7 +357,8 @@ fn chart_draws_both_curves_on_a_canvas() {
 fn simulate_track_runs_every_filter_on_the_same_data() {
     let app = sensors();
     let run = |name: &str| {
-        let t = ok(app.simulate_track("II", 0.0, 0.0, 0.0, 0.0, 0.1, 100, 7, name, 500));
+        let t =
+            ok(app.simulate_track(&track_settings(json!({ "filter": name, "particles": 500 }))));
         parse(&stringify(&ok(t.data())))
     };
     let (ekf, ukf, pf) = (run("ekf"), run("ukf"), run("pf"));

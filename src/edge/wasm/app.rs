@@ -2,10 +2,11 @@
 //! core plus conversion.
 
 use js_sys::Float64Array;
+use serde::Deserialize;
 use wasm_bindgen::prelude::*;
 
 use super::json::{to_js, CrlbJs, NodesJs, SnapshotJs};
-use super::{err, point, window};
+use super::{err, point, settings, window};
 use crate::localize::{crlb_at, crlb_map, Grid};
 use crate::present::simulate_snapshot;
 use crate::present::Session;
@@ -17,6 +18,19 @@ extern "C" {
     /// `performance.now()`, ms (window or worker).
     #[wasm_bindgen(js_namespace = performance, js_name = now)]
     fn performance_now() -> f64;
+}
+
+/// The settings of `App.compute_map_in` (JSON: `{window, nx, ny}`, every field required,
+/// unknown ones refused).
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct MapWindow {
+    /// `[x_min, x_max, y_min, y_max]`, m.
+    window: [f64; 4],
+    /// Cells along x.
+    nx: usize,
+    /// Cells along y.
+    ny: usize,
 }
 
 /// The page's state: a validated scenario and its compiled model.
@@ -211,23 +225,14 @@ impl App {
         self.map_over(self.session.scenario().area_m, nx, ny, out)
     }
 
-    /// The same map over any window `[x_min, x_max] × [y_min, y_max]`, m (the page's zoomed and
-    /// panned view): every cell computed at full resolution in the window, not a crop of the
-    /// area's map. A window that is not a finite, non-empty rectangle is a named error
-    /// (`window.x` / `window.y`).
-    #[allow(clippy::too_many_arguments)]
-    pub fn compute_map_in(
-        &self,
-        x_min: f64,
-        x_max: f64,
-        y_min: f64,
-        y_max: f64,
-        nx: usize,
-        ny: usize,
-        out: &Float64Array,
-    ) -> Result<f64, JsError> {
-        let w = window([x_min, x_max, y_min, y_max]).map_err(err)?;
-        self.map_over(w, nx, ny, out)
+    /// The same map over any window of `settings_json`, one object (JSON text): `{window:
+    /// [x_min, x_max, y_min, y_max] (m), nx, ny}` (the page's zoomed and panned view): every
+    /// cell computed at full resolution in the window, not a crop of the area's map. A window
+    /// that is not a finite, non-empty rectangle is a named error (`window.x` / `window.y`), an
+    /// unknown, missing or mistyped field `settings: invalid JSON: …` naming it.
+    pub fn compute_map_in(&self, settings_json: &str, out: &Float64Array) -> Result<f64, JsError> {
+        let MapWindow { window: w, nx, ny } = settings("settings", settings_json)?;
+        self.map_over(window(w).map_err(err)?, nx, ny, out)
     }
 
     fn map_over(

@@ -1,6 +1,6 @@
 //! What every binding shares: the module start (panics routed to the console), the presets,
-//! and the two conversions at the JavaScript edge (a core error to an exception, two numbers
-//! to a checked point).
+//! and the conversions at the JavaScript edge (a core error to an exception, a settings object's
+//! JSON to the binding's serde struct, two numbers to a checked point).
 
 use alloc::format;
 use alloc::string::{String, ToString};
@@ -36,6 +36,18 @@ pub fn preset_json(name: &str) -> Result<String, JsError> {
 /// A core error as a JavaScript exception with its message.
 pub(super) fn err(e: Error) -> JsError {
     JsError::new(&e.to_string())
+}
+
+/// The settings object of a binding: `json`, the JSON text of one object (the page passes
+/// `JSON.stringify({…})`, as for `ChannelJob`'s settings), read into the binding's serde struct
+/// `T` (which refuses unknown fields). Malformed JSON, a missing, unknown or mistyped field
+/// (a non-finite number is `null` in JSON) is the core's [`Error::Parse`] naming the field,
+/// prefixed by `what`: `settings: invalid JSON: dt_s: invalid type: null, expected f64 …`.
+pub(super) fn settings<T: serde::de::DeserializeOwned>(
+    what: &str,
+    json: &str,
+) -> Result<T, JsError> {
+    crate::scenario::parse_json(json).map_err(|e| JsError::new(&format!("{what}: {e}")))
 }
 
 /// A window `[x_min, x_max, y_min, y_max]` (m) from JavaScript: a finite, non-empty rectangle,

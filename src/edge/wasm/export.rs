@@ -13,7 +13,7 @@ use serde::Deserialize;
 use wasm_bindgen::prelude::*;
 
 use super::tracking::Track;
-use super::{window, App};
+use super::{settings, window, App};
 use crate::chart::{
     crlb_map_svg, default_titles, draw_mtl_scene, scenario_nodes, scene_window, suggested_size,
     ChartOptions, MapData, MapOverlay, SceneChartOptions,
@@ -380,28 +380,43 @@ struct MapDataJs<'a> {
     unbounded: &'static str,
 }
 
+/// The settings of [`map_data_text`] (JSON: `{window, nx, ny, scenario, format}`, every field
+/// required, unknown ones refused).
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct MapDataSettings {
+    /// `[x_min, x_max, y_min, y_max]`, m: the map's window.
+    window: [f64; 4],
+    /// Cells along x.
+    nx: usize,
+    /// Cells along y.
+    ny: usize,
+    /// The scenario's name (the JSON's `scenario`).
+    scenario: String,
+    /// `csv` or `json`.
+    format: String,
+}
+
 /// The CRLB map `values` (m, row-major, row `j` at the `j`-th lowest y, as `App.compute_map_in`
-/// writes them) over the window `[x0, x1] × [y0, y1]` m on an `nx × ny` grid, as a data file:
+/// writes them) as a data file, with `settings_json`, one object (JSON text): `{window: [x0,
+/// x1, y0, y1] (m, the map's window), nx, ny (its grid), scenario (its name), format}`:
 /// `format` `"csv"`: a header `x_m,y_m,rmse_m` and one line per cell (cell centres, rows from
 /// the lowest y; an unbounded cell's `rmse_m` empty); `"json"`: `{scenario, quantity, units,
 /// grid: {x0, x1, y0, y1, nx, ny}, x_m: [centres], y_m: [centres], order: "row-major, y
 /// ascending", rmse_m: [nx·ny values, null where unbounded], unbounded}`. Every number is the
-/// core's, written so that it reads back as the same `f64`. Throws `map_data_text: …`.
+/// core's, written so that it reads back as the same `f64`. Throws `map_data_text: …` (an
+/// unknown, missing or mistyped setting: `map_data_text: invalid JSON: …` naming it).
 #[wasm_bindgen]
-#[allow(clippy::too_many_arguments)]
-pub fn map_data_text(
-    values: &[f64],
-    x0: f64,
-    x1: f64,
-    y0: f64,
-    y1: f64,
-    nx: usize,
-    ny: usize,
-    scenario: &str,
-    format: &str,
-) -> Result<String, JsError> {
+pub fn map_data_text(values: &[f64], settings_json: &str) -> Result<String, JsError> {
     const F: &str = "map_data_text";
-    let csv = data_format(F, format)?;
+    let MapDataSettings {
+        window: [x0, x1, y0, y1],
+        nx,
+        ny,
+        scenario,
+        format,
+    } = settings(F, settings_json)?;
+    let csv = data_format(F, &format)?;
     let area = window([x0, x1, y0, y1]).map_err(|e| fail(F, e))?;
     let grid = Grid::new(area, nx, ny).map_err(|e| fail(F, e))?;
     if values.len() != grid.len() {
@@ -425,7 +440,7 @@ pub fn map_data_text(
         return Ok(out);
     }
     let doc = MapDataJs {
-        scenario,
+        scenario: &scenario,
         quantity: "CRLB RMSE bound sqrt(σx² + σy²) of a snapshot fix",
         units: "m",
         grid: MapGridJs {

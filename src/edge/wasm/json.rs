@@ -473,20 +473,35 @@ fn filter_map<S: serde::Serializer>(f: &[FilterCurvesJs], s: S) -> Result<S::Ok,
     map.end()
 }
 
+/// Where a study is, for a [`MonteCarloJs`]: the lead filter's `trajectories_done`, the work
+/// items run (`chunks_done` of `chunk_count`), every filter's curves, the particle filter's
+/// `particles` and `particle_budget` (`None` without it) and the filters whose every run failed.
+pub(super) struct StudyProgressJs<'a> {
+    pub(super) trajectories_done: usize,
+    pub(super) chunks_done: usize,
+    pub(super) chunk_count: usize,
+    pub(super) filters: Vec<FilterCurvesJs<'a>>,
+    pub(super) particles: Option<usize>,
+    pub(super) particle_budget: Option<usize>,
+    pub(super) failed_filters: Vec<FailedFilterJs>,
+}
+
 impl<'a> MonteCarloJs<'a> {
-    /// `curves` of the study `cfg` after `chunks_done` of `chunk_count` work items, the lead
-    /// filter's covering `trajectories_done` trajectories, with every filter's curves.
-    #[allow(clippy::too_many_arguments)]
+    /// `curves` of the study `cfg` at `progress`.
     pub(super) fn new(
         curves: &'a MonteCarloResult,
         cfg: &MonteCarloConfig,
-        trajectories_done: usize,
-        chunks_done: usize,
-        chunk_count: usize,
-        filters: Vec<FilterCurvesJs<'a>>,
-        particles: Option<usize>,
-        particle_budget: Option<usize>,
+        progress: StudyProgressJs<'a>,
     ) -> MonteCarloJs<'a> {
+        let StudyProgressJs {
+            trajectories_done,
+            chunks_done,
+            chunk_count,
+            filters,
+            particles,
+            particle_budget,
+            failed_filters,
+        } = progress;
         MonteCarloJs {
             curves,
             trajectories: cfg.trajectories,
@@ -500,14 +515,8 @@ impl<'a> MonteCarloJs<'a> {
             filters,
             particles,
             particle_budget,
-            failed_filters: Vec::new(),
+            failed_filters,
         }
-    }
-
-    /// With the filters whose every run failed.
-    pub(super) fn with_failed(mut self, failed: Vec<FailedFilterJs>) -> MonteCarloJs<'a> {
-        self.failed_filters = failed;
-        self
     }
 }
 

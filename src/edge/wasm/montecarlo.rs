@@ -8,11 +8,12 @@
 
 use wasm_bindgen::prelude::*;
 
-use super::err;
 use alloc::vec::Vec;
+use serde::Deserialize;
 
-use super::json::{to_json, FailedFilterJs, FilterCurvesJs, MonteCarloJs};
-use super::tracking::{checked_steps, page_filter, prior_and_motion};
+use super::json::{to_json, FailedFilterJs, FilterCurvesJs, MonteCarloJs, StudyProgressJs};
+use super::tracking::{checked_steps, page_filter, Trajectory};
+use super::{err, settings};
 use crate::study::{check_cost, FilterStudy, PAGE_STUDY_CPU_S};
 use crate::track::{paper_initial_covariance, FilterKind, MonteCarloConfig};
 use crate::{Model, Scenario};
@@ -29,6 +30,25 @@ fn check_page_cost(model: &Model, study: &FilterStudy) -> Result<(), JsError> {
     .map_err(err)
 }
 
+/// The settings of a [`MonteCarloJob`] (JSON: `{trajectory: {kind, x0_m, y0_m, vx_mps,
+/// vy_mps}, dt_s, steps, trajectories, noise_runs, seed}`, every field required, unknown ones
+/// refused).
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct StudySettings {
+    trajectory: Trajectory,
+    /// Step `T`, s.
+    dt_s: f64,
+    /// Steps after t₀ (1 … [`MAX_TRACK_STEPS`](super::MAX_TRACK_STEPS)).
+    steps: usize,
+    /// Truth trajectories.
+    trajectories: usize,
+    /// Noise runs per truth trajectory.
+    noise_runs: usize,
+    /// The seed.
+    seed: u32,
+}
+
 /// A Monte Carlo study of ε(t) of one or more trackers and ε_PCRLB(t) in progress: the core's
 /// [`FilterStudy`] run a few work items per call.
 #[wasm_bindgen]
@@ -39,27 +59,26 @@ pub struct MonteCarloJob {
 
 #[wasm_bindgen]
 impl MonteCarloJob {
-    /// A study on scenario JSON `scenario_json` (schema v1) for trajectory `kind` (`I`, `II`,
-    /// `III`, or `custom` with prior mean `(x0, y0, vx, vy)`), `P(t₀)`, `q̃` and EKF set-up of
-    /// spec §9.5, step `dt_s`, `steps` steps (1 … 10 000), `trajectories` × `noise_runs` EKF
-    /// runs and `seed`. Throws the core's message on bad input; nothing runs yet.
+    /// A study on scenario JSON `scenario_json` (schema v1) of `settings_json`, one object
+    /// (JSON text): `{trajectory: {kind, x0_m, y0_m, vx_mps, vy_mps}, dt_s, steps,
+    /// trajectories, noise_runs, seed}`: trajectory `kind` (`I`, `II`, `III`, or `custom` with
+    /// prior mean start `(x0_m, y0_m)` m and velocity `(vx_mps, vy_mps)` m/s, as
+    /// `App.simulate_track`), `P(t₀)`, `q̃` and EKF set-up of spec §9.5, step `dt_s` s,
+    /// `steps` steps (1 … 10 000), `trajectories` × `noise_runs` EKF runs and `seed`. Throws
+    /// the core's message naming the field on bad input (`settings: invalid JSON: …` for an
+    /// unknown, missing or mistyped one); nothing runs yet.
     #[wasm_bindgen(constructor)]
-    #[allow(clippy::too_many_arguments)]
-    pub fn new(
-        scenario_json: &str,
-        kind: &str,
-        x0: f64,
-        y0: f64,
-        vx: f64,
-        vy: f64,
-        dt_s: f64,
-        steps: usize,
-        trajectories: usize,
-        noise_runs: usize,
-        seed: u32,
-    ) -> Result<MonteCarloJob, JsError> {
+    pub fn new(scenario_json: &str, settings_json: &str) -> Result<MonteCarloJob, JsError> {
         let model = Model::new(&Scenario::from_json(scenario_json).map_err(err)?).map_err(err)?;
-        let (mean_state, motion) = prior_and_motion(kind, [x0, y0, vx, vy], dt_s).map_err(err)?;
+        let StudySettings {
+            trajectory,
+            dt_s,
+            steps,
+            trajectories,
+            noise_runs,
+            seed,
+        } = settings("settings", settings_json)?;
+        let (mean_state, motion) = trajectory.prior_and_motion(dt_s).map_err(err)?;
         let cfg = MonteCarloConfig {
             motion,
             steps,
@@ -187,18 +206,18 @@ impl MonteCarloJob {
                 error: alloc::string::ToString::to_string(e),
             })
             .collect();
-        to_json(
-            &MonteCarloJs::new(
-                &top,
-                cfg,
-                lead.sums.trajectories,
-                self.study.items_done(),
-                self.study.item_count(),
-                per_filter,
-                self.study.particles(),
-                self.study.particle_budget(),
-            )
-            .with_failed(failed),
-        )
+        to_json(&MonteCarloJs::new(
+            &top,
+            cfg,
+            StudyProgressJs {
+                trajectories_done: lead.sums.trajectories,
+                chunks_done: self.study.items_done(),
+                chunk_count: self.study.item_count(),
+                filters: per_filter,
+                particles: self.study.particles(),
+                particle_budget: self.study.particle_budget(),
+                failed_filters: failed,
+            },
+        ))
     }
 }

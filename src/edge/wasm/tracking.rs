@@ -5,8 +5,10 @@
 
 use wasm_bindgen::prelude::*;
 
+use serde::Deserialize;
+
 use super::json::{to_js, EstimateJs, FrameJs, TrackDataJs};
-use super::{err, App};
+use super::{err, settings, App};
 use crate::error::Error;
 use crate::math::{Real, Vec2, Vec4};
 use crate::present::{track_estimate, track_frame, track_mean_state, velocity_through};
@@ -56,15 +58,45 @@ pub(super) fn checked_steps(steps: usize) -> crate::Result<usize> {
     }
 }
 
-/// The prior mean of `kind` (`I`, `II`, `III`, or `custom` from `x0, y0, vx, vy`) and the CV
-/// model for step `dt_s` with the paper's intensity, both validated.
-pub(super) fn prior_and_motion(
-    kind: &str,
-    [x0, y0, vx, vy]: [Real; 4],
+/// The trajectory of a track or study: `kind` (`I`, `II`, `III` of spec §9.4, or `custom`), and
+/// for `custom` the prior mean's start `(x0_m, y0_m)` m and velocity `(vx_mps, vy_mps)` m/s
+/// (ignored for the others).
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct Trajectory {
+    kind: String,
+    x0_m: Real,
+    y0_m: Real,
+    vx_mps: Real,
+    vy_mps: Real,
+}
+
+impl Trajectory {
+    /// Its prior mean and the CV model for step `dt_s` with the paper's intensity, both
+    /// validated.
+    pub(super) fn prior_and_motion(&self, dt_s: Real) -> crate::Result<(Vec4, ConstantVelocity)> {
+        let start = Vec2::new(self.x0_m, self.y0_m);
+        let mean = track_mean_state(&self.kind, start, Vec2::new(self.vx_mps, self.vy_mps))?;
+        Ok((mean, ConstantVelocity::validated(dt_s, PAPER_INTENSITY)?))
+    }
+}
+
+/// The settings of `App.simulate_track` (JSON: `{trajectory: {kind, x0_m, y0_m, vx_mps,
+/// vy_mps}, dt_s, steps, seed, filter, particles}`, every field required, unknown ones refused).
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct TrackSettings {
+    trajectory: Trajectory,
+    /// Step `T`, s.
     dt_s: Real,
-) -> crate::Result<(Vec4, ConstantVelocity)> {
-    let mean = track_mean_state(kind, Vec2::new(x0, y0), Vec2::new(vx, vy))?;
-    Ok((mean, ConstantVelocity::validated(dt_s, PAPER_INTENSITY)?))
+    /// Steps after t₀ (1 … [`MAX_TRACK_STEPS`]).
+    steps: usize,
+    /// The noise streams' seed.
+    seed: u32,
+    /// `ekf`, `ukf` or `pf`.
+    filter: String,
+    /// The particle filter's particles (ignored by the others).
+    particles: usize,
 }
 
 /// A simulated track: the run and the scenario it was simulated on.
@@ -81,30 +113,28 @@ pub struct Track {
 
 #[wasm_bindgen]
 impl App {
-    /// Simulates one track ([`simulate_track`]): trajectory `kind` = `"I"`, `"II"`, `"III"`
-    /// (spec §9.4; `x0 … vy` ignored) or `"custom"` (prior mean start `(x0, y0)` m, velocity
-    /// `(vx, vy)` m/s), `P(t₀)` and `q̃` of §9.5, step `dt_s`, `steps` steps (1 … 10 000),
-    /// noise streams from `seed`, tracked by `filter` (`ekf`, `ukf`, or `pf` with `particles`
+    /// Simulates one track ([`simulate_track`]) of `settings_json`, one object (JSON text):
+    /// `{trajectory: {kind, x0_m, y0_m, vx_mps, vy_mps}, dt_s, steps, seed, filter,
+    /// particles}`: trajectory `kind` = `"I"`, `"II"`, `"III"` (spec §9.4; `x0_m … vy_mps`
+    /// ignored) or `"custom"` (prior mean start `(x0_m, y0_m)` m, velocity `(vx_mps, vy_mps)`
+    /// m/s), `P(t₀)` and `q̃` of §9.5, step `dt_s` s, `steps` steps (1 … 10 000), noise
+    /// streams from `seed`, tracked by `filter` (`ekf`, `ukf`, or `pf` with `particles`
     /// particles; `steps × particles` at most [`MAX_TRACK_PARTICLE_STEPS`]). Every filter sees
     /// the same truth and delays for one seed. The filter starts at the prior mean. Throws on
-    /// bad input.
-    #[allow(clippy::too_many_arguments)]
-    pub fn simulate_track(
-        &self,
-        kind: &str,
-        x0: f64,
-        y0: f64,
-        vx: f64,
-        vy: f64,
-        dt_s: f64,
-        steps: usize,
-        seed: u32,
-        filter: &str,
-        particles: usize,
-    ) -> Result<Track, JsError> {
-        let (mean, motion) = prior_and_motion(kind, [x0, y0, vx, vy], dt_s).map_err(err)?;
+    /// bad input, naming the field (`settings: invalid JSON: …` for an unknown, missing or
+    /// mistyped one).
+    pub fn simulate_track(&self, settings_json: &str) -> Result<Track, JsError> {
+        let TrackSettings {
+            trajectory,
+            dt_s,
+            steps,
+            seed,
+            filter,
+            particles,
+        } = settings("settings", settings_json)?;
+        let (mean, motion) = trajectory.prior_and_motion(dt_s).map_err(err)?;
         let steps = checked_steps(steps).map_err(err)?;
-        let tracker = page_filter("filter", filter, particles).map_err(err)?;
+        let tracker = page_filter("filter", &filter, particles).map_err(err)?;
         if matches!(tracker, FilterKind::Pf(_))
             && steps.saturating_mul(particles) > MAX_TRACK_PARTICLE_STEPS
         {
@@ -138,7 +168,7 @@ impl App {
             scenario: session.scenario().clone(),
             model: session.model().clone(),
             run,
-            kind: kind.to_string(),
+            kind: trajectory.kind,
             seed,
             steps,
             filter: tracker,

@@ -301,12 +301,15 @@ fn monte_carlo_progress_and_result() {
         let v = value(&MonteCarloJs::new(
             &r,
             &cfg,
-            sums.trajectories,
-            chunk + 1,
-            cfg.chunk_count(),
-            vec![ekf],
-            None,
-            None,
+            StudyProgressJs {
+                trajectories_done: sums.trajectories,
+                chunks_done: chunk + 1,
+                chunk_count: cfg.chunk_count(),
+                filters: vec![ekf],
+                particles: None,
+                particle_budget: None,
+                failed_filters: Vec::new(),
+            },
         ));
         assert_eq!(
             keys(&v),
