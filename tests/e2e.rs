@@ -27,6 +27,10 @@ use scatterloc::{Model, Scenario, Vec2};
 #[path = "e2e/tracking.rs"]
 mod tracking;
 
+/// The tests' shared steps: click, select, type, keys, the banner, waiting for a view's state.
+#[path = "e2e/ui.rs"]
+mod ui;
+
 /// Multi-target mode: drag a target, the detection follows (issue 4).
 #[cfg(test)]
 #[path = "e2e/mtl.rs"]
@@ -311,6 +315,26 @@ fn with_browser<T>(f: impl AsyncFnOnce(&Client, u16, u16) -> Result<T, String>) 
     outcome.unwrap_or_else(|e| panic!("{e}"))
 }
 
+/// One browser session: `f(client, port)`, then the browser is closed (an `Err` fails the test
+/// with its message).
+fn session<T, F, Fut>(f: F) -> T
+where
+    F: FnOnce(Client, u16) -> Fut,
+    Fut: std::future::Future<Output = Result<T, String>>,
+{
+    let _serial = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
+    let port = start_server();
+    let driver = Driver::start();
+    let r = runtime().block_on(async {
+        let c = connect(&driver).await;
+        let r = f(c.clone(), port).await;
+        let _ = c.close().await;
+        r
+    });
+    drop(driver);
+    r.unwrap_or_else(|e| panic!("{e}"))
+}
+
 /// Loads the page and waits for `data-ready` (or fails fast on `data-error`).
 async fn open(c: &Client, port: u16) -> Result<(), String> {
     open_hash(c, port, "").await
@@ -321,6 +345,19 @@ async fn open_hash(c: &Client, port: u16, hash: &str) -> Result<(), String> {
     c.goto(&format!("http://127.0.0.1:{port}/{hash}"))
         .await
         .map_err(|e| e.to_string())?;
+    ready(c).await
+}
+
+/// Opens `url` as a fresh page (through about:blank, so a hash-only change reloads too) and
+/// waits for `data-ready` (or fails on `data-error`).
+async fn open_url(c: &Client, url: &str) -> Result<(), String> {
+    c.goto("about:blank").await.map_err(|e| e.to_string())?;
+    c.goto(url).await.map_err(|e| e.to_string())?;
+    ready(c).await
+}
+
+/// Waits for the page's `data-ready` (or fails fast on `data-error`).
+async fn ready(c: &Client) -> Result<(), String> {
     let body = c
         .wait()
         .at_most(Duration::from_secs(60))

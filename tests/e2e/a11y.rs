@@ -8,16 +8,14 @@
 use std::path::Path;
 use std::time::Duration;
 
-use fantoccini::actions::{InputSource, KeyAction, KeyActions};
 use fantoccini::wd::TimeoutConfiguration;
 use fantoccini::Client;
 use serde_json::Value;
 
-use super::mtl::{banner, wait_view};
+use super::ui::{banner, press, view_ready, wait_view, SHIFT};
 use super::{console_errors, js, open, open_hash, settle, with_browser, MAP_HASH};
 
 const TAB: char = '\u{E004}';
-const SHIFT: char = '\u{E008}';
 const LEFT: char = '\u{E012}';
 const UP: char = '\u{E013}';
 const RIGHT: char = '\u{E014}';
@@ -76,16 +74,6 @@ fn by_impact(v: &[Value]) -> [usize; 4] {
 async fn reopen(c: &Client, port: u16, hash: &str) -> Result<(), String> {
     c.goto("about:blank").await.map_err(|e| e.to_string())?;
     open_hash(c, port, hash).await?;
-    settle(c).await
-}
-
-/// Waits until the view on screen has drawn: the page idle and, in the multi-target view, its
-/// worker's first result.
-async fn view_ready(c: &Client) -> Result<(), String> {
-    settle(c).await?;
-    if js(c, "return window.pageState.mode").await? == "mtl" {
-        wait_view(c, 60).await?;
-    }
     settle(c).await
 }
 
@@ -186,23 +174,6 @@ fn axe_all_rules_no_violations() {
     assert!(bad.is_empty(), "violations: {bad:#?}");
 }
 
-/// Presses `keys` in turn (each down then up) on the focused element; with `shift` held.
-async fn press(c: &Client, keys: &[char], shift: bool) -> Result<(), String> {
-    let mut k = KeyActions::new("keyboard".to_string());
-    if shift {
-        k = k.then(KeyAction::Down { value: SHIFT });
-    }
-    for &key in keys {
-        k = k
-            .then(KeyAction::Down { value: key })
-            .then(KeyAction::Up { value: key });
-    }
-    if shift {
-        k = k.then(KeyAction::Up { value: SHIFT });
-    }
-    c.perform_actions(k).await.map_err(|e| e.to_string())
-}
-
 /// `[kind, index, plot focused, live region text]`.
 async fn selection(c: &Client) -> Result<Value, String> {
     js(
@@ -269,7 +240,7 @@ async fn tab_in(c: &Client) -> Result<(), String> {
          all[all.indexOf(plot) - 1].focus();",
     )
     .await?;
-    press(c, &[TAB], false).await?;
+    press(c, &[], &[TAB]).await?;
     if selection(c).await?[2] != true {
         return Err("Tab from the control before the plot did not focus the plot".into());
     }
@@ -287,17 +258,17 @@ async fn keyboard(c: &Client, port: u16) -> Result<Keys, String> {
     tab_in(c).await?;
     let mut tabs = vec![selection(c).await?];
     for _ in 0..nodes {
-        press(c, &[TAB], false).await?;
+        press(c, &[], &[TAB]).await?;
         tabs.push(selection(c).await?);
     }
     // Shift+Tab from the next control back in: the last node.
-    press(c, &[TAB], true).await?;
+    press(c, &[SHIFT], &[TAB]).await?;
     let back = selection(c).await?;
 
     // Rx2 selected (Shift+Tab from the last node walks back), then the arrow keys.
     tab_in(c).await?;
     while kind_index(&selection(c).await?) != ("rx".to_string(), Some(1)) {
-        press(c, &[TAB], false).await?;
+        press(c, &[], &[TAB]).await?;
         if selection(c).await?[2] != true {
             return Err("Rx2 not reached by Tab".into());
         }
@@ -305,20 +276,20 @@ async fn keyboard(c: &Client, port: u16) -> Result<Keys, String> {
     settle(c).await?;
     let hash0 = js(c, MAP_HASH).await?;
     let mut pos = vec![selected_xy(c).await?];
-    press(c, &[RIGHT], false).await?;
+    press(c, &[], &[RIGHT]).await?;
     settle(c).await?;
     pos.push(selected_xy(c).await?);
-    press(c, &[UP], false).await?;
+    press(c, &[], &[UP]).await?;
     settle(c).await?;
     pos.push(selected_xy(c).await?);
-    press(c, &[LEFT], true).await?;
+    press(c, &[SHIFT], &[LEFT]).await?;
     settle(c).await?;
     pos.push(selected_xy(c).await?);
     let map_changed = js(c, MAP_HASH).await? != hash0;
 
     // Delete removes Rx2.
     let before = counts(c).await?;
-    press(c, &[DELETE], false).await?;
+    press(c, &[], &[DELETE]).await?;
     settle(c).await?;
     let after = counts(c).await?;
     let live = selection(c).await?[3].as_str().unwrap_or("").to_string();
@@ -334,7 +305,7 @@ async fn keyboard(c: &Client, port: u16) -> Result<Keys, String> {
         }
         let n = counts(c).await?;
         let scenario = js(c, "return window.app.scenario_json()").await?;
-        press(c, &[DELETE], false).await?;
+        press(c, &[], &[DELETE]).await?;
         settle(c).await?;
         if n[0] == 1 {
             let same = js(c, "return window.app.scenario_json()").await? == scenario;
@@ -348,7 +319,7 @@ async fn keyboard(c: &Client, port: u16) -> Result<Keys, String> {
     reopen(c, port, "#mode=tracking").await?;
     tab_in(c).await?;
     let a = selected_xy(c).await?;
-    press(c, &[RIGHT], false).await?;
+    press(c, &[], &[RIGHT]).await?;
     settle(c).await?;
     let b = selected_xy(c).await?;
     let tracking_move = [b[0] - a[0], b[1] - a[1]];
@@ -362,11 +333,11 @@ async fn keyboard(c: &Client, port: u16) -> Result<Keys, String> {
         + scene["receivers"].as_array().map_or(0, Vec::len);
     js(c, "document.getElementById('plot').focus()").await?;
     for _ in 0..skip {
-        press(c, &[TAB], false).await?;
+        press(c, &[], &[TAB]).await?;
     }
     let sel = js(c, "return window.mtl.state().selected").await?;
     let t0: [f64; 2] = serde_json::from_value(scene["targets"][0].clone()).unwrap_or([0.0; 2]);
-    press(c, &[RIGHT], false).await?;
+    press(c, &[], &[RIGHT]).await?;
     wait_view(c, 60).await?;
     let t1: [f64; 2] = serde_json::from_value(
         js(c, "return window.mtl.state().scene.targets[0]")

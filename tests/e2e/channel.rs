@@ -14,7 +14,7 @@
 //! rejects the running job and the next job runs.
 
 use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::Command;
 use std::time::{Duration, Instant};
 
@@ -24,6 +24,7 @@ use serde_json::Value;
 use scatterloc::error::limits::MAX_PAGE_RECORDING_BYTES;
 use scatterloc::npz::read_recording;
 
+use super::ui::temp_dir;
 use super::{console_errors, js, open, with_browser};
 
 const BIN: &str = env!("CARGO_BIN_EXE_scatterloc");
@@ -37,14 +38,6 @@ pub(super) fn cli(args: &[&str]) -> Vec<u8> {
         String::from_utf8_lossy(&out.stderr)
     );
     out.stdout
-}
-
-/// A fresh temporary directory (removed by the test at its end).
-fn temp_dir() -> PathBuf {
-    let d = std::env::temp_dir().join(format!("scatterloc-e2e-channel-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
 }
 
 fn unbase64(s: &str) -> Vec<u8> {
@@ -454,7 +447,7 @@ fn print_timings(what: &str, r: &Value) {
 #[test]
 #[ignore = "needs chromedriver, headless Chromium and the wasm package (www/pkg)"]
 fn channel_view_worker_equals_the_cli() {
-    let dir = temp_dir();
+    let dir = temp_dir("channel");
     let f = cli_files(&dir);
     let (rec64, cal64) = (base64(&f.recording), base64(&f.calibration));
     // A member declaring 300 MiB (over the page's 256 MiB cap; 300 kB compressed), and one

@@ -21,71 +21,15 @@ use std::time::{Duration, Instant};
 use fantoccini::{Client, Locator};
 use serde_json::{json, Value};
 
-use super::mtl::banner;
+use super::ui::{banner, channel_state, click, keys, wait_banner, wait_channel, END, HOME, RIGHT};
 use super::{console_errors, js, open_hash, settle, with_browser};
 
 const PNG_SIGNATURE: [u8; 8] = [0x89, b'P', b'N', b'G', 0x0d, 0x0a, 0x1a, 0x0a];
-const HOME: &str = "\u{E011}";
-const END: &str = "\u{E010}";
-const RIGHT: &str = "\u{E014}";
-
-pub(super) async fn click(c: &Client, id: &str) -> Result<(), String> {
-    let e = c.find(Locator::Id(id)).await.map_err(|e| e.to_string())?;
-    e.click().await.map_err(|e| format!("click {id}: {e}"))
-}
-
-pub(super) async fn state(c: &Client) -> Result<Value, String> {
-    js(c, "return window.channel.state()").await
-}
-
-/// Polls the channel state until `done` holds (at most `secs`), failing fast on a console error.
-pub(super) async fn wait_state(
-    c: &Client,
-    secs: u64,
-    what: &str,
-    done: impl Fn(&Value) -> bool,
-) -> Result<Value, String> {
-    let t0 = Instant::now();
-    loop {
-        let s = state(c).await?;
-        if done(&s) {
-            return Ok(s);
-        }
-        let errors = console_errors(c).await?;
-        if !errors.is_empty() {
-            return Err(format!("{what}: console errors {errors:?}; state {s}"));
-        }
-        if t0.elapsed() > Duration::from_secs(secs) {
-            return Err(format!("{what}: not after {secs} s; state {s}"));
-        }
-        tokio::time::sleep(Duration::from_millis(50)).await;
-    }
-}
-
-/// The error banner's text once shown (at most 10 s).
-async fn wait_banner(c: &Client) -> Result<String, String> {
-    let t0 = Instant::now();
-    loop {
-        let b = banner(c).await?;
-        if !b.is_empty() || t0.elapsed() > Duration::from_secs(10) {
-            return Ok(b);
-        }
-        tokio::time::sleep(Duration::from_millis(30)).await;
-    }
-}
 
 async fn dismiss(c: &Client) -> Result<(), String> {
     js(c, "document.getElementById('error-close').click()")
         .await
         .map(|_| ())
-}
-
-/// Keys typed into element `id` (it gets the focus).
-pub(super) async fn keys(c: &Client, id: &str, k: &str) -> Result<(), String> {
-    let e = c.find(Locator::Id(id)).await.map_err(|e| e.to_string())?;
-    e.send_keys(k)
-        .await
-        .map_err(|e| format!("keys to {id}: {e}"))
 }
 
 /// Chooses `what` in #chan-save-what, clicks Save and reads the file through its download link.
@@ -198,23 +142,23 @@ async fn run(c: &Client, port: u16, bad: &str) -> Result<Outcome, String> {
 
     // Simulate a walk through the scenario.
     click(c, "chan-simulate").await?;
-    let simulated = wait_state(c, 300, "simulate", |s| {
+    let simulated = wait_channel(c, 300, "simulate", |s| {
         s["recording"].is_object() && s["running"].is_null()
     })
     .await?;
 
     // Run, and stop it while it estimates.
     click(c, "chan-run").await?;
-    wait_state(c, 120, "run started", |s| {
+    wait_channel(c, 120, "run started", |s| {
         s["running"] == "run" && s["progress"].is_object()
     })
     .await?;
     click(c, "chan-stop").await?;
-    let after_stop = wait_state(c, 30, "stop", |s| s["running"].is_null()).await?;
+    let after_stop = wait_channel(c, 30, "stop", |s| s["running"].is_null()).await?;
 
     // Run to the end.
     click(c, "chan-run").await?;
-    let done = wait_state(c, 900, "run", |s| s["runs"] == 1 && s["running"].is_null()).await?;
+    let done = wait_channel(c, 900, "run", |s| s["runs"] == 1 && s["running"].is_null()).await?;
     let texts = js(c, "return window.channel.texts()").await?;
     let track: Value = serde_json::from_str(texts["track"].as_str().unwrap_or("null"))
         .map_err(|e| e.to_string())?;
@@ -225,15 +169,15 @@ async fn run(c: &Client, port: u16, bad: &str) -> Result<Outcome, String> {
     let mut cursors = Vec::new();
     keys(c, "chan-scrub", HOME).await?;
     settle(c).await?;
-    cursors.push(state(c).await?);
+    cursors.push(channel_state(c).await?);
     for _ in 0..5 {
         keys(c, "chan-scrub", RIGHT).await?;
     }
     settle(c).await?;
-    cursors.push(state(c).await?);
+    cursors.push(channel_state(c).await?);
     keys(c, "chan-scrub", END).await?;
     settle(c).await?;
-    cursors.push(state(c).await?);
+    cursors.push(channel_state(c).await?);
 
     // A picture of the view at the last snapshot, for a look by eye (temp dir).
     if let Ok(png) = c.screenshot().await {
@@ -507,7 +451,7 @@ async fn two_segments(
             .await
             .map_err(|e| e.to_string())?;
     }
-    wait_state(c, 60, "files", |s| {
+    wait_channel(c, 60, "files", |s| {
         s["recording"].is_object() && s["truth"].is_string()
     })
     .await?;
@@ -520,7 +464,7 @@ async fn two_segments(
     .unwrap_or_default()
     .to_string();
     click(c, "chan-run").await?;
-    let done = wait_state(c, 600, "run", |s| {
+    let done = wait_channel(c, 600, "run", |s| {
         (s["runs"] == 1 || s["statusState"] == "error") && s["running"].is_null()
     })
     .await?;
@@ -535,7 +479,7 @@ async fn two_segments(
         .map_or(0, |l| l + 2);
     js(c, &format!("window.channel.seek({k})")).await?;
     settle(c).await?;
-    let gap = state(c).await?;
+    let gap = channel_state(c).await?;
     let gap_info = js(c, "return document.getElementById('chan-info').textContent")
         .await?
         .as_str()
@@ -543,7 +487,7 @@ async fn two_segments(
         .to_string();
     keys(c, "chan-scrub", END).await?;
     settle(c).await?;
-    let last = state(c).await?;
+    let last = channel_state(c).await?;
     js(
         c,
         "document.getElementById('chan-figures').scrollIntoView()",

@@ -8,7 +8,7 @@
 
 use std::time::{Duration, Instant};
 
-use fantoccini::{Client, Locator};
+use fantoccini::Client;
 use serde_json::Value;
 
 use scatterloc::localize::{crlb_map, Grid};
@@ -16,7 +16,7 @@ use scatterloc::present::{colorbar_ticks, LogScale};
 use scatterloc::{scenario::presets, Model};
 
 use super::svg::{count, svg_texts};
-use super::tracking::{mc_done, wait_state};
+use super::ui::{click, mc_done, wait_tracking};
 use super::{console_errors, js, open, settle, with_browser};
 
 const PNG_SIGNATURE: [u8; 8] = [0x89, b'P', b'N', b'G', 0x0d, 0x0a, 0x1a, 0x0a];
@@ -27,11 +27,6 @@ pub(super) struct Saved {
     pub(super) info: Value,
     pub(super) text: String,
     head: Vec<u8>,
-}
-
-async fn click(c: &Client, id: &str) -> Result<(), String> {
-    let e = c.find(Locator::Id(id)).await.map_err(|e| e.to_string())?;
-    e.click().await.map_err(|e| e.to_string())
 }
 
 /// Chooses `what` and `format` in the selects, clicks Save figure and waits for the file.
@@ -124,7 +119,7 @@ async fn run(c: &Client, port: u16) -> Result<Outcome, String> {
     let snapshot_png = save(c, "map", "png").await?;
 
     click(c, "mode-tracking").await?;
-    wait_state(c, 120, |s| {
+    wait_tracking(c, 120, |s| {
         mc_done(s) && s["steps"].as_u64().unwrap_or(0) > 0
     })
     .await?;

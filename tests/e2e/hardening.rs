@@ -5,7 +5,6 @@
 //! keeps the map work of each drag move bounded and ends on the full-resolution map; URL options
 //! name the option, the value and the allowed range.
 
-use std::future::Future;
 use std::time::{Duration, Instant};
 
 use fantoccini::{Client, Locator};
@@ -14,30 +13,11 @@ use serde_json::{json, Value};
 use scatterloc::scenario::{Receiver, Transmitter};
 use scatterloc::Scenario;
 
-use super::mtl::{banner, state, wait_view};
+use super::ui::{banner, mtl_state, points, wait_banner, wait_view};
 use super::{
-    connect, console_errors, drag_on_plot, js, open, open_hash, probe, runtime, settle,
-    start_server, Driver, MAP_HASH, PROBE_HASH, SERIAL,
+    console_errors, drag_on_plot, js, open, open_hash, open_url, probe, session, settle, MAP_HASH,
+    PROBE_HASH,
 };
-
-/// One browser session: `f(client, port)`, then the browser is closed.
-pub(super) fn session<T, F, Fut>(f: F) -> T
-where
-    F: FnOnce(Client, u16) -> Fut,
-    Fut: Future<Output = Result<T, String>>,
-{
-    let _serial = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
-    let port = start_server();
-    let driver = Driver::start();
-    let r = runtime().block_on(async {
-        let c = connect(&driver).await;
-        let r = f(c.clone(), port).await;
-        let _ = c.close().await;
-        r
-    });
-    drop(driver);
-    r.unwrap_or_else(|e| panic!("{e}"))
-}
 
 /// Sets input `id` to `value` and fires `change` (what Enter or leaving the field does).
 async fn set_input(c: &Client, id: &str, value: &str) -> Result<(), String> {
@@ -56,22 +36,6 @@ const PLOT_HASH: &str = "const c = document.getElementById('plot'); \
     const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data; \
     let h = 2166136261; for (let i = 0; i < d.length; i++) { h ^= d[i]; h = Math.imul(h, 16777619) >>> 0; } \
     return h;";
-
-/// The error banner's text once it is shown (at most 10 s), or "".
-async fn wait_banner(c: &Client) -> Result<String, String> {
-    let t0 = Instant::now();
-    loop {
-        let b = banner(c).await?;
-        if !b.is_empty() || t0.elapsed() > Duration::from_secs(10) {
-            return Ok(b);
-        }
-        tokio::time::sleep(Duration::from_millis(30)).await;
-    }
-}
-
-fn points(v: &Value) -> Vec<[f64; 2]> {
-    serde_json::from_value(v.clone()).unwrap_or_default()
-}
 
 fn nearest(det: &[[f64; 2]], t: [f64; 2]) -> f64 {
     det.iter()
@@ -115,7 +79,7 @@ fn mtl_stale_recompute_is_replaced_by_a_later_edit() {
         // Wait until the worker has been on the slow scene for 600 ms (its result must not come).
         let t0 = Instant::now();
         let busy = loop {
-            let s = state(&c).await?;
+            let s = mtl_state(&c).await?;
             if s["pending"] == false {
                 return Err(format!(
                     "the slow scene finished in {:?}: not slow; {s}",
@@ -149,7 +113,7 @@ fn mtl_stale_recompute_is_replaced_by_a_later_edit() {
         slow["max_candidates"] = json!(5000);
         js(&c, &format!("return window.mtl.setScene({slow})")).await?;
         let budget = wait_banner(&c).await?;
-        let kept = state(&c).await?;
+        let kept = mtl_state(&c).await?;
         let budget_ok =
             budget.contains("more than 5000 candidates") && kept["detected"] == after["detected"];
         if !budget_ok {
@@ -212,7 +176,7 @@ fn mtl_bad_numbers_are_named_and_change_nothing() {
         ] {
             set_input(&c, id, text).await?;
             banners.push(wait_banner(&c).await?);
-            let s = state(&c).await?;
+            let s = mtl_state(&c).await?;
             let invalid = js(
                 &c,
                 &format!("return document.getElementById('{id}').classList.contains('invalid')"),
@@ -419,9 +383,10 @@ fn large_network() -> String {
 }
 
 /// Item 9: with 4096 links (map 128²), every refresh of a real-mouse drag of a receiver computes
-/// a reduced map within about a frame on the main thread (the old page computed the full map per
-/// move); after the drag the full-resolution map (from the worker) is shown and equals the core's
-/// map of the final scenario.
+/// a reduced map on the main thread, the resolution the page's cost model picks for its frame
+/// budget (the old page computed the full map per move); after the drag the full-resolution map
+/// (from the worker) is shown and equals the core's map of the final scenario. The refresh and
+/// kernel times are printed (docs/benchmarks.md), not asserted.
 #[test]
 #[ignore = "needs chromium + chromedriver and www/pkg (wasm-pack build); run with --ignored"]
 fn large_network_drag_is_bounded_and_ends_on_the_full_map() {
@@ -512,19 +477,21 @@ fn large_network_drag_is_bounded_and_ends_on_the_full_map() {
     );
     assert!(moved > 1.0, "the receiver followed the mouse ({moved} m)");
     assert!(drag.len() >= 3, "refreshes during the drag: {log:?}");
+    // The timings above are printed, not asserted (issue 39: a loaded machine failed a bound of
+    // half the full map's time, 47.2 ms against 45.5 ms): the page's own timings are reported in
+    // docs/benchmarks.md. What holds on any machine: every refresh during the drag drew a map
+    // smaller than the full one, chosen by the page's cost model for its 10 ms budget.
     for r in &drag {
-        assert_ne!(r["res"], "128x128", "a reduced map while dragging: {r}");
+        let cells = |res: &str| -> Option<f64> {
+            let (a, b) = res.split_once('x')?;
+            Some(a.parse::<f64>().ok()? * b.parse::<f64>().ok()?)
+        };
+        let n = r["res"].as_str().and_then(cells);
+        assert!(
+            n.is_some_and(|n| n < 128.0 * 128.0),
+            "a reduced map while dragging: {r}"
+        );
     }
-    // About a frame for the map (10 ms budget; slack for a loaded 2-core machine), and far below
-    // the full map's cost for the whole refresh.
-    assert!(
-        med(&map) < 25.0 && max(&map) < 80.0,
-        "map kernel while dragging: {map:?}"
-    );
-    assert!(
-        max(&total) < 250.0 && max(&total) < full_ms / 2.0,
-        "refresh while dragging: {total:?}"
-    );
     assert_eq!(fin["res"], "128x128", "{fin}");
     assert_eq!(fin["source"], "worker", "{fin}");
     assert!(
@@ -714,7 +681,7 @@ fn url_options_bad_ones_are_named_and_the_rest_applies() {
     let results = session(|c, port| async move {
         let mut out = Vec::new();
         for (hash, check) in plan {
-            super::plan::open_url(&c, &format!("http://127.0.0.1:{port}/{hash}")).await?;
+            open_url(&c, &format!("http://127.0.0.1:{port}/{hash}")).await?;
             settle(&c).await?;
             out.push(json!([
                 banner(&c).await?,
@@ -750,7 +717,7 @@ fn copy_link_at_the_zoom_limits_reopens_the_same_window() {
     let results = session(|c, port| async move {
         let mut out = Vec::new();
         for (factor, dx, dy) in [(1e-9, 1e7, -1e7), (1e9, -1e7, 1e7), (1e-9, 0.0, 0.0)] {
-            super::plan::open_url(&c, &format!("http://127.0.0.1:{port}/#res=128")).await?;
+            open_url(&c, &format!("http://127.0.0.1:{port}/#res=128")).await?;
             settle(&c).await?;
             let link = c
                 .execute_async(
@@ -766,7 +733,7 @@ fn copy_link_at_the_zoom_limits_reopens_the_same_window() {
             if !url.starts_with("http") {
                 return Err(format!("no link: {link}"));
             }
-            super::plan::open_url(&c, &url).await?;
+            open_url(&c, &url).await?;
             settle(&c).await?;
             out.push(json!([
                 link[1],
@@ -890,7 +857,7 @@ fn copy_link_reads_back_or_offers_the_scenario_file() {
         let errors = console_errors(&c).await?;
         // The link of the 0.9 MiB scenario, opened as a fresh page.
         let url = small[1].as_str().unwrap_or_default().to_string();
-        super::plan::open_url(&c, &url).await?;
+        open_url(&c, &url).await?;
         settle(&c).await?;
         let reopened = json!([
             js(&c, "return window.app.scenario_json()").await?,
@@ -977,7 +944,7 @@ fn long_node_names_are_refused_promptly_on_every_path() {
             )
             .await
             .map_err(|e| e.to_string())?;
-        super::plan::open_url(&c, link.as_str().unwrap_or_default()).await?;
+        open_url(&c, link.as_str().unwrap_or_default()).await?;
         settle(&c).await?;
         let url = json!([
             banner(&c).await?,
@@ -989,11 +956,9 @@ fn long_node_names_are_refused_promptly_on_every_path() {
     let (import, import_banner, kept, errors, url) = o;
     println!("e2e: 10 MB name: {import} {import_banner:?}; 500 kB name in a link: {url}");
     assert!(errors.is_empty(), "console errors: {errors:?}");
+    // Refused, by the name cap (the banner below): the time it took is printed above, not
+    // asserted (issue 39: tests do not time the wall clock).
     assert_eq!(import[0], false, "the import is refused");
-    assert!(
-        import[1].as_f64().unwrap_or(f64::INFINITY) < 1000.0,
-        "refused promptly: {import}"
-    );
     // The field as the core's validation names it (the cap's error, issue 24).
     assert!(
         import_banner.starts_with("Import of big-name.json failed: ")

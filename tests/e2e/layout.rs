@@ -4,11 +4,12 @@
 
 use std::io::{Read, Write};
 use std::net::TcpStream;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use fantoccini::{Client, Locator};
 use serde_json::{json, Value};
 
+use super::ui::{poll, view_ready};
 use super::{
     connect, console_errors, js, open_hash, runtime, settle, start_server, Driver, MAP_HASH, SERIAL,
 };
@@ -113,27 +114,6 @@ async fn set_viewport(c: &Client, w: u32, h: u32) -> Result<(), String> {
     Err(format!("viewport {w}×{h} asked, {inner} set"))
 }
 
-/// The views' states once the view's worker (if any) has produced something to draw.
-async fn view_ready(c: &Client, mode: &str) -> Result<(), String> {
-    let t0 = Instant::now();
-    loop {
-        let ok = match mode {
-            "mtl" => {
-                let s = js(c, "return window.mtl.state()").await?;
-                s["viewGen"].as_u64().unwrap_or(0) > 0
-            }
-            _ => true,
-        };
-        if ok {
-            return settle(c).await;
-        }
-        if t0.elapsed() > Duration::from_secs(60) {
-            return Err(format!("{mode} view never drew"));
-        }
-        tokio::time::sleep(Duration::from_millis(30)).await;
-    }
-}
-
 /// Clicks the mode button `to` with a real (WebDriver) click and waits for the page to switch.
 async fn click_mode(c: &Client, to: &str) -> Result<Value, String> {
     c.find(Locator::Id(&format!("mode-{to}")))
@@ -142,24 +122,17 @@ async fn click_mode(c: &Client, to: &str) -> Result<Value, String> {
         .click()
         .await
         .map_err(|e| format!("click #mode-{to}: {e}"))?;
-    let t0 = Instant::now();
-    loop {
-        let s = js(
-            c,
-            "return {mode: window.pageState.mode, \
-             pressed: ['snapshot', 'tracking', 'mtl'].filter((m) => \
-               document.getElementById('mode-' + m).getAttribute('aria-pressed') === 'true'), \
-             body: document.body.className}",
-        )
-        .await?;
-        if s["mode"] == to {
-            return Ok(s);
-        }
-        if t0.elapsed() > Duration::from_secs(5) {
-            return Err(format!("#mode-{to} clicked, page state {s}"));
-        }
-        tokio::time::sleep(Duration::from_millis(30)).await;
-    }
+    poll(
+        c,
+        "return {mode: window.pageState.mode, \
+         pressed: ['snapshot', 'tracking', 'mtl'].filter((m) => \
+           document.getElementById('mode-' + m).getAttribute('aria-pressed') === 'true'), \
+         body: document.body.className}",
+        5,
+        &format!("#mode-{to} clicked"),
+        |s| s["mode"] == to,
+    )
+    .await
 }
 
 /// One row of the layout table: viewport, view, measurements, and the state after the click.
@@ -192,7 +165,7 @@ fn layout_at_four_widths_in_three_views() {
                 set_viewport(&c, w, h).await?;
                 for (hash, mode, to) in VIEWS {
                     open_hash(&c, port, hash).await?;
-                    view_ready(&c, mode).await?;
+                    view_ready(&c).await?;
                     let m = js(&c, MEASURE).await?;
                     let after_click = click_mode(&c, to).await?;
                     rows.push(Row {

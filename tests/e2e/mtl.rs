@@ -3,35 +3,11 @@
 //! new true position); prints the page's own recompute times (each view during the drag, and
 //! after new clutter draws); no console errors.
 
-use std::time::{Duration, Instant};
-
 use fantoccini::{Client, Locator};
 use serde_json::{json, Value};
 
+use super::ui::{banner, mtl_state, points, wait_view};
 use super::{console_errors, drag_on_plot, js, open, settle, with_browser};
-
-pub(super) async fn state(c: &Client) -> Result<Value, String> {
-    js(c, "return window.mtl.state()").await
-}
-
-/// Polls `window.mtl.state()` until the worker has answered the newest scene.
-pub(super) async fn wait_view(c: &Client, secs: u64) -> Result<Value, String> {
-    let t0 = Instant::now();
-    loop {
-        let s = state(c).await?;
-        if s["pending"] == false && s["viewGen"].as_u64().unwrap_or(0) > 0 {
-            return Ok(s);
-        }
-        if t0.elapsed() > Duration::from_secs(secs) {
-            return Err(format!("no view in {secs} s; last state {s}"));
-        }
-        tokio::time::sleep(Duration::from_millis(25)).await;
-    }
-}
-
-fn points(v: &Value) -> Vec<[f64; 2]> {
-    serde_json::from_value(v.clone()).unwrap_or_default()
-}
 
 struct Outcome {
     before: Value,
@@ -51,17 +27,6 @@ struct Outcome {
     /// `[mode, body has mode-mtl, #map-ms display, #mtl-section display]` back in snapshot mode.
     back: Value,
     errors: Vec<String>,
-}
-
-/// The error banner's text, if shown.
-pub(super) async fn banner(c: &Client) -> Result<String, String> {
-    let v = js(
-        c,
-        "const e = document.getElementById('error'); \
-         return e.hidden ? '' : document.getElementById('error-text').textContent;",
-    )
-    .await?;
-    Ok(v.as_str().unwrap_or_default().to_string())
 }
 
 /// Drags target T2 by 8 moves of (−12, +9) px, 50 ms apart.
@@ -121,7 +86,7 @@ async fn drag_target(c: &Client, port: u16) -> Result<Outcome, String> {
     }
     // Bad input: a disc covering Tx1, then a negative cσ typed into its input; both rejected
     // with the core's named message in the banner, the scene unchanged.
-    let good = state(c).await?["scene"].clone();
+    let good = mtl_state(c).await?["scene"].clone();
     let mut bad = good.clone();
     bad["discs"][0] = json!([1.1, 1.0]);
     js(c, &format!("return window.mtl.setScene({bad})")).await?;

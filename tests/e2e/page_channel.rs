@@ -14,31 +14,18 @@
 //!   are typed; the progress reports every phase after the estimates (track, figure, the results
 //!   handed over, read and drawn on the page) instead of sitting at 95 % with the last count.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::{Duration, Instant};
 
 use fantoccini::{Client, Locator};
 use serde_json::Value;
 
 use super::channel::cli;
-use super::channel_ui::{keys, state, wait_state};
-use super::mtl::banner;
+use super::ui::{banner, channel_state, keys, temp_dir, wait_channel, RIGHT};
 use super::{console_errors, drag_on_plot, js, open_hash, settle, with_browser};
 
 const TAB: &str = "\u{E004}";
-const RIGHT: &str = "\u{E014}";
 const ENTER: &str = "\u{E007}";
-
-/// A fresh temporary directory of this test (removed at its end).
-fn temp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!(
-        "scatterloc-e2e-page-channel-{name}-{}",
-        std::process::id()
-    ));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
 
 /// `cir simulate` of `scenario` (a file in `dir`) into `dir/out`: `duration` s at `dt` s.
 fn simulate(dir: &Path, scenario: &str, out: &str, duration: &str, dt: &str, seed: &str) -> Value {
@@ -81,7 +68,7 @@ async fn choose(c: &Client, id: &str, path: &Path, key: &str) -> Result<String, 
         .map_err(|e| format!("{id}: {e}"))?;
     let t0 = Instant::now();
     loop {
-        let s = state(c).await?;
+        let s = channel_state(c).await?;
         let named = match &s[key] {
             Value::String(n) => n == &name,
             Value::Object(o) => o.get("name").and_then(Value::as_str) == Some(name.as_str()),
@@ -101,7 +88,7 @@ async fn choose(c: &Client, id: &str, path: &Path, key: &str) -> Result<String, 
 /// Presses Run and waits for run number `n` to be shown.
 async fn run(c: &Client, n: u64) -> Result<Value, String> {
     js(c, "document.getElementById('chan-run').click()").await?;
-    wait_state(c, 600, "run", |s| s["runs"] == n && s["running"].is_null()).await
+    wait_channel(c, 600, "run", |s| s["runs"] == n && s["running"].is_null()).await
 }
 
 /// What the stale checks read after each change.
@@ -129,7 +116,7 @@ async fn figures_faded(c: &Client) -> Result<bool, String> {
 /// Asserts the result is marked stale for `change` (status, map, charts) and returns the state.
 async fn assert_stale(c: &Client, change: &str) -> Result<(), String> {
     settle(c).await?;
-    let s = state(c).await?;
+    let s = channel_state(c).await?;
     let (reasons, status, st, drawn) = stale_of(&s);
     if !reasons.iter().any(|r| r == change)
         || !status.starts_with("stale: ")
@@ -150,7 +137,7 @@ async fn assert_stale(c: &Client, change: &str) -> Result<(), String> {
 /// Asserts the result shown is current (after a Run).
 async fn assert_current(c: &Client) -> Result<(), String> {
     settle(c).await?;
-    let s = state(c).await?;
+    let s = channel_state(c).await?;
     let (reasons, status, st, drawn) = stale_of(&s);
     if !reasons.is_empty() || !status.starts_with("Done in") || st != "done" || drawn != Some(false)
     {
@@ -170,7 +157,7 @@ async fn assert_current(c: &Client) -> Result<(), String> {
 #[test]
 #[ignore = "needs chromium + chromedriver and www/pkg (wasm-pack build); run with --ignored"]
 fn channel_result_goes_stale_on_every_change() {
-    let dir = temp_dir("stale");
+    let dir = temp_dir("page-channel-stale");
     preset(&dir);
     simulate(&dir, "s.json", "a", "2.98", "0.02", "1");
     simulate(&dir, "s.json", "b", "2.98", "0.02", "2");
@@ -216,8 +203,8 @@ fn channel_result_goes_stale_on_every_change() {
         keys(c, "plot", TAB).await?;
         keys(c, "plot", RIGHT).await?;
         settle(c).await?;
-        let moved: Vec<String> =
-            serde_json::from_value(state(c).await?["stale"].clone()).map_err(|e| e.to_string())?;
+        let moved: Vec<String> = serde_json::from_value(channel_state(c).await?["stale"].clone())
+            .map_err(|e| e.to_string())?;
         let node = moved
             .iter()
             .find(|r| r.ends_with(" moved") && (r.starts_with("Tx") || r.starts_with("Rx")))
@@ -243,7 +230,7 @@ fn channel_result_goes_stale_on_every_change() {
         // 4. Another recording opened: the result stays, marked stale.
         choose(c, "chan-file", &dir.join("walk-b.npz"), "recording").await?;
         assert_stale(c, "recording walk-b.npz opened").await?;
-        let s = state(c).await?;
+        let s = channel_state(c).await?;
         assert!(
             s["steps"].as_u64().unwrap_or(0) > 0,
             "the stale result stays shown"
@@ -277,7 +264,7 @@ fn css_rgb(v: &Value) -> Vec<u64> {
 #[test]
 #[ignore = "needs chromium + chromedriver and www/pkg (wasm-pack build); run with --ignored"]
 fn delays_picture_is_readable_and_small() {
-    let dir = temp_dir("delays");
+    let dir = temp_dir("page-channel-delays");
     preset(&dir);
     let sum = simulate(&dir, "s.json", "long", "76.35", "0.05", "1");
     assert_eq!(sum["snapshots"], 1528, "{sum}");
@@ -296,7 +283,7 @@ fn delays_picture_is_readable_and_small() {
         )
         .await?;
         settle(c).await?;
-        let s = state(c).await?;
+        let s = channel_state(c).await?;
         let cursor = js(
             c,
             "const st = window.channel.state(); const cv = document.getElementById('chan-delays-cursor'); \
@@ -476,7 +463,7 @@ fn delays_picture_is_readable_and_small() {
 #[test]
 #[ignore = "needs chromium + chromedriver and www/pkg (wasm-pack build); run with --ignored"]
 fn bad_files_are_named_at_open_and_progress_is_honest() {
-    let dir = temp_dir("open");
+    let dir = temp_dir("page-channel-open");
     preset(&dir);
     // A scenario with a fifth receiver: its recording has link (Tx, Rx5), the page's lacks it.
     let mut five: Value =
@@ -493,10 +480,10 @@ fn bad_files_are_named_at_open_and_progress_is_honest() {
         open_hash(c, port, "#mode=channel").await?;
         settle(c).await?;
         let links = choose(c, "chan-file", &dir.join("five/recording.npz"), "recording").await?;
-        let after_links = state(c).await?;
+        let after_links = channel_state(c).await?;
         choose(c, "chan-file", &dir.join("a/recording.npz"), "recording").await?;
         let truth = choose(c, "chan-truth-file", &dir.join("other/truth.json"), "truth").await?;
-        let after_truth = state(c).await?;
+        let after_truth = channel_state(c).await?;
         // The empty area as a time range; "to" typed, not yet committed.
         js(
             c,

@@ -12,8 +12,8 @@ use fantoccini::wd::TimeoutConfiguration;
 use fantoccini::Client;
 use serde_json::Value;
 
-use super::mtl::wait_view;
-use super::page_theme::{poll, reopen, set_theme};
+use super::page_theme::{reopen, set_theme};
+use super::ui::{poll, wait_view};
 use super::{console_errors, js, settle, with_browser};
 
 const THEMES: [&str; 2] = ["dark", "light"];

@@ -21,62 +21,20 @@ use std::time::{Duration, Instant};
 use fantoccini::{Client, Locator};
 use serde_json::{json, Value};
 
-use super::channel_ui::{click, keys};
-use super::hardening::session;
-use super::mtl::{banner, wait_view};
-use super::plan::open_url;
-use super::state::{select, type_in};
+use super::state::{capture, close, quiet};
+use super::ui::{
+    banner, click, keys, select, type_in, view_ready, wait_channel, wait_tracking, wait_view, END,
+    HOME, RIGHT,
+};
 use super::*;
-
-const HOME: &str = "\u{E011}";
-const END: &str = "\u{E010}";
-const RIGHT: &str = "\u{E014}";
 
 /// The page's views, as their mode buttons `mode-<view>` name them.
 const VIEWS: [&str; 4] = ["snapshot", "tracking", "mtl", "channel"];
-
-/// The page is idle and the undo history has looked at the last change.
-async fn quiet(c: &Client) -> Result<(), String> {
-    settle(c).await?;
-    let t0 = Instant::now();
-    loop {
-        let h = js(c, "return window.pageStateModel.history()").await?;
-        if h["pending"] == false && h["busy"] == false {
-            settle(c).await?;
-            return Ok(());
-        }
-        if t0.elapsed() > Duration::from_secs(60) {
-            return Err(format!("history never settled: {h}"));
-        }
-        tokio::time::sleep(Duration::from_millis(30)).await;
-    }
-}
-
-async fn capture(c: &Client) -> Result<Value, String> {
-    js(c, "return window.pageStateModel.capture()").await
-}
 
 /// `{index, length}` of the undo history.
 async fn history(c: &Client) -> Result<Value, String> {
     let h = js(c, "return window.pageStateModel.history()").await?;
     Ok(json!({"index": h["index"], "length": h["length"]}))
-}
-
-/// Equal, numbers within 1e-12 (relative to their size, at least absolute).
-fn close(a: &Value, b: &Value) -> bool {
-    match (a, b) {
-        (Value::Number(x), Value::Number(y)) => {
-            let (x, y) = (x.as_f64().unwrap(), y.as_f64().unwrap());
-            (x - y).abs() <= 1e-12 * x.abs().max(y.abs()).max(1.0)
-        }
-        (Value::Array(x), Value::Array(y)) => {
-            x.len() == y.len() && x.iter().zip(y).all(|(a, b)| close(a, b))
-        }
-        (Value::Object(x), Value::Object(y)) => {
-            x.len() == y.len() && x.iter().all(|(k, a)| y.get(k).is_some_and(|b| close(a, b)))
-        }
-        _ => a == b,
-    }
 }
 
 /// The first dotted path where `a` and `b` differ (beyond 1e-12), or None.
@@ -101,11 +59,9 @@ fn first_difference(a: &Value, b: &Value, path: &str) -> Option<String> {
     }
 }
 
-/// Waits for the mode's view to be drawn (the multi-target view's worker answers), then quiet.
-async fn view_ready(c: &Client, view: &str) -> Result<(), String> {
-    if view == "mtl" {
-        wait_view(c, 60).await?;
-    }
+/// Waits for the view on screen to be drawn (the multi-target view's worker answers), then quiet.
+async fn view_quiet(c: &Client) -> Result<(), String> {
+    view_ready(c).await?;
     quiet(c).await
 }
 
@@ -174,7 +130,7 @@ async fn set_view_settings(c: &Client, view: &str) -> Result<(), String> {
         }
         _ => return Err(format!("no such view {view}")),
     }
-    view_ready(c, view).await
+    view_quiet(c).await
 }
 
 /// The state sections that hold `view`'s own settings (they must differ from the defaults).
@@ -255,7 +211,7 @@ async fn round_trip(c: &Client, port: u16, view: &str, file: &Path) -> Result<Va
     quiet(c).await?;
     let defaults = capture(c).await?;
     click(c, &format!("mode-{view}")).await?;
-    view_ready(c, view).await?;
+    view_quiet(c).await?;
     set_view_settings(c, view).await?;
     let saved = capture(c).await?;
     let set_banner = banner(c).await?;
@@ -271,7 +227,7 @@ async fn round_trip(c: &Client, port: u16, view: &str, file: &Path) -> Result<Va
     let mut link_view = Value::Null;
     if let Some(url) = copied["url"].as_str().filter(|u| !u.is_empty()) {
         open_url(c, url).await?;
-        view_ready(c, view).await?;
+        view_quiet(c).await?;
         from_link = capture(c).await?;
         link_banner = banner(c).await?;
         link_view = view_shown(c).await?;
@@ -280,7 +236,7 @@ async fn round_trip(c: &Client, port: u16, view: &str, file: &Path) -> Result<Va
     open(c, port).await?;
     quiet(c).await?;
     open_state_file(c, file, &saved).await?;
-    view_ready(c, view).await?;
+    view_quiet(c).await?;
     let from_file = capture(c).await?;
     let file_banner = banner(c).await?;
     let file_view = view_shown(c).await?;
@@ -401,49 +357,6 @@ fn state_round_trip_from_every_view() {
     assert_eq!(f["url"], "", "no link is given: {f}");
 }
 
-/// Polls `window.channel.state()` until `done` holds (at most `secs`).
-async fn wait_channel(
-    c: &Client,
-    secs: u64,
-    what: &str,
-    done: impl Fn(&Value) -> bool,
-) -> Result<Value, String> {
-    let t0 = Instant::now();
-    loop {
-        let s = js(c, "return window.channel.state()").await?;
-        if done(&s) {
-            return Ok(s);
-        }
-        let errors = console_errors(c).await?;
-        if !errors.is_empty() {
-            return Err(format!("{what}: console errors {errors:?}"));
-        }
-        if t0.elapsed() > Duration::from_secs(secs) {
-            return Err(format!("{what}: not after {secs} s; step {}", s["step"]));
-        }
-        tokio::time::sleep(Duration::from_millis(50)).await;
-    }
-}
-
-/// Polls `window.tracking.state()` until `done` holds (at most 120 s).
-async fn wait_tracking(
-    c: &Client,
-    what: &str,
-    done: impl Fn(&Value) -> bool,
-) -> Result<Value, String> {
-    let t0 = Instant::now();
-    loop {
-        let s = js(c, "return window.tracking.state()").await?;
-        if done(&s) {
-            return Ok(s);
-        }
-        if t0.elapsed() > Duration::from_secs(120) {
-            return Err(format!("{what}: not after 120 s; step {}", s["step"]));
-        }
-        tokio::time::sleep(Duration::from_millis(50)).await;
-    }
-}
-
 /// Play, the time cursor and the playback speed are not edits, in the channel and the tracking
 /// views: the history's length and index stay, and Undo still takes back the real edit made
 /// before them, leaving the cursor and the speed as they are.
@@ -462,9 +375,9 @@ fn history_untouched_by_cursor_and_play() {
         let mut t_lengths = Vec::new();
         select(&c, "track-speed", "4").await?;
         click(&c, "track-play").await?;
-        let s0 = wait_tracking(&c, "play", |s| s["playing"] == true).await?;
+        let s0 = wait_tracking(&c, 120, |s| s["playing"] == true).await?;
         let from = s0["step"].as_u64().unwrap_or(0);
-        wait_tracking(&c, "play 20 steps", |s| {
+        wait_tracking(&c, 120, |s| {
             s["step"].as_u64().unwrap_or(0) >= from + 20 || s["playing"] == false
         })
         .await?;

@@ -9,15 +9,14 @@
 //! background is at least 4.5:1. The channel status line's colour against its panel is
 //! computed as well (the issue measured 1.78:1 and 1.69:1 on white).
 
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use fantoccini::wd::TimeoutConfiguration;
 use fantoccini::Client;
 use serde_json::Value;
 
 use super::a11y::{axe_source, axe_violations};
-use super::mtl::wait_view;
-use super::tracking::{mc_done, wait_state};
+use super::ui::{contrast, mc_done, poll, wait_tracking, wait_view};
 use super::{console_errors, js, open_hash, settle, with_browser};
 
 const THEMES: [&str; 2] = ["dark", "light"];
@@ -72,25 +71,6 @@ const STATUS_COLOURS: &str = "\
     return { state: el.dataset.state, text: el.textContent, \
              color: rgb(getComputedStyle(el).color).slice(0, 3), bg: bg || [255, 255, 255] };";
 
-/// sRGB relative luminance (WCAG 2) of 8-bit `[r, g, b]`.
-fn luminance(c: &[f64]) -> f64 {
-    let lin = |v: f64| {
-        let s = v / 255.0;
-        if s <= 0.04045 {
-            s / 12.92
-        } else {
-            ((s + 0.055) / 1.055).powf(2.4)
-        }
-    };
-    0.2126 * lin(c[0]) + 0.7152 * lin(c[1]) + 0.0722 * lin(c[2])
-}
-
-/// WCAG contrast ratio of two colours (`[r, g, b, …]`, 8 bit).
-fn contrast(a: &[f64], b: &[f64]) -> f64 {
-    let (la, lb) = (luminance(a), luminance(b));
-    (la.max(lb) + 0.05) / (la.min(lb) + 0.05)
-}
-
 fn rgb(v: &Value) -> Option<Vec<f64>> {
     let c: Vec<f64> = serde_json::from_value(v.clone()).ok()?;
     (c.len() >= 3).then_some(c)
@@ -116,27 +96,6 @@ pub(super) async fn reopen(c: &Client, port: u16, hash: &str) -> Result<(), Stri
     c.goto("about:blank").await.map_err(|e| e.to_string())?;
     open_hash(c, port, hash).await?;
     settle(c).await
-}
-
-/// Polls `script` (returning a value) until `done` holds, at most `secs` seconds.
-pub(super) async fn poll(
-    c: &Client,
-    script: &str,
-    secs: u64,
-    what: &str,
-    done: impl Fn(&Value) -> bool,
-) -> Result<Value, String> {
-    let t0 = Instant::now();
-    loop {
-        let v = js(c, script).await?;
-        if done(&v) {
-            return Ok(v);
-        }
-        if t0.elapsed() > Duration::from_secs(secs) {
-            return Err(format!("{what}: not after {secs} s; last {v}"));
-        }
-        tokio::time::sleep(Duration::from_millis(50)).await;
-    }
 }
 
 /// Switches the theme (the page's hook, as the toggle does) and waits for the redraw.
@@ -209,7 +168,7 @@ async fn views(c: &Client, port: u16) -> Result<Views, String> {
 
     // Tracking: scenario II at step 45 with the filter's zoom inset, the Monte Carlo done.
     reopen(c, port, "#mode=tracking&track=II&step=45").await?;
-    wait_state(c, 120, mc_done).await?;
+    wait_tracking(c, 120, mc_done).await?;
     settle(c).await?;
     poll(c, inset_box, 20, "tracking inset", has_box).await?;
     both_themes(c, &axe, "tracking + inset", true, false, &mut runs).await?;

@@ -8,6 +8,7 @@
 //! [`RECORDER`]): each `fillText` with its box as drawn (device px), each stroked path of the
 //! chart, and the frames (a fill of the whole canvas starts one).
 
+use super::ui::{contrast, mc_done, points, poll, wait_channel, wait_tracking};
 use super::*;
 use crate::svg::svg_texts;
 
@@ -139,8 +140,9 @@ const EXPECTED_TRACK: &str = "\
     const steps = window.wasm.track_steps(10, dt); \
     const d = window.tracking.state().drawn; \
     const vel = kind === 'custom' ? window.wasm.drag_velocity(d.x0, d.y0, d.x1, d.y1, 10) : [0, 0]; \
-    const t = window.app.simulate_track(kind, d.x0, d.y0, vel[0], vel[1], dt, steps, Number(v('track-seed')), \
-      v('track-filter'), Number(v('track-particles'))); \
+    const t = window.app.simulate_track(JSON.stringify({ \
+      trajectory: { kind, x0_m: d.x0, y0_m: d.y0, vx_mps: vel[0], vy_mps: vel[1] }, dt_s: dt, steps, \
+      seed: Number(v('track-seed')), filter: v('track-filter'), particles: Number(v('track-particles')) })); \
     const data = t.data(); t.free(); \
     return { kind, filter: data.filter, truth: data.truth.map((p) => [p[0], p[1]]), \
       estimates: data.estimates.map((p) => [p[0], p[1]]) };";
@@ -200,10 +202,6 @@ const MAP_PLOT_HASH: &str = "const c = document.getElementById('plot'); \
     const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data; \
     let h = 2166136261; for (let i = 0; i < d.length; i++) { h ^= d[i]; h = Math.imul(h, 16777619) >>> 0; } \
     return h;";
-
-fn points(v: &Value) -> Vec<[f64; 2]> {
-    serde_json::from_value(v.clone()).unwrap_or_default()
-}
 
 /// Issue 38 §2: after each kind of tracking-panel change (scenario, T, filter, seed, particles,
 /// a drawn trajectory), without Play or the slider, the map draws the track the new settings
@@ -379,7 +377,7 @@ fn monte_carlo_chart_status_and_bar_agree() {
         open_hash(c, port, "#mode=tracking&filters=ekf,ukf,pf&runs=50").await?;
         settle(c).await?;
         js(c, RECORDER).await?;
-        super::tracking::wait_state(c, 120, super::tracking::mc_done).await?;
+        wait_tracking(c, 120, mc_done).await?;
         // The long study, asked for as the panel does; read at once.
         let at_start = js(
             c,
@@ -684,7 +682,7 @@ fn monte_carlo_filter_curves_differ_in_line_style() {
             .click()
             .await
             .map_err(|e| e.to_string())?;
-        super::tracking::wait_state(c, 180, super::tracking::mc_done).await?;
+        wait_tracking(c, 180, mc_done).await?;
         let canvas = js(
             c,
             "const f = window.__rec.frames['track-chart']; \
@@ -746,23 +744,6 @@ fn monte_carlo_filter_curves_differ_in_line_style() {
 // ---------------------------------------------------------------------------------------------
 // §10: overlays.
 
-/// WCAG contrast of two sRGB colours.
-fn contrast(a: [f64; 3], b: [f64; 3]) -> f64 {
-    let lum = |c: [f64; 3]| {
-        let f = |v: f64| {
-            let v = v / 255.0;
-            if v <= 0.03928 {
-                v / 12.92
-            } else {
-                ((v + 0.055) / 1.055).powf(2.4)
-            }
-        };
-        0.2126 * f(c[0]) + 0.7152 * f(c[1]) + 0.0722 * f(c[2])
-    };
-    let (x, y) = (lum(a), lum(b));
-    (x.max(y) + 0.05) / (x.min(y) + 0.05)
-}
-
 /// Samples across every link's iso-delay ellipse on the snapshot map: at points of the outline
 /// `{link, line: [rgb across the normal from −8 to +8 px, 1 px apart]}` (device px).
 const ELLIPSE_SAMPLES: &str = "\
@@ -801,7 +782,7 @@ fn ellipse_readability(samples: &Value) -> (usize, usize) {
         let (m0, m1) = (line[0], line[16]);
         let black = [0.0; 3];
         // A smooth map: both sides alike; bright: high contrast with black.
-        if contrast(m0, m1) > 1.15 || contrast(m0, black) < 8.0 {
+        if contrast(&m0, &m1) > 1.15 || contrast(&m0, &black) < 8.0 {
             continue;
         }
         bright += 1;
@@ -809,16 +790,16 @@ fn ellipse_readability(samples: &Value) -> (usize, usize) {
         let line_px = line[6..=10]
             .iter()
             .copied()
-            .max_by(|a, b| contrast(*a, m0).total_cmp(&contrast(*b, m0)))
+            .max_by(|a, b| contrast(a, &m0).total_cmp(&contrast(b, &m0)))
             .unwrap();
-        let own = contrast(line_px, m0);
+        let own = contrast(&line_px, &m0);
         // A casing: the darkest pixel within 3 px of the centre.
         let dark = line[5..=11]
             .iter()
             .copied()
-            .min_by(|a, b| contrast(*a, black).total_cmp(&contrast(*b, black)))
+            .min_by(|a, b| contrast(a, &black).total_cmp(&contrast(b, &black)))
             .unwrap();
-        let cased = contrast(dark, m0) >= 3.0 && contrast(dark, line_px) >= 3.0;
+        let cased = contrast(&dark, &m0) >= 3.0 && contrast(&dark, &line_px) >= 3.0;
         if own >= 3.0 || cased {
             ok += 1;
         }
@@ -899,17 +880,14 @@ fn detection_and_velocity_labels_apart_and_inside() {
         if !msg.is_null() {
             return Err(format!("scene refused: {msg}"));
         }
-        let t0 = Instant::now();
-        loop {
-            let s = js(c, "return window.mtl.state()").await?;
-            if !s["pending"].as_bool().unwrap_or(true) && s["viewGen"] == s["gen"] {
-                break;
-            }
-            if t0.elapsed() > Duration::from_secs(60) {
-                return Err("multi-target view never came".into());
-            }
-            tokio::time::sleep(Duration::from_millis(50)).await;
-        }
+        poll(
+            c,
+            "return window.mtl.state()",
+            60,
+            "multi-target view",
+            |s| !s["pending"].as_bool().unwrap_or(true) && s["viewGen"] == s["gen"],
+        )
+        .await?;
         settle(c).await?;
         js(c, "window.mtl.setMode('mtl')").await?;
         settle(c).await?;
@@ -961,25 +939,6 @@ fn detection_and_velocity_labels_apart_and_inside() {
     assert!(errors.is_empty(), "console errors: {errors:?}");
 }
 
-/// Polls the channel view's state until `done` holds (at most `secs`).
-async fn wait_channel(
-    c: &Client,
-    secs: u64,
-    done: impl Fn(&Value) -> bool,
-) -> Result<Value, String> {
-    let t0 = Instant::now();
-    loop {
-        let s = js(c, "return window.channel.state()").await?;
-        if done(&s) {
-            return Ok(s);
-        }
-        if t0.elapsed() > Duration::from_secs(secs) {
-            return Err(format!("channel: not after {secs} s; state {s}"));
-        }
-        tokio::time::sleep(Duration::from_millis(100)).await;
-    }
-}
-
 /// What a Save entry's label promises of the file it saves: `(name part, SVG title start)` by the
 /// label's noun ("Error chart" of "Error chart (PNG)"); the format comes from the parentheses.
 fn promise(noun: &str) -> Option<(&'static str, &'static str)> {
@@ -1016,7 +975,7 @@ fn save_entries_save_what_they_name() {
             .click()
             .await
             .map_err(|e| e.to_string())?;
-        wait_channel(c, 300, |s| {
+        wait_channel(c, 300, "channel", |s| {
             s["recording"].is_object() && s["running"].is_null()
         })
         .await?;
@@ -1026,7 +985,10 @@ fn save_entries_save_what_they_name() {
             .click()
             .await
             .map_err(|e| e.to_string())?;
-        wait_channel(c, 900, |s| s["runs"] == 1 && s["running"].is_null()).await?;
+        wait_channel(c, 900, "channel", |s| {
+            s["runs"] == 1 && s["running"].is_null()
+        })
+        .await?;
         let options: Vec<(String, String)> = serde_json::from_value(
             js(
                 c,

@@ -5,14 +5,14 @@
 //! Saving the RMSE chart while the study runs gives a figure labelled partial, with the runs done
 //! so far; once done the label is gone.
 
-use fantoccini::{Client, Locator};
+use fantoccini::Client;
 use serde_json::Value;
 
 use scatterloc::study::FAILED_NOTE;
 
 use super::export::{save, Saved};
 use super::svg::svg_texts;
-use super::tracking::{mc_done, state, wait_state};
+use super::ui::{click, mc_done, tracking_state, wait_tracking};
 use super::{console_errors, js, open, settle, with_browser};
 
 /// The most PF failures tolerated in the page's 192 runs: the rate measured natively on seeds
@@ -33,21 +33,18 @@ struct Outcome {
     errors: Vec<String>,
 }
 
-async fn click(c: &Client, id: &str) -> Result<(), String> {
-    let e = c.find(Locator::Id(id)).await.map_err(|e| e.to_string())?;
-    e.click().await.map_err(|e| e.to_string())
-}
-
 async fn run(c: &Client, port: u16) -> Result<Outcome, String> {
     open(c, port).await?;
     js(c, "window.figureExport.setDryRun(true);").await?;
     settle(c).await?;
     click(c, "mode-tracking").await?;
-    wait_state(c, 60, |s| s["kind"] == "I" && mc_done(s)).await?;
-    let gen = state(c).await?["mcGeneration"].as_u64().unwrap_or(0);
+    wait_tracking(c, 60, |s| s["kind"] == "I" && mc_done(s)).await?;
+    let gen = tracking_state(c).await?["mcGeneration"]
+        .as_u64()
+        .unwrap_or(0);
     click(c, "mc-pf").await?;
     let newer = |s: &Value, gen: u64| s["mcGeneration"].as_u64().unwrap_or(0) > gen;
-    let done = wait_state(c, 180, |s| {
+    let done = wait_tracking(c, 180, |s| {
         mc_done(s) && s["mcFilters"] == "ekf,pf" && newer(s, gen)
     })
     .await?;
@@ -61,12 +58,12 @@ async fn run(c: &Client, port: u16) -> Result<Outcome, String> {
     // Re-run: the PF's 192 runs take seconds; save once the first partial result is there.
     let gen = done["mcGeneration"].as_u64().unwrap_or(0);
     click(c, "mc-restart").await?;
-    let running_state = wait_state(c, 60, |s| {
+    let running_state = wait_tracking(c, 60, |s| {
         s["mcState"] == "running" && newer(s, gen) && s["mcDone"].as_u64().unwrap_or(0) > 0
     })
     .await?;
     let running_svg = save(c, "rmse", "svg").await?;
-    wait_state(c, 180, mc_done).await?;
+    wait_tracking(c, 180, mc_done).await?;
     Ok(Outcome {
         result,
         note: note.as_str().unwrap_or_default().to_string(),

@@ -16,7 +16,7 @@ use scatterloc::scenario::Area;
 use scatterloc::{Model, Scenario, Vec2};
 
 use super::svg::embedded_png;
-use super::tracking::{mc_done, wait_state};
+use super::ui::{mc_done, wait_tracking};
 use super::{console_errors, drag_on_plot, js, open, settle, with_browser};
 
 fn f64s(v: &Value) -> Vec<f64> {
@@ -423,7 +423,7 @@ async fn inset_run(c: &Client, port: u16) -> Result<(Vec<(String, Value)>, Vec<S
         .click()
         .await
         .map_err(|e| e.to_string())?;
-    wait_state(c, 120, |s| s["steps"].as_u64().unwrap_or(0) > 0).await?;
+    wait_tracking(c, 120, |s| s["steps"].as_u64().unwrap_or(0) > 0).await?;
     js(c, "window.tracking.pause();").await?;
     let steps = js(c, "return window.tracking.state().steps")
         .await?
@@ -679,7 +679,7 @@ async fn data_run(c: &Client, port: u16) -> Result<Value, String> {
         .click()
         .await
         .map_err(|e| e.to_string())?;
-    wait_state(c, 180, |s| {
+    wait_tracking(c, 180, |s| {
         mc_done(s) && s["steps"].as_u64().unwrap_or(0) > 0
     })
     .await?;

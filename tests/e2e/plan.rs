@@ -6,17 +6,11 @@
 
 use std::time::{Duration, Instant};
 
-use fantoccini::{Client, Locator};
+use fantoccini::Client;
 use serde_json::{json, Value};
 
-use super::hardening::session;
-use super::mtl::banner;
-use super::{console_errors, drag_on_plot, js, open, settle};
-
-async fn click(c: &Client, id: &str) -> Result<(), String> {
-    let e = c.find(Locator::Id(id)).await.map_err(|e| e.to_string())?;
-    e.click().await.map_err(|e| e.to_string())
-}
+use super::ui::{banner, click, poll};
+use super::{console_errors, drag_on_plot, js, open, open_url, session, settle};
 
 async fn plan_state(c: &Client) -> Result<Value, String> {
     js(c, "return window.plan.state()").await
@@ -24,41 +18,12 @@ async fn plan_state(c: &Client) -> Result<Value, String> {
 
 /// Polls `window.plan.state()` until `done(state)`, at most `secs`.
 async fn wait_plan(c: &Client, secs: u64, done: impl Fn(&Value) -> bool) -> Result<Value, String> {
-    let t0 = Instant::now();
-    loop {
-        let s = plan_state(c).await?;
-        if done(&s) {
-            return Ok(s);
-        }
-        if t0.elapsed() > Duration::from_secs(secs) {
-            return Err(format!(
-                "plan: condition not met in {secs} s; last state {s}"
-            ));
-        }
-        tokio::time::sleep(Duration::from_millis(25)).await;
-    }
+    poll(c, "return window.plan.state()", secs, "plan", done).await
 }
 
 /// The plan finished and its final layout is applied (no glide left).
 fn finished(s: &Value) -> bool {
     (s["state"] == "done" || s["state"] == "error") && s["gliding"] == false
-}
-
-/// Opens `url` as a fresh page (through about:blank, so a hash-only change reloads too) and
-/// waits for `data-ready` (or fails on `data-error`).
-pub(super) async fn open_url(c: &Client, url: &str) -> Result<(), String> {
-    c.goto("about:blank").await.map_err(|e| e.to_string())?;
-    c.goto(url).await.map_err(|e| e.to_string())?;
-    let body = c
-        .wait()
-        .at_most(Duration::from_secs(60))
-        .for_element(Locator::Css("body[data-ready='1'], body[data-error]"))
-        .await
-        .map_err(|e| format!("page never became ready: {e}"))?;
-    if let Some(e) = body.attr("data-error").await.map_err(|e| e.to_string())? {
-        return Err(format!("page error: {e}"));
-    }
-    Ok(())
 }
 
 /// `[[x, y], …]` of the scenario object's `receivers` or `transmitters`.

@@ -2,7 +2,7 @@
 //! `SCATTERLOC_SCREENSHOT_HASH`; `mode=channel` simulates, estimates and tracks a walk first), taken through the same browser harness as the end-to-end tests.
 //! Not a test (it asserts nothing): `cargo run --example screenshot` (examples/screenshot.rs).
 
-use super::tracking::{mc_done, wait_state};
+use super::ui::{mc_done, wait_tracking};
 use super::{connect, js, open_hash, runtime, settle, start_server, Driver, SERIAL};
 
 /// Writes docs/screenshot-tracking.png (tracking mode, scenario II at 4.5 s, the particle
@@ -53,11 +53,11 @@ pub(crate) fn tracking_screenshot() {
             )
             .await?;
             if hash.contains("mode=tracking") {
-                let s = wait_state(&c, 60, mc_done).await?;
+                let s = wait_tracking(&c, 60, mc_done).await?;
                 // Once more with the worker warm (the first run includes its start-up).
                 js(&c, "window.tracking.restartMc()").await?;
                 let gen = s["mcGeneration"].as_u64().unwrap_or(0);
-                wait_state(&c, 60, |s| {
+                wait_tracking(&c, 60, |s| {
                     mc_done(s) && s["mcGeneration"].as_u64().unwrap_or(0) > gen
                 })
                 .await?;

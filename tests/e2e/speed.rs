@@ -10,8 +10,7 @@ use serde_json::{json, Value};
 
 use scatterloc::scenario::{presets, Pattern};
 
-use super::hardening::session;
-use super::{console_errors, drag_on_plot, js, open_hash, settle};
+use super::{console_errors, drag_on_plot, js, open_hash, session, settle};
 
 /// sensors2019 with four transmitters (the preset's parabolic Tx at four corners of its
 /// receivers, boresights turned inwards): 16 links.

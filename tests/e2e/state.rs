@@ -8,59 +8,16 @@
 
 use std::time::{Duration, Instant};
 
-use fantoccini::actions::{InputSource, KeyAction, KeyActions};
 use fantoccini::{Client, Locator};
 use serde_json::{json, Value};
 
-use super::hardening::session;
-use super::mtl::{banner, wait_view};
-use super::plan::open_url;
-use super::{console_errors, drag_on_plot, js, open, settle};
+use super::ui::{banner, click, press, select, type_in, wait_view, CONTROL, SHIFT};
+use super::{console_errors, drag_on_plot, js, open, open_url, session, settle};
 
-const ENTER: char = '\u{E007}';
-const CONTROL: char = '\u{E009}';
-const SHIFT: char = '\u{E008}';
 const RIGHT: char = '\u{E014}';
-const NULL_KEY: char = '\u{E000}';
-
-async fn click(c: &Client, id: &str) -> Result<(), String> {
-    let e = c.find(Locator::Id(id)).await.map_err(|e| e.to_string())?;
-    e.click().await.map_err(|e| format!("click {id}: {e}"))
-}
-
-pub(super) async fn select(c: &Client, id: &str, value: &str) -> Result<(), String> {
-    let e = c.find(Locator::Id(id)).await.map_err(|e| e.to_string())?;
-    e.select_by_value(value)
-        .await
-        .map_err(|e| format!("select {id} = {value}: {e}"))
-}
-
-/// Types `text` over the whole content of input `id` (Ctrl+A, the text, Enter).
-pub(super) async fn type_in(c: &Client, id: &str, text: &str) -> Result<(), String> {
-    let e = c.find(Locator::Id(id)).await.map_err(|e| e.to_string())?;
-    e.click().await.map_err(|e| format!("click {id}: {e}"))?;
-    e.send_keys(&format!("{CONTROL}a{NULL_KEY}{text}{ENTER}"))
-        .await
-        .map_err(|e| format!("type into {id}: {e}"))
-}
-
-/// Presses `key` (down, up) with the modifiers `mods` held, on the focused element.
-async fn press(c: &Client, mods: &[char], key: char) -> Result<(), String> {
-    let mut k = KeyActions::new("keyboard".to_string());
-    for &m in mods {
-        k = k.then(KeyAction::Down { value: m });
-    }
-    k = k
-        .then(KeyAction::Down { value: key })
-        .then(KeyAction::Up { value: key });
-    for &m in mods.iter().rev() {
-        k = k.then(KeyAction::Up { value: m });
-    }
-    c.perform_actions(k).await.map_err(|e| e.to_string())
-}
 
 /// The page is idle and the history has looked at the last change.
-async fn quiet(c: &Client) -> Result<(), String> {
+pub(super) async fn quiet(c: &Client) -> Result<(), String> {
     settle(c).await?;
     let t0 = Instant::now();
     loop {
@@ -77,7 +34,7 @@ async fn quiet(c: &Client) -> Result<(), String> {
     }
 }
 
-async fn capture(c: &Client) -> Result<Value, String> {
+pub(super) async fn capture(c: &Client) -> Result<Value, String> {
     js(c, "return window.pageStateModel.capture()").await
 }
 
@@ -164,7 +121,7 @@ fn at_path<'a>(v: &'a Value, path: &str) -> &'a Value {
 }
 
 /// Equal, numbers within 1e-12 (relative to their size, at least absolute).
-fn close(a: &Value, b: &Value) -> bool {
+pub(super) fn close(a: &Value, b: &Value) -> bool {
     match (a, b) {
         (Value::Number(x), Value::Number(y)) => {
             let (x, y) = (x.as_f64().unwrap(), y.as_f64().unwrap());
@@ -359,8 +316,8 @@ async fn set_everything(c: &Client) -> Result<(), String> {
     type_in(c, "mtl-plos", "0.85").await?;
     for id in ["mtl-te", "mtl-tb"] {
         js(c, &format!("document.getElementById('{id}').focus()")).await?;
-        press(c, &[], RIGHT).await?;
-        press(c, &[], RIGHT).await?;
+        press(c, &[], &[RIGHT]).await?;
+        press(c, &[], &[RIGHT]).await?;
     }
     click(c, "mtl-add-target").await?;
     click(c, "mtl-remove-disc").await?;
@@ -579,14 +536,14 @@ fn undo_and_redo_restore_every_kind_of_edit() {
             match how {
                 "keys" => {
                     js(c, "document.getElementById('plot').focus()").await?;
-                    press(c, &[CONTROL], 'z').await?;
+                    press(c, &[CONTROL], &['z']).await?;
                 }
                 _ => click(c, "undo").await?,
             }
             quiet(c).await?;
             let undone = doc(c).await?;
             match how {
-                "keys" => press(c, &[SHIFT, CONTROL], 'z').await?,
+                "keys" => press(c, &[SHIFT, CONTROL], &['z']).await?,
                 _ => click(c, "redo").await?,
             }
             quiet(c).await?;
@@ -632,12 +589,12 @@ fn undo_and_redo_restore_every_kind_of_edit() {
         // A keyboard move (Shift+Right: 1 m).
         let (b, i) = (doc(&c).await?, history_index(&c).await?);
         js(&c, "document.getElementById('plot').focus()").await?;
-        press(&c, &[SHIFT], RIGHT).await?;
+        press(&c, &[SHIFT], &[RIGHT]).await?;
         record(&c, &mut steps, "keyboard move", b, i, "keys").await?;
         // Ctrl+Z in a text field is the field's own: the page's state stays.
         let (b, i) = (doc(&c).await?, history_index(&c).await?);
         click(&c, "rx-gain").await?;
-        press(&c, &[CONTROL], 'z').await?;
+        press(&c, &[CONTROL], &['z']).await?;
         quiet(&c).await?;
         let in_field = json!([history_index(&c).await? == i, doc(&c).await? == b]);
         // A panel edit.

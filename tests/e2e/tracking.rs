@@ -3,7 +3,7 @@
 //! while it runs cancels and restarts it (no console errors); the browser's result equals the
 //! native core's for the page's final scenario.
 
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use fantoccini::{Client, Locator};
 use serde_json::Value;
@@ -15,39 +15,8 @@ use scatterloc::track::{paper_initial_covariance, PAPER_INTENSITY};
 use scatterloc::track::{run_sequential, MonteCarloConfig};
 use scatterloc::{Model, Scenario};
 
+use super::ui::{click, mc_done, select, tracking_state, wait_tracking};
 use super::{console_errors, drag_on_plot, js, open, settle, with_browser};
-
-pub(super) async fn state(c: &Client) -> Result<Value, String> {
-    js(c, "return window.tracking.state()").await
-}
-
-/// Polls `window.tracking.state()` until `done(state)`, at most `secs` seconds.
-pub(super) async fn wait_state(
-    c: &Client,
-    secs: u64,
-    done: impl Fn(&Value) -> bool,
-) -> Result<Value, String> {
-    let t0 = Instant::now();
-    loop {
-        let s = state(c).await?;
-        if done(&s) {
-            return Ok(s);
-        }
-        if t0.elapsed() > Duration::from_secs(secs) {
-            return Err(format!("timed out waiting; last state {s}"));
-        }
-        tokio::time::sleep(Duration::from_millis(25)).await;
-    }
-}
-
-pub(super) fn mc_done(s: &Value) -> bool {
-    s["mcState"] == "done"
-}
-
-async fn click(c: &Client, id: &str) -> Result<(), String> {
-    let e = c.find(Locator::Id(id)).await.map_err(|e| e.to_string())?;
-    e.click().await.map_err(|e| e.to_string())
-}
 
 /// Pixels of the chart canvas in the EKF curve's blue (0, 114, 178) and the PCRLB curve's
 /// vermillion (213, 94, 0), also where antialiasing blends them with the white background (grid, text
@@ -85,7 +54,9 @@ struct Outcome {
 
 /// Picks `runs` in the Monte Carlo size select and waits for that study to finish.
 async fn set_runs(c: &Client, runs: &str) -> Result<Value, String> {
-    let gen = state(c).await?["mcGeneration"].as_u64().unwrap_or(0);
+    let gen = tracking_state(c).await?["mcGeneration"]
+        .as_u64()
+        .unwrap_or(0);
     let select = c
         .find(Locator::Id("mc-runs"))
         .await
@@ -94,7 +65,7 @@ async fn set_runs(c: &Client, runs: &str) -> Result<Value, String> {
         .select_by_value(runs)
         .await
         .map_err(|e| e.to_string())?;
-    wait_state(c, 60, |s| {
+    wait_tracking(c, 60, |s| {
         mc_done(s) && s["mcGeneration"].as_u64().unwrap_or(0) > gen
     })
     .await
@@ -124,13 +95,13 @@ async fn scenario_ii(c: &Client, port: u16) -> Result<Outcome, String> {
     kind.select_by_value("II")
         .await
         .map_err(|e| e.to_string())?;
-    let first = wait_state(c, 60, |s| s["kind"] == "II" && mc_done(s)).await?;
+    let first = wait_tracking(c, 60, |s| s["kind"] == "II" && mc_done(s)).await?;
     let (blue_px, red_px) = chart_pixels(c).await?;
 
-    let before_play = state(c).await?;
+    let before_play = tracking_state(c).await?;
     click(c, "track-play").await?;
     tokio::time::sleep(Duration::from_millis(1200)).await;
-    let playing = state(c).await?;
+    let playing = tracking_state(c).await?;
     click(c, "track-play").await?;
 
     // A large study (10 000 runs, about 50 times the default's time, some 0.3 s here) so that it
@@ -144,7 +115,7 @@ async fn scenario_ii(c: &Client, port: u16) -> Result<Outcome, String> {
     .await?;
     let rx_moved = drag_rx2(c).await?;
     let gen = running_before_drag["mcGeneration"].as_u64().unwrap_or(0);
-    let after_drag = wait_state(c, 60, |s| {
+    let after_drag = wait_tracking(c, 60, |s| {
         mc_done(s) && s["mcGeneration"].as_u64().unwrap_or(0) > gen
     })
     .await?;
@@ -181,7 +152,7 @@ async fn draw_trajectory(c: &Client) -> Result<Value, String> {
     kind.select_by_value("custom")
         .await
         .map_err(|e| e.to_string())?;
-    let s = wait_state(c, 60, |s| s["kind"] == "custom" && mc_done(s)).await?;
+    let s = wait_tracking(c, 60, |s| s["kind"] == "custom" && mc_done(s)).await?;
     let gen = s["mcGeneration"].as_u64().unwrap_or(0);
     let px = js(
         c,
@@ -194,7 +165,7 @@ async fn draw_trajectory(c: &Client) -> Result<Value, String> {
     let half = |v: f64| (v / 2.0).round();
     let step = (half(p[2]), half(p[3]), 60);
     drag_on_plot(c, [p[0], p[1]], &[step, step]).await?;
-    wait_state(c, 60, |s| {
+    wait_tracking(c, 60, |s| {
         mc_done(s) && s["mcGeneration"].as_u64().unwrap_or(0) > gen
     })
     .await?;
@@ -365,19 +336,14 @@ struct FiltersOutcome {
     errors: Vec<String>,
 }
 
-async fn select(c: &Client, id: &str, value: &str) -> Result<(), String> {
-    let e = c.find(Locator::Id(id)).await.map_err(|e| e.to_string())?;
-    e.select_by_value(value).await.map_err(|e| e.to_string())
-}
-
 async fn three_filters(c: &Client, port: u16) -> Result<FiltersOutcome, String> {
     open(c, port).await?;
     settle(c).await?;
     click(c, "mode-tracking").await?;
     select(c, "track-kind", "II").await?;
-    wait_state(c, 60, |s| s["kind"] == "II" && mc_done(s)).await?;
+    wait_tracking(c, 60, |s| s["kind"] == "II" && mc_done(s)).await?;
     select(c, "track-filter", "pf").await?;
-    let pf_track = wait_state(c, 60, |s| s["filter"] == "pf").await?;
+    let pf_track = wait_tracking(c, 60, |s| s["filter"] == "pf").await?;
     let pf_data = js(
         c,
         "const d = window.tracking.trackData(); \
@@ -385,10 +351,12 @@ async fn three_filters(c: &Client, port: u16) -> Result<FiltersOutcome, String> 
                  entries: d.truth.length, ellipses: d.ellipses.filter((e) => e).length};",
     )
     .await?;
-    let gen = state(c).await?["mcGeneration"].as_u64().unwrap_or(0);
+    let gen = tracking_state(c).await?["mcGeneration"]
+        .as_u64()
+        .unwrap_or(0);
     click(c, "mc-ukf").await?;
     click(c, "mc-pf").await?;
-    let done = wait_state(c, 180, |s| {
+    let done = wait_tracking(c, 180, |s| {
         mc_done(s)
             && s["mcFilters"] == "ekf,ukf,pf"
             && s["mcGeneration"].as_u64().unwrap_or(0) > gen

@@ -10,7 +10,7 @@ use scatterloc::scenario::Area;
 use scatterloc::{scenario::presets, Model};
 
 use super::layout::cdp;
-use super::tracking::{mc_done, wait_state};
+use super::ui::{mc_done, wait_tracking};
 use super::{console_errors, js, open, open_hash, settle, with_browser};
 
 /// The map's values, the window and colour range they were drawn with, and its grid size.
@@ -254,7 +254,7 @@ async fn run(c: &fantoccini::Client, port: u16, dport: u16) -> Result<Outcome, S
 
     // Tracking: the same view and map; the Zoom buttons and the wheel.
     js(c, "document.getElementById('mode-tracking').click()").await?;
-    wait_state(c, 120, |s| {
+    wait_tracking(c, 120, |s| {
         mc_done(s) && s["steps"].as_u64().unwrap_or(0) > 0
     })
     .await?;

@@ -1,5 +1,5 @@
 // The page: loads the wasm core, owns the state, the refresh loop (one redraw per animation frame
-// at most) and the mode switch between the four views (VIEWS): snapshot (map.js, with the Plan
+// at most) and the mode switch between the four views (views.js VIEWS): snapshot (map.js, with the Plan
 // panel of plan.js), tracking (tracking.js), multi-target (mtl.js) and channel (channel.js);
 // reads its options, and a shared scenario, from the URL hash and writes them back for "Copy
 // link" (share.js). All numbers come from the core; JavaScript routes events and draws. Loaded
@@ -8,29 +8,25 @@
 import init, * as wasm from '../pkg/scatterloc.js';
 import { $, clip, decimal, decimalIn, errorText, showError } from './dom.js';
 import { decodeScenario, decodeState, viewLink } from './share.js';
-import { attachState, registerSection } from './state.js';
+import { attachState } from './state.js';
 import { registerHooks } from './hooks.js';
 import { View } from './view.js';
-import { MapView } from './map.js';
-import { Panel } from './panel.js';
+import { MapView, registerMapState } from './map.js';
+import { Panel, registerScenarioState } from './panel.js';
 import { attachPointer, hitNode } from './interact.js';
 import { attachKeyboard } from './keyboard.js';
-import { FILTERS, SEED_RANGE, Tracking } from './tracking.js';
-import { Mtl } from './mtl.js';
-import { Plan } from './plan.js';
+import { FILTERS, SEED_RANGE, Tracking, registerTrackingState } from './tracking.js';
+import { Mtl, registerMtlState } from './mtl.js';
+import { Plan, registerPlanState } from './plan.js';
 import { FigureExport } from './export.js';
-import { Zoomer } from './zoom.js';
+import { Zoomer, registerViewState } from './zoom.js';
 import { setLinkColors } from './draw.js';
-import { CHANNEL_TRANSIENT, Channel, applyChannelSettings, channelSettings, checkChannelState } from './channel.js';
+import { Channel, registerChannelState } from './channel.js';
+import { registerColoursState } from './colour-lock.js';
+import { VIEWS, registerModeState } from './views.js';
 import { homeWithNodes } from './outside.js';
 import { attachHelp } from './help.js';
 import { attachTheme } from './theme.js';
-
-/**
- * The page's views, one list: each has its top-bar button `mode-<view>`, is a value of the URL
- * option `mode` and of the page state's `mode` (state.js), and has its entry in Help's Views.
- */
-const VIEWS = ['snapshot', 'tracking', 'mtl', 'channel'];
 
 /**
  * Every option the page reads from the URL hash (anything else is named in the banner as unknown):
@@ -48,8 +44,8 @@ const KNOWN = ['mode', 'preset', 'res', 'target', 'seed', 'view', 'roi', 'scenar
 KNOWN.push('probe'); // the pinned probe (map.js pinProbe)
 
 /**
- * The URL hash -> {opts, errors}. Every option is parsed strictly with the panel's own ranges
- * (issue 24): a choice must be one of the panel's choices (its <select>'s values: `res`, `runs`,
+ * The URL hash -> {opts, errors}. Every option is parsed strictly with the panel's own ranges:
+ * a choice must be one of the panel's choices (its <select>'s values: `res`, `runs`,
  * `ex`, `dt`, `speed`, `filter`, `particles`), a number a strict decimal (dom.js `decimal`) in
  * the range the panel or the core uses (`step`: the core's track_field_ranges; `seed`, `tseed`:
  * the seed inputs' range; `target`, `custom`: the core's coordinate range, check_point; `view`,
@@ -180,7 +176,7 @@ export async function start() {
     target: null, // { x, y, seed }
     snap: null, // the snapshot of the placed target
     fix: null, // what map.js shows: the snapshot, or the track frame in tracking mode
-    mode: 'snapshot', // or 'tracking', 'mtl'
+    mode: 'snapshot', // one of VIEWS (views.js)
     overlay: null,
     insetTitle: 'target zoom',
     insetAvoid: [],
@@ -364,16 +360,19 @@ export async function start() {
   refresh();
   $('loading').hidden = true; // the first map is drawn
   setMode(opts.mode);
-  // The page state (state.js): saved and opened as a file, carried by the link, undo/redo. The
-  // channel view's settings (not its recordings) and the colour lock are sections of it; a state
-  // file written before they existed still opens (optional). The channel view's cursor and
-  // playback speed are not edits (transient: undo leaves them be), as the tracking view's.
-  registerSection('channel', {
-    get: channelSettings, apply: applyChannelSettings, check: checkChannelState, optional: true,
-    transient: CHANNEL_TRANSIENT,
-  });
-  registerSection('colours', { get: () => map.lock.get(), apply: (v) => map.lock.set(v), optional: true });
-  const pageState = attachState({ app, wasm, st, view, panel, tracking, mtl, plan, zoom, ctx, setMode, views: VIEWS, homeFor: setHomeFor });
+  // The page state (state.js): saved and opened as a file, carried by the link, undo/redo. Each
+  // view registers its own section; they are checked and applied in this order.
+  const homeFor = setHomeFor;
+  registerChannelState();
+  registerColoursState(map.lock);
+  registerScenarioState({ app, wasm, st, plan, ctx, homeFor });
+  registerMapState(ctx); // grid, target
+  registerPlanState(plan, ctx);
+  registerTrackingState(tracking, wasm);
+  registerMtlState(mtl, wasm);
+  registerViewState({ app, wasm, st, view, mtl, plan, tracking, zoom, ctx, homeFor });
+  registerModeState(st, setMode);
+  const pageState = attachState({ app, panel, tracking, plan, ctx });
   if (opts.state) {
     const [key, value] = opts.state;
     try {

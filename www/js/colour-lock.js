@@ -9,6 +9,7 @@
 // setColourRange({locked, min_m, max_m}) (strict; throws a ColourRangeError naming the field).
 
 import { $, decimal, errorText, showError, clearError } from './dom.js';
+import { registerSection } from './state.js';
 
 /** The error of a bad colour range (its `name` is 'ColourRangeError'). */
 export class ColourRangeError extends Error {
@@ -138,4 +139,13 @@ export class ColourLock {
     if (v > s[1]) return '  ·  above the locked colour range (drawn in its highest colour)';
     return '';
   }
+}
+
+/**
+ * Registers the page state's `colours` section: the colour lock's range (optional: a state
+ * without it leaves the lock as it is).
+ * @param {ColourLock} lock - the map's colour lock (map.js `lock`)
+ */
+export function registerColoursState(lock) {
+  registerSection('colours', { get: () => lock.get(), apply: (v) => lock.set(v), optional: true });
 }

@@ -43,8 +43,9 @@ export class DataExport {
     const { app, wasm, st, tracking } = this.ctx;
     if (what === 'map') {
       if (!st.values || !st.mapWindow) throw new Error('no map computed yet');
-      const [x0, x1, y0, y1] = st.mapWindow;
-      return wasm.map_data_text(st.values, x0, x1, y0, y1, st.res, st.res, app.scenario().name, format);
+      return wasm.map_data_text(st.values, JSON.stringify({
+        window: st.mapWindow, nx: st.res, ny: st.res, scenario: app.scenario().name, format,
+      }));
     }
     if (what === 'track') {
       if (!tracking.track) throw new Error('no track simulated yet');

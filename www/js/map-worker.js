@@ -17,7 +17,6 @@ serveLatest((m) => {
     scenario = m.scenario;
   }
   const values = new Float64Array(m.n * m.n);
-  const [x0, x1, y0, y1] = m.window;
-  const kernelMs = app.compute_map_in(x0, x1, y0, y1, m.n, m.n, values);
+  const kernelMs = app.compute_map_in(JSON.stringify({ window: m.window, nx: m.n, ny: m.n }), values);
   return { value: { n: m.n, window: m.window, values, kernelMs }, transfer: [values.buffer] };
 });

@@ -17,6 +17,9 @@ import { JobWorker } from './workers.js';
 import { C, FONT, FONT_B, FULL, clipTo, cross, drawAxes, drawNodes, drawScaleBar, ellipsePath, fitText, haloText, linkColor, polyline } from './draw.js';
 import { ColourLock } from './colour-lock.js';
 import { HARD, InsetControls, chooseBox } from './inset.js';
+import { registerSection } from './state.js';
+import { choice, fields, number } from './state-fields.js';
+import { SEED_RANGE } from './tracking.js';
 
 /** Main-thread budget of the map kernel per refresh, ms (about 60 % of a 60 Hz frame). */
 const FRAME_MS = 10;
@@ -102,7 +105,7 @@ export class MapView {
     const { app, st } = this.ctx;
     this.resize(n);
     const [x0, x1, y0, y1] = this.ctx.view.area;
-    const ms = app.compute_map_in(x0, x1, y0, y1, n, n, st.values);
+    const ms = app.compute_map_in(JSON.stringify({ window: [x0, x1, y0, y1], nx: n, ny: n }), st.values);
     st.mapWindow = [x0, x1, y0, y1];
     this.learn(n, links, ms);
     this.paint();
@@ -550,4 +553,43 @@ function makeBarCanvas(rgba) {
   const img = new ImageData(new Uint8ClampedArray(rgba), 1, n);
   c.getContext('2d').putImageData(img, 0, 0);
   return c;
+}
+
+/**
+ * Registers the page state's `grid` (the map's resolution) and `target` (the placed target and
+ * the next target's seed) sections, in that order.
+ * @param {object} ctx - app.js ctx: {wasm, st, changed}
+ */
+export function registerMapState(ctx) {
+  const { wasm, st } = ctx;
+  registerSection('grid', {
+    get: () => ({ res: Number($('resolution').value) }),
+    check: (v) => {
+      fields(v, 'state.grid', ['res']);
+      choice(v.res, 'state.grid.res', 'resolution');
+    },
+    apply: (v) => {
+      $('resolution').value = String(v.res);
+      ctx.changed({ map: true });
+    },
+  });
+
+  registerSection('target', {
+    get: () => ({ point: st.target ? { ...st.target } : null, next_seed: st.nextSeed }),
+    check: (v) => {
+      fields(v, 'state.target', ['point', 'next_seed']);
+      number(v.next_seed, 'state.target.next_seed', SEED_RANGE);
+      if (v.point === null) return;
+      fields(v.point, 'state.target.point', ['x', 'y', 'seed']);
+      number(v.point.x, 'state.target.point.x');
+      number(v.point.y, 'state.target.point.y');
+      wasm.check_point('state.target.point', v.point.x, v.point.y);
+      number(v.point.seed, 'state.target.point.seed', SEED_RANGE);
+    },
+    apply: (v) => {
+      st.target = v.point ? { ...v.point } : null;
+      st.nextSeed = v.next_seed;
+      ctx.changed({ target: true });
+    },
+  });
 }

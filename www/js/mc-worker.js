@@ -13,8 +13,10 @@ import { serveLatest } from './worker-loop.js';
 const SLICE_MS = 40; // work between progress reports and cancellation checks
 
 serveLatest(async (m, { progress, pause }) => {
-  const job = new MonteCarloJob(m.scenario, m.kind, m.x0, m.y0, m.vx, m.vy, m.dt_s, m.steps,
-    m.trajectories, m.noise_runs, m.seed);
+  const job = new MonteCarloJob(m.scenario, JSON.stringify({
+    trajectory: { kind: m.kind, x0_m: m.x0, y0_m: m.y0, vx_mps: m.vx, vy_mps: m.vy },
+    dt_s: m.dt_s, steps: m.steps, trajectories: m.trajectories, noise_runs: m.noise_runs, seed: m.seed,
+  }));
   try {
     if (m.filters) job.set_filters(m.filters, m.particles, m.particle_budget);
     const report = () => ({ done: job.chunks_done(), total: job.chunk_count(), result: job.result_json() });

@@ -11,6 +11,8 @@ import { JobWorker } from './workers.js';
 import { MARGIN, View } from './view.js';
 import { hitRadius, pickNearest } from './interact.js';
 import { drawMtl } from './mtl-draw.js';
+import { registerSection } from './state.js';
+import { fields, inputNumber, isObject, number, rect, shown } from './state-fields.js';
 
 /** Shown around the region, m. */
 export const MARGIN_M = 0.4;
@@ -44,6 +46,9 @@ function fieldValue(id) {
   const { key, name, range } = FIELD[id];
   return decimalIn($(id).value, key === name ? key : `${key} (${name})`, range);
 }
+
+/** The multi-target view's home: the scene's region [x0, x1, y0, y1] and a margin of MARGIN_M. */
+export const mtlHome = ([x0, x1, y0, y1]) => [x0 - MARGIN_M, x1 + MARGIN_M, y0 - MARGIN_M, y1 + MARGIN_M];
 
 export class Mtl {
   /** @param {object} ctx - {wasm, st, changed}. */
@@ -370,10 +375,9 @@ export class Mtl {
 
   /** Redraws the canvas (called by app.js's refresh in this mode). */
   draw() {
-    const [x0, x1, y0, y1] = this.scene.region;
     this.view.resize();
     // The region and a margin; a zoomed window (zoom.js) stays until the region changes.
-    this.view.setHome([x0 - MARGIN_M, x1 + MARGIN_M, y0 - MARGIN_M, y1 + MARGIN_M]);
+    this.view.setHome(mtlHome(this.scene.region));
     this.syncPanel();
     drawMtl(this.view, this.scene, this.result, this.selected, this.wasm);
   }
@@ -438,4 +442,41 @@ export class Mtl {
     const r = this.canvas.getBoundingClientRect();
     return [p.x - r.width / 2, p.y - r.height / 2];
   }
+}
+
+/**
+ * Registers the page state's `mtl` section: the scene (the core's check) and the two detection
+ * probabilities. Its check hands the scene's region to the view section (`pending.region`).
+ * @param {Mtl} mtl - the multi-target view
+ * @param {object} wasm - the core (mtl_check_scene)
+ */
+export function registerMtlState(mtl, wasm) {
+  registerSection('mtl', {
+    get: () => ({
+      scene: structuredClone(mtl.scene),
+      p_u: inputNumber('mtl-pu', Number($('mtl-pu').defaultValue)),
+      p_los: inputNumber('mtl-plos', Number($('mtl-plos').defaultValue)),
+    }),
+    check: (v, pending) => {
+      fields(v, 'state.mtl', ['scene', 'p_u', 'p_los']);
+      if (!isObject(v.scene)) throw new Error(`state.mtl.scene: ${shown(v.scene)} is not a scene object`);
+      try {
+        wasm.mtl_check_scene(JSON.stringify(v.scene));
+      } catch (e) {
+        throw new Error(`state.mtl.scene: ${errorText(e)}`);
+      }
+      number(v.p_u, 'state.mtl.p_u', FIELD['mtl-pu'].range);
+      number(v.p_los, 'state.mtl.p_los', FIELD['mtl-plos'].range);
+      pending.region = rect(v.scene.region, 'state.mtl.scene.region');
+    },
+    apply: (v) => {
+      $('mtl-pu').value = String(v.p_u);
+      $('mtl-plos').value = String(v.p_los);
+      mtl.scene = structuredClone(v.scene);
+      const n = mtl.selected && mtl.scene[mtl.listOf(mtl.selected.kind)];
+      if (!n || mtl.selected.index >= n.length) mtl.selected = null;
+      mtl.syncPanel();
+      mtl.submit();
+    },
+  });
 }

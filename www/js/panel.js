@@ -5,6 +5,9 @@
 import { $, errorText, fillKeyValues, fixed, showError, clearError } from './dom.js';
 import { linkColor } from './draw.js';
 import { readNumber, showNumber } from './numfield.js';
+import { homeWithNodes } from './outside.js';
+import { registerSection } from './state.js';
+import { choice, fields, isObject, shown } from './state-fields.js';
 
 export class Panel {
   /**
@@ -295,4 +298,43 @@ function fillSelect(sel, nodes, index) {
     sel.replaceChildren(...names.map((n, i) => new Option(n, String(i))));
   }
   sel.value = String(index);
+}
+
+/**
+ * Registers the page state's `scenario` section: the preset's name and the scenario JSON (a
+ * link's state carries `json: null`, the link giving the scenario itself). Its check loads the
+ * scenario into a scratch App and hands its area and home to the later sections (`pending`).
+ * @param {object} p - {app, wasm, st, plan, ctx (ctx.changed), homeFor (app.js setHomeFor)}
+ */
+export function registerScenarioState({ app, wasm, st, plan, ctx, homeFor }) {
+  registerSection('scenario', {
+    get: () => ({ preset: $('preset').value, json: JSON.parse(app.scenario_json()) }),
+    check: (v, pending) => {
+      fields(v, 'state.scenario', ['preset', 'json']);
+      choice(v.preset, 'state.scenario.preset', 'preset');
+      if (v.json === null && pending.linkScenario) return; // the link's own scenario option
+      if (!isObject(v.json)) throw new Error(`state.scenario.json: ${shown(v.json)} is not a scenario object`);
+      const scratch = wasm.App.from_preset(wasm.preset_names()[0]);
+      try {
+        scratch.set_scenario_json(JSON.stringify(v.json));
+        pending.area = Array.from(scratch.area());
+        pending.home = homeWithNodes(pending.area, scratch.nodes()).home;
+      } catch (e) {
+        throw new Error(`state.scenario.json: ${errorText(e)}`);
+      } finally {
+        scratch.free();
+      }
+    },
+    apply: (v) => {
+      if (v.json !== null) {
+        plan.cancel('state restored');
+        const text = JSON.stringify(v.json);
+        if (app.scenario_json() !== text) app.set_scenario_json(text);
+        homeFor();
+        st.nodes = app.nodes();
+        ctx.changed({ all: true });
+      }
+      $('preset').value = v.preset;
+    },
+  });
 }

@@ -13,6 +13,8 @@
 import { $, clearError, decimalIn, errorText, fitCanvas, fixed, showError } from './dom.js';
 import { C, FONT } from './draw.js';
 import { JobWorker } from './workers.js';
+import { registerSection } from './state.js';
+import { choice, fields, inputNumber, number, rect } from './state-fields.js';
 
 /** Duration of a node glide to an improved layout, ms. */
 const GLIDE_MS = 200;
@@ -683,4 +685,43 @@ export class Plan {
       kept: !!this.kept,
     };
   }
+}
+
+/**
+ * Registers the page state's `plan` section: the Plan panel's choices and numbers (FIELDS'
+ * ranges) and the region of interest (checked against the new scenario's area, `pending.area`).
+ * @param {Plan} plan - the Plan panel
+ * @param {object} ctx - app.js ctx (ctx.changed)
+ */
+export function registerPlanState(plan, ctx) {
+  const PLAN = [['move', 'plan-move'], ['objective', 'plan-objective'], ['grid', 'plan-grid']];
+  const PLAN_NUM = [['t', 'plan-t'], ['budget', 'plan-budget'], ['seed', 'plan-seed']];
+  registerSection('plan', {
+    get: () => {
+      const o = { roi: plan.roi ? [...plan.roi] : null };
+      for (const [k, id] of PLAN) o[k] = id === 'plan-grid' ? Number($(id).value) : $(id).value;
+      for (const [k, id] of PLAN_NUM) o[k] = inputNumber(id, Number($(id).defaultValue));
+      return o;
+    },
+    check: (v, pending) => {
+      fields(v, 'state.plan', ['roi', ...PLAN.map((x) => x[0]), ...PLAN_NUM.map((x) => x[0])]);
+      for (const [k, id] of PLAN) choice(v[k], `state.plan.${k}`, id);
+      for (const [k, id] of PLAN_NUM) number(v[k], `state.plan.${k}`, FIELDS[id]);
+      if (v.roi !== null) {
+        rect(v.roi, 'state.plan.roi');
+        try {
+          plan.checkRoi(v.roi, pending.area);
+        } catch (e) {
+          throw new Error(`state.plan.roi: ${errorText(e)}`);
+        }
+      }
+    },
+    apply: (v) => {
+      for (const [k, id] of [...PLAN, ...PLAN_NUM]) $(id).value = String(v[k]);
+      for (const [, id] of PLAN_NUM) $(id).classList.remove('invalid');
+      plan.roi = v.roi ? [...v.roi] : null;
+      plan.sync();
+      ctx.changed({ draw: true });
+    },
+  });
 }

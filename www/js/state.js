@@ -18,16 +18,13 @@
 // cursor, a playback speed) are saved and linked but are not edits: the history leaves them out,
 // and an undo keeps them as they are.
 //
-// The views a state may name (its `mode`) are the page's own list (app.js VIEWS, handed to
-// attachState), so a state saved in any view, the channel view included, restores.
+// Each view registers its own section (its `register…State`, called by app.js in the order of
+// restoring: channel, colours, scenario, grid, target, plan, tracking, mtl, view, mode); the
+// checks read values with state-fields.js.
 
-import { homeWithNodes } from './outside.js';
-import { $, clip, decimal, decimalIn, errorText, showError, clearError } from './dom.js';
+import { clip, errorText, showError, clearError, $ } from './dom.js';
 import { MAX_BYTES } from './share.js';
-import { View } from './view.js';
-import { FILTERS, SEED_RANGE } from './tracking.js';
-import { FIELDS as PLAN_FIELDS } from './plan.js';
-import { FIELD as MTL_FIELD, MARGIN_M as MTL_MARGIN_M } from './mtl.js';
+import { isObject, shown } from './state-fields.js';
 
 /** The `format` field of a state file. */
 export const STATE_FORMAT = 'scatterloc-page-state';
@@ -55,76 +52,6 @@ export function registerSection(name, {
   if (sections.some((s) => s.name === name)) throw new Error(`state section ${name}: registered twice`);
   sections.push({ name, get, apply, check, history, optional, transient });
 }
-
-// ---------- strict readers (each throws naming the path) ----------
-
-const isObject = (v) => v !== null && typeof v === 'object' && !Array.isArray(v);
-const shown = (v) => clip(JSON.stringify(v) ?? String(v));
-
-/** `v` must be an object with exactly the fields `keys`. */
-function fields(v, path, keys) {
-  if (!isObject(v)) throw new Error(`${path}: ${shown(v)} is not an object (fields ${keys.join(', ')})`);
-  for (const k of Object.keys(v)) {
-    if (!keys.includes(k)) throw new Error(`${path}.${clip(k)}: unknown field (known: ${keys.join(', ')})`);
-  }
-  for (const k of keys) if (!(k in v)) throw new Error(`${path}.${k}: missing`);
-}
-
-/** A finite number (in `range`, dom.js decimalIn's form, if given). */
-function number(v, path, range = null) {
-  if (typeof v !== 'number' || !Number.isFinite(v)) throw new Error(`${path}: ${shown(v)} is not a finite number`);
-  if (range) decimalIn(String(v), path, range);
-  return v;
-}
-
-function flag(v, path) {
-  if (typeof v !== 'boolean') throw new Error(`${path}: ${shown(v)} is not true or false`);
-  return v;
-}
-
-/** The values of <select> `id`. */
-const optionsOf = (id) => [...$(id).options].map((o) => o.value);
-
-/** One of <select> `id`'s values (a number is compared as written there). */
-function choice(v, path, id) {
-  const values = optionsOf(id);
-  const t = typeof v === 'number' ? String(v) : v;
-  if (typeof t !== 'string' || !values.includes(t)) {
-    throw new Error(`${path}: ${shown(v)} is not one of ${values.map((x) => (x === '' ? '""' : x)).join(', ')}`);
-  }
-  return t;
-}
-
-/** [x0, x1, y0, y1] of finite numbers. */
-function rect(v, path) {
-  if (!Array.isArray(v) || v.length !== 4) throw new Error(`${path}: ${shown(v)} is not [x0, x1, y0, y1]`);
-  v.forEach((x, i) => number(x, `${path}[${i}]`));
-  return v;
-}
-
-/** A window [x0, x1, y0, y1] that a zoom and pan of a view with home `home` could show (View.setWindow). */
-function checkWindow(v, path, home) {
-  rect(v, path);
-  const probe = new View(document.createElement('canvas'));
-  probe.setHome(home);
-  try {
-    probe.setWindow(v);
-  } catch (e) {
-    throw new Error(`${path}: ${errorText(e)}`);
-  }
-}
-
-/** The number in input `id`, or `fallback` where its text is not a valid one (being typed). */
-function inputNumber(id, fallback) {
-  try {
-    return decimal($(id).value, id);
-  } catch (_) {
-    return fallback;
-  }
-}
-
-/** The multi-target view's home: its region and margin (mtl.js draw). */
-const mtlHome = ([x0, x1, y0, y1]) => [x0 - MTL_MARGIN_M, x1 + MTL_MARGIN_M, y0 - MTL_MARGIN_M, y1 + MTL_MARGIN_M];
 
 // ---------- the state object ----------
 
@@ -188,227 +115,23 @@ export function restoreState(obj, { names = null, pending = {} } = {}) {
   }
 }
 
-// ---------- the page's sections ----------
+// ---------- the model ----------
 
 /**
- * Registers the page's sections, the history, the buttons (Undo, Redo, Save state, Open state),
- * the keyboard shortcuts and the confirmation before a scenario switch.
- * @param {object} p - {app, wasm, st, view, panel, tracking, mtl, plan, zoom, changed (ctx.changed's
- *   holder: the ctx object), setMode, views (the page's views, app.js VIEWS: what `mode` may be),
- *   homeFor (app.js setHomeFor: sets the map's home to the area widened to its nodes)}
- * @returns the state model: {capture, restore, linkState, openLink, checkLink, save, undo, redo,
- *   history, dirty}
+ * Starts the history, the buttons (Undo, Redo, Save state, Open state), the keyboard shortcuts
+ * and the confirmation before a scenario switch, over the sections registered so far.
+ * @param {object} p - {app, panel, tracking, plan, ctx (app.js ctx: its `changed` is wrapped so
+ *   that every change is looked at)}
+ * @returns the state model: {openLink, checkLink, linkState, save, undo, redo, dirty, hooks()}
  */
 export function attachState(p) {
-  const { app, wasm, st, view, panel, tracking, mtl, plan, zoom, ctx, setMode, views, homeFor } = p;
-  const changed = (f) => ctx.changed(f);
-
-  registerSection('scenario', {
-    get: () => ({ preset: $('preset').value, json: JSON.parse(app.scenario_json()) }),
-    check: (v, pending) => {
-      fields(v, 'state.scenario', ['preset', 'json']);
-      choice(v.preset, 'state.scenario.preset', 'preset');
-      if (v.json === null && pending.linkScenario) return; // the link's own scenario option
-      if (!isObject(v.json)) throw new Error(`state.scenario.json: ${shown(v.json)} is not a scenario object`);
-      const scratch = wasm.App.from_preset(wasm.preset_names()[0]);
-      try {
-        scratch.set_scenario_json(JSON.stringify(v.json));
-        pending.area = Array.from(scratch.area());
-        pending.home = homeWithNodes(pending.area, scratch.nodes()).home;
-      } catch (e) {
-        throw new Error(`state.scenario.json: ${errorText(e)}`);
-      } finally {
-        scratch.free();
-      }
-    },
-    apply: (v) => {
-      if (v.json !== null) {
-        plan.cancel('state restored');
-        const text = JSON.stringify(v.json);
-        if (app.scenario_json() !== text) app.set_scenario_json(text);
-        homeFor();
-        st.nodes = app.nodes();
-        changed({ all: true });
-      }
-      $('preset').value = v.preset;
-    },
-  });
-
-  registerSection('grid', {
-    get: () => ({ res: Number($('resolution').value) }),
-    check: (v) => {
-      fields(v, 'state.grid', ['res']);
-      choice(v.res, 'state.grid.res', 'resolution');
-    },
-    apply: (v) => {
-      $('resolution').value = String(v.res);
-      changed({ map: true });
-    },
-  });
-
-  registerSection('target', {
-    get: () => ({ point: st.target ? { ...st.target } : null, next_seed: st.nextSeed }),
-    check: (v) => {
-      fields(v, 'state.target', ['point', 'next_seed']);
-      number(v.next_seed, 'state.target.next_seed', SEED_RANGE);
-      if (v.point === null) return;
-      fields(v.point, 'state.target.point', ['x', 'y', 'seed']);
-      number(v.point.x, 'state.target.point.x');
-      number(v.point.y, 'state.target.point.y');
-      wasm.check_point('state.target.point', v.point.x, v.point.y);
-      number(v.point.seed, 'state.target.point.seed', SEED_RANGE);
-    },
-    apply: (v) => {
-      st.target = v.point ? { ...v.point } : null;
-      st.nextSeed = v.next_seed;
-      changed({ target: true });
-    },
-  });
-
-  const PLAN = [['move', 'plan-move'], ['objective', 'plan-objective'], ['grid', 'plan-grid']];
-  const PLAN_NUM = [['t', 'plan-t'], ['budget', 'plan-budget'], ['seed', 'plan-seed']];
-  registerSection('plan', {
-    get: () => {
-      const o = { roi: plan.roi ? [...plan.roi] : null };
-      for (const [k, id] of PLAN) o[k] = id === 'plan-grid' ? Number($(id).value) : $(id).value;
-      for (const [k, id] of PLAN_NUM) o[k] = inputNumber(id, Number($(id).defaultValue));
-      return o;
-    },
-    check: (v, pending) => {
-      fields(v, 'state.plan', ['roi', ...PLAN.map((x) => x[0]), ...PLAN_NUM.map((x) => x[0])]);
-      for (const [k, id] of PLAN) choice(v[k], `state.plan.${k}`, id);
-      for (const [k, id] of PLAN_NUM) number(v[k], `state.plan.${k}`, PLAN_FIELDS[id]);
-      if (v.roi !== null) {
-        rect(v.roi, 'state.plan.roi');
-        try {
-          plan.checkRoi(v.roi, pending.area);
-        } catch (e) {
-          throw new Error(`state.plan.roi: ${errorText(e)}`);
-        }
-      }
-    },
-    apply: (v) => {
-      for (const [k, id] of [...PLAN, ...PLAN_NUM]) $(id).value = String(v[k]);
-      for (const [, id] of PLAN_NUM) $(id).classList.remove('invalid');
-      plan.roi = v.roi ? [...v.roi] : null;
-      plan.sync();
-      changed({ draw: true });
-    },
-  });
-
-  const TRACK = [['dt', 'track-dt'], ['ex', 'track-ex'], ['filter', 'track-filter'], ['particles', 'track-particles'],
-    ['runs', 'mc-runs'], ['speed', 'track-speed']];
-  const stepRange = JSON.parse(wasm.track_field_ranges()).step;
-  registerSection('tracking', {
-    transient: ['speed'], // the playback speed, like the step (the view section's): not an edit
-    get: () => {
-      const o = { kind: tracking.kind, drawn: { ...tracking.drawn } };
-      for (const [k, id] of TRACK) o[k] = k === 'filter' ? $(id).value : Number($(id).value);
-      o.seed = inputNumber('track-seed', tracking.p ? tracking.p.seed : 1);
-      o.mc_filters = FILTERS.filter((f) => $(`mc-${f}`).checked);
-      return o;
-    },
-    check: (v) => {
-      fields(v, 'state.tracking', ['kind', 'drawn', ...TRACK.map((x) => x[0]), 'seed', 'mc_filters']);
-      choice(v.kind, 'state.tracking.kind', 'track-kind');
-      fields(v.drawn, 'state.tracking.drawn', ['x0', 'y0', 'x1', 'y1']);
-      for (const c of ['x0', 'y0', 'x1', 'y1']) number(v.drawn[c], `state.tracking.drawn.${c}`);
-      wasm.check_point('state.tracking.drawn.start', v.drawn.x0, v.drawn.y0);
-      wasm.check_point('state.tracking.drawn.end', v.drawn.x1, v.drawn.y1);
-      for (const [k, id] of TRACK) choice(v[k], `state.tracking.${k}`, id);
-      number(v.seed, 'state.tracking.seed', SEED_RANGE);
-      const f = v.mc_filters;
-      if (!Array.isArray(f) || f.some((x) => !FILTERS.includes(x)) || new Set(f).size !== f.length) {
-        throw new Error(`state.tracking.mc_filters: ${shown(f)} is not a list of distinct filters of ${FILTERS.join(', ')}`);
-      }
-    },
-    apply: (v) => {
-      for (const [k, id] of TRACK) $(id).value = String(v[k]);
-      $('track-kind').value = v.kind;
-      $('track-seed').value = String(v.seed);
-      for (const f of FILTERS) $(`mc-${f}`).checked = v.mc_filters.includes(f);
-      tracking.kind = v.kind;
-      tracking.drawn = { ...v.drawn };
-      tracking.rerun(); // (only in the tracking view)
-      tracking.redraw();
-    },
-  });
-
-  registerSection('mtl', {
-    get: () => ({
-      scene: structuredClone(mtl.scene),
-      p_u: inputNumber('mtl-pu', Number($('mtl-pu').defaultValue)),
-      p_los: inputNumber('mtl-plos', Number($('mtl-plos').defaultValue)),
-    }),
-    check: (v, pending) => {
-      fields(v, 'state.mtl', ['scene', 'p_u', 'p_los']);
-      if (!isObject(v.scene)) throw new Error(`state.mtl.scene: ${shown(v.scene)} is not a scene object`);
-      try {
-        wasm.mtl_check_scene(JSON.stringify(v.scene));
-      } catch (e) {
-        throw new Error(`state.mtl.scene: ${errorText(e)}`);
-      }
-      number(v.p_u, 'state.mtl.p_u', MTL_FIELD['mtl-pu'].range);
-      number(v.p_los, 'state.mtl.p_los', MTL_FIELD['mtl-plos'].range);
-      pending.region = rect(v.scene.region, 'state.mtl.scene.region');
-    },
-    apply: (v) => {
-      $('mtl-pu').value = String(v.p_u);
-      $('mtl-plos').value = String(v.p_los);
-      mtl.scene = structuredClone(v.scene);
-      const n = mtl.selected && mtl.scene[mtl.listOf(mtl.selected.kind)];
-      if (!n || mtl.selected.index >= n.length) mtl.selected = null;
-      mtl.syncPanel();
-      mtl.submit();
-    },
-  });
-
-  registerSection('view', {
-    history: false,
-    get: () => ({
-      map: view.zoomed() ? Array.from(view.area) : null,
-      mtl: mtl.view.home && mtl.view.zoomed() ? Array.from(mtl.view.area) : null,
-      plan_open: plan.open,
-      step: tracking.track ? tracking.step : (tracking.startStep ?? 0),
-    }),
-    check: (v, pending) => {
-      fields(v, 'state.view', ['map', 'mtl', 'plan_open', 'step']);
-      const home = pending.home ?? homeWithNodes(Array.from(app.area()), app.nodes()).home;
-      if (v.map !== null) checkWindow(v.map, 'state.view.map', home);
-      if (v.mtl !== null) checkWindow(v.mtl, 'state.view.mtl', mtlHome(pending.region ?? mtl.scene.region));
-      flag(v.plan_open, 'state.view.plan_open');
-      number(v.step, 'state.view.step', { min: stepRange[0], max: stepRange[1], integer: true });
-    },
-    apply: (v) => {
-      homeFor();
-      if (v.map) view.setWindow(v.map); else view.reset();
-      mtl.view.setHome(mtlHome(mtl.scene.region));
-      if (v.mtl) mtl.view.setWindow(v.mtl); else mtl.view.reset();
-      if (plan.open !== v.plan_open) plan.setOpen(v.plan_open);
-      if (tracking.active() && tracking.track) tracking.seek(v.step);
-      else tracking.startStep = v.step;
-      zoom.show();
-      changed(st.mode === 'mtl' ? { mtl: true } : { map: true });
-    },
-  });
-
-  registerSection('mode', {
-    history: false,
-    get: () => st.mode,
-    check: (v) => {
-      if (!views.includes(v)) throw new Error(`state.mode: ${shown(v)} is not one of ${views.join(', ')}`);
-    },
-    apply: (v) => setMode(v),
-  });
-
-  const model = new StateModel(p, changed);
-  return model;
+  return new StateModel(p);
 }
 
 // ---------- history, files, links, the confirm dialog ----------
 
 class StateModel {
-  constructor(p, changed) {
+  constructor(p) {
     this.p = p;
     this.entries = []; // JSON text of the history sections' snapshots
     this.index = -1;

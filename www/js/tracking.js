@@ -7,6 +7,8 @@
 import { $, decimalIn, errorText, fillKeyValues, fixed, showError, clearError } from './dom.js';
 import { MonteCarlo } from './montecarlo.js';
 import { drawTrack } from './track-draw.js';
+import { registerSection } from './state.js';
+import { choice, fields, inputNumber, number, shown } from './state-fields.js';
 
 /** The run's duration, s: the scenarios of spec §9.4 last 10 s (a drawn trajectory too). */
 export const DURATION_S = 10;
@@ -103,8 +105,10 @@ export class Tracking {
     if (!this.active()) return;
     try {
       const p = this.params();
-      const track = this.ctx.app.simulate_track(p.kind, p.x0, p.y0, p.vx, p.vy, p.dt_s, p.steps, p.seed,
-        p.filter, p.particles);
+      const track = this.ctx.app.simulate_track(JSON.stringify({
+        trajectory: { kind: p.kind, x0_m: p.x0, y0_m: p.y0, vx_mps: p.vx, vy_mps: p.vy },
+        dt_s: p.dt_s, steps: p.steps, seed: p.seed, filter: p.filter, particles: p.particles,
+      }));
       if (this.track) this.track.free();
       this.track = track;
       this.p = p;
@@ -279,4 +283,50 @@ export class Tracking {
       layer: this.layer || null,
     };
   }
+}
+
+/**
+ * Registers the page state's `tracking` section: the trajectory (kind, the drawn one), the
+ * panel's choices, the seed and the Monte Carlo's filters. The playback speed is transient
+ * (like the step, the view section's): saved and linked, not an edit.
+ * @param {Tracking} tracking - the tracking view
+ * @param {object} wasm - the core (check_point, track_field_ranges)
+ */
+export function registerTrackingState(tracking, wasm) {
+  const TRACK = [['dt', 'track-dt'], ['ex', 'track-ex'], ['filter', 'track-filter'], ['particles', 'track-particles'],
+    ['runs', 'mc-runs'], ['speed', 'track-speed']];
+  registerSection('tracking', {
+    transient: ['speed'],
+    get: () => {
+      const o = { kind: tracking.kind, drawn: { ...tracking.drawn } };
+      for (const [k, id] of TRACK) o[k] = k === 'filter' ? $(id).value : Number($(id).value);
+      o.seed = inputNumber('track-seed', tracking.p ? tracking.p.seed : 1);
+      o.mc_filters = FILTERS.filter((f) => $(`mc-${f}`).checked);
+      return o;
+    },
+    check: (v) => {
+      fields(v, 'state.tracking', ['kind', 'drawn', ...TRACK.map((x) => x[0]), 'seed', 'mc_filters']);
+      choice(v.kind, 'state.tracking.kind', 'track-kind');
+      fields(v.drawn, 'state.tracking.drawn', ['x0', 'y0', 'x1', 'y1']);
+      for (const c of ['x0', 'y0', 'x1', 'y1']) number(v.drawn[c], `state.tracking.drawn.${c}`);
+      wasm.check_point('state.tracking.drawn.start', v.drawn.x0, v.drawn.y0);
+      wasm.check_point('state.tracking.drawn.end', v.drawn.x1, v.drawn.y1);
+      for (const [k, id] of TRACK) choice(v[k], `state.tracking.${k}`, id);
+      number(v.seed, 'state.tracking.seed', SEED_RANGE);
+      const f = v.mc_filters;
+      if (!Array.isArray(f) || f.some((x) => !FILTERS.includes(x)) || new Set(f).size !== f.length) {
+        throw new Error(`state.tracking.mc_filters: ${shown(f)} is not a list of distinct filters of ${FILTERS.join(', ')}`);
+      }
+    },
+    apply: (v) => {
+      for (const [k, id] of TRACK) $(id).value = String(v[k]);
+      $('track-kind').value = v.kind;
+      $('track-seed').value = String(v.seed);
+      for (const f of FILTERS) $(`mc-${f}`).checked = v.mc_filters.includes(f);
+      tracking.kind = v.kind;
+      tracking.drawn = { ...v.drawn };
+      tracking.rerun(); // (only in the tracking view)
+      tracking.redraw();
+    },
+  });
 }

@@ -1,4 +1,4 @@
-// Zoom and pan of the plot in the three views (issue 16 §3). The window lives in the view on
+// Zoom and pan of the plot in the three views. The window lives in the view on
 // screen (view.js: zoomAt, panBy, reset); this file routes the gestures to it:
 //   wheel (and a trackpad pinch, which Chromium sends as ctrl+wheel)   zoom about the cursor
 //   two fingers on the plot    pinch zoom about their midpoint, panning with it
@@ -12,6 +12,10 @@
 // drawn from the window and the new map. The multi-target view redraws its region.
 
 import { $ } from './dom.js';
+import { homeWithNodes } from './outside.js';
+import { mtlHome } from './mtl.js';
+import { registerSection } from './state.js';
+import { checkWindow, fields, flag, number } from './state-fields.js';
 
 /** Wheel travel (CSS px) that zooms by a factor of 2 (a mouse notch is about 100 px: ×1.26). */
 const WHEEL_PX_PER_DOUBLING = 300;
@@ -171,4 +175,44 @@ export class Zoomer {
       ticks: view.drawn.ticks, scaleBar: view.drawn.scaleBar, level: $('zoom-level').textContent,
     };
   }
+}
+
+/**
+ * Registers the page state's `view` section (not in the undo history): the map's and the
+ * multi-target view's zoomed windows, whether the Plan panel is open and the tracking step.
+ * The windows are checked against the homes of the scenario and scene being restored
+ * (`pending.home`, `pending.region`) or, without them, the ones shown.
+ * @param {object} p - {app, wasm, st, view, mtl, plan, tracking, zoom, ctx (ctx.changed),
+ *   homeFor (app.js setHomeFor)}
+ */
+export function registerViewState({ app, wasm, st, view, mtl, plan, tracking, zoom, ctx, homeFor }) {
+  const stepRange = JSON.parse(wasm.track_field_ranges()).step;
+  registerSection('view', {
+    history: false,
+    get: () => ({
+      map: view.zoomed() ? Array.from(view.area) : null,
+      mtl: mtl.view.home && mtl.view.zoomed() ? Array.from(mtl.view.area) : null,
+      plan_open: plan.open,
+      step: tracking.track ? tracking.step : (tracking.startStep ?? 0),
+    }),
+    check: (v, pending) => {
+      fields(v, 'state.view', ['map', 'mtl', 'plan_open', 'step']);
+      const home = pending.home ?? homeWithNodes(Array.from(app.area()), app.nodes()).home;
+      if (v.map !== null) checkWindow(v.map, 'state.view.map', home);
+      if (v.mtl !== null) checkWindow(v.mtl, 'state.view.mtl', mtlHome(pending.region ?? mtl.scene.region));
+      flag(v.plan_open, 'state.view.plan_open');
+      number(v.step, 'state.view.step', { min: stepRange[0], max: stepRange[1], integer: true });
+    },
+    apply: (v) => {
+      homeFor();
+      if (v.map) view.setWindow(v.map); else view.reset();
+      mtl.view.setHome(mtlHome(mtl.scene.region));
+      if (v.mtl) mtl.view.setWindow(v.mtl); else mtl.view.reset();
+      if (plan.open !== v.plan_open) plan.setOpen(v.plan_open);
+      if (tracking.active() && tracking.track) tracking.seek(v.step);
+      else tracking.startStep = v.step;
+      zoom.show();
+      ctx.changed(st.mode === 'mtl' ? { mtl: true } : { map: true });
+    },
+  });
 }
