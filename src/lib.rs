@@ -16,17 +16,23 @@
 //!   ellipses and seeded noise draws (E2).
 //! - [`localize`]: the snapshot CRLB and its map kernel (E8, S18–S24) and the weighted
 //!   Levenberg–Marquardt fix (E5–E6).
-//! - [`track`]: the motion model (E7), the EKF (§6), the posterior CRLB (E9), trajectories and
-//!   the Monte Carlo study (§8, §9.5).
+//! - [`channel`]: the channel front end's signal processing (`channel-estimation.md` C1–C10):
+//!   recordings, the background and its alignment, the bounded snapshot estimator (C5), the path
+//!   tracker (C6), the FFTs and the signal-level simulator.
+//! - [`track`]: the motion model (E7), the EKF (§6), UKF and particle filter behind one
+//!   [`track::Filter`] seam, the posterior CRLB (E9), trajectories and the Monte Carlo chunks
+//!   (§8, §9.5).
 //! - [`track::gating`], a stage of tracking: calibration, 3σ gating (E4), association (§4), the
-//!   gated tracker and the §9.6 stand-in.
+//!   gated tracker of any filter, C11's segments (start, loss, restart) and the §9.6 stand-in.
 //! - [`formats`]: one serde type per file the tracker reads or writes (measurements with
 //!   `steps` or `raw_steps`, calibration snapshots, calibration result, truth), with checks.
 //! - [`mtl`]: multi-target localization under correlated blocking (`multi-target.md`).
 //! - [`plan`]: network planning — move nodes to minimise a CRLB objective over a region
 //!   (CMA-ES with restarts, constraints).
 //! - [`study`]: the use cases every front end shares — the Monte Carlo study over any list of
-//!   filters, its part files and their merge, run through a [`study::Driver`].
+//!   filters, its part files and their merge, tracking from a measurement file, the channel
+//!   chain from a recording to a track (`study::ChannelRequest`, `estimate_recording`,
+//!   `cir_track`), run through a [`study::Driver`].
 //! - [`present`]: view models shared by the page and the figures: ticks, colour map, snapshot and
 //!   track views, the interactive session.
 //!
@@ -35,8 +41,9 @@
 //!   Monte Carlo studies and multi-target sweeps.
 //! - `chart` (feature `chart`): plotters figures on any drawing backend (SVG/PNG natively, a
 //!   canvas in the page).
-//! - `wasm` (feature `wasm`, wasm32 only; implies `chart`): the page's bindings; they only wrap
-//!   the core.
+//! - `npz` (feature `npz`): the `.npz` channel-recording reader and writer (docs/recording.md).
+//! - `wasm` (feature `wasm`, wasm32 only; implies `chart` and `npz`): the page's bindings; they
+//!   only wrap the core.
 //!
 //! The CLI lives in `src/bin/scatterloc` (feature `cli`, which implies `parallel` and `chart`) and
 //! uses only the public API. `--no-default-features --features parallel` is the core with the

@@ -3,7 +3,8 @@
 //! (`bounds`, spec C12 7), the SIMD CRLB map kernel against its scalar reference (`map_kernel`), the
 //! planner's evidence (`planning`, `filters-and-planning.md` §3) and property tests of the core
 //! (`properties`, proptest; shrunk failures in `library/properties.proptest-regressions`) and the
-//! `.npz` recording format of docs/recording.md (`recording`, feature `npz`).
+//! `.npz` recording format of docs/recording.md (`recording`, feature `npz`) and the house rules of
+//! ARCHITECTURE.md read off the source (`house`: no import circle, the layer table, the line cap).
 #![cfg(not(target_arch = "wasm32"))]
 
 mod common;
@@ -26,3 +27,6 @@ mod properties;
 #[cfg(feature = "npz")]
 #[path = "library/recording.rs"]
 mod recording;
+
+#[path = "library/house.rs"]
+mod house;

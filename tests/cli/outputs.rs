@@ -437,9 +437,10 @@ fn a_full_disk_leaves_nothing() {
 
 /// Issue: a 100 MB node or scenario name made `crlb-map --out m.png` and `plan --figure` run for
 /// minutes. Names are capped at 256 bytes (`limits::MAX_NAME_BYTES`) in the core's scenario
-/// validation: a named error, fast.
+/// validation: a named error before any work (the cap's message is the proof; how long it took is
+/// not asserted: tests do not time the wall clock, issue 39).
 #[test]
-fn long_names_are_a_named_error_fast() {
+fn long_names_are_a_named_error_before_any_work() {
     let dir = TempDir::new();
     let mut s: Value = serde_json::from_str(&presets::sensors2019().to_json()).unwrap();
     s["transmitters"][0]["name"] = Value::String("T".repeat(10 << 20));
@@ -448,7 +449,6 @@ fn long_names_are_a_named_error_fast() {
     s["name"] = Value::String("S".repeat(100 << 20));
     let big = dir.write("name.json", &s);
     let png = dir.path("m.png");
-    let t = Instant::now();
     fails(
         &["crlb-map", "--scenario", &node, "--out", &png],
         &["transmitters[0].name", "10485760 bytes long, at most 256"],
@@ -462,7 +462,6 @@ fn long_names_are_a_named_error_fast() {
         .concat(),
         &["name: 104857600 bytes long, at most 256"],
     );
-    assert!(t.elapsed() < Duration::from_secs(60), "{:?}", t.elapsed());
     assert_eq!(
         new_files(&dir, &["node.json", "name.json"]),
         Vec::<String>::new()

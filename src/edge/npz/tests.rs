@@ -1,5 +1,4 @@
 use std::io::{Cursor, Write};
-use std::time::Instant;
 
 use super::*;
 use crate::channel::{Layout, Pulse, Recording};
@@ -306,28 +305,25 @@ fn set_declared_size(z: &mut [u8], size: u32) {
 }
 
 #[test]
-fn zip_bombs_are_refused_quickly() {
+fn zip_bombs_are_refused_before_inflating() {
     // A member declaring 4·10⁹ bytes (over MAX_RECORDING_BYTES = 1.06·10⁹; the largest a zip
     // without zip64 can declare) is refused before inflating.
     let mut z = zip_of(&[("cfr.npy", vec![0u8; 1000])], true);
     set_declared_size(&mut z, 4_000_000_000);
-    let t = Instant::now();
     let got = err(&z);
     assert!(got.starts_with("cfr: 4000000000 is"), "{got}");
-    let mut elapsed = t.elapsed();
     // A member declaring 1000 bytes that inflates to 200 MB (200 kB compressed) is refused after
     // reading 1001 bytes of it.
     let mut z = zip_of(&[("cir.npy", vec![0u8; 200 << 20])], true);
     assert!(z.len() < 400_000, "{}", z.len());
     set_declared_size(&mut z, 1000);
-    let t = Instant::now();
     let got = err(&z);
-    elapsed += t.elapsed();
     assert!(
         got.starts_with("cir: the member inflates to more than its declared 1000 bytes"),
         "{got}"
     );
-    assert!(elapsed.as_secs_f64() < 0.5, "{elapsed:?}");
+    // That message is only reached through `take(declared + 1)` (read.rs `members`): at most
+    // 1001 bytes were inflated. No wall-clock bound (issue 39: tests do not time the clock).
 }
 
 #[test]
