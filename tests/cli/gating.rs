@@ -197,6 +197,30 @@ fn gating_commands_name_their_bad_input() {
         ],
         &["--gap-s", "must be > 0"],
     );
+    // simulate-walk: the duration and the steps in the words of `montecarlo` and `track` (the
+    // generator moved into the core in issue 39; these messages stayed).
+    let out = dir.path("walk");
+    let walk = |extra: &[&str]| -> Vec<String> {
+        let mut a: Vec<String> = ["simulate-walk", "--scenario", s, "--out-dir", &out]
+            .iter()
+            .map(|x| x.to_string())
+            .collect();
+        a.extend(extra.iter().map(|x| x.to_string()));
+        a
+    };
+    let args = walk(&["--duration", "0"]);
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    fails(&args, &["--duration: must be > 0 s (got 0)"]);
+    let args = walk(&["--duration", "1e9", "--dt", "0.1"]);
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    fails(
+        &args,
+        &["--duration / --dt: 1000000000 s at 0.1 s is 10000000000 steps, outside 1..="],
+    );
+    let args = walk(&["--dt", "-1"]);
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    fails(&args, &["--dt"]);
+    assert!(!std::path::Path::new(&out).exists(), "no directory made");
     // track: both forms, unknown rule, calibration of the wrong size or with a bad sigma.
     let base = json!({
         "dt_s": 0.1, "process_noise": 0.1, "initial_state": [12.0, 6.0, 0.0, 1.4],

@@ -8,12 +8,13 @@ use std::path::Path;
 
 use scatterloc::formats::{CalibrationResult, CalibrationSnapshots, Measurements, Truth};
 use scatterloc::track::gating::{Calibration, ClusterConfig, WalkRequest, WalkSimulation};
+use scatterloc::track::ConstantVelocity;
 use scatterloc::Model;
 
 use super::flags::{at_flag, in_file};
 use super::io::{emit_json, model_of, one_stdin, read_json_file, read_scenario};
 use super::output::{check_writable, write_json_file, Format, OutputSet};
-use super::study::flag_error;
+use super::study::{checked_steps, flag_error};
 use crate::cli::{CalibrateArgs, SimulateWalkArgs, WalkStart};
 use crate::failure::CliError;
 
@@ -130,7 +131,11 @@ pub fn simulate_walk(args: &SimulateWalkArgs) -> Result<(), CliError> {
             .map_or(d.start_from_truth, |s| s == WalkStart::Truth),
     };
     let bandwidth_hz = scenario.radio.bandwidth_hz;
-    // Checked before the directory is made; drawn after.
+    // Checked before the directory is made; drawn after. The duration and step count first in
+    // the words `montecarlo` and `track` use for them (seconds, and the duration and dt that
+    // gave the steps); the core checks them again with everything else.
+    ConstantVelocity::validated(req.dt_s, req.process_noise).map_err(flag_error)?;
+    checked_steps(req.duration_s, req.dt_s)?;
     req.check(&model, bandwidth_hz).map_err(flag_error)?;
     let created = prepare_out_dir(dir)?;
     let written = req
