@@ -9,7 +9,8 @@ use scatterloc::native::{run_pcrlb_parallel, Parallel};
 use scatterloc::study::{check_cost, CurveDoc, McMeta, MonteCarloStudy, RunTime, TrackStudy};
 use scatterloc::track::{
     nominal_pcrlb_rmse, paper_initial_covariance, step_count, ConstantVelocity, TrackScenario,
-    MAX_STEPS, PAPER_DURATION_S, PAPER_INTENSITY, PAPER_STEP_S,
+    DEFAULT_STUDY_SEED, MAX_STEPS, PAPER_DURATION_S, PAPER_INTENSITY, PAPER_NOISE_RUNS, PAPER_RUNS,
+    PAPER_STEP_S,
 };
 use scatterloc::Error;
 
@@ -23,6 +24,7 @@ use crate::tracking::{cpu_cap, settings};
 // signatures show them); they are the CLI's, the paper's study ([S] Fig. 3):
 const _: () = assert!(PAPER_STEP_S == 2.048e-3 && PAPER_DURATION_S == 10.0);
 const _: () = assert!(PAPER_INTENSITY == 0.01);
+const _: () = assert!(PAPER_RUNS == 5000 && PAPER_NOISE_RUNS == 50 && DEFAULT_STUDY_SEED == 1);
 
 /// The curves of one trajectory of a study.
 #[pyclass(module = "scatterloc", frozen)]
@@ -435,8 +437,8 @@ pub fn pcrlb(
         }
     }
     let (runs, seed, threads) = (
-        runs.unwrap_or(5000),
-        seed.unwrap_or(1),
+        runs.unwrap_or(PAPER_RUNS),
+        seed.unwrap_or(DEFAULT_STUDY_SEED),
         threads.unwrap_or(0),
     );
     check_threads(threads)?;

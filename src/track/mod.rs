@@ -41,8 +41,8 @@ pub use shared::{check_covariance, MeasurementNoise, PredictedDelay, UpdateSumma
 pub(crate) use shared::{range_information_per_snr, spd_quadratic_form, NodeView};
 pub use track_sim::{simulate_track, TrackRun};
 pub use trajectory::{
-    paper_initial_covariance, step_count, TrackScenario, TruthSampler, PAPER_DURATION_S,
-    PAPER_INTENSITY, PAPER_STEP_S,
+    paper_initial_covariance, step_count, TrackScenario, TruthSampler, DEFAULT_STUDY_SEED,
+    PAPER_DURATION_S, PAPER_INTENSITY, PAPER_NOISE_RUNS, PAPER_RUNS, PAPER_STEP_S,
 };
 pub use ukf::{
     Ukf, UkfParams, ALPHA_RANGE as UKF_ALPHA_RANGE, MAX_PRIOR_VARIANCE as UKF_MAX_PRIOR_VARIANCE,

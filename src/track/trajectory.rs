@@ -14,6 +14,13 @@ pub const PAPER_INTENSITY: Real = 0.01;
 pub const PAPER_DURATION_S: Real = 10.0;
 /// Time step `T_g` of \[S\] Table 1, s.
 pub const PAPER_STEP_S: Real = 2.048e-3;
+/// Trajectories of the paper-scale Monte Carlo study (\[S\] §5.2; spec §8): the default of
+/// `scatterloc montecarlo`/`pcrlb --runs` and Python's `runs`.
+pub const PAPER_RUNS: usize = 5000;
+/// Measurement-noise realisations per trajectory of the paper-scale study (`--noise-runs`).
+pub const PAPER_NOISE_RUNS: usize = 50;
+/// The seed of every study when none is given (the CLI's `--seed`, Python's `seed`).
+pub const DEFAULT_STUDY_SEED: u64 = 1;
 
 /// The three scenarios of \[S\] Fig. 2b on layout L4 (spec §9.4 \[choice\]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -12,7 +12,9 @@ use scatterloc::math::Shard;
 use scatterloc::study::{
     FilterStudy, MonteCarloStudy, PartFile, PartSet, RunTime, ShardDoc, Timing, TrackStudy,
 };
-use scatterloc::track::{nominal_pcrlb_rmse, paper_initial_covariance};
+use scatterloc::track::{
+    nominal_pcrlb_rmse, paper_initial_covariance, DEFAULT_STUDY_SEED, PAPER_NOISE_RUNS, PAPER_RUNS,
+};
 
 use super::filters::filter_kinds;
 use super::parts::PartReader;
@@ -49,14 +51,14 @@ fn chart_options(study: &MonteCarloStudy) -> TrackingChartOptions {
 /// The study of `montecarlo`'s flags, checked (errors name the flags).
 fn study_of(args: &MontecarloArgs) -> Result<MonteCarloStudy, CliError> {
     let track = parse_study(&args.study)?;
-    let runs = args.runs.unwrap_or(5000);
-    let noise_runs = args.noise_runs.unwrap_or(50);
+    let runs = args.runs.unwrap_or(PAPER_RUNS);
+    let noise_runs = args.noise_runs.unwrap_or(PAPER_NOISE_RUNS);
     let names = match &args.filters {
         Some(list) => list.0.clone(),
         None => vec![FilterName::Ekf],
     };
     let kinds = filter_kinds(&names, &args.settings, "--filters")?;
-    let seed = args.seed.unwrap_or(1);
+    let seed = args.seed.unwrap_or(DEFAULT_STUDY_SEED);
     MonteCarloStudy::new(track, runs, noise_runs, seed, args.oracle_noise, &kinds)
         .map_err(flag_error)
 }
@@ -206,8 +208,11 @@ pub fn pcrlb(args: &PcrlbArgs) -> Result<(), CliError> {
             "--{f}: only for the Monte Carlo bound (drop --nominal)"
         )));
     }
-    let runs = args.runs.unwrap_or(5000);
-    let (seed, (threads, _)) = (args.seed.unwrap_or(1), threads(args.threads)?);
+    let runs = args.runs.unwrap_or(PAPER_RUNS);
+    let (seed, (threads, _)) = (
+        args.seed.unwrap_or(DEFAULT_STUDY_SEED),
+        threads(args.threads)?,
+    );
     let configs = study
         .trajectories
         .iter()
