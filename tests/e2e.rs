@@ -113,6 +113,10 @@ pub(crate) mod screenshot;
 #[path = "e2e/pictures.rs"]
 mod pictures;
 
+/// Issue 39: the channel view's defaults and ranges are the core's settings table.
+#[cfg(test)]
+#[path = "e2e/channel_settings.rs"]
+mod channel_settings;
 /// Issue 38 §6, §7, §9: channel results marked stale, the delays picture, checks at open.
 #[cfg(test)]
 #[path = "e2e/page_channel.rs"]

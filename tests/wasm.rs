@@ -34,6 +34,10 @@ mod export;
 #[path = "wasm/recording.rs"]
 mod recording;
 
+/// The channel view's settings table (`channel_settings`).
+#[path = "wasm/channel_settings.rs"]
+mod channel_settings;
+
 fn message(e: JsError) -> String {
     let v: JsValue = e.into();
     v.dyn_into::<js_sys::Error>()

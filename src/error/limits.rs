@@ -37,6 +37,33 @@ impl Range {
     }
 }
 
+/// An interval with both ends excluded (`min < v < max`), for a quantity that may come
+/// arbitrarily close to its ends (a probability), with the words an error shows.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct OpenRange {
+    /// The excluded lower end.
+    pub min: f64,
+    /// The excluded upper end.
+    pub max: f64,
+    /// The interval in words (shown in errors).
+    pub allowed: &'static str,
+}
+
+impl OpenRange {
+    /// `Ok` when `min < v < max`; else [`Error::OutOfRange`] naming `field` (NaN included).
+    pub fn check(&self, field: &str, v: f64) -> Result<()> {
+        if v > self.min && v < self.max {
+            Ok(())
+        } else {
+            Err(Error::OutOfRange {
+                field: field.into(),
+                value: v,
+                allowed: self.allowed,
+            })
+        }
+    }
+}
+
 /// Any coordinate (node positions, area and region bounds): `|x| ≤ 10⁷ m`. The model is planar
 /// free-space propagation; 10 000 km is past any ground network, and every derived length
 /// (spans, bistatic ranges up to 4·√2·10⁷ m) stays far from overflow.
@@ -142,6 +169,14 @@ pub const C_SIGMA_M: Range = Range {
     min: 1e-3,
     max: 1e3,
     allowed: "1e-3 to 1e3 m",
+};
+
+/// The false-alarm probability per snapshot `P_fa` of a channel run's estimator (C5, the
+/// request's `pfa`): `0 < pfa < 1`.
+pub const FALSE_ALARM_PROBABILITY: OpenRange = OpenRange {
+    min: 0.0,
+    max: 1.0,
+    allowed: "0 < pfa < 1",
 };
 
 /// The person's extent `σ_e` that widens the delays of a channel track (`extent_sigma_m`):

@@ -30,11 +30,12 @@ mod sums;
 mod track;
 
 pub use channel::{
-    cir_track, delays_only, estimate_link, estimate_recording, prepare, BoundCounts,
-    ChannelRequest, ChannelStatics, CirStart, CirTrackOutput, DelayReference, DelaySigma,
-    EstimationRun, FrontEndConfig, LinkEstimates, LinkFront, LinkStatics, LinkStaticsInfo,
-    Prepared, RecordingEstimates, SegmentDoc, StaticMode, BACKGROUND_MAX_PATHS,
-    DEFAULT_PROCESS_NOISE, EXTENT_SIGMA_M, LOS_WITHIN_DB, RECURSIVE_CLUSTER_DB,
+    channel_settings, channel_settings_json, cir_track, delays_only, estimate_link,
+    estimate_recording, prepare, BoundCounts, Bounds, ChannelRequest, ChannelSetting,
+    ChannelStatics, CirStart, CirTrackOutput, DelayReference, DelaySigma, EstimationRun,
+    FrontEndConfig, LinkEstimates, LinkFront, LinkStatics, LinkStaticsInfo, Prepared,
+    RecordingEstimates, SegmentDoc, SettingKind, StaticMode, BACKGROUND_MAX_PATHS,
+    DEFAULT_PROCESS_NOISE, DEFAULT_SEED, EXTENT_SIGMA_M, LOS_WITHIN_DB, RECURSIVE_CLUSTER_DB,
 };
 pub use cost::{check_cost, track_cpu_s, MAX_CPU_S, PAGE_STUDY_CPU_S, PAGE_TRACK_CPU_S};
 pub use drive::{Driver, Sequential};

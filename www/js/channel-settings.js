@@ -1,48 +1,33 @@
-// The channel view's settings in one place: their names, the command line's defaults (`cir
-// estimate` / `cir track`), their ranges (the core's limits) and the one strict check of a
-// settings object, shared by the panel (channel.js reads its inputs through it) and the state
-// helpers (channelSettings / applyChannelSettings). Nothing here touches the DOM.
+// The channel view's settings in one place: their names, defaults and ranges, and the one strict
+// check of a settings object, shared by the panel (channel.js reads its inputs through it) and
+// the state helpers (channelSettings / applyChannelSettings). The settings of the core's
+// ChannelRequest (the tracker's and the front end's: `cir estimate` / `cir track`) come with
+// their defaults and ranges from the core's table (wasm channel_settings, read once after
+// app.js has initialised the module): a new setting or a new default is written in the core
+// only. The page's own settings (where the empty area comes from, the link shown, the cursor,
+// the playback speed) are listed here. Nothing here touches the DOM.
 
 import { clip, decimal } from './dom.js';
+import { channel_settings } from '../pkg/scatterloc.js';
 
-/** The trackers of `cir track --filter`. */
-export const CHANNEL_FILTERS = ['ekf', 'ukf', 'pf'];
 /**
  * Where the empty area comes from: a recording of it ('file'; optional: without one the
  * background is learnt from the recording itself), or a time range of the recording.
  */
 export const CALIBRATION_SOURCES = ['file', 'range'];
-/** How static paths are kept from the tracker (the core's StaticMode: `cir … --statics`). */
-export const CHANNEL_STATICS = ['background', 'clusters'];
-/**
- * Which delays the tracker reads (the core's DelayReference, `--delay-reference`); 'auto' sends
- * none: the recording's own `synchronized` flag decides (absolute without one).
- */
-export const DELAY_REFERENCES = ['auto', 'absolute', 'los'];
 /** The playback speeds of the transport's <select>. */
 export const CHANNEL_SPEEDS = [0.25, 0.5, 1, 2, 4];
 
+/** The page's keys of the core's settings where they differ from the request's JSON keys. */
+const PAGE_KEYS = { pfa: 'p_fa' };
 /**
- * Every setting: [key, kind, default, check]. Numbers are checked with `range` {min, max,
- * integer, open: [lo open, hi open], allowed (text)}: the core's limits (EstimatorConfig::validate:
- * 0 < P_fa < 1, 1 … MAX_PATHS = 64 paths; PROCESS_NOISE: 0 < q ≤ 1e6 m²/s³; pf MAX_PARTICLES
- * = 1000000). Defaults are the command line's (cir.rs: q = 1, EXTENT_SIGMA_M = 0.2 m, EKF,
- * 1000 particles, seed 1; the estimator's 12 paths and P_fa = 10⁻³; the simulator's 1 s of
- * empty area at the start; the core's ChannelRequest: statics 'background', the delay
- * reference of the recording, a background time constant of 10 s within limits::
- * BACKGROUND_TIME_S = 1e-3 … 1e6 s).
+ * The page's choice for a core choice whose default is none ('auto': no delay_reference is
+ * sent, the recording's own `synchronized` flag decides, absolute without one).
  */
-export const CHANNEL_FIELDS = [
-  ['filter', 'choice', 'ekf', { values: CHANNEL_FILTERS }],
-  ['particles', 'number', 1000, { min: 1, max: 1_000_000, integer: true, allowed: 'an integer 1 … 1000000' }],
-  ['seed', 'number', 1, { min: 0, max: Number.MAX_SAFE_INTEGER, integer: true, allowed: 'an integer 0 … 9007199254740991' }],
-  ['process_noise', 'number', 1, { min: 0, max: 1e6, open: [true, false], allowed: '0 < q ≤ 1000000 m²/s³' }],
-  ['p_fa', 'number', 1e-3, { min: 0, max: 1, open: [true, true], allowed: '0 < P_fa < 1' }],
-  ['max_paths', 'number', 12, { min: 1, max: 64, integer: true, allowed: 'an integer 1 … 64' }],
-  ['extent_sigma_m', 'number', 0.2, { min: 0, max: 1000, allowed: '0 … 1000 m' }],
-  ['statics', 'choice', 'background', { values: CHANNEL_STATICS }],
-  ['delay_reference', 'choice', 'auto', { values: DELAY_REFERENCES }],
-  ['background_time_s', 'number', 10, { min: 1e-3, max: 1e6, allowed: '0.001 … 1000000 s' }],
+const AUTO = 'auto';
+
+/** The page's own settings (the same shape as channelFields'). */
+const PAGE_FIELDS = [
   ['calibration', 'choice', 'file', { values: CALIBRATION_SOURCES }],
   ['empty_from_s', 'number', 0, { min: 0, max: 1e9, allowed: '0 … 1000000000 s' }],
   ['empty_to_s', 'number', 1, { min: 0, max: 1e9, allowed: '0 … 1000000000 s' }],
@@ -51,9 +36,49 @@ export const CHANNEL_FIELDS = [
   ['speed', 'choice', 1, { values: CHANNEL_SPEEDS }],
 ];
 
+/** A range in the page's words: `an integer 1 … 64`, `0 … 1000 m`, `0 < q ≤ 1000000 m²/s³`. */
+function allowedText({ min, max, integer, open }, unit, symbol) {
+  if (integer) return `an integer ${min} … ${max}`;
+  const u = unit ? ` ${unit}` : '';
+  if (!open[0] && !open[1]) return `${min} … ${max}${u}`;
+  return `${min} ${open[0] ? '<' : '≤'} ${symbol} ${open[1] ? '<' : '≤'} ${max}${u}`;
+}
+
+/**
+ * One entry of the core's table ({key, kind: 'number' | 'integer' | 'choice', default, min, max,
+ * open, unit, symbol | values}) as a page field. Integers stop at Number.MAX_SAFE_INTEGER (the
+ * largest the page holds exactly: the particle filter's seed).
+ */
+function coreField(e) {
+  const key = PAGE_KEYS[e.key] ?? e.key;
+  if (e.kind === 'choice') {
+    return e.default === null
+      ? [key, 'choice', AUTO, { values: [AUTO, ...e.values] }]
+      : [key, 'choice', e.default, { values: e.values }];
+  }
+  const integer = e.kind === 'integer';
+  const range = { min: e.min, max: integer ? Math.min(e.max, Number.MAX_SAFE_INTEGER) : e.max, integer, open: e.open };
+  range.allowed = allowedText(range, e.unit, e.symbol);
+  return [key, 'number', e.default, range];
+}
+
+let fields = null;
+
+/**
+ * Every setting: [key, kind ('number' | 'choice'), default, check]. Numbers are checked with
+ * `check` {min, max, integer, open: [lo open, hi open], allowed (text)}, choices with {values}.
+ * The core's settings first (filter, particles, seed, process_noise, p_fa, max_paths,
+ * extent_sigma_m, statics, delay_reference, background_time_s: the core's order), then the
+ * page's (PAGE_FIELDS).
+ */
+export function channelFields() {
+  if (!fields) fields = [...JSON.parse(channel_settings()).map(coreField), ...PAGE_FIELDS];
+  return fields;
+}
+
 /** The defaults as a fresh settings object. */
 export function defaultChannelSettings() {
-  return Object.fromEntries(CHANNEL_FIELDS.map(([k, , d]) => [k, d]));
+  return Object.fromEntries(channelFields().map(([k, , d]) => [k, d]));
 }
 
 /** `v` (a number) against `range`; throws naming `field`. */
@@ -70,7 +95,7 @@ function checkNumber(field, v, range) {
 
 /** The text of an input for setting `key` as a number, strictly parsed (dom.js) and range-checked. */
 export function parseChannelField(key, text, label = key) {
-  const f = CHANNEL_FIELDS.find((x) => x[0] === key);
+  const f = channelFields().find((x) => x[0] === key);
   if (!f || f[1] !== 'number') throw new Error(`channel setting ${key}: not a number setting`);
   const v = decimal(text, label);
   try {
@@ -82,7 +107,7 @@ export function parseChannelField(key, text, label = key) {
 }
 
 /**
- * A settings object checked strictly: a plain object with exactly the keys of CHANNEL_FIELDS (a
+ * A settings object checked strictly: a plain object with exactly the keys of channelFields() (a
  * missing key takes its default; an unknown key, a wrong type or a value out of range throws an
  * Error naming the key, the value and what is allowed), and the empty range ordered (from < to).
  * Returns a fresh object.
@@ -91,11 +116,11 @@ export function checkChannelSettings(obj) {
   if (obj === null || typeof obj !== 'object' || Array.isArray(obj)) {
     throw new Error(`channel settings: ${clip(JSON.stringify(obj) ?? String(obj))} is not an object`);
   }
-  const known = CHANNEL_FIELDS.map((f) => f[0]);
+  const known = channelFields().map((f) => f[0]);
   const unknown = Object.keys(obj).find((k) => !known.includes(k));
   if (unknown !== undefined) throw new Error(`channel settings: unknown setting "${clip(unknown)}" (known: ${known.join(', ')})`);
   const out = {};
-  for (const [key, kind, def, check] of CHANNEL_FIELDS) {
+  for (const [key, kind, def, check] of channelFields()) {
     const v = Object.hasOwn(obj, key) ? obj[key] : def;
     if (kind === 'choice') {
       if (!check.values.includes(v)) {

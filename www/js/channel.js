@@ -25,7 +25,7 @@
 
 import { $, errorText } from './dom.js';
 import { ChannelJobs } from './channel-job.js';
-import { CHANNEL_FIELDS, checkChannelSettings, defaultChannelSettings } from './channel-settings.js';
+import { channelFields, checkChannelSettings, defaultChannelSettings } from './channel-settings.js';
 import { registerSection } from './state.js';
 import { channelFiles } from './channel-files.js';
 import { channelRun } from './channel-run.js';
@@ -171,8 +171,10 @@ export class Channel {
 
 // The parts' methods (each file's concern) on the one class, so the view is one object for app.js and the hooks.
 Object.assign(Channel.prototype, channelFiles, channelRun, channelPlayer);
-/** The settings' keys (for the state helper's documentation and tests). */
-export const CHANNEL_SETTING_KEYS = CHANNEL_FIELDS.map((f) => f[0]);
+/** The settings' keys (for the state helper's documentation and tests; after the wasm start). */
+export function channelSettingKeys() {
+  return channelFields().map((f) => f[0]);
+}
 
 /**
  * Registers the page state's `channel` section: every setting of the channel view (not its

@@ -17,6 +17,8 @@
 //!   backend), both by the CLI's chart code (`chart::channel`), and the map overlay of one
 //!   snapshot (`overlay(k)`: the track's segments up to it, nothing outside a segment).
 //!
+//! - [`channel_settings`]: the settings the view's panel shows, with their defaults and ranges.
+//!
 //! Every error is an exception carrying the core's one-line message (naming the field or the
 //! array); sizes are capped before parsing ([`crate::error::limits::MAX_PAGE_RECORDING_BYTES`]);
 //! non-finite numbers reach JavaScript as `null`.
@@ -62,6 +64,14 @@ use crate::{Model, Scenario};
 /// Most particle-steps (`snapshots × particles`) of a channel-view track: the track runs in
 /// one call of the worker (a few seconds at most).
 pub const MAX_CHANNEL_PARTICLE_STEPS: usize = 20_000_000;
+
+/// The channel view's settings of the core's `ChannelRequest` as JSON: each one's key, kind,
+/// default and range ([`crate::study::channel_settings`]), which the page's panel reads instead of
+/// repeating them (`www/js/channel-settings.js`).
+#[wasm_bindgen]
+pub fn channel_settings() -> String {
+    crate::study::channel_settings_json()
+}
 
 /// A core error as a JavaScript exception, its message prefixed by `what` (`recording`,
 /// `calibration`, `truth`, …).

@@ -37,8 +37,8 @@ pub use app::App;
 pub use base::{check_point, check_rect, preset_json, preset_names, start};
 use base::{err, point, settings, window};
 pub use channel::{
-    channel_recording_summary, check_channel_truth, simulate_channel, ChannelFigures, ChannelJob,
-    SimulatedChannel,
+    channel_recording_summary, channel_settings, check_channel_truth, simulate_channel,
+    ChannelFigures, ChannelJob, SimulatedChannel,
 };
 pub use chart::draw_tracking_chart;
 pub use export::{map_data_text, mtl_scene_svg, tracking_chart_svg, MAX_FIGURE_PX, MAX_FIGURE_RES};

@@ -1,7 +1,8 @@
 //! From a channel recording to a track, as one use case (issue 36; spec channel-estimation.md
 //! C1–C11, §4–§6): the one home of the chain that the CLI's `cir estimate` and `cir track`, the
 //! page's channel view and the Python package drive. A [`ChannelRequest`] holds every setting
-//! and its default; per recorded link the front end builds its statics — the background of
+//! and its default, [`channel_settings`] lists those the page shows with their defaults and
+//! ranges (the page reads them from there); per recorded link the front end builds its statics — the background of
 //! the empty area (C9) with the static clusters that gate what is left of it, a recursive
 //! background, or C7's clusters — and estimates every snapshot (C5 on the residual, C6 path
 //! tracks, delays absolute or relative to the direct path, C10) ([`estimate_recording`], one
@@ -38,6 +39,7 @@
 mod estimates;
 mod front;
 mod request;
+mod settings;
 mod track;
 
 pub use estimates::{
@@ -50,9 +52,13 @@ pub use front::{
 };
 pub use request::{
     ChannelRequest, DelayReference, DelaySigma, FrontEndConfig, StaticMode, DEFAULT_PROCESS_NOISE,
-    EXTENT_SIGMA_M,
+    DEFAULT_SEED, EXTENT_SIGMA_M,
 };
+pub use settings::{channel_settings, channel_settings_json, Bounds, ChannelSetting, SettingKind};
 pub use track::{cir_track, CirStart, CirTrackOutput, SegmentDoc};
+
+#[cfg(test)]
+mod tests;
 
 use alloc::vec::Vec;
 

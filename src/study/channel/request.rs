@@ -1,10 +1,9 @@
 //! What a channel run is asked to do: [`ChannelRequest`], the one home of every setting of the
 //! chain from a recording to a track and of its default. The CLI's flags, the page's settings
 //! object (this type's JSON, field for field) and the Python keywords all fill it; its
-//! [`ChannelRequest::check`] names the field at fault.
-
-// `!(x > 0.0)` is meant: a NaN must fail these checks as well.
-#![allow(clippy::neg_cmp_op_on_partial_ord)]
+//! [`ChannelRequest::check`] names the field at fault. The settings the page shows, with their
+//! defaults and `check`'s ranges, are listed as data by `settings.rs`
+//! ([`super::channel_settings`]).
 
 use alloc::borrow::Cow;
 use alloc::string::{String, ToString};
@@ -26,6 +25,9 @@ pub const DEFAULT_PROCESS_NOISE: Real = 1.0;
 /// Default spread of the scatterer's own extent, as path length (m): a person's body radius is
 /// about 0.2 m ([`ChannelRequest::extent_sigma_m`]).
 pub const EXTENT_SIGMA_M: Real = 0.2;
+
+/// Default seed of the particle filter of a channel run ([`ChannelRequest::seed`]).
+pub const DEFAULT_SEED: u64 = 1;
 
 /// How static paths are kept from the tracker (spec C9, C7).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
@@ -336,23 +338,19 @@ impl ChannelRequest {
         }
     }
 
-    /// The particle filter's seed (default 1).
+    /// The particle filter's seed (default [`DEFAULT_SEED`]).
     pub fn seed(&self) -> u64 {
-        self.seed.unwrap_or(1)
+        self.seed.unwrap_or(DEFAULT_SEED)
     }
 
-    /// Checks every setting, naming the field at fault: `pfa`, the front end's
-    /// ([`FrontEndConfig::validate`]: `max_paths`, `background_time_s`), the filter's
-    /// ([`ChannelRequest::filter_kind`]), `process_noise` (E7's range), `extent_sigma_m` (0 … 1 km,
-    /// ≥ 0), `calibration_range_s` (finite, `t0 ≤ t1`), the segments'.
+    /// Checks every setting, naming the field at fault: `pfa`
+    /// ([`limits::FALSE_ALARM_PROBABILITY`]), the front end's ([`FrontEndConfig::validate`]:
+    /// `max_paths`, `background_time_s`), the filter's ([`ChannelRequest::filter_kind`]),
+    /// `process_noise` (E7's range), `extent_sigma_m` ([`limits::PERSON_EXTENT_M`]),
+    /// `calibration_range_s` (finite, `t0 ≤ t1`), the segments'. The ranges are the ones
+    /// [`super::channel_settings`] lists for the page.
     pub fn check(&self) -> Result<()> {
-        if !(self.pfa > 0.0 && self.pfa < 1.0) {
-            return Err(Error::OutOfRange {
-                field: "pfa".into(),
-                value: self.pfa,
-                allowed: "0 < pfa < 1",
-            });
-        }
+        limits::FALSE_ALARM_PROBABILITY.check("pfa", self.pfa)?;
         self.front_end(None).validate()?;
         self.filter_kind()?;
         ConstantVelocity::validated(1.0, self.process_noise)?;
