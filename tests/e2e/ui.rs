@@ -103,11 +103,30 @@ pub(super) async fn poll(
     what: &str,
     done: impl Fn(&Value) -> bool,
 ) -> Result<Value, String> {
+    poll_checked(c, script, secs, what, false, done).await
+}
+
+/// [`poll`], failing at once on a console error when `fail_on_console` (a job that threw will not
+/// reach its state).
+async fn poll_checked(
+    c: &Client,
+    script: &str,
+    secs: u64,
+    what: &str,
+    fail_on_console: bool,
+    done: impl Fn(&Value) -> bool,
+) -> Result<Value, String> {
     let t0 = Instant::now();
     loop {
         let v = js(c, script).await?;
         if done(&v) {
             return Ok(v);
+        }
+        if fail_on_console {
+            let errors = console_errors(c).await?;
+            if !errors.is_empty() {
+                return Err(format!("{what}: console errors {errors:?}; state {v}"));
+            }
         }
         if t0.elapsed() > Duration::from_secs(secs) {
             return Err(format!("{what}: not after {secs} s; last {v}"));
@@ -129,21 +148,7 @@ pub(super) async fn wait_channel(
     what: &str,
     done: impl Fn(&Value) -> bool,
 ) -> Result<Value, String> {
-    let t0 = Instant::now();
-    loop {
-        let s = channel_state(c).await?;
-        if done(&s) {
-            return Ok(s);
-        }
-        let errors = console_errors(c).await?;
-        if !errors.is_empty() {
-            return Err(format!("{what}: console errors {errors:?}; state {s}"));
-        }
-        if t0.elapsed() > Duration::from_secs(secs) {
-            return Err(format!("{what}: not after {secs} s; state {s}"));
-        }
-        tokio::time::sleep(Duration::from_millis(50)).await;
-    }
+    poll_checked(c, "return window.channel.state()", secs, what, true, done).await
 }
 
 /// The tracking view's state hook (`window.tracking.state()`).

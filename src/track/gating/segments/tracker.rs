@@ -73,23 +73,8 @@ impl<'a> SegmentTracker<'a> {
         crate::error::limits::PROCESS_NOISE.check("process_noise", setup.process_noise)?;
         let grid = StartGrid::new(setup.model, setup.area, setup.segments.grid_step_m)?;
         Ok(SegmentTracker {
-            model: setup.model,
-            calibration: setup.calibration,
-            area: setup.area,
-            cfg: setup.segments,
-            kind: setup.kind,
-            process_noise: setup.process_noise,
-            rule: setup.rule,
-            estimate_sigmas: setup.estimate_sigmas,
-            gate_sigma_s: setup.gate_sigma_s,
-            loss: true,
-            rng,
             grid: Some(grid),
-            hypotheses: Vec::new(),
-            held: None,
-            last_t: None,
-            interval: None,
-            k: None,
+            ..Self::from_setup(setup, rng, true)
         })
     }
 
@@ -101,6 +86,19 @@ impl<'a> SegmentTracker<'a> {
         t0_s: Real,
     ) -> Self {
         SegmentTracker {
+            held: Some(Held {
+                tracker,
+                window: Vec::new(),
+                last_hit_t: t0_s,
+            }),
+            last_t: Some(t0_s),
+            ..Self::from_setup(setup, crate::measure::rng(0, 0), false)
+        }
+    }
+
+    /// The settings of `setup`, nothing held, no start grid, no time seen yet.
+    fn from_setup(setup: SegmentSetup<'a>, rng: Rng, loss: bool) -> Self {
+        SegmentTracker {
             model: setup.model,
             calibration: setup.calibration,
             area: setup.area,
@@ -110,16 +108,12 @@ impl<'a> SegmentTracker<'a> {
             rule: setup.rule,
             estimate_sigmas: setup.estimate_sigmas,
             gate_sigma_s: setup.gate_sigma_s,
-            loss: false,
-            rng: crate::measure::rng(0, 0),
+            loss,
+            rng,
             grid: None,
             hypotheses: Vec::new(),
-            held: Some(Held {
-                tracker,
-                window: Vec::new(),
-                last_hit_t: t0_s,
-            }),
-            last_t: Some(t0_s),
+            held: None,
+            last_t: None,
             interval: None,
             k: None,
         }
