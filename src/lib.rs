@@ -72,6 +72,8 @@ pub use edge::chart;
 pub use edge::native;
 #[cfg(feature = "npz")]
 pub use edge::npz;
+#[cfg(feature = "npz")]
+pub use edge::csi;
 #[cfg(all(feature = "wasm", target_arch = "wasm32"))]
 pub use edge::wasm;
 

@@ -9,6 +9,8 @@ pub mod chart;
 #[cfg(all(feature = "parallel", not(target_arch = "wasm32")))]
 pub mod native;
 #[cfg(feature = "npz")]
+pub mod csi;
+#[cfg(feature = "npz")]
 pub mod npz;
 #[cfg(all(feature = "wasm", target_arch = "wasm32"))]
 pub mod wasm;
