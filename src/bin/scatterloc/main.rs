@@ -75,6 +75,7 @@ fn run(command: cli::Command) -> Result<(), CliError> {
             CirCommand::Simulate(a) => cmd::cir_simulate(&a),
             CirCommand::Estimate(a) => cmd::cir_estimate(&a),
             CirCommand::Track(a) => cmd::cir_track(&a),
+            CirCommand::Convert(a) => cmd::cir_convert(&a),
         },
         Command::Merge(a) => cmd::merge(&a),
         Command::Slurm { command } => match command {

@@ -8,6 +8,7 @@
 //! `cir estimate`/`cir track`/`cir convert`, the page and Python. Every malformed file is an
 //! [`crate::Error::InvalidFile`] or [`crate::Error::SizeLimit`] naming the frame and the field.
 
+mod bfee;
 mod capture;
 mod esp32;
 mod feitcsi;
@@ -15,6 +16,7 @@ mod intel5300;
 mod nexmon;
 mod open;
 mod picoscenes;
+mod summary;
 
 #[cfg(test)]
 mod tests;
@@ -22,4 +24,5 @@ mod tests;
 pub use capture::{
     to_recording, Conversion, ConvertOptions, CsiCapture, CsiFormat, PairLink,
 };
+pub use summary::LISTED;
 pub use open::{detect, open_recording, read_capture, CsiSummary, OpenOptions, Opened};

@@ -38,6 +38,46 @@ pub enum CirCommand {
     /// covariances, links_used, delays_used_s, sigmas_used_s, choices, static_removed, start,
     /// segments [{first, last, end, …}], front_end, calibration, error (with --truth)}.
     Track(CirTrackArgs),
+    /// Convert a Wi-Fi CSI tool's file to a recording (.npz, docs/recording.md).
+    ///
+    /// Reads Intel 5300 (.dat), Nexmon (pcap), PicoScenes (.csi), FeitCSI (.csi) and ESP32
+    /// (CSV) files; puts the reported subcarriers on a uniform grid with a mask (P[n] = 0 where
+    /// no subcarrier is reported: null, DC, guard, grouped-out); applies the gain the format
+    /// reports (RSSI/AGC); maps antenna pairs to the scenario's links (--links). Prints what it
+    /// found: format, device, frames, bandwidth, antennas, subcarriers, dropped frames, notes.
+    Convert(CirConvertArgs),
+}
+
+/// `scatterloc cir convert`.
+#[derive(Debug, Args)]
+pub struct CirConvertArgs {
+    /// The CSI file ('-' = standard input).
+    #[arg(value_name = "IN")]
+    pub input: String,
+    /// The recording to write (.npz).
+    #[arg(value_name = "OUT.npz")]
+    pub output: String,
+    #[command(flatten)]
+    pub csi: CsiArgs,
+}
+
+/// How a recording file is read: `.npz` or a CSI tool's file (`cir convert`, `cir estimate`,
+/// `cir track`).
+#[derive(Debug, Args)]
+pub struct CsiArgs {
+    /// The file's format [default: auto, by its first bytes].
+    #[arg(long, value_name = "FORMAT", value_parser = [
+        "auto", "npz", "intel5300", "nexmon", "picoscenes", "feitcsi", "esp32",
+    ])]
+    pub format: Option<String>,
+    /// Which antenna pair of a CSI file is which link of the scenario: rxR.txT=A:B,… (receive
+    /// antenna R and transmit antenna T → transmitter A, receiver B), e.g. rx0.tx0=0:0,rx1.tx0=0:1
+    /// [default: every pair, rxR.txT → transmitter T, receiver R].
+    #[arg(long, value_name = "MAP")]
+    pub links: Option<String>,
+    /// Keep the CSI as written: do not apply the RSSI/AGC gain the format reports.
+    #[arg(long)]
+    pub raw_gain: bool,
 }
 
 /// `scatterloc cir simulate`.
@@ -136,6 +176,8 @@ pub struct FrontEndArgs {
     /// Worker threads (0 = all cores) [default: 0].
     #[arg(long, value_name = "N", value_parser = whole)]
     pub threads: Option<usize>,
+    #[command(flatten)]
+    pub csi: CsiArgs,
 }
 
 /// `scatterloc cir estimate`.
@@ -144,7 +186,7 @@ pub struct CirEstimateArgs {
     /// Scenario JSON file ('-' = standard input).
     #[arg(long, value_name = "FILE")]
     pub scenario: String,
-    /// The recording (.npz, docs/recording.md).
+    /// The recording (.npz, docs/recording.md, or a CSI tool's file: see --format).
     #[arg(long, value_name = "REC.npz")]
     pub cir: String,
     /// The estimates (.json).

@@ -21,8 +21,8 @@ use std::ffi::OsString;
 use clap::{CommandFactory, FromArgMatches, Parser, Subcommand, ValueEnum};
 
 pub use cir::{
-    CirCommand, CirEstimateArgs, CirSimulateArgs, CirTrackArgs, FrontEndArgs, ReferenceName,
-    SigmaSource, StaticsName,
+    CirCommand, CirConvertArgs, CirEstimateArgs, CirSimulateArgs, CirTrackArgs, FrontEndArgs, ReferenceName,
+    SigmaSource, CsiArgs, StaticsName,
 };
 pub use filters::{FilterName, FilterSettings};
 pub use mtl::{MtlCommand, MtlLocateArgs, RocArgs, Table2Args};
@@ -58,6 +58,8 @@ Commands at a glance (`scatterloc help COMMAND` for every flag):
   scatterloc cir track --scenario FILE --calibration CAL.npz --cir REC.npz --out TRACK.json
                        [--figure F.{svg,png}] [--delays-figure D.{svg,png}] [--truth FILE]
                        [--filter ekf|ukf|pf]
+  scatterloc cir convert IN OUT.npz [--format auto|intel5300|nexmon|picoscenes|feitcsi|esp32]
+                         [--links rxR.txT=A:B,...] [--raw-gain]
   scatterloc montecarlo [--preset NAME | --scenario FILE] [--trajectory I|II|III|all]
                         [--runs N] [--noise-runs N] [--dt T] [--duration S] [--process-noise Q]
                         [--seed N] [--threads N] [--oracle-noise] [--out FIG.{svg,png}]

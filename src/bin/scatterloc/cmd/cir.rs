@@ -4,7 +4,7 @@
 //! the simulator [`scatterloc::channel::simulate_recording`] → files written all or none.
 
 use scatterloc::channel::{Recording, SimulationRequest};
-use scatterloc::error::{limits, Cancel};
+use scatterloc::error::Cancel;
 use scatterloc::formats::{CalibrationSnapshots, Measurements, Truth};
 use scatterloc::native::Parallel;
 use scatterloc::present::{estimates_doc, track_doc, track_errors};
@@ -17,20 +17,25 @@ use scatterloc::{npz, Model, Scenario};
 
 use super::flags::{at_flag, in_file, renamed, with_flag};
 use super::gating::{prepare_out_dir_for, walk_file};
-use super::io::{emit_summary, model_of, one_stdin, read_bytes, read_json_file, read_scenario};
+use super::io::{emit_summary, model_of, one_stdin, read_json_file, read_scenario};
 use super::output::{check_distinct, check_writable, Format, OutputSet};
 use super::study::{catch_ctrl_c, interrupted, run_with_counter, threads};
 use crate::cli::{
-    Association, CirEstimateArgs, CirSimulateArgs, CirTrackArgs, FrontEndArgs, ReferenceName,
+    Association, CirEstimateArgs, CsiArgs, CirSimulateArgs, CirTrackArgs, FrontEndArgs, ReferenceName,
     SigmaSource, StaticsName,
 };
 use crate::failure::CliError;
 
-/// Reads the recording `--flag PATH` (.npz, docs/recording.md), checked against `model`.
-fn read_recording(flag: &str, path: &str, model: &Model) -> Result<Recording, CliError> {
-    let bytes = read_bytes(flag, path, limits::MAX_RECORDING_BYTES)?;
+/// Reads the recording `--flag PATH` (.npz, docs/recording.md, or a CSI tool's file read as
+/// `csi` says), checked against `model`.
+fn read_recording(
+    flag: &str,
+    path: &str,
+    model: &Model,
+    csi: &CsiArgs,
+) -> Result<Recording, CliError> {
     // The reader validates what it read (`Recording::validate`); the links against the scenario.
-    let rec = npz::read_recording(&bytes).map_err(|e| in_file(flag, path, e))?;
+    let rec = super::cir_convert::open(flag, path, csi)?.recording;
     rec.link_map(model).map_err(|e| in_file(flag, path, e))?;
     Ok(rec)
 }
@@ -110,9 +115,10 @@ fn empty_area(
     req: &ChannelRequest,
     rec: &Recording,
     model: &Model,
+    csi: &CsiArgs,
 ) -> Result<Option<Recording>, CliError> {
     let file = match path {
-        Some(p) => Some(read_recording("calibration", p, model)?),
+        Some(p) => Some(read_recording("calibration", p, model, csi)?),
         None => None,
     };
     req.empty_area(file.as_ref(), rec)
@@ -202,8 +208,14 @@ pub fn cir_estimate(args: &CirEstimateArgs) -> Result<(), CliError> {
     let (threads, _) = threads(args.front_end.threads)?;
     let scenario = read_scenario(&args.scenario)?;
     let model = model_of(&scenario)?;
-    let rec = read_recording("cir", &args.cir, &model)?;
-    let empty = empty_area(args.calibration.as_deref(), &req, &rec, &model)?;
+    let rec = read_recording("cir", &args.cir, &model, &args.front_end.csi)?;
+    let empty = empty_area(
+        args.calibration.as_deref(),
+        &req,
+        &rec,
+        &model,
+        &args.front_end.csi,
+    )?;
     let measurements = match &args.measurements {
         Some(_) => Some(uniform_dt(&rec.t_s, q)?),
         None => None,
@@ -326,8 +338,14 @@ pub fn cir_track(args: &CirTrackArgs) -> Result<(), CliError> {
     let (threads, _) = threads(args.front_end.threads)?;
     let scenario = read_scenario(&args.scenario)?;
     let model = model_of(&scenario)?;
-    let rec = read_recording("cir", &args.cir, &model)?;
-    let empty = empty_area(args.calibration.as_deref(), &req, &rec, &model)?;
+    let rec = read_recording("cir", &args.cir, &model, &args.front_end.csi)?;
+    let empty = empty_area(
+        args.calibration.as_deref(),
+        &req,
+        &rec,
+        &model,
+        &args.front_end.csi,
+    )?;
     let truth = match &args.truth {
         Some(p) => {
             let t: Truth = read_json_file("truth", p)?;

@@ -1,6 +1,7 @@
 //! The commands of `scatterloc`, one file per family: the single-snapshot commands (`preset`,
 //! `crlb`, `locate` in `scenario`, `crlb-map` in `crlb_map`), tracking (`track` with its figure
-//! in `track_fig`), the channel front end (`cir simulate|estimate|track` in `cir`), gating
+//! in `track_fig`), the channel front end (`cir simulate|estimate|track` in `cir`; `cir convert`
+//! and the opening of any recording file, `.npz` or CSI, in `cir_convert`), gating
 //! (`calibrate`, `simulate-walk`), the tracking studies (`montecarlo`, `pcrlb`, sharing `study`
 //! and `report`), network planning (`plan`), the multi-target commands (`mtl`), and scale-out:
 //! one shard of a study (`--shard`, its part file in `shard`), `merge` (the part files read by
@@ -9,6 +10,7 @@
 //! stdout and files atomically (`output`).
 
 mod cir;
+mod cir_convert;
 mod cir_fig;
 mod crlb_map;
 mod filters;
@@ -30,6 +32,7 @@ mod track;
 mod track_fig;
 
 pub use cir::{cir_estimate, cir_simulate, cir_track};
+pub use cir_convert::cir_convert;
 pub use crlb_map::crlb_map;
 pub use gating::{calibrate, simulate_walk};
 pub use merge::merge;

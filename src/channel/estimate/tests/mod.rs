@@ -5,6 +5,8 @@
 //! (fast in debug); the full counts are the `#[ignore]`d `*_full` tests (release, via
 //! scripts/reproduce.sh). `--nocapture` prints the measured values.
 
+mod masked;
+
 use alloc::vec;
 use alloc::vec::Vec;
 
