@@ -17,7 +17,8 @@ Tracking
 Planning and multi-target
     :func:`plan`, :func:`mtl_locate`
 Channel recordings (CFR/CIR to delays)
-    :class:`Recording`, :func:`read_recording`, :func:`write_recording`,
+    :class:`Recording`, :func:`read_recording` (``.npz`` or a Wi-Fi CSI file), :func:`read_csi`,
+    :func:`write_recording`,
     :func:`simulate_recording`, :func:`estimate`, :func:`estimate_recording`, :func:`cir_track`
 Stone Soup
     :mod:`scatterloc.stonesoup` (``BistaticDelayModel``; needs ``pip install scatterloc[stonesoup]``)
@@ -52,6 +53,7 @@ from ._scatterloc import (
     mtl_locate,
     pcrlb,
     plan,
+    read_csi,
     read_recording,
     simulate_recording,
     track,
@@ -85,6 +87,7 @@ __all__ = [
     "mtl_locate",
     "pcrlb",
     "plan",
+    "read_csi",
     "read_recording",
     "simulate_recording",
     "track",

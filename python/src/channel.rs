@@ -405,22 +405,21 @@ fn check_samples(field: &str, shape: &[usize], s: usize, p: usize) -> PyResult<(
     }
 }
 
-/// Reads a recording (`.npz`, docs/recording.md; at most the CLI's cap of 1 GiB + 64 MiB).
+/// Reads a recording: a `.npz` (docs/recording.md) or a Wi-Fi CSI tool's file converted as
+/// `scatterloc cir convert` does (at most the CLI's cap of 1 GiB + 64 MiB). `format`: `auto`
+/// (default: by the first bytes), `npz`, `intel5300`, `nexmon`, `picoscenes`, `feitcsi`,
+/// `esp32`; `links`: the antenna pairs' links `rxR.txT=A:B,…` (default: every pair, link
+/// (T, R)); `raw_gain`: keep the CSI unscaled (default: the format's RSSI/AGC gain applied).
 #[pyfunction]
-pub fn read_recording(py: Python<'_>, path: &Bound<'_, PyAny>) -> PyResult<PyRecording> {
-    use std::io::Read;
-    let p = path_string(path)?;
-    let f = std::fs::File::open(&p)?;
-    let mut bytes = Vec::new();
-    f.take(limits::MAX_RECORDING_BYTES + 1)
-        .read_to_end(&mut bytes)?;
-    if bytes.len() as u64 > limits::MAX_RECORDING_BYTES {
-        return Err(arg_error(
-            "path",
-            format!("'{p}' is larger than {} bytes", limits::MAX_RECORDING_BYTES),
-        ));
-    }
-    let rec = run_quick(py, || npz::read_recording(&bytes))?;
+#[pyo3(signature = (path, *, format = None, links = None, raw_gain = false))]
+pub fn read_recording(
+    py: Python<'_>,
+    path: &Bound<'_, PyAny>,
+    format: Option<String>,
+    links: Option<String>,
+    raw_gain: bool,
+) -> PyResult<PyRecording> {
+    let rec = crate::csi::open(py, path, format, links, raw_gain)?.recording;
     Ok(PyRecording { rec })
 }
 

@@ -16,6 +16,7 @@
 //! - `mtl`: `mtl_locate`.
 //! - `channel`: `Recording`, `read_recording`, `write_recording`, `simulate_recording`,
 //!   `estimate`, `estimate_recording`, `cir_track`.
+//! - `csi`: `read_csi` and the CSI keywords of `read_recording` (Wi-Fi CSI tools' files).
 //! - `bench`: native timings for the package's benchmark (docs/benchmarks.md).
 //!
 //! The Python side (`python/scatterloc/`) re-exports these, adds the Stone Soup model and
@@ -24,6 +25,7 @@
 mod bench;
 mod channel;
 mod convert;
+mod csi;
 mod errors;
 mod mtl;
 mod output;
@@ -66,6 +68,7 @@ fn _scatterloc(m: &Bound<'_, PyModule>) -> PyResult<()> {
         wrap_pyfunction!(planning::plan, m)?,
         wrap_pyfunction!(mtl::mtl_locate, m)?,
         wrap_pyfunction!(channel::read_recording, m)?,
+        wrap_pyfunction!(csi::read_csi, m)?,
         wrap_pyfunction!(channel::write_recording, m)?,
         wrap_pyfunction!(channel::simulate_recording, m)?,
         wrap_pyfunction!(channel::estimate, m)?,

@@ -8,6 +8,9 @@ import { checkChannelSettings, parseChannelField } from './channel-settings.js';
 
 /** The largest recording file read, bytes (the core's limits::MAX_PAGE_RECORDING_BYTES, 256 MiB). */
 export const MAX_RECORDING_FILE_BYTES = 256 * 2 ** 20;
+/** A recording's file name: `.npz` (docs/recording.md) or a Wi-Fi CSI tool's file (the core
+ * tells the format by its first bytes). */
+export const RECORDING_FILE = /\.(npz|dat|pcap|csi|csv)$/i;
 /** The largest truth file read, bytes (the core's limits::MAX_PAGE_TEXT_BYTES, 64 MiB). */
 export const MAX_TRUTH_FILE_BYTES = 64 * 2 ** 20;
 
@@ -189,15 +192,16 @@ export const channelFiles = {
   },
 
   /**
-   * Dropped files: a .json is the truth, the first .npz the recording and a second one the
-   * empty area's recording (the calibration source becomes "recording").
+   * Dropped files: a .json is the truth, the first recording (.npz, or a Wi-Fi CSI tool's
+   * .dat/.pcap/.csi/.csv: RECORDING_FILE) the recording and a second one the empty area's
+   * recording (the calibration source becomes "recording").
    */
   async dropFiles(files) {
-    const npz = files.filter((f) => /\.npz$/i.test(f.name));
+    const npz = files.filter((f) => RECORDING_FILE.test(f.name));
     const json = files.filter((f) => /\.json$/i.test(f.name));
     const other = files.filter((f) => !npz.includes(f) && !json.includes(f));
     if (other.length) {
-      this.fail(`Dropped file ${clip(other[0].name)}: not a recording (.npz) or a truth file (.json)`);
+      this.fail(`Dropped file ${clip(other[0].name)}: not a recording (.npz, .dat, .pcap, .csi, .csv) or a truth file (.json)`);
       return;
     }
     if (npz[0]) await this.openRecording(npz[0]);

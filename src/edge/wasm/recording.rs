@@ -1,12 +1,12 @@
-//! `read_recording_summary`: a dropped `.npz` channel recording (docs/recording.md) read by
-//! [`crate::npz::read_recording`], summarised for the page.
+//! `read_recording_summary`: a dropped channel recording (`.npz`, docs/recording.md, or a Wi-Fi
+//! CSI tool's file) read as the channel view reads it, summarised for the page.
 
 use serde::Serialize;
 use wasm_bindgen::prelude::*;
 
 use super::base::err;
 use super::json::to_js;
-use crate::npz::read_recording;
+use super::channel::page_recording;
 
 /// The page's summary of a recording.
 #[derive(Serialize)]
@@ -23,12 +23,12 @@ struct RecordingSummary {
     duration_s: f64,
 }
 
-/// Reads the bytes of a `.npz` recording and returns `{snapshots, links, layout ("cfr" or
+/// Reads the bytes of a recording (`.npz` or CSI) and returns `{snapshots, links, layout ("cfr" or
 /// "cir"), samples_per_link, duration_s}`. Throws the reader's named error (naming the array) on
 /// a malformed file.
 #[wasm_bindgen]
 pub fn read_recording_summary(bytes: &[u8]) -> Result<JsValue, JsError> {
-    let rec = read_recording(bytes).map_err(err)?;
+    let rec = page_recording(bytes).map_err(err)?;
     to_js(&RecordingSummary {
         snapshots: rec.snapshot_count(),
         links: rec.link_count(),

@@ -33,7 +33,7 @@ use crate::{npz, Model, Scenario};
 /// Link-snapshots estimated per clock reading (each is 0.1–2 ms).
 const UNITS_PER_READING: usize = 4;
 
-/// Reads a dropped `.npz` recording named `what` (`recording`, `calibration`): its size is
+/// Reads a dropped recording (`.npz` or CSI) named `what` (`recording`, `calibration`): its size is
 /// checked before parsing ([`MAX_PAGE_RECORDING_BYTES`]), the reader's caps while parsing, and
 /// its links against `model`.
 fn read_page_recording(
@@ -44,7 +44,7 @@ fn read_page_recording(
     // Before the bytes are copied into the module's memory.
     check_size(what, bytes.length() as usize, MAX_PAGE_RECORDING_BYTES).map_err(err)?;
     let bytes = bytes.to_vec();
-    let rec = npz::read_recording_within(&bytes, MAX_PAGE_RECORDING_BYTES).map_err(named(what))?;
+    let rec = super::open::page_recording(&bytes).map_err(named(what))?;
     rec.link_map(model).map_err(named(what))?;
     Ok(rec)
 }

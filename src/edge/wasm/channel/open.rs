@@ -15,7 +15,8 @@ use crate::edge::wasm::json::to_js;
 use crate::error::limits::{MAX_PAGE_RECORDING_BYTES, MAX_PAGE_TEXT_BYTES};
 use crate::error::Error;
 use crate::formats::Truth;
-use crate::npz;
+use crate::channel::Recording;
+use crate::csi::{open_recording, OpenOptions};
 
 /// `channel_recording_summary`'s result.
 #[derive(Serialize)]
@@ -28,7 +29,23 @@ struct OpenedRecording {
     t_s: Vec<f64>,
 }
 
-/// Reads the bytes of a `.npz` recording opened in the channel view and checks its links
+/// A recording file of the page: a `.npz` or a Wi-Fi CSI tool's file (format by its first
+/// bytes, every antenna pair as link `(tx, rx)`, the format's gain applied: the CLI's defaults),
+/// within the page's cap.
+pub(crate) fn page_recording(bytes: &[u8]) -> Result<Recording, Error> {
+    let opts = OpenOptions {
+        max_npz_bytes: MAX_PAGE_RECORDING_BYTES,
+        convert: crate::csi::ConvertOptions {
+            links: None,
+            apply_gain: true,
+        },
+        ..OpenOptions::default()
+    };
+    open_recording(bytes, &opts).map(|o| o.recording)
+}
+
+/// Reads the bytes of a recording opened in the channel view (`.npz`, or a Wi-Fi CSI tool's
+/// file: [`page_recording`]) and checks its links
 /// against the scenario JSON `scenario_json` (the job's reader, caps and check, as at Run):
 /// returns `{snapshots, links, layout ("cfr" | "cir"), samples_per_link, duration_s, t_s (the
 /// snapshot times, s)}`. Throws the reader's named error (`npz: …`, the size cap), or
@@ -47,7 +64,7 @@ pub fn channel_recording_summary(
         MAX_PAGE_RECORDING_BYTES,
     )
     .map_err(err)?;
-    let rec = npz::read_recording_within(&bytes.to_vec(), MAX_PAGE_RECORDING_BYTES).map_err(err)?;
+    let rec = page_recording(&bytes.to_vec()).map_err(err)?;
     rec.link_map(&model).map_err(err)?;
     to_js(&OpenedRecording {
         snapshots: rec.snapshot_count(),

@@ -1,0 +1,285 @@
+//! The RXS frames of a PicoScenes file and the capture made of them (module doc of
+//! `picoscenes`).
+
+use alloc::format;
+use alloc::string::String;
+use alloc::vec::Vec;
+
+use super::csi::{self, Csi};
+use crate::edge::csi::capture::{CsiCapture, CsiFormat};
+use crate::error::limits::{MAX_RECORDING_SAMPLES, MAX_SNAPSHOTS};
+use crate::error::{Error, Result};
+use crate::math::Real;
+
+/// The frame's magic word.
+const MAGIC: u32 = 0x2015_0315;
+
+/// Little-endian reads from a frame's bytes whose errors name the frame and the field.
+pub(super) struct Cursor<'a> {
+    bytes: &'a [u8],
+    pos: usize,
+    /// The frame (0-based, file order).
+    pub frame: usize,
+    prefix: String,
+}
+
+impl<'a> Cursor<'a> {
+    /// A cursor over `bytes` of `frame`; fields are named `<segment>.<field>`.
+    pub fn new(bytes: &'a [u8], frame: usize, segment: &str) -> Self {
+        let prefix = if segment.is_empty() {
+            String::new()
+        } else {
+            format!("{segment}.")
+        };
+        Cursor {
+            bytes,
+            pos: 0,
+            frame,
+            prefix,
+        }
+    }
+
+    /// The error of `field`.
+    pub fn bad(&self, field: &str, reason: String) -> Error {
+        Error::InvalidFile {
+            field: format!("frame {}: {}{field}", self.frame, self.prefix),
+            reason,
+        }
+    }
+
+    /// The next `n` bytes.
+    pub fn take(&mut self, field: &str, n: usize) -> Result<&'a [u8]> {
+        let rest = self.bytes.get(self.pos..).unwrap_or_default();
+        let out = rest.get(..n).ok_or_else(|| {
+            self.bad(
+                field,
+                format!("truncated: {n} bytes needed, {} remain", rest.len()),
+            )
+        })?;
+        self.pos += n;
+        Ok(out)
+    }
+
+    fn array<const N: usize>(&mut self, field: &str) -> Result<[u8; N]> {
+        let b = self.take(field, N)?;
+        let mut a = [0u8; N];
+        a.copy_from_slice(b);
+        Ok(a)
+    }
+
+    /// A u8.
+    pub fn u8(&mut self, field: &str) -> Result<u8> {
+        Ok(self.array::<1>(field)?[0])
+    }
+
+    /// A u16.
+    pub fn u16(&mut self, field: &str) -> Result<u16> {
+        self.array(field).map(u16::from_le_bytes)
+    }
+
+    /// A u32.
+    pub fn u32(&mut self, field: &str) -> Result<u32> {
+        self.array(field).map(u32::from_le_bytes)
+    }
+
+    /// A u64.
+    pub fn u64(&mut self, field: &str) -> Result<u64> {
+        self.array(field).map(u64::from_le_bytes)
+    }
+
+    /// The bytes not read yet.
+    pub fn rest(&self) -> &'a [u8] {
+        self.bytes.get(self.pos..).unwrap_or_default()
+    }
+}
+
+/// What one frame holds: the `RxSBasic` timestamp (µs) and the CSI, where present.
+fn parse_frame(body: &[u8], frame: usize) -> Result<(Option<u64>, Option<Csi>)> {
+    let mut c = Cursor::new(body, frame, "");
+    let magic = c.u32("magic")?;
+    if magic != MAGIC {
+        return Err(c.bad("magic", format!("{magic:#010x}: {MAGIC:#010x} expected")));
+    }
+    let version = c.u16("frame version")?;
+    if version != 1 {
+        return Err(c.bad(
+            "frame version",
+            format!("{version}: unsupported (1 is read)"),
+        ));
+    }
+    let n = c.u8("numRxSegments")?;
+    let (mut tstamp, mut data) = (None, None);
+    for i in 0..n {
+        let len = c.u32(&format!("segment {i} length"))? as usize;
+        let seg = c.take(&format!("segment {i} length"), len)?;
+        let mut s = Cursor::new(seg, frame, &format!("segment {i}"));
+        let name_len = usize::from(s.u8("name length")?);
+        let name = s.take("name", name_len)?;
+        let name = name.split(|&b| b == 0).next().unwrap_or_default();
+        let version = s.u16("version")?;
+        match name {
+            b"RxSBasic" => {
+                let mut r = Cursor::new(s.rest(), frame, "RxSBasic");
+                let size = match version {
+                    1 => 26,
+                    2 => 28,
+                    3 => 30,
+                    v => {
+                        return Err(r.bad("version", format!("{v}: unsupported (1 to 3 are read)")))
+                    }
+                };
+                r.u16("deviceType")?;
+                tstamp = Some(r.u64("tstamp")?);
+                r.take("header", size - 10)?;
+            }
+            b"CSI" => {
+                let mut r = Cursor::new(s.rest(), frame, "CSI");
+                data = Some(csi::parse(&mut r, version)?);
+            }
+            _ => {}
+        }
+    }
+    Ok((tstamp, data))
+}
+
+/// What must agree between frames, in words.
+fn describe(c: &Csi) -> String {
+    format!(
+        "{} {} {} MHz at {} Hz, {} Rx × {} Tx, {} subcarriers {}…{} spaced {} Hz",
+        csi::device_name(c.device),
+        csi::format_name(c.format),
+        c.cbw,
+        c.carrier_hz,
+        c.n_rx,
+        c.n_tx,
+        c.subcarriers.len(),
+        c.subcarriers.first().copied().unwrap_or(0),
+        c.subcarriers.last().copied().unwrap_or(0),
+        c.spacing_hz
+    )
+}
+
+/// Whether `bytes` start like a PicoScenes RXS frame (magic word and frame version 1).
+pub fn sniff(bytes: &[u8]) -> bool {
+    bytes.get(4..8) == Some(&MAGIC.to_le_bytes()[..]) && bytes.get(8..10) == Some(&[1, 0][..])
+}
+
+/// Reads a PicoScenes `.csi` file (module doc). Errors name the frame (0-based, file order)
+/// and the field (`frame length`, `magic`, `segment i length`, `CSI.NumTones`,
+/// `CSI.CSIBufferLength`, …); an unsupported device layout or segment version is an error
+/// naming it.
+pub fn read(bytes: &[u8]) -> Result<CsiCapture> {
+    let (mut pos, mut frame) = (0usize, 0usize);
+    let mut first: Option<Csi> = None;
+    let (mut t_s, mut values, mut skipped) = (Vec::new(), Vec::new(), Vec::new());
+    while pos < bytes.len() {
+        let mut c = Cursor::new(bytes.get(pos..).unwrap_or_default(), frame, "");
+        let len = c.u32("frame length")? as usize;
+        let body = c.take("frame length", len)?;
+        pos += 4 + len;
+        let (tstamp, data) = parse_frame(body, frame)?;
+        let (tstamp, data) = match (tstamp, data) {
+            (Some(t), Some(d)) => (t, d),
+            (_, None) => {
+                skipped.push((frame, "no CSI segment".into()));
+                frame += 1;
+                continue;
+            }
+            (None, Some(_)) => {
+                skipped.push((frame, "no RxSBasic segment (no timestamp)".into()));
+                frame += 1;
+                continue;
+            }
+        };
+        let reference = first.get_or_insert_with(|| Csi {
+            values: Vec::new(),
+            ..data.clone()
+        });
+        let same = (
+            data.device,
+            data.format,
+            data.cbw,
+            data.carrier_hz,
+            data.spacing_hz,
+        ) == (
+            reference.device,
+            reference.format,
+            reference.cbw,
+            reference.carrier_hz,
+            reference.spacing_hz,
+        ) && (data.n_rx, data.n_tx) == (reference.n_rx, reference.n_tx)
+            && data.subcarriers == reference.subcarriers;
+        if !same {
+            let reason = format!(
+                "{} differs from the first CSI frame's {}",
+                describe(&data),
+                describe(reference)
+            );
+            skipped.push((frame, reason));
+            frame += 1;
+            continue;
+        }
+        if t_s.len() >= MAX_SNAPSHOTS {
+            return Err(Error::SizeLimit {
+                field: "frames",
+                value: t_s.len() + 1,
+                min: 1,
+                max: MAX_SNAPSHOTS,
+            });
+        }
+        if values.len() + data.values.len() > MAX_RECORDING_SAMPLES {
+            return Err(Error::SizeLimit {
+                field: "CSI values",
+                value: values.len() + data.values.len(),
+                min: 1,
+                max: MAX_RECORDING_SAMPLES,
+            });
+        }
+        values.extend_from_slice(&data.values);
+        t_s.push(tstamp as Real / 1e6);
+        frame += 1;
+    }
+    let Some(r) = first else {
+        return Err(Error::InvalidFile {
+            field: "frame 0: CSI".into(),
+            reason: format!("none of the {frame} frames has CSI and RxSBasic segments"),
+        });
+    };
+    let mut notes: Vec<String> = Vec::new();
+    notes.push("antenna phase offsets not calibrated".into());
+    notes.push(
+        "timing offset (SFO/STO) and carrier phase (CFO) not removed: the front end removes \
+         them per snapshot (C9/C10)"
+            .into(),
+    );
+    if r.device == 0x5300 {
+        notes.push("ANTSEL not applied (as csiread and PicoScenes' parser leave it)".into());
+    }
+    if r.n_tx > 1 {
+        notes.push("CSI per space-time stream: the spatial mapping is not removed".into());
+    }
+    notes.push("no gain: PicoScenes reports RSSI but no CSI amplitude scaling".into());
+    let pilots = csi::pilots(r.format, r.cbw)
+        .into_iter()
+        .filter(|p| r.subcarriers.contains(p))
+        .collect();
+    let cap = CsiCapture {
+        format: CsiFormat::PicoScenes,
+        device: csi::device_name(r.device),
+        frame_format: csi::format_name(r.format).into(),
+        center_hz: (r.carrier_hz > 0).then_some(r.carrier_hz as Real),
+        bandwidth_hz: Real::from(r.cbw) * 1e6,
+        spacing_hz: Real::from(r.spacing_hz),
+        subcarriers: r.subcarriers,
+        pilots,
+        n_rx: r.n_rx,
+        n_tx: r.n_tx,
+        t_s,
+        csi: values,
+        gain: None,
+        notes,
+        skipped,
+    };
+    cap.validate()?;
+    Ok(cap)
+}
