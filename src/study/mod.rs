@@ -30,10 +30,10 @@ mod sums;
 mod track;
 
 pub use channel::{
-    channel_settings, channel_settings_json, cir_track, delays_only, estimate_link,
+    channel_settings, channel_settings_json, cir_track, delays_only, direct_paths, estimate_link,
     estimate_recording, prepare, BoundCounts, Bounds, ChannelRequest, ChannelSetting,
     ChannelStatics, CirStart, CirTrackOutput, DelayReference, DelaySigma, EstimationRun,
-    FrontEndConfig, LinkEstimates, LinkFront, LinkStatics, LinkStaticsInfo, Prepared,
+    FrontEndConfig, LinkDirectPath, LinkEstimates, LinkFront, LinkStatics, LinkStaticsInfo, Prepared,
     RecordingEstimates, SegmentDoc, SettingKind, StaticMode, BACKGROUND_MAX_PATHS,
     DEFAULT_PROCESS_NOISE, DEFAULT_SEED, EXTENT_SIGMA_M, LOS_WITHIN_DB, RECURSIVE_CLUSTER_DB,
 };

@@ -159,7 +159,11 @@ impl CsiCapture {
                 found: self.csi.len(),
             });
         }
-        if let Some(i) = self.csi.iter().position(|z| !(z.re.is_finite() && z.im.is_finite())) {
+        if let Some(i) = self
+            .csi
+            .iter()
+            .position(|z| !(z.re.is_finite() && z.im.is_finite()))
+        {
             let per = self.n_rx * self.n_tx * self.subcarriers.len();
             return Err(Error::NonFinite {
                 field: format!("frame {}: csi[{}]", i / per, i % per),
@@ -179,10 +183,16 @@ impl CsiCapture {
                 });
             }
             if let Some(f) = g.iter().position(|v| !(v.is_finite() && *v > 0.0)) {
-                return Err(bad(&format!("frame {f}: gain"), "not finite and > 0".into()));
+                return Err(bad(
+                    &format!("frame {f}: gain"),
+                    "not finite and > 0".into(),
+                ));
             }
         }
-        for (field, v) in [("spacing_hz", self.spacing_hz), ("bandwidth_hz", self.bandwidth_hz)] {
+        for (field, v) in [
+            ("spacing_hz", self.spacing_hz),
+            ("bandwidth_hz", self.bandwidth_hz),
+        ] {
             if !(v.is_finite() && v > 0.0) {
                 return Err(bad(field, format!("{v}: must be finite and > 0")));
             }
@@ -240,7 +250,10 @@ impl PairLink {
                 tx: num(tx)?,
                 link: [num(a)?, num(b)?],
             };
-            if out.iter().any(|q: &PairLink| (q.rx, q.tx) == (p.rx, p.tx) || q.link == p.link) {
+            if out
+                .iter()
+                .any(|q: &PairLink| (q.rx, q.tx) == (p.rx, p.tx) || q.link == p.link)
+            {
                 return Err(Error::InvalidFile {
                     field: format!("links[{i}]"),
                     reason: format!("{item:?}: this antenna pair or link is already mapped"),
@@ -255,7 +268,13 @@ impl PairLink {
     /// from transmitter `t` to receiver `r`, in the order of [`CsiCapture::pair`].
     pub fn all(n_rx: usize, n_tx: usize) -> Vec<PairLink> {
         (0..n_rx)
-            .flat_map(|r| (0..n_tx).map(move |t| PairLink { rx: r, tx: t, link: [t, r] }))
+            .flat_map(|r| {
+                (0..n_tx).map(move |t| PairLink {
+                    rx: r,
+                    tx: t,
+                    link: [t, r],
+                })
+            })
             .collect()
     }
 }

@@ -506,6 +506,18 @@ mod tests {
     }
 
     #[test]
+    fn any_byte_of_the_first_frames_overwritten_never_panics() {
+        let good = example();
+        for at in 0..2 * REC {
+            for x in [0x00, 0x7F, 0xFF] {
+                let mut v = good.clone();
+                v[at] = x;
+                let _ = read(&v);
+            }
+        }
+    }
+
+    #[test]
     fn sniff_claims_only_this_format() {
         assert!(sniff(&example()));
         for other in [

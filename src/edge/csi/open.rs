@@ -121,4 +121,3 @@ pub fn open_recording(bytes: &[u8], options: &OpenOptions) -> Result<Opened> {
         }
     }
 }
-

@@ -53,7 +53,12 @@ fn grid_mask_links_and_dropped_frames() {
     };
     let want_f: Vec<f64> = (-3..=2).map(|k| k as f64 * 312.5e3).collect();
     assert_eq!(freq_hz, &want_f);
-    let mask: Vec<f64> = system_response.as_ref().unwrap().iter().map(|p| p.re).collect();
+    let mask: Vec<f64> = system_response
+        .as_ref()
+        .unwrap()
+        .iter()
+        .map(|p| p.re)
+        .collect();
     assert_eq!(mask, vec![1.0, 0.0, 1.0, 0.0, 0.0, 1.0]);
     // Gain not asked for: the raw values at their bins, zeros elsewhere.
     let h = r.response(1, 1);
@@ -102,7 +107,11 @@ fn link_map_errors_are_named() {
 fn capture_checks_are_named() {
     let mut c = capture();
     c.subcarriers = vec![2, -1, -3];
-    assert!(c.validate().unwrap_err().to_string().contains("subcarriers"));
+    assert!(c
+        .validate()
+        .unwrap_err()
+        .to_string()
+        .contains("subcarriers"));
     let mut c = capture();
     c.csi[7] = Complex::new(f64::NAN, 0.0);
     let e = c.validate().unwrap_err().to_string();
@@ -112,7 +121,11 @@ fn capture_checks_are_named() {
     assert!(c.validate().is_err());
     let mut c = capture();
     c.subcarriers = vec![-40000, 40000, 40001];
-    assert!(c.validate().unwrap_err().to_string().contains("subcarrier span"));
+    assert!(c
+        .validate()
+        .unwrap_err()
+        .to_string()
+        .contains("subcarrier span"));
 }
 
 #[test]

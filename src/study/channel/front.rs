@@ -138,7 +138,7 @@ fn relative(tau: Real, tau0: Real, base: Real, span: Real) -> Real {
 /// one furthest before the strongest, cyclically, by less than a quarter of the unambiguous
 /// span `span` (delays are known modulo it: a free-running receiver's direct path may sit just
 /// below the span's end while its echoes wrap to its start).
-fn los_of(paths: &[PathEstimate], span: Real) -> Option<&PathEstimate> {
+pub(super) fn los_of(paths: &[PathEstimate], span: Real) -> Option<&PathEstimate> {
     let top = paths
         .iter()
         .max_by(|a, b| a.alpha.norm_sqr().total_cmp(&b.alpha.norm_sqr()))?;

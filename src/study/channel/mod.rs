@@ -36,12 +36,14 @@
 //! assert!(!track.segments.is_empty());
 //! ```
 
+mod direct;
 mod estimates;
 mod front;
 mod request;
 mod settings;
 mod track;
 
+pub use direct::{direct_paths, LinkDirectPath};
 pub use estimates::{
     estimate_link, estimate_recording, prepare, BoundCounts, ChannelStatics, EstimationRun,
     LinkStaticsInfo, Prepared, RecordingEstimates,

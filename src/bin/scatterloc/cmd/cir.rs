@@ -21,8 +21,8 @@ use super::io::{emit_summary, model_of, one_stdin, read_json_file, read_scenario
 use super::output::{check_distinct, check_writable, Format, OutputSet};
 use super::study::{catch_ctrl_c, interrupted, run_with_counter, threads};
 use crate::cli::{
-    Association, CirEstimateArgs, CsiArgs, CirSimulateArgs, CirTrackArgs, FrontEndArgs, ReferenceName,
-    SigmaSource, StaticsName,
+    Association, CirEstimateArgs, CirSimulateArgs, CirTrackArgs, CsiArgs, FrontEndArgs,
+    ReferenceName, SigmaSource, StaticsName,
 };
 use crate::failure::CliError;
 
@@ -34,10 +34,23 @@ fn read_recording(
     model: &Model,
     csi: &CsiArgs,
 ) -> Result<Recording, CliError> {
+    Ok(open_recording(flag, path, model, csi)?.recording)
+}
+
+/// [`read_recording`] with what a CSI file held (`csi: None` for a `.npz`).
+fn open_recording(
+    flag: &str,
+    path: &str,
+    model: &Model,
+    csi: &CsiArgs,
+) -> Result<scatterloc::csi::Opened, CliError> {
     // The reader validates what it read (`Recording::validate`); the links against the scenario.
-    let rec = super::cir_convert::open(flag, path, csi)?.recording;
-    rec.link_map(model).map_err(|e| in_file(flag, path, e))?;
-    Ok(rec)
+    let opened = super::cir_convert::open(flag, path, csi)?;
+    opened
+        .recording
+        .link_map(model)
+        .map_err(|e| in_file(flag, path, e))?;
+    Ok(opened)
 }
 
 /// A core error of the request, named by the flag that sets its field.
@@ -208,7 +221,8 @@ pub fn cir_estimate(args: &CirEstimateArgs) -> Result<(), CliError> {
     let (threads, _) = threads(args.front_end.threads)?;
     let scenario = read_scenario(&args.scenario)?;
     let model = model_of(&scenario)?;
-    let rec = read_recording("cir", &args.cir, &model, &args.front_end.csi)?;
+    let opened = open_recording("cir", &args.cir, &model, &args.front_end.csi)?;
+    let rec = opened.recording;
     let empty = empty_area(
         args.calibration.as_deref(),
         &req,
@@ -216,6 +230,22 @@ pub fn cir_estimate(args: &CirEstimateArgs) -> Result<(), CliError> {
         &model,
         &args.front_end.csi,
     )?;
+    // A CSI file: what it held and its direct path per link (C10; issue 40).
+    let csi_doc = match &opened.csi {
+        Some(summary) => {
+            let direct = scatterloc::study::direct_paths(
+                &rec,
+                scenario.radio.bandwidth_hz,
+                Cancel::when(&interrupted),
+            )
+            .map_err(|e| match e {
+                scatterloc::Error::Cancelled => super::study::cancelled(),
+                e => in_file("cir", &args.cir, e),
+            })?;
+            Some((summary.to_json(&rec), direct))
+        }
+        None => None,
+    };
     let measurements = match &args.measurements {
         Some(_) => Some(uniform_dt(&rec.t_s, q)?),
         None => None,
@@ -263,18 +293,21 @@ pub fn cir_estimate(args: &CirEstimateArgs) -> Result<(), CliError> {
     }
     files.commit()?;
     let paths: usize = est.paths.iter().flatten().map(Vec::len).sum();
-    emit_summary(
-        &serde_json::json!({
-            "out": args.out,
-            "snapshots": est.len(),
-            "links": rec.links.len(),
-            "paths": paths,
-            "statics": cfg.statics.name(),
-            "delay_reference": cfg.delay_reference.name(),
-            "bounds": est.bounds(),
-        })
-        .to_string(),
-    )
+    let mut summary = serde_json::json!({
+        "out": args.out,
+        "snapshots": est.len(),
+        "links": rec.links.len(),
+        "paths": paths,
+        "statics": cfg.statics.name(),
+        "delay_reference": cfg.delay_reference.name(),
+        "bounds": est.bounds(),
+    });
+    if let Some((csi, direct)) = csi_doc {
+        summary["csi"] = csi;
+        summary["direct_path"] = serde_json::to_value(&direct)
+            .map_err(|e| CliError::output(format!("encoding JSON: {e}")))?;
+    }
+    emit_summary(&summary.to_string())
 }
 
 /// The uniform step of `t_s` (within 1e-6 relative), checked as a CV model with `q`, for

@@ -14,10 +14,9 @@ use crate::failure::CliError;
 /// The reader's options of `csi`'s flags (`--links` parsed; its errors name the flag).
 pub fn options(csi: &CsiArgs) -> Result<OpenOptions, CliError> {
     let links = match &csi.links {
-        Some(text) => Some(
-            PairLink::parse_list(text)
-                .map_err(|e| CliError::usage(format!("--links: {e}")))?,
-        ),
+        Some(text) => {
+            Some(PairLink::parse_list(text).map_err(|e| CliError::usage(format!("--links: {e}")))?)
+        }
         None => None,
     };
     Ok(OpenOptions {

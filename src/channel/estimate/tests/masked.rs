@@ -120,7 +120,11 @@ fn estimator_reaches_c4_on_masked_grids() {
                      ratio {:.3}",
                     r / b
                 );
-                assert!((r / b - 1.0).abs() <= tol, "{name} seed {seed}: ratio {}", r / b);
+                assert!(
+                    (r / b - 1.0).abs() <= tol,
+                    "{name} seed {seed}: ratio {}",
+                    r / b
+                );
             }
         }
     }

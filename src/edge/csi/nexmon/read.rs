@@ -299,24 +299,16 @@ fn assemble(
             ));
             continue;
         }
-        if t_s.len() >= MAX_SNAPSHOTS || csi.len() + per_frame > MAX_RECORDING_SAMPLES {
+        let caps = [
+            ("frames", t_s.len() + 1, MAX_SNAPSHOTS),
+            ("CSI values", csi.len() + per_frame, MAX_RECORDING_SAMPLES),
+        ];
+        if let Some(&(field, value, max)) = caps.iter().find(|c| c.1 > c.2) {
             return Err(Error::SizeLimit {
-                field: if t_s.len() >= MAX_SNAPSHOTS {
-                    "frames"
-                } else {
-                    "CSI values"
-                },
-                value: if t_s.len() >= MAX_SNAPSHOTS {
-                    t_s.len() + 1
-                } else {
-                    csi.len() + per_frame
-                },
+                field,
+                value,
                 min: 1,
-                max: if t_s.len() >= MAX_SNAPSHOTS {
-                    MAX_SNAPSHOTS
-                } else {
-                    MAX_RECORDING_SAMPLES
-                },
+                max,
             });
         }
         let base = csi.len();

@@ -9,7 +9,7 @@ use alloc::vec::Vec;
 use super::super::bfee;
 use super::frame::Cursor;
 use crate::error::limits::{MAX_BINS_PER_LINK, MAX_LINKS};
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::math::Complex;
 
 /// `PicoScenesDeviceType` values.
@@ -53,6 +53,15 @@ pub(super) fn device_name(device: u16) -> String {
         USRP => "USRP".into(),
         VIRTUAL_SDR => "PicoScenes virtual SDR".into(),
         d => format!("PicoScenes device {d:#06x}"),
+    }
+}
+
+/// The unit of `RxSBasic.tstamp`, ticks per second: ns for the SDRs (the host's clock since
+/// the Unix epoch), µs for the NICs (their hardware clock).
+pub(super) fn ticks_per_second(device: u16) -> f64 {
+    match device {
+        USRP | VIRTUAL_SDR => 1e9,
+        _ => 1e6,
     }
 }
 
@@ -325,4 +334,152 @@ fn signal_matrix(c: &Cursor<'_>, buf: &[u8], tones: usize, n_rx: usize) -> Resul
         values[(rr * n_tx + t) * k + kk] = Complex::new(part(2 * i), part(2 * i + 1));
     }
     Ok((n_tx, subcarriers, values))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A version-2 CSI segment body.
+    fn body(device: u16, cbw: u16, tones: u16, n_rx: u8, offset: i16, buf: &[u8]) -> Vec<u8> {
+        let mut b = device.to_le_bytes().to_vec();
+        b.push(1); // HT
+        b.extend(cbw.to_le_bytes());
+        b.extend(5_180_000_000u64.to_le_bytes());
+        b.extend(20_000_000u64.to_le_bytes());
+        b.extend(312_500u32.to_le_bytes());
+        b.extend(tones.to_le_bytes());
+        b.extend([1, n_rx, 0, 0]);
+        b.extend(offset.to_le_bytes());
+        b.extend((buf.len() as u32).to_le_bytes());
+        b.extend(buf);
+        b
+    }
+
+    fn parse_v2(b: &[u8]) -> Result<Csi> {
+        parse(&mut Cursor::new(b, 7, "CSI"), 2)
+    }
+
+    #[test]
+    fn qca9300_ten_bit_values_imaginary_first() {
+        // 2 chains × 1 stream × 56 tones; value v: chain v mod 2, tone v / 2.
+        let z = |v: i32| ((v % 50) - 25, 3 - (v % 37));
+        let mut nums = Vec::new();
+        for v in 0..112 {
+            let (re, im) = z(v);
+            nums.extend([im, re]);
+        }
+        let mut buf = vec![0u8; 280];
+        for (i, &n) in nums.iter().enumerate() {
+            let bits = (n as u32) & 0x3FF;
+            for j in 0..10 {
+                if bits >> j & 1 == 1 {
+                    buf[(i * 10 + j) / 8] |= 1 << ((i * 10 + j) % 8);
+                }
+            }
+        }
+        let c = parse_v2(&body(QCA9300, 20, 56, 2, 0, &buf)).unwrap();
+        assert_eq!((c.n_rx, c.n_tx, c.subcarriers.len()), (2, 1, 56));
+        assert_eq!((c.subcarriers[27], c.subcarriers[28]), (-1, 1));
+        for v in 0..112usize {
+            let (re, im) = z(v as i32);
+            let got = c.values[(v % 2) * 56 + v / 2];
+            assert_eq!(got, Complex::new(re.into(), im.into()), "value {v}");
+        }
+        let e = parse_v2(&body(QCA9300, 20, 30, 2, 0, &buf))
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("frame 7: CSI.NumTones"), "{e}");
+        let e = parse_v2(&body(QCA9300, 20, 56, 3, 0, &buf))
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("frame 7: CSI.CSIBufferLength"), "{e}");
+    }
+
+    fn matrix(version: u8, dims: &[u64], kind: &[u8; 4], values: &[u8]) -> Vec<u8> {
+        let mut m = vec![b'B', b'B', b'v', b'0' + version, dims.len() as u8];
+        for &d in dims {
+            if version == 1 {
+                m.extend((d as u32).to_le_bytes());
+            } else {
+                m.extend(d.to_le_bytes());
+            }
+        }
+        m.extend(kind);
+        m.extend(values);
+        m
+    }
+
+    #[test]
+    fn sdr_layout_with_explicit_indices() {
+        let mut buf: Vec<u8> = [-2i16, 1, 3].iter().flat_map(|k| k.to_le_bytes()).collect();
+        // Column-major [3 tones, 1 stream, 2 chains] of complex int16: value i = (i+1, -(i+1)).
+        let vals: Vec<u8> = (1..=6i16)
+            .flat_map(|i| [i, -i])
+            .flat_map(|x| x.to_le_bytes())
+            .collect();
+        buf.extend(matrix(1, &[3, 1, 2], b"CI\x10C", &vals));
+        let c = parse_v2(&body(USRP, 20, 3, 2, 10, &buf)).unwrap();
+        assert_eq!(c.subcarriers, [8, 11, 13]);
+        assert_eq!((c.n_rx, c.n_tx), (2, 1));
+        // Chain 1, tone 2 is element 2 + 3·1 = 5: (6, -6).
+        assert_eq!(c.values[3 + 2], Complex::new(6.0, -6.0));
+        assert_eq!(c.values[1], Complex::new(2.0, -2.0));
+        // Row-major complex float32, BBv2: element i is tone i / 2, chain i mod 2.
+        let mut buf: Vec<u8> = [-2i16, 1, 3].iter().flat_map(|k| k.to_le_bytes()).collect();
+        let vals: Vec<u8> = (1..=6)
+            .flat_map(|i| [i as f32, 0.5])
+            .flat_map(|x| x.to_le_bytes())
+            .collect();
+        buf.extend(matrix(2, &[3, 1, 2], b"CF\x20R", &vals));
+        let c = parse_v2(&body(VIRTUAL_SDR, 20, 3, 2, 0, &buf)).unwrap();
+        assert_eq!(c.values[3 + 2], Complex::new(6.0, 0.5));
+        assert_eq!(c.values[1], Complex::new(3.0, 0.5));
+        // Wrong dimensions, a bad header, a short buffer.
+        let mut bad = buf.clone();
+        bad[6] = b'X';
+        let e = parse_v2(&body(USRP, 20, 3, 2, 0, &bad))
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("frame 7: CSI.SignalMatrix"), "{e}");
+        let e = parse_v2(&body(USRP, 20, 3, 1, 0, &buf))
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("frame 7: CSI.SignalMatrix dimensions"), "{e}");
+        let e = parse_v2(&body(USRP, 20, 3, 2, 0, &buf[..buf.len() - 1]))
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("frame 7: CSI.SignalMatrix values"), "{e}");
+        // Indices must increase.
+        let mut swap = buf.clone();
+        swap[..2].copy_from_slice(&5i16.to_le_bytes());
+        let e = parse_v2(&body(USRP, 20, 3, 2, 0, &swap))
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("frame 7: CSI.subcarrier indices"), "{e}");
+        // Huge dimensions: an error, no allocation.
+        let mut buf: Vec<u8> = [-2i16, 1, 3].iter().flat_map(|k| k.to_le_bytes()).collect();
+        buf.extend(matrix(2, &[3, u64::MAX, 2], b"CD\x40C", &[]));
+        assert!(parse_v2(&body(USRP, 20, 3, 2, 0, &buf)).is_err());
+    }
+
+    #[test]
+    fn other_devices_and_versions_are_named_unsupported() {
+        for dev in [AX200, AX210, 0x0802] {
+            let e = parse_v2(&body(dev, 20, 56, 1, 0, &[0; 224]))
+                .unwrap_err()
+                .to_string();
+            assert!(
+                e.starts_with("frame 7: CSI.DeviceType") && e.contains("unsupported"),
+                "{e}"
+            );
+        }
+        let e = parse(&mut Cursor::new(&[0; 64], 7, "CSI"), 5)
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("frame 7: CSI.version"), "{e}");
+        assert_eq!(pilots(2, 80), [-103, -75, -39, -11, 11, 39, 75, 103]);
+        assert_eq!(ticks_per_second(USRP), 1e9);
+        assert_eq!(ticks_per_second(IWL5300), 1e6);
+    }
 }

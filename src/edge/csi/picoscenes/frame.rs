@@ -93,7 +93,8 @@ impl<'a> Cursor<'a> {
     }
 }
 
-/// What one frame holds: the `RxSBasic` timestamp (µs) and the CSI, where present.
+/// What one frame holds: the `RxSBasic` timestamp (µs for the NICs, ns for the SDRs) and the
+/// CSI, where present.
 fn parse_frame(body: &[u8], frame: usize) -> Result<(Option<u64>, Option<Csi>)> {
     let mut c = Cursor::new(body, frame, "");
     let magic = c.u32("magic")?;
@@ -236,7 +237,7 @@ pub fn read(bytes: &[u8]) -> Result<CsiCapture> {
             });
         }
         values.extend_from_slice(&data.values);
-        t_s.push(tstamp as Real / 1e6);
+        t_s.push(tstamp as Real / csi::ticks_per_second(data.device));
         frame += 1;
     }
     let Some(r) = first else {
@@ -282,4 +283,160 @@ pub fn read(bytes: &[u8]) -> Result<CsiCapture> {
     };
     cap.validate()?;
     Ok(cap)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::Complex;
+
+    const DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/csi/");
+
+    fn file(name: &str) -> Vec<u8> {
+        std::fs::read(format!("{DIR}{name}")).unwrap()
+    }
+
+    fn example() -> Vec<u8> {
+        file("pico/picoscenes_iwl5300_example.csi")
+    }
+
+    /// Frame 0 is 4 + 358 bytes; frame 1 4 + 1618.
+    const F0: usize = 362;
+    const F1: usize = 1622;
+
+    fn err_of(edit: &[(usize, &[u8])]) -> String {
+        let mut v = example();
+        for (at, b) in edit {
+            v[*at..*at + b.len()].copy_from_slice(b);
+        }
+        read(&v).unwrap_err().to_string()
+    }
+
+    #[test]
+    fn reads_the_iwl5300_example_like_csiread() {
+        let cap = read(&example()).unwrap();
+        // csiread 1.4.1: c = csiread.Picoscenes(f, {'CSI': [30, 3, 2], 'PilotCSI': [0, 0, 0],
+        // 'LegacyCSI': [0, 0, 0], 'BasebandSignals': [0, 0, 0], 'PreEQSymbols': [0, 0, 0],
+        // 'MPDU': 1522}, if_report=False); c.read(): 112 frames; raw['CSI']['Info'] NumTx 1,
+        // NumRx 2 except these 13 (12 with 2 streams, frame 47 with 1 chain).
+        let skipped: Vec<usize> = cap.skipped.iter().map(|s| s.0).collect();
+        assert_eq!(
+            skipped,
+            [4, 16, 33, 47, 50, 53, 64, 68, 72, 78, 82, 91, 101]
+        );
+        assert!(cap.skipped[0]
+            .1
+            .starts_with("Intel 5300 HT 20 MHz at 2437000000 Hz, 2 Rx × 2 Tx"));
+        assert!(cap.skipped[3].1.contains("1 Rx × 1 Tx"));
+        assert_eq!(cap.frame_count(), 99);
+        assert_eq!((cap.n_rx, cap.n_tx), (2, 1));
+        assert_eq!(
+            (cap.device.as_str(), cap.frame_format.as_str()),
+            ("Intel 5300", "HT")
+        );
+        assert_eq!(cap.bandwidth_hz, 20e6);
+        assert_eq!(cap.center_hz, Some(2.437e9));
+        assert_eq!(cap.spacing_hz, 312_500.0);
+        assert_eq!(cap.gain, None);
+        // raw['CSI']['SubcarrierIndex'][0].
+        let want = [
+            -28, -26, -24, -22, -20, -18, -16, -14, -12, -10, -8, -6, -4, -2, -1, 1, 3, 5, 7, 9,
+            11, 13, 15, 17, 19, 21, 23, 25, 27, 28,
+        ];
+        assert_eq!(cap.subcarriers, want);
+        assert_eq!(cap.pilots, [7, 21]);
+        // raw['CSI']['CSI'][file frame, k, r, t]; capture frame = file frame − skipped before.
+        for ((file_f, f, r, k), (re, im)) in [
+            ((0, 0, 0, 0), (-6, 12)),
+            ((0, 0, 1, 29), (2, 8)),
+            ((0, 0, 1, 14), (10, -10)),
+            ((57, 51, 0, 13), (-4, 27)),
+            ((111, 98, 0, 0), (-10, -16)),
+            ((111, 98, 1, 29), (-3, -8)),
+        ] {
+            let z = cap.pair(f, r, 0)[k];
+            assert_eq!(
+                z,
+                Complex::new(re as Real, im as Real),
+                "file frame {file_f}"
+            );
+        }
+        // raw['RxSBasic']['Timestamp'][0], [-1] (µs).
+        assert_eq!(cap.t_s[0], 302584960555.0 / 1e6);
+        assert_eq!(cap.t_s[98], 302595358943.0 / 1e6);
+    }
+
+    #[test]
+    fn truncation_never_panics_and_errs_inside_a_frame() {
+        let bytes = example();
+        for cut in 0..F0 + F1 + 5 {
+            match read(&bytes[..cut]) {
+                Ok(cap) => {
+                    assert!(cut == F0 || cut == F0 + F1, "cut {cut} parsed");
+                    assert_eq!(cap.frame_count(), 1 + usize::from(cut > F0));
+                }
+                Err(e) => {
+                    let f = usize::from(cut >= F0) + usize::from(cut >= F0 + F1);
+                    let f = if cut == 0 { 0 } else { f };
+                    let e = e.to_string();
+                    assert!(e.starts_with(&format!("frame {f}: ")), "cut {cut}: {e}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn malformed_frames_name_frame_and_field() {
+        let cases: [(&[(usize, &[u8])], &str); 11] = [
+            (&[(4, &[0])], "frame 0: magic"),
+            (&[(8, &[2])], "frame 0: frame version"),
+            (&[(F0, &[0xF0, 0xFF, 0xFF, 0xFF])], "frame 1: frame length"),
+            (&[(11, &[0xFF, 0xFF, 0, 0])], "frame 0: segment 0 length"),
+            (&[(0x6d, &[9])], "frame 0: CSI.version"),
+            (&[(0x6f, &[0x00, 0x21])], "frame 0: CSI.DeviceType"),
+            (&[(0x88, &[31])], "frame 0: CSI.NumTones"),
+            (&[(0x8b, &[0])], "frame 0: CSI.NumRx"),
+            (&[(0x8b, &[4])], "frame 0: CSI.NumRx"),
+            (&[(0x90, &[72])], "frame 0: CSI.CSIBufferLength"),
+            (&[(0x90, &[0xFF, 0xFF, 0xFF])], "frame 0: CSI.CSI buffer"),
+        ];
+        for (edit, want) in cases {
+            let e = err_of(edit);
+            assert!(e.starts_with(want), "{want}: {e}");
+        }
+        assert!(err_of(&[(0x6f, &[0x00, 0x21])]).contains("unsupported"));
+        let e = read(&[0, 0, 0, 0]).unwrap_err().to_string();
+        assert!(
+            e.starts_with("frame 1: CSI") || e.starts_with("frame 0: "),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn any_byte_of_the_first_frames_overwritten_never_panics() {
+        let good = example();
+        for at in 0..F0 + F1 {
+            for x in [0x00, 0x7F, 0xFF] {
+                let mut v = good.clone();
+                v[at] = x;
+                let _ = read(&v);
+            }
+        }
+    }
+
+    #[test]
+    fn sniff_claims_only_this_format() {
+        assert!(sniff(&example()));
+        for other in [
+            "intel/example.dat",
+            "nexmon/example_4366c0.pcap",
+            "feitcsi/HESU160_5500.csi",
+            "feitcsi/VHT80_5500.csi",
+            "esp32/example_data.csv",
+            "../recording-cir-int16.npz",
+        ] {
+            assert!(!sniff(&file(other)), "{other}");
+        }
+        assert!(!sniff(&example()[..9]));
+    }
 }

@@ -15,7 +15,9 @@
 //! A segment: u32 `segmentLength` (the bytes that follow), u8 name length, the name
 //! (`RxSBasic`, `ExtraInfo`, `MVMExtra`, `CSI`, `PilotCSI`, `LegacyCSI`, `BasebandSignal`, …),
 //! u16 version, the body. Read here: `RxSBasic` (v1–v3: u16 `deviceType`, u64 `tstamp` — the
-//! hardware timestamp, **µs** — then frequencies, CBW, format, MCS, antennas, noise floor and
+//! timestamp: **µs** of the NIC's clock for IWL5300/QCA9300/AX2x0, **ns** since the Unix epoch
+//! for the SDRs (USRP, virtual SDR; csiread's USRP example file steps by ~10⁷ per frame, its
+//! IWL5300 and QCA9300 files by ~10⁵ and ~10²) — then frequencies, CBW, format, MCS, antennas, noise floor and
 //! RSSIs) and `CSI` (v1–v4):
 //!
 //! | bytes | field | version |
