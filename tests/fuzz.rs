@@ -6,7 +6,8 @@
 //! only the CLI parses. The invariant (`fuzz/check.rs`): `Ok` with finite outputs, or a named
 //! error (one line, at most 1000 bytes, naming the input), within a time and memory budget.
 //! Issue 37's kinds generate their inputs instead: noise-free responses, CIR tap windows,
-//! edited `.npz` archives and simulator scenes (at the end of this file).
+//! edited `.npz` archives and simulator scenes (at the end of this file); issue 40's the six real
+//! Wi-Fi CSI files edited byte-wise (`fuzz/csi.rs`).
 //!
 //! Case counts: small by default (CI, debug build); `SCATTERLOC_FUZZ_CASES=N` sets every kind
 //! (`scripts/fuzz.sh` runs 10⁴ per kind in release). The RNG is ChaCha with a fixed seed
@@ -40,6 +41,9 @@ use scatterloc::{Error, Model};
 
 #[path = "fuzz/check.rs"]
 mod check;
+#[cfg(feature = "npz")]
+#[path = "fuzz/csi.rs"]
+mod csi;
 #[path = "fuzz/docs.rs"]
 mod docs;
 #[allow(dead_code)]

@@ -571,6 +571,25 @@ mod tests {
     }
 
     #[test]
+    fn any_character_changed_never_panics() {
+        let b = file("esp32/example_data.csv");
+        let end = b
+            .iter()
+            .enumerate()
+            .filter(|(_, &c)| c == b'\n')
+            .nth(1)
+            .unwrap()
+            .0;
+        for at in 0..=end {
+            for v in [b',', b'[', b']', b'\n', b'9', 0xff] {
+                let mut c = b[..=end].to_vec();
+                c[at] = v;
+                let _ = read(&c);
+            }
+        }
+    }
+
+    #[test]
     fn headerless_unsigned_and_wrapping_clock() {
         let mut a = line("14", "0", "4294967000", "0", "128", 128);
         a = a.replace("[-50 ", "[200 ");

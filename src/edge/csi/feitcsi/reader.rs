@@ -137,6 +137,9 @@ fn push_values(
     m: &Map,
     gap: Option<(usize, usize)>,
 ) {
+    if k_raw == 0 {
+        return;
+    }
     let tones = m.tones();
     for block in data.chunks_exact(4 * k_raw) {
         let entries = block

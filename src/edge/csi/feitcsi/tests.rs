@@ -234,6 +234,20 @@ fn truncated_files_fail_with_the_frame_and_field() {
 }
 
 #[test]
+fn any_header_byte_changed_never_panics() {
+    let b = file("feitcsi/VHT80_5500.csi");
+    let two = 2 * (HEADER + 1936);
+    for at in (0..HEADER).chain(HEADER + 1936..HEADER + 1936 + HEADER) {
+        for v in [0x00, 0x01, 0x7f, 0xff] {
+            let mut c = b[..two].to_vec();
+            c[at] = v;
+            let _ = read(&c);
+            let _ = sniff(&c);
+        }
+    }
+}
+
+#[test]
 fn bad_headers_are_named() {
     let he160 = flags(4, 3);
     let mut b = frame(he160, 2, 1, 1992, 0, 0);
