@@ -409,17 +409,19 @@ fn check_samples(field: &str, shape: &[usize], s: usize, p: usize) -> PyResult<(
 /// `scatterloc cir convert` does (at most the CLI's cap of 1 GiB + 64 MiB). `format`: `auto`
 /// (default: by the first bytes), `npz`, `intel5300`, `nexmon`, `picoscenes`, `feitcsi`,
 /// `esp32`; `links`: the antenna pairs' links `rxR.txT=A:B,…` (default: every pair, link
-/// (T, R)); `raw_gain`: keep the CSI unscaled (default: the format's RSSI/AGC gain applied).
+/// (T, R)); `raw_gain`: keep the CSI unscaled (default: the format's RSSI/AGC gain applied);
+/// `all_subcarriers`: keep the subcarriers no frame occupies (default: left out).
 #[pyfunction]
-#[pyo3(signature = (path, *, format = None, links = None, raw_gain = false))]
+#[pyo3(signature = (path, *, format = None, links = None, raw_gain = false, all_subcarriers = false))]
 pub fn read_recording(
     py: Python<'_>,
     path: &Bound<'_, PyAny>,
     format: Option<String>,
     links: Option<String>,
     raw_gain: bool,
+    all_subcarriers: bool,
 ) -> PyResult<PyRecording> {
-    let rec = crate::csi::open(py, path, format, links, raw_gain)?.recording;
+    let rec = crate::csi::open(py, path, format, links, raw_gain, all_subcarriers)?.recording;
     Ok(PyRecording { rec })
 }
 

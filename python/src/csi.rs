@@ -39,6 +39,7 @@ pub fn open(
     format: Option<String>,
     links: Option<String>,
     raw_gain: bool,
+    all_subcarriers: bool,
 ) -> PyResult<Opened> {
     let bytes = read_file(path)?;
     let links = match links {
@@ -50,6 +51,7 @@ pub fn open(
         convert: ConvertOptions {
             links,
             apply_gain: !raw_gain,
+            keep_unoccupied: all_subcarriers,
         },
         max_npz_bytes: limits::MAX_RECORDING_BYTES,
     };
@@ -89,7 +91,10 @@ pub fn read_csi<'py>(
     let k = cap.subcarriers.len();
     d.set_item("t_s", array(py, cap.t_s.clone(), &[frames])?)?;
     d.set_item("subcarriers", array(py, cap.subcarriers.clone(), &[k])?)?;
-    d.set_item("pilots", array(py, cap.pilots.clone(), &[cap.pilots.len()])?)?;
+    d.set_item(
+        "pilots",
+        array(py, cap.pilots.clone(), &[cap.pilots.len()])?,
+    )?;
     let csi: Vec<Complex64> = cap.csi.iter().map(|z| Complex64::new(z.re, z.im)).collect();
     d.set_item("csi", array(py, csi, &[frames, cap.n_rx, cap.n_tx, k])?)?;
     match &cap.gain {

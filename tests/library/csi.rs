@@ -13,18 +13,20 @@ use scatterloc::error::{limits, Cancel};
 use scatterloc::math::SPEED_OF_LIGHT;
 use scatterloc::study::direct_paths;
 
-/// (file, format, frames in the recording, links, grid bins). ESP32: 60 CSI lines, each
+/// (file, format, frames in the recording, links, grid bins). PicoScenes: 112 frames, 13 of
+/// another antenna configuration skipped (99 kept). Nexmon: 20 MHz frames on the lowest
+/// sub-channel of an 80 MHz chanspec: 52 occupied tones, grid 53. ESP32: 60 CSI lines, each
 /// packet printed twice with the same `local_timestamp` (and the same CSI): 27 repeats dropped.
 const FILES: [(&str, &str, usize, usize, usize); 6] = [
     ("intel/example.dat", "intel5300", 26, 6, 57),
     (
         "pico/picoscenes_iwl5300_example.csi",
         "picoscenes",
-        112,
+        99,
         2,
         57,
     ),
-    ("nexmon/example_4366c0.pcap", "nexmon", 293, 1, 245),
+    ("nexmon/example_4366c0.pcap", "nexmon", 293, 1, 53),
     ("feitcsi/VHT80_5500.csi", "feitcsi", 40, 2, 245),
     ("feitcsi/HESU160_5500.csi", "feitcsi", 26, 2, 2025),
     ("esp32/example_data.csv", "esp32", 33, 1, 53),

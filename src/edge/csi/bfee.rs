@@ -114,7 +114,7 @@ mod tests {
     #[test]
     fn payload_length_is_calc_len() {
         for n in 1..=9 {
-            assert_eq!(payload_len(n, 1), Some((30 * (16 * n + 3) + 7) / 8));
+            assert_eq!(payload_len(n, 1), Some((30 * (16 * n + 3)).div_ceil(8)));
         }
         assert_eq!(payload_len(usize::MAX, 2), None);
     }

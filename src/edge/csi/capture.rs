@@ -287,6 +287,74 @@ pub struct ConvertOptions {
     /// Multiply each frame by the format's reported gain ([`CsiCapture::gain`]), where it has
     /// one.
     pub apply_gain: bool,
+    /// Keep every reported subcarrier, also those no frame occupies ([`occupied`]): `false`
+    /// (the default) leaves them out.
+    pub keep_unoccupied: bool,
+}
+
+/// A block of the subcarrier grid is unoccupied when its mean power is this far below the
+/// strongest block's, dB.
+pub const UNOCCUPIED_BLOCK_DB: Real = 20.0;
+/// Within the occupied blocks, a subcarrier is unoccupied when its mean power is this far below
+/// their median subcarrier's, dB.
+pub const UNOCCUPIED_TONE_DB: Real = 30.0;
+
+/// The reported subcarriers the frames actually occupy (positions into
+/// [`CsiCapture::subcarriers`]). A card may report a wider band than the frames it hears use —
+/// Nexmon reports its chanspec's 80 MHz for a 20 MHz legacy frame on one of its sub-channels,
+/// leaving three quarters of the subcarriers at noise — and noise-only bins fitted as signal
+/// spoil the delay estimate. Rule: the mean power of each subcarrier over all frames and antenna
+/// pairs; the 20 MHz blocks of the grid (64 subcarriers at 312.5 kHz, 256 at 78.125 kHz, aligned
+/// on index 0) whose mean power is more than [`UNOCCUPIED_BLOCK_DB`] below the strongest block
+/// are unoccupied, and so is a subcarrier of an occupied block more than [`UNOCCUPIED_TONE_DB`]
+/// below the median subcarrier of the occupied blocks (a null or guard tone of the narrower
+/// frame). At least two subcarriers are always kept (the strongest ones).
+pub fn occupied(cap: &CsiCapture) -> Vec<usize> {
+    let k = cap.subcarriers.len();
+    let mut power = vec![0.0; k];
+    for chunk in cap.csi.chunks_exact(k) {
+        for (p, z) in power.iter_mut().zip(chunk) {
+            *p += z.norm_sqr();
+        }
+    }
+    let block_len = (20e6 / cap.spacing_hz).round().max(1.0) as i64;
+    let block = |i: usize| (cap.subcarriers[i] as i64).div_euclid(block_len);
+    let mut blocks: Vec<(i64, Real, usize)> = Vec::new();
+    for i in 0..k {
+        match blocks.iter_mut().find(|b| b.0 == block(i)) {
+            Some(b) => {
+                b.1 += power[i];
+                b.2 += 1;
+            }
+            None => blocks.push((block(i), power[i], 1)),
+        }
+    }
+    let mean = |b: &(i64, Real, usize)| b.1 / b.2 as Real;
+    let top = blocks.iter().map(mean).fold(0.0, Real::max);
+    let floor = top * crate::math::db_to_linear(-UNOCCUPIED_BLOCK_DB);
+    let live: Vec<i64> = blocks
+        .iter()
+        .filter(|b| mean(b) >= floor && mean(b) > 0.0)
+        .map(|b| b.0)
+        .collect();
+    let in_live: Vec<usize> = (0..k).filter(|&i| live.contains(&block(i))).collect();
+    let mut sorted: Vec<Real> = in_live.iter().map(|&i| power[i]).collect();
+    sorted.sort_by(Real::total_cmp);
+    let median = sorted.get(sorted.len() / 2).copied().unwrap_or(0.0);
+    let tone_floor = median * crate::math::db_to_linear(-UNOCCUPIED_TONE_DB);
+    let keep: Vec<usize> = in_live
+        .into_iter()
+        .filter(|&i| power[i] >= tone_floor && power[i] > 0.0)
+        .collect();
+    if keep.len() >= 2 {
+        return keep;
+    }
+    // Degenerate (all zero, or one strong tone): the two strongest.
+    let mut order: Vec<usize> = (0..k).collect();
+    order.sort_by(|&a, &b| power[b].total_cmp(&power[a]).then(a.cmp(&b)));
+    let mut two: Vec<usize> = order.into_iter().take(2).collect();
+    two.sort_unstable();
+    two
 }
 
 /// A capture converted: the recording and what the conversion did.
@@ -298,10 +366,13 @@ pub struct Conversion {
     pub dropped: Vec<(usize, Real)>,
     /// Whether the format's gain was applied.
     pub gain_applied: bool,
+    /// The reported subcarriers left out as unoccupied ([`occupied`]).
+    pub unoccupied: Vec<i32>,
 }
 
 /// The recording of a capture (docs/recording.md, "CSI files"): the uniform grid from the
-/// lowest to the highest reported subcarrier at the capture's spacing, `P[n] = 1` where a
+/// lowest to the highest occupied subcarrier ([`occupied`], unless
+/// [`ConvertOptions::keep_unoccupied`]) at the capture's spacing, `P[n] = 1` where an occupied
 /// subcarrier is reported and 0 elsewhere (`H[n] = 0` there), the times relative to the first
 /// frame, frames whose time does not increase dropped (listed), `synchronized = false` (a
 /// Wi-Fi receiver's clock is its own: C10). Errors: an antenna index in `links` beyond the
@@ -327,13 +398,25 @@ pub fn to_recording(cap: &CsiCapture, options: &ConvertOptions) -> Result<Conver
             });
         }
     }
-    let k0 = cap.subcarriers[0];
-    let span = (cap.subcarriers[cap.subcarriers.len() - 1] - k0) as usize + 1;
+    let kept: Vec<usize> = if options.keep_unoccupied {
+        (0..cap.subcarriers.len()).collect()
+    } else {
+        occupied(cap)
+    };
+    let unoccupied: Vec<i32> = (0..cap.subcarriers.len())
+        .filter(|i| !kept.contains(i))
+        .map(|i| cap.subcarriers[i])
+        .collect();
+    let k0 = cap.subcarriers[kept[0]];
+    let span = (cap.subcarriers[kept[kept.len() - 1]] - k0) as usize + 1;
     let freq_hz: Vec<Real> = (0..span)
         .map(|n| (k0 as Real + n as Real) * cap.spacing_hz)
         .collect();
     let mut response = vec![Complex::new(0.0, 0.0); span];
-    let slot: Vec<usize> = cap.subcarriers.iter().map(|&k| (k - k0) as usize).collect();
+    let slot: Vec<usize> = kept
+        .iter()
+        .map(|&i| (cap.subcarriers[i] - k0) as usize)
+        .collect();
     for &n in &slot {
         response[n] = Complex::new(1.0, 0.0);
     }
@@ -358,8 +441,9 @@ pub fn to_recording(cap: &CsiCapture, options: &ConvertOptions) -> Result<Conver
         for p in &pairs {
             let start = samples.len();
             samples.resize(start + span, Complex::new(0.0, 0.0));
-            for (z, &n) in cap.pair(f, p.rx, p.tx).iter().zip(&slot) {
-                samples[start + n] = *z * g;
+            let h = cap.pair(f, p.rx, p.tx);
+            for (&i, &n) in kept.iter().zip(&slot) {
+                samples[start + n] = h[i] * g;
             }
         }
     }
@@ -379,5 +463,6 @@ pub fn to_recording(cap: &CsiCapture, options: &ConvertOptions) -> Result<Conver
         recording,
         dropped,
         gain_applied,
+        unoccupied,
     })
 }

@@ -22,7 +22,8 @@ mod summary;
 mod tests;
 
 pub use capture::{
-    to_recording, Conversion, ConvertOptions, CsiCapture, CsiFormat, PairLink,
+    occupied, to_recording, Conversion, ConvertOptions, CsiCapture, CsiFormat, PairLink,
+    UNOCCUPIED_BLOCK_DB, UNOCCUPIED_TONE_DB,
 };
 pub use summary::LISTED;
 pub use open::{detect, open_recording, read_capture, CsiSummary, OpenOptions, Opened};

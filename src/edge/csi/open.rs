@@ -84,6 +84,8 @@ pub struct CsiSummary {
     pub dropped: Vec<(usize, f64)>,
     /// Whether the format's gain was applied.
     pub gain_applied: bool,
+    /// The reported subcarriers left out as unoccupied.
+    pub unoccupied: Vec<i32>,
 }
 
 fn is_npz(bytes: &[u8]) -> bool {
@@ -116,6 +118,7 @@ pub fn open_recording(bytes: &[u8], options: &OpenOptions) -> Result<Opened> {
                     capture,
                     dropped: conversion.dropped,
                     gain_applied: conversion.gain_applied,
+                    unoccupied: conversion.unoccupied,
                 }),
             })
         }

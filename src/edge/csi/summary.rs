@@ -18,7 +18,8 @@ impl CsiSummary {
     /// (counts and the first [`LISTED`]), `bandwidth_hz`, `center_hz` (null where the format
     /// does not say), `spacing_hz`, `n_rx`, `n_tx`, `subcarriers` (count), `subcarrier_range`,
     /// `pilots`, `grid_bins` (the uniform grid's length) and `masked_bins` (grid bins without a
-    /// subcarrier, `P[n] = 0`), `links`, `gain_applied`, `notes`.
+    /// subcarrier, `P[n] = 0`), `links`, `gain_applied`, `unoccupied` (reported subcarriers left out
+    /// as unoccupied: count and range), `notes`.
     pub fn to_json(&self, recording: &Recording) -> Value {
         let c = &self.capture;
         let grid = match &recording.layout {
@@ -58,6 +59,10 @@ impl CsiSummary {
             "masked_bins": grid.saturating_sub(c.subcarriers.len()),
             "links": recording.links,
             "gain_applied": self.gain_applied,
+            "unoccupied": {
+                "count": self.unoccupied.len(),
+                "range": [self.unoccupied.first(), self.unoccupied.last()],
+            },
             "notes": c.notes,
         })
     }

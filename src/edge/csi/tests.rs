@@ -74,6 +74,7 @@ fn gain_and_an_explicit_link_map() {
     let opts = ConvertOptions {
         links: Some(PairLink::parse_list("rx1.tx0=2:5").unwrap()),
         apply_gain: true,
+        keep_unoccupied: true,
     };
     let c = to_recording(&capture(), &opts).unwrap();
     assert!(c.gain_applied);
@@ -98,6 +99,7 @@ fn link_map_errors_are_named() {
     let opts = ConvertOptions {
         links: Some(PairLink::parse_list("rx2.tx0=0:0").unwrap()),
         apply_gain: false,
+        keep_unoccupied: true,
     };
     let e = to_recording(&capture(), &opts).unwrap_err().to_string();
     assert!(e.contains("links[0]"), "{e}");

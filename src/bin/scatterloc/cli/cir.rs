@@ -78,6 +78,10 @@ pub struct CsiArgs {
     /// Keep the CSI as written: do not apply the RSSI/AGC gain the format reports.
     #[arg(long)]
     pub raw_gain: bool,
+    /// Keep every subcarrier the file reports, also those no frame occupies (by default the
+    /// 20 MHz blocks 20 dB below the strongest, and tones 30 dB below the median, are left out).
+    #[arg(long)]
+    pub all_subcarriers: bool,
 }
 
 /// `scatterloc cir simulate`.

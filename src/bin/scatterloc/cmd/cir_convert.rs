@@ -24,6 +24,7 @@ pub fn options(csi: &CsiArgs) -> Result<OpenOptions, CliError> {
         convert: ConvertOptions {
             links,
             apply_gain: !csi.raw_gain,
+            keep_unoccupied: csi.all_subcarriers,
         },
         max_npz_bytes: limits::MAX_RECORDING_BYTES,
     })

@@ -11,7 +11,7 @@
 //! | 46      | u8    | `num_rx`                                                         |
 //! | 47      | u8    | `num_tx`                                                         |
 //! | 52–55   | u32   | `num_subcarriers` K                                              |
-//! | 60–63, 64–67 | u32 | `rssi_1`, `rssi_2` (dB, positive: −dBm)                   |
+//! | 60–63, 64–67 | u32 | `rssi_1`, `rssi_2` (as the firmware reports them; not used)  |
 //! | 68–73   | 6 × u8 | source MAC                                                      |
 //! | 88–91   | u32   | `mu_clock`, µs (CSIKit's name; wraps after 71.6 min)             |
 //! | 92–95   | u32   | `rate_flags`: bits 0–3 MCS, 8–10 format (0 CCK, 1 legacy OFDM, 2 HT, 3 VHT, 4 HE, 5 EHT), 11–13 width (0 20, 1 40, 2 80, 3 160, 4 320 MHz), 14/15 antenna A/B, 16 LDPC, 17 two streams, 19 beamforming |
@@ -31,10 +31,11 @@
 //!
 //! **Pilots are left out**: the firmware writes exactly 0 at every pilot tone (FeitCSI's docs:
 //! "the CSI of pilot subcarriers is too low to be useful"; all ten FeitCSI files of CSIKit, every
-//! frame and antenna: 0 at HT ±7, ±21; HT/VHT 40 ±11, ±25, ±53; VHT 80 ±11, ±39, ±75, ±103;
+//! frame and antenna: 0 at HT/VHT 20 ±7, ±21; HT/VHT 40 ±11, ±25, ±53; VHT 80 ±11, ±39, ±75, ±103;
 //! VHT 160 ±25, ±53, ±89, ±117, ±139, ±167, ±203, ±231; HE 20 ±22, ±48, ±90, ±116; …), so they
 //! are not reported subcarriers and the conversion masks them (`P[n] = 0`) rather than
-//! interpolate them as FeitCSI's GUI and CSIKit do; `pilots` is therefore empty. The other
+//! interpolate them as FeitCSI's GUI and CSIKit do (legacy 20 MHz ±7, ±21 left out likewise, as
+//! FeitCSI lists them; no legacy file was at hand); `pilots` is therefore empty. The other
 //! values are the file's, unscaled. Frames of another format, width or antenna count than the
 //! first readable frame, and CCK/EHT/320 MHz frames (no map here), are skipped with the reason.
 

@@ -278,11 +278,14 @@ pub fn read(bytes: &[u8]) -> Result<CsiCapture> {
         i += 1;
     }
     let Some(c) = config else {
-        return Err(bad(
-            0,
-            "rate_flags",
-            format!("no frame of a format with a subcarrier map ({} frames)", i),
-        ));
+        return Err(match i {
+            0 => bad(0, "header", "an empty file".into()),
+            _ => bad(
+                0,
+                "rate_flags",
+                format!("no frame of a format with a subcarrier map ({i} frames)"),
+            ),
+        });
     };
     notes.extend([
         "pilot tones left out: the firmware writes 0 there (not interpolated)".to_string(),

@@ -230,7 +230,10 @@ fn truncated_files_fail_with_the_frame_and_field() {
             }
         }
     }
-    assert!(read(&[]).is_err());
+    assert_eq!(
+        read(&[]).unwrap_err().to_string(),
+        "frame 0: header: an empty file"
+    );
 }
 
 #[test]

@@ -429,10 +429,3 @@ fn mutated_headers_never_panic_and_cooked_capture_reads() {
     let cap = read(&b).unwrap();
     assert_eq!(cap.pair(0, 0, 0)[0], Complex::new(5.0, 0.0));
 }
-#[test]
-fn tmp_dump() {
-    let cap = read(&real()).unwrap();
-    let mut out = Vec::new();
-    for z in &cap.csi { out.extend_from_slice(&z.re.to_le_bytes()); out.extend_from_slice(&z.im.to_le_bytes()); }
-    std::fs::write("/tmp/nex_dump.bin", out).unwrap();
-}

@@ -387,7 +387,8 @@ mod tests {
 
     #[test]
     fn malformed_frames_name_frame_and_field() {
-        let cases: [(&[(usize, &[u8])], &str); 11] = [
+        type Edit<'a> = &'a [(usize, &'a [u8])];
+        let cases: [(Edit, &str); 11] = [
             (&[(4, &[0])], "frame 0: magic"),
             (&[(8, &[2])], "frame 0: frame version"),
             (&[(F0, &[0xF0, 0xFF, 0xFF, 0xFF])], "frame 1: frame length"),

@@ -38,6 +38,7 @@ pub(crate) fn page_recording(bytes: &[u8]) -> Result<Recording, Error> {
         convert: crate::csi::ConvertOptions {
             links: None,
             apply_gain: true,
+            keep_unoccupied: false,
         },
         ..OpenOptions::default()
     };
