@@ -12,6 +12,7 @@ import json
 from pathlib import Path
 from typing import Any
 
+import csiread  # pinned in python/requirements-test.txt
 import numpy as np
 import pytest
 
@@ -20,7 +21,6 @@ from conftest import ROOT, Cli
 
 DATA = ROOT / "tests" / "data" / "csi"
 
-csiread = pytest.importorskip("csiread")
 
 
 def ours(name: str) -> dict[str, Any]:
@@ -76,15 +76,17 @@ def test_nexmon_equals_csiread() -> None:
     np.testing.assert_allclose(o["t_s"], n.sec + n.usec * 1e-6, rtol=0, atol=1e-6)
 
 
-def csikit(name: str) -> Any:
-    reader = pytest.importorskip("CSIKit.reader")
+def csikit(name: str, **kw: Any) -> Any:
+    from CSIKit import reader
+
     f = str(DATA / name)
-    return reader.get_reader(f).read_file(f, scaled=False)
+    return reader.get_reader(f).read_file(f, scaled=False, **kw)
 
 
 @pytest.mark.parametrize("name", ["feitcsi/VHT80_5500.csi", "feitcsi/HESU160_5500.csi"])
 def test_feitcsi_equals_csikit(name: str) -> None:
-    d = csikit(name)
+    # interpolate=False: CSIKit's default fills the pilot tones by interpolation.
+    d = csikit(name, interpolate=False)
     o = ours(name)
     frames = [np.asarray(f.csi_matrix) for f in d.frames]  # (K_all, rx, tx) each
     assert o["csi"].shape[0] == len(frames)
@@ -137,12 +139,20 @@ def test_convert_writes_the_masked_grid(cli: Cli, name: str) -> None:
     out = cli.json("cir", "convert", str(DATA / name), "rec.npz")
     raw = ours(name)
     z = np.load(cli.cwd / "rec.npz")
-    k = raw["subcarriers"]
+    # The occupied subcarriers (all reported ones but Nexmon's: its 20 MHz frames fill one
+    # sub-channel of the 80 MHz chanspec).
+    power = (np.abs(raw["csi"]) ** 2).mean(axis=(0, 1, 2))
+    kept = raw["subcarriers"][power > 0] if name.startswith("nexmon") else raw["subcarriers"]
     f = z["freq_hz"]
-    assert out["grid_bins"] == len(f) == k[-1] - k[0] + 1
-    np.testing.assert_allclose(f, np.arange(k[0], k[-1] + 1) * raw["spacing_hz"], rtol=1e-15)
     mask = z["system_response"]
-    np.testing.assert_array_equal(mask, np.isin(np.arange(k[0], k[-1] + 1), k).astype(mask.dtype))
+    k_grid = np.round(f / raw["spacing_hz"]).astype(np.int64)
+    assert out["grid_bins"] == len(f) == k_grid[-1] - k_grid[0] + 1
+    np.testing.assert_allclose(f, k_grid * raw["spacing_hz"], rtol=1e-15)
+    present = k_grid[mask != 0]
+    assert set(present.tolist()) <= set(kept.tolist())
+    assert len(present) == len(raw["subcarriers"]) - out["unoccupied"]["count"]
+    if not name.startswith("nexmon"):
+        np.testing.assert_array_equal(present, raw["subcarriers"])
     assert int(z["synchronized"]) == 0
     cfr = z["cfr"]
     assert np.all(cfr[:, :, mask == 0] == 0)
