@@ -1,6 +1,6 @@
 //! End-to-end tests of the `scatterloc` binary, one module per command family: presets, CRLB,
 //! maps, locate, help and completions (`basics`), tracking studies (`tracking`, `montecarlo`,
-//! `filters`), the gating pipeline (`gating`), the planner (`plan`), the multi-target commands
+//! `filters`), the gating pipeline (`gating`), the Wi-Fi CSI files through `cir convert`/`cir estimate` (`csi`), the planner (`plan`), the multi-target commands
 //! (`mtl`), sharded studies and `merge` (`scale_out`), bounded, named bad input (`hardening`;
 //! issue 37's command-line items in `hardening3`), and the outputs of a fixed set of commands pinned to those of the binary before issue 23
 //! (`pinned`), and the output writer's guarantees: atomic, never through a link, a FIFO or a
@@ -24,8 +24,18 @@ mod basics;
 #[path = "cli/cir.rs"]
 mod cir;
 
+#[cfg(feature = "npz")]
+#[path = "cli/csi.rs"]
+mod csi;
+
+#[path = "cli/detections.rs"]
+mod detections;
+
 #[path = "cli/filters.rs"]
 mod filters;
+
+#[path = "cli/follow.rs"]
+mod follow;
 
 #[path = "cli/gating.rs"]
 mod gating;

@@ -279,8 +279,9 @@ impl PairLink {
     }
 }
 
-/// How to turn a capture into a recording.
-#[derive(Debug, Clone, PartialEq, Default)]
+/// How to turn a capture into a recording. The default is the CLI's, the page's and Python's:
+/// every antenna pair, the format's gain applied, unoccupied subcarriers left out.
+#[derive(Debug, Clone, PartialEq)]
 pub struct ConvertOptions {
     /// The antenna pairs to keep and their links (`None`: [`PairLink::all`]).
     pub links: Option<Vec<PairLink>>,
@@ -290,6 +291,16 @@ pub struct ConvertOptions {
     /// Keep every reported subcarrier, also those no frame occupies ([`occupied`]): `false`
     /// (the default) leaves them out.
     pub keep_unoccupied: bool,
+}
+
+impl Default for ConvertOptions {
+    fn default() -> Self {
+        ConvertOptions {
+            links: None,
+            apply_gain: true,
+            keep_unoccupied: false,
+        }
+    }
 }
 
 /// A block of the subcarrier grid is unoccupied when its mean power is this far below the

@@ -37,7 +37,11 @@ fn capture() -> CsiCapture {
 
 #[test]
 fn grid_mask_links_and_dropped_frames() {
-    let c = to_recording(&capture(), &ConvertOptions::default()).unwrap();
+    let opts = ConvertOptions {
+        apply_gain: false,
+        ..ConvertOptions::default()
+    };
+    let c = to_recording(&capture(), &opts).unwrap();
     let r = &c.recording;
     // Frame 2 repeats frame 1's time: dropped and listed.
     assert_eq!(c.dropped, vec![(2, 10.5)]);

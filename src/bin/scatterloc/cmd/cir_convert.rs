@@ -35,7 +35,11 @@ pub fn options(csi: &CsiArgs) -> Result<OpenOptions, CliError> {
 pub fn open(flag: &str, path: &str, csi: &CsiArgs) -> Result<Opened, CliError> {
     let opts = options(csi)?;
     let bytes = read_bytes(flag, path, limits::MAX_RECORDING_BYTES)?;
-    open_recording(&bytes, &opts).map_err(|e| in_file(flag, path, e))
+    open_recording(&bytes, &opts).map_err(|e| match flag {
+        // The positional input of `cir convert`.
+        "IN" => CliError::usage(format!("IN {path}: {e}")),
+        _ => in_file(flag, path, e),
+    })
 }
 
 /// `scatterloc cir convert IN OUT.npz [--format F] [--links MAP] [--raw-gain]`: writes the

@@ -35,11 +35,7 @@ struct OpenedRecording {
 pub(crate) fn page_recording(bytes: &[u8]) -> Result<Recording, Error> {
     let opts = OpenOptions {
         max_npz_bytes: MAX_PAGE_RECORDING_BYTES,
-        convert: crate::csi::ConvertOptions {
-            links: None,
-            apply_gain: true,
-            keep_unoccupied: false,
-        },
+        convert: crate::csi::ConvertOptions::default(),
         ..OpenOptions::default()
     };
     open_recording(bytes, &opts).map(|o| o.recording)
