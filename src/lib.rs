@@ -42,6 +42,8 @@
 //! - `chart` (feature `chart`): plotters figures on any drawing backend (SVG/PNG natively, a
 //!   canvas in the page).
 //! - `npz` (feature `npz`): the `.npz` channel-recording reader and writer (docs/recording.md).
+//! - `csi` (feature `npz`): the readers of the Wi-Fi CSI tools' files (Intel 5300, Nexmon,
+//!   PicoScenes, FeitCSI, ESP32) and `open_recording` for any recording file (issue 40).
 //! - `wasm` (feature `wasm`, wasm32 only; implies `chart` and `npz`): the page's bindings; they
 //!   only wrap the core.
 //!

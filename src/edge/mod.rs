@@ -1,8 +1,8 @@
 //! The edges around the `no_std` core, each a cargo feature (ARCHITECTURE.md, "Features"): the
 //! parallel driver on threads (`native`, feature `parallel`, not on wasm32), the figures on any
 //! plotters backend (`chart`), the `.npz` recording reader and writer (`npz`, std, native and
-//! wasm32) and the page's bindings (`wasm`, wasm32). They only wrap the core: no maths here. The
-//! crate root re-exports them as `scatterloc::{native, chart, npz, wasm}`.
+//! wasm32), the Wi-Fi CSI files' readers (`csi`, with `npz`) and the page's bindings (`wasm`, wasm32). They only wrap the core: no maths here. The
+//! crate root re-exports them as `scatterloc::{native, chart, npz, csi, wasm}`.
 
 #[cfg(feature = "chart")]
 pub mod chart;
