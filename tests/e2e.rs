@@ -136,6 +136,11 @@ mod page_theme;
 #[path = "e2e/page_tracking.rs"]
 mod page_tracking;
 
+/// Issue 40: the channel view opens a Wi-Fi CSI file with the CLI's reader.
+#[cfg(test)]
+#[path = "e2e/page_csi.rs"]
+mod page_csi;
+
 /// A channel track's NEES against its truth (issue 38 §11), shared with the CLI tests.
 #[cfg(test)]
 #[path = "common/nees.rs"]
