@@ -619,6 +619,75 @@ fn fuzz_ekf() {
     );
 }
 
+// ------------------------------------------------------------------------------- detections
+
+/// The L4 preset's delays of a walker at `at` as one detections line per link at `t`, every
+/// field given (issue 40 §3, docs/detections.md).
+fn detection_lines(model: &Model, at: Vec2, t: f64) -> Vec<Value> {
+    model
+        .network
+        .delays(at)
+        .iter()
+        .enumerate()
+        .map(|(rx, d)| {
+            serde_json::json!({"timestamp": t, "tx": 0, "rx": rx, "unit": "s",
+                "delay": [d, d + 2e-8], "snr": [25.0, null], "sigma": [null, 1e-10],
+                "doppler": [3.5, -1.0]})
+        })
+        .collect()
+}
+
+/// A detections file whose middle line is a mutated line (JSON on one line) between a valid
+/// first and last frame → `Detections::from_text` → `to_measurements` on the L4 model →
+/// `study::track_measurements` (the EKF, gated raw steps): finite states, or a named error.
+fn run_detections(line: &str) -> Verdict {
+    let model = Model::new(&presets::sensors2019()).expect("preset");
+    let area = presets::sensors2019().area_m;
+    let text = |t: f64, at: Vec2| {
+        detection_lines(&model, at, t)
+            .iter()
+            .map(|l| l.to_string())
+            .collect::<Vec<_>>()
+            .join("\n")
+    };
+    let file = format!(
+        "{}\n{}\n{}\n",
+        text(0.0, Vec2::new(10.0, 10.0)),
+        line.replace('\n', " "),
+        text(0.2, Vec2::new(10.2, 10.0))
+    );
+    let d = named!(scatterloc::formats::Detections::from_text(&file));
+    let m = named!(d.to_measurements(&model, 0.5));
+    let out = named!(scatterloc::study::track_measurements(
+        &scatterloc::study::TrackRequest {
+            model: &model,
+            area: &area,
+            measurements: &m,
+            calibration: None,
+            rule: scatterloc::track::gating::AssociationRule::Spec,
+            filter: scatterloc::track::FilterKind::Ekf,
+            seed: 1,
+        }
+    ));
+    nonfinite_in_debug("track over detections", &format!("{:?}", out.states))?;
+    Ok(Pass::Ok)
+}
+
+#[test]
+fn fuzz_detections() {
+    let model = Model::new(&presets::sensors2019()).expect("preset");
+    let mut bases = detection_lines(&model, Vec2::new(10.1, 10.0), 0.1);
+    // The link as [tx, rx], ranges in metres.
+    bases.push(
+        serde_json::json!({"timestamp": 0.1, "link": [0, 1], "unit": "m",
+        "delay": [14.5, 30.0], "snr": [20.0, 3.0]}),
+    );
+    fuzz(file!(), "detections", 200, KNOWN, docs(bases, 4), |c| {
+        let m = mutated(c);
+        case(&m, guarded(&m.text, || run_detections(&m.text)))
+    });
+}
+
 // ------------------------------------------------------------------------------- the CLI kinds
 
 /// Runs `scatterloc <args>` with `files` (name, text) written to this thread's case directory

@@ -73,6 +73,7 @@ fn check2_scenario(pattern: Pattern, nf_db: Real) -> Scenario {
     s.radio.noise_figure_db = Some(nf_db);
     s.transmitters = vec![Transmitter {
         name: "Tx".into(),
+        height_m: 0.0,
         position_m: [0.0, 0.0],
         power_dbm: 37.0,
         gain_dbi: 9.0,
@@ -80,6 +81,7 @@ fn check2_scenario(pattern: Pattern, nf_db: Real) -> Scenario {
     }];
     s.receivers = vec![Receiver {
         name: "Rx".into(),
+        height_m: 0.0,
         position_m: [10.0, 10.0],
         gain_dbi: 8.0,
     }];
@@ -590,6 +592,7 @@ fn line_network(rx_x: &[Real]) -> Scenario {
         .enumerate()
         .map(|(i, x)| Receiver {
             name: format!("Rx{i}"),
+            height_m: 0.0,
             position_m: [*x, 0.0],
             gain_dbi: 8.0,
         })

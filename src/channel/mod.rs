@@ -17,6 +17,7 @@ mod paths;
 mod recording;
 mod simulate;
 mod snapshot;
+mod stream;
 
 pub use background::{
     AlignMode, Alignment, JointAlignment, LinkBackground, DEFAULT_BACKGROUND_TIME_S,
@@ -36,3 +37,7 @@ pub use simulate::{
     DEFAULT_CALIBRATION_DURATION_S, DEFAULT_DT_S, DEFAULT_SUBCARRIERS,
 };
 pub use snapshot::{DelayEstimate, Snapshot};
+pub use stream::{
+    encode_frame, rounded_to_f32, FrameHeader, END_MARKER, LENGTH_BYTES, STREAM_FORMAT,
+    STREAM_VERSION,
+};

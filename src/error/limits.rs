@@ -349,6 +349,11 @@ pub const DELAY_IMAGE_DR_DB: Range = Range {
 /// 2.048 ms) with N = 241 subcarriers is 2.8·10⁸: record it in pieces of ≤ 2 minutes.
 pub const MAX_RECORDING_SAMPLES: usize = 64 << 20;
 
+/// Largest header line of a frame stream (`cir track --follow`, docs/recording.md "Streaming
+/// frames"), bytes: 16 MiB, room for [`MAX_LINKS`] links and [`MAX_BINS_PER_LINK`] bins with
+/// their system response as JSON; a stream whose first 16 MiB hold no `\n` is refused.
+pub const MAX_STREAM_HEADER_BYTES: usize = 16 << 20;
+
 /// Largest `.npz` recording file, and the largest total of its members once inflated, bytes:
 /// the samples' cap as complex128 plus 64 MiB for the other arrays and the headers. A member
 /// that declares more is refused before inflating, one that inflates to more while inflating
@@ -403,3 +408,30 @@ pub const MAX_PAGE_RECORDING_BYTES: u64 = 256 << 20;
 
 /// Largest truth or scenario text the page's channel view reads, bytes: 64 MiB.
 pub const MAX_PAGE_TEXT_BYTES: usize = 64 << 20;
+
+/// Detections files (JSON lines, docs/detections.md, issue 40): the longest line, bytes. A line
+/// of [`MAX_DETECTIONS_PER_LINE`] detections with delay, SNR, σ and Doppler at 25 bytes each is
+/// 410 kB; 1 MiB bounds what one line's parse may allocate.
+pub const MAX_DETECTION_LINE_BYTES: usize = 1 << 20;
+
+/// Detections files: most lines (blank and `#` lines counted), 2²²: 10⁶ frames of 4 links, the
+/// tracker's [`crate::track::MAX_STEPS`], fit; the file itself is read up to
+/// [`MAX_INPUT_BYTES`].
+pub const MAX_DETECTION_LINES: usize = 1 << 22;
+
+/// Detections files: most detections of one link in one frame (a CFAR detector's list; the
+/// channel front end gives at most [`MAX_PATHS`]).
+pub const MAX_DETECTIONS_PER_LINE: usize = 4096;
+
+/// Detections files: an SNR, dB: −300 to 300 dB (its linear value and the σ_τ of E8 stay
+/// finite and > 0).
+pub const DETECTION_SNR_DB: Range = Range {
+    min: -300.0,
+    max: 300.0,
+    allowed: "-300 to 300 dB",
+};
+
+/// Detections files: relative tolerance of the uniform frame spacing (as [`FREQ_UNIFORM_TOL`]
+/// of a recording's bins and `cir estimate --measurements`' snapshot times): every
+/// `t[k] − t[k−1]` within `1e-6·T` of `T = (t[K−1] − t[0])/(K−1)`.
+pub const FRAME_UNIFORM_TOL: f64 = 1e-6;

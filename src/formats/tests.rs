@@ -128,3 +128,5 @@ fn channel_truth_reads_as_truth() {
     assert!(t.resolved.is_empty());
     t.check_times(&truth.t_s).unwrap();
 }
+
+mod detections;

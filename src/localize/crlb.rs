@@ -3,7 +3,6 @@
 //! over a grid that writes into a caller-provided buffer.
 
 use crate::math::{sqrt, Mat2, Real, Vec2, PI, SPEED_OF_LIGHT};
-use crate::measure::unit_from;
 use crate::measure::Ellipse;
 use crate::measure::{Model, SNR_DISTANCE_FLOOR_M};
 
@@ -63,13 +62,13 @@ fn link_weights(model: &Model) -> impl Iterator<Item = Real> + '_ {
     model.snr_scale.iter().map(move |s| k * s)
 }
 
-/// `F(r) = Jᵀ F_τ J`, 1/m² (E8 with E3).
+/// `F(r) = Jᵀ F_τ J`, 1/m² (E8 with E3; 3-D distances when nodes are off the target's plane).
 pub fn fisher(model: &Model, r: Vec2) -> Mat2 {
     let mut f = Mat2::zeros();
     for (p, w) in link_weights(model).enumerate() {
         let l = model.network.links[p];
-        let (u_tx, d_tx) = unit_from(model.network.transmitters[l.tx], r);
-        let (u_rx, d_rx) = unit_from(model.network.receivers[l.rx], r);
+        let (u_tx, d_tx) = model.network.tx_unit(l.tx, r);
+        let (u_rx, d_rx) = model.network.rx_unit(l.rx, r);
         let (d_tx, d_rx) = (
             d_tx.max(SNR_DISTANCE_FLOOR_M),
             d_rx.max(SNR_DISTANCE_FLOOR_M),

@@ -11,8 +11,9 @@ mod simulate;
 
 pub use ellipse::Ellipse;
 pub use geometry::{
-    bistatic_delay, bistatic_range, delay_gradient, iso_delay_ellipse, iso_range_ellipse,
-    range_and_gradient, range_gradient, unit_from, Network, UNIT_VECTOR_MIN_DISTANCE_M,
+    bistatic_delay, bistatic_range, bistatic_range_dz, delay_gradient, iso_delay_ellipse,
+    iso_range_ellipse, los_range_dz, node_distance, range_and_gradient, range_and_gradient_dz,
+    range_gradient, unit_from, unit_from_dz, Network, UNIT_VECTOR_MIN_DISTANCE_M,
 };
 pub use model::{
     noise_power_w, sigma_delay_from_snr, Model, DEFAULT_NOISE_FIGURE_DB, SNR_DISTANCE_FLOOR_M,

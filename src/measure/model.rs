@@ -8,8 +8,8 @@ use crate::math::{
     db_to_linear, dbm_to_watt, sqrt, Real, Vec2, BOLTZMANN, PI, REFERENCE_TEMPERATURE_K,
     SPEED_OF_LIGHT,
 };
+use crate::measure::Network;
 use crate::measure::TxPattern;
-use crate::measure::{unit_from, Network};
 use crate::scenario::{Pattern, Radio, Scenario, Transmitter};
 
 /// Default receiver noise figure `F`, dB (spec §7).
@@ -63,6 +63,16 @@ pub fn noise_power_w(radio: &Radio) -> Real {
                 * radio.bandwidth_hz
                 * db_to_linear(radio.noise_figure_db.unwrap_or(DEFAULT_NOISE_FIGURE_DB))
         }
+    }
+}
+
+/// A node's vertical offset from the target's plane, `z_node − z_target`, m (exactly 0 when both
+/// heights are 0, so a planar scenario keeps its bits).
+fn vertical_offset(node_m: Real, target_m: Real) -> Real {
+    if node_m == target_m {
+        0.0
+    } else {
+        node_m - target_m
     }
 }
 
@@ -143,6 +153,16 @@ impl Model {
                     .iter()
                     .map(|r| Vec2::new(r.position_m[0], r.position_m[1]))
                     .collect(),
+                transmitters_dz: s
+                    .transmitters
+                    .iter()
+                    .map(|t| vertical_offset(t.height_m, s.target.height_m))
+                    .collect(),
+                receivers_dz: s
+                    .receivers
+                    .iter()
+                    .map(|r| vertical_offset(r.height_m, s.target.height_m))
+                    .collect(),
                 links,
             },
             patterns: s
@@ -162,11 +182,12 @@ impl Model {
         self.network.links.len()
     }
 
-    /// `SNR_p(r)` of link `p` for a scatterer at `r`, linear (E8, with the 1 m distance floor).
+    /// `SNR_p(r)` of link `p` for a scatterer at `r`, linear (E8, with the 1 m distance floor;
+    /// 3-D distances, the Tx gain toward the 3-D direction, see [`TxPattern::gain_toward`]).
     pub fn snr(&self, p: usize, r: Vec2) -> Real {
         let l = self.network.links[p];
-        let (u_tx, d_tx) = unit_from(self.network.transmitters[l.tx], r);
-        let (_, d_rx) = unit_from(self.network.receivers[l.rx], r);
+        let (u_tx, d_tx) = self.network.tx_unit(l.tx, r);
+        let (_, d_rx) = self.network.rx_unit(l.rx, r);
         self.snr_from_geometry(p, self.patterns[l.tx].gain_toward(u_tx), d_tx, d_rx)
     }
 

@@ -73,7 +73,10 @@ impl TxPattern {
     }
 
     /// Linear gain toward the unit direction `u` (Tx → point). A zero `u` (point on the Tx)
-    /// gets the peak gain. Uses the verified [`GainPolynomial`] when there is one (≤ 1e-12
+    /// gets the peak gain. In a 3-D room `u` is the horizontal part of the 3-D unit vector
+    /// ([`crate::measure::unit_from_dz`]); the boresight is horizontal, so `u·b = cos ψ` with ψ
+    /// the 3-D angle off boresight (a point straight below or above the Tx, `u = 0`, takes the
+    /// peak gain, as on the Tx: a simplification at that one point). Uses the verified [`GainPolynomial`] when there is one (≤ 1e-12
     /// relative from the exact formula [`TxPattern::gain_toward_cos`]), so every consumer — point
     /// bound, map, simulation, EKF — sees the same gain without an `acos` and `exp` per call.
     #[inline(always)]

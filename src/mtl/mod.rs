@@ -17,6 +17,13 @@
 //! - [`algorithm`]: Algorithm 1 (§4), staged matching with the vector likelihood (M6) and
 //!   the final selection by `J` (M2).
 //! - [`brute`]: the brute-force reference over all matchings (small instances, tests).
+//!
+//! This layer stays planar (issue 40): its nodes and targets share one plane and its ranges are
+//! the 2-D (M1) of [`crate::measure::bistatic_range`]. It never reads a [`crate::scenario`]
+//! file, so node heights cannot reach it silently: its own inputs hold `[x, y]` positions only
+//! and refuse a third coordinate or an unknown field such as `height_m` with a parse error that
+//! names the field (tested in `tests/spec_checks_3d.rs`). The single-target model (`measure`)
+//! is the one with heights.
 
 pub mod algorithm;
 pub mod blocking;

@@ -110,7 +110,9 @@ pub fn simulate_snapshot(model: &Model, area: &Area, truth: Vec2, seed: u64) -> 
 
 /// Link `p` of a scatterer at `truth` measured at `delay_s` with noise `sigma_s`: its iso-delay
 /// ellipse, outline and the arc within about `view_radius_m` of the truth. Shared with the
-/// track frames of [`crate::present`].
+/// track frames of [`crate::present`]. A link with a node off the target's plane (issue 40)
+/// keeps the planar ellipse in `ellipse` (an approximation there) but draws the exact 3-D
+/// iso-delay curve as its outline and arc ([`crate::measure::Network::iso_delay_curve`]).
 pub(crate) fn link_sim(
     model: &Model,
     p: usize,
@@ -120,7 +122,7 @@ pub(crate) fn link_sim(
     view_radius_m: Real,
 ) -> LinkSim {
     let ellipse = model.network.iso_delay_ellipse(p, delay_s);
-    LinkSim {
+    let planar = LinkSim {
         link: model.network.links[p],
         delay_s,
         sigma_s,
@@ -128,6 +130,15 @@ pub(crate) fn link_sim(
         ellipse,
         outline: ellipse.map_or_else(Vec::new, |e| e.polygon(OUTLINE_POINTS)),
         arc: ellipse.map_or_else(Vec::new, |e| e.arc_near(truth, view_radius_m, ARC_POINTS)),
+    };
+    if model.network.link_is_planar(p) {
+        return planar;
+    }
+    let net = &model.network;
+    LinkSim {
+        outline: net.iso_delay_curve(p, delay_s, OUTLINE_POINTS),
+        arc: net.iso_delay_arc_near(p, delay_s, truth, view_radius_m, ARC_POINTS),
+        ..planar
     }
 }
 

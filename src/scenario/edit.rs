@@ -54,7 +54,7 @@ impl Scenario {
         checked_index("receivers", i, self.receivers.len())
     }
 
-    /// Adds a transmitter at `position_m` with the radio settings of the last one and a fresh
+    /// Adds a transmitter at `position_m` with the radio settings and height of the last one and a fresh
     /// name (`TxN`); with an explicit link list it is linked to every receiver. Returns its index.
     pub fn add_transmitter(&mut self, position_m: [f64; 2]) -> Result<usize> {
         self.apply(|s| {
@@ -71,13 +71,14 @@ impl Scenario {
         })
     }
 
-    /// Adds a receiver at `position_m` with the gain of the last one and a fresh name (`RxN`);
+    /// Adds a receiver at `position_m` with the gain and height of the last one and a fresh name (`RxN`);
     /// with an explicit link list it is linked to every transmitter. Returns its index.
     pub fn add_receiver(&mut self, position_m: [f64; 2]) -> Result<usize> {
         self.apply(|s| {
             let r = Receiver {
                 name: s.fresh_name("Rx"),
                 position_m,
+                height_m: s.receivers.last().map_or(0.0, |r| r.height_m),
                 gain_dbi: s.receivers.last().map_or(0.0, |r| r.gain_dbi),
             };
             if let LinkSpec::List(l) = &mut s.links {
@@ -211,6 +212,22 @@ impl Scenario {
     /// Sets the antenna gain `G_Rx` of receiver `i`, dBi.
     pub fn set_rx_gain_dbi(&mut self, i: usize, v: f64) -> Result<()> {
         self.edit_receiver(i, |r| r.gain_dbi = v)
+    }
+
+    /// Sets the antenna height of transmitter `i`, m (issue 40; validated as
+    /// `transmitters[i].height_m`).
+    pub fn set_tx_height_m(&mut self, i: usize, v: f64) -> Result<()> {
+        self.edit_transmitter(i, |t| t.height_m = v)
+    }
+
+    /// Sets the antenna height of receiver `i`, m (validated as `receivers[i].height_m`).
+    pub fn set_rx_height_m(&mut self, i: usize, v: f64) -> Result<()> {
+        self.edit_receiver(i, |r| r.height_m = v)
+    }
+
+    /// Sets the height of the target's plane (its body centre), m (`target.height_m`).
+    pub fn set_target_height_m(&mut self, v: f64) -> Result<()> {
+        self.edit_with(|s| s.target.height_m = v)
     }
 
     /// [`Scenario::apply`] of an infallible change.

@@ -28,6 +28,7 @@ fn receivers(positions: &[[f64; 2]], gain_dbi: f64) -> Vec<Receiver> {
         .enumerate()
         .map(|(i, p)| Receiver {
             name: alloc::format!("Rx{}", i + 1),
+            height_m: 0.0,
             position_m: *p,
             gain_dbi,
         })
@@ -52,6 +53,7 @@ pub fn sensors2019() -> Scenario {
         radio: radio(),
         transmitters: vec![Transmitter {
             name: "Tx".into(),
+            height_m: 0.0,
             position_m: [0.0, 0.0],
             power_dbm: 37.0,
             gain_dbi: 9.0,
@@ -66,7 +68,10 @@ pub fn sensors2019() -> Scenario {
             8.0,
         ),
         links: LinkSpec::All,
-        target: Target { rcs_m2: 1.0 },
+        target: Target {
+            rcs_m2: 1.0,
+            height_m: 0.0,
+        },
         area_m: Area {
             x: [-7.5, 30.0],
             y: [-10.0, 26.0],
@@ -82,6 +87,7 @@ pub fn iclgnss2019() -> Scenario {
         radio: radio(),
         transmitters: vec![Transmitter {
             name: "Tx".into(),
+            height_m: 0.0,
             position_m: [0.0, 0.0],
             power_dbm: 36.0,
             gain_dbi: 8.0,
@@ -89,7 +95,10 @@ pub fn iclgnss2019() -> Scenario {
         }],
         receivers: receivers(&[[-10.0, 0.0], [-10.0, 10.0], [0.0, 10.0]], 8.0),
         links: LinkSpec::All,
-        target: Target { rcs_m2: 100.0 },
+        target: Target {
+            rcs_m2: 100.0,
+            height_m: 0.0,
+        },
         area_m: Area {
             x: [-45.0, 30.0],
             y: [-5.0, 15.0],

@@ -65,6 +65,10 @@ pub struct Transmitter {
     pub name: String,
     /// Position `r^Tx_k`, m.
     pub position_m: [f64; 2],
+    /// Antenna height above the floor, m (default 0; omitted from the JSON when 0). With the
+    /// target's [`Target::height_m`] it sets the node's vertical offset in the 3-D ranges (E1).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub height_m: f64,
     /// Transmit power `P_Tx`, dBm.
     pub power_dbm: f64,
     /// Peak (boresight) antenna gain `G₀`, dBi.
@@ -100,6 +104,10 @@ pub struct Receiver {
     pub name: String,
     /// Position `r^Rx_l`, m.
     pub position_m: [f64; 2],
+    /// Antenna height above the floor, m (default 0; omitted from the JSON when 0), as
+    /// [`Transmitter::height_m`].
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub height_m: f64,
     /// Omnidirectional antenna gain `G_Rx`, dBi.
     pub gain_dbi: f64,
 }
@@ -110,6 +118,17 @@ pub struct Receiver {
 pub struct Target {
     /// Radar cross section σ_RCS, m².
     pub rcs_m2: f64,
+    /// Height of the horizontal plane the scatterer moves in (its body centre, e.g. 1.0 m for a
+    /// walking person), m (default 0; omitted from the JSON when 0). Every position of the
+    /// target is a point of this plane; ranges are 3-D from the nodes' heights (E1).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub height_m: f64,
+}
+
+/// Whether a height is exactly 0 (the default, left out when serialising so that a planar
+/// scenario's JSON is unchanged).
+fn is_zero(v: &f64) -> bool {
+    *v == 0.0
 }
 
 /// An axis-aligned rectangle, m.

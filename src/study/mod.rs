@@ -15,6 +15,7 @@
 //!   filter ([`TrackOutput`], the document of `scatterloc track`).
 //! - [`ChannelRequest`], [`estimate_recording`] / [`EstimationRun`], [`cir_track`]: a channel
 //!   recording through the front end (C5–C10) to a track with segments (C11) (issues 25, 36).
+//! - [`LiveFront`] + [`LiveRun`]: the same chain live, frame by frame (issue 40 §3).
 //! - [`check_cost`], [`track_cpu_s`], [`FilterStudy::predicted_cpu_s`]: the predicted work
 //!   of a study or a track and the caps front ends refuse work over (issue 24).
 //! - [`PartSet`], [`PartFile`]: the part file format (`scatterloc-part`, version 2, with a digest of its sums) and what `merge` checks.
@@ -34,6 +35,7 @@ pub use channel::{
     estimate_recording, prepare, BoundCounts, Bounds, ChannelRequest, ChannelSetting,
     ChannelStatics, CirStart, CirTrackOutput, DelayReference, DelaySigma, EstimationRun,
     FrontEndConfig, LinkDirectPath, LinkEstimates, LinkFront, LinkStatics, LinkStaticsInfo, Prepared,
+    LiveFront, LiveRun, LiveState, LIVE_REPLAY_SNAPSHOTS,
     RecordingEstimates, SegmentDoc, SettingKind, StaticMode, BACKGROUND_MAX_PATHS,
     DEFAULT_PROCESS_NOISE, DEFAULT_SEED, EXTENT_SIGMA_M, LOS_WITHIN_DB, RECURSIVE_CLUSTER_DB,
 };

@@ -37,7 +37,7 @@ use alloc::vec::Vec;
 use rand::Rng as _;
 
 use crate::error::{Error, Result};
-use crate::math::{exp, ln, sqrt, Mat4, Real, Vec4, SPEED_OF_LIGHT};
+use crate::math::{exp, ln, sqrt, Mat4, Real, Vec2, Vec4, SPEED_OF_LIGHT};
 use crate::measure::{Model, Rng};
 use crate::track::shared::{
     check_covariance, check_state, check_update, first_input_error, link_sigmas, predict_gaussian,
@@ -510,10 +510,7 @@ fn range_pass(
     let mut d = vec![0.0; ntx + nrx];
     for (j, x) in particles.iter().enumerate() {
         // Each node's distance once (E1: a link's range is the sum of its two).
-        for (k, node) in net.transmitters.iter().chain(&net.receivers).enumerate() {
-            let (dx, dy) = (x[0] - node.x, x[1] - node.y);
-            d[k] = sqrt(dx * dx + dy * dy);
-        }
+        net.node_distances_into(Vec2::new(x[0], x[1]), &mut d);
         let mut s = 0.0;
         for (k, &p) in used.iter().enumerate() {
             let l = net.links[p];
@@ -577,10 +574,7 @@ impl Filter for ParticleFilter {
         let mut d = vec![0.0; ntx + net.receivers.len()];
         // The particle's range on every link (E1: the sum of its two node distances), m.
         let mut ranges = |x: &Vec4, out: &mut [Real]| {
-            for (k, node) in net.transmitters.iter().chain(&net.receivers).enumerate() {
-                let (dx, dy) = (x[0] - node.x, x[1] - node.y);
-                d[k] = sqrt(dx * dx + dy * dy);
-            }
+            net.node_distances_into(Vec2::new(x[0], x[1]), &mut d);
             for (o, l) in out.iter_mut().zip(&net.links) {
                 *o = d[l.tx] + d[ntx + l.rx];
             }

@@ -409,22 +409,27 @@ fn sigma_ranges(
     let m = z0.len();
     let net = &model.network;
     let (px, py) = (points.map(|p| p.x), points.map(|p| p.y));
-    let dist = |n: Vec2| {
+    // 3-D node distances (E1): `√(dx² + (dy² + dz²))`, the planar bits when dz = 0.
+    let dist = |n: Vec2, dz: Real| {
         let (dx, dy) = (center.x - n.x, center.y - n.y);
         let at: [Real; 4] = core::array::from_fn(|k| {
             let (dx, dy) = (px[k] - n.x, py[k] - n.y);
-            sqrt(dx * dx + dy * dy)
+            sqrt(dx * dx + (dy * dy + dz * dz))
         });
-        (sqrt(dx * dx + dy * dy), at)
+        (sqrt(dx * dx + (dy * dy + dz * dz)), at)
     };
     let present = net.links.iter().zip(z).filter(|(_, v)| v.is_some());
     // The links of one transmitter are consecutive for a full mesh; reuse its distances.
     let mut last_tx = (usize::MAX, (0.0, [0.0; 4]));
     for ((i, z0), (l, _)) in z0.iter_mut().enumerate().zip(present) {
         if last_tx.0 != l.tx {
-            last_tx = (l.tx, dist(net.transmitters[l.tx]));
+            last_tx = (
+                l.tx,
+                dist(net.transmitters[l.tx], net.transmitters_dz[l.tx]),
+            );
         }
-        let ((t0, t), (r0, r)) = (last_tx.1, dist(net.receivers[l.rx]));
+        let rx = dist(net.receivers[l.rx], net.receivers_dz[l.rx]);
+        let ((t0, t), (r0, r)) = (last_tx.1, rx);
         *z0 = t0 + r0;
         for k in 0..4 {
             d[k * m + i] = (t[k] + r[k]) - *z0;

@@ -153,6 +153,7 @@ fn mesh_scenario(dir: &TempDir, k: usize, l: usize) -> String {
     s.transmitters = (0..k)
         .map(|i| Transmitter {
             name: format!("T{i}"),
+            height_m: 0.0,
             position_m: [3.0 * i as f64 - 2.0, -1.0 + 0.5 * i as f64],
             ..tx.clone()
         })
@@ -161,6 +162,7 @@ fn mesh_scenario(dir: &TempDir, k: usize, l: usize) -> String {
     s.receivers = (0..l)
         .map(|i| Receiver {
             name: format!("R{i}"),
+            height_m: 0.0,
             position_m: [-6.0 + 4.5 * i as f64, if i % 2 == 0 { 12.0 } else { -8.0 }],
             ..rx.clone()
         })

@@ -73,6 +73,7 @@ pub fn mesh(k: usize, l: usize) -> Model {
     s.transmitters = (0..k)
         .map(|i| Transmitter {
             name: format!("T{i}"),
+            height_m: 0.0,
             position_m: [3.0 * i as Real - 2.0, -1.0 + 0.5 * i as Real],
             pattern: if i % 2 == 1 {
                 Pattern::Omni
@@ -86,6 +87,7 @@ pub fn mesh(k: usize, l: usize) -> Model {
     s.receivers = (0..l)
         .map(|i| Receiver {
             name: format!("R{i}"),
+            height_m: 0.0,
             position_m: [-6.0 + 4.5 * i as Real, if i % 2 == 0 { 12.0 } else { -8.0 }],
             ..rx.clone()
         })

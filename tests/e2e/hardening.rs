@@ -364,6 +364,7 @@ fn large_network() -> String {
     s.transmitters = (0..64)
         .map(|i| Transmitter {
             name: format!("Tx{}", i + 1),
+            height_m: 0.0,
             position_m: at(i, 0.0),
             ..tx0.clone()
         })
@@ -371,6 +372,7 @@ fn large_network() -> String {
     s.receivers = (0..64)
         .map(|i| Receiver {
             name: format!("Rx{}", i + 1),
+            height_m: 0.0,
             position_m: at(i, 2.2),
             ..rx0.clone()
         })
@@ -762,6 +764,7 @@ fn wide_scenario(n: usize, name: &str) -> String {
     s.transmitters = (0..n)
         .map(|i| Transmitter {
             name: format!("Tx{i:04}-{}", "n".repeat(94)),
+            height_m: 0.0,
             position_m: [
                 -4.123_456_789_012_345 + 0.011_111_111_111_111 * (i % 64) as f64,
                 -7.987_654_321_098_765 + 0.031_111_111_111_111 * (i / 64) as f64,

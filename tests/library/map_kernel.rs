@@ -57,6 +57,7 @@ fn random_case(seed: u64) -> (Scenario, Grid) {
     s.transmitters = (0..k)
         .map(|i| Transmitter {
             name: format!("Tx{i}"),
+            height_m: 0.0,
             position_m: node(&mut rng),
             power_dbm: rng.random_range(0.0..40.0),
             gain_dbi: rng.random_range(0.0..15.0),
@@ -66,6 +67,7 @@ fn random_case(seed: u64) -> (Scenario, Grid) {
     s.receivers = (0..l)
         .map(|i| Receiver {
             name: format!("Rx{i}"),
+            height_m: 0.0,
             position_m: node(&mut rng),
             gain_dbi: rng.random_range(0.0..15.0),
         })

@@ -78,6 +78,7 @@ fn scenario() -> impl Strategy<Value = Scenario> {
                 .enumerate()
                 .map(|(i, (p, power, gain, pattern))| Transmitter {
                     name: format!("Tx{i}"),
+                    height_m: 0.0,
                     position_m: [p.x, p.y],
                     power_dbm: power,
                     gain_dbi: gain,
@@ -89,6 +90,7 @@ fn scenario() -> impl Strategy<Value = Scenario> {
                 .enumerate()
                 .map(|(i, (p, gain))| Receiver {
                     name: format!("Rx{i}"),
+                    height_m: 0.0,
                     position_m: [p.x, p.y],
                     gain_dbi: gain,
                 })
@@ -118,7 +120,10 @@ fn scenario() -> impl Strategy<Value = Scenario> {
                 transmitters,
                 receivers,
                 links,
-                target: Target { rcs_m2: rcs },
+                target: Target {
+                    rcs_m2: rcs,
+                    height_m: 0.0,
+                },
                 area_m: Area {
                     x: [x0, x0 + w],
                     y: [y0, y0 + h],
@@ -138,6 +143,8 @@ fn network() -> impl Strategy<Value = Network> {
                 .flat_map(|rx| (0..transmitters.len()).map(move |tx| LinkIndex { tx, rx }))
                 .collect();
             Network {
+                transmitters_dz: vec![0.0; transmitters.len()],
+                receivers_dz: vec![0.0; receivers.len()],
                 transmitters,
                 receivers,
                 links,
@@ -150,6 +157,8 @@ fn swapped(net: &Network) -> Network {
     Network {
         transmitters: net.receivers.clone(),
         receivers: net.transmitters.clone(),
+        transmitters_dz: net.receivers_dz.clone(),
+        receivers_dz: net.transmitters_dz.clone(),
         links: net
             .links
             .iter()

@@ -74,8 +74,10 @@ fn run(command: cli::Command) -> Result<(), CliError> {
         Command::Cir { command } => match command {
             CirCommand::Simulate(a) => cmd::cir_simulate(&a),
             CirCommand::Estimate(a) => cmd::cir_estimate(&a),
+            CirCommand::Track(a) if a.follow => cmd::cir_track_follow(&a),
             CirCommand::Track(a) => cmd::cir_track(&a),
             CirCommand::Convert(a) => cmd::cir_convert(&a),
+            CirCommand::Stream(a) => cmd::cir_stream(&a),
         },
         Command::Merge(a) => cmd::merge(&a),
         Command::Slurm { command } => match command {

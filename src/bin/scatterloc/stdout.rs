@@ -68,6 +68,12 @@ pub fn write_summary(bytes: &[u8]) -> Result<(), CliError> {
     put(bytes, false)
 }
 
+/// Descriptor 1 for a stream of result lines (`cir track --follow`), refused when closed as
+/// [`write`] does; each `write_all` on it goes out at once (no buffer of ours).
+pub fn result_stream() -> Result<File, CliError> {
+    open(true)
+}
+
 /// Writes `bytes` to descriptor 1 ([`open`] with `result`) and flushes.
 fn put(bytes: &[u8], result: bool) -> Result<(), CliError> {
     let mut f = open(result)?;

@@ -17,6 +17,17 @@ pub(super) fn dist(a: Vec2, b: Vec2) -> Real {
     sqrt(d.x * d.x + d.y * d.y)
 }
 
+/// The 3-D distance between `a` and a point `dz` below or above `b`: `√(‖b − a‖² + dz²)`
+/// ([`dist`], bitwise, when `dz = 0`).
+pub(super) fn dist_dz(a: Vec2, b: Vec2, dz: Real) -> Real {
+    if dz == 0.0 {
+        dist(a, b)
+    } else {
+        let d = b - a;
+        sqrt(d.x * d.x + (d.y * d.y + dz * dz))
+    }
+}
+
 /// A wall as a line: a point, the direction `b − a`, and `Γ`.
 #[derive(Debug, Clone, Copy)]
 pub(super) struct Line {

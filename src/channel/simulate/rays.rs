@@ -1,18 +1,30 @@
 //! The paths of one link: its link budget ([`LinkBudget`]: Friis and bistatic radar powers with the
 //! Tx pattern, E8), the static rays (LoS, first- and second-order wall reflections by the image
 //! method, point scatterers) and the body's paths through a point, direct and via each wall.
+//!
+//! Heights (issue 40): the walls are vertical, so the image method runs in the plane and a
+//! reflection leaves heights unchanged; a path's length is `√(L_xy² + Δz²)` with `L_xy` its
+//! unfolded horizontal length and `Δz` the height difference of its ends. The body and the
+//! point scatterers are in the target's plane; the Tx nodes' and Rx nodes' vertical offsets from
+//! it are [`LinkBudget::dz_tx`], [`LinkBudget::dz_rx`]. The Tx gain is taken toward the 3-D
+//! direction of the path's first leg ([`crate::measure::unit_from_dz`]). Shadowing by the walker
+//! is tested on the horizontal projection of a path.
 
 use alloc::vec::Vec;
 
-use super::geometry::{dist, segment_distance, v, Line};
+use super::geometry::{dist, dist_dz, segment_distance, v, Line};
 use super::{ChannelScene, PathKind};
 use crate::math::{cos, sin, Real, Vec2, PI, SPEED_OF_LIGHT};
-use crate::measure::{unit_from, SNR_DISTANCE_FLOOR_M};
+use crate::measure::{unit_from_dz, SNR_DISTANCE_FLOOR_M};
 
 /// One link's constants.
 pub(super) struct LinkBudget<'a> {
     pub(super) tx: Vec2,
     pub(super) rx: Vec2,
+    /// The Tx's vertical offset from the target's plane, m (0 in a planar room).
+    pub(super) dz_tx: Real,
+    /// The Rx's vertical offset from the target's plane, m (0 in a planar room).
+    pub(super) dz_rx: Real,
     pub(super) pattern: &'a crate::measure::TxPattern,
     /// `P_Tx·G_Rx`, W.
     pub(super) ptx_grx: Real,
@@ -20,25 +32,36 @@ pub(super) struct LinkBudget<'a> {
 }
 
 impl LinkBudget<'_> {
-    fn gain_toward(&self, p: Vec2) -> Real {
-        self.pattern.gain_toward(unit_from(self.tx, p).0)
+    /// The Tx gain toward the point `p` that lies `dz` below the Tx (3-D direction).
+    fn gain_toward(&self, p: Vec2, dz: Real) -> Real {
+        self.pattern.gain_toward(unit_from_dz(self.tx, dz, p).0)
     }
 
-    /// Friis power over the (unfolded) length `len`, Tx gain toward `first` (the first bounce
-    /// or the Rx), W.
-    pub(super) fn friis(&self, first: Vec2, len: Real) -> Real {
+    /// The Tx's height above the point of a straight (unfolded) path from the Tx to an end `dz`
+    /// below it, at horizontal distance `along` of the path's horizontal length `total`.
+    fn drop_at(dz: Real, along: Real, total: Real) -> Real {
+        if dz == 0.0 || total <= 0.0 {
+            dz
+        } else {
+            dz * (along / total).min(1.0)
+        }
+    }
+
+    /// Friis power over the (unfolded, 3-D) length `len`, Tx gain toward `first` (the first
+    /// bounce or the Rx), which lies `first_dz` below the Tx, W.
+    pub(super) fn friis(&self, first: Vec2, first_dz: Real, len: Real) -> Real {
         let l = len.max(SNR_DISTANCE_FLOOR_M);
         let k = self.lambda / (4.0 * PI * l);
-        self.ptx_grx * self.gain_toward(first) * k * k
+        self.ptx_grx * self.gain_toward(first, first_dz) * k * k
     }
 
     /// Bistatic radar power of a scatterer of RCS `rcs` at distances `d1`, `d2` (floored at
-    /// 1 m as in E8), Tx gain toward `first`, W.
-    pub(super) fn radar(&self, first: Vec2, d1: Real, d2: Real, rcs: Real) -> Real {
+    /// 1 m as in E8), Tx gain toward `first`, `first_dz` below the Tx, W.
+    pub(super) fn radar(&self, first: Vec2, first_dz: Real, d1: Real, d2: Real, rcs: Real) -> Real {
         let d1 = d1.max(SNR_DISTANCE_FLOOR_M);
         let d2 = d2.max(SNR_DISTANCE_FLOOR_M);
         let four_pi3 = (4.0 * PI) * (4.0 * PI) * (4.0 * PI);
-        self.ptx_grx * rcs * self.lambda * self.lambda * self.gain_toward(first)
+        self.ptx_grx * rcs * self.lambda * self.lambda * self.gain_toward(first, first_dz)
             / (four_pi3 * d1 * d1 * d2 * d2)
     }
 }
@@ -59,13 +82,15 @@ pub(super) struct StaticRay {
 /// The static paths of a link (LoS, walls, wall–wall, point scatterers).
 pub(super) fn static_rays(lb: &LinkBudget, lines: &[Line], scene: &ChannelScene) -> Vec<StaticRay> {
     let (tx, rx) = (lb.tx, lb.rx);
+    // The Tx's height above the Rx (a vertical wall keeps it along every reflected path).
+    let h = lb.dz_tx - lb.dz_rx;
     let mut rays = Vec::new();
     let z = Vec2::zeros();
-    let d = dist(tx, rx);
+    let d = dist_dz(tx, rx, h);
     rays.push(StaticRay {
         kind: PathKind::Los,
         delay: d / SPEED_OF_LIGHT,
-        power: lb.friis(rx, d),
+        power: lb.friis(rx, h, d),
         sign: 1.0,
         points: [tx, rx, z, z],
         npoints: 2,
@@ -77,11 +102,12 @@ pub(super) fn static_rays(lb: &LinkBudget, lines: &[Line], scene: &ChannelScene)
             continue;
         }
         if let Some(p) = w.crossing(tx, img) {
-            let len = dist(tx, img);
+            let len = dist_dz(tx, img, h);
+            let first_dz = LinkBudget::drop_at(h, dist(tx, p), dist(tx, img));
             rays.push(StaticRay {
                 kind: PathKind::Wall,
                 delay: len / SPEED_OF_LIGHT,
-                power: lb.friis(p, len) * w.gamma * w.gamma,
+                power: lb.friis(p, first_dz, len) * w.gamma * w.gamma,
                 sign: w.gamma,
                 points: [tx, p, rx, z],
                 npoints: 3,
@@ -108,12 +134,13 @@ pub(super) fn static_rays(lb: &LinkBudget, lines: &[Line], scene: &ChannelScene)
                 if wj.side(p) * wj.side(rx) <= 0.0 || wi.side(tx) * wi.side(q) <= 0.0 {
                     continue;
                 }
-                let len = dist(t2, rx);
+                let len = dist_dz(t2, rx, h);
+                let first_dz = LinkBudget::drop_at(h, dist(tx, p), dist(t2, rx));
                 let g = wi.gamma * wj.gamma;
                 rays.push(StaticRay {
                     kind: PathKind::WallWall,
                     delay: len / SPEED_OF_LIGHT,
-                    power: lb.friis(p, len) * g * g,
+                    power: lb.friis(p, first_dz, len) * g * g,
                     sign: g,
                     points: [tx, p, q, rx],
                     npoints: 4,
@@ -124,11 +151,11 @@ pub(super) fn static_rays(lb: &LinkBudget, lines: &[Line], scene: &ChannelScene)
     }
     for s in &scene.scatterers {
         let p = v(s.position_m);
-        let (d1, d2) = (dist(tx, p), dist(p, rx));
+        let (d1, d2) = (dist_dz(tx, p, lb.dz_tx), dist_dz(p, rx, lb.dz_rx));
         rays.push(StaticRay {
             kind: PathKind::Scatterer,
             delay: (d1 + d2) / SPEED_OF_LIGHT,
-            power: lb.radar(p, d1, d2, s.rcs_m2),
+            power: lb.radar(p, lb.dz_tx, d1, d2, s.rcs_m2),
             sign: 1.0,
             points: [tx, p, rx, z],
             npoints: 3,
@@ -156,11 +183,12 @@ pub(super) fn body_paths(
     out: &mut Vec<(PathKind, Real, Real, Real)>,
 ) {
     let (tx, rx) = (lb.tx, lb.rx);
-    let (d1, d2) = (dist(tx, c), dist(c, rx));
+    let (zt, zr) = (lb.dz_tx, lb.dz_rx);
+    let (d1, d2) = (dist_dz(tx, c, zt), dist_dz(c, rx, zr));
     out.push((
         PathKind::Body,
         (d1 + d2) / SPEED_OF_LIGHT,
-        lb.radar(c, d1, d2, rcs),
+        lb.radar(c, zt, d1, d2, rcs),
         1.0,
     ));
     if !double {
@@ -172,11 +200,12 @@ pub(super) fn body_paths(
         if w.side(tx) * w.side(c) > 0.0 {
             let ti = w.mirror(tx);
             if let Some(p) = w.crossing(ti, c) {
-                let d1 = dist(ti, c);
+                let d1 = dist_dz(ti, c, zt);
+                let first_dz = LinkBudget::drop_at(zt, dist(tx, p), dist(ti, c));
                 out.push((
                     PathKind::BodyWall,
                     (d1 + d2) / SPEED_OF_LIGHT,
-                    lb.radar(p, d1, d2, rcs) * g2,
+                    lb.radar(p, first_dz, d1, d2, rcs) * g2,
                     w.gamma,
                 ));
             }
@@ -185,12 +214,12 @@ pub(super) fn body_paths(
         if w.side(rx) * w.side(c) > 0.0 {
             let ri = w.mirror(rx);
             if let Some(_p) = w.crossing(c, ri) {
-                let d1 = dist(tx, c);
-                let d2 = dist(c, ri);
+                let d1 = dist_dz(tx, c, zt);
+                let d2 = dist_dz(c, ri, zr);
                 out.push((
                     PathKind::BodyWall,
                     (d1 + d2) / SPEED_OF_LIGHT,
-                    lb.radar(c, d1, d2, rcs) * g2,
+                    lb.radar(c, zt, d1, d2, rcs) * g2,
                     w.gamma,
                 ));
             }

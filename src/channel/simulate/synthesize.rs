@@ -155,6 +155,8 @@ pub(super) fn synthesize(
         .map(|l| LinkBudget {
             tx: model.network.transmitters[l.tx],
             rx: model.network.receivers[l.rx],
+            dz_tx: model.network.transmitters_dz[l.tx],
+            dz_rx: model.network.receivers_dz[l.rx],
             pattern: &model.patterns[l.tx],
             ptx_grx: dbm_to_watt(scenario.transmitters[l.tx].power_dbm)
                 * db_to_linear(scenario.receivers[l.rx].gain_dbi),

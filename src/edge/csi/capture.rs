@@ -331,13 +331,13 @@ pub fn occupied(cap: &CsiCapture) -> Vec<usize> {
     let block_len = (20e6 / cap.spacing_hz).round().max(1.0) as i64;
     let block = |i: usize| (cap.subcarriers[i] as i64).div_euclid(block_len);
     let mut blocks: Vec<(i64, Real, usize)> = Vec::new();
-    for i in 0..k {
+    for (i, &p) in power.iter().enumerate() {
         match blocks.iter_mut().find(|b| b.0 == block(i)) {
             Some(b) => {
-                b.1 += power[i];
+                b.1 += p;
                 b.2 += 1;
             }
-            None => blocks.push((block(i), power[i], 1)),
+            None => blocks.push((block(i), p, 1)),
         }
     }
     let mean = |b: &(i64, Real, usize)| b.1 / b.2 as Real;

@@ -74,11 +74,11 @@ pub fn crlb_map_scalar(model: &Model, grid: &Grid, out: &mut [Real]) -> Result<(
     for (j, out_row) in out.chunks_exact_mut(nx).enumerate() {
         let y = grid.y(j);
         for (k, row) in tx_rows.iter_mut().enumerate() {
-            row.fill(net.transmitters[k], y, &xs);
+            row.fill(net.transmitters[k], net.transmitters_dz[k], y, &xs);
             row.apply_pattern(&model.patterns[k]);
         }
         for (l, row) in rx_rows.iter_mut().enumerate() {
-            row.fill(net.receivers[l], y, &xs);
+            row.fill(net.receivers[l], net.receivers_dz[l], y, &xs);
         }
         fisher.clear();
         for (link, &w) in net.links.iter().zip(&weights) {
@@ -107,15 +107,17 @@ impl NodeRow {
         }
     }
 
-    /// Unit vectors node → cell (zero on the node, spec §3) and `1/max(d², 1)`.
-    fn fill(&mut self, node: Vec2, y: Real, xs: &[Real]) {
+    /// Unit vectors node → cell (horizontal parts of the 3-D ones for a node at vertical offset
+    /// `dz`; zero on the node, spec §3) and `1/max(d², 1)` with the 3-D `d² = dx² + (dy² + dz²)`.
+    fn fill(&mut self, node: Vec2, dz: Real, y: Real, xs: &[Real]) {
         let dy = y - node.y;
+        let dy2 = dy * dy + dz * dz;
         let floor2 = SNR_DISTANCE_FLOOR_M * SNR_DISTANCE_FLOOR_M;
         let n = xs.len();
         let (ux, uy, w) = (&mut self.ux[..n], &mut self.uy[..n], &mut self.weight[..n]);
         for i in 0..n {
             let dx = xs[i] - node.x;
-            let d2 = dx * dx + dy * dy;
+            let d2 = dx * dx + dy2;
             let d = sqrt(d2);
             let inv = if d < UNIT_VECTOR_MIN_DISTANCE_M {
                 0.0

@@ -32,7 +32,8 @@ struct NodeLanes<L> {
     weight: L,
 }
 
-/// A node's offset from the current row: `dy = y − y_node` and `dy²`.
+/// A node's offset from the current row: `dy = y − y_node` and `dy² + dz²` (its vertical offset
+/// `dz` from the target's plane; exactly `dy²` when `dz = 0`).
 #[derive(Clone, Copy)]
 struct RowOffset<L> {
     x: L,
@@ -94,11 +95,13 @@ impl<'a, L: Lanes> Kernel<'a, L> {
         let mut rx = vec![none; nrx * BLOCK];
         for (r, out_row) in out.chunks_exact_mut(nx).enumerate() {
             let y = self.grid.y(first_row + r);
-            for (o, node) in tx_offsets.iter_mut().zip(&net.transmitters) {
-                *o = RowOffset::new(arch, *node, y);
+            let txs = net.transmitters.iter().zip(&net.transmitters_dz);
+            for (o, (node, &dz)) in tx_offsets.iter_mut().zip(txs) {
+                *o = RowOffset::new(arch, *node, dz, y);
             }
-            for (o, node) in rx_offsets.iter_mut().zip(&net.receivers) {
-                *o = RowOffset::new(arch, *node, y);
+            let rxs = net.receivers.iter().zip(&net.receivers_dz);
+            for (o, (node, &dz)) in rx_offsets.iter_mut().zip(rxs) {
+                *o = RowOffset::new(arch, *node, dz, y);
             }
             for (b, xs) in self.xs.chunks(BLOCK).enumerate() {
                 let n = xs.len();
@@ -157,12 +160,12 @@ impl<'a, L: Lanes> Kernel<'a, L> {
 
 impl<L: Lanes> RowOffset<L> {
     #[inline(always)]
-    fn new(arch: L::Arch, node: Vec2, y: Real) -> RowOffset<L> {
+    fn new(arch: L::Arch, node: Vec2, dz: Real, y: Real) -> RowOffset<L> {
         let dy = y - node.y;
         RowOffset {
             x: L::splat(arch, node.x),
             dy: L::splat(arch, dy),
-            dy2: L::splat(arch, dy * dy),
+            dy2: L::splat(arch, dy * dy + dz * dz),
         }
     }
 }

@@ -6,13 +6,16 @@ use alloc::vec::Vec;
 use super::{DelayMeasurements, MIN_LINKS};
 use crate::error::{check_len, limits, Error, Result};
 use crate::math::{Mat2, Real, Vec2, SPEED_OF_LIGHT};
-use crate::measure::{bistatic_range, range_and_gradient, Network};
+use crate::measure::{bistatic_range_dz, range_and_gradient_dz, Network};
 
-/// One used link in range units: foci, measured range `cτ̂` and weight `1/(cσ)²`.
+/// One used link in range units: foci, their vertical offsets from the target's plane, measured
+/// range `cτ̂` and weight `1/(cσ)²`.
 #[derive(Clone, Copy)]
 pub(super) struct Row {
     tx: Vec2,
     rx: Vec2,
+    dz_tx: Real,
+    dz_rx: Real,
     range: Real,
     weight: Real,
 }
@@ -37,10 +40,13 @@ impl Problem {
                 return Err(Error::InvalidSigma { link: p, value: *s });
             }
             let (tx, rx) = net.link_nodes(p);
+            let (dz_tx, dz_rx) = net.link_dz(p);
             let sr = SPEED_OF_LIGHT * s;
             rows.push(Row {
                 tx,
                 rx,
+                dz_tx,
+                dz_rx,
                 range: SPEED_OF_LIGHT * d,
                 weight: 1.0 / (sr * sr),
             });
@@ -60,7 +66,7 @@ impl Problem {
         self.rows
             .iter()
             .map(|row| {
-                let e = row.range - bistatic_range(row.tx, row.rx, r);
+                let e = row.range - bistatic_range_dz(row.tx, row.dz_tx, row.rx, row.dz_rx, r);
                 row.weight * e * e
             })
             .sum()
@@ -71,7 +77,7 @@ impl Problem {
     pub(super) fn linearize(&self, r: Vec2) -> (Real, Mat2, Vec2) {
         let (mut cost, mut n, mut g) = (0.0, Mat2::zeros(), Vec2::zeros());
         for row in &self.rows {
-            let (d, j) = range_and_gradient(row.tx, row.rx, r);
+            let (d, j) = range_and_gradient_dz(row.tx, row.dz_tx, row.rx, row.dz_rx, r);
             let e = row.range - d;
             cost += row.weight * e * e;
             n += row.weight * j * j.transpose();

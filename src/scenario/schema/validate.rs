@@ -35,6 +35,7 @@ impl Scenario {
             limits::check_name(&format!("transmitters[{i}].name"), &t.name)?;
             unique_name(&mut names, &t.name)?;
             position(&format!("transmitters[{i}].position_m"), t.position_m)?;
+            height(&format!("transmitters[{i}].height_m"), t.height_m)?;
             limits::POWER_DBM.check(&format!("transmitters[{i}].power_dbm"), t.power_dbm)?;
             limits::GAIN_DBI.check(&format!("transmitters[{i}].gain_dbi"), t.gain_dbi)?;
             if let Pattern::Parabolic {
@@ -64,9 +65,11 @@ impl Scenario {
             limits::check_name(&format!("receivers[{i}].name"), &rx.name)?;
             unique_name(&mut names, &rx.name)?;
             position(&format!("receivers[{i}].position_m"), rx.position_m)?;
+            height(&format!("receivers[{i}].height_m"), rx.height_m)?;
             limits::GAIN_DBI.check(&format!("receivers[{i}].gain_dbi"), rx.gain_dbi)?;
         }
         limits::RCS_M2.check("target.rcs_m2", self.target.rcs_m2)?;
+        height("target.height_m", self.target.height_m)?;
         self.area_m.validate()?;
         if let LinkSpec::List(pairs) = &self.links {
             for (i, [t, r]) in pairs.iter().enumerate() {
@@ -110,6 +113,12 @@ fn position(field: &str, p: [f64; 2]) -> Result<()> {
         limits::COORDINATE_M.check(field, v)?;
     }
     Ok(())
+}
+
+/// A height: finite and within [`limits::COORDINATE_M`] (the limits of a coordinate).
+fn height(field: &str, h: f64) -> Result<()> {
+    check_finite(field, h)?;
+    limits::COORDINATE_M.check(field, h)
 }
 
 fn node_count(field: &'static str, n: usize) -> Result<()> {

@@ -118,7 +118,7 @@ pub struct LinkStaticsInfo {
 }
 
 impl LinkStaticsInfo {
-    fn of(s: &LinkStatics) -> LinkStaticsInfo {
+    pub(super) fn of(s: &LinkStatics) -> LinkStaticsInfo {
         LinkStaticsInfo {
             empty_snapshots: s.empty_snapshots,
             background: s.background.is_some(),
@@ -131,8 +131,8 @@ impl LinkStaticsInfo {
 /// A recording and the empty area's, checked and mapped onto a model.
 #[derive(Debug, Clone)]
 pub struct Prepared {
-    map: Vec<usize>,
-    band: BandMap,
+    pub(super) map: Vec<usize>,
+    pub(super) band: BandMap,
     empty_band: Option<BandMap>,
     baseline_s: Vec<Real>,
 }
@@ -183,7 +183,7 @@ pub fn prepare(
 
 impl Prepared {
     /// The statics and the front end of recorded link `link`.
-    fn link(
+    pub(super) fn link(
         &self,
         rec: &Recording,
         empty: Option<&Recording>,

@@ -410,12 +410,49 @@ impl LinkFront {
     pub fn step(&mut self, rec: &Recording, map: &ResponseMap, cancel: Cancel) -> Result<()> {
         let s = self.out.paths.len();
         let estimated = map.fill(rec, s, self.link, &mut self.h)?;
+        let prev = s.checked_sub(1).map(|p| rec.t_s[p]);
+        let (tracked, used, align, work) =
+            self.estimate_filled(s, rec.t_s[s], prev, estimated, cancel)?;
+        self.out.paths.push(tracked);
+        self.out.noise_var.push(used);
+        self.out.alignment.push(align);
+        self.out.work.push(work);
+        Ok(())
+    }
+
+    /// Snapshot `s` of the link at `t_s` (the previous one at `prev_t_s`) from its response
+    /// `h` (a CFR's bins, as [`ResponseMap::fill`] gives them): the same estimation as
+    /// [`LinkFront::step`], returned instead of kept (the live run, `study::LiveRun`).
+    pub(super) fn step_response(
+        &mut self,
+        s: usize,
+        t_s: Real,
+        prev_t_s: Option<Real>,
+        h: &[Complex],
+        cancel: Cancel,
+    ) -> Result<LinkSnapshot> {
+        self.h.clear();
+        self.h.extend_from_slice(h);
+        self.estimate_filled(s, t_s, prev_t_s, None, cancel)
+    }
+
+    /// Estimates snapshot `s` (at `t_s`, the previous at `prev_t_s`) of the response in
+    /// `self.h`; `estimated` the map's out-of-band noise estimate.
+    fn estimate_filled(
+        &mut self,
+        s: usize,
+        t_s: Real,
+        prev_t_s: Option<Real>,
+        estimated: Option<Real>,
+        cancel: Cancel,
+    ) -> Result<LinkSnapshot> {
         let nv = self.given.or(estimated);
-        let lambda = if s == 0 {
-            0.0
-        } else {
-            let dt = rec.t_s[s] - rec.t_s[s - 1];
-            Real::max(dt / self.background_time_s, 1.0 / (s + 1) as Real)
+        let lambda = match prev_t_s {
+            Some(t0) if s > 0 => {
+                let dt = t_s - t0;
+                Real::max(dt / self.background_time_s, 1.0 / (s + 1) as Real)
+            }
+            _ => 0.0,
         };
         let recursive = self.statics.empty_snapshots == 0;
         let span = self.span;
@@ -425,14 +462,13 @@ impl LinkFront {
             statics,
             h,
             r,
-            out,
             ..
         } = self;
         let reference = statics.reference;
         let mut used = 0.0;
         let mut work = EstimateWork::default();
         let mut align = None;
-        let tracked = tracker.step(rec.t_s[s], |seeds| {
+        let tracked = tracker.step(t_s, |seeds| {
             let e = match statics.background.as_mut() {
                 Some(bg) => {
                     // Seeds back in the background's time base.
@@ -477,13 +513,13 @@ impl LinkFront {
             work = e.work;
             Ok(in_reference(e, reference, span))
         })?;
-        out.paths.push(tracked);
-        out.noise_var.push(used);
-        out.alignment.push(align);
-        out.work.push(work);
-        Ok(())
+        Ok((tracked, used, align, work))
     }
 }
+
+/// One link-snapshot's output: its tracked paths, the noise variance used, its alignment, the
+/// estimation's work.
+pub(super) type LinkSnapshot = (Vec<TrackedPath>, Real, Option<Alignment>, EstimateWork);
 
 /// Both passes of an aligned snapshot.
 fn merge_work(a: EstimateWork, b: EstimateWork) -> EstimateWork {
@@ -521,7 +557,8 @@ fn in_reference(mut e: SnapshotEstimate, reference: Reference, span: Real) -> Sn
     e
 }
 
-/// The baseline delays `‖t − r‖/c` of `rec`'s links on `model` (recording order).
+/// The baseline delays `‖t − r‖/c` of `rec`'s links on `model` (recording order): 3-D, with the
+/// nodes' own heights, when they differ ([`crate::measure::Network::los_delay`]).
 pub fn baselines(model: &crate::measure::Model, rec: &Recording) -> Result<Vec<Real>> {
     let map = rec.link_map(model)?;
     Ok(map
@@ -532,7 +569,8 @@ pub fn baselines(model: &crate::measure::Model, rec: &Recording) -> Result<Vec<R
                 model.network.transmitters[l.tx],
                 model.network.receivers[l.rx],
             );
-            sqrt((t - r).norm_squared()) / SPEED_OF_LIGHT
+            let h = model.network.receivers_dz[l.rx] - model.network.transmitters_dz[l.tx];
+            sqrt((t - r).norm_squared() + h * h) / SPEED_OF_LIGHT
         })
         .collect())
 }

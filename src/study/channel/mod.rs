@@ -7,7 +7,8 @@
 //! background, or C7's clusters — and estimates every snapshot (C5 on the residual, C6 path
 //! tracks, delays absolute or relative to the direct path, C10) ([`estimate_recording`], one
 //! driver job per link, or [`EstimationRun`] in slices); the track ([`cir_track`]) starts by
-//! itself, detects its loss and restarts (C11) with any filter.
+//! itself, detects its loss and restarts (C11) with any filter; [`LiveFront`] + [`LiveRun`]
+//! run the same chain frame by frame, as frames arrive (issue 40 §3).
 //!
 //! ```
 //! use scatterloc::channel::{simulate_recording, ChannelScene};
@@ -39,6 +40,7 @@
 mod direct;
 mod estimates;
 mod front;
+mod live;
 mod request;
 mod settings;
 mod track;
@@ -52,6 +54,7 @@ pub use front::{
     LinkEstimates, LinkFront, LinkStatics, BACKGROUND_MAX_PATHS, LOS_WITHIN_DB,
     RECURSIVE_CLUSTER_DB,
 };
+pub use live::{LiveFront, LiveRun, LiveState, LIVE_REPLAY_SNAPSHOTS};
 pub use request::{
     ChannelRequest, DelayReference, DelaySigma, FrontEndConfig, StaticMode, DEFAULT_PROCESS_NOISE,
     DEFAULT_SEED, EXTENT_SIGMA_M,

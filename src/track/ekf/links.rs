@@ -79,12 +79,15 @@ const NO_TX: TxView = TxView {
 /// Transmitters `first ..` (at most `B`, lanes past the last one unused) as seen from `r`.
 #[inline(always)]
 fn tx_views<const B: usize>(model: &Model, first: usize, r: Vec2, gain: bool) -> [TxView; B] {
-    let nodes = &model.network.transmitters[first..];
-    let (mut x, mut y) = ([0.0; B], [0.0; B]);
-    for (i, node) in nodes.iter().take(B).enumerate() {
-        (x[i], y[i]) = (node.x, node.y);
+    let net = &model.network;
+    let nodes = net.transmitters[first..]
+        .iter()
+        .zip(&net.transmitters_dz[first..]);
+    let (mut x, mut y, mut dz) = ([0.0; B], [0.0; B], [0.0; B]);
+    for (i, (node, &z)) in nodes.take(B).enumerate() {
+        (x[i], y[i], dz[i]) = (node.x, node.y, z);
     }
-    let v = NodeViews::new(&x, &y, &[r.x; B], &[r.y; B]);
+    let v = NodeViews::new(&x, &y, &dz, &[r.x; B], &[r.y; B]);
     let mut out = [NO_TX; B];
     for (i, pattern) in model.patterns[first..].iter().take(B).enumerate() {
         out[i] = TxView {
@@ -106,7 +109,14 @@ fn tx_views<const B: usize>(model: &Model, first: usize, r: Vec2, gain: bool) ->
 #[inline(always)]
 fn tx_seen_from<const L: usize>(model: &Model, k: usize, r: &[Vec2; L], gain: bool) -> [TxView; L] {
     let node = model.network.transmitters[k];
-    let v = NodeViews::new(&[node.x; L], &[node.y; L], &r.map(|r| r.x), &r.map(|r| r.y));
+    let dz = model.network.transmitters_dz[k];
+    let v = NodeViews::new(
+        &[node.x; L],
+        &[node.y; L],
+        &[dz; L],
+        &r.map(|r| r.x),
+        &r.map(|r| r.y),
+    );
     let gains = if gain {
         model.patterns[k].gains_toward(v.ux, v.uy)
     } else {
@@ -345,19 +355,20 @@ fn add_block<W: Weights>(
     // Gather: the transmitter's view, the receiver, the delay and the factor of w. An unused lane
     // gets z = 0 and a factor that gives w = 0; its inputs are not checked.
     let tx: [TxView; BLOCK] = core::array::from_fn(|i| tx_view(links[i].tx));
-    let (mut rx_x, mut rx_y) = ([0.0; BLOCK], [0.0; BLOCK]);
+    let (mut rx_x, mut rx_y, mut rx_dz) = ([0.0; BLOCK], [0.0; BLOCK], [0.0; BLOCK]);
     let (mut zv, mut factor, mut used) = ([0.0; BLOCK], [W::UNUSED; BLOCK], [false; BLOCK]);
     let mut valid = true;
     for i in 0..BLOCK {
         let node = model.network.receivers[links[i].rx];
         (rx_x[i], rx_y[i]) = (node.x, node.y);
+        rx_dz[i] = model.network.receivers_dz[links[i].rx];
         if let Some(v) = z[i] {
             let (f, ok) = w.factor(first + i);
             (zv[i], factor[i], used[i]) = (v, f, true);
             valid &= ok & limits::DELAY_S.contains(v);
         }
     }
-    let rv = NodeViews::<BLOCK>::new(&rx_x, &rx_y, &[r.x; BLOCK], &[r.y; BLOCK]);
+    let rv = NodeViews::<BLOCK>::new(&rx_x, &rx_y, &rx_dz, &[r.x; BLOCK], &[r.y; BLOCK]);
     // Per link the terms of the sums; every used w positive, every z and w finite.
     let mut t = [[0.0; 6]; BLOCK];
     let (mut nu, mut weight) = ([0.0; BLOCK], [0.0; BLOCK]);

@@ -64,13 +64,22 @@ impl Scratch {
 fn truth_step(model: &Model, s: &mut Scratch, n: usize, r: Vec2) -> Mat2 {
     let net = &model.network;
     s.tx_views.clear();
-    for (k, &tx) in net.transmitters.iter().enumerate() {
-        let v = NodeView::new(tx, r);
+    for (k, (&tx, &dz)) in net
+        .transmitters
+        .iter()
+        .zip(&net.transmitters_dz)
+        .enumerate()
+    {
+        let v = NodeView::new(tx, dz, r);
         s.tx_views.push((v, model.patterns[k].gain_toward(v.unit)));
     }
     s.rx_views.clear();
-    s.rx_views
-        .extend(net.receivers.iter().map(|&rx| NodeView::new(rx, r)));
+    s.rx_views.extend(
+        net.receivers
+            .iter()
+            .zip(&net.receivers_dz)
+            .map(|(&rx, &dz)| NodeView::new(rx, dz, r)),
+    );
     let links = net.links.len();
     let info_per_snr = range_information_per_snr(model);
     let fill = s.table.len() >= links * (n + 1);

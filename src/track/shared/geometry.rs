@@ -19,11 +19,14 @@ pub(crate) struct NodeViews<const B: usize> {
 }
 
 impl<const B: usize> NodeViews<B> {
-    /// Nodes `(x[i], y[i])` seen from the points `(px[i], py[i])`.
+    /// Nodes `(x[i], y[i])` at vertical offsets `dz[i]` from the target's plane seen from the
+    /// points `(px[i], py[i])` of that plane: 3-D distances `√(dx² + (dy² + dz²))` (bitwise the
+    /// planar ones when `dz = 0`), the horizontal parts of the 3-D unit vectors.
     #[inline(always)]
     pub(crate) fn new(
         x: &[Real; B],
         y: &[Real; B],
+        dz: &[Real; B],
         px: &[Real; B],
         py: &[Real; B],
     ) -> NodeViews<B> {
@@ -35,7 +38,7 @@ impl<const B: usize> NodeViews<B> {
         };
         for i in 0..B {
             let (dx, dy) = (px[i] - x[i], py[i] - y[i]);
-            let distance = sqrt(dx * dx + dy * dy);
+            let distance = sqrt(dx * dx + (dy * dy + dz[i] * dz[i]));
             let inv = 1.0 / distance;
             let near = distance < UNIT_VECTOR_MIN_DISTANCE_M;
             v.ux[i] = if near { 0.0 } else { dx * inv };
@@ -64,9 +67,10 @@ pub(crate) struct NodeView {
 }
 
 impl NodeView {
+    /// A node at `node` and vertical offset `dz` seen from `r`.
     #[inline(always)]
-    pub(crate) fn new(node: Vec2, r: Vec2) -> NodeView {
-        let v = NodeViews::<1>::new(&[node.x], &[node.y], &[r.x], &[r.y]);
+    pub(crate) fn new(node: Vec2, dz: Real, r: Vec2) -> NodeView {
+        let v = NodeViews::<1>::new(&[node.x], &[node.y], &[dz], &[r.x], &[r.y]);
         NodeView {
             unit: Vec2::new(v.ux[0], v.uy[0]),
             distance: v.distance[0],

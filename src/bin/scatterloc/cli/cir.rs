@@ -46,6 +46,25 @@ pub enum CirCommand {
     /// reports (RSSI/AGC); maps antenna pairs to the scenario's links (--links). Prints what it
     /// found: format, device, frames, bandwidth, antennas, subcarriers, dropped frames, notes.
     Convert(CirConvertArgs),
+    /// Write a recording (.npz, frequency responses) as a frame stream (docs/recording.md,
+    /// "Streaming frames"), the input of `cir track --follow`: a JSON header line, then one
+    /// frame per snapshot (samples as float32), then the end marker, on standard output.
+    Stream(CirStreamArgs),
+}
+
+/// `scatterloc cir stream`.
+#[derive(Debug, Args)]
+pub struct CirStreamArgs {
+    /// The recording (.npz with a `cfr` array); the stream goes to standard output.
+    #[arg(value_name = "REC.npz")]
+    pub input: String,
+    /// Write the recording this many times, each copy's times after the previous copy's by
+    /// its span plus one mean step (a long stream for benchmarks) [default: 1].
+    #[arg(long, value_name = "N", value_parser = whole)]
+    pub repeat: Option<usize>,
+    /// Leave out the end marker (a stream that stops as if its writer were still running).
+    #[arg(long)]
+    pub no_end: bool,
 }
 
 /// `scatterloc cir convert`.
@@ -207,6 +226,11 @@ pub struct CirEstimateArgs {
     /// amplitude, sigma], the first snapshot as initial_snapshot; uniform snapshot times only).
     #[arg(long, value_name = "FILE.json")]
     pub measurements: Option<String>,
+    /// Also write the estimates as detections, JSON lines (docs/detections.md; `track
+    /// --detections` reads them): per snapshot and recorded link the delays (s), SNR (dB) and
+    /// sigma (s).
+    #[arg(long, value_name = "D.jsonl")]
+    pub detections_out: Option<String>,
     /// Process-noise intensity q written to --measurements, m^2/s^3 [default: 1].
     #[arg(long, value_name = "Q", value_parser = finite)]
     pub process_noise: Option<f64>,
@@ -233,12 +257,24 @@ pub struct CirTrackArgs {
     /// gated (C7) [default: a recursive background learnt from the recording itself].
     #[arg(long, value_name = "CAL.npz")]
     pub calibration: Option<String>,
-    /// Recording of the walk (.npz).
-    #[arg(long, value_name = "REC.npz")]
-    pub cir: String,
+    /// Recording of the walk (.npz); with --follow a frame stream (docs/recording.md,
+    /// "Streaming frames") in a file that grows, or '-' for standard input [--follow default: -].
+    #[arg(long, value_name = "REC.npz", required_unless_present = "follow")]
+    pub cir: Option<String>,
     /// The track (.json).
-    #[arg(long, value_name = "TRACK.json")]
-    pub out: String,
+    #[arg(
+        long,
+        value_name = "TRACK.json",
+        required_unless_present = "follow",
+        conflicts_with = "follow"
+    )]
+    pub out: Option<String>,
+    /// Track as frames arrive: read --cir as a frame stream (a file followed as it grows,
+    /// until its end marker; or standard input) and write one JSON line per frame on stdout as
+    /// soon as it is computed: {t_s, state, covariance, segment, links_used, delays_s,
+    /// snapshot, event, end, dropped_hypotheses}. Ctrl-C: exit 130, the lines written kept.
+    #[arg(long, conflicts_with_all = ["figure", "delays_figure", "truth", "calibration_range", "threads"])]
+    pub follow: bool,
     /// The track on the map, the position error over time and its CDF (.svg or .png; with
     /// --truth).
     #[arg(long, value_name = "F.{svg,png}")]

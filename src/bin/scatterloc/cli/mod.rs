@@ -21,7 +21,7 @@ use std::ffi::OsString;
 use clap::{CommandFactory, FromArgMatches, Parser, Subcommand, ValueEnum};
 
 pub use cir::{
-    CirCommand, CirConvertArgs, CirEstimateArgs, CirSimulateArgs, CirTrackArgs, FrontEndArgs, ReferenceName,
+    CirCommand, CirConvertArgs, CirEstimateArgs, CirSimulateArgs, CirStreamArgs, CirTrackArgs, FrontEndArgs, ReferenceName,
     SigmaSource, CsiArgs, StaticsName,
 };
 pub use filters::{FilterName, FilterSettings};
@@ -46,6 +46,7 @@ Commands at a glance (`scatterloc help COMMAND` for every flag):
   scatterloc locate --scenario FILE --delays FILE
   scatterloc track --scenario FILE --measurements FILE [--calibration FILE]
                    [--association spec|gated] [--out FIG.{svg,png} [--truth FILE]]
+  scatterloc track --scenario FILE --detections D.jsonl [--process-noise Q] [the same flags]
   scatterloc calibrate --scenario FILE --snapshots FILE [--gap-s G] [--min-fraction F]
                        [--sigma-floor-s S] [--out OUT.json]
   scatterloc simulate-walk --scenario FILE --out-dir DIR [--duration S] [--dt T] [--seed N]
@@ -54,7 +55,7 @@ Commands at a glance (`scatterloc help COMMAND` for every flag):
   scatterloc cir simulate --scenario FILE --out-dir DIR [--scene FILE] [--walk POINTS]
                           [--duration S] [--dt T] [--seed N]
   scatterloc cir estimate --scenario FILE --cir REC.npz --out EST.json [--snapshots F]
-                          [--measurements F]
+                          [--measurements F] [--detections-out D.jsonl]
   scatterloc cir track --scenario FILE --calibration CAL.npz --cir REC.npz --out TRACK.json
                        [--figure F.{svg,png}] [--delays-figure D.{svg,png}] [--truth FILE]
                        [--filter ekf|ukf|pf]
@@ -164,6 +165,11 @@ pub enum Command {
     ///
     /// --out: a figure of the filter's 1 sigma position sqrt(Pxx + Pyy) and the links used over
     /// time; --truth FILE ({t_s, states}, e.g. simulate-walk's truth.json) adds the error.
+    ///
+    /// --detections D.jsonl instead of --measurements: JSON lines of other tools' (or `cir
+    /// estimate --detections-out`'s) detections, one per frame and link (docs/detections.md);
+    /// the first frame is the initial_snapshot, the others the raw_steps, dt_s their spacing,
+    /// process_noise --process-noise.
     Track(TrackArgs),
     /// Learn the static paths of the empty area from calibration snapshots (spec §4).
     ///

@@ -12,9 +12,18 @@ pub struct TrackArgs {
     #[arg(long, value_name = "FILE")]
     pub scenario: String,
     /// Measurements JSON file ('-' = standard input): dt_s, process_noise, the start, and steps
-    /// or raw_steps (see above).
+    /// or raw_steps (see above). Give this or --detections.
     #[arg(long, value_name = "FILE")]
-    pub measurements: String,
+    pub measurements: Option<String>,
+    /// Detections, JSON lines ('-' = standard input; docs/detections.md): per frame and link
+    /// {timestamp, tx, rx, unit, delay, snr, sigma, doppler}; the first frame starts the track
+    /// (as initial_snapshot), the others are its raw_steps. Give this or --measurements.
+    #[arg(long, value_name = "D.jsonl")]
+    pub detections: Option<String>,
+    /// Process-noise intensity q of the track over --detections, m^2/s^3 [default: 1, as
+    /// `cir estimate --measurements` writes].
+    #[arg(long, value_name = "Q", value_parser = finite)]
+    pub process_noise: Option<f64>,
     /// Static paths from `scatterloc calibrate` (raw_steps only); estimates within 3 sigma of a
     /// static cluster are discarded (E4) [default: none, nothing is static].
     #[arg(long, value_name = "FILE")]

@@ -5,7 +5,7 @@
 
 use scatterloc::channel::{Recording, SimulationRequest};
 use scatterloc::error::Cancel;
-use scatterloc::formats::{CalibrationSnapshots, Measurements, Truth};
+use scatterloc::formats::{CalibrationSnapshots, Detections, Measurements, Truth};
 use scatterloc::native::Parallel;
 use scatterloc::present::{estimates_doc, track_doc, track_errors};
 use scatterloc::study::{
@@ -28,7 +28,7 @@ use crate::failure::CliError;
 
 /// Reads the recording `--flag PATH` (.npz, docs/recording.md, or a CSI tool's file read as
 /// `csi` says), checked against `model`.
-fn read_recording(
+pub(super) fn read_recording(
     flag: &str,
     path: &str,
     model: &Model,
@@ -54,13 +54,13 @@ fn open_recording(
 }
 
 /// A core error of the request, named by the flag that sets its field.
-fn flag_error(e: &scatterloc::Error) -> CliError {
+pub(super) fn flag_error(e: &scatterloc::Error) -> CliError {
     CliError::usage(with_flag(e).unwrap_or_else(|| e.to_string()))
 }
 
 /// The request of the front end's flags (and, for `cir track`, the tracker's), checked by the
 /// core.
-fn request(fe: &FrontEndArgs, track: Option<&CirTrackArgs>) -> Result<ChannelRequest, CliError> {
+pub(super) fn request(fe: &FrontEndArgs, track: Option<&CirTrackArgs>) -> Result<ChannelRequest, CliError> {
     let mut r = ChannelRequest::default();
     if let Some(k) = fe.max_paths {
         r.max_paths = k;
@@ -191,7 +191,7 @@ fn output(flag: &str, path: &str, allowed: &[Format]) -> Result<Format, CliError
 }
 
 /// `scatterloc cir estimate --scenario S --cir REC.npz --out EST.json [--calibration CAL.npz]
-/// [--snapshots F] [--measurements F]`.
+/// [--snapshots F] [--measurements F] [--detections-out D.jsonl]`.
 pub fn cir_estimate(args: &CirEstimateArgs) -> Result<(), CliError> {
     catch_ctrl_c();
     one_stdin(&[
@@ -209,6 +209,11 @@ pub fn cir_estimate(args: &CirEstimateArgs) -> Result<(), CliError> {
             output(flag, p, &[Format::Json])?;
             outputs.push((flag, p));
         }
+    }
+    if let Some(p) = &args.detections_out {
+        // JSON lines: any name (`.jsonl` by convention).
+        check_writable("detections-out", p)?;
+        outputs.push(("detections-out", p));
     }
     check_distinct(&outputs)?;
     let q = args.process_noise.unwrap_or(DEFAULT_PROCESS_NOISE);
@@ -291,6 +296,10 @@ pub fn cir_estimate(args: &CirEstimateArgs) -> Result<(), CliError> {
         };
         files.json("measurements", p, &doc)?;
     }
+    if let Some(p) = &args.detections_out {
+        let d = Detections::from_paths(&model.network.links, &est.t_s, &est.recorded, &est.paths);
+        files.bytes("detections-out", p, d.to_text().as_bytes())?;
+    }
     files.commit()?;
     let paths: usize = est.paths.iter().flatten().map(Vec::len).sum();
     let mut summary = serde_json::json!({
@@ -341,13 +350,18 @@ fn uniform_dt(t_s: &[f64], q: f64) -> Result<(f64, f64), CliError> {
 /// `scatterloc cir track --scenario S --cir REC.npz --out TRACK.json [--calibration CAL.npz]`.
 pub fn cir_track(args: &CirTrackArgs) -> Result<(), CliError> {
     catch_ctrl_c();
+    // Both required by the flags without --follow (`cir_follow::cir_track_follow`).
+    let (cir, out) = match (args.cir.as_deref(), args.out.as_deref()) {
+        (Some(c), Some(o)) => (c, o),
+        _ => return Err(CliError::usage("--cir and --out are required (or --follow)")),
+    };
     one_stdin(&[
         ("scenario", Some(&args.scenario)),
-        ("cir", Some(&args.cir)),
+        ("cir", Some(cir)),
         ("calibration", args.calibration.as_deref()),
         ("truth", args.truth.as_deref()),
     ])?;
-    output("out", &args.out, &[Format::Json])?;
+    output("out", out, &[Format::Json])?;
     let figure = match &args.figure {
         Some(p) => Some((
             p.as_str(),
@@ -363,7 +377,7 @@ pub fn cir_track(args: &CirTrackArgs) -> Result<(), CliError> {
         None => None,
     };
     let figures = [("figure", figure), ("delays-figure", delays_figure)];
-    let outputs: Vec<(&str, &str)> = std::iter::once(("out", args.out.as_str()))
+    let outputs: Vec<(&str, &str)> = std::iter::once(("out", out))
         .chain(figures.iter().filter_map(|(f, o)| o.map(|(p, _)| (*f, p))))
         .collect();
     check_distinct(&outputs)?;
@@ -371,7 +385,7 @@ pub fn cir_track(args: &CirTrackArgs) -> Result<(), CliError> {
     let (threads, _) = threads(args.front_end.threads)?;
     let scenario = read_scenario(&args.scenario)?;
     let model = model_of(&scenario)?;
-    let rec = read_recording("cir", &args.cir, &model, &args.front_end.csi)?;
+    let rec = read_recording("cir", cir, &model, &args.front_end.csi)?;
     let empty = empty_area(
         args.calibration.as_deref(),
         &req,
@@ -396,7 +410,7 @@ pub fn cir_track(args: &CirTrackArgs) -> Result<(), CliError> {
         empty.as_ref(),
         &cfg,
         threads,
-        (&args.cir, args.calibration.as_deref()),
+        (cir, args.calibration.as_deref()),
     )?;
     let (res, _) = run_with_counter(est.len(), "snapshots", "track", |cancel, _| {
         let stop = || cancel.load(std::sync::atomic::Ordering::Relaxed);
@@ -409,7 +423,7 @@ pub fn cir_track(args: &CirTrackArgs) -> Result<(), CliError> {
             Cancel::when(&stop),
         )
     })?;
-    let track = res.map_err(|e| in_file("cir", &args.cir, e))?;
+    let track = res.map_err(|e| in_file("cir", cir, e))?;
     // The error view (per snapshot, its statistics and CDF) once, for TRACK.json and --figure.
     let truth_states: Vec<Option<[f64; 4]>> = truth
         .as_ref()
@@ -418,11 +432,11 @@ pub fn cir_track(args: &CirTrackArgs) -> Result<(), CliError> {
     let view = track_errors(&track.t_s, &track.states, &truth_states)
         .map_err(|e| at_flag("truth", e))?
         .with_segments(&track)
-        .map_err(|e| in_file("cir", &args.cir, e))?;
+        .map_err(|e| in_file("cir", cir, e))?;
     let error = truth.as_ref().and(view.stats);
     let doc = track_doc(&track, &req, &cfg, &statics, &est, error).map_err(|e| flag_error(&e))?;
     let mut files = OutputSet::new();
-    files.json("out", &args.out, &doc)?;
+    files.json("out", out, &doc)?;
     if let Some((p, f)) = delays_figure {
         super::cir_fig::stage_delays_figure(
             &mut files,
@@ -442,7 +456,7 @@ pub fn cir_track(args: &CirTrackArgs) -> Result<(), CliError> {
     files.commit()?;
     emit_summary(
         &serde_json::json!({
-            "out": args.out,
+            "out": out,
             "snapshots": track.t_s.len(),
             "start": track.start.as_ref().map(|s| s.t_s),
             "segments": track.segments.len(),

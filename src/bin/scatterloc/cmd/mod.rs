@@ -1,7 +1,8 @@
 //! The commands of `scatterloc`, one file per family: the single-snapshot commands (`preset`,
 //! `crlb`, `locate` in `scenario`, `crlb-map` in `crlb_map`), tracking (`track` with its figure
 //! in `track_fig`), the channel front end (`cir simulate|estimate|track` in `cir`; `cir convert`
-//! and the opening of any recording file, `.npz` or CSI, in `cir_convert`), gating
+//! and the opening of any recording file, `.npz` or CSI, in `cir_convert`; `cir track --follow` and
+//! `cir stream`, the frame stream, in `cir_follow`), gating
 //! (`calibrate`, `simulate-walk`), the tracking studies (`montecarlo`, `pcrlb`, sharing `study`
 //! and `report`), network planning (`plan`), the multi-target commands (`mtl`), and scale-out:
 //! one shard of a study (`--shard`, its part file in `shard`), `merge` (the part files read by
@@ -12,6 +13,7 @@
 mod cir;
 mod cir_convert;
 mod cir_fig;
+mod cir_follow;
 mod crlb_map;
 mod filters;
 mod flags;
@@ -33,6 +35,7 @@ mod track_fig;
 
 pub use cir::{cir_estimate, cir_simulate, cir_track};
 pub use cir_convert::cir_convert;
+pub use cir_follow::{cir_stream, cir_track_follow};
 pub use crlb_map::crlb_map;
 pub use gating::{calibrate, simulate_walk};
 pub use merge::merge;

@@ -7,28 +7,51 @@
 //! `--filter ukf|pf` runs the UKF or the particle filter instead, in either form: gating and
 //! association then use that filter's predicted delays and innovation σ (its sigma points, its
 //! weighted particles).
+//! `--detections D.jsonl` reads the JSON lines of docs/detections.md instead
+//! ([`scatterloc::formats::Detections`], converted to the raw form with `--process-noise`).
 
 use scatterloc::error::Cancel;
-use scatterloc::formats::{Measurements, Steps};
-use scatterloc::study::{track_cpu_s, track_measurements_in, TrackRequest};
+use scatterloc::formats::{Detections, Measurements, Steps};
+use scatterloc::study::{track_cpu_s, track_measurements_in, TrackRequest, DEFAULT_PROCESS_NOISE};
 use scatterloc::track::gating::AssociationRule;
 
 use super::filters::filter_kinds;
-use super::flags::in_file;
+use super::flags::{in_file, with_flag};
 use super::gating::read_calibration;
-use super::io::{emit, model_of, one_stdin, read_json_file, read_scenario};
+use super::io::{emit, model_of, one_stdin, read_input, read_json_file, read_scenario};
 use super::output::{check_writable, Format};
 use super::study::{cost_refused, run_with_bar};
 use super::track_fig::{read_truth, write_track_figure, TrackSeries};
 use crate::cli::{Association, FilterName, TrackArgs};
 use crate::failure::CliError;
 
-/// `scatterloc track --scenario S --measurements M [--calibration C] [--association R]`.
+/// `scatterloc track --scenario S (--measurements M | --detections D) [--calibration C]
+/// [--association R]`.
 pub fn track(args: &TrackArgs) -> Result<(), CliError> {
-    let mpath = args.measurements.as_str();
+    // The input: a measurements file, or detections (JSON lines, turned into one).
+    let (flag, mpath) = match (&args.measurements, &args.detections) {
+        (Some(m), None) => ("measurements", m.as_str()),
+        (None, Some(d)) => ("detections", d.as_str()),
+        (Some(_), Some(_)) => {
+            return Err(CliError::usage(
+                "--measurements/--detections: give one of them, not both",
+            ))
+        }
+        (None, None) => {
+            return Err(CliError::usage(
+                "--measurements/--detections: give one of them (the delays to track)",
+            ))
+        }
+    };
+    if args.process_noise.is_some() && args.detections.is_none() {
+        return Err(CliError::usage(
+            "--process-noise: only with --detections (a measurements file has its own \
+             process_noise)",
+        ));
+    }
     one_stdin(&[
         ("scenario", Some(&args.scenario)),
-        ("measurements", Some(mpath)),
+        (flag, Some(mpath)),
         ("calibration", args.calibration.as_deref()),
         ("truth", args.truth.as_deref()),
     ])?;
@@ -53,9 +76,20 @@ pub fn track(args: &TrackArgs) -> Result<(), CliError> {
         ));
     }
     let scenario = read_scenario(&args.scenario)?;
-    let m: Measurements = read_json_file("measurements", mpath)?;
-    let bad = |e: &dyn std::fmt::Display| in_file("measurements", mpath, e);
+    let bad = |e: &dyn std::fmt::Display| in_file(flag, mpath, e);
     let model = model_of(&scenario)?;
+    let m: Measurements = match &args.detections {
+        None => read_json_file("measurements", mpath)?,
+        Some(_) => {
+            let q = args.process_noise.unwrap_or(DEFAULT_PROCESS_NOISE);
+            Detections::from_text(&read_input(flag, mpath)?)
+                .and_then(|d| d.to_measurements(&model, q))
+                .map_err(|e| match with_flag(&e) {
+                    Some(text) => CliError::usage(text),
+                    None => bad(&e),
+                })?
+        }
+    };
     let n = model.link_count();
     let rule = match args.association {
         None | Some(Association::Spec) => AssociationRule::Spec,
@@ -82,8 +116,10 @@ pub fn track(args: &TrackArgs) -> Result<(), CliError> {
         track_cpu_s(kind, n, steps),
         1,
         args.max_cpu_hours,
-        "the steps of --measurements, --particles, or use --filter ekf or a scenario with fewer \
-         links",
+        &format!(
+            "the steps of --{flag}, --particles, or use --filter ekf or a scenario with fewer \
+             links"
+        ),
     )?;
     let req = TrackRequest {
         model: &model,

@@ -7,7 +7,7 @@ use alloc::vec;
 use alloc::vec::Vec;
 
 use super::super::bfee;
-use super::frame::Cursor;
+use super::cursor::Cursor;
 use crate::error::limits::{MAX_BINS_PER_LINK, MAX_LINKS};
 use crate::error::Result;
 use crate::math::Complex;

@@ -49,6 +49,7 @@
 //! differ from the first CSI frame's, are skipped with the reason.
 
 mod csi;
+mod cursor;
 mod frame;
 
 pub use frame::{read, sniff};

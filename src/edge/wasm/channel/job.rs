@@ -28,7 +28,7 @@ use crate::study::{
     FrontEndConfig, RecordingEstimates,
 };
 use crate::track::FilterKind;
-use crate::{npz, Model, Scenario};
+use crate::{Model, Scenario};
 
 /// Link-snapshots estimated per clock reading (each is 0.1–2 ms).
 const UNITS_PER_READING: usize = 4;

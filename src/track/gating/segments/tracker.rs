@@ -137,6 +137,21 @@ impl<'a> SegmentTracker<'a> {
         self.hypotheses.len()
     }
 
+    /// The earliest snapshot a confirmation may still replay from: the oldest held
+    /// hypothesis' fix (`None`: no hypothesis held). A caller that keeps only a window of
+    /// snapshots for `replay` (a live run) keeps those from here on.
+    pub fn oldest_fix(&self) -> Option<usize> {
+        self.hypotheses.iter().map(|h| h.born).min()
+    }
+
+    /// Drops the hypotheses whose fix is before snapshot `k0` (a live run's replay window is
+    /// full: their replay could not be served); returns how many.
+    pub fn drop_hypotheses_before(&mut self, k0: usize) -> usize {
+        let before = self.hypotheses.len();
+        self.hypotheses.retain(|h| h.born >= k0);
+        before - self.hypotheses.len()
+    }
+
     pub(super) fn motion(&self, dt: Real) -> Result<ConstantVelocity> {
         ConstantVelocity::validated(dt, self.process_noise)
     }
