@@ -18,7 +18,7 @@ Planning and multi-target
     :func:`plan`, :func:`mtl_locate`
 Channel recordings (CFR/CIR to delays)
     :class:`Recording`, :func:`read_recording` (``.npz`` or a Wi-Fi CSI file), :func:`read_csi`,
-    :func:`write_recording`,
+    :func:`write_recording`, :func:`track_stream` (live, frame by frame),
     :func:`simulate_recording`, :func:`estimate`, :func:`estimate_recording`, :func:`cir_track`
 Stone Soup
     :mod:`scatterloc.stonesoup` (``BistaticDelayModel``; needs ``pip install scatterloc[stonesoup]``)
@@ -41,6 +41,7 @@ from ._scatterloc import (
     StaticCalibration,
     StudyResult,
     Track,
+    TrackStream,
     __version__,
     calibrate,
     cir_track,
@@ -57,6 +58,7 @@ from ._scatterloc import (
     read_recording,
     simulate_recording,
     track,
+    track_stream,
     write_recording,
 )
 
@@ -75,6 +77,7 @@ __all__ = [
     "StaticCalibration",
     "StudyResult",
     "Track",
+    "TrackStream",
     "__version__",
     "calibrate",
     "cir_track",
@@ -91,5 +94,6 @@ __all__ = [
     "read_recording",
     "simulate_recording",
     "track",
+    "track_stream",
     "write_recording",
 ]

@@ -23,6 +23,7 @@ __all__ = [
     "StaticCalibration",
     "StudyResult",
     "Track",
+    "TrackStream",
     "__version__",
     "_bench",
     "calibrate",
@@ -36,9 +37,11 @@ __all__ = [
     "mtl_locate",
     "pcrlb",
     "plan",
+    "read_csi",
     "read_recording",
     "simulate_recording",
     "track",
+    "track_stream",
     "write_recording",
 ]
 
@@ -492,6 +495,23 @@ def read_recording(
     all_subcarriers: bool = False,
 ) -> Recording: ...
 def read_csi(path: _PathLike, *, format: Optional[str] = None) -> dict[str, Any]: ...
+@final
+class TrackStream:
+    """The iterator of :func:`track_stream`: one state dict per frame pulled."""
+    def __iter__(self) -> TrackStream: ...
+    def __next__(self) -> dict[str, Any]: ...
+
+def track_stream(
+    scenario: _ScenarioLike,
+    header: Recording,
+    frames: Any,
+    *,
+    calibration: Optional[Recording] = None,
+) -> TrackStream:
+    """``scatterloc cir track --follow`` in Python: one dict per frame (``t_s``, ``state``,
+    ``covariance``, ``segment``, ``links_used``, ``delays_s``, ``snapshot``, ``event``, ``end``,
+    ``dropped_hypotheses``), computed as each ``(t, samples (links, bins))`` of ``frames`` is
+    pulled; ``header`` gives the links, bins, system response and clock flag."""
 def write_recording(path: _PathLike, recording: Recording) -> None: ...
 def simulate_recording(
     scenario: _ScenarioLike,

@@ -36,7 +36,7 @@ use crate::scenario::scenario_arg;
 /// The dtypes a sample array may have: the `.npz` reader's (docs/recording.md), so an array
 /// `Recording` takes is one the reader takes from a file and the other way round.
 #[derive(Clone, Copy, PartialEq, Eq)]
-enum SampleDtypes {
+pub(crate) enum SampleDtypes {
     /// complex64 or complex128 (`cfr`, `system_response`, `pulse`, `estimate`'s `response`).
     Complex,
     /// Those, or int16/int32 (I, Q) pairs on a last axis of length 2 (`cir`).
@@ -50,7 +50,7 @@ enum SampleDtypes {
 /// the shape (for I/Q pairs without their last axis) before anything is copied or converted:
 /// it checks the shape and the size caps, so a broadcast view of 10¹⁰ samples is refused
 /// without being copied.
-fn complex_arg(
+pub(crate) fn complex_arg(
     obj: &Bound<'_, PyAny>,
     field: &str,
     dtypes: SampleDtypes,

@@ -17,6 +17,7 @@
 //! - `channel`: `Recording`, `read_recording`, `write_recording`, `simulate_recording`,
 //!   `estimate`, `estimate_recording`, `cir_track`.
 //! - `csi`: `read_csi` and the CSI keywords of `read_recording` (Wi-Fi CSI tools' files).
+//! - `stream`: `track_stream`, the live chain of `cir track --follow` as an iterator.
 //! - `bench`: native timings for the package's benchmark (docs/benchmarks.md).
 //!
 //! The Python side (`python/scatterloc/`) re-exports these, adds the Stone Soup model and
@@ -33,6 +34,7 @@ mod planning;
 mod run;
 mod scenario;
 mod snapshot;
+mod stream;
 mod studies;
 mod tracking;
 
@@ -57,6 +59,7 @@ fn _scatterloc(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<channel::PyRecording>()?;
     m.add_class::<channel::Paths>()?;
     m.add_class::<channel::ChannelTrack>()?;
+    m.add_class::<stream::TrackStream>()?;
     for f in [
         wrap_pyfunction!(snapshot::crlb, m)?,
         wrap_pyfunction!(snapshot::crlb_map, m)?,
@@ -69,6 +72,7 @@ fn _scatterloc(m: &Bound<'_, PyModule>) -> PyResult<()> {
         wrap_pyfunction!(mtl::mtl_locate, m)?,
         wrap_pyfunction!(channel::read_recording, m)?,
         wrap_pyfunction!(csi::read_csi, m)?,
+        wrap_pyfunction!(stream::track_stream, m)?,
         wrap_pyfunction!(channel::write_recording, m)?,
         wrap_pyfunction!(channel::simulate_recording, m)?,
         wrap_pyfunction!(channel::estimate, m)?,

@@ -100,6 +100,29 @@ pub struct DetectionFrame {
 }
 
 /// A detections file: its frames, strictly increasing in time.
+///
+/// # Example
+///
+/// ```
+/// use scatterloc::formats::{Detections, RawEstimate};
+/// use scatterloc::scenario::presets;
+/// use scatterloc::Model;
+///
+/// let text = "# two frames of the L4 layout\n\
+///     {\"timestamp\": 0.0, \"tx\": 0, \"rx\": 1, \"delay\": [5e-8], \"sigma\": [1e-10]}\n\
+///     {\"timestamp\": 0.1, \"link\": [0, 1], \"unit\": \"m\", \"delay\": [15.0]}\n";
+/// let d = Detections::from_text(text).unwrap();
+/// assert_eq!(d.frames.len(), 2);
+/// let model = Model::new(&presets::sensors2019()).unwrap();
+/// let m = d.to_measurements(&model, 1.0).unwrap();
+/// assert_eq!(m.dt_s, 0.1);
+/// let first = m.initial_snapshot.unwrap();
+/// assert_eq!(first[1], vec![RawEstimate::WithSigma([5e-8, 1.0, 1e-10])]);
+/// // A bad line is named with its line and field.
+/// let e = Detections::from_text("\n{\"timestamp\": 0, \"tx\": 0, \"rx\": 0, \"delay\": [0]}")
+///     .unwrap_err();
+/// assert_eq!(e.to_string(), "line 2: delay[0]: 0 s is out of range (0 < delay <= 1 s)");
+/// ```
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Detections {
     /// The frames.
