@@ -70,12 +70,12 @@ pub mod track;
 mod edge;
 #[cfg(feature = "chart")]
 pub use edge::chart;
+#[cfg(feature = "npz")]
+pub use edge::csi;
 #[cfg(all(feature = "parallel", not(target_arch = "wasm32")))]
 pub use edge::native;
 #[cfg(feature = "npz")]
 pub use edge::npz;
-#[cfg(feature = "npz")]
-pub use edge::csi;
 #[cfg(all(feature = "wasm", target_arch = "wasm32"))]
 pub use edge::wasm;
 

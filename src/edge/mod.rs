@@ -6,10 +6,10 @@
 
 #[cfg(feature = "chart")]
 pub mod chart;
-#[cfg(all(feature = "parallel", not(target_arch = "wasm32")))]
-pub mod native;
 #[cfg(feature = "npz")]
 pub mod csi;
+#[cfg(all(feature = "parallel", not(target_arch = "wasm32")))]
+pub mod native;
 #[cfg(feature = "npz")]
 pub mod npz;
 #[cfg(all(feature = "wasm", target_arch = "wasm32"))]

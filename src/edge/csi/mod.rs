@@ -25,5 +25,5 @@ pub use capture::{
     occupied, to_recording, Conversion, ConvertOptions, CsiCapture, CsiFormat, PairLink,
     UNOCCUPIED_BLOCK_DB, UNOCCUPIED_TONE_DB,
 };
-pub use summary::LISTED;
 pub use open::{detect, open_recording, read_capture, CsiSummary, OpenOptions, Opened};
+pub use summary::LISTED;

@@ -45,8 +45,8 @@ mod open;
 mod simulate;
 
 pub use job::ChannelJob;
-pub use open::{channel_recording_summary, check_channel_truth};
 pub(crate) use open::page_recording;
+pub use open::{channel_recording_summary, check_channel_truth};
 pub use simulate::{simulate_channel, SimulatedChannel};
 
 use super::base::err;

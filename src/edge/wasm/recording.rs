@@ -5,8 +5,8 @@ use serde::Serialize;
 use wasm_bindgen::prelude::*;
 
 use super::base::err;
-use super::json::to_js;
 use super::channel::page_recording;
+use super::json::to_js;
 
 /// The page's summary of a recording.
 #[derive(Serialize)]

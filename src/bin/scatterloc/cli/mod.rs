@@ -21,8 +21,8 @@ use std::ffi::OsString;
 use clap::{CommandFactory, FromArgMatches, Parser, Subcommand, ValueEnum};
 
 pub use cir::{
-    CirCommand, CirConvertArgs, CirEstimateArgs, CirSimulateArgs, CirStreamArgs, CirTrackArgs, FrontEndArgs, ReferenceName,
-    SigmaSource, CsiArgs, StaticsName,
+    CirCommand, CirConvertArgs, CirEstimateArgs, CirSimulateArgs, CirStreamArgs, CirTrackArgs,
+    CsiArgs, FrontEndArgs, ReferenceName, SigmaSource, StaticsName,
 };
 pub use filters::{FilterName, FilterSettings};
 pub use mtl::{MtlCommand, MtlLocateArgs, RocArgs, Table2Args};

@@ -60,7 +60,10 @@ pub(super) fn flag_error(e: &scatterloc::Error) -> CliError {
 
 /// The request of the front end's flags (and, for `cir track`, the tracker's), checked by the
 /// core.
-pub(super) fn request(fe: &FrontEndArgs, track: Option<&CirTrackArgs>) -> Result<ChannelRequest, CliError> {
+pub(super) fn request(
+    fe: &FrontEndArgs,
+    track: Option<&CirTrackArgs>,
+) -> Result<ChannelRequest, CliError> {
     let mut r = ChannelRequest::default();
     if let Some(k) = fe.max_paths {
         r.max_paths = k;
@@ -353,7 +356,11 @@ pub fn cir_track(args: &CirTrackArgs) -> Result<(), CliError> {
     // Both required by the flags without --follow (`cir_follow::cir_track_follow`).
     let (cir, out) = match (args.cir.as_deref(), args.out.as_deref()) {
         (Some(c), Some(o)) => (c, o),
-        _ => return Err(CliError::usage("--cir and --out are required (or --follow)")),
+        _ => {
+            return Err(CliError::usage(
+                "--cir and --out are required (or --follow)",
+            ))
+        }
     };
     one_stdin(&[
         ("scenario", Some(&args.scenario)),

@@ -10,13 +10,13 @@ use serde::Serialize;
 use wasm_bindgen::prelude::*;
 
 use super::{check_size, named, scenario_and_model};
+use crate::channel::Recording;
+use crate::csi::{open_recording, OpenOptions};
 use crate::edge::wasm::base::err;
 use crate::edge::wasm::json::to_js;
 use crate::error::limits::{MAX_PAGE_RECORDING_BYTES, MAX_PAGE_TEXT_BYTES};
 use crate::error::Error;
 use crate::formats::Truth;
-use crate::channel::Recording;
-use crate::csi::{open_recording, OpenOptions};
 
 /// `channel_recording_summary`'s result.
 #[derive(Serialize)]
