@@ -139,7 +139,7 @@ fn bad_input_is_named() {
     let junk = dir.write_text("junk.bin", "neither a zip nor CSI\n");
     fails(
         &["cir", "convert", &junk, &dir.path("rec.npz")],
-        &["IN", "not a recording"],
+        &["IN", "not a zip archive", "nor a CSI file"],
     );
     // A truncated Intel 5300 log: the frame and the field.
     let bytes = std::fs::read(&intel).unwrap();

@@ -100,6 +100,24 @@ pub fn open_recording(bytes: &[u8], options: &OpenOptions) -> Result<Opened> {
     let csi_format = match format {
         "auto" if is_npz(bytes) => None,
         "npz" => None,
+        // Neither a zip nor a CSI file this crate recognises: the `.npz` reader's own message
+        // (what a damaged `.npz` needs), saying that no CSI reader took it either.
+        "auto" if detect(bytes).is_none() => {
+            return match crate::npz::read_recording_within(bytes, options.max_npz_bytes) {
+                Ok(recording) => Ok(Opened {
+                    recording,
+                    csi: None,
+                }),
+                Err(Error::InvalidFile { field, reason }) => Err(Error::InvalidFile {
+                    field,
+                    reason: alloc::format!(
+                        "{reason}; nor a CSI file of intel5300, nexmon, picoscenes, feitcsi or \
+                         esp32 (--format forces a reader)"
+                    ),
+                }),
+                Err(e) => Err(e),
+            };
+        }
         "auto" => Some(None),
         name => Some(Some(CsiFormat::parse(name)?)),
     };
