@@ -464,8 +464,12 @@ def test_a_failed_write_leaves_the_old_file_and_nothing_else(what, tmp_path):
 
 CTRL_C_CHILD = textwrap.dedent(
     """
+    import signal
     import sys
     import numpy as np
+    # Python's own SIGINT handler, whatever the parent left: a shell that starts the suite in
+    # the background (`cmd &` without job control) leaves SIGINT ignored, and children inherit it.
+    signal.signal(signal.SIGINT, signal.default_int_handler)
     import scatterloc as sl
     call = sys.argv[1]
     # 24 snapshots of 65536 bins, each a diffuse cluster of 64 paths spread over 40 dB (the

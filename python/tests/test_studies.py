@@ -106,7 +106,11 @@ def test_ctrl_c_stops_a_study():
     """A paper-scale study (minutes) interrupted by SIGINT raises KeyboardInterrupt: it ends with
     the interrupt's status long before the study could finish (the 30 s guard below is a hang
     guard; the time it took is printed, not asserted: tests do not time the wall clock)."""
+    # The child restores Python's own SIGINT handler: a shell that starts this suite in the
+    # background (`cmd &` without job control) leaves SIGINT ignored, and children inherit that.
     code = (
+        "import signal\n"
+        "signal.signal(signal.SIGINT, signal.default_int_handler)\n"
         "import scatterloc as sl, sys, time\n"
         "print('ready', flush=True)\n"
         "t0 = time.perf_counter()\n"
