@@ -390,11 +390,7 @@ pub fn read(bytes: &[u8]) -> Result<CsiCapture> {
 mod tests {
     use super::*;
 
-    const DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/csi/");
-
-    fn file(name: &str) -> Vec<u8> {
-        std::fs::read(format!("{DIR}{name}")).unwrap()
-    }
+    use crate::edge::csi::test_file as file;
 
     fn err(text: &str) -> String {
         read(text.as_bytes()).unwrap_err().to_string()

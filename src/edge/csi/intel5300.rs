@@ -337,11 +337,7 @@ mod tests {
     use super::*;
     use crate::math::Complex;
 
-    const DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/csi/");
-
-    fn file(name: &str) -> Vec<u8> {
-        std::fs::read(format!("{DIR}{name}")).unwrap()
-    }
+    use crate::edge::csi::test_file as file;
 
     fn example() -> Vec<u8> {
         file("intel/example.dat")

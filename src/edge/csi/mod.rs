@@ -21,6 +21,16 @@ mod summary;
 #[cfg(test)]
 mod tests;
 
+/// The bytes of `tests/data/csi/<name>` (the six real files), for the readers' tests.
+#[cfg(test)]
+pub(crate) fn test_file(name: &str) -> alloc::vec::Vec<u8> {
+    std::fs::read(alloc::format!(
+        "{}/tests/data/csi/{name}",
+        env!("CARGO_MANIFEST_DIR")
+    ))
+    .expect("a test file of tests/data/csi")
+}
+
 pub use capture::{
     occupied, to_recording, Conversion, ConvertOptions, CsiCapture, CsiFormat, PairLink,
     UNOCCUPIED_BLOCK_DB, UNOCCUPIED_TONE_DB,

@@ -43,15 +43,14 @@ pub fn read_capture(bytes: &[u8], format: Option<CsiFormat>) -> Result<CsiCaptur
             })
         }
     };
-    let cap = match format {
-        CsiFormat::Intel5300 => intel5300::read(bytes)?,
-        CsiFormat::Nexmon => nexmon::read(bytes)?,
-        CsiFormat::PicoScenes => picoscenes::read(bytes)?,
-        CsiFormat::FeitCsi => feitcsi::read(bytes)?,
-        CsiFormat::Esp32 => esp32::read(bytes)?,
-    };
-    cap.validate()?;
-    Ok(cap)
+    // Each reader checks its capture (`CsiCapture::validate`) before it returns it.
+    match format {
+        CsiFormat::Intel5300 => intel5300::read(bytes),
+        CsiFormat::Nexmon => nexmon::read(bytes),
+        CsiFormat::PicoScenes => picoscenes::read(bytes),
+        CsiFormat::FeitCsi => feitcsi::read(bytes),
+        CsiFormat::Esp32 => esp32::read(bytes),
+    }
 }
 
 /// How [`open_recording`] reads a file.

@@ -11,11 +11,7 @@ use super::{read, sniff};
 use crate::edge::csi::capture::CsiCapture;
 use crate::math::Real;
 
-const DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/csi/");
-
-fn file(name: &str) -> Vec<u8> {
-    std::fs::read(format!("{DIR}{name}")).unwrap()
-}
+use crate::edge::csi::test_file as file;
 
 fn tones(ranges: &[(i32, i32)], pilots: &[i32]) -> Vec<i32> {
     let all = ranges.iter().flat_map(|&(a, b)| a..=b);
