@@ -864,3 +864,10 @@ fn filters_predict_and_track_with_3d_delays() {
     println!("PCRLB after 3 s: 3-D room {l3:.3e} m, planar room {l2:.3e} m");
     assert!(l3.is_finite() && (l3 - l2).abs() > 1e-3 * l2);
 }
+
+// ---------------------------------------------------------------------------------------------
+// A fix and a bound with a free height (the target's z unknown).
+// ---------------------------------------------------------------------------------------------
+
+#[path = "spec_checks_3d/free_z.rs"]
+mod free_z;

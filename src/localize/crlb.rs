@@ -6,10 +6,12 @@ use crate::math::{sqrt, Mat2, Real, Vec2, PI, SPEED_OF_LIGHT};
 use crate::measure::Ellipse;
 use crate::measure::{Model, SNR_DISTANCE_FLOOR_M};
 
+mod free_z;
 mod grid;
 mod map;
 mod simd;
 
+pub use free_z::{bound3_from_fisher, crlb_free_z, fisher_free_z, Bound3, CrlbFreeZ};
 pub use grid::{Grid, MAX_GRID_CELLS, MAX_GRID_SIDE};
 pub use map::{crlb_map, crlb_map_rows, crlb_map_rows_with, crlb_map_scalar};
 

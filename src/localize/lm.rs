@@ -13,14 +13,16 @@ use crate::measure::Network;
 use crate::scenario::Area;
 
 mod chi2;
+mod free_z;
 mod iterate;
 mod problem;
 mod start;
 
 pub use chi2::chi_square_upper_tail;
+pub use free_z::{locate_free_z, FreeZReport, FREE_Z_START_OFFSETS_M};
 pub use start::{GRID_STARTS, MAX_GRID_START_NODES};
 
-use iterate::iterate;
+use iterate::{iterate, Run};
 use problem::Problem;
 use start::grid_starts;
 
@@ -137,6 +139,28 @@ pub struct LmReport {
     pub restarted: bool,
 }
 
+/// One planar LM run from `start` as a report; the covariance is `(JᵀR⁻¹J)⁻¹` at the end point.
+fn fix(p: &Problem, cfg: &LmConfig, start: Vec2) -> LmReport {
+    let Run {
+        x,
+        normal: n,
+        cost,
+        iterations,
+        termination,
+    } = iterate(p, cfg, start);
+    LmReport {
+        position: x,
+        covariance_m2: crate::localize::bound_from_fisher(n[(0, 0)], n[(0, 1)], n[(1, 1)])
+            .map(|b| b.covariance_m2),
+        cost,
+        iterations,
+        termination,
+        links_used: p.rows.len(),
+        start,
+        restarted: false,
+    }
+}
+
 /// Weighted LM fix (E5–E6). Starts at `initial` or, when `None`, at the best node of a
 /// `config.grid_step_m` grid over `area`.
 pub fn locate(
@@ -162,12 +186,12 @@ pub fn locate(
         let starts = grid_starts(problem, area, config.grid_step_m);
         let best = starts
             .into_iter()
-            .map(|s| iterate(problem, config, s))
+            .map(|s| fix(problem, config, s))
             .min_by(|a, b| a.cost.total_cmp(&b.cost));
         // An empty list means every node had a non-finite cost: start at the area's centre.
         Ok(best.unwrap_or_else(|| {
             let centre = Vec2::new(0.5 * (area.x[0] + area.x[1]), 0.5 * (area.y[0] + area.y[1]));
-            iterate(problem, config, centre)
+            fix(problem, config, centre)
         }))
     };
     let Some(start) = initial else {
@@ -178,7 +202,7 @@ pub fn locate(
             field: "initial_m".into(),
         });
     }
-    let report = iterate(&problem, config, start);
+    let report = fix(&problem, config, start);
     let dof = problem.rows.len() - 2;
     let implausible = config.restart_tail_probability.is_some_and(|p| {
         dof > 0 && report.cost > dof as Real && chi_square_upper_tail(dof, report.cost) < p

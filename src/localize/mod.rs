@@ -8,10 +8,11 @@ mod crlb;
 mod lm;
 
 pub use crlb::{
-    bound_from_fisher, crlb_at, crlb_map, crlb_map_rows, crlb_map_rows_with, crlb_map_scalar,
-    fisher, Bound, CrlbPoint, Grid, MAX_GRID_CELLS, MAX_GRID_SIDE, SINGULAR_RCOND,
+    bound3_from_fisher, bound_from_fisher, crlb_at, crlb_free_z, crlb_map, crlb_map_rows,
+    crlb_map_rows_with, crlb_map_scalar, fisher, fisher_free_z, Bound, Bound3, CrlbFreeZ,
+    CrlbPoint, Grid, MAX_GRID_CELLS, MAX_GRID_SIDE, SINGULAR_RCOND,
 };
 pub use lm::{
-    chi_square_upper_tail, locate, DelayMeasurements, LmConfig, LmReport, Termination, GRID_STARTS,
-    MAX_GRID_START_NODES, MIN_LINKS,
+    chi_square_upper_tail, locate, locate_free_z, DelayMeasurements, FreeZReport, LmConfig,
+    LmReport, Termination, FREE_Z_START_OFFSETS_M, GRID_STARTS, MAX_GRID_START_NODES, MIN_LINKS,
 };

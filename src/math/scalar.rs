@@ -12,6 +12,10 @@ pub type Real = f64;
 pub type Vec2 = nalgebra::Vector2<Real>;
 /// A symmetric 2×2 matrix (Fisher information in 1/m², covariance in m²).
 pub type Mat2 = nalgebra::Matrix2<Real>;
+/// A 3-D position `[x, y, z]ᵀ` in metres (a fix with a free height, issue 40 §2).
+pub type Vec3 = nalgebra::Vector3<Real>;
+/// A symmetric 3×3 matrix (Fisher information or covariance over `[x, y, z]`).
+pub type Mat3 = nalgebra::Matrix3<Real>;
 /// A tracking state `[x, y, vx, vy]ᵀ` (m, m/s) (S11).
 pub type Vec4 = nalgebra::Vector4<Real>;
 /// A 4×4 matrix over the tracking state (transition, covariance, information).

@@ -66,6 +66,19 @@ pub fn unit_from_dz(node: Vec2, dz: Real, r: Vec2) -> (Vec2, Real) {
     }
 }
 
+/// The vertical component of the unit vector from a node at vertical distance `h` above the
+/// target (`h = dz − δz`) to the target, for a node at 3-D distance `d`: the height's term of
+/// the range gradient (issue 40 §2, a fix with a free height); 0 where [`unit_from_dz`] gives
+/// the zero vector (the target on the node).
+#[inline(always)]
+pub fn vertical_unit(h: Real, d: Real) -> Real {
+    if d < UNIT_VECTOR_MIN_DISTANCE_M {
+        0.0
+    } else {
+        -h / d
+    }
+}
+
 /// Bistatic range with vertical offsets (E1 in 3-D): `√(‖r − r^Tx‖² + dz_Tx²) +
 /// √(‖r − r^Rx‖² + dz_Rx²)`, m. Both offsets 0 is [`bistatic_range`], bitwise.
 #[inline]

@@ -13,7 +13,7 @@ pub use ellipse::Ellipse;
 pub use geometry::{
     bistatic_delay, bistatic_range, bistatic_range_dz, delay_gradient, iso_delay_ellipse,
     iso_range_ellipse, los_range_dz, node_distance, range_and_gradient, range_and_gradient_dz,
-    range_gradient, unit_from, unit_from_dz, Network, UNIT_VECTOR_MIN_DISTANCE_M,
+    range_gradient, unit_from, unit_from_dz, vertical_unit, Network, UNIT_VECTOR_MIN_DISTANCE_M,
 };
 pub use model::{
     noise_power_w, sigma_delay_from_snr, Model, DEFAULT_NOISE_FIGURE_DB, SNR_DISTANCE_FLOOR_M,

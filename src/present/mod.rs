@@ -13,6 +13,7 @@ mod channel_figure;
 mod channel_files;
 mod channel_view;
 mod colormap;
+mod free_z_docs;
 mod plan_view;
 mod scene;
 mod session;
@@ -34,6 +35,7 @@ pub use channel_view::{
 pub use colormap::{
     colorbar_rgba, fill_rgba, render_rgba, viridis, LogScale, LINK_RGB, UNBOUNDED_RGB,
 };
+pub use free_z_docs::{sym3, CrlbFreeZDoc, FixFreeZDoc};
 pub use plan_view::{
     area_of, run_plan, run_plan_with, PlanHistoryJson, PlanImprovementJson, PlanJson,
     PlanObjectiveJson, PlanPathJson, PlanProgressJson, PlanRequest, DEFAULT_PLAN_BUDGET,

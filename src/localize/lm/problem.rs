@@ -3,6 +3,7 @@
 
 use alloc::vec::Vec;
 
+use super::iterate::LmProblem;
 use super::{DelayMeasurements, MIN_LINKS};
 use crate::error::{check_len, limits, Error, Result};
 use crate::math::{Mat2, Real, Vec2, SPEED_OF_LIGHT};
@@ -12,12 +13,12 @@ use crate::measure::{bistatic_range_dz, range_and_gradient_dz, Network};
 /// range `cτ̂` and weight `1/(cσ)²`.
 #[derive(Clone, Copy)]
 pub(super) struct Row {
-    tx: Vec2,
-    rx: Vec2,
-    dz_tx: Real,
-    dz_rx: Real,
-    range: Real,
-    weight: Real,
+    pub(super) tx: Vec2,
+    pub(super) rx: Vec2,
+    pub(super) dz_tx: Real,
+    pub(super) dz_rx: Real,
+    pub(super) range: Real,
+    pub(super) weight: Real,
 }
 
 /// Validated problem in range units.
@@ -84,5 +85,15 @@ impl Problem {
             g += (row.weight * e) * j;
         }
         (cost, n, g)
+    }
+}
+
+impl LmProblem<2> for Problem {
+    fn cost(&self, x: &Vec2) -> Real {
+        Problem::cost(self, *x)
+    }
+
+    fn linearize(&self, x: &Vec2) -> (Real, Mat2, Vec2) {
+        Problem::linearize(self, *x)
     }
 }

@@ -21,6 +21,14 @@ pub struct CrlbArgs {
     /// The point, metres: X,Y (e.g. 10,0).
     #[arg(long, value_name = "X,Y", value_parser = xy)]
     pub at: [f64; 2],
+    /// The bound over [x, y, z] with the target's height unknown (nodes at their heights;
+    /// docs/rooms-3d.md): sigma_z_m, the 3-D RMSE bound and, beside it, the horizontal bound with
+    /// the height known.
+    #[arg(long)]
+    pub free_z: bool,
+    /// With --free-z: the target's height Z, metres [default: the scenario's target.height_m].
+    #[arg(long, value_name = "Z", value_parser = finite, requires = "free_z")]
+    pub height: Option<f64>,
 }
 
 /// `scatterloc crlb-map`.
@@ -70,4 +78,8 @@ pub struct LocateArgs {
     /// Delays JSON file ('-' = standard input): {"delays_s": [..], "sigma_s": .., "initial_m": [x, y]}.
     #[arg(long, value_name = "FILE")]
     pub delays: String,
+    /// Fix [x, y, z] with the target's height unknown (LM over three unknowns from the planar fix
+    /// at the scenario's target height; "initial_m" may then be [x, y, z]; docs/rooms-3d.md).
+    #[arg(long)]
+    pub free_z: bool,
 }

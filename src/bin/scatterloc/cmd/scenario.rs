@@ -3,8 +3,9 @@
 use serde::Deserialize;
 
 use scatterloc::formats::Sigma;
-use scatterloc::localize::{locate as lm_locate, DelayMeasurements, LmConfig};
-use scatterloc::present::{CrlbDoc, FixDoc};
+use scatterloc::localize::{locate as lm_locate, locate_free_z, DelayMeasurements, LmConfig};
+use scatterloc::math::Vec3;
+use scatterloc::present::{CrlbDoc, CrlbFreeZDoc, FixDoc, FixFreeZDoc};
 use scatterloc::{scenario::presets, Vec2};
 
 use super::flags::{at_flag, in_file};
@@ -22,6 +23,10 @@ pub fn preset(args: &PresetArgs) -> Result<(), CliError> {
 pub fn crlb(args: &CrlbArgs) -> Result<(), CliError> {
     let s = read_scenario(&args.scenario)?;
     let model = model_of(&s)?;
+    if args.free_z {
+        let height = args.height.unwrap_or(s.target.height_m);
+        return emit_json(&CrlbFreeZDoc::at(&s, &model, args.at, height));
+    }
     let doc = CrlbDoc::at(&s, &model, args.at).map_err(|e| at_flag("scenario", e))?;
     emit_json(&doc)
 }
@@ -34,9 +39,10 @@ struct DelaysFile {
     delays_s: Vec<Option<f64>>,
     /// One σ for all links or one per link, s.
     sigma_s: Sigma,
-    /// Start of the iteration, m (default: grid search over the area).
+    /// Start of the iteration, m: [x, y], or [x, y, z] with `--free-z` (default: grid search
+    /// over the area, at the scenario's target height).
     #[serde(default)]
-    initial_m: Option<[f64; 2]>,
+    initial_m: Option<Vec<f64>>,
 }
 
 /// `scatterloc locate --scenario S --delays D`.
@@ -55,8 +61,32 @@ pub fn locate(args: &LocateArgs) -> Result<(), CliError> {
         delays_s: &d.delays_s,
         sigmas_s: &sigmas,
     };
-    let initial = d.initial_m.map(|p| Vec2::new(p[0], p[1]));
-    let rep = lm_locate(&model.network, &m, &LmConfig::default(), initial, &s.area_m)
-        .map_err(|e| bad(e.to_string()))?;
+    let (cfg, z_t) = (LmConfig::default(), s.target.height_m);
+    if args.free_z {
+        let initial = match d.initial_m.as_deref() {
+            None => None,
+            Some(&[x, y]) => Some(Vec3::new(x, y, 0.0)),
+            Some(&[x, y, z]) => Some(Vec3::new(x, y, z - z_t)),
+            Some(_) => {
+                return Err(bad(
+                    "initial_m: expected [x, y] or [x, y, z] (metres)".into()
+                ))
+            }
+        };
+        let rep = locate_free_z(&model.network, &m, &cfg, initial, &s.area_m)
+            .map_err(|e| bad(e.to_string()))?;
+        return emit_json(&FixFreeZDoc::new(&rep, z_t));
+    }
+    let initial = match d.initial_m.as_deref() {
+        None => None,
+        Some(&[x, y]) => Some(Vec2::new(x, y)),
+        Some(_) => {
+            return Err(bad(
+                "initial_m: expected [x, y] (metres; [x, y, z] needs --free-z)".into(),
+            ))
+        }
+    };
+    let rep =
+        lm_locate(&model.network, &m, &cfg, initial, &s.area_m).map_err(|e| bad(e.to_string()))?;
     emit_json(&FixDoc::from(&rep))
 }
