@@ -141,6 +141,11 @@ mod page_tracking;
 #[path = "e2e/page_csi.rs"]
 mod page_csi;
 
+/// Issue 40 §2: the panel edits node and target heights (the core's CRLB and fix, undo, state, link).
+#[cfg(test)]
+#[path = "e2e/page_heights.rs"]
+mod page_heights;
+
 /// A channel track's NEES against its truth (issue 38 §11), shared with the CLI tests.
 #[cfg(test)]
 #[path = "common/nees.rs"]
@@ -154,6 +159,10 @@ mod page_look;
 #[cfg(test)]
 #[path = "e2e/page_nees.rs"]
 mod page_nees;
+/// Issue 40 §3: Replay, the recording through the live run, equals the batch run; Stop.
+#[cfg(test)]
+#[path = "e2e/page_replay.rs"]
+mod page_replay;
 
 /// One browser at a time (2-core machines).
 static SERIAL: Mutex<()> = Mutex::new(());

@@ -38,6 +38,10 @@ mod recording;
 #[path = "wasm/channel_settings.rs"]
 mod channel_settings;
 
+/// The channel view's Replay (`ChannelReplay`): the CLI's live lines, the batch run's states.
+#[path = "wasm/replay.rs"]
+mod replay;
+
 fn message(e: JsError) -> String {
     let v: JsValue = e.into();
     v.dyn_into::<js_sys::Error>()

@@ -43,6 +43,7 @@ export const channelPlayer = {
   /** Moves the cursor to snapshot n (clamped): map, read-outs, chart cursors. */
   seek(n) {
     if (!this.result) return;
+    this.hideReplay();
     this.step = Math.max(0, Math.min(Math.round(n), this.steps() - 1));
     this.pos = this.result.track.t_s[this.step];
     this.show();
@@ -56,6 +57,7 @@ export const channelPlayer = {
   /** Plays from the cursor (from the start when at the end) at the chosen speed. */
   play() {
     if (!this.result) return;
+    this.hideReplay();
     if (this.step >= this.steps() - 1) this.seek(0);
     this.playing = true;
     this.pos = this.result.track.t_s[this.step];
@@ -143,6 +145,11 @@ export const channelPlayer = {
 
   /** The map layer (app.js sets it as the scene's overlay in this view). */
   overlayLayer(ctx, view) {
+    // A replay shown (running, or ended and not yet dismissed by the cursor): its states.
+    if (this.replay && this.replay.show) {
+      this.drawn = this.drawReplay(ctx, view);
+      return;
+    }
     if (!this.result) {
       this.drawn = null;
       return;

@@ -101,10 +101,24 @@ export const channelRun = {
     $('chan-stop').addEventListener('click', () => this.stop());
   },
 
+  /**
+   * The core's ChannelRequest of the panel's text as it stands (an input not yet committed with
+   * Enter counts too), checked (this.s updated); throws the named error. Run and Replay use it.
+   */
+  panelSettings() {
+    for (const [key, id, label] of INPUTS) {
+      const v = parseChannelField(key, $(id).value, label);
+      this.s = checkChannelSettings({ ...this.s, [key]: v });
+    }
+    return this.jobSettings();
+  },
+
   /** Run, Stop, Simulate and the result's controls enabled as the job and the result allow. */
   showButtons() {
-    const busy = this.running !== null;
+    const replaying = this.replaying();
+    const busy = this.running !== null || replaying;
     $('chan-run').disabled = busy || !this.rec;
+    $('chan-replay').disabled = busy || !this.rec;
     $('chan-stop').disabled = !busy;
     $('chan-simulate').disabled = busy;
     const has = !!this.result;
@@ -220,14 +234,10 @@ export const channelRun = {
       this.fail('Run: open, drop or simulate a recording first');
       return;
     }
+    if (this.replaying()) return;
     let settings;
     try {
-      // The panel's text as it stands (an input not yet committed with Enter counts too).
-      for (const [key, id, label] of INPUTS) {
-        const v = parseChannelField(key, $(id).value, label);
-        this.s = checkChannelSettings({ ...this.s, [key]: v });
-      }
-      settings = this.jobSettings();
+      settings = this.panelSettings();
     } catch (e) {
       this.fail(`Run: ${errorText(e)}`);
       return;
@@ -268,8 +278,13 @@ export const channelRun = {
     this.showButtons();
   },
 
-  /** Stops the running job (simulation or run); the result shown stays. */
+  /** Stops the running job (simulation or run) or the replay; the result shown stays. */
   stop() {
+    if (this.replaying()) {
+      this.stopped += 1;
+      this.stopReplay();
+      return;
+    }
     if (!this.running) return;
     this.stopped += 1;
     this.jobs.stop();
@@ -382,6 +397,7 @@ export const channelRun = {
   /** Drops the result shown (charts, read-outs, cursor) and says what to do next. */
   clearResult() {
     this.pause();
+    this.clearReplay();
     if (this.fig) this.fig.free();
     this.fig = null;
     this.result = null;

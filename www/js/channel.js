@@ -16,7 +16,8 @@
 //
 // The Channel class is composed of its parts: channel-files.js (the files and the settings
 // panel), channel-run.js (the running job, the status line, stale marking) and channel-player.js
-// (the cursor, the map layer, the charts, Save); this file holds its fields, the mode switch,
+// (the cursor, the map layer, the charts, Save) and channel-replay.js (Replay: the recording
+// frame by frame through the core's live run, as `cir track --follow`); this file holds its fields, the mode switch,
 // the test hooks and the page state's `channel` section.
 //
 // The state section (registerChannelState) calls channelSettings() / applyChannelSettings(obj)
@@ -30,6 +31,7 @@ import { registerSection } from './state.js';
 import { channelFiles } from './channel-files.js';
 import { channelRun } from './channel-run.js';
 import { channelPlayer } from './channel-player.js';
+import { channelReplay } from './channel-replay.js';
 
 let instance = null;
 
@@ -115,6 +117,7 @@ export class Channel {
     this.bindFiles();
     this.bindRun();
     this.bindPlayer();
+    this.bindReplay();
   }
 
   /** Mode switch: redraw the charts (their size may have changed while hidden), or pause. */
@@ -160,6 +163,7 @@ export class Channel {
       wallMs: r ? r.wallMs : null,
       workerMs: r ? r.ms : null,
       settings: this.settings(),
+      replay: this.replayState(),
     };
   }
 
@@ -170,7 +174,7 @@ export class Channel {
 }
 
 // The parts' methods (each file's concern) on the one class, so the view is one object for app.js and the hooks.
-Object.assign(Channel.prototype, channelFiles, channelRun, channelPlayer);
+Object.assign(Channel.prototype, channelFiles, channelRun, channelPlayer, channelReplay);
 /** The settings' keys (for the state helper's documentation and tests; after the wasm start). */
 export function channelSettingKeys() {
   return channelFields().map((f) => f[0]);

@@ -31,11 +31,14 @@ export class Panel {
     this.bind('bandwidth', (v) => ctx.app.set_bandwidth_hz(v * 1e6));
     this.bind('nf', (v) => ctx.app.set_noise_figure_db(v));
     this.bind('rcs', (v) => ctx.app.set_rcs_m2(v));
+    // Heights (issue 40, docs/rooms-3d.md): the target's plane here, each node's below.
+    this.bind('target-h', (v) => ctx.app.set_target_height_m(v));
 
     // Selected transmitter.
     const tx = () => ctx.st.selTx;
     this.bind('tx-x', (v) => ctx.app.move_transmitter(tx(), v, this.field('tx-y')));
     this.bind('tx-y', (v) => ctx.app.move_transmitter(tx(), this.field('tx-x'), v));
+    this.bind('tx-h', (v) => ctx.app.set_tx_height_m(tx(), v));
     this.bind('tx-power', (v) => ctx.app.set_tx_power_dbm(tx(), v));
     this.bind('tx-gain', (v) => ctx.app.set_tx_gain_dbi(tx(), v));
     const pattern = () => ctx.app.set_tx_pattern(tx(), $('tx-pattern').value,
@@ -53,6 +56,7 @@ export class Panel {
     const rx = () => ctx.st.selRx;
     this.bind('rx-x', (v) => ctx.app.move_receiver(rx(), v, this.field('rx-y')));
     this.bind('rx-y', (v) => ctx.app.move_receiver(rx(), this.field('rx-x'), v));
+    this.bind('rx-h', (v) => ctx.app.set_rx_height_m(rx(), v));
     this.bind('rx-gain', (v) => ctx.app.set_rx_gain_dbi(rx(), v));
 
     $('tx-select').addEventListener('change', (e) => this.select('tx', Number(e.target.value)));
@@ -94,8 +98,10 @@ export class Panel {
       bandwidth: 'radio.bandwidth_hz (MHz)',
       nf: 'radio.noise_figure_db',
       rcs: 'target.rcs_m2',
+      'target-h': 'target.height_m',
       'tx-x': `transmitters[${selTx}].position_m[0]`,
       'tx-y': `transmitters[${selTx}].position_m[1]`,
+      'tx-h': `transmitters[${selTx}].height_m`,
       'tx-power': `transmitters[${selTx}].power_dbm`,
       'tx-gain': `transmitters[${selTx}].gain_dbi`,
       'tx-boresight': `transmitters[${selTx}].pattern.boresight_deg`,
@@ -103,6 +109,7 @@ export class Panel {
       'tx-floor': `transmitters[${selTx}].pattern.floor_db`,
       'rx-x': `receivers[${selRx}].position_m[0]`,
       'rx-y': `receivers[${selRx}].position_m[1]`,
+      'rx-h': `receivers[${selRx}].height_m`,
       'rx-gain': `receivers[${selRx}].gain_dbi`,
     }[id] ?? id;
   }
@@ -209,11 +216,13 @@ export class Panel {
     set('nf', s.radio.noise_figure_db ?? (s.radio.noise_power_dbm === undefined ? 10 : ''));
     $('nf').placeholder = s.radio.noise_power_dbm === undefined ? '' : `P_n ${s.radio.noise_power_dbm} dBm`;
     set('rcs', s.target.rcs_m2);
+    set('target-h', s.target.height_m ?? 0); // omitted from the JSON when 0
     fillSelect($('tx-select'), s.transmitters, st.selTx);
     fillSelect($('rx-select'), s.receivers, st.selRx);
     const t = s.transmitters[st.selTx];
     set('tx-x', t.position_m[0]);
     set('tx-y', t.position_m[1]);
+    set('tx-h', t.height_m ?? 0);
     set('tx-power', t.power_dbm);
     set('tx-gain', t.gain_dbi);
     const p = t.pattern || { kind: 'omni' };
@@ -226,6 +235,7 @@ export class Panel {
     const r = s.receivers[st.selRx];
     set('rx-x', r.position_m[0]);
     set('rx-y', r.position_m[1]);
+    set('rx-h', r.height_m ?? 0);
     set('rx-gain', r.gain_dbi);
     $('tx-remove').disabled = s.transmitters.length < 2;
     $('rx-remove').disabled = s.receivers.length < 2;
@@ -240,8 +250,10 @@ export class Panel {
     $('target-resample').disabled = !fix;
     if (!fix) return;
     const m = (v) => `${fixed(v, 3)} m`;
+    // The target's plane (issue 40): shown only off the floor, so a planar page reads as before.
+    const h = this.ctx.app.target_height_m();
     const rows = [
-      ['Target', `${m(fix.truth.x)}, ${m(fix.truth.y)}`, ''],
+      ['Target', `${m(fix.truth.x)}, ${m(fix.truth.y)}${h ? ` · h ${m(h)}` : ''}`, ''],
       ['CRLB RMSE', fix.crlb.rmse_label, 'crlb'],
       ['CRLB σx / σy', `${fix.crlb.sigma_x_label} / ${fix.crlb.sigma_y_label}`, 'crlb'],
     ];

@@ -218,6 +218,30 @@ impl App {
         self.edit(|s| s.set_rx_gain_dbi(i, v))
     }
 
+    /// Antenna height of transmitter `i` above the floor, m (issue 40; a non-finite value or
+    /// one past the coordinate limits is the core's named error `transmitters[i].height_m`).
+    pub fn set_tx_height_m(&mut self, i: usize, v: f64) -> Result<(), JsError> {
+        self.edit(|s| s.set_tx_height_m(i, v))
+    }
+
+    /// Antenna height of receiver `i` above the floor, m (named error `receivers[i].height_m`).
+    pub fn set_rx_height_m(&mut self, i: usize, v: f64) -> Result<(), JsError> {
+        self.edit(|s| s.set_rx_height_m(i, v))
+    }
+
+    /// Height of the plane the target moves in (its body centre), m: the CRLB map, the fixes
+    /// and the tracks are then computed in that plane with 3-D ranges (E1; named error
+    /// `target.height_m`).
+    pub fn set_target_height_m(&mut self, v: f64) -> Result<(), JsError> {
+        self.edit(|s| s.set_target_height_m(v))
+    }
+
+    /// Height of the target's plane, m (0 for a planar scenario): the target read-out's, without
+    /// converting the whole scenario.
+    pub fn target_height_m(&self) -> f64 {
+        self.session.scenario().target.height_m
+    }
+
     /// CRLB RMSE map over the area on an `nx × ny` grid of cell centres (row-major, row 0 =
     /// lowest y) written into `out` (a `Float64Array` of `nx·ny`), m; unbounded cells are
     /// `Infinity`. Returns the kernel time, ms.

@@ -17,6 +17,8 @@
 //!   backend), both by the CLI's chart code (`chart::channel`), and the map overlay of one
 //!   snapshot (`overlay(k)`: the track's segments up to it, nothing outside a segment).
 //!
+//! - [`ChannelReplay`] (in the same worker; `live.rs`): the recording frame by frame through
+//!   the core's live run, each frame's state the line `cir track --follow` writes ("Replay").
 //! - [`channel_settings`]: the settings the view's panel shows, with their defaults and ranges.
 //!
 //! Every error is an exception carrying the core's one-line message (naming the field or the
@@ -39,12 +41,15 @@ use web_sys::HtmlCanvasElement;
 mod cursor;
 /// `ChannelJob`: the chain from a recording to its track, in slices.
 mod job;
+/// `ChannelReplay`: a recording frame by frame through the core's live run (issue 40 §3).
+mod live;
 /// The checks at open: a recording's links, a truth file's times.
 mod open;
 /// `simulate_channel`: the simulation use case.
 mod simulate;
 
 pub use job::ChannelJob;
+pub use live::ChannelReplay;
 pub(crate) use open::page_recording;
 pub use open::{channel_recording_summary, check_channel_truth};
 pub use simulate::{simulate_channel, SimulatedChannel};

@@ -36,6 +36,7 @@ mod tracking;
 pub use app::App;
 pub use base::{check_point, check_rect, preset_json, preset_names, start};
 use base::{err, point, settings, window};
+pub use channel::ChannelReplay;
 pub use channel::{
     channel_recording_summary, channel_settings, check_channel_truth, simulate_channel,
     ChannelFigures, ChannelJob, SimulatedChannel,

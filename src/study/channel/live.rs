@@ -28,6 +28,7 @@
 
 use alloc::collections::VecDeque;
 use alloc::format;
+use alloc::string::String;
 use alloc::vec;
 use alloc::vec::Vec;
 
@@ -154,6 +155,20 @@ pub struct LiveState {
     pub end: Option<&'static str>,
     /// Hypotheses dropped so far because their replay left the window (module docs).
     pub dropped_hypotheses: usize,
+}
+
+impl LiveState {
+    /// Its JSON text: the line `cir track --follow` writes for the frame (without the `\n`) and
+    /// the object the page's Replay shows (`wasm::ChannelReplay::push`), serialised here once
+    /// for both. Keys: `t_s`, `state`, `covariance`, `segment`, `links_used`, `delays_s`,
+    /// `snapshot`, `event`, `end`, `dropped_hypotheses` (non-finite numbers as `null`).
+    /// Errors: [`Error::InvalidFile`] of `frames[k]` if serde fails (it does not on these types).
+    pub fn to_json(&self) -> Result<String> {
+        serde_json::to_string(self).map_err(|e| Error::InvalidFile {
+            field: format!("frames[{}]", self.snapshot),
+            reason: format!("cannot encode the frame's state: {e}"),
+        })
+    }
 }
 
 /// A live run (module docs): frames in, one [`LiveState`] per frame out.

@@ -36,7 +36,7 @@ const UNITS_PER_READING: usize = 4;
 /// Reads a dropped recording (`.npz` or CSI) named `what` (`recording`, `calibration`): its size is
 /// checked before parsing ([`MAX_PAGE_RECORDING_BYTES`]), the reader's caps while parsing, and
 /// its links against `model`.
-fn read_page_recording(
+pub(super) fn read_page_recording(
     what: &'static str,
     bytes: &js_sys::Uint8Array,
     model: &Model,
@@ -53,7 +53,7 @@ fn read_page_recording(
 /// area's problems `calibration…` (statics `clusters` without an empty area, links or bands
 /// that differ, no direct path in the background), which stay as they are; anything else is
 /// the recording's.
-fn estimation_error(e: Error) -> JsError {
+pub(super) fn estimation_error(e: Error) -> JsError {
     if e.field().is_some_and(|f| f.starts_with("calibration")) {
         err(e)
     } else {
@@ -63,7 +63,7 @@ fn estimation_error(e: Error) -> JsError {
 
 /// The page's cap on a particle filter's work: particles × snapshots within
 /// [`MAX_CHANNEL_PARTICLE_STEPS`] (the track runs in one call of the worker).
-fn check_particle_steps(req: &ChannelRequest, snapshots: usize) -> Result<(), Error> {
+pub(super) fn check_particle_steps(req: &ChannelRequest, snapshots: usize) -> Result<(), Error> {
     if let FilterKind::Pf(pf) = req.filter_kind()? {
         if pf.particles.saturating_mul(snapshots) > MAX_CHANNEL_PARTICLE_STEPS {
             return Err(Error::SizeLimit {
