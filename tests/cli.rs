@@ -37,6 +37,13 @@ mod filters;
 #[path = "cli/follow.rs"]
 mod follow;
 
+#[cfg(feature = "npz")]
+#[path = "cli/follow_csi.rs"]
+mod follow_csi;
+
+#[path = "cli/free_z.rs"]
+mod free_z;
+
 #[path = "cli/gating.rs"]
 mod gating;
 

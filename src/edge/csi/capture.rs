@@ -390,90 +390,143 @@ pub struct Conversion {
 /// capture ([`Error::OutOfRange`]), no frame left, and [`Recording::validate`]'s.
 pub fn to_recording(cap: &CsiCapture, options: &ConvertOptions) -> Result<Conversion> {
     cap.validate()?;
-    let pairs = match &options.links {
-        Some(p) => p.clone(),
-        None => PairLink::all(cap.n_rx, cap.n_tx),
-    };
-    if pairs.is_empty() {
-        return Err(Error::InvalidFile {
-            field: "links".into(),
-            reason: "no antenna pair mapped".into(),
-        });
-    }
-    for (i, p) in pairs.iter().enumerate() {
-        if p.rx >= cap.n_rx || p.tx >= cap.n_tx {
-            return Err(Error::OutOfRange {
-                field: format!("links[{i}]"),
-                value: if p.rx >= cap.n_rx { p.rx } else { p.tx } as Real,
-                allowed: "an antenna the capture has (rx < n_rx, tx < n_tx)",
-            });
-        }
-    }
-    let kept: Vec<usize> = if options.keep_unoccupied {
-        (0..cap.subcarriers.len()).collect()
-    } else {
-        occupied(cap)
-    };
-    let unoccupied: Vec<i32> = (0..cap.subcarriers.len())
-        .filter(|i| !kept.contains(i))
-        .map(|i| cap.subcarriers[i])
-        .collect();
-    let k0 = cap.subcarriers[kept[0]];
-    let span = (cap.subcarriers[kept[kept.len() - 1]] - k0) as usize + 1;
-    let freq_hz: Vec<Real> = (0..span)
-        .map(|n| (k0 as Real + n as Real) * cap.spacing_hz)
-        .collect();
-    let mut response = vec![Complex::new(0.0, 0.0); span];
-    let slot: Vec<usize> = kept
-        .iter()
-        .map(|&i| (cap.subcarriers[i] - k0) as usize)
-        .collect();
-    for &n in &slot {
-        response[n] = Complex::new(1.0, 0.0);
-    }
-    let gain_applied = options.apply_gain && cap.gain.is_some();
+    let grid = Grid::of(cap, options)?;
     let mut t_s = Vec::with_capacity(cap.frame_count());
     let mut dropped = Vec::new();
-    let mut samples = Vec::with_capacity(cap.frame_count() * pairs.len() * span);
-    let t0 = cap.t_s[0];
-    for f in 0..cap.frame_count() {
-        let t = cap.t_s[f] - t0;
-        if let Some(&last) = t_s.last() {
-            if t <= last {
-                dropped.push((f, cap.t_s[f]));
-                continue;
-            }
-        }
-        t_s.push(t);
-        let g = match (&cap.gain, gain_applied) {
-            (Some(g), true) => g[f],
-            _ => 1.0,
-        };
-        for p in &pairs {
-            let start = samples.len();
-            samples.resize(start + span, Complex::new(0.0, 0.0));
-            let h = cap.pair(f, p.rx, p.tx);
-            for (&i, &n) in kept.iter().zip(&slot) {
-                samples[start + n] = h[i] * g;
-            }
-        }
-    }
-    let recording = Recording {
-        t_s,
-        links: pairs.iter().map(|p| p.link).collect(),
-        layout: Layout::Cfr {
-            freq_hz,
-            system_response: Some(response),
-        },
-        samples,
-        noise_var: None,
-        synchronized: Some(false),
-    };
+    let mut samples = Vec::with_capacity(cap.frame_count() * grid.pairs.len() * grid.span);
+    grid.frames(cap, cap.t_s[0], &mut t_s, &mut dropped, &mut samples);
+    let recording = grid.recording(t_s, samples);
     recording.validate()?;
     Ok(Conversion {
         recording,
         dropped,
-        gain_applied,
-        unoccupied,
+        gain_applied: grid.gain_applied,
+        unoccupied: grid.unoccupied,
     })
+}
+
+/// The grid of a conversion ([`to_recording`]): the antenna pairs kept, the reported
+/// subcarriers kept and their slots on the uniform grid, whether the gain is applied. A stream
+/// fixes it by its first frame and converts every later frame on it.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Grid {
+    pub(crate) pairs: Vec<PairLink>,
+    /// Positions into the capture's subcarriers kept, and their bins on the grid.
+    kept: Vec<usize>,
+    slot: Vec<usize>,
+    pub(crate) span: usize,
+    freq_hz: Vec<Real>,
+    response: Vec<Complex>,
+    pub(crate) gain_applied: bool,
+    pub(crate) unoccupied: Vec<i32>,
+}
+
+impl Grid {
+    /// The grid of `cap` (checked) under `options`. Errors: an antenna index in `links` beyond
+    /// the capture ([`Error::OutOfRange`]), no pair mapped.
+    pub(crate) fn of(cap: &CsiCapture, options: &ConvertOptions) -> Result<Grid> {
+        let pairs = match &options.links {
+            Some(p) => p.clone(),
+            None => PairLink::all(cap.n_rx, cap.n_tx),
+        };
+        if pairs.is_empty() {
+            return Err(Error::InvalidFile {
+                field: "links".into(),
+                reason: "no antenna pair mapped".into(),
+            });
+        }
+        for (i, p) in pairs.iter().enumerate() {
+            if p.rx >= cap.n_rx || p.tx >= cap.n_tx {
+                return Err(Error::OutOfRange {
+                    field: format!("links[{i}]"),
+                    value: if p.rx >= cap.n_rx { p.rx } else { p.tx } as Real,
+                    allowed: "an antenna the capture has (rx < n_rx, tx < n_tx)",
+                });
+            }
+        }
+        let kept: Vec<usize> = if options.keep_unoccupied {
+            (0..cap.subcarriers.len()).collect()
+        } else {
+            occupied(cap)
+        };
+        let unoccupied: Vec<i32> = (0..cap.subcarriers.len())
+            .filter(|i| !kept.contains(i))
+            .map(|i| cap.subcarriers[i])
+            .collect();
+        let k0 = cap.subcarriers[kept[0]];
+        let span = (cap.subcarriers[kept[kept.len() - 1]] - k0) as usize + 1;
+        let freq_hz: Vec<Real> = (0..span)
+            .map(|n| (k0 as Real + n as Real) * cap.spacing_hz)
+            .collect();
+        let mut response = vec![Complex::new(0.0, 0.0); span];
+        let slot: Vec<usize> = kept
+            .iter()
+            .map(|&i| (cap.subcarriers[i] - k0) as usize)
+            .collect();
+        for &n in &slot {
+            response[n] = Complex::new(1.0, 0.0);
+        }
+        Ok(Grid {
+            pairs,
+            kept,
+            slot,
+            span,
+            freq_hz,
+            response,
+            gain_applied: options.apply_gain && cap.gain.is_some(),
+            unoccupied,
+        })
+    }
+
+    /// Appends `cap`'s frames on this grid: the time relative to `t0`, a frame whose time does
+    /// not increase over the last of `t_s` dropped (into `dropped`), the gain when applied, the
+    /// kept subcarriers of each pair into its slots (0 elsewhere). `cap` must have this grid's
+    /// subcarriers and antennas (the caller checks).
+    pub(crate) fn frames(
+        &self,
+        cap: &CsiCapture,
+        t0: Real,
+        t_s: &mut Vec<Real>,
+        dropped: &mut Vec<(usize, Real)>,
+        samples: &mut Vec<Complex>,
+    ) {
+        for f in 0..cap.frame_count() {
+            let t = cap.t_s[f] - t0;
+            if let Some(&last) = t_s.last() {
+                if t <= last {
+                    dropped.push((f, cap.t_s[f]));
+                    continue;
+                }
+            }
+            t_s.push(t);
+            let g = match (&cap.gain, self.gain_applied) {
+                (Some(g), true) => g[f],
+                _ => 1.0,
+            };
+            for p in &self.pairs {
+                let start = samples.len();
+                samples.resize(start + self.span, Complex::new(0.0, 0.0));
+                let h = cap.pair(f, p.rx, p.tx);
+                for (&i, &n) in self.kept.iter().zip(&self.slot) {
+                    samples[start + n] = h[i] * g;
+                }
+            }
+        }
+    }
+
+    /// The recording of converted frames (`synchronized = false`, the mask as the system
+    /// response).
+    pub(crate) fn recording(&self, t_s: Vec<Real>, samples: Vec<Complex>) -> Recording {
+        Recording {
+            t_s,
+            links: self.pairs.iter().map(|p| p.link).collect(),
+            layout: Layout::Cfr {
+                freq_hz: self.freq_hz.clone(),
+                system_response: Some(self.response.clone()),
+            },
+            samples,
+            noise_var: None,
+            synchronized: Some(false),
+        }
+    }
 }

@@ -232,25 +232,53 @@ fn parse_line(
     }))
 }
 
-/// Reads the tool's CSV (module doc): per kept CSI line the L-LTF on −26…−1, 2…26, the time
-/// from `local_timestamp` (µs, unwrapped), the carrier from `channel`. Errors: a header line
-/// without a column this reader needs, a CSI line whose field count is not the header's or a
-/// field that does not parse (naming the frame, the field and the line), no usable CSI line,
-/// the caps.
-pub fn read(bytes: &[u8]) -> Result<CsiCapture> {
-    let mut cols = Columns::of(&DEFAULT_COLUMNS).map_err(|name| Error::InvalidFile {
-        field: "header".into(),
-        reason: format!("column {name} missing"),
-    })?;
-    let mut t_s = Vec::new();
-    let mut csi = Vec::new();
-    let mut skipped: Vec<(usize, String)> = Vec::new();
-    let mut first: Option<(i64, i64)> = None;
-    let mut clock: Option<(u32, u64)> = None;
-    let (mut lltf_only, mut unsigned) = (false, false);
-    let mut i = 0usize;
-    for (line_index, raw) in bytes.split(|&b| b == b'\n').enumerate() {
-        let n = line_index + 1;
+/// The state of the CSV read line by line (what [`read`] and the stream share): the columns,
+/// the first line's channel and antenna, the clock, and the frames read since the last
+/// [`Reader::capture`].
+pub(crate) struct Reader {
+    cols: Columns,
+    /// Lines seen (the next one's number is `lines + 1`).
+    lines: usize,
+    /// `CSI_DATA` lines seen.
+    i: usize,
+    t_s: Vec<Real>,
+    csi: Vec<Complex>,
+    /// Frames and values taken out by earlier [`Reader::capture`] calls (for the caps).
+    taken: (usize, usize),
+    skipped: Vec<(usize, String)>,
+    first: Option<(i64, i64)>,
+    clock: Option<(u32, u64)>,
+    lltf_only: bool,
+    unsigned: bool,
+}
+
+impl Reader {
+    /// A reader with the default columns.
+    pub(crate) fn new() -> Result<Reader> {
+        let cols = Columns::of(&DEFAULT_COLUMNS).map_err(|name| Error::InvalidFile {
+            field: "header".into(),
+            reason: format!("column {name} missing"),
+        })?;
+        Ok(Reader {
+            cols,
+            lines: 0,
+            i: 0,
+            t_s: Vec::new(),
+            csi: Vec::new(),
+            taken: (0, 0),
+            skipped: Vec::new(),
+            first: None,
+            clock: None,
+            lltf_only: false,
+            unsigned: false,
+        })
+    }
+
+    /// The next line (without its `\n`).
+    pub(crate) fn line(&mut self, raw: &[u8]) -> Result<()> {
+        self.lines += 1;
+        let n = self.lines;
+        let i = self.i;
         let raw = raw.strip_suffix(b"\r").unwrap_or(raw);
         let raw = if n == 1 {
             raw.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(raw)
@@ -258,7 +286,7 @@ pub fn read(bytes: &[u8]) -> Result<CsiCapture> {
             raw
         };
         if raw.iter().all(u8::is_ascii_whitespace) {
-            continue;
+            return Ok(());
         }
         let is_csi = raw.starts_with(b"CSI_DATA,");
         let Ok(text) = core::str::from_utf8(raw) else {
@@ -268,56 +296,59 @@ pub fn read(bytes: &[u8]) -> Result<CsiCapture> {
                     reason: format!("line {n}: not UTF-8 text"),
                 });
             }
-            skipped.push((i, format!("line {n}: not a CSI_DATA line (not text)")));
-            continue;
+            self.skipped
+                .push((i, format!("line {n}: not a CSI_DATA line (not text)")));
+            return Ok(());
         };
         if text.starts_with("type,") {
             let names: Vec<&str> = text.split(',').collect();
-            cols = Columns::of(&names).map_err(|name| Error::InvalidFile {
+            self.cols = Columns::of(&names).map_err(|name| Error::InvalidFile {
                 field: "header".into(),
                 reason: format!("line {n}: column {name} missing"),
             })?;
-            continue;
+            return Ok(());
         }
         if !is_csi {
             let start: String = text.chars().take(24).collect();
-            skipped.push((i, format!("line {n}: not a CSI_DATA line ({start:?})")));
-            continue;
+            self.skipped
+                .push((i, format!("line {n}: not a CSI_DATA line ({start:?})")));
+            return Ok(());
         }
         let frame = i;
-        i += 1;
-        let line = match parse_line(text, &cols, frame, n)? {
+        self.i += 1;
+        let line = match parse_line(text, &self.cols, frame, n)? {
             Ok(line) => line,
             Err(why) => {
-                skipped.push((frame, why));
-                continue;
+                self.skipped.push((frame, why));
+                return Ok(());
             }
         };
         // Times over every parsed line (a skipped one's clock is as good), from the first line's
         // `local_timestamp` as the chip wrote it, each step modulo 2³² µs.
-        let ticks = match clock {
+        let ticks = match self.clock {
             None => u64::from(line.timestamp),
             Some((prev, ticks)) => ticks + u64::from(line.timestamp.wrapping_sub(prev)),
         };
-        clock = Some((line.timestamp, ticks));
-        match first {
-            None => first = Some((line.channel, line.ant)),
+        self.clock = Some((line.timestamp, ticks));
+        match self.first {
+            None => self.first = Some((line.channel, line.ant)),
             Some((ch, ant)) if (ch, ant) != (line.channel, line.ant) => {
-                skipped.push((
+                self.skipped.push((
                     frame,
                     format!(
                         "line {n}: channel {} antenna {}, the capture is channel {ch} antenna {ant}",
                         line.channel, line.ant
                     ),
                 ));
-                continue;
+                return Ok(());
             }
             Some(_) => {}
         }
-        if t_s.len() >= MAX_SNAPSHOTS || csi.len() + 51 > MAX_RECORDING_SAMPLES {
+        let (frames, values) = (self.taken.0 + self.t_s.len(), self.taken.1 + self.csi.len());
+        if frames >= MAX_SNAPSHOTS || values + 51 > MAX_RECORDING_SAMPLES {
             return Err(Error::SizeLimit {
                 field: "frames",
-                value: t_s.len() + 1,
+                value: frames + 1,
                 min: 1,
                 max: MAX_SNAPSHOTS.min(MAX_RECORDING_SAMPLES / 51),
             });
@@ -326,64 +357,95 @@ pub fn read(bytes: &[u8]) -> Result<CsiCapture> {
             let e = k.rem_euclid(64) as usize;
             // Espressif: imaginary first, then real.
             let (im, re) = (line.lltf[2 * e], line.lltf[2 * e + 1]);
-            csi.push(Complex::new(re.into(), im.into()));
+            self.csi.push(Complex::new(re.into(), im.into()));
         }
-        t_s.push(ticks as Real / 1e6);
-        lltf_only |= line.lltf_only;
-        unsigned |= line.unsigned;
+        self.t_s.push(ticks as Real / 1e6);
+        self.lltf_only |= line.lltf_only;
+        self.unsigned |= line.unsigned;
+        Ok(())
     }
-    let Some((channel, _)) = first else {
-        let reason = match skipped.iter().find(|s| s.1.contains("CSI")) {
-            _ if i == 0 => "no CSI_DATA line".to_string(),
-            Some((_, why)) => format!("no usable CSI_DATA line ({i} skipped; {why})"),
-            None => format!("no usable CSI_DATA line ({i} skipped)"),
+
+    /// Whether frames were read since the last [`Reader::capture`].
+    pub(crate) fn has_frames(&self) -> bool {
+        !self.t_s.is_empty()
+    }
+
+    /// The capture of the frames read since the last call (taken out; the state kept).
+    /// Errors: no usable CSI line at all.
+    pub(crate) fn capture(&mut self) -> Result<CsiCapture> {
+        let i = self.i;
+        let Some((channel, _)) = self.first else {
+            let reason = match self.skipped.iter().find(|s| s.1.contains("CSI")) {
+                _ if i == 0 => "no CSI_DATA line".to_string(),
+                Some((_, why)) => format!("no usable CSI_DATA line ({i} skipped; {why})"),
+                None => format!("no usable CSI_DATA line ({i} skipped)"),
+            };
+            return Err(Error::InvalidFile {
+                field: "CSI_DATA".into(),
+                reason,
+            });
         };
-        return Err(Error::InvalidFile {
-            field: "CSI_DATA".into(),
-            reason,
-        });
-    };
-    let mut notes = Vec::new();
-    notes.push(
-        "L-LTF only (legacy tones −26…−1, 2…26); the HT-LTF and STBC-HT-LTF are not used"
-            .to_string(),
-    );
-    notes.push(
-        "subcarrier 1 left out: the ESP32's first four CSI bytes (subcarriers 0, 1) are invalid"
-            .to_string(),
-    );
-    if lltf_only {
-        notes.push("128 values printed where len is larger (the tool's ONLY_LLTF option)".into());
+        let t_s = core::mem::take(&mut self.t_s);
+        let csi = core::mem::take(&mut self.csi);
+        self.taken = (self.taken.0 + t_s.len(), self.taken.1 + csi.len());
+        let mut notes = Vec::new();
+        notes.push(
+            "L-LTF only (legacy tones −26…−1, 2…26); the HT-LTF and STBC-HT-LTF are not used"
+                .to_string(),
+        );
+        notes.push(
+            "subcarrier 1 left out: the ESP32's first four CSI bytes (subcarriers 0, 1) are invalid"
+                .to_string(),
+        );
+        if self.lltf_only {
+            notes.push(
+                "128 values printed where len is larger (the tool's ONLY_LLTF option)".into(),
+            );
+        }
+        if self.unsigned {
+            notes.push("values 128–255 (printed unsigned) read as int8".into());
+        }
+        notes.push(
+            "timing offset (SFO/STO) and carrier phase (CFO) not removed: the front end removes \
+             them per snapshot (C9/C10)"
+                .to_string(),
+        );
+        notes.push(
+            "no AGC gain reported: amplitudes are after the chip's AGC; rssi not applied".into(),
+        );
+        let cap = CsiCapture {
+            format: CsiFormat::Esp32,
+            device: "ESP32".into(),
+            frame_format: "legacy".into(),
+            center_hz: channel_hz(channel),
+            bandwidth_hz: 20e6,
+            spacing_hz: 312_500.0,
+            subcarriers: tones().collect(),
+            pilots: [-21, -7, 7, 21].into(),
+            n_rx: 1,
+            n_tx: 1,
+            t_s,
+            csi,
+            gain: None,
+            notes,
+            skipped: self.skipped.clone(),
+        };
+        cap.validate()?;
+        Ok(cap)
     }
-    if unsigned {
-        notes.push("values 128–255 (printed unsigned) read as int8".into());
+}
+
+/// Reads the tool's CSV (module doc): per kept CSI line the L-LTF on −26…−1, 2…26, the time
+/// from `local_timestamp` (µs, unwrapped), the carrier from `channel`. Errors: a header line
+/// without a column this reader needs, a CSI line whose field count is not the header's or a
+/// field that does not parse (naming the frame, the field and the line), no usable CSI line,
+/// the caps.
+pub fn read(bytes: &[u8]) -> Result<CsiCapture> {
+    let mut reader = Reader::new()?;
+    for raw in bytes.split(|&b| b == b'\n') {
+        reader.line(raw)?;
     }
-    notes.push(
-        "timing offset (SFO/STO) and carrier phase (CFO) not removed: the front end removes them \
-         per snapshot (C9/C10)"
-            .to_string(),
-    );
-    notes
-        .push("no AGC gain reported: amplitudes are after the chip's AGC; rssi not applied".into());
-    let cap = CsiCapture {
-        format: CsiFormat::Esp32,
-        device: "ESP32".into(),
-        frame_format: "legacy".into(),
-        center_hz: channel_hz(channel),
-        bandwidth_hz: 20e6,
-        spacing_hz: 312_500.0,
-        subcarriers: tones().collect(),
-        pilots: [-21, -7, 7, 21].into(),
-        n_rx: 1,
-        n_tx: 1,
-        t_s,
-        csi,
-        gain: None,
-        notes,
-        skipped,
-    };
-    cap.validate()?;
-    Ok(cap)
+    reader.capture()
 }
 
 #[cfg(test)]

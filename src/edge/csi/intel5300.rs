@@ -198,40 +198,54 @@ pub fn sniff(bytes: &[u8]) -> bool {
     false
 }
 
-/// Reads a CSI Tool `.dat` log (module doc). Errors name the record (`frame i`, 0-based in
-/// file order, every record counted) and the field: a truncated record, `field_len` 0, a bfee
-/// header shorter than 20 bytes, `Nrx`/`Ntx` outside 1–3, `len` not `60·Nrx·Ntx + 12`, a
-/// payload beyond the record; no bfee record at all.
-pub fn read(bytes: &[u8]) -> Result<CsiCapture> {
-    let mut pos = 0;
-    let mut frame = 0;
-    let mut first: Option<(usize, usize, bool)> = None;
-    let (mut t_s, mut csi, mut gain) = (Vec::new(), Vec::new(), Vec::new());
-    let mut skipped = Vec::new();
-    let mut notes = Vec::new();
-    let (mut wraps, mut last_ts): (u64, Option<u32>) = (0, None);
-    let mut bad_perm = None;
-    while pos < bytes.len() {
-        let (code, body, used) = record(bytes, pos, frame)?;
-        pos += used;
+/// The length of the record at the start of `bytes` (`2 + field_len`), once its 2-byte length
+/// is there: how the stream splitter cuts the log (`None`: fewer than 2 bytes).
+pub(crate) fn record_len(bytes: &[u8]) -> Option<usize> {
+    let h = bytes.get(..2)?;
+    Some(2 + usize::from(u16::from_be_bytes([h[0], h[1]])))
+}
+
+/// The state of a log read record by record (what [`read`] and the stream share): the first
+/// bfee's configuration, the clock's wraps, and the frames read since the last
+/// [`Reader::capture`].
+#[derive(Default)]
+pub(crate) struct Reader {
+    frame: usize,
+    first: Option<(usize, usize, bool)>,
+    t_s: Vec<Real>,
+    csi: Vec<crate::math::Complex>,
+    gain: Vec<Real>,
+    /// Frames taken out by earlier [`Reader::capture`] calls (for the caps).
+    taken: (usize, usize),
+    skipped: Vec<(usize, String)>,
+    wraps: u64,
+    last_ts: Option<u32>,
+    bad_perm: Option<(usize, Vec<usize>)>,
+}
+
+impl Reader {
+    /// Record `self.frame` (the bytes of [`record`], length field included).
+    pub(crate) fn record(&mut self, rec: &[u8]) -> Result<()> {
+        let frame = self.frame;
+        self.frame += 1;
+        let (code, body, _) = record(rec, 0, frame)?;
         if code != BFEE {
-            skipped.push((
+            self.skipped.push((
                 frame,
                 format!("record code {code:#04x}: not CSI (bfee is 0xbb)"),
             ));
-            frame += 1;
-            continue;
+            return Ok(());
         }
         let b = parse_bfee(body, frame)?;
-        if last_ts.is_some_and(|l| b.timestamp_low < l) {
-            wraps += 1;
+        if self.last_ts.is_some_and(|l| b.timestamp_low < l) {
+            self.wraps += 1;
         }
-        last_ts = Some(b.timestamp_low);
+        self.last_ts = Some(b.timestamp_low);
         let config = (b.n_rx, b.n_tx, b.bw40);
-        let (n_rx, n_tx, bw40) = *first.get_or_insert(config);
+        let (n_rx, n_tx, bw40) = *self.first.get_or_insert(config);
         if config != (n_rx, n_tx, bw40) {
             let mhz = |w: bool| if w { 40 } else { 20 };
-            skipped.push((
+            self.skipped.push((
                 frame,
                 format!(
                     "Nrx {} Ntx {} {} MHz differs from the first CSI frame's Nrx {n_rx} Ntx \
@@ -242,94 +256,130 @@ pub fn read(bytes: &[u8]) -> Result<CsiCapture> {
                     mhz(bw40)
                 ),
             ));
-            frame += 1;
-            continue;
+            return Ok(());
         }
         let p = &b.perm[..b.n_rx];
         let valid = (0..b.n_rx).all(|r| p.contains(&r));
-        if !valid && bad_perm.is_none() {
-            bad_perm = Some((frame, p.to_vec()));
+        if !valid && self.bad_perm.is_none() {
+            self.bad_perm = Some((frame, p.to_vec()));
         }
         let values = bfee::decode(b.payload, b.n_rx, b.n_tx, valid.then_some(p))
             .ok_or_else(|| bad(frame, "payload", "CSI bit stream shorter than len".into()))?;
-        if t_s.len() >= MAX_SNAPSHOTS {
+        let frames = self.taken.0 + self.t_s.len();
+        if frames >= MAX_SNAPSHOTS {
             return Err(Error::SizeLimit {
                 field: "frames",
-                value: t_s.len() + 1,
+                value: frames + 1,
                 min: 1,
                 max: MAX_SNAPSHOTS,
             });
         }
-        if csi.len() + values.len() > MAX_RECORDING_SAMPLES {
+        let values_now = self.taken.1 + self.csi.len() + values.len();
+        if values_now > MAX_RECORDING_SAMPLES {
             return Err(Error::SizeLimit {
                 field: "CSI values",
-                value: csi.len() + values.len(),
+                value: values_now,
                 min: 1,
                 max: MAX_RECORDING_SAMPLES,
             });
         }
-        gain.push(scaled_csi_gain(&b, &values));
-        csi.extend_from_slice(&values);
-        t_s.push(((wraps << 32) + u64::from(b.timestamp_low)) as Real / 1e6);
-        frame += 1;
+        self.gain.push(scaled_csi_gain(&b, &values));
+        self.csi.extend_from_slice(&values);
+        self.t_s
+            .push(((self.wraps << 32) + u64::from(b.timestamp_low)) as Real / 1e6);
+        Ok(())
     }
-    let Some((n_rx, n_tx, bw40)) = first else {
-        return Err(Error::InvalidFile {
-            field: "frame 0: code".into(),
-            reason: format!("none of the {frame} records is beamforming feedback (0xbb): no CSI"),
-        });
-    };
-    notes.push(
-        "antenna phase offsets not calibrated (the 5300's chains start with random phases)".into(),
-    );
-    notes.push(
-        "timing offset (SFO/STO) and carrier phase (CFO) not removed: the front end removes \
-         them per snapshot (C9/C10)"
-            .into(),
-    );
-    if n_tx > 1 {
+
+    /// Whether frames were read since the last [`Reader::capture`].
+    pub(crate) fn has_frames(&self) -> bool {
+        !self.t_s.is_empty()
+    }
+
+    /// The capture of the frames read since the last call (taken out; the state kept).
+    /// Errors: no bfee record at all.
+    pub(crate) fn capture(&mut self) -> Result<CsiCapture> {
+        let Some((n_rx, n_tx, bw40)) = self.first else {
+            return Err(Error::InvalidFile {
+                field: "frame 0: code".into(),
+                reason: format!(
+                    "none of the {} records is beamforming feedback (0xbb): no CSI",
+                    self.frame
+                ),
+            });
+        };
+        let t_s = core::mem::take(&mut self.t_s);
+        let csi = core::mem::take(&mut self.csi);
+        let gain = core::mem::take(&mut self.gain);
+        self.taken = (self.taken.0 + t_s.len(), self.taken.1 + csi.len());
+        let mut notes: Vec<String> = Vec::new();
         notes.push(
-            "CSI per space-time stream: the transmitter's spatial mapping is not removed \
-             (csiread's get_scaled_csi_sm)"
+            "antenna phase offsets not calibrated (the 5300's chains start with random phases)"
                 .into(),
         );
-    }
-    if let Some((f, p)) = bad_perm {
-        notes.push(format!(
-            "antenna_sel of frame {f} (perm {p:?}) and possibly later ones is not a permutation \
-             of the {n_rx} chains: rows left as stored for those frames (csiread would scatter \
-             them)"
-        ));
-    }
-    let gain = match gain.iter().position(|g| !(g.is_finite() && *g > 0.0)) {
-        None => Some(gain),
-        Some(i) => {
-            notes.push(format!(
-                "no gain: get_scaled_csi's factor of CSI frame {i} is undefined (RSSI or CSI \
-                 all zero)"
-            ));
-            None
+        notes.push(
+            "timing offset (SFO/STO) and carrier phase (CFO) not removed: the front end removes \
+             them per snapshot (C9/C10)"
+                .into(),
+        );
+        if n_tx > 1 {
+            notes.push(
+                "CSI per space-time stream: the transmitter's spatial mapping is not removed \
+                 (csiread's get_scaled_csi_sm)"
+                    .into(),
+            );
         }
-    };
-    let cap = CsiCapture {
-        format: CsiFormat::Intel5300,
-        device: "Intel 5300".into(),
-        frame_format: "HT".into(),
-        center_hz: None,
-        bandwidth_hz: if bw40 { 40e6 } else { 20e6 },
-        spacing_hz: 312_500.0,
-        subcarriers: bfee::subcarriers(bw40),
-        pilots: bfee::pilots(bw40),
-        n_rx,
-        n_tx,
-        t_s,
-        csi,
-        gain,
-        notes,
-        skipped,
-    };
-    cap.validate()?;
-    Ok(cap)
+        if let Some((f, p)) = &self.bad_perm {
+            notes.push(format!(
+                "antenna_sel of frame {f} (perm {p:?}) and possibly later ones is not a \
+                 permutation of the {n_rx} chains: rows left as stored for those frames (csiread \
+                 would scatter them)"
+            ));
+        }
+        let gain = match gain.iter().position(|g| !(g.is_finite() && *g > 0.0)) {
+            None => Some(gain),
+            Some(i) => {
+                notes.push(format!(
+                    "no gain: get_scaled_csi's factor of CSI frame {i} is undefined (RSSI or CSI \
+                     all zero)"
+                ));
+                None
+            }
+        };
+        let cap = CsiCapture {
+            format: CsiFormat::Intel5300,
+            device: "Intel 5300".into(),
+            frame_format: "HT".into(),
+            center_hz: None,
+            bandwidth_hz: if bw40 { 40e6 } else { 20e6 },
+            spacing_hz: 312_500.0,
+            subcarriers: bfee::subcarriers(bw40),
+            pilots: bfee::pilots(bw40),
+            n_rx,
+            n_tx,
+            t_s,
+            csi,
+            gain,
+            notes,
+            skipped: self.skipped.clone(),
+        };
+        cap.validate()?;
+        Ok(cap)
+    }
+}
+
+/// Reads a CSI Tool `.dat` log (module doc). Errors name the record (`frame i`, 0-based in
+/// file order, every record counted) and the field: a truncated record, `field_len` 0, a bfee
+/// header shorter than 20 bytes, `Nrx`/`Ntx` outside 1–3, `len` not `60·Nrx·Ntx + 12`, a
+/// payload beyond the record; no bfee record at all.
+pub fn read(bytes: &[u8]) -> Result<CsiCapture> {
+    let mut pos = 0;
+    let mut reader = Reader::default();
+    while pos < bytes.len() {
+        let (_, _, used) = record(bytes, pos, reader.frame)?;
+        reader.record(&bytes[pos..pos + used])?;
+        pos += used;
+    }
+    reader.capture()
 }
 
 #[cfg(test)]

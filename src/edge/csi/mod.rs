@@ -16,7 +16,9 @@ mod intel5300;
 mod nexmon;
 mod open;
 mod picoscenes;
+mod stream;
 mod summary;
+mod tones;
 
 #[cfg(test)]
 mod tests;
@@ -36,4 +38,5 @@ pub use capture::{
     UNOCCUPIED_BLOCK_DB, UNOCCUPIED_TONE_DB,
 };
 pub use open::{detect, open_recording, read_capture, CsiSummary, OpenOptions, Opened};
+pub use stream::{CsiFrame, CsiStream, MAX_CSI_RECORD_BYTES};
 pub use summary::LISTED;

@@ -10,13 +10,23 @@
 //! exit 130 after the lines already written. At a clean end a summary line goes to stderr: frames,
 //! the latency from a frame's last byte read to its line written (median, p99, max) and the
 //! process's peak resident memory (`VmHWM`).
+//!
+//! With `--format intel5300|nexmon|picoscenes|feitcsi|esp32` (or `auto`, the default, by the
+//! first bytes: `{` is a frame stream) `--cir` is a CSI tool's output read as a stream: the
+//! bytes go to the core's [`CsiStream`] as they arrive (its records cut, each frame converted
+//! as `cir track` converts the file, with `--links`, `--raw-gain`, `--all-subcarriers`; the grid
+//! and mask fixed by the first frame), and each frame it completes is tracked at once. Standard
+//! input's end ends the run (an incomplete last record: a named error after the lines written);
+//! a followed CSI file has no end marker and is followed until Ctrl-C.
 
+use std::collections::VecDeque;
 use std::fs::File;
 use std::io::{BufReader, Read, Write};
 use std::sync::mpsc::{sync_channel, Receiver, RecvTimeoutError};
 use std::time::{Duration, Instant};
 
 use scatterloc::channel::{encode_frame, FrameHeader, END_MARKER};
+use scatterloc::csi::{detect, CsiFormat, CsiFrame, CsiStream};
 use scatterloc::error::limits::{MAX_RECORDING_BYTES, MAX_STREAM_HEADER_BYTES};
 use scatterloc::math::Complex;
 use scatterloc::study::{LiveFront, LiveRun};
@@ -26,7 +36,7 @@ use super::cir::{flag_error, read_recording, request};
 use super::flags::{at_flag, in_file};
 use super::io::{model_of, one_stdin, read_bytes, read_scenario};
 use super::study::{catch_ctrl_c, interrupted};
-use crate::cli::{CirStreamArgs, CirTrackArgs};
+use crate::cli::{CirStreamArgs, CirTrackArgs, CsiArgs};
 use crate::failure::CliError;
 
 /// How often a followed file at its end is read again.
@@ -142,9 +152,71 @@ impl Source {
         Ok(got)
     }
 
-    /// The header line (without its `\n`), at most [`MAX_STREAM_HEADER_BYTES`] bytes.
-    fn header(&mut self) -> Result<Vec<u8>, Error> {
-        let mut line = Vec::new();
+    /// Reads what is there into `buf`: at least one byte, or 0 at standard input's end. A file
+    /// at its end is read again every [`POLL`] (a followed CSI file has no end marker: it is
+    /// followed until Ctrl-C); Ctrl-C while waiting: exit 130.
+    fn some(&mut self, buf: &mut [u8]) -> Result<usize, CliError> {
+        // Bounded by Ctrl-C while waiting; each turn that does not wait returns.
+        loop {
+            match self {
+                Source::File(f) => {
+                    let n = f
+                        .read(buf)
+                        .map_err(|e| at_flag("cir", format!("reading: {e}")))?;
+                    if n > 0 {
+                        return Ok(n);
+                    }
+                    if interrupted() {
+                        return Err(stopped());
+                    }
+                    std::thread::sleep(POLL);
+                }
+                Source::Stdin { chunk, at, .. } if *at < chunk.len() => {
+                    let n = (chunk.len() - *at).min(buf.len());
+                    buf[..n].copy_from_slice(&chunk[*at..*at + n]);
+                    *at += n;
+                    return Ok(n);
+                }
+                Source::Stdin { ended: true, .. } => return Ok(0),
+                Source::Stdin { .. } => {
+                    // Waits for the next chunk (or the end) as `fill` does.
+                    if let Source::Stdin {
+                        rx,
+                        chunk,
+                        at,
+                        ended,
+                        ..
+                    } = self
+                    {
+                        match rx.recv_timeout(POLL) {
+                            Ok(Ok(c)) if c.is_empty() => *ended = true,
+                            Ok(Ok(c)) => {
+                                *chunk = c;
+                                *at = 0;
+                            }
+                            Ok(Err(e)) => {
+                                return Err(at_flag("cir", format!("reading standard input: {e}")))
+                            }
+                            Err(RecvTimeoutError::Timeout) => {
+                                if interrupted() {
+                                    return Err(stopped());
+                                }
+                            }
+                            Err(RecvTimeoutError::Disconnected) => *ended = true,
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// The header line (without its `\n`), at most [`MAX_STREAM_HEADER_BYTES`] bytes, after
+    /// the bytes `line` already read of it (by the format's sniffing).
+    fn header(&mut self, mut line: Vec<u8>) -> Result<Vec<u8>, Error> {
+        if let Some(nl) = line.iter().position(|&b| b == b'\n') {
+            line.truncate(nl);
+            return Ok(line);
+        }
         let mut b = [0u8; 1];
         // Bounded by the header cap.
         while line.len() <= MAX_STREAM_HEADER_BYTES {
@@ -275,6 +347,147 @@ fn summary(frames: u64, lat: &Latency) {
     eprintln!("{doc}");
 }
 
+/// The most bytes read to tell a CSI format from a frame stream by their first bytes.
+const SNIFF_BYTES: usize = 1 << 20;
+
+/// What `--cir` holds: a frame stream, or a CSI format read as a stream (the core's
+/// [`CsiStream`]: its records cut as they arrive, each frame converted as `cir track` converts
+/// the whole file).
+enum Input {
+    Frames {
+        header: FrameHeader,
+        payload: Vec<u8>,
+    },
+    Csi {
+        stream: Box<CsiStream>,
+        /// Frames converted, not yet tracked, with when their last byte was read.
+        ready: VecDeque<(CsiFrame, Instant)>,
+        ended: bool,
+    },
+}
+
+impl Input {
+    /// The input of `--format` (`None`/`auto`: a frame stream when the first byte is `{` or
+    /// white space, else the CSI format of the first bytes, else a frame stream whose header
+    /// the core refuses: only a header that is not JSON reaches that, so no byte of a frame is
+    /// lost to the sniffing).
+    fn open(
+        src: &mut Source,
+        format: Option<&str>,
+        options: &CsiArgs,
+    ) -> Result<Input, FrameError> {
+        let csi = |format: CsiFormat, first: &[u8]| -> Result<Input, FrameError> {
+            let opts = super::cir_convert::options(options).map_err(FrameError::Cli)?;
+            let stream = CsiStream::new(format, opts.convert).map_err(FrameError::Core)?;
+            let mut input = Input::Csi {
+                stream: Box::new(stream),
+                ready: VecDeque::new(),
+                ended: false,
+            };
+            if !first.is_empty() {
+                input.feed(first, Instant::now())?;
+            }
+            Ok(input)
+        };
+        let frames = |src: &mut Source, first: Vec<u8>| -> Result<Input, FrameError> {
+            let line = src.header(first).map_err(FrameError::Core)?;
+            let header = FrameHeader::from_json(&line).map_err(FrameError::Core)?;
+            let payload = vec![0u8; header.payload_len()];
+            Ok(Input::Frames { header, payload })
+        };
+        match format.unwrap_or("auto") {
+            "auto" => {}
+            "npz" => {
+                return Err(FrameError::Cli(at_flag(
+                    "format",
+                    "npz with --follow: a .npz is read whole (cir stream REC.npz | cir track \
+                     --follow streams it)",
+                )))
+            }
+            name => return csi(CsiFormat::parse(name).map_err(FrameError::Core)?, &[]),
+        }
+        let mut first: Vec<u8> = Vec::new();
+        let mut buf = vec![0u8; CHUNK];
+        // Bounded by SNIFF_BYTES (each turn reads ≥ 1 byte) and the input's end.
+        while first.len() < SNIFF_BYTES {
+            if matches!(first.first(), Some(b) if *b == b'{' || b.is_ascii_whitespace()) {
+                return frames(src, first);
+            }
+            if let Some(f) = detect(&first) {
+                return csi(f, &first);
+            }
+            // The first byte alone: a frame stream's bytes after it are its header's.
+            let want = if first.is_empty() { 1 } else { CHUNK };
+            let n = src.some(&mut buf[..want]).map_err(FrameError::Cli)?;
+            if n == 0 {
+                break;
+            }
+            first.extend_from_slice(&buf[..n]);
+        }
+        frames(src, first)
+    }
+
+    /// The frames' header (a CSI stream's: fixed by its first frame).
+    fn header(&self) -> Option<&FrameHeader> {
+        match self {
+            Input::Frames { header, .. } => Some(header),
+            Input::Csi { stream, .. } => stream.header(),
+        }
+    }
+
+    /// CSI bytes read at `at` (empty: the input's end) into the stream.
+    fn feed(&mut self, bytes: &[u8], at: Instant) -> Result<(), FrameError> {
+        if let Input::Csi {
+            stream,
+            ready,
+            ended,
+        } = self
+        {
+            let mut out = Vec::new();
+            if bytes.is_empty() {
+                *ended = true;
+                stream.end(&mut out)
+            } else {
+                stream.push(bytes, &mut out)
+            }
+            .map_err(FrameError::Core)?;
+            ready.extend(out.into_iter().map(|f| (f, at)));
+        }
+        Ok(())
+    }
+
+    /// The next frame `k` (its samples into `samples`): its time and when its last byte was
+    /// read; `None` at the end.
+    fn next(
+        &mut self,
+        src: &mut Source,
+        k: u64,
+        samples: &mut Vec<Complex>,
+    ) -> Result<Option<(f64, Instant)>, FrameError> {
+        let mut buf = Vec::new();
+        // Bounded by the input: each turn reads ≥ 1 byte or ends it.
+        loop {
+            match self {
+                Input::Frames { header, payload } => {
+                    return next_frame(src, header, k, payload, samples)
+                }
+                Input::Csi { ready, ended, .. } => {
+                    if let Some((f, at)) = ready.pop_front() {
+                        *samples = f.samples;
+                        return Ok(Some((f.t_s, at)));
+                    }
+                    if *ended {
+                        return Ok(None);
+                    }
+                }
+            }
+            buf.resize(CHUNK, 0);
+            let n = src.some(&mut buf).map_err(FrameError::Cli)?;
+            self.feed(&buf[..n], Instant::now())?;
+        }
+    }
+}
+
 /// `scatterloc cir track --follow --scenario S [--cir FRAMES|-] [--calibration CAL.npz]
 /// [tracker and front-end flags]`.
 pub fn cir_track_follow(args: &CirTrackArgs) -> Result<(), CliError> {
@@ -300,19 +513,25 @@ pub fn cir_track_follow(args: &CirTrackArgs) -> Result<(), CliError> {
     let mut out = crate::stdout::result_stream()?;
     let mut src = Source::open(path)?;
     let bad = |e: Error| in_file("cir", path, e);
-    let header = FrameHeader::from_json(&src.header().map_err(bad)?).map_err(bad)?;
     let frame_err = |e: FrameError| match e {
         FrameError::Core(e) => bad(e),
         FrameError::Cli(e) => e,
     };
-    let mut payload = vec![0u8; header.payload_len()];
-    let mut samples = Vec::with_capacity(header.samples());
+    let csi_args = &args.front_end.csi;
+    let mut input =
+        Input::open(&mut src, csi_args.format.as_deref(), csi_args).map_err(frame_err)?;
+    let mut samples = Vec::new();
     let mut lat = Latency::new();
-    let Some(first) =
-        next_frame(&mut src, &header, 0, &mut payload, &mut samples).map_err(frame_err)?
-    else {
+    let Some(first) = input.next(&mut src, 0, &mut samples).map_err(frame_err)? else {
         summary(0, &lat);
         return Ok(());
+    };
+    // A CSI stream's header is known from its first frame on.
+    let Some(header) = input.header().cloned() else {
+        return Err(bad(Error::InvalidFile {
+            field: "frames[0]".into(),
+            reason: "no header".into(),
+        }));
     };
     let cfg = req.front_end(header.synchronized);
     let (statics, front) = LiveFront::new(
@@ -336,7 +555,7 @@ pub fn cir_track_follow(args: &CirTrackArgs) -> Result<(), CliError> {
     let result = loop {
         let frame = match pending.take() {
             Some(f) => Some(f),
-            None => match next_frame(&mut src, &header, k, &mut payload, &mut samples) {
+            None => match input.next(&mut src, k, &mut samples) {
                 Ok(f) => f,
                 Err(e) => break Err(frame_err(e)),
             },
@@ -354,7 +573,8 @@ pub fn cir_track_follow(args: &CirTrackArgs) -> Result<(), CliError> {
                 }))
             }
         };
-        let mut line = match serde_json::to_string(&state) {
+        // The core's one serialisation of a frame's state (the page's Replay shows the same).
+        let mut line = match state.to_json() {
             Ok(l) => l,
             Err(e) => break Err(CliError::output(format!("encoding JSON: {e}"))),
         };

@@ -45,3 +45,4 @@ mod reader;
 mod tests;
 
 pub use reader::{read, sniff};
+pub(crate) use reader::{record_len, Reader};

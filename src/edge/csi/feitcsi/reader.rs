@@ -166,26 +166,44 @@ struct Config {
     tx: u8,
 }
 
-/// Reads a FeitCSI file (module doc): the raw values on every non-pilot tone of the map of the
-/// first readable frame's format and width. Errors name the frame and the field: a header cut
-/// short, a `csi_length` past the end of the file or not 4·rx·tx·K, an antenna count outside
-/// 1–4, a subcarrier count not of its map; no readable frame at all; the caps.
-pub fn read(bytes: &[u8]) -> Result<CsiCapture> {
-    let bad = |i: usize, field: &str, reason: String| Error::InvalidFile {
+/// The length of the frame at the start of `bytes` (`HEADER + csi_length`), once its header is
+/// there: how the stream splitter cuts the file (`None`: fewer than [`HEADER`] bytes).
+pub(crate) fn record_len(bytes: &[u8]) -> Option<usize> {
+    header(bytes).map(|h| HEADER.saturating_add(h.csi_length))
+}
+
+fn bad(i: usize, field: &str, reason: String) -> Error {
+    Error::InvalidFile {
         field: format!("frame {i}: {field}"),
         reason,
-    };
-    let mut config: Option<Config> = None;
-    let mut subcarriers = Vec::new();
-    let mut t_s = Vec::new();
-    let mut csi: Vec<Complex> = Vec::new();
-    let mut skipped = Vec::new();
-    let mut notes = Vec::new();
-    // The previous frame's clocks and its time in ticks from the first frame's.
-    let mut clock: Option<(u32, u32, u64)> = None;
-    let mut first_tick = 0u32;
-    let (mut pos, mut i) = (0usize, 0usize);
-    while let Some(rest) = bytes.get(pos..).filter(|r| !r.is_empty()) {
+    }
+}
+
+/// The state of a file read frame by frame (what [`read`] and the stream share): the first
+/// readable frame's configuration and map, the clocks, and the frames read since the last
+/// [`Reader::capture`].
+#[derive(Default)]
+pub(crate) struct Reader {
+    config: Option<Config>,
+    subcarriers: Vec<i32>,
+    t_s: Vec<Real>,
+    csi: Vec<Complex>,
+    /// Frames and values taken out by earlier [`Reader::capture`] calls (for the caps).
+    taken: (usize, usize),
+    skipped: Vec<(usize, String)>,
+    notes: Vec<String>,
+    /// The previous frame's clocks and its time in ticks from the first frame's.
+    clock: Option<(u32, u32, u64)>,
+    first_tick: u32,
+    /// Frames seen.
+    i: usize,
+}
+
+impl Reader {
+    /// The frame at the start of `rest` (its header and CSI, maybe more bytes after them);
+    /// returns its length.
+    pub(crate) fn frame(&mut self, rest: &[u8]) -> Result<usize> {
+        let i = self.i;
         let h = header(rest).ok_or_else(|| {
             bad(
                 i,
@@ -226,9 +244,9 @@ pub fn read(bytes: &[u8]) -> Result<CsiCapture> {
             ));
         }
         // Times: the tick difference to the previous frame, wraps counted by `mu_clock`.
-        let ticks = match clock {
+        let ticks = match self.clock {
             None => {
-                first_tick = h.ftm_clock;
+                self.first_tick = h.ftm_clock;
                 0
             }
             Some((ftm, mu, ticks)) => {
@@ -238,24 +256,25 @@ pub fn read(bytes: &[u8]) -> Result<CsiCapture> {
                 ticks.saturating_add(fine + (wraps << 32))
             }
         };
-        clock = Some((h.ftm_clock, h.mu_clock, ticks));
-        match frame_map(i, &h, config)? {
-            Err(why) => skipped.push((i, why)),
+        self.clock = Some((h.ftm_clock, h.mu_clock, ticks));
+        match frame_map(i, &h, self.config)? {
+            Err(why) => self.skipped.push((i, why)),
             Ok((cfg, m, gap)) => {
-                if config.is_none() {
+                if self.config.is_none() {
                     let tones = m.tones().into_iter();
-                    subcarriers = tones.filter(|&k| !m.is_pilot(k)).collect();
-                    config = Some(cfg);
+                    self.subcarriers = tones.filter(|&k| !m.is_pilot(k)).collect();
+                    self.config = Some(cfg);
                 }
-                if t_s.len() >= MAX_SNAPSHOTS {
+                let frames = self.taken.0 + self.t_s.len();
+                if frames >= MAX_SNAPSHOTS {
                     return Err(Error::SizeLimit {
                         field: "frames",
-                        value: t_s.len() + 1,
+                        value: frames + 1,
                         min: 1,
                         max: MAX_SNAPSHOTS,
                     });
                 }
-                let values = csi.len() + rx * tx * subcarriers.len();
+                let values = self.taken.1 + self.csi.len() + rx * tx * self.subcarriers.len();
                 if values > MAX_RECORDING_SAMPLES {
                     return Err(Error::SizeLimit {
                         field: "CSI values",
@@ -264,60 +283,93 @@ pub fn read(bytes: &[u8]) -> Result<CsiCapture> {
                         max: MAX_RECORDING_SAMPLES,
                     });
                 }
-                if gap.is_some() && !notes.iter().any(|n: &String| n.contains("firmware bug")) {
-                    notes.push(format!(
+                if gap.is_some()
+                    && !self
+                        .notes
+                        .iter()
+                        .any(|n: &String| n.contains("firmware bug"))
+                {
+                    self.notes.push(format!(
                         "160 MHz firmware bug: {k_raw} values per antenna pair, the padding \
                          entries dropped as FeitCSI does (from frame {i})"
                     ));
                 }
-                push_values(&mut csi, &rest[HEADER..end], k_raw, &m, gap);
-                t_s.push((u64::from(first_tick) + ticks) as Real * TICK_S);
+                push_values(&mut self.csi, &rest[HEADER..end], k_raw, &m, gap);
+                self.t_s
+                    .push((u64::from(self.first_tick) + ticks) as Real * TICK_S);
             }
         }
-        pos += end;
-        i += 1;
+        self.i += 1;
+        Ok(end)
     }
-    let Some(c) = config else {
-        return Err(match i {
-            0 => bad(0, "header", "an empty file".into()),
-            _ => bad(
-                0,
-                "rate_flags",
-                format!("no frame of a format with a subcarrier map ({i} frames)"),
-            ),
-        });
-    };
-    notes.extend([
-        "pilot tones left out: the firmware writes 0 there (not interpolated)".to_string(),
-        "antenna phase offsets not calibrated".to_string(),
-        "timing offset (SFO/STO) and carrier phase (CFO) not removed: the front end removes them \
-         per snapshot (C9/C10)"
-            .to_string(),
-        "no AGC reported: RSSI (rssi_1/rssi_2) not applied as a gain".to_string(),
-        "carrier frequency not stored in the file".to_string(),
-    ]);
-    let spacing_hz = if c.phy == Phy::He {
-        78_125.0
-    } else {
-        312_500.0
-    };
-    let cap = CsiCapture {
-        format: CsiFormat::FeitCsi,
-        device: "Intel AX200/AX210".into(),
-        frame_format: c.phy.name().into(),
-        center_hz: None,
-        bandwidth_hz: Real::from(c.width) * 1e6,
-        spacing_hz,
-        subcarriers,
-        pilots: Vec::new(),
-        n_rx: c.rx.into(),
-        n_tx: c.tx.into(),
-        t_s,
-        csi,
-        gain: None,
-        notes,
-        skipped,
-    };
-    cap.validate()?;
-    Ok(cap)
+
+    /// Whether frames were read since the last [`Reader::capture`].
+    pub(crate) fn has_frames(&self) -> bool {
+        !self.t_s.is_empty()
+    }
+
+    /// The capture of the frames read since the last call (taken out; the state kept).
+    /// Errors: no readable frame at all.
+    pub(crate) fn capture(&mut self) -> Result<CsiCapture> {
+        let Some(c) = self.config else {
+            return Err(match self.i {
+                0 => bad(0, "header", "an empty file".into()),
+                i => bad(
+                    0,
+                    "rate_flags",
+                    format!("no frame of a format with a subcarrier map ({i} frames)"),
+                ),
+            });
+        };
+        let t_s = core::mem::take(&mut self.t_s);
+        let csi = core::mem::take(&mut self.csi);
+        self.taken = (self.taken.0 + t_s.len(), self.taken.1 + csi.len());
+        let mut notes = self.notes.clone();
+        notes.extend([
+            "pilot tones left out: the firmware writes 0 there (not interpolated)".to_string(),
+            "antenna phase offsets not calibrated".to_string(),
+            "timing offset (SFO/STO) and carrier phase (CFO) not removed: the front end removes \
+             them per snapshot (C9/C10)"
+                .to_string(),
+            "no AGC reported: RSSI (rssi_1/rssi_2) not applied as a gain".to_string(),
+            "carrier frequency not stored in the file".to_string(),
+        ]);
+        let spacing_hz = if c.phy == Phy::He {
+            78_125.0
+        } else {
+            312_500.0
+        };
+        let cap = CsiCapture {
+            format: CsiFormat::FeitCsi,
+            device: "Intel AX200/AX210".into(),
+            frame_format: c.phy.name().into(),
+            center_hz: None,
+            bandwidth_hz: Real::from(c.width) * 1e6,
+            spacing_hz,
+            subcarriers: self.subcarriers.clone(),
+            pilots: Vec::new(),
+            n_rx: c.rx.into(),
+            n_tx: c.tx.into(),
+            t_s,
+            csi,
+            gain: None,
+            notes,
+            skipped: self.skipped.clone(),
+        };
+        cap.validate()?;
+        Ok(cap)
+    }
+}
+
+/// Reads a FeitCSI file (module doc): the raw values on every non-pilot tone of the map of the
+/// first readable frame's format and width. Errors name the frame and the field: a header cut
+/// short, a `csi_length` past the end of the file or not 4·rx·tx·K, an antenna count outside
+/// 1–4, a subcarrier count not of its map; no readable frame at all; the caps.
+pub fn read(bytes: &[u8]) -> Result<CsiCapture> {
+    let mut reader = Reader::default();
+    let mut pos = 0usize;
+    while let Some(rest) = bytes.get(pos..).filter(|r| !r.is_empty()) {
+        pos += reader.frame(rest)?;
+    }
+    reader.capture()
 }

@@ -57,3 +57,4 @@ mod read;
 mod tests;
 
 pub use read::{read, sniff};
+pub(crate) use read::{Reader, PCAP_HEADER};

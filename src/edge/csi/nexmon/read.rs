@@ -51,13 +51,13 @@ fn bad(field: String, reason: String) -> Error {
 }
 
 /// A CSI packet accepted for grouping.
-struct Accepted<'a> {
+struct Accepted {
     record: usize,
     t_s: Real,
     seq: u16,
     core: u8,
     stream: u8,
-    words: &'a [u8],
+    words: Vec<u8>,
 }
 
 /// What the first CSI packet fixed for the whole capture.
@@ -68,71 +68,108 @@ struct Config {
     version: HeaderVersion,
 }
 
-/// Reads a Nexmon CSI pcap (module doc): every record to UDP port 5500 with the Nexmon magic
-/// is one antenna pair of one frame; consecutive packets of one sequence number make a frame.
-pub fn read(bytes: &[u8]) -> Result<CsiCapture> {
-    if is_pcapng(bytes) {
-        return Err(bad(
-            "capture".into(),
-            "a pcapng file: save the capture as classic pcap (e.g. `editcap -F pcap in.pcapng \
-             out.pcap`, or `tcpdump -w`)"
-                .into(),
-        ));
+/// Bytes of the pcap file header.
+pub(crate) const PCAP_HEADER: usize = 24;
+/// Bytes of a pcap record header.
+const RECORD_HEADER: usize = 16;
+
+/// The state of a capture read packet by packet (what [`read`] and the stream share): the pcap
+/// header, the first CSI packet's configuration, the packets accepted and not yet assembled.
+pub(crate) struct Reader {
+    parser: PcapParser,
+    link: u32,
+    frac_s: Real,
+    frac_max: u32,
+    skipped: Vec<(usize, String)>,
+    accepted: Vec<Accepted>,
+    config: Option<Config>,
+    /// Records seen.
+    record: usize,
+    /// The stream's cores and streams, fixed by its first frame.
+    masks: Option<(u8, u8)>,
+}
+
+impl Reader {
+    /// The reader of a capture whose first bytes (at least its 24-byte header) are `bytes`.
+    /// Errors: a pcapng file, not a pcap header, a link type nexmon_csi does not write.
+    pub(crate) fn new(bytes: &[u8]) -> Result<Reader> {
+        if is_pcapng(bytes) {
+            return Err(bad(
+                "capture".into(),
+                "a pcapng file: save the capture as classic pcap (e.g. `editcap -F pcap \
+                 in.pcapng out.pcap`, or `tcpdump -w`)"
+                    .into(),
+            ));
+        }
+        let (_, parser) = PcapParser::new(bytes).map_err(|e| {
+            bad(
+                "pcap header".into(),
+                match e {
+                    PcapError::IncompleteBuffer => {
+                        format!("{} bytes, the pcap file header has 24", bytes.len())
+                    }
+                    _ => "not a pcap file (magic number)".into(),
+                },
+            )
+        })?;
+        let header = parser.header();
+        let link = u32::from(header.datalink);
+        if link != LINKTYPE_ETHERNET && link != LINKTYPE_LINUX_SLL {
+            return Err(bad(
+                "pcap header: link type".into(),
+                format!("{link}: nexmon_csi captures are Ethernet (1) or Linux cooked (113)"),
+            ));
+        }
+        let (frac_s, frac_max) = match header.ts_resolution {
+            TsResolution::MicroSecond => (1e-6, 1_000_000),
+            TsResolution::NanoSecond => (1e-9, 1_000_000_000),
+        };
+        Ok(Reader {
+            parser,
+            link,
+            frac_s,
+            frac_max,
+            skipped: Vec::new(),
+            accepted: Vec::new(),
+            config: None,
+            record: 0,
+            masks: None,
+        })
     }
-    let (mut rest, parser) = PcapParser::new(bytes).map_err(|e| {
-        bad(
-            "pcap header".into(),
-            match e {
-                PcapError::IncompleteBuffer => {
-                    format!("{} bytes, the pcap file header has 24", bytes.len())
-                }
-                _ => "not a pcap file (magic number)".into(),
-            },
-        )
-    })?;
-    let header = parser.header();
-    let link = u32::from(header.datalink);
-    if link != LINKTYPE_ETHERNET && link != LINKTYPE_LINUX_SLL {
-        return Err(bad(
-            "pcap header: link type".into(),
-            format!("{link}: nexmon_csi captures are Ethernet (1) or Linux cooked (113)"),
-        ));
+
+    /// The length of the record at the start of `rest` (`16 + incl_len`), once its header is
+    /// there: how the stream splitter cuts the capture.
+    pub(crate) fn record_len(&self, rest: &[u8]) -> Option<usize> {
+        let w = rest.get(8..12)?;
+        let b = [w[0], w[1], w[2], w[3]];
+        let incl = match self.parser.header().endianness {
+            Endianness::Big => u32::from_be_bytes(b),
+            Endianness::Little => u32::from_le_bytes(b),
+        };
+        Some(RECORD_HEADER.saturating_add(incl as usize))
     }
-    let (frac_s, frac_max) = match header.ts_resolution {
-        TsResolution::MicroSecond => (1e-6, 1_000_000),
-        TsResolution::NanoSecond => (1e-9, 1_000_000_000),
-    };
-    let mut skipped: Vec<(usize, String)> = Vec::new();
-    let mut accepted: Vec<Accepted> = Vec::new();
-    let mut config: Option<Config> = None;
-    let mut record = 0usize;
-    while !rest.is_empty() {
-        let (next, raw) = parser.next_raw_packet(rest).map_err(|_| {
-            let word = |at: usize| {
-                let b = [rest[at], rest[at + 1], rest[at + 2], rest[at + 3]];
-                match header.endianness {
-                    Endianness::Big => u32::from_be_bytes(b),
-                    Endianness::Little => u32::from_le_bytes(b),
-                }
-            };
-            let reason = if rest.len() < 16 {
-                format!("record header truncated: {} of its 16 bytes", rest.len())
-            } else {
-                format!(
+
+    /// The record at the start of `rest` (maybe more bytes after it); returns its length.
+    pub(crate) fn packet(&mut self, rest: &[u8]) -> Result<usize> {
+        let record = self.record;
+        let (next, raw) = self.parser.next_raw_packet(rest).map_err(|_| {
+            let reason = match self.record_len(rest) {
+                Some(len) if rest.len() >= RECORD_HEADER => format!(
                     "incl_len {} bytes, but {} remain after the record header",
-                    word(8),
-                    rest.len() - 16
-                )
+                    len - RECORD_HEADER,
+                    rest.len() - RECORD_HEADER
+                ),
+                _ => format!("record header truncated: {} of its 16 bytes", rest.len()),
             };
             bad(format!("frame {record}: pcap record"), reason)
         })?;
-        rest = next;
+        let used = rest.len() - next.len();
         let i = record;
-        record += 1;
-        if raw.ts_frac >= frac_max {
+        self.record += 1;
+        if raw.ts_frac >= self.frac_max {
             return Err(bad(
                 format!("frame {i}: timestamp"),
-                format!("fraction {} ≥ {frac_max} (one second)", raw.ts_frac),
+                format!("fraction {} ≥ {} (one second)", raw.ts_frac, self.frac_max),
             ));
         }
         // `next_raw_packet` borrows from `bytes` (never owns).
@@ -140,11 +177,11 @@ pub fn read(bytes: &[u8]) -> Result<CsiCapture> {
             alloc::borrow::Cow::Borrowed(d) => d,
             alloc::borrow::Cow::Owned(_) => &[],
         };
-        let packet = match udp_payload(link, data).and_then(nexmon_header) {
+        let packet = match udp_payload(self.link, data).and_then(nexmon_header) {
             Ok(p) => p,
             Err(reason) => {
-                skipped.push((i, reason));
-                continue;
+                self.skipped.push((i, reason));
+                return Ok(used);
             }
         };
         let this = Config {
@@ -152,14 +189,14 @@ pub fn read(bytes: &[u8]) -> Result<CsiCapture> {
             chanspec: chanspec(packet.chanspec, i)?,
             version: packet.version,
         };
-        let cfg = *config.get_or_insert(this);
+        let cfg = *self.config.get_or_insert(this);
         if let Some(reason) = differs(&cfg, &this) {
-            skipped.push((i, reason));
-            continue;
+            self.skipped.push((i, reason));
+            return Ok(used);
         }
         let need = cfg.chanspec.nfft * 4;
         let Some(words) = packet.csi.get(..need) else {
-            skipped.push((
+            self.skipped.push((
                 i,
                 format!(
                     "CSI {} bytes: {} MHz needs {} words of 4 bytes (captured {} of {} bytes)",
@@ -170,32 +207,108 @@ pub fn read(bytes: &[u8]) -> Result<CsiCapture> {
                     raw.orig_len
                 ),
             ));
-            continue;
+            return Ok(used);
         };
-        let t_s = Real::from(raw.ts_sec) + Real::from(raw.ts_frac) * frac_s;
-        accepted.push(Accepted {
+        let t_s = Real::from(raw.ts_sec) + Real::from(raw.ts_frac) * self.frac_s;
+        self.accepted.push(Accepted {
             record: i,
             t_s,
             seq: packet.seq,
             core: packet.core,
             stream: packet.stream,
-            words,
+            words: words.to_vec(),
         });
+        Ok(used)
     }
-    let Some(cfg) = config.filter(|_| !accepted.is_empty()) else {
-        let first = match skipped.first() {
-            Some((i, why)) => format!(" (frame {i}: {why})"),
-            None => String::new(),
+
+    /// The capture of every packet accepted (batch: the cores and streams over all of them).
+    fn capture(&mut self) -> Result<CsiCapture> {
+        let Some(cfg) = self.config.filter(|_| !self.accepted.is_empty()) else {
+            let first = match self.skipped.first() {
+                Some((i, why)) => format!(" (frame {i}: {why})"),
+                None => String::new(),
+            };
+            return Err(bad(
+                "capture".into(),
+                format!(
+                    "no Nexmon CSI packet (UDP to port 5500, magic 0x1111, a full CSI payload) \
+                     among its {} pcap records{first}",
+                    self.record
+                ),
+            ));
         };
-        return Err(bad(
-            "capture".into(),
-            format!(
-                "no Nexmon CSI packet (UDP to port 5500, magic 0x1111, a full CSI payload) \
-                 among its {record} pcap records{first}"
-            ),
-        ));
-    };
-    assemble(cfg, &accepted, skipped)
+        let masks = masks(&self.accepted);
+        assemble(cfg, &self.accepted, self.skipped.clone(), masks)
+    }
+
+    /// Streaming: whether the first held frame is complete — a later packet starts another
+    /// (another sequence number, or an antenna pair again) — or, at the stream's `end`, any
+    /// packet is held.
+    pub(crate) fn frame_ready(&self, end: bool) -> bool {
+        let n = group_end(&self.accepted, 0);
+        n > 0 && (end || n < self.accepted.len())
+    }
+
+    /// Streaming: the first held frame taken out, as a capture of one frame on the cores and
+    /// streams of the stream's first frame (`None`: it lacks some of them or has others — skipped,
+    /// as the batch read skips an incomplete frame).
+    pub(crate) fn take_frame(&mut self) -> Result<Option<CsiCapture>> {
+        let n = group_end(&self.accepted, 0);
+        let group: Vec<Accepted> = self.accepted.drain(..n).collect();
+        let Some(cfg) = self.config.filter(|_| !group.is_empty()) else {
+            return Ok(None);
+        };
+        let (cores, streams) = *self.masks.get_or_insert_with(|| masks(&group));
+        let (here_c, here_s) = masks(&group);
+        let want = (cores.count_ones() * streams.count_ones()) as usize;
+        if group.len() != want || here_c & !cores != 0 || here_s & !streams != 0 {
+            self.skipped.push((
+                group[0].record,
+                format!(
+                    "sequence number {}: {} antenna pairs, not the {want} of the stream's first \
+                     frame — frame incomplete",
+                    group[0].seq,
+                    group.len()
+                ),
+            ));
+            return Ok(None);
+        }
+        assemble(cfg, &group, self.skipped.clone(), (cores, streams)).map(Some)
+    }
+}
+
+/// The cores and streams (bit masks) of `packets`.
+fn masks(packets: &[Accepted]) -> (u8, u8) {
+    let cores: u8 = packets.iter().fold(0, |m, p| m | 1 << p.core);
+    let streams: u8 = packets.iter().fold(0, |m, p| m | 1 << p.stream);
+    (cores, streams)
+}
+
+/// The end of the frame that starts at `start`: the run of one sequence number without a
+/// repeated antenna pair.
+fn group_end(packets: &[Accepted], start: usize) -> usize {
+    let mut seen = 0u64;
+    let mut end = start;
+    while let Some(p) = packets.get(end) {
+        let bit = 1u64 << (p.core * 8 + p.stream);
+        if p.seq != packets[start].seq || seen & bit != 0 {
+            break;
+        }
+        seen |= bit;
+        end += 1;
+    }
+    end
+}
+
+/// Reads a Nexmon CSI pcap (module doc): every record to UDP port 5500 with the Nexmon magic
+/// is one antenna pair of one frame; consecutive packets of one sequence number make a frame.
+pub fn read(bytes: &[u8]) -> Result<CsiCapture> {
+    let mut reader = Reader::new(bytes)?;
+    let mut pos = PCAP_HEADER;
+    while pos < bytes.len() {
+        pos += reader.packet(&bytes[pos..])?;
+    }
+    reader.capture()
 }
 
 fn differs(cfg: &Config, this: &Config) -> Option<String> {
@@ -238,10 +351,9 @@ fn assemble(
     cfg: Config,
     packets: &[Accepted],
     mut skipped: Vec<(usize, String)>,
+    (cores, streams): (u8, u8),
 ) -> Result<CsiCapture> {
     let nfft = cfg.chanspec.nfft;
-    let cores: u8 = packets.iter().fold(0, |m, p| m | 1 << p.core);
-    let streams: u8 = packets.iter().fold(0, |m, p| m | 1 << p.stream);
     let (n_rx, n_tx) = (cores.count_ones() as usize, streams.count_ones() as usize);
     let rank = |mask: u8, i: u8| (mask & ((1u16 << i) - 1) as u8).count_ones() as usize;
     // The firmware's PHY status words (Rssi header) over bins o..o+3.
@@ -269,16 +381,7 @@ fn assemble(
     let mut start = 0;
     while start < packets.len() {
         // The run of one sequence number without a repeated antenna pair.
-        let mut seen = 0u64;
-        let mut end = start;
-        while let Some(p) = packets.get(end) {
-            let bit = 1u64 << (p.core * 8 + p.stream);
-            if p.seq != packets[start].seq || seen & bit != 0 {
-                break;
-            }
-            seen |= bit;
-            end += 1;
-        }
+        let end = group_end(packets, start);
         let group = &packets[start..end];
         start = end;
         let first = &group[0];
@@ -315,7 +418,7 @@ fn assemble(
         csi.resize(base + per_frame, Complex::new(0.0, 0.0));
         let unpacked: Vec<Vec<Word>> = group
             .iter()
-            .map(|p| words(p.words, cfg.chip.sample, cfg.version))
+            .map(|p| words(&p.words, cfg.chip.sample, cfg.version))
             .collect();
         // unpack_float's autoscale (nbits = 10), over every word of the frame.
         let shft = match cfg.chip.sample {

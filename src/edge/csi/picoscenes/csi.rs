@@ -7,7 +7,9 @@ use alloc::vec;
 use alloc::vec::Vec;
 
 use super::super::bfee;
+use super::super::tones::{map, Phy};
 use super::cursor::Cursor;
+use super::mvm;
 use crate::error::limits::{MAX_BINS_PER_LINK, MAX_LINKS};
 use crate::error::Result;
 use crate::math::Complex;
@@ -33,9 +35,12 @@ pub(super) struct Csi {
     pub carrier_hz: u64,
     /// `SubcarrierBandwidth`, Hz.
     pub spacing_hz: u32,
+    /// `SubcarrierOffset` (added to the indices; the pilots shift with them).
+    pub offset: i32,
     /// Receive chains.
     pub n_rx: usize,
-    /// Streams measured (`NumTx + NumESS`, as the buffer holds them).
+    /// Streams measured (as the buffer holds them: IWL5300/QCA9300 `NumTx + NumESS`, from its
+    /// length; AX200/AX210 `NumTx`; the SDRs the `SignalMatrix`'s).
     pub n_tx: usize,
     /// Subcarrier indices (strictly increasing).
     pub subcarriers: Vec<i32>,
@@ -77,27 +82,18 @@ pub(super) fn format_name(format: i8) -> &'static str {
     }
 }
 
-/// The pilots of a format and bandwidth (IEEE 802.11-2016/802.11ax); the caller keeps those
-/// among the reported subcarriers.
+/// The pilots of a format and bandwidth (IEEE 802.11-2016/802.11ax, the subcarrier maps of
+/// `csi::tones`; HE-MU as HE-SU), in index order; the caller keeps those among the reported
+/// subcarriers.
 pub(super) fn pilots(format: i8, cbw: u16) -> Vec<i32> {
-    let half: &[i32] = match (format, cbw) {
-        (0..=2, 20) => &[7, 21],
-        (1 | 2, 40) => &[11, 25, 53],
-        (2, 80) => &[11, 39, 75, 103],
-        (2, 160) => &[25, 53, 89, 117, 139, 167, 203, 231],
-        (3 | 4, 20) => &[22, 48, 90, 116],
-        (3 | 4, 40) => &[10, 36, 78, 104, 144, 170, 212, 238],
-        (3 | 4, 80) => &[24, 92, 158, 226, 266, 334, 400, 468],
-        _ => &[],
+    let phy = match format {
+        0 => Phy::Legacy,
+        1 => Phy::Ht,
+        2 => Phy::Vht,
+        3 | 4 => Phy::He,
+        _ => return Vec::new(),
     };
-    let mut p: Vec<i32> = half
-        .iter()
-        .rev()
-        .map(|k| -k)
-        .chain(half.iter().copied())
-        .collect();
-    p.sort_unstable();
-    p
+    map(phy, u32::from(cbw)).map_or_else(Vec::new, |m| m.all_pilots())
 }
 
 /// Parses the body of a `CSI` segment of `version` (1–4).
@@ -118,7 +114,7 @@ pub(super) fn parse(c: &mut Cursor<'_>, version: u16) -> Result<Csi> {
     c.u64("SamplingRate")?;
     let spacing_hz = c.u32("SubcarrierBandwidth")?;
     let tones = usize::from(c.u16("NumTones")?);
-    c.u8("NumTx")?;
+    let num_tx = usize::from(c.u8("NumTx")?);
     let n_rx = usize::from(c.u8("NumRx")?);
     c.u8("NumESS")?;
     if version >= 3 {
@@ -146,13 +142,14 @@ pub(super) fn parse(c: &mut Cursor<'_>, version: u16) -> Result<Csi> {
     let (n_tx, mut subcarriers, values) = match device {
         IWL5300 => iwl5300(c, buf, tones, n_rx, cbw)?,
         QCA9300 => qca9300(c, buf, tones, n_rx, cbw)?,
+        AX200 | AX210 => mvm::read(c, buf, format, cbw, tones, num_tx, n_rx)?,
         USRP | VIRTUAL_SDR => signal_matrix(c, buf, tones, n_rx)?,
         _ => {
             return Err(c.bad(
                 "DeviceType",
                 format!(
-                    "{} ({device:#06x}): CSI layout unsupported (IWL5300, QCA9300 and the SDR \
-                     layout with explicit subcarrier indices are read)",
+                    "{} ({device:#06x}): CSI layout unsupported (IWL5300, QCA9300, AX200/AX210 \
+                     and the SDR layout with explicit subcarrier indices are read)",
                     device_name(device)
                 ),
             ))
@@ -170,6 +167,7 @@ pub(super) fn parse(c: &mut Cursor<'_>, version: u16) -> Result<Csi> {
         cbw,
         carrier_hz,
         spacing_hz,
+        offset,
         n_rx,
         n_tx,
         subcarriers,
@@ -465,7 +463,7 @@ mod tests {
 
     #[test]
     fn other_devices_and_versions_are_named_unsupported() {
-        for dev in [AX200, AX210, 0x0802] {
+        for dev in [0x0802, 0x3000] {
             let e = parse_v2(&body(dev, 20, 56, 1, 0, &[0; 224]))
                 .unwrap_err()
                 .to_string();
@@ -479,7 +477,179 @@ mod tests {
             .to_string();
         assert!(e.starts_with("frame 7: CSI.version"), "{e}");
         assert_eq!(pilots(2, 80), [-103, -75, -39, -11, 11, 39, 75, 103]);
+        // HE 160: the HE 80 pilots around ±512 (802.11ax §27.3.11.13), 32 in all.
+        let he160 = pilots(3, 160);
+        assert_eq!(
+            (he160.len(), he160[0], he160[15], he160[16]),
+            (32, -980, -44, 44)
+        );
         assert_eq!(ticks_per_second(USRP), 1e9);
         assert_eq!(ticks_per_second(IWL5300), 1e6);
+    }
+
+    /// A version-3 CSI segment body (csiread's version; `NumCSI` 1, `NumESS` 1, ignored by the
+    /// MVM layout) of `format`.
+    #[allow(clippy::too_many_arguments)]
+    fn mvm_body(
+        device: u16,
+        format: u8,
+        cbw: u16,
+        tones: u16,
+        n_tx: u8,
+        n_rx: u8,
+        offset: i16,
+        buf: &[u8],
+    ) -> Vec<u8> {
+        let mut b = device.to_le_bytes().to_vec();
+        b.push(format);
+        b.extend(cbw.to_le_bytes());
+        b.extend(5_500_000_000u64.to_le_bytes());
+        b.extend((u64::from(cbw) * 1_000_000).to_le_bytes());
+        b.extend(if format == 3 { 78_125u32 } else { 312_500 }.to_le_bytes());
+        b.extend(tones.to_le_bytes());
+        b.extend([n_tx, n_rx, 1]);
+        b.extend(1u16.to_le_bytes());
+        b.push(0);
+        b.extend(offset.to_le_bytes());
+        b.extend((buf.len() as u32).to_le_bytes());
+        b.extend(buf);
+        b
+    }
+
+    /// The raw value `i` of the pattern: both parts sweep the whole i16 range.
+    fn raw(i: usize) -> (i16, i16) {
+        let re = (i as u32).wrapping_mul(40_503) as u16 as i16;
+        (re, !re)
+    }
+
+    /// The tables of PicoScenes' `CSISegment.cxx` (`*_Subcarriers_Indices`, as ranges) and the
+    /// pilots of IEEE 802.11-2016 §19.3.11.10, §21.3.10.10 and 802.11ax §27.3.11.13 (positive
+    /// halves), written out here as the independent reference.
+    #[allow(clippy::type_complexity)]
+    const TABLES: [(u8, u16, usize, &[(i32, i32)], &[i32]); 11] = [
+        (0, 20, 52, &[(-26, -1), (1, 26)], &[7, 21]),
+        (1, 20, 56, &[(-28, -1), (1, 28)], &[7, 21]),
+        (2, 20, 56, &[(-28, -1), (1, 28)], &[7, 21]),
+        (1, 40, 114, &[(-58, -2), (2, 58)], &[11, 25, 53]),
+        (2, 40, 114, &[(-58, -2), (2, 58)], &[11, 25, 53]),
+        (2, 80, 242, &[(-122, -2), (2, 122)], &[11, 39, 75, 103]),
+        (
+            2,
+            160,
+            484,
+            &[(-250, -130), (-126, -6), (6, 126), (130, 250)],
+            &[25, 53, 89, 117, 139, 167, 203, 231],
+        ),
+        (3, 20, 242, &[(-122, -2), (2, 122)], &[22, 48, 90, 116]),
+        (
+            3,
+            40,
+            484,
+            &[(-244, -3), (3, 244)],
+            &[10, 36, 78, 104, 144, 170, 212, 238],
+        ),
+        (
+            3,
+            80,
+            996,
+            &[(-500, -3), (3, 500)],
+            &[24, 92, 158, 226, 266, 334, 400, 468],
+        ),
+        (
+            3,
+            160,
+            1992,
+            &[(-1012, -515), (-509, -12), (12, 509), (515, 1012)],
+            &[
+                44, 112, 178, 246, 286, 354, 420, 488, 536, 604, 670, 738, 778, 846, 912, 980,
+            ],
+        ),
+    ];
+
+    #[test]
+    fn mvm_every_table_with_its_values_in_tone_stream_chain_order() {
+        for (format, cbw, k_raw, ranges, half) in TABLES {
+            let table: Vec<i32> = ranges.iter().flat_map(|&(a, b)| a..=b).collect();
+            assert_eq!(table.len(), k_raw);
+            for (device, n_tx, n_rx, offset) in [(AX200, 1u8, 2u8, 0i16), (AX210, 2, 2, -3)] {
+                let (nt, nr) = (usize::from(n_tx), usize::from(n_rx));
+                let buf: Vec<u8> = (0..k_raw * nt * nr)
+                    .flat_map(|i| {
+                        let (re, im) = raw(i);
+                        [re.to_le_bytes(), im.to_le_bytes()]
+                    })
+                    .flatten()
+                    .collect();
+                assert_eq!(buf.len(), nt * nr * k_raw * 4);
+                let b = mvm_body(device, format, cbw, k_raw as u16, n_tx, n_rx, offset, &buf);
+                let c = parse(&mut Cursor::new(&b, 7, "CSI"), 3).unwrap();
+                let kept: Vec<usize> = (0..k_raw)
+                    .filter(|&j| !half.contains(&table[j].abs()))
+                    .collect();
+                assert_eq!(kept.len(), k_raw - 2 * half.len(), "{format} {cbw}");
+                let want: Vec<i32> = kept.iter().map(|&j| table[j] + i32::from(offset)).collect();
+                assert_eq!(c.subcarriers, want, "{format} {cbw}");
+                assert_eq!((c.device, c.format, c.cbw), (device, format as i8, cbw));
+                assert_eq!((c.n_rx, c.n_tx, c.carrier_hz), (nr, nt, 5_500_000_000));
+                let k = kept.len();
+                assert_eq!(c.values.len(), k * nt * nr);
+                for r in 0..nr {
+                    for t in 0..nt {
+                        for (n, &j) in kept.iter().enumerate() {
+                            // Column-major {NumTones, NumTx, NumRx}: i = j + K·(t + NumTx·r).
+                            let (re, im) = raw(j + k_raw * (t + nt * r));
+                            let got = c.values[(r * nt + t) * k + n];
+                            assert_eq!(got, Complex::new(re.into(), im.into()));
+                        }
+                    }
+                }
+            }
+        }
+        // The v4 header (with FirmwareVersion) reads the same layout.
+        let mut b = mvm_body(AX210, 1, 20, 56, 1, 1, 0, &[1; 224]);
+        b.insert(2, 9);
+        let c = parse(&mut Cursor::new(&b, 7, "CSI"), 4).unwrap();
+        assert_eq!(
+            (c.subcarriers.len(), c.values[0]),
+            (52, Complex::new(257.0, 257.0))
+        );
+    }
+
+    #[test]
+    fn mvm_wrong_sizes_and_pairs_without_a_table_are_named() {
+        let v3 = |b: Vec<u8>| {
+            parse(&mut Cursor::new(&b, 7, "CSI"), 3)
+                .unwrap_err()
+                .to_string()
+        };
+        let cases: [(u8, u16, u16, u8, usize, &str); 9] = [
+            (2, 80, 242, 1, 242 * 8 - 4, "frame 7: CSI.CSIBufferLength"),
+            (2, 80, 242, 1, 242 * 8 + 4, "frame 7: CSI.CSIBufferLength"),
+            (2, 80, 242, 2, 242 * 8, "frame 7: CSI.CSIBufferLength"),
+            (2, 80, 242, 0, 0, "frame 7: CSI.NumTx"),
+            (2, 160, 498, 1, 498 * 8, "frame 7: CSI.NumTones"),
+            (3, 20, 56, 1, 56 * 8, "frame 7: CSI.NumTones"),
+            (1, 80, 242, 1, 242 * 8, "frame 7: CSI.CBW"),
+            (0, 40, 114, 1, 114 * 8, "frame 7: CSI.CBW"),
+            (4, 20, 242, 1, 242 * 8, "frame 7: CSI.PacketFormat"),
+        ];
+        for (format, cbw, tones, n_tx, len, want) in cases {
+            let e = v3(mvm_body(
+                AX200,
+                format,
+                cbw,
+                tones,
+                n_tx,
+                2,
+                0,
+                &vec![0; len],
+            ));
+            assert!(e.starts_with(want), "{want}: {e}");
+        }
+        let e = v3(mvm_body(AX200, 2, 80, 242, 1, 2, 0, &[0; 100]));
+        assert!(
+            e.contains("100: NumTx·NumRx·NumTones·4 = 1·2·242·4 = 1936"),
+            "{e}"
+        );
     }
 }

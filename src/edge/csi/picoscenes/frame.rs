@@ -87,34 +87,48 @@ pub fn sniff(bytes: &[u8]) -> bool {
     bytes.get(4..8) == Some(&MAGIC.to_le_bytes()[..]) && bytes.get(8..10) == Some(&[1, 0][..])
 }
 
-/// Reads a PicoScenes `.csi` file (module doc). Errors name the frame (0-based, file order)
-/// and the field (`frame length`, `magic`, `segment i length`, `CSI.NumTones`,
-/// `CSI.CSIBufferLength`, …); an unsupported device layout or segment version is an error
-/// naming it.
-pub fn read(bytes: &[u8]) -> Result<CsiCapture> {
-    let (mut pos, mut frame) = (0usize, 0usize);
-    let mut first: Option<Csi> = None;
-    let (mut t_s, mut values, mut skipped) = (Vec::new(), Vec::new(), Vec::new());
-    while pos < bytes.len() {
-        let mut c = Cursor::new(bytes.get(pos..).unwrap_or_default(), frame, "");
+/// The length of the frame at the start of `bytes` (`4 + frame length`), once its length field
+/// is there: how the stream splitter cuts the file (`None`: fewer than 4 bytes).
+pub(crate) fn record_len(bytes: &[u8]) -> Option<usize> {
+    let h = bytes.get(..4)?;
+    Some(4usize.saturating_add(u32::from_le_bytes([h[0], h[1], h[2], h[3]]) as usize))
+}
+
+/// The state of a file read frame by frame (what [`read`] and the stream share): the first CSI
+/// frame's layout and the frames read since the last [`Reader::capture`].
+#[derive(Default)]
+pub(crate) struct Reader {
+    frame: usize,
+    first: Option<Csi>,
+    t_s: Vec<Real>,
+    values: Vec<crate::math::Complex>,
+    /// Frames and values taken out by earlier [`Reader::capture`] calls (for the caps).
+    taken: (usize, usize),
+    skipped: Vec<(usize, String)>,
+}
+
+impl Reader {
+    /// The frame at the start of `rest` (maybe more bytes after it); returns its length.
+    pub(crate) fn frame(&mut self, rest: &[u8]) -> Result<usize> {
+        let frame = self.frame;
+        let mut c = Cursor::new(rest, frame, "");
         let len = c.u32("frame length")? as usize;
         let body = c.take("frame length", len)?;
-        pos += 4 + len;
+        self.frame += 1;
         let (tstamp, data) = parse_frame(body, frame)?;
         let (tstamp, data) = match (tstamp, data) {
             (Some(t), Some(d)) => (t, d),
             (_, None) => {
-                skipped.push((frame, "no CSI segment".into()));
-                frame += 1;
-                continue;
+                self.skipped.push((frame, "no CSI segment".into()));
+                return Ok(4 + len);
             }
             (None, Some(_)) => {
-                skipped.push((frame, "no RxSBasic segment (no timestamp)".into()));
-                frame += 1;
-                continue;
+                self.skipped
+                    .push((frame, "no RxSBasic segment (no timestamp)".into()));
+                return Ok(4 + len);
             }
         };
-        let reference = first.get_or_insert_with(|| Csi {
+        let reference = self.first.get_or_insert_with(|| Csi {
             values: Vec::new(),
             ..data.clone()
         });
@@ -138,73 +152,109 @@ pub fn read(bytes: &[u8]) -> Result<CsiCapture> {
                 describe(&data),
                 describe(reference)
             );
-            skipped.push((frame, reason));
-            frame += 1;
-            continue;
+            self.skipped.push((frame, reason));
+            return Ok(4 + len);
         }
-        if t_s.len() >= MAX_SNAPSHOTS {
+        let frames = self.taken.0 + self.t_s.len();
+        if frames >= MAX_SNAPSHOTS {
             return Err(Error::SizeLimit {
                 field: "frames",
-                value: t_s.len() + 1,
+                value: frames + 1,
                 min: 1,
                 max: MAX_SNAPSHOTS,
             });
         }
-        if values.len() + data.values.len() > MAX_RECORDING_SAMPLES {
+        let values = self.taken.1 + self.values.len() + data.values.len();
+        if values > MAX_RECORDING_SAMPLES {
             return Err(Error::SizeLimit {
                 field: "CSI values",
-                value: values.len() + data.values.len(),
+                value: values,
                 min: 1,
                 max: MAX_RECORDING_SAMPLES,
             });
         }
-        values.extend_from_slice(&data.values);
-        t_s.push(tstamp as Real / csi::ticks_per_second(data.device));
-        frame += 1;
+        self.values.extend_from_slice(&data.values);
+        self.t_s
+            .push(tstamp as Real / csi::ticks_per_second(data.device));
+        Ok(4 + len)
     }
-    let Some(r) = first else {
-        return Err(Error::InvalidFile {
-            field: "frame 0: CSI".into(),
-            reason: format!("none of the {frame} frames has CSI and RxSBasic segments"),
-        });
-    };
-    let mut notes: Vec<String> = Vec::new();
-    notes.push("antenna phase offsets not calibrated".into());
-    notes.push(
-        "timing offset (SFO/STO) and carrier phase (CFO) not removed: the front end removes \
-         them per snapshot (C9/C10)"
-            .into(),
-    );
-    if r.device == 0x5300 {
-        notes.push("ANTSEL not applied (as csiread and PicoScenes' parser leave it)".into());
+
+    /// Whether frames were read since the last [`Reader::capture`].
+    pub(crate) fn has_frames(&self) -> bool {
+        !self.t_s.is_empty()
     }
-    if r.n_tx > 1 {
-        notes.push("CSI per space-time stream: the spatial mapping is not removed".into());
+
+    /// The capture of the frames read since the last call (taken out; the state kept).
+    /// Errors: no CSI frame at all.
+    pub(crate) fn capture(&mut self) -> Result<CsiCapture> {
+        let Some(r) = &self.first else {
+            return Err(Error::InvalidFile {
+                field: "frame 0: CSI".into(),
+                reason: format!(
+                    "none of the {} frames has CSI and RxSBasic segments",
+                    self.frame
+                ),
+            });
+        };
+        let t_s = core::mem::take(&mut self.t_s);
+        let values = core::mem::take(&mut self.values);
+        self.taken = (self.taken.0 + t_s.len(), self.taken.1 + values.len());
+        let mut notes: Vec<String> = Vec::new();
+        notes.push("antenna phase offsets not calibrated".into());
+        notes.push(
+            "timing offset (SFO/STO) and carrier phase (CFO) not removed: the front end removes \
+             them per snapshot (C9/C10)"
+                .into(),
+        );
+        if r.device == 0x5300 {
+            notes.push("ANTSEL not applied (as csiread and PicoScenes' parser leave it)".into());
+        }
+        if r.n_tx > 1 {
+            notes.push("CSI per space-time stream: the spatial mapping is not removed".into());
+        }
+        notes.push("no gain: PicoScenes reports RSSI but no CSI amplitude scaling".into());
+        if matches!(r.device, 0x2000 | 0x2100) {
+            notes.push("pilots left out (the AX200/AX210 firmware writes 0 there)".into());
+        }
+        // The pilots shift with the indices (`SubcarrierOffset`).
+        let pilots = csi::pilots(r.format, r.cbw)
+            .into_iter()
+            .map(|p| p + r.offset)
+            .filter(|p| r.subcarriers.contains(p))
+            .collect();
+        let cap = CsiCapture {
+            format: CsiFormat::PicoScenes,
+            device: csi::device_name(r.device),
+            frame_format: csi::format_name(r.format).into(),
+            center_hz: (r.carrier_hz > 0).then_some(r.carrier_hz as Real),
+            bandwidth_hz: Real::from(r.cbw) * 1e6,
+            spacing_hz: Real::from(r.spacing_hz),
+            subcarriers: r.subcarriers.clone(),
+            pilots,
+            n_rx: r.n_rx,
+            n_tx: r.n_tx,
+            t_s,
+            csi: values,
+            gain: None,
+            notes,
+            skipped: self.skipped.clone(),
+        };
+        cap.validate()?;
+        Ok(cap)
     }
-    notes.push("no gain: PicoScenes reports RSSI but no CSI amplitude scaling".into());
-    let pilots = csi::pilots(r.format, r.cbw)
-        .into_iter()
-        .filter(|p| r.subcarriers.contains(p))
-        .collect();
-    let cap = CsiCapture {
-        format: CsiFormat::PicoScenes,
-        device: csi::device_name(r.device),
-        frame_format: csi::format_name(r.format).into(),
-        center_hz: (r.carrier_hz > 0).then_some(r.carrier_hz as Real),
-        bandwidth_hz: Real::from(r.cbw) * 1e6,
-        spacing_hz: Real::from(r.spacing_hz),
-        subcarriers: r.subcarriers,
-        pilots,
-        n_rx: r.n_rx,
-        n_tx: r.n_tx,
-        t_s,
-        csi: values,
-        gain: None,
-        notes,
-        skipped,
-    };
-    cap.validate()?;
-    Ok(cap)
+}
+
+/// Reads a PicoScenes `.csi` file (module doc). Errors name the frame (0-based, file order)
+/// and the field (`frame length`, `magic`, `segment i length`, `CSI.NumTones`,
+/// `CSI.CSIBufferLength`, …); an unsupported device layout or segment version is an error
+/// naming it.
+pub fn read(bytes: &[u8]) -> Result<CsiCapture> {
+    let mut reader = Reader::default();
+    let mut pos = 0usize;
+    while pos < bytes.len() {
+        pos += reader.frame(bytes.get(pos..).unwrap_or_default())?;
+    }
+    reader.capture()
 }
 
 #[cfg(test)]
@@ -312,7 +362,7 @@ mod tests {
             (&[(F0, &[0xF0, 0xFF, 0xFF, 0xFF])], "frame 1: frame length"),
             (&[(11, &[0xFF, 0xFF, 0, 0])], "frame 0: segment 0 length"),
             (&[(0x6d, &[9])], "frame 0: CSI.version"),
-            (&[(0x6f, &[0x00, 0x21])], "frame 0: CSI.DeviceType"),
+            (&[(0x6f, &[0x02, 0x08])], "frame 0: CSI.DeviceType"),
             (&[(0x88, &[31])], "frame 0: CSI.NumTones"),
             (&[(0x8b, &[0])], "frame 0: CSI.NumRx"),
             (&[(0x8b, &[4])], "frame 0: CSI.NumRx"),
@@ -323,7 +373,7 @@ mod tests {
             let e = err_of(edit);
             assert!(e.starts_with(want), "{want}: {e}");
         }
-        assert!(err_of(&[(0x6f, &[0x00, 0x21])]).contains("unsupported"));
+        assert!(err_of(&[(0x6f, &[0x02, 0x08])]).contains("unsupported"));
         let e = read(&[0, 0, 0, 0]).unwrap_err().to_string();
         assert!(
             e.starts_with("frame 1: CSI") || e.starts_with("frame 0: "),

@@ -42,8 +42,9 @@
 //! `NumTx`, is the true stream count; the example file has `NumTx = 1, NumRx = 2`: 2 Rx × 1 Tx;
 //! `ANTSEL` is not applied, as csiread and PicoScenes' parser leave it); QCA9300 — 10-bit
 //! packed values on all HT subcarriers; USRP/virtual SDR — `NumTones` i16 subcarrier indices
-//! and a `SignalMatrix` (`BBv1`/`BBv2`) of complex values. The AX200/AX210 (MVM) layout and
-//! other devices are an "unsupported" error naming the device. The carrier is `CarrierFreq`,
+//! and a `SignalMatrix` (`BBv1`/`BBv2`) of complex values; AX200/AX210 (MVM) — i16 pairs on the
+//! firmware's table of the format and CBW, without its pilots (the `mvm` module). Other devices
+//! are an "unsupported" error naming the device. The carrier is `CarrierFreq`,
 //! the spacing `SubcarrierBandwidth`; no gain (PicoScenes reports RSSI, no CSI scaling).
 //! Frames without CSI, or whose device, format, bandwidth, carrier, antennas or subcarriers
 //! differ from the first CSI frame's, are skipped with the reason.
@@ -51,5 +52,7 @@
 mod csi;
 mod cursor;
 mod frame;
+mod mvm;
 
 pub use frame::{read, sniff};
+pub(crate) use frame::{record_len, Reader};
