@@ -20,6 +20,9 @@ Channel recordings (CFR/CIR to delays)
     :class:`Recording`, :func:`read_recording` (``.npz`` or a Wi-Fi CSI file), :func:`read_csi`,
     :func:`write_recording`, :func:`track_stream` (live, frame by frame),
     :func:`simulate_recording`, :func:`estimate`, :func:`estimate_recording`, :func:`cir_track`
+Detections (JSON lines, docs/detections.md)
+    :class:`Detections`, :func:`read_detections`, :func:`write_detections`,
+    ``Paths.to_detections()``; :func:`track` takes them
 Stone Soup
     :mod:`scatterloc.stonesoup` (``BistaticDelayModel``; needs ``pip install scatterloc[stonesoup]``)
 
@@ -31,6 +34,7 @@ from ._scatterloc import (
     Crlb,
     CrlbMap,
     Curves,
+    Detections,
     Fix,
     MtlResult,
     Paths,
@@ -55,10 +59,12 @@ from ._scatterloc import (
     pcrlb,
     plan,
     read_csi,
+    read_detections,
     read_recording,
     simulate_recording,
     track,
     track_stream,
+    write_detections,
     write_recording,
 )
 
@@ -67,6 +73,7 @@ __all__ = [
     "Crlb",
     "CrlbMap",
     "Curves",
+    "Detections",
     "Fix",
     "MtlResult",
     "Paths",
@@ -91,9 +98,11 @@ __all__ = [
     "pcrlb",
     "plan",
     "read_csi",
+    "read_detections",
     "read_recording",
     "simulate_recording",
     "track",
     "track_stream",
+    "write_detections",
     "write_recording",
 ]

@@ -2,7 +2,17 @@
 
 import os
 from types import ModuleType
-from typing import Any, Callable, Literal, Mapping, Optional, Sequence, Union, final
+from typing import (
+    Any,
+    Callable,
+    Iterable,
+    Literal,
+    Mapping,
+    Optional,
+    Sequence,
+    Union,
+    final,
+)
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -13,6 +23,7 @@ __all__ = [
     "Crlb",
     "CrlbMap",
     "Curves",
+    "Detections",
     "Fix",
     "MtlResult",
     "Paths",
@@ -38,10 +49,12 @@ __all__ = [
     "pcrlb",
     "plan",
     "read_csi",
+    "read_detections",
     "read_recording",
     "simulate_recording",
     "track",
     "track_stream",
+    "write_detections",
     "write_recording",
 ]
 
@@ -275,7 +288,9 @@ class Track:
 
 def track(
     scenario: _ScenarioLike,
-    measurements: Union[ArrayLike, Sequence[Sequence[ArrayLike]], Mapping[str, Any], _PathLike],
+    measurements: Union[
+        ArrayLike, Sequence[Sequence[ArrayLike]], Mapping[str, Any], _PathLike, Detections
+    ],
     *,
     dt: Optional[float] = None,
     process_noise: Optional[float] = None,
@@ -504,14 +519,60 @@ class TrackStream:
 def track_stream(
     scenario: _ScenarioLike,
     header: Recording,
-    frames: Any,
+    frames: Optional[Iterable[tuple[float, ArrayLike]]] = None,
     *,
     calibration: Optional[Recording] = None,
+    filter: Optional[_FilterName] = None,
+    process_noise: Optional[float] = None,
+    association: Optional[Literal["gated", "spec"]] = None,
+    sigma: Optional[Literal["estimator", "budget"]] = None,
+    extent_sigma: Optional[float] = None,
+    seed: Optional[int] = None,
+    particles: Optional[int] = None,
+    roughening: Optional[float] = None,
+    bootstrap: Optional[bool] = None,
+    ukf_alpha: Optional[float] = None,
+    ukf_beta: Optional[float] = None,
+    ukf_kappa: Optional[float] = None,
+    max_paths: Optional[int] = None,
+    pfa: Optional[float] = None,
+    statics: Optional[_Statics] = None,
+    delay_reference: Optional[_DelayReference] = None,
+    background_time: Optional[float] = None,
 ) -> TrackStream:
     """``scatterloc cir track --follow`` in Python: one dict per frame (``t_s``, ``state``,
     ``covariance``, ``segment``, ``links_used``, ``delays_s``, ``snapshot``, ``event``, ``end``,
     ``dropped_hypotheses``), computed as each ``(t, samples (links, bins))`` of ``frames`` is
-    pulled; ``header`` gives the links, bins, system response and clock flag."""
+    pulled; ``header`` gives the links, bins, system response and clock flag, and without
+    ``frames`` its own snapshots are the frames. The keywords are ``cir_track``'s that
+    ``--follow`` accepts, checked before the first frame."""
+@final
+class Detections:
+    """Detections, JSON lines (docs/detections.md), in long format: one row per detection."""
+    def __new__(cls, lines: Iterable[Mapping[str, Any]]) -> Detections: ...
+    @property
+    def t(self) -> _F64: ...
+    @property
+    def frame(self) -> _I64: ...
+    @property
+    def links(self) -> _I64: ...
+    @property
+    def delay(self) -> _F64: ...
+    @property
+    def snr_db(self) -> _Masked: ...
+    @property
+    def sigma(self) -> _Masked: ...
+    @property
+    def doppler(self) -> _Masked: ...
+    def to_text(self) -> str: ...
+    def lines(self) -> list[dict[str, Any]]: ...
+    def __len__(self) -> int: ...
+    def __eq__(self, other: object, /) -> bool: ...
+
+def read_detections(source: _PathLike) -> Detections:
+    """A detections file (a path), or its text (a str holding a newline or starting with
+    ``{`` or ``#``); errors name the line and the field."""
+def write_detections(path: _PathLike, detections: Detections) -> None: ...
 def write_recording(path: _PathLike, recording: Recording) -> None: ...
 def simulate_recording(
     scenario: _ScenarioLike,
@@ -554,6 +615,8 @@ class Paths:
     @property
     def t(self) -> _F64: ...
     def to_dict(self) -> Optional[dict[str, Any]]: ...
+    def to_detections(self) -> Detections:
+        """``cir estimate --detections-out`` of these paths (``estimate_recording``'s only)."""
     def __len__(self) -> int: ...
 
 def estimate(

@@ -15,7 +15,7 @@ use pyo3::prelude::*;
 
 use scatterloc::channel::{ChannelScene, Layout, Pulse, Recording, SimulationRequest, TrackedPath};
 use scatterloc::error::{limits, Cancel};
-use scatterloc::formats::Truth;
+use scatterloc::formats::{Detections, Truth};
 use scatterloc::native::Parallel;
 use scatterloc::npz;
 use scatterloc::present::{estimates_doc, track_doc, track_errors};
@@ -29,6 +29,7 @@ use scatterloc::track::gating::AssociationRule;
 use crate::convert::{
     array, asarray, dtype_name, f64_array, masked, path_string, to_python, too_many, JsonDoc, Len,
 };
+use crate::detections::PyDetections;
 use crate::errors::{arg_error, Core};
 use crate::run::{check_threads, run_job, run_quick};
 use crate::scenario::scenario_arg;
@@ -546,6 +547,8 @@ pub struct Paths {
     #[pyo3(get)]
     t: Py<PyAny>,
     doc: Option<JsonDoc>,
+    /// `estimate_recording`'s paths as detections (`cir estimate --detections-out`).
+    detections: Option<Detections>,
 }
 
 #[pymethods]
@@ -556,6 +559,19 @@ impl Paths {
         match &self.doc {
             Some(d) => d.to_python(py),
             None => Ok(py.None().into_bound(py)),
+        }
+    }
+
+    /// The paths as detections, as `scatterloc cir estimate --detections-out` writes them
+    /// (docs/detections.md: per snapshot and recorded link every path's delay, SNR and σ̂_τ);
+    /// from `estimate_recording` only (`estimate`'s paths have no scenario links).
+    fn to_detections(&self) -> PyResult<PyDetections> {
+        match &self.detections {
+            Some(d) => Ok(PyDetections { d: d.clone() }),
+            None => Err(arg_error(
+                "paths",
+                "detections need the scenario's links: estimate_recording's paths, not estimate's",
+            )),
         }
     }
 
@@ -620,37 +636,42 @@ fn paths_object(
         noise_var: array(py, noise, noise_shape)?.unbind(),
         t: array(py, t.to_vec(), &[t.len()])?.unbind(),
         doc,
+        detections: None,
     })
 }
 
-/// The front end's keywords of `estimate_recording` and `cir_track` (None: the core's default).
+/// The front end's keywords of `estimate_recording`, `cir_track` and `track_stream` (None: the
+/// core's default).
 #[derive(Default)]
-struct FrontEndKw<'a> {
-    max_paths: Option<usize>,
-    pfa: Option<f64>,
-    statics: Option<&'a str>,
-    delay_reference: Option<&'a str>,
-    background_time: Option<f64>,
-    calibration_range: Option<[f64; 2]>,
+pub(crate) struct FrontEndKw<'a> {
+    pub max_paths: Option<usize>,
+    pub pfa: Option<f64>,
+    pub statics: Option<&'a str>,
+    pub delay_reference: Option<&'a str>,
+    pub background_time: Option<f64>,
+    pub calibration_range: Option<[f64; 2]>,
 }
 
-/// The tracker's keywords of `cir_track` (None: the core's default).
-struct TrackKw<'a> {
-    filter: Option<&'a str>,
-    process_noise: Option<f64>,
-    association: Option<&'a str>,
-    sigma: Option<&'a str>,
-    extent_sigma: Option<f64>,
-    seed: Option<u64>,
-    particles: Option<usize>,
-    roughening: Option<f64>,
-    bootstrap: Option<bool>,
-    ukf: [Option<f64>; 3],
+/// The tracker's keywords of `cir_track` and `track_stream` (None: the core's default).
+pub(crate) struct TrackKw<'a> {
+    pub filter: Option<&'a str>,
+    pub process_noise: Option<f64>,
+    pub association: Option<&'a str>,
+    pub sigma: Option<&'a str>,
+    pub extent_sigma: Option<f64>,
+    pub seed: Option<u64>,
+    pub particles: Option<usize>,
+    pub roughening: Option<f64>,
+    pub bootstrap: Option<bool>,
+    pub ukf: [Option<f64>; 3],
 }
 
 /// The core's [`ChannelRequest`] of the given keywords (the others at its defaults), checked
 /// by the core ([`ChannelRequest::check`]: errors name the request's field).
-fn request(fe: &FrontEndKw<'_>, track: Option<&TrackKw<'_>>) -> PyResult<ChannelRequest> {
+pub(crate) fn request(
+    fe: &FrontEndKw<'_>,
+    track: Option<&TrackKw<'_>>,
+) -> PyResult<ChannelRequest> {
     let mut r = ChannelRequest::default();
     if let Some(k) = fe.max_paths {
         r.max_paths = k;
@@ -885,7 +906,7 @@ pub fn estimate_recording(
     let doc = JsonDoc::of(&estimates_doc(sc.model(), &est, &cfg, &statics))?;
     let l = sc.model().link_count();
     let noise: Vec<f64> = est.noise_var.iter().flatten().copied().collect();
-    paths_object(
+    let mut paths = paths_object(
         py,
         &est.t_s,
         &est.paths,
@@ -893,7 +914,15 @@ pub fn estimate_recording(
         &[est.len(), l],
         true,
         Some(doc),
-    )
+    )?;
+    let links = &sc.model().network.links;
+    paths.detections = Some(Detections::from_paths(
+        links,
+        &est.t_s,
+        &est.recorded,
+        &est.paths,
+    ));
+    Ok(paths)
 }
 
 /// [`estimate_all`] off the GIL with Ctrl-C and progress.

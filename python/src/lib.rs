@@ -18,6 +18,7 @@
 //!   `estimate`, `estimate_recording`, `cir_track`.
 //! - `csi`: `read_csi` and the CSI keywords of `read_recording` (Wi-Fi CSI tools' files).
 //! - `stream`: `track_stream`, the live chain of `cir track --follow` as an iterator.
+//! - `detections`: `Detections`, `read_detections`, `write_detections` (JSON lines).
 //! - `bench`: native timings for the package's benchmark (docs/benchmarks.md).
 //!
 //! The Python side (`python/scatterloc/`) re-exports these, adds the Stone Soup model and
@@ -27,6 +28,7 @@ mod bench;
 mod channel;
 mod convert;
 mod csi;
+mod detections;
 mod errors;
 mod mtl;
 mod output;
@@ -60,6 +62,7 @@ fn _scatterloc(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<channel::Paths>()?;
     m.add_class::<channel::ChannelTrack>()?;
     m.add_class::<stream::TrackStream>()?;
+    m.add_class::<detections::PyDetections>()?;
     for f in [
         wrap_pyfunction!(snapshot::crlb, m)?,
         wrap_pyfunction!(snapshot::crlb_map, m)?,
@@ -73,6 +76,8 @@ fn _scatterloc(m: &Bound<'_, PyModule>) -> PyResult<()> {
         wrap_pyfunction!(channel::read_recording, m)?,
         wrap_pyfunction!(csi::read_csi, m)?,
         wrap_pyfunction!(stream::track_stream, m)?,
+        wrap_pyfunction!(detections::read_detections, m)?,
+        wrap_pyfunction!(detections::write_detections, m)?,
         wrap_pyfunction!(channel::write_recording, m)?,
         wrap_pyfunction!(channel::simulate_recording, m)?,
         wrap_pyfunction!(channel::estimate, m)?,

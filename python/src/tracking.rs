@@ -9,11 +9,14 @@ use scatterloc::error::Cancel;
 use scatterloc::formats::{
     CalibrationResult, CalibrationSnapshots, Measurements, RawEstimate, RawStep, Sigma,
 };
-use scatterloc::study::{track_cpu_s, track_measurements_in, TrackOutput, TrackRequest, MAX_CPU_S};
+use scatterloc::study::{
+    track_cpu_s, track_measurements_in, TrackOutput, TrackRequest, DEFAULT_PROCESS_NOISE, MAX_CPU_S,
+};
 use scatterloc::track::gating::{AssociationRule, Calibration, ClusterConfig};
 use scatterloc::track::{FilterKind, FilterSettings};
 
 use crate::convert::{array, f64_array, masked, matrix, to_json_text, to_python};
+use crate::detections::PyDetections;
 use crate::errors::{arg_error, Core};
 use crate::run::run_sized;
 use crate::scenario::{read_text, scenario_arg};
@@ -315,7 +318,10 @@ pub fn track_object(py: Python<'_>, out: TrackOutput) -> PyResult<Track> {
 ///   associated (`association`: `"spec"` or `"gated"`); start from `initial_state` and
 ///   `initial_covariance`, or from the LM fix of `initial_snapshot` (one raw step at t₀);
 /// - a dict (a measurement file, as `json.load` gives it) or a path to one; the other
-///   measurement arguments must then be absent.
+///   measurement arguments must then be absent;
+/// - `Detections` (docs/detections.md; `scatterloc track --detections`): the first frame
+///   starts the track (`initial_snapshot`), the others are its raw steps, `dt` their mean
+///   spacing; `process_noise` (default 1 m²/s³) is the only other measurement argument.
 ///
 /// `filter` settings (`ukf_alpha`, `ukf_beta`, `ukf_kappa`; `particles`, `roughening`,
 /// `bootstrap`, `seed`) apply to their filter only (an error otherwise, as the CLI's flags).
@@ -365,13 +371,19 @@ pub fn track(
         filter,
         seed,
     )?;
-    let is_file = measurements.cast::<pyo3::types::PyDict>().is_ok()
+    let detections = measurements.cast::<PyDetections>().ok();
+    let is_file = detections.is_some()
+        || measurements.cast::<pyo3::types::PyDict>().is_ok()
         || measurements.cast::<pyo3::types::PyString>().is_ok()
         || measurements.hasattr("__fspath__")?;
     let m: Measurements = if is_file {
         let given = [
             ("dt", dt.is_some()),
-            ("process_noise", process_noise.is_some()),
+            // Detections take the process noise (`track --detections --process-noise`).
+            (
+                "process_noise",
+                process_noise.is_some() && detections.is_none(),
+            ),
             ("initial_state", initial_state.is_some()),
             ("initial_covariance", initial_covariance.is_some()),
             ("initial_snapshot", initial_snapshot.is_some()),
@@ -380,15 +392,24 @@ pub fn track(
         if let Some((f, _)) = given.iter().find(|(_, g)| *g) {
             return Err(arg_error(
                 f,
-                "given twice: the measurement file (dict or path) holds it",
+                if detections.is_some() {
+                    "not with detections: the frames give it (their spacing, the first frame)"
+                } else {
+                    "given twice: the measurement file (dict or path) holds it"
+                },
             ));
         }
-        let text = if measurements.cast::<pyo3::types::PyDict>().is_ok() {
-            to_json_text(measurements, "measurements")?
+        if let Some(d) = detections {
+            let q = process_noise.unwrap_or(DEFAULT_PROCESS_NOISE);
+            d.get().d.to_measurements(model, q).py()?
         } else {
-            read_text(&crate::convert::path_string(measurements)?, "measurements")?
-        };
-        Measurements::from_json(text.trim_start_matches('\u{feff}')).py()?
+            let text = if measurements.cast::<pyo3::types::PyDict>().is_ok() {
+                to_json_text(measurements, "measurements")?
+            } else {
+                read_text(&crate::convert::path_string(measurements)?, "measurements")?
+            };
+            Measurements::from_json(text.trim_start_matches('\u{feff}')).py()?
+        }
     } else {
         let dt = dt.ok_or_else(|| arg_error("dt", "required with delays or raw estimates"))?;
         let q = process_noise
