@@ -6,13 +6,21 @@
 //! valid recording of finite samples, or a named error (one line, at most 1000 bytes), without
 //! reserving what the file only declares (the peak address space grows by at most
 //! [`CSI_RESERVE_LIMIT`]), within the in-process time budget.
+//!
+//! `csi_streams`: the same edited files pushed through `csi::CsiStream` (the reader of `cir
+//! track --follow`) in chunks of a random size, then its end. Invariant: every frame out has
+//! finite samples, `links × bins` of them as the stream's header says, at increasing times, or
+//! a named error — never a panic — and the bytes held between pushes stay within one record.
 
 use proptest::prelude::*;
 
 use super::check::{self, core_err, fail, guarded, Class, Pass, Verdict};
 use super::runner::fuzz;
 use super::{Case, KNOWN};
-use scatterloc::csi::{read_capture, to_recording, ConvertOptions, CsiFormat};
+use scatterloc::csi::{
+    read_capture, to_recording, ConvertOptions, CsiFormat, CsiFrame, CsiStream,
+    MAX_CSI_RECORD_BYTES,
+};
 
 /// Growth of the peak address space one case may cause (the largest base file is 421 KB and
 /// reads into ~2 MB).
@@ -198,6 +206,96 @@ fn fuzz_csi_files() {
             let f = if *auto { None } else { Some(format) };
             Case {
                 verdict: guarded(&desc, || run(&z, f)),
+                what: desc,
+            }
+        },
+    );
+}
+
+/// `z` through a [`CsiStream`] of `format` in `chunk`-byte pushes (module doc's invariant).
+fn run_stream(z: &[u8], format: CsiFormat, chunk: usize) -> Verdict {
+    let mut s = match CsiStream::new(format, ConvertOptions::default()) {
+        Ok(s) => s,
+        Err(e) => return core_err(&e),
+    };
+    let mut out: Vec<CsiFrame> = Vec::new();
+    let mut frames = 0usize;
+    let mut last_t = f64::NEG_INFINITY;
+    let mut check = |s: &CsiStream, out: &mut Vec<CsiFrame>| -> Result<(), String> {
+        if s.pending_bytes() > MAX_CSI_RECORD_BYTES + chunk {
+            return Err(format!("{} bytes held between pushes", s.pending_bytes()));
+        }
+        for f in out.drain(..) {
+            let h = s.header().ok_or("a frame before the stream's header")?;
+            let want = h.links.len() * h.freq_hz.len();
+            if f.samples.len() != want {
+                return Err(format!(
+                    "frame {frames}: {} samples, the header says {want}",
+                    f.samples.len()
+                ));
+            }
+            if !f.t_s.is_finite()
+                || f.samples
+                    .iter()
+                    .any(|c| !(c.re.is_finite() && c.im.is_finite()))
+            {
+                return Err(format!(
+                    "frame {frames}: a sample or its time is not finite"
+                ));
+            }
+            if f.t_s < last_t {
+                return Err(format!("frame {frames}: time {} after {last_t}", f.t_s));
+            }
+            last_t = f.t_s;
+            frames += 1;
+        }
+        Ok(())
+    };
+    for piece in z.chunks(chunk.max(1)) {
+        if let Err(e) = s.push(piece, &mut out) {
+            return core_err(&e);
+        }
+        if let Err(m) = check(&s, &mut out) {
+            return Err(fail(Class::BadOutput, m));
+        }
+    }
+    if let Err(e) = s.end(&mut out) {
+        return core_err(&e);
+    }
+    check(&s, &mut out).map_err(|m| fail(Class::BadOutput, m))?;
+    Ok(Pass::Ok)
+}
+
+#[test]
+fn fuzz_csi_streams() {
+    let bases: Vec<Vec<u8>> = FILES
+        .iter()
+        .map(|(name, _)| {
+            std::fs::read(format!(
+                "{}/tests/data/csi/{name}",
+                env!("CARGO_MANIFEST_DIR")
+            ))
+            .expect("a CSI test file")
+        })
+        .collect();
+    // Chunks from 64 bytes (a pipe's small reads) to 64 KiB (the CLI's read size).
+    let strategy = (
+        0..FILES.len(),
+        prop_oneof![64usize..512, 512usize..65_536],
+        prop::collection::vec(edit(), 0..=4),
+    );
+    fuzz(
+        file!(),
+        "csi_streams",
+        200,
+        KNOWN,
+        strategy,
+        |(base, chunk, edits)| {
+            let (name, format) = FILES[*base];
+            let desc = format!("{name} in {chunk}-byte pushes, edits {edits:?}");
+            let z = apply(&bases[*base], edits);
+            Case {
+                verdict: guarded(&desc, || run_stream(&z, format, *chunk)),
                 what: desc,
             }
         },
