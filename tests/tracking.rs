@@ -25,6 +25,9 @@ mod filters_mc;
 #[path = "tracking/gating.rs"]
 mod gating;
 
+#[path = "tracking/gospa.rs"]
+mod gospa;
+
 #[path = "tracking/montecarlo.rs"]
 mod montecarlo;
 

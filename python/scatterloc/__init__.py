@@ -15,7 +15,7 @@ Scenario and snapshot
 Tracking
     :func:`track`, :func:`calibrate`, :func:`montecarlo`, :func:`pcrlb`
 Planning and multi-target
-    :func:`plan`, :func:`mtl_locate`
+    :func:`plan`, :func:`mtl_locate`, :func:`gospa` (the GOSPA metric)
 Channel recordings (CFR/CIR to delays)
     :class:`Recording`, :func:`read_recording` (``.npz`` or a Wi-Fi CSI file), :func:`read_csi`,
     :func:`write_recording`, :func:`track_stream` (live, frame by frame),
@@ -53,6 +53,7 @@ from ._scatterloc import (
     crlb_map,
     estimate,
     estimate_recording,
+    gospa,
     locate,
     montecarlo,
     mtl_locate,
@@ -92,6 +93,7 @@ __all__ = [
     "crlb_map",
     "estimate",
     "estimate_recording",
+    "gospa",
     "locate",
     "montecarlo",
     "mtl_locate",

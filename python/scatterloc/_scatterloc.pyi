@@ -43,6 +43,7 @@ __all__ = [
     "crlb_map",
     "estimate",
     "estimate_recording",
+    "gospa",
     "locate",
     "montecarlo",
     "mtl_locate",
@@ -183,6 +184,10 @@ class Crlb:
     def to_dicts(self) -> list[dict[str, Any]]: ...
 
 def crlb(scenario: _ScenarioLike, points: ArrayLike) -> Crlb: ...
+
+def gospa(truth: ArrayLike, estimates: ArrayLike, *, c: float, p: float = 2.0) -> dict[str, Any]:
+    """GOSPA (alpha = 2) between true positions and estimates, (n, 2) in metres."""
+    ...
 
 @final
 class CrlbMap:

@@ -30,6 +30,7 @@ mod convert;
 mod csi;
 mod detections;
 mod errors;
+mod gospa;
 mod mtl;
 mod output;
 mod planning;
@@ -64,6 +65,7 @@ fn _scatterloc(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<stream::TrackStream>()?;
     m.add_class::<detections::PyDetections>()?;
     for f in [
+        wrap_pyfunction!(gospa::gospa, m)?,
         wrap_pyfunction!(snapshot::crlb, m)?,
         wrap_pyfunction!(snapshot::crlb_map, m)?,
         wrap_pyfunction!(snapshot::locate, m)?,

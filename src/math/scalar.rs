@@ -51,6 +51,12 @@ pub fn acos(x: Real) -> Real {
     libm::acos(x)
 }
 
+/// `x^y` (`libm`'s: the same bits natively and in wasm).
+#[inline(always)]
+pub fn pow(x: Real, y: Real) -> Real {
+    libm::pow(x, y)
+}
+
 /// Natural exponential.
 #[inline(always)]
 pub fn exp(x: Real) -> Real {

@@ -5,12 +5,14 @@
 //! posterior CRLB recursion (E9, §8), the trajectories of \[S\] Fig. 2b and the Monte Carlo
 //! prior (§9.4–9.5), one simulated run for display, the raw-estimate front end (`gating`: spec
 //! §4, C7, C11), and the Monte Carlo study of the tracker against its bound, chunked so that any
-//! driver (sequential, `native`, the page's worker) gives the same result.
+//! driver (sequential, `native`, the page's worker) gives the same result; and the GOSPA metric
+//! that scores a multi-target estimate (issue 41).
 
 mod cost;
 mod ekf;
 mod filter;
 pub mod gating;
+mod gospa;
 mod montecarlo;
 mod motion;
 mod pcrlb;
@@ -27,6 +29,7 @@ pub use cost::{
 pub(crate) use ekf::update_lanes;
 pub use ekf::Ekf;
 pub use filter::{Filter, FilterKind, FilterSettings, Tracker};
+pub use gospa::{gospa, Gospa, GospaConfig, MAX_GOSPA_POINTS};
 pub use montecarlo::{
     finish, pcrlb_from_sums, run_chunk, run_chunk_in, run_filter_chunk, run_filter_chunk_in,
     run_pcrlb_sequential, run_sequential, run_truth_chunk, MonteCarloConfig, MonteCarloResult,
