@@ -176,9 +176,9 @@ fn run(z: &[u8], format: Option<CsiFormat>) -> Verdict {
     Ok(Pass::Ok)
 }
 
-#[test]
-fn fuzz_csi_files() {
-    let bases: Vec<Vec<u8>> = FILES
+/// The bytes of [`FILES`], in order.
+fn base_files() -> Vec<Vec<u8>> {
+    FILES
         .iter()
         .map(|(name, _)| {
             std::fs::read(format!(
@@ -187,7 +187,12 @@ fn fuzz_csi_files() {
             ))
             .expect("a CSI test file")
         })
-        .collect();
+        .collect()
+}
+
+#[test]
+fn fuzz_csi_files() {
+    let bases = base_files();
     let strategy = (
         0..FILES.len(),
         any::<bool>(),
@@ -268,16 +273,7 @@ fn run_stream(z: &[u8], format: CsiFormat, chunk: usize) -> Verdict {
 
 #[test]
 fn fuzz_csi_streams() {
-    let bases: Vec<Vec<u8>> = FILES
-        .iter()
-        .map(|(name, _)| {
-            std::fs::read(format!(
-                "{}/tests/data/csi/{name}",
-                env!("CARGO_MANIFEST_DIR")
-            ))
-            .expect("a CSI test file")
-        })
-        .collect();
+    let bases = base_files();
     // Chunks from 64 bytes (a pipe's small reads) to 64 KiB (the CLI's read size).
     let strategy = (
         0..FILES.len(),

@@ -99,54 +99,11 @@ impl Source {
     /// A file at its end is read again every [`POLL`]; Ctrl-C while waiting: exit 130.
     fn fill(&mut self, buf: &mut [u8]) -> Result<usize, CliError> {
         let mut got = 0;
-        // Bounded by the bytes asked for (each turn reads ≥ 1 byte) and by Ctrl-C while waiting.
+        // Bounded by the bytes asked for: each turn reads ≥ 1 byte or ends.
         while got < buf.len() {
-            match self {
-                Source::File(f) => {
-                    let n = f
-                        .read(&mut buf[got..])
-                        .map_err(|e| at_flag("cir", format!("reading: {e}")))?;
-                    if n == 0 {
-                        if interrupted() {
-                            return Err(stopped());
-                        }
-                        std::thread::sleep(POLL);
-                    }
-                    got += n;
-                }
-                Source::Stdin {
-                    rx,
-                    chunk,
-                    at,
-                    ended,
-                } => {
-                    if *at < chunk.len() {
-                        let n = (chunk.len() - *at).min(buf.len() - got);
-                        buf[got..got + n].copy_from_slice(&chunk[*at..*at + n]);
-                        *at += n;
-                        got += n;
-                        continue;
-                    }
-                    if *ended {
-                        return Ok(got);
-                    }
-                    match rx.recv_timeout(POLL) {
-                        Ok(Ok(c)) if c.is_empty() => *ended = true,
-                        Ok(Ok(c)) => {
-                            *chunk = c;
-                            *at = 0;
-                        }
-                        Ok(Err(e)) => {
-                            return Err(at_flag("cir", format!("reading standard input: {e}")))
-                        }
-                        Err(RecvTimeoutError::Timeout) => {
-                            if interrupted() {
-                                return Err(stopped());
-                            }
-                        }
-                        Err(RecvTimeoutError::Disconnected) => *ended = true,
-                    }
-                }
+            match self.some(&mut buf[got..])? {
+                0 => break,
+                n => got += n,
             }
         }
         Ok(got)
@@ -179,7 +136,7 @@ impl Source {
                 }
                 Source::Stdin { ended: true, .. } => return Ok(0),
                 Source::Stdin { .. } => {
-                    // Waits for the next chunk (or the end) as `fill` does.
+                    // Waits for the next chunk (or the end).
                     if let Source::Stdin {
                         rx,
                         chunk,
