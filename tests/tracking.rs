@@ -25,6 +25,12 @@ mod filters_mc;
 #[path = "tracking/gating.rs"]
 mod gating;
 
+#[path = "tracking/multi.rs"]
+mod multi;
+
+#[path = "tracking/multi_studies.rs"]
+mod multi_studies;
+
 #[path = "tracking/gospa.rs"]
 mod gospa;
 

@@ -15,6 +15,7 @@ pub mod gating;
 mod gospa;
 mod montecarlo;
 mod motion;
+pub mod multi;
 mod pcrlb;
 mod pf;
 mod shared;

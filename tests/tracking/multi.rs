@@ -1,0 +1,285 @@
+//! The multi-target tracker's parts against independent references: loopy BP against the
+//! exact marginals (exact on trees, close on loops), the Kalman update against the
+//! information-form closed form, the MAP cardinality against enumeration, the birth search on
+//! noise-free delays; named errors for bad scans; and the studies of issue 41 §3 at a size a
+//! debug build runs (the full sizes are `multi_studies::*_full`, release).
+
+use scatterloc::math::{Mat4, Real, Vec2, Vec4};
+use scatterloc::measure::{rng, uniform01};
+use scatterloc::track::multi::{
+    bp_marginals, exact_marginals, kalman_update, map_cardinality, people_layout, people_region,
+    BirthGrid, Births, DelayBirth, DelayLinks, Detection, MultiConfig, Pmb, PositionSensor,
+    MAX_BP_ITERATIONS, MAX_DETECTIONS_PER_SENSOR,
+};
+use scatterloc::track::ConstantVelocity;
+use scatterloc::Model;
+
+use crate::multi_studies::{people_run, williams_rms, PEOPLE_STEPS};
+
+fn random_psi(n: usize, m: usize, seed: u64) -> Vec<Real> {
+    let mut r = rng(seed, 0);
+    (0..n * m)
+        .map(|_| {
+            let u = uniform01(&mut r);
+            if u < 0.3 {
+                0.0
+            } else {
+                10.0 * uniform01(&mut r)
+            }
+        })
+        .collect()
+}
+
+#[test]
+fn bp_is_exact_on_trees_and_close_on_loops() {
+    let mut worst_loop: Real = 0.0;
+    for seed in 0..300u64 {
+        // A tree: one track or one measurement.
+        for (n, m) in [(1, 5), (4, 1)] {
+            let psi = random_psi(n, m, seed);
+            let (bp, ex) = (bp_marginals(&psi, n, m), exact_marginals(&psi, n, m));
+            assert!(bp.converged);
+            for (a, b) in bp
+                .track
+                .iter()
+                .zip(&ex.track)
+                .chain(bp.free.iter().zip(&ex.free))
+            {
+                assert!((a - b).abs() < 1e-9, "tree seed {seed}: {a} vs {b}");
+            }
+        }
+        let (n, m) = (3, 4);
+        let psi = random_psi(n, m, seed + 1000);
+        let (bp, ex) = (bp_marginals(&psi, n, m), exact_marginals(&psi, n, m));
+        assert!(bp.iterations <= MAX_BP_ITERATIONS);
+        for i in 0..n {
+            let s: Real = bp.track[i * (m + 1)..(i + 1) * (m + 1)].iter().sum();
+            assert!((s - 1.0).abs() < 1e-12);
+        }
+        for (a, b) in bp.track.iter().zip(&ex.track) {
+            worst_loop = worst_loop.max((a - b).abs());
+        }
+    }
+    // Loopy BP is approximate on loops; measured worst error over 300 random 3 × 4 problems.
+    assert!(worst_loop < 0.15, "loopy BP error {worst_loop}");
+    println!("loopy BP worst marginal error over 300 problems: {worst_loop:.4}");
+}
+
+#[test]
+fn bp_reaches_its_iteration_bound_on_a_hard_loop() {
+    // Strong, symmetric weights on a full bipartite loop converge slowly: the bound is reached
+    // and reported, the marginals stay probabilities.
+    let (n, m) = (6, 6);
+    let psi = vec![1e6; n * m];
+    let bp = bp_marginals(&psi, n, m);
+    assert!(bp.iterations <= MAX_BP_ITERATIONS);
+    for v in bp.track.iter().chain(&bp.free) {
+        assert!(v.is_finite() && (0.0..=1.0).contains(v));
+    }
+    let psi = [5.0, 0.0, 0.0, 5.0];
+    let bp = bp_marginals(&psi, 2, 2);
+    assert!(bp.converged && bp.iterations < MAX_BP_ITERATIONS);
+}
+
+#[test]
+fn kalman_update_equals_the_information_form() {
+    let sensor = PositionSensor {
+        sigma_m: 0.7,
+        detection: 0.9,
+        clutter_intensity: 1e-4,
+    };
+    let mut r = rng(5, 0);
+    for _ in 0..200 {
+        let x = Vec4::new(uniform01(&mut r) * 10.0, 3.0, 0.5, -0.2);
+        let a = Mat4::from_fn(|i, j| uniform01(&mut r) - 0.5 + if i == j { 1.5 } else { 0.0 });
+        let p = a * a.transpose();
+        let z = [x[0] + 0.3, x[1] - 0.8];
+        let obs = scatterloc::track::multi::MeasurementModel::observe(&sensor, 0, &x, None);
+        let u = kalman_update(&x, &p, &obs, &z).unwrap();
+        // Information form: P⁺ = (P⁻¹ + Hᵀ R⁻¹ H)⁻¹, x⁺ = x + P⁺ Hᵀ R⁻¹ (z − Hx).
+        let mut h = nalgebra::Matrix2x4::<Real>::zeros();
+        h[(0, 0)] = 1.0;
+        h[(1, 1)] = 1.0;
+        let rinv = nalgebra::Matrix2::<Real>::identity() / 0.49;
+        let pp = (p.try_inverse().unwrap() + h.transpose() * rinv * h)
+            .try_inverse()
+            .unwrap();
+        let nu = nalgebra::Vector2::new(z[0] - x[0], z[1] - x[1]);
+        let xp = x + pp * h.transpose() * rinv * nu;
+        assert!((u.state - xp).norm() < 1e-9 * (1.0 + xp.norm()));
+        assert!((u.covariance - pp).norm() < 1e-9 * (1.0 + pp.norm()));
+        // Predictive likelihood: 𝒩(z; Hx, H P Hᵀ + R).
+        let s = h * p * h.transpose() + nalgebra::Matrix2::identity() * 0.49;
+        let d2 = (nu.transpose() * s.try_inverse().unwrap() * nu)[0];
+        let ll = -0.5 * d2 - (2.0 * std::f64::consts::PI).ln() - 0.5 * s.determinant().ln();
+        assert!((u.log_likelihood - ll).abs() < 1e-9);
+        assert!((u.distance2 - d2).abs() < 1e-9 * (1.0 + d2));
+    }
+}
+
+#[test]
+fn map_cardinality_equals_enumeration() {
+    let mut r = rng(9, 0);
+    for _ in 0..300 {
+        let n = 1 + (uniform01(&mut r) * 8.0) as usize;
+        let e: Vec<Real> = (0..n).map(|_| uniform01(&mut r)).collect();
+        let mut p = vec![0.0; n + 1];
+        for mask in 0u32..(1 << n) {
+            let w: Real = (0..n)
+                .map(|i| if mask >> i & 1 == 1 { e[i] } else { 1.0 - e[i] })
+                .product();
+            p[mask.count_ones() as usize] += w;
+        }
+        let best = (0..=n).fold(0, |b, k| if p[k] > p[b] { k } else { b });
+        assert_eq!(map_cardinality(&e), best);
+    }
+}
+
+#[test]
+fn birth_search_finds_targets_from_noise_free_delays() {
+    let model = Model::new(&people_layout()).unwrap();
+    let grid = BirthGrid::new(&model, DelayBirth::new(people_region(), 8), None).unwrap();
+    let targets = [
+        Vec2::new(2.3, 1.7),
+        Vec2::new(7.9, 6.2),
+        Vec2::new(5.6, 3.1),
+    ];
+    let free: Vec<Vec<(Real, Option<Real>)>> = (0..8)
+        .map(|p| {
+            targets
+                .iter()
+                .map(|t| (model.network.delay(p, *t), None))
+                .collect()
+        })
+        .collect();
+    let fixes = grid.search(&model, &free, None);
+    assert_eq!(fixes.len(), 3);
+    for t in targets {
+        let d = fixes
+            .iter()
+            .map(|f| (f.position - t).norm())
+            .fold(Real::INFINITY, Real::min);
+        assert!(d < 1e-6, "target {t:?}: nearest fix {d} m");
+    }
+    for f in &fixes {
+        assert_eq!(f.used.iter().flatten().count(), 8);
+        let r = f.existence(0.01, &people_region(), 0.9, 5.0 / 60e-9);
+        assert!(r > 0.999, "{r}");
+    }
+    // Delays on too few links give no birth.
+    let few: Vec<Vec<(Real, Option<Real>)>> = (0..8)
+        .map(|p| if p < 4 { free[p].clone() } else { vec![] })
+        .collect();
+    assert!(grid.search(&model, &few, None).is_empty());
+}
+
+#[test]
+fn bad_scans_are_named_and_leave_the_tracker_unchanged() {
+    let model = Model::new(&people_layout()).unwrap();
+    let links = DelayLinks::new(&model, 0.9, 5.0, 60e-9, None).unwrap();
+    let cfg = MultiConfig::new(ConstantVelocity::new(0.1, 0.5));
+    let grid = BirthGrid::new(&model, DelayBirth::new(people_region(), 8), None).unwrap();
+    let mut t = Pmb::new(cfg, Births::Delays(grid)).unwrap();
+    let good: Vec<Vec<Detection>> = (0..8)
+        .map(|p| {
+            vec![Detection::delay(
+                model.network.delay(p, Vec2::new(4.0, 4.0)),
+                None,
+            )]
+        })
+        .collect();
+    t.step(&links, &good).unwrap();
+    let before = t.bernoullis().to_vec();
+    let e = t.step(&links, &good[..7]).unwrap_err().to_string();
+    assert!(
+        e.contains("scan") && e.contains('8') && e.contains('7'),
+        "{e}"
+    );
+    let mut nan = good.clone();
+    nan[3][0] = Detection::delay(Real::NAN, None);
+    assert!(t
+        .step(&links, &nan)
+        .unwrap_err()
+        .to_string()
+        .contains("scan[3][0]"));
+    let mut bad_sigma = good.clone();
+    bad_sigma[2][0].sigma = Some(-1.0);
+    assert!(t.step(&links, &bad_sigma).is_err());
+    let mut flood = good.clone();
+    flood[0] = vec![Detection::delay(5e-8, None); MAX_DETECTIONS_PER_SENSOR + 1];
+    let e = t.step(&links, &flood).unwrap_err().to_string();
+    assert!(e.contains("detections per link"), "{e}");
+    assert_eq!(t.bernoullis(), &before[..]);
+    // Empty scans are fine: the target's existence decays.
+    let empty = vec![Vec::new(); 8];
+    let r0 = t.estimates()[0].existence;
+    t.step(&links, &empty).unwrap();
+    assert!(t.bernoullis().iter().all(|b| b.existence < r0));
+    // Thousands of clutter delays at the cap: one scan in bounded work, finite output.
+    let mut r = rng(3, 0);
+    let heavy: Vec<Vec<Detection>> = (0..8)
+        .map(|p| {
+            let lo = model.network.los_delay(p);
+            (0..MAX_DETECTIONS_PER_SENSOR)
+                .map(|_| Detection::delay(lo + 60e-9 * uniform01(&mut r), None))
+                .collect()
+        })
+        .collect();
+    t.step(&links, &heavy).unwrap();
+    for e in t.estimates() {
+        assert!(e.state.iter().all(|v| v.is_finite()));
+    }
+    // Bad settings are named.
+    assert!(DelayLinks::new(&model, 1.0, 5.0, 60e-9, None).is_err());
+    assert!(DelayLinks::new(&model, 0.9, -1.0, 60e-9, None).is_err());
+    let bad = MultiConfig {
+        survival: 1.5,
+        ..cfg
+    };
+    assert!(Pmb::new(
+        bad,
+        Births::Poisson {
+            initial: vec![],
+            per_scan: vec![]
+        }
+    )
+    .is_err());
+}
+
+#[test]
+fn williams15_at_debug_size() {
+    // 3 seeds × 30 runs (the full check is 100 runs, release): the RMS GOSPA of the PMB
+    // tracker. Measured at full size: see multi_studies::williams15_rms_gospa_full.
+    for seed in [11, 12, 13] {
+        let rms = williams_rms(seed, 30);
+        assert!(rms < 3.45, "seed {seed}: RMS GOSPA {rms}");
+    }
+}
+
+#[test]
+fn people_at_debug_size() {
+    // 3 seeds × 6 runs of 3 walkers: PMB beats GNN by ≥ 30 % in mean GOSPA, localisation within
+    // 1.5× of the known-association bound after the first second, no cardinality error.
+    for seed in [21, 22, 23] {
+        let (mut gp, mut gg, mut loc, mut bnd, mut card) = (0.0, 0.0, 0.0, 0.0, 0usize);
+        for run in 0..6 {
+            let r = people_run(3, seed, run);
+            gp += r.pmb.steps.iter().map(|s| s.gospa).sum::<Real>();
+            gg += r.gnn.steps.iter().map(|s| s.gospa).sum::<Real>();
+            for (k, s) in r.pmb.steps.iter().enumerate().skip(10) {
+                loc += s.localisation;
+                bnd += r.bound_m2[k];
+                card += s.cardinality_error;
+            }
+        }
+        assert!(gp <= 0.7 * gg, "seed {seed}: PMB {gp} vs GNN {gg}");
+        assert!(
+            loc <= 1.5 * bnd,
+            "seed {seed}: localisation {loc} vs bound {bnd}"
+        );
+        assert!(
+            card <= 6 * (PEOPLE_STEPS - 10) / 10,
+            "seed {seed}: cardinality errors {card}"
+        );
+    }
+}
