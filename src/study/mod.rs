@@ -18,6 +18,8 @@
 //! - [`LiveFront`] + [`LiveRun`]: the same chain live, frame by frame (issue 40 §3).
 //! - [`check_cost`], [`track_cpu_s`], [`FilterStudy::predicted_cpu_s`]: the predicted work
 //!   of a study or a track and the caps front ends refuse work over (issue 24).
+//! - [`track_multi`]: a measurements file's `raw_steps` with several targets, tracked by the
+//!   PMB tracker or the GNN baseline ([`MultiTrackOutput`], issue 41).
 //! - [`PartSet`], [`PartFile`]: the part file format (`scatterloc-part`, version 2, with a digest of its sums) and what `merge` checks.
 
 mod channel;
@@ -25,6 +27,7 @@ mod cost;
 mod drive;
 mod filters;
 mod montecarlo;
+mod multi;
 mod part;
 mod roc;
 mod sums;
@@ -45,6 +48,10 @@ pub use filters::{particle_chunks, FilterResults, FilterRun, FilterStudy};
 pub use montecarlo::{
     curve_label, failed_label, CurveDoc, FilterCurves, FilterDoc, FiltersConfig, McConfig, McMeta,
     MonteCarloStudy, PcrlbMeta, RunTime, TrackStudy, FAILED_NOTE,
+};
+pub use multi::{
+    lives, multi_scans, multi_tracker, score_multi, simulate_people, track_multi, LabelledTrack,
+    MultiScoreDoc, MultiSettings, MultiTrackOutput, MultiTruth, TargetDoc, TruthTarget,
 };
 pub use part::{
     differs, inconsistent, load_sums, merged_timing, software, sums_digest, Part, PartFile,

@@ -32,6 +32,6 @@ pub use sensors::{
     check_detection, DelayLinks, Detection, MeasurementModel, Observation, PositionSensor,
 };
 pub use sim::{
-    delay_scans, people_layout, people_region, people_truth, poisson, position_scans, williams15,
-    williams15_truth, Truth, Williams15,
+    delay_scans, people_layout, people_region, people_truth, people_truth_in, poisson,
+    position_scans, williams15, williams15_truth, Truth, Williams15,
 };

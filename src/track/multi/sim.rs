@@ -195,10 +195,23 @@ pub fn people_region() -> Area {
     }
 }
 
-/// People walking for `steps` scans at spacing `dt_s` (`walkers` in 2..=5, capped):
-/// 0 and 1 cross at the middle of the run; 2 and 3 walk side by side 0.7 m apart; 4 stands
-/// still for the first half, then walks. Each path's ends move by 𝒩(0, 0.2²) m per run.
+/// People walking for `steps` scans at spacing `dt_s` (`walkers` in 1..=5, capped) in
+/// [`people_region`]: 0 and 1 cross at the middle of the run; 2 and 3 walk side by side 0.7 m
+/// apart; 4 stands still for the first half, then walks. Each path's ends move by
+/// 𝒩(0, 0.2²) m per run.
 pub fn people_truth(walkers: usize, steps: usize, dt_s: Real, rng: &mut Rng) -> Truth {
+    people_truth_in(&people_region(), walkers, steps, dt_s, rng)
+}
+
+/// [`people_truth`] with the paths stretched from [`people_region`] onto `region` (the
+/// side-by-side spacing stays 0.7 m).
+pub fn people_truth_in(
+    region: &Area,
+    walkers: usize,
+    steps: usize,
+    dt_s: Real,
+    rng: &mut Rng,
+) -> Truth {
     let plans: [([Real; 2], [Real; 2], Real); 5] = [
         ([1.5, 1.5], [8.5, 7.5], 0.0),
         ([1.5, 7.5], [8.5, 1.5], 0.0),
@@ -206,13 +219,22 @@ pub fn people_truth(walkers: usize, steps: usize, dt_s: Real, rng: &mut Rng) -> 
         ([8.5, 3.3], [1.5, 3.3], 0.0),
         ([3.0, 6.0], [7.0, 6.5], 0.5),
     ];
+    let base = people_region();
+    let map = |p: [Real; 2]| {
+        Vec2::new(
+            region.x[0]
+                + (p[0] - base.x[0]) * (region.x[1] - region.x[0]) / (base.x[1] - base.x[0]),
+            region.y[0]
+                + (p[1] - base.y[0]) * (region.y[1] - region.y[0]) / (base.y[1] - base.y[0]),
+        )
+    };
     let w = walkers.clamp(1, 5);
-    let jitter = |rng: &mut Rng| 0.2 * standard_normal(rng);
+    let jitter = |rng: &mut Rng| Vec2::new(0.2 * standard_normal(rng), 0.2 * standard_normal(rng));
     let mut paths: Vec<(Vec2, Vec2, Real)> = plans[..w]
         .iter()
         .map(|(a, b, still)| {
-            let a = Vec2::new(a[0] + jitter(rng), a[1] + jitter(rng));
-            let b = Vec2::new(b[0] + jitter(rng), b[1] + jitter(rng));
+            let a = map(*a) + jitter(rng);
+            let b = map(*b) + jitter(rng);
             (a, b, *still)
         })
         .collect();

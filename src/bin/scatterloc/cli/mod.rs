@@ -32,7 +32,9 @@ pub use shard::{MergeArgs, ShardArgs};
 pub use slurm::{SlurmCommand, SubmitArgs};
 pub use study::{MontecarloArgs, PcrlbArgs, StudyArgs};
 pub use track::{CalibrateArgs, SimulateWalkArgs, TrackArgs};
-pub use values::{Association, MtlModel, RocExperiment, ShardSpec, Trajectory, WalkStart};
+pub use values::{
+    Association, MtlModel, MultiMethod, RocExperiment, ShardSpec, Trajectory, WalkStart,
+};
 
 use crate::failure::CliError;
 

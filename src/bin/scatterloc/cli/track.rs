@@ -3,7 +3,9 @@
 use clap::Args;
 
 use super::filters::{FilterName, FilterSettings};
-use super::values::{finite, seed, whole, Association, WalkStart};
+use super::values::{
+    finite, probability, seed, whole, Association, MultiMethod, TargetsMode, WalkStart,
+};
 
 /// `scatterloc track`.
 #[derive(Debug, Args)]
@@ -56,6 +58,34 @@ pub struct TrackArgs {
     /// prediction and its calibration: docs/benchmarks.md "Cost model"); > 0.
     #[arg(long, value_name = "H", value_parser = finite)]
     pub max_cpu_hours: Option<f64>,
+    /// Several targets: `auto` tracks every target the raw_steps show, with births, deaths and
+    /// a stable label per target (docs/multi-target.md); prints labelled tracks.
+    #[arg(long, value_name = "auto", ignore_case = true)]
+    pub targets: Option<TargetsMode>,
+    /// The multi-target tracker: pmb (belief propagation) or gnn (baseline) [default: pmb]
+    /// (--targets auto only).
+    #[arg(
+        long,
+        value_name = "pmb|gnn",
+        ignore_case = true,
+        hide_possible_values = true
+    )]
+    pub method: Option<MultiMethod>,
+    /// Detection probability of a target per link and scan [default: 0.9] (--targets auto).
+    #[arg(long, value_name = "P", value_parser = probability)]
+    pub detection_probability: Option<f64>,
+    /// Mean clutter delays per link and scan [default: 5] (--targets auto).
+    #[arg(long, value_name = "N", value_parser = finite)]
+    pub clutter: Option<f64>,
+    /// Width of the delay window clutter is spread over, ns [default: 60] (--targets auto).
+    #[arg(long, value_name = "NS", value_parser = finite)]
+    pub clutter_window_ns: Option<f64>,
+    /// Expected new targets per scan over the scenario's area [default: 0.01] (--targets auto).
+    #[arg(long, value_name = "R", value_parser = finite)]
+    pub birth_rate: Option<f64>,
+    /// GOSPA cut-off c of the score against --truth, m [default: 1] (--targets auto).
+    #[arg(long, value_name = "M", value_parser = finite)]
+    pub gospa_c: Option<f64>,
 }
 
 /// `scatterloc calibrate`.
@@ -115,4 +145,13 @@ pub struct SimulateWalkArgs {
     /// How measurements.json starts the filter [default: snapshot].
     #[arg(long, value_name = "HOW")]
     pub start: Option<WalkStart>,
+    /// Several people (1..=5; issue 41): two crossing, two side by side, one standing still a
+    /// while; writes measurements.json (raw_steps with --false-alarms clutter delays per link,
+    /// default 5) and truth.json ({t_s, targets}) for `track --targets auto` [default
+    /// duration: 10 s].
+    #[arg(long, value_name = "N", value_parser = whole)]
+    pub walkers: Option<usize>,
+    /// Detection probability per link and scan of --walkers [default: 0.9].
+    #[arg(long, value_name = "P", value_parser = probability)]
+    pub detection_probability: Option<f64>,
 }

@@ -122,6 +122,22 @@ pub fn trp_order(v: &str) -> Result<TrpOrder, String> {
         .map_err(|_| format!("expected comma-separated 0-based TRP indices, got '{v}'"))
 }
 
+/// `--targets` of `track`: `auto` tracks an unknown number of targets (issue 41).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum TargetsMode {
+    /// Every target the delays show: births, deaths and labels (docs/multi-target.md).
+    Auto,
+}
+
+/// `--method` of `track --targets auto`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum MultiMethod {
+    /// The PMB tracker with belief-propagation association.
+    Pmb,
+    /// Global nearest neighbour with an EKF per track (the baseline).
+    Gnn,
+}
+
 /// `--association` of `track` (spec §4).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum Association {

@@ -7,7 +7,9 @@
 use std::path::Path;
 
 use scatterloc::formats::{CalibrationResult, CalibrationSnapshots, Measurements, Truth};
+use scatterloc::study::{simulate_people, MultiSettings};
 use scatterloc::track::gating::{Calibration, ClusterConfig, WalkRequest, WalkSimulation};
+use scatterloc::track::multi::people_region;
 use scatterloc::track::ConstantVelocity;
 use scatterloc::Model;
 
@@ -116,6 +118,14 @@ pub fn simulate_walk(args: &SimulateWalkArgs) -> Result<(), CliError> {
     if dir.is_empty() {
         return Err(CliError::usage("--out-dir: the path is empty".to_string()));
     }
+    if let Some(walkers) = args.walkers {
+        return simulate_walkers(args, &scenario, &model, walkers);
+    }
+    if args.detection_probability.is_some() {
+        return Err(CliError::usage(
+            "--detection-probability: only with --walkers (several people)",
+        ));
+    }
     let d = WalkRequest::default();
     let req = WalkRequest {
         duration_s: args.duration.unwrap_or(d.duration_s),
@@ -193,4 +203,77 @@ fn write_walk(dir: &str, sim: WalkSimulation) -> Result<(usize, usize), CliError
     files.json("out-dir", &truth_file, &truth)?;
     files.commit()?;
     Ok(summary)
+}
+
+/// `simulate-walk --walkers N`: the library's [`simulate_people`] → measurements.json (raw
+/// scans) and truth.json (several labelled targets).
+fn simulate_walkers(
+    args: &SimulateWalkArgs,
+    scenario: &scatterloc::Scenario,
+    model: &scatterloc::Model,
+    walkers: usize,
+) -> Result<(), CliError> {
+    if args.calibration_snapshots.is_some() || args.start.is_some() {
+        return Err(CliError::usage(
+            "--calibration-snapshots/--start: not with --walkers (no static paths are simulated; \
+             the multi-target tracker starts its own tracks)",
+        ));
+    }
+    let dt = args.dt.unwrap_or(0.1);
+    let duration = args.duration.unwrap_or(10.0);
+    let q = args.process_noise.unwrap_or(0.5);
+    ConstantVelocity::validated(dt, q).map_err(flag_error)?;
+    let steps = checked_steps(duration, dt)? + 1;
+    let settings = MultiSettings {
+        detection_probability: args.detection_probability.unwrap_or(0.9),
+        clutter: args.false_alarms.unwrap_or(5.0),
+        ..MultiSettings::default()
+    };
+    let region = walk_region(&scenario.area_m);
+    let (m, truth) = simulate_people(
+        model,
+        &region,
+        walkers,
+        steps,
+        dt,
+        q,
+        &settings,
+        args.seed.unwrap_or(1),
+    )
+    .map_err(flag_error)?;
+    let dir = args.out_dir.as_str();
+    let created = prepare_out_dir(dir)?;
+    let mut files = OutputSet::new();
+    let written = files
+        .json("out-dir", &walk_file(dir, "measurements.json"), &m)
+        .and_then(|_| files.json("out-dir", &walk_file(dir, "truth.json"), &truth))
+        .and_then(|_| files.commit());
+    if written.is_err() && created {
+        let _ = std::fs::remove_dir(dir);
+    }
+    written?;
+    emit_json(&serde_json::json!({
+        "steps": steps,
+        "walkers": walkers,
+        "region_m": {"x": region.x, "y": region.y},
+        "detection_probability": settings.detection_probability,
+        "clutter_per_link": settings.clutter,
+        "clutter_window_s": settings.clutter_window_s,
+        "files": ["measurements.json", "truth.json"],
+    }))
+}
+
+/// Where the walkers walk: the people region of issue 41 when the area holds it, else the
+/// central half of the area.
+fn walk_region(area: &scatterloc::scenario::Area) -> scatterloc::scenario::Area {
+    let p = people_region();
+    if area.x[0] <= p.x[0] && area.x[1] >= p.x[1] && area.y[0] <= p.y[0] && area.y[1] >= p.y[1] {
+        return p;
+    }
+    let (cx, cy) = ((area.x[0] + area.x[1]) / 2.0, (area.y[0] + area.y[1]) / 2.0);
+    let (hx, hy) = ((area.x[1] - area.x[0]) / 4.0, (area.y[1] - area.y[0]) / 4.0);
+    scatterloc::scenario::Area {
+        x: [cx - hx, cx + hx],
+        y: [cy - hy, cy + hy],
+    }
 }

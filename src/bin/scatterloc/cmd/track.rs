@@ -12,8 +12,12 @@
 
 use scatterloc::error::Cancel;
 use scatterloc::formats::{Detections, Measurements, Steps};
-use scatterloc::study::{track_cpu_s, track_measurements_in, TrackRequest, DEFAULT_PROCESS_NOISE};
+use scatterloc::study::{
+    score_multi, track_cpu_s, track_measurements_in, track_multi, MultiSettings, MultiTruth,
+    TrackRequest, DEFAULT_PROCESS_NOISE,
+};
 use scatterloc::track::gating::AssociationRule;
+use scatterloc::track::multi::MultiKind;
 
 use super::filters::filter_kinds;
 use super::flags::{in_file, with_flag};
@@ -22,7 +26,7 @@ use super::io::{emit, model_of, one_stdin, read_input, read_json_file, read_scen
 use super::output::{check_writable, Format};
 use super::study::{cost_refused, run_with_bar};
 use super::track_fig::{read_truth, write_track_figure, TrackSeries};
-use crate::cli::{Association, FilterName, TrackArgs};
+use crate::cli::{Association, FilterName, MultiMethod, TrackArgs};
 use crate::failure::CliError;
 
 /// `scatterloc track --scenario S (--measurements M | --detections D) [--calibration C]
@@ -61,13 +65,14 @@ pub fn track(args: &TrackArgs) -> Result<(), CliError> {
             check_writable("out", p)?;
             Some((p, f))
         }
-        None if args.truth.is_some() => {
+        None if args.truth.is_some() && args.targets.is_none() => {
             return Err(CliError::usage(
                 "--truth: only used with --out (the figure)",
             ))
         }
         None => None,
     };
+    multi_flags_need_targets(args)?;
     let name = args.filter.unwrap_or(FilterName::Ekf);
     let kind = filter_kinds(&[name], &args.settings, "--filter")?[0];
     if args.seed.is_some() && name != FilterName::Pf {
@@ -99,6 +104,9 @@ pub fn track(args: &TrackArgs) -> Result<(), CliError> {
         Some(path) => Some(read_calibration(path, &model)?),
         None => None,
     };
+    if args.targets.is_some() {
+        return track_several(args, &scenario, &model, &m, calibration.as_ref(), bad);
+    }
     if matches!(m.steps(), Ok(Steps::Plain(_)))
         && (args.calibration.is_some() || args.association.is_some())
     {
@@ -167,5 +175,106 @@ pub fn track(args: &TrackArgs) -> Result<(), CliError> {
     }
     let text =
         serde_json::to_string(&out).map_err(|e| CliError::output(format!("encoding JSON: {e}")))?;
+    emit(&text)
+}
+
+/// The flags of `--targets auto` given without it: a usage error naming them.
+fn multi_flags_need_targets(args: &TrackArgs) -> Result<(), CliError> {
+    let given = [
+        ("--method", args.method.is_some()),
+        (
+            "--detection-probability",
+            args.detection_probability.is_some(),
+        ),
+        ("--clutter", args.clutter.is_some()),
+        ("--clutter-window-ns", args.clutter_window_ns.is_some()),
+        ("--birth-rate", args.birth_rate.is_some()),
+        ("--gospa-c", args.gospa_c.is_some()),
+    ];
+    if args.targets.is_some() {
+        // The single-target flags do not apply.
+        let single = [
+            ("--filter", args.filter.is_some()),
+            ("--association", args.association.is_some()),
+            ("--out", args.out.is_some()),
+            ("--seed", args.seed.is_some()),
+        ];
+        if let Some((f, _)) = single.iter().find(|(_, g)| *g) {
+            return Err(CliError::usage(format!(
+                "{f}: not with --targets auto (the multi-target tracker has its own settings: \
+                 --method, --detection-probability, --clutter, --clutter-window-ns, --birth-rate)"
+            )));
+        }
+        return Ok(());
+    }
+    match given.iter().find(|(_, g)| *g) {
+        Some((f, _)) => Err(CliError::usage(format!(
+            "{f}: only with --targets auto (several targets)"
+        ))),
+        None => Ok(()),
+    }
+}
+
+/// `track --targets auto`: the library's [`track_multi`] on the file's raw_steps.
+fn track_several(
+    args: &TrackArgs,
+    scenario: &scatterloc::Scenario,
+    model: &scatterloc::Model,
+    m: &Measurements,
+    calibration: Option<&scatterloc::track::gating::Calibration>,
+    bad: impl Fn(&dyn std::fmt::Display) -> CliError,
+) -> Result<(), CliError> {
+    multi_flags_need_targets(args)?;
+    let mut settings = MultiSettings::default();
+    if let Some(k) = args.method {
+        settings.method = match k {
+            MultiMethod::Pmb => MultiKind::Pmb,
+            MultiMethod::Gnn => MultiKind::Gnn,
+        };
+    }
+    if let Some(p) = args.detection_probability {
+        settings.detection_probability = p;
+    }
+    if let Some(c) = args.clutter {
+        settings.clutter = c;
+    }
+    if let Some(w) = args.clutter_window_ns {
+        settings.clutter_window_s = w * 1e-9;
+    }
+    if let Some(r) = args.birth_rate {
+        settings.birth_rate = r;
+    }
+    let scans = m.raw_steps.as_ref().map_or(0, |r| r.len()) + 1;
+    let (res, _) = run_with_bar(scans, "scans", "track", |cancel, _| {
+        let stop = || cancel.load(std::sync::atomic::Ordering::Relaxed);
+        track_multi(
+            model,
+            &scenario.area_m,
+            m,
+            calibration,
+            &settings,
+            Cancel::when(&stop),
+        )
+    })?;
+    let out = res.map_err(|e| match with_flag(&e) {
+        Some(text) => CliError::usage(text),
+        None => bad(&e),
+    })?;
+    let mut doc =
+        serde_json::to_value(&out).map_err(|e| CliError::output(format!("encoding JSON: {e}")))?;
+    if let Some(path) = args.truth.as_deref() {
+        let truth: MultiTruth = read_json_file("truth", path)?;
+        let c = args.gospa_c.unwrap_or(1.0);
+        let score = score_multi(&out, &truth, c).map_err(|e| match with_flag(&e) {
+            Some(text) => CliError::usage(text),
+            None => in_file("truth", path, e),
+        })?;
+        doc["score"] = serde_json::to_value(&score)
+            .map_err(|e| CliError::output(format!("encoding JSON: {e}")))?;
+    } else if args.gospa_c.is_some() {
+        return Err(CliError::usage("--gospa-c: only with --truth (the score)"));
+    }
+    let text =
+        serde_json::to_string(&doc).map_err(|e| CliError::output(format!("encoding JSON: {e}")))?;
     emit(&text)
 }

@@ -1,0 +1,499 @@
+//! The multi-target use case (issue 41 §2): a measurements file's `raw_steps` (every link's
+//! unlabelled delays per scan; `initial_snapshot`, if present, is the first scan) tracked by
+//! the PMB tracker or the GNN baseline ([`crate::track::multi`]), with static paths removed by
+//! a calibration (E4, C9) first. The CLI's `track --targets auto`, the Python package's
+//! `track_multi` and the page call this one function and print its document
+//! ([`MultiTrackOutput`]): per scan the labelled targets, and per label its life (first and
+//! last scan, why it started and ended).
+
+use alloc::string::String;
+use alloc::vec::Vec;
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::{Cancel, Error, Result};
+use crate::formats::{Measurements, RawEstimate, RawStep};
+use crate::measure::Model;
+use crate::scenario::Area;
+use crate::track::gating::Calibration;
+use crate::track::multi::{
+    BirthGrid, Births, DelayBirth, DelayLinks, Detection, Gnn, GnnManagement, MultiConfig,
+    MultiKind, MultiTracker, Pmb, TargetEstimate,
+};
+
+/// The settings of a multi-target track (JSON keys as the fields; all optional in files).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct MultiSettings {
+    /// `pmb` (default) or `gnn`.
+    #[serde(with = "kind_name")]
+    pub method: MultiKind,
+    /// `P_D` per link (default 0.9).
+    pub detection_probability: f64,
+    /// Mean clutter delays per link and scan (default 5).
+    pub clutter: f64,
+    /// The window clutter is spread over, s (default 60 ns).
+    pub clutter_window_s: f64,
+    /// Where targets appear (default: the scenario's area).
+    pub birth_region: Option<Area>,
+    /// Expected new targets per scan (default 0.01).
+    pub birth_rate: f64,
+    /// Spacing of the birth grid, m (default 0.25).
+    pub birth_grid_m: f64,
+    /// Gated delays a birth needs (default: links − 2, at least 3).
+    pub birth_min_links: Option<usize>,
+    /// Survival probability per scan (default 0.99).
+    pub survival: f64,
+    /// A target is reported above this existence (default 0.5).
+    pub existence_threshold: f64,
+}
+
+impl Default for MultiSettings {
+    fn default() -> Self {
+        MultiSettings {
+            method: MultiKind::Pmb,
+            detection_probability: 0.9,
+            clutter: 5.0,
+            clutter_window_s: 60e-9,
+            birth_region: None,
+            birth_rate: 0.01,
+            birth_grid_m: 0.25,
+            birth_min_links: None,
+            survival: 0.99,
+            existence_threshold: 0.5,
+        }
+    }
+}
+
+mod kind_name {
+    use super::MultiKind;
+    use serde::{Deserialize, Deserializer, Serializer};
+
+    pub fn serialize<S: Serializer>(k: &MultiKind, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(k.name())
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<MultiKind, D::Error> {
+        let s = alloc::string::String::deserialize(d)?;
+        MultiKind::parse(&s).map_err(serde::de::Error::custom)
+    }
+}
+
+/// One reported target of a scan.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct TargetDoc {
+    /// Its label.
+    pub label: u64,
+    /// `[x, y, vx, vy]`, m and m/s.
+    pub state: [f64; 4],
+    /// Covariance, row-major.
+    pub covariance: [[f64; 4]; 4],
+    /// Existence probability (1 for the GNN's confirmed tracks).
+    pub existence: f64,
+}
+
+impl From<&TargetEstimate> for TargetDoc {
+    fn from(e: &TargetEstimate) -> Self {
+        TargetDoc {
+            label: e.label,
+            state: e.state.into(),
+            covariance: core::array::from_fn(|i| core::array::from_fn(|j| e.covariance[(i, j)])),
+            existence: e.existence,
+        }
+    }
+}
+
+/// One labelled track's life.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct LabelledTrack {
+    /// Its label.
+    pub label: u64,
+    /// First and last scan it was reported at (0-based, inclusive).
+    pub first_scan: usize,
+    /// Last scan reported.
+    pub last_scan: usize,
+    /// Scans it was reported at.
+    pub scans: usize,
+    /// `confirmed` (its first report).
+    pub start: String,
+    /// `lost` (no longer reported before the end) or `end_of_data`.
+    pub end: String,
+}
+
+/// The document of a multi-target track.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct MultiTrackOutput {
+    /// `pmb` or `gnn`.
+    pub method: String,
+    /// The settings used.
+    pub settings: MultiSettings,
+    /// Scan times `t_k = k T` (the initial snapshot, if any, is scan 0), s.
+    pub t_s: Vec<f64>,
+    /// Per scan, the reported targets in label order.
+    pub targets: Vec<Vec<TargetDoc>>,
+    /// Per label, its life, in label order.
+    pub tracks: Vec<LabelledTrack>,
+    /// Estimates removed as static by the calibration, per scan (all links).
+    pub static_removed: Vec<usize>,
+}
+
+/// The scans of a measurements file for a multi-target track: the `initial_snapshot` (if any)
+/// then every raw step, each as detections per link (static ones removed).
+pub fn multi_scans(
+    m: &Measurements,
+    links: usize,
+    calibration: Option<&Calibration>,
+) -> Result<(Vec<Vec<Vec<Detection>>>, Vec<usize>)> {
+    let Some(raw) = &m.raw_steps else {
+        return Err(Error::InvalidFile {
+            field: "raw_steps".into(),
+            reason: "a multi-target track needs raw_steps (every link's delays per scan)".into(),
+        });
+    };
+    if let Some(c) = calibration {
+        c.check_links(links)?;
+    }
+    let mut scans = Vec::with_capacity(raw.len() + 1);
+    let mut removed = Vec::with_capacity(raw.len() + 1);
+    let all: Vec<(String, &RawStep)> = m
+        .initial_snapshot
+        .iter()
+        .map(|s| (String::from("initial_snapshot"), s))
+        .chain(
+            raw.iter()
+                .enumerate()
+                .map(|(k, s)| (alloc::format!("raw_steps[{k}]"), s)),
+        )
+        .collect();
+    if all.len() > crate::track::MAX_STEPS {
+        return Err(Error::InvalidFile {
+            field: "raw_steps".into(),
+            reason: alloc::format!(
+                "{} scans, at most {} are allowed",
+                all.len(),
+                crate::track::MAX_STEPS
+            ),
+        });
+    }
+    for (field, step) in all {
+        crate::formats::one_list_per_link(&field, step.len(), links)?;
+        let mut gone = 0;
+        let scan = step
+            .iter()
+            .enumerate()
+            .map(|(p, list)| {
+                list.iter()
+                    .filter_map(|e| {
+                        let (d, s) = match *e {
+                            RawEstimate::Pair([d, _]) => (d, None),
+                            RawEstimate::WithSigma([d, _, s]) => (d, Some(s)),
+                        };
+                        if calibration.is_some_and(|c| c.links[p].is_static(d)) {
+                            gone += 1;
+                            None
+                        } else {
+                            Some(Detection::delay(d, s))
+                        }
+                    })
+                    .collect()
+            })
+            .collect();
+        scans.push(scan);
+        removed.push(gone);
+    }
+    Ok((scans, removed))
+}
+
+/// The tracker of `settings` for `model` (`sigma_s`: the file's fixed σ per link).
+pub fn multi_tracker(
+    model: &Model,
+    area: &Area,
+    motion: crate::track::ConstantVelocity,
+    settings: &MultiSettings,
+    sigma_s: Option<&[f64]>,
+) -> Result<MultiTracker> {
+    let links = model.link_count();
+    let cfg = MultiConfig {
+        survival: settings.survival,
+        existence_threshold: settings.existence_threshold,
+        ..MultiConfig::new(motion)
+    };
+    let mut birth = DelayBirth::new(settings.birth_region.unwrap_or(*area), links);
+    birth.rate = settings.birth_rate;
+    birth.step_m = settings.birth_grid_m;
+    if let Some(k) = settings.birth_min_links {
+        birth.min_links = k;
+    }
+    let grid = BirthGrid::new(model, birth, sigma_s)?;
+    Ok(match settings.method {
+        MultiKind::Pmb => MultiTracker::Pmb(Pmb::new(cfg, Births::Delays(grid))?),
+        MultiKind::Gnn => MultiTracker::Gnn(Gnn::new(cfg, GnnManagement::default(), Some(grid))?),
+    })
+}
+
+/// A measurements file tracked with several targets (see the module docs); asks `cancel`
+/// between scans.
+pub fn track_multi(
+    model: &Model,
+    area: &Area,
+    m: &Measurements,
+    calibration: Option<&Calibration>,
+    settings: &MultiSettings,
+    cancel: Cancel,
+) -> Result<MultiTrackOutput> {
+    let links = model.link_count();
+    let motion = m.motion()?;
+    let sigmas = m.sigmas(links)?;
+    let sensors = DelayLinks::new(
+        model,
+        settings.detection_probability,
+        settings.clutter,
+        settings.clutter_window_s,
+        sigmas.clone(),
+    )?;
+    let mut tracker = multi_tracker(model, area, motion, settings, sigmas.as_deref())?;
+    let (scans, static_removed) = multi_scans(m, links, calibration)?;
+    let mut targets = Vec::with_capacity(scans.len());
+    let mut t_s = Vec::with_capacity(scans.len());
+    for (k, scan) in scans.iter().enumerate() {
+        cancel.check()?;
+        tracker
+            .step(&sensors, scan)
+            .map_err(|e| Error::InvalidFile {
+                field: alloc::format!("scan {k}"),
+                reason: alloc::format!("{e}"),
+            })?;
+        targets.push(tracker.estimates().iter().map(TargetDoc::from).collect());
+        t_s.push(k as f64 * m.dt_s);
+    }
+    let tracks = lives(&targets);
+    Ok(MultiTrackOutput {
+        method: tracker.name().into(),
+        settings: *settings,
+        t_s,
+        targets,
+        tracks,
+        static_removed,
+    })
+}
+
+/// Each label's life from the per-scan reports.
+pub fn lives(targets: &[Vec<TargetDoc>]) -> Vec<LabelledTrack> {
+    let mut out: alloc::collections::BTreeMap<u64, LabelledTrack> = Default::default();
+    let last = targets.len().saturating_sub(1);
+    for (k, scan) in targets.iter().enumerate() {
+        for t in scan {
+            let e = out.entry(t.label).or_insert(LabelledTrack {
+                label: t.label,
+                first_scan: k,
+                last_scan: k,
+                scans: 0,
+                start: "confirmed".into(),
+                end: String::new(),
+            });
+            e.last_scan = k;
+            e.scans += 1;
+        }
+    }
+    out.into_values()
+        .map(|mut t| {
+            t.end = if t.last_scan == last {
+                "end_of_data"
+            } else {
+                "lost"
+            }
+            .into();
+            t
+        })
+        .collect()
+}
+
+/// One true target of a scan in a truth file.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TruthTarget {
+    /// Its label.
+    pub label: u64,
+    /// `[x, y, vx, vy]`, m and m/s.
+    pub state: [f64; 4],
+}
+
+/// The truth of several targets (`simulate-walk --walkers`'s `truth.json`): per scan the targets
+/// present.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MultiTruth {
+    /// Scan times, s.
+    pub t_s: Vec<f64>,
+    /// Per scan, the targets present.
+    pub targets: Vec<Vec<TruthTarget>>,
+}
+
+impl MultiTruth {
+    /// The core's [`Truth`](crate::track::multi::Truth).
+    pub fn to_truth(&self) -> crate::track::multi::Truth {
+        crate::track::multi::Truth {
+            steps: self
+                .targets
+                .iter()
+                .map(|s| {
+                    s.iter()
+                        .map(|t| (t.label, crate::math::Vec4::from(t.state)))
+                        .collect()
+                })
+                .collect(),
+        }
+    }
+}
+
+/// Several people walking in `model`'s network ([`people_truth_in`](crate::track::multi::people_truth_in)
+/// over `region`) and their delay scans: the measurements file (`raw_steps`, the first scan as
+/// `initial_snapshot`, process noise `process_noise`) and the truth. Seeded.
+#[allow(clippy::too_many_arguments)]
+pub fn simulate_people(
+    model: &Model,
+    region: &Area,
+    walkers: usize,
+    steps: usize,
+    dt_s: f64,
+    process_noise: f64,
+    settings: &MultiSettings,
+    seed: u64,
+) -> Result<(Measurements, MultiTruth)> {
+    crate::track::ConstantVelocity::validated(dt_s, process_noise)?;
+    if !(1..=5).contains(&walkers) {
+        return Err(Error::SizeLimit {
+            field: "walkers",
+            value: walkers,
+            min: 1,
+            max: 5,
+        });
+    }
+    if !(2..=crate::track::MAX_STEPS).contains(&steps) {
+        return Err(Error::SizeLimit {
+            field: "steps",
+            value: steps,
+            min: 2,
+            max: crate::track::MAX_STEPS,
+        });
+    }
+    crate::track::multi::check_detection(settings.detection_probability)?;
+    DelayLinks::new(
+        model,
+        settings.detection_probability,
+        settings.clutter,
+        settings.clutter_window_s,
+        None,
+    )?;
+    let mut r = crate::measure::rng(seed, 0);
+    let truth = crate::track::multi::people_truth_in(region, walkers, steps, dt_s, &mut r);
+    let scans = crate::track::multi::delay_scans(
+        model,
+        &truth,
+        settings.detection_probability,
+        settings.clutter,
+        settings.clutter_window_s,
+        &mut r,
+    );
+    let raw: Vec<RawStep> = scans
+        .iter()
+        .map(|scan| {
+            scan.iter()
+                .map(|l| {
+                    l.iter()
+                        .map(|d| RawEstimate::Pair([d.value[0], 1.0]))
+                        .collect()
+                })
+                .collect()
+        })
+        .collect();
+    let mut raw = raw.into_iter();
+    let first = raw.next();
+    let m = Measurements {
+        dt_s,
+        process_noise,
+        initial_state: None,
+        initial_covariance: None,
+        initial_snapshot: first,
+        sigma_s: None,
+        steps: None,
+        raw_steps: Some(raw.collect()),
+    };
+    let t = MultiTruth {
+        t_s: (0..steps).map(|k| k as f64 * dt_s).collect(),
+        targets: truth
+            .steps
+            .iter()
+            .map(|s| {
+                s.iter()
+                    .map(|(label, x)| TruthTarget {
+                        label: *label,
+                        state: (*x).into(),
+                    })
+                    .collect()
+            })
+            .collect(),
+    };
+    Ok((m, t))
+}
+
+/// GOSPA (`c`, `p = 2`) of a multi-target track against a truth, per scan, with the label
+/// switches and the mean cardinality error (the scores of issue 41 §1).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct MultiScoreDoc {
+    /// `c`, m.
+    pub c_m: f64,
+    /// GOSPA per scan, m.
+    pub gospa_m: Vec<f64>,
+    /// Its localisation part per scan, m².
+    pub localisation_m2: Vec<f64>,
+    /// Its missed part per scan, m².
+    pub missed_m2: Vec<f64>,
+    /// Its false part per scan, m².
+    pub false_m2: Vec<f64>,
+    /// Mean GOSPA over the scans, m.
+    pub mean_gospa_m: f64,
+    /// Label switches over all true targets.
+    pub switches: usize,
+    /// Mean `|n̂ − n|`.
+    pub mean_cardinality_error: f64,
+}
+
+/// The score of `out` against `truth` (scans compared up to the shorter of the two).
+pub fn score_multi(out: &MultiTrackOutput, truth: &MultiTruth, c_m: f64) -> Result<MultiScoreDoc> {
+    let est: Vec<Vec<TargetEstimate>> = out
+        .targets
+        .iter()
+        .map(|s| {
+            s.iter()
+                .map(|t| TargetEstimate {
+                    label: t.label,
+                    state: t.state.into(),
+                    covariance: crate::math::Mat4::from_fn(|i, j| t.covariance[i][j]),
+                    existence: t.existence,
+                })
+                .collect()
+        })
+        .collect();
+    let s = crate::track::multi::score_run(
+        &truth.to_truth(),
+        &est,
+        &crate::track::GospaConfig { c: c_m, p: 2.0 },
+    )?;
+    let n = s.steps.len().max(1) as f64;
+    Ok(MultiScoreDoc {
+        c_m,
+        gospa_m: s.steps.iter().map(|x| x.gospa).collect(),
+        localisation_m2: s.steps.iter().map(|x| x.localisation).collect(),
+        missed_m2: s.steps.iter().map(|x| x.missed).collect(),
+        false_m2: s.steps.iter().map(|x| x.false_).collect(),
+        mean_gospa_m: s.steps.iter().map(|x| x.gospa).sum::<f64>() / n,
+        switches: s.total_switches(),
+        mean_cardinality_error: s
+            .steps
+            .iter()
+            .map(|x| x.cardinality_error as f64)
+            .sum::<f64>()
+            / n,
+    })
+}
