@@ -18,7 +18,7 @@ use crate::scenario::Area;
 use crate::track::gating::Calibration;
 use crate::track::multi::{
     BirthGrid, Births, DelayBirth, DelayLinks, Detection, Gnn, GnnManagement, MultiConfig,
-    MultiKind, MultiTracker, Pmb, TargetEstimate,
+    MultiKind, MultiTracker, Pmb, Scan, TargetEstimate,
 };
 
 /// The settings of a multi-target track (JSON keys as the fields; all optional in files).
@@ -143,7 +143,7 @@ pub fn multi_scans(
     m: &Measurements,
     links: usize,
     calibration: Option<&Calibration>,
-) -> Result<(Vec<Vec<Vec<Detection>>>, Vec<usize>)> {
+) -> Result<(Vec<Scan>, Vec<usize>)> {
     let Some(raw) = &m.raw_steps else {
         return Err(Error::InvalidFile {
             field: "raw_steps".into(),

@@ -10,6 +10,9 @@ use crate::track::multi::sensors::{Detection, MeasurementModel};
 use crate::track::multi::{Gnn, Pmb};
 use crate::track::ConstantVelocity;
 
+/// One scan: per sensor (link), its detections.
+pub type Scan = Vec<Vec<Detection>>;
+
 /// Most detections one sensor (link) may report in one scan: beyond it a scan is refused with
 /// a named error, so a scan's time stays bounded (the BP and the gating are linear in it).
 pub const MAX_DETECTIONS_PER_SENSOR: usize = 1024;

@@ -21,7 +21,7 @@ pub use association::{
 };
 pub use birth::{BirthFix, BirthGrid, DelayBirth, MAX_BIRTH_CELLS};
 pub use config::{
-    check_scan, Component, MultiConfig, MultiKind, MultiTracker, TargetEstimate,
+    check_scan, Component, MultiConfig, MultiKind, MultiTracker, Scan, TargetEstimate,
     MAX_DETECTIONS_PER_SENSOR, MAX_TRACKS,
 };
 pub use gaussian::{kalman_update, moment_match, Bernoulli, Updated};
