@@ -50,8 +50,9 @@ pub use montecarlo::{
     MonteCarloStudy, PcrlbMeta, RunTime, TrackStudy, FAILED_NOTE,
 };
 pub use multi::{
-    lives, multi_scans, multi_tracker, score_multi, simulate_people, track_multi, LabelledTrack,
-    MultiScoreDoc, MultiSettings, MultiTrackOutput, MultiTruth, TargetDoc, TruthTarget,
+    lives, multi_scans, multi_tracker, score_multi, simulate_people, track_multi, walk_region,
+    LabelledTrack, MultiScoreDoc, MultiSettings, MultiTrackOutput, MultiTruth, TargetDoc,
+    TruthTarget,
 };
 pub use part::{
     differs, inconsistent, load_sums, merged_timing, software, sums_digest, Part, PartFile,

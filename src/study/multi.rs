@@ -497,3 +497,19 @@ pub fn score_multi(out: &MultiTrackOutput, truth: &MultiTruth, c_m: f64) -> Resu
             / n,
     })
 }
+
+/// Where `simulate-walk --walkers` people walk in a scenario of area `area`: the people region
+/// of issue 41 ([`people_region`](crate::track::multi::people_region)) when the area holds it,
+/// else the central half of the area.
+pub fn walk_region(area: &Area) -> Area {
+    let p = crate::track::multi::people_region();
+    if area.x[0] <= p.x[0] && area.x[1] >= p.x[1] && area.y[0] <= p.y[0] && area.y[1] >= p.y[1] {
+        return p;
+    }
+    let (cx, cy) = ((area.x[0] + area.x[1]) / 2.0, (area.y[0] + area.y[1]) / 2.0);
+    let (hx, hy) = ((area.x[1] - area.x[0]) / 4.0, (area.y[1] - area.y[0]) / 4.0);
+    Area {
+        x: [cx - hx, cx + hx],
+        y: [cy - hy, cy + hy],
+    }
+}

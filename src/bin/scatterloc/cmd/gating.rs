@@ -9,7 +9,6 @@ use std::path::Path;
 use scatterloc::formats::{CalibrationResult, CalibrationSnapshots, Measurements, Truth};
 use scatterloc::study::{simulate_people, MultiSettings};
 use scatterloc::track::gating::{Calibration, ClusterConfig, WalkRequest, WalkSimulation};
-use scatterloc::track::multi::people_region;
 use scatterloc::track::ConstantVelocity;
 use scatterloc::Model;
 
@@ -229,7 +228,7 @@ fn simulate_walkers(
         clutter: args.false_alarms.unwrap_or(5.0),
         ..MultiSettings::default()
     };
-    let region = walk_region(&scenario.area_m);
+    let region = scatterloc::study::walk_region(&scenario.area_m);
     let (m, truth) = simulate_people(
         model,
         &region,
@@ -261,19 +260,4 @@ fn simulate_walkers(
         "clutter_window_s": settings.clutter_window_s,
         "files": ["measurements.json", "truth.json"],
     }))
-}
-
-/// Where the walkers walk: the people region of issue 41 when the area holds it, else the
-/// central half of the area.
-fn walk_region(area: &scatterloc::scenario::Area) -> scatterloc::scenario::Area {
-    let p = people_region();
-    if area.x[0] <= p.x[0] && area.x[1] >= p.x[1] && area.y[0] <= p.y[0] && area.y[1] >= p.y[1] {
-        return p;
-    }
-    let (cx, cy) = ((area.x[0] + area.x[1]) / 2.0, (area.y[0] + area.y[1]) / 2.0);
-    let (hx, hy) = ((area.x[1] - area.x[0]) / 4.0, (area.y[1] - area.y[0]) / 4.0);
-    scatterloc::scenario::Area {
-        x: [cx - hx, cx + hx],
-        y: [cy - hy, cy + hy],
-    }
 }
