@@ -56,6 +56,9 @@ mod hardening3;
 #[path = "cli/montecarlo.rs"]
 mod montecarlo;
 
+#[path = "cli/multi.rs"]
+mod multi;
+
 #[path = "cli/mtl.rs"]
 mod mtl;
 

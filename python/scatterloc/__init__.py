@@ -15,7 +15,8 @@ Scenario and snapshot
 Tracking
     :func:`track`, :func:`calibrate`, :func:`montecarlo`, :func:`pcrlb`
 Planning and multi-target
-    :func:`plan`, :func:`mtl_locate`, :func:`gospa` (the GOSPA metric)
+    :func:`plan`, :func:`mtl_locate`, :func:`gospa` (the GOSPA metric), :func:`track_multi`
+    (several people, PMB or GNN), :func:`simulate_people`
 Channel recordings (CFR/CIR to delays)
     :class:`Recording`, :func:`read_recording` (``.npz`` or a Wi-Fi CSI file), :func:`read_csi`,
     :func:`write_recording`, :func:`track_stream` (live, frame by frame),
@@ -37,6 +38,7 @@ from ._scatterloc import (
     Detections,
     Fix,
     MtlResult,
+    MultiTrack,
     Paths,
     Plan,
     Recording,
@@ -62,8 +64,10 @@ from ._scatterloc import (
     read_csi,
     read_detections,
     read_recording,
+    simulate_people,
     simulate_recording,
     track,
+    track_multi,
     track_stream,
     write_detections,
     write_recording,
@@ -77,6 +81,7 @@ __all__ = [
     "Detections",
     "Fix",
     "MtlResult",
+    "MultiTrack",
     "Paths",
     "Plan",
     "Recording",
@@ -102,8 +107,10 @@ __all__ = [
     "read_csi",
     "read_detections",
     "read_recording",
+    "simulate_people",
     "simulate_recording",
     "track",
+    "track_multi",
     "track_stream",
     "write_detections",
     "write_recording",

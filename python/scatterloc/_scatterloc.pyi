@@ -26,6 +26,7 @@ __all__ = [
     "Detections",
     "Fix",
     "MtlResult",
+    "MultiTrack",
     "Paths",
     "Plan",
     "Recording",
@@ -52,8 +53,10 @@ __all__ = [
     "read_csi",
     "read_detections",
     "read_recording",
+    "simulate_people",
     "simulate_recording",
     "track",
+    "track_multi",
     "track_stream",
     "write_detections",
     "write_recording",
@@ -74,6 +77,7 @@ _ScenarioLike = Union["Scenario", str, Mapping[str, Any], "os.PathLike[str]"]
 _FilterName = Literal["ekf", "ukf", "pf"]
 _Statics = Literal["background", "clusters"]
 _DelayReference = Literal["absolute", "los"]
+_MultiMethod = Literal["pmb", "gnn"]
 
 class ScatterlocError(ValueError):
     """Bad input: ``field`` names the input at fault as the core names it (or is None),
@@ -315,6 +319,64 @@ def track(
     association: Optional[Literal["spec", "gated"]] = None,
     max_cpu_hours: Optional[float] = None,
 ) -> Track: ...
+
+@final
+class MultiTrack:
+    """A multi-target track: the reported targets in long format, one row per scan and target."""
+
+    @property
+    def t(self) -> _F64: ...
+    @property
+    def scan(self) -> _I64: ...
+    @property
+    def label(self) -> _I64: ...
+    @property
+    def states(self) -> _F64: ...
+    @property
+    def covariances(self) -> _F64: ...
+    @property
+    def existence(self) -> _F64: ...
+    @property
+    def count(self) -> _I64: ...
+    @property
+    def labels(self) -> _I64: ...
+    @property
+    def tracks(self) -> list[dict[str, Any]]: ...
+    @property
+    def static_removed(self) -> _I64: ...
+    @property
+    def score(self) -> Optional[dict[str, Any]]: ...
+    @property
+    def method(self) -> str: ...
+    def to_dict(self) -> dict[str, Any]: ...
+    def __len__(self) -> int: ...
+
+def track_multi(
+    scenario: _ScenarioLike,
+    measurements: Union[Mapping[str, Any], _PathLike, Detections],
+    *,
+    calibration: Optional[Union[StaticCalibration, Mapping[str, Any], _PathLike]] = None,
+    method: _MultiMethod = "pmb",
+    detection_probability: float = 0.9,
+    clutter: float = 5.0,
+    clutter_window_s: float = 60e-9,
+    birth_rate: float = 0.01,
+    truth: Optional[Union[Mapping[str, Any], _PathLike]] = None,
+    gospa_c: Optional[float] = None,
+    process_noise: Optional[float] = None,
+) -> MultiTrack: ...
+
+def simulate_people(
+    scenario: _ScenarioLike,
+    walkers: int,
+    *,
+    duration_s: float = 10.0,
+    dt_s: float = 0.1,
+    process_noise: float = 0.5,
+    detection_probability: float = 0.9,
+    clutter: float = 5.0,
+    seed: int = 1,
+) -> tuple[dict[str, Any], dict[str, Any]]: ...
 
 @final
 class Curves:

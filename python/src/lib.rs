@@ -14,6 +14,7 @@
 //! - `studies`: `montecarlo`, `pcrlb`.
 //! - `planning`: `plan`.
 //! - `mtl`: `mtl_locate`.
+//! - `multi`: `track_multi`, `simulate_people` (several targets, issue 41).
 //! - `channel`: `Recording`, `read_recording`, `write_recording`, `simulate_recording`,
 //!   `estimate`, `estimate_recording`, `cir_track`.
 //! - `csi`: `read_csi` and the CSI keywords of `read_recording` (Wi-Fi CSI tools' files).
@@ -32,6 +33,7 @@ mod detections;
 mod errors;
 mod gospa;
 mod mtl;
+mod multi;
 mod output;
 mod planning;
 mod run;
@@ -59,6 +61,7 @@ fn _scatterloc(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<studies::StudyResult>()?;
     m.add_class::<planning::Plan>()?;
     m.add_class::<mtl::MtlResult>()?;
+    m.add_class::<multi::MultiTrack>()?;
     m.add_class::<channel::PyRecording>()?;
     m.add_class::<channel::Paths>()?;
     m.add_class::<channel::ChannelTrack>()?;
@@ -75,6 +78,8 @@ fn _scatterloc(m: &Bound<'_, PyModule>) -> PyResult<()> {
         wrap_pyfunction!(studies::pcrlb, m)?,
         wrap_pyfunction!(planning::plan, m)?,
         wrap_pyfunction!(mtl::mtl_locate, m)?,
+        wrap_pyfunction!(multi::track_multi, m)?,
+        wrap_pyfunction!(multi::simulate_people, m)?,
         wrap_pyfunction!(channel::read_recording, m)?,
         wrap_pyfunction!(csi::read_csi, m)?,
         wrap_pyfunction!(stream::track_stream, m)?,

@@ -18,7 +18,8 @@
 //! `export.rs` (the page's "Save figure": the map and tracking figures as SVG through the CLI's
 //! chart code), `recording.rs` (`read_recording_summary`: a dropped `.npz` channel recording),
 //! `channel.rs` (the channel view: `simulate_channel`, `ChannelJob` run in a Web Worker,
-//! `ChannelFigures`).
+//! `ChannelFigures`), `multi.rs` (several people in the tracking view: `track_people`, run in a
+//! Web Worker, and `draw_people_chart`, its GOSPA chart).
 
 mod app;
 mod base;
@@ -28,6 +29,7 @@ mod export;
 mod json;
 mod montecarlo;
 mod mtl;
+mod multi;
 mod plan;
 mod recording;
 mod render;
@@ -45,6 +47,10 @@ pub use chart::draw_tracking_chart;
 pub use export::{map_data_text, mtl_scene_svg, tracking_chart_svg, MAX_FIGURE_PX, MAX_FIGURE_RES};
 pub use montecarlo::MonteCarloJob;
 pub use mtl::{mtl_check_scene, mtl_default_scene, mtl_view_of, MtlSession};
+pub use multi::{
+    draw_people_chart, track_people, PEOPLE_DT_S, PEOPLE_DURATION_S, PEOPLE_GOSPA_C_M,
+    PEOPLE_PROCESS_NOISE,
+};
 pub use plan::{plan_field_ranges, plan_network};
 pub use recording::read_recording_summary;
 pub use render::{

@@ -1,0 +1,285 @@
+//! `track --targets auto` and `simulate-walk --walkers` (issue 41): the CLI prints the library's
+//! documents (study::track_multi, score_multi, simulate_people) bit for bit, and refuses bad
+//! input with one named line.
+
+use crate::common::cli::{fails, ok_json, ok_json_line, read_json, TempDir};
+use scatterloc::error::Cancel;
+use scatterloc::formats::Measurements;
+use scatterloc::study::{
+    score_multi, simulate_people, track_multi, walk_region, MultiSettings, MultiTruth,
+};
+use scatterloc::track::multi::{people_layout, MultiKind};
+use scatterloc::Model;
+use serde_json::{json, Value};
+
+fn people_scenario(dir: &TempDir) -> String {
+    dir.write(
+        "people.json",
+        &serde_json::to_value(people_layout()).unwrap(),
+    )
+}
+
+#[test]
+fn walkers_and_their_multi_target_track_are_the_librarys() {
+    let dir = TempDir::new();
+    let s = people_scenario(&dir);
+    let out = dir.path("walk");
+    for seed in ["3", "4"] {
+        let summary = ok_json(&[
+            "simulate-walk",
+            "--scenario",
+            &s,
+            "--out-dir",
+            &out,
+            "--walkers",
+            "3",
+            "--seed",
+            seed,
+        ]);
+        assert_eq!(summary["steps"], json!(101));
+        // The files are the library's.
+        let scenario = people_layout();
+        let model = Model::new(&scenario).unwrap();
+        let region = walk_region(&scenario.area_m);
+        let (m, truth) = simulate_people(
+            &model,
+            &region,
+            3,
+            101,
+            0.1,
+            0.5,
+            &MultiSettings::default(),
+            seed.parse().unwrap(),
+        )
+        .unwrap();
+        let meas_path = format!("{out}/measurements.json");
+        let truth_path = format!("{out}/truth.json");
+        assert_eq!(read_json(&meas_path), serde_json::to_value(&m).unwrap());
+        assert_eq!(
+            read_json(&truth_path),
+            serde_json::to_value(&truth).unwrap()
+        );
+        for (method, kind) in [("pmb", MultiKind::Pmb), ("gnn", MultiKind::Gnn)] {
+            let doc = ok_json_line(&[
+                "track",
+                "--scenario",
+                &s,
+                "--measurements",
+                &meas_path,
+                "--targets",
+                "auto",
+                "--method",
+                method,
+                "--truth",
+                &truth_path,
+            ]);
+            let settings = MultiSettings {
+                method: kind,
+                ..MultiSettings::default()
+            };
+            let lib =
+                track_multi(&model, &scenario.area_m, &m, None, &settings, Cancel::NEVER).unwrap();
+            let score = score_multi(&lib, &truth, 1.0).unwrap();
+            let mut want = serde_json::to_value(&lib).unwrap();
+            want["score"] = serde_json::to_value(&score).unwrap();
+            assert_eq!(doc, want, "{method} seed {seed}");
+            // Three walkers found and kept to the end, labels kept.
+            let tracks = doc["tracks"].as_array().unwrap();
+            let to_end = tracks.iter().filter(|t| t["end"] == "end_of_data").count();
+            assert_eq!(to_end, 3, "{method} seed {seed}: {tracks:?}");
+            assert!(doc["score"]["mean_gospa_m"].as_f64().unwrap() < 0.1);
+        }
+    }
+}
+
+#[test]
+fn the_settings_flags_reach_the_document() {
+    let dir = TempDir::new();
+    let s = people_scenario(&dir);
+    let out = dir.path("walk");
+    ok_json(&[
+        "simulate-walk",
+        "--scenario",
+        &s,
+        "--out-dir",
+        &out,
+        "--walkers",
+        "2",
+        "--seed",
+        "9",
+        "--false-alarms",
+        "2",
+        "--detection-probability",
+        "0.95",
+        "--duration",
+        "3",
+    ]);
+    let meas_path = format!("{out}/measurements.json");
+    let m: Measurements = serde_json::from_value(read_json(&meas_path)).unwrap();
+    assert_eq!(m.raw_steps.as_ref().unwrap().len(), 30);
+    let doc = ok_json_line(&[
+        "track",
+        "--scenario",
+        &s,
+        "--measurements",
+        &meas_path,
+        "--targets",
+        "auto",
+        "--detection-probability",
+        "0.95",
+        "--clutter",
+        "2",
+        "--clutter-window-ns",
+        "60",
+        "--birth-rate",
+        "0.05",
+    ]);
+    assert_eq!(doc["settings"]["detection_probability"], json!(0.95));
+    assert_eq!(doc["settings"]["clutter"], json!(2.0));
+    assert_eq!(doc["settings"]["birth_rate"], json!(0.05));
+    assert_eq!(doc["targets"].as_array().unwrap().len(), 31);
+    let truth: MultiTruth =
+        serde_json::from_value(read_json(&format!("{out}/truth.json"))).unwrap();
+    assert_eq!(truth.targets[0].len(), 2);
+}
+
+#[test]
+fn bad_multi_target_input_is_named() {
+    let dir = TempDir::new();
+    let s = people_scenario(&dir);
+    let out = dir.path("walk");
+    ok_json(&[
+        "simulate-walk",
+        "--scenario",
+        &s,
+        "--out-dir",
+        &out,
+        "--walkers",
+        "2",
+        "--duration",
+        "1",
+    ]);
+    let meas = format!("{out}/measurements.json");
+    let truth = format!("{out}/truth.json");
+    let base = ["track", "--scenario", &s, "--measurements", &meas];
+    let with = |extra: &[&str]| -> Vec<String> {
+        base.iter().chain(extra).map(|x| x.to_string()).collect()
+    };
+    let run = |extra: &[&str], needles: &[&str]| {
+        let a = with(extra);
+        let a: Vec<&str> = a.iter().map(String::as_str).collect();
+        fails(&a, needles);
+    };
+    run(&["--method", "gnn"], &["--method", "--targets auto"]);
+    run(
+        &["--targets", "auto", "--filter", "ukf"],
+        &["--filter", "not with --targets auto"],
+    );
+    run(&["--targets", "auto", "--method", "jpda"], &["--method"]);
+    run(
+        &["--targets", "auto", "--detection-probability", "1.5"],
+        &["detection-probability"],
+    );
+    run(&["--targets", "auto", "--clutter", "-1"], &["clutter"]);
+    run(
+        &["--targets", "auto", "--gospa-c", "2"],
+        &["--gospa-c", "--truth"],
+    );
+    run(&["--targets", "some"], &["--targets"]);
+    // Inconsistent target counts: a scan with one list too few.
+    let mut m = read_json(&meas);
+    m["raw_steps"][3].as_array_mut().unwrap().pop();
+    let bad = dir.write("bad.json", &m);
+    fails(
+        &[
+            "track",
+            "--scenario",
+            &s,
+            "--measurements",
+            &bad,
+            "--targets",
+            "auto",
+        ],
+        &["raw_steps[3]", "one per link"],
+    );
+    // A plain steps file has no unlabelled delays to track several targets from.
+    let plain = dir.write(
+        "plain.json",
+        &json!({"dt_s": 0.1, "process_noise": 0.1, "initial_state": [1, 2, 0, 0],
+                "initial_covariance": [[0.1,0,0,0],[0,0.1,0,0],[0,0,0.01,0],[0,0,0,0.01]],
+                "steps": [[3.0e-8, null, null, null, null, null, null, null]]}),
+    );
+    fails(
+        &[
+            "track",
+            "--scenario",
+            &s,
+            "--measurements",
+            &plain,
+            "--targets",
+            "auto",
+        ],
+        &["raw_steps"],
+    );
+    // Thousands of clutter delays on a link: the cap, named.
+    let mut flood = read_json(&meas);
+    flood["raw_steps"][0][0] = Value::Array(vec![json!([5e-8, 1.0]); 5000]);
+    let f = dir.write("flood.json", &flood);
+    fails(
+        &[
+            "track",
+            "--scenario",
+            &s,
+            "--measurements",
+            &f,
+            "--targets",
+            "auto",
+        ],
+        &["detections per link", "1024"],
+    );
+    // A truth of the wrong shape.
+    let t = dir.write(
+        "t.json",
+        &json!({"t_s": [0.0], "targets": [[{"label": 0}]]}),
+    );
+    fails(
+        &[
+            "track",
+            "--scenario",
+            &s,
+            "--measurements",
+            &meas,
+            "--targets",
+            "auto",
+            "--truth",
+            &t,
+        ],
+        &["truth"],
+    );
+    let _ = truth;
+    // simulate-walk's walkers are capped.
+    fails(
+        &[
+            "simulate-walk",
+            "--scenario",
+            &s,
+            "--out-dir",
+            &dir.path("w2"),
+            "--walkers",
+            "9",
+        ],
+        &["walkers", "5"],
+    );
+    fails(
+        &[
+            "simulate-walk",
+            "--scenario",
+            &s,
+            "--out-dir",
+            &dir.path("w3"),
+            "--detection-probability",
+            "0.5",
+        ],
+        &["--detection-probability", "--walkers"],
+    );
+}
