@@ -20,6 +20,8 @@
 //!   of a study or a track and the caps front ends refuse work over (issue 24).
 //! - [`track_multi`]: a measurements file's `raw_steps` with several targets, tracked by the
 //!   PMB tracker or the GNN baseline ([`MultiTrackOutput`], issue 41).
+//! - [`MultiStudy`]: the multi-target Monte Carlo (PMB and GNN against the known-association
+//!   bound, GOSPA per scan; sharded as `multi-target` parts).
 //! - [`PartSet`], [`PartFile`]: the part file format (`scatterloc-part`, version 2, with a digest of its sums) and what `merge` checks.
 
 mod channel;
@@ -28,6 +30,7 @@ mod drive;
 mod filters;
 mod montecarlo;
 mod multi;
+mod multi_study;
 mod part;
 mod roc;
 mod sums;
@@ -53,6 +56,10 @@ pub use multi::{
     lives, multi_scans, multi_tracker, score_multi, simulate_people, track_multi, walk_region,
     LabelledTrack, MultiScoreDoc, MultiSettings, MultiTrackOutput, MultiTruth, TargetDoc,
     TruthTarget,
+};
+pub use multi_study::{
+    known_association_bound, multi_study_doc, MethodDoc, MethodSums, MultiStudy, MultiStudyConfig,
+    MultiStudyDoc, MultiSums, MAX_MULTI_RUNS,
 };
 pub use part::{
     differs, inconsistent, load_sums, merged_timing, software, sums_digest, Part, PartFile,

@@ -283,3 +283,83 @@ fn bad_multi_target_input_is_named() {
         &["--detection-probability", "--walkers"],
     );
 }
+
+#[test]
+fn montecarlo_targets_sharded_merges_to_the_whole_run() {
+    let dir = TempDir::new();
+    let whole = dir.path("whole.json");
+    let args = [
+        "montecarlo",
+        "--targets",
+        "2",
+        "--runs",
+        "3",
+        "--duration",
+        "2",
+        "--seed",
+        "5",
+    ];
+    let table = crate::common::cli::run(&[&args[..], &["--json", &whole]].concat());
+    assert!(
+        table.status.success(),
+        "{}",
+        String::from_utf8_lossy(&table.stderr)
+    );
+    let mut parts = Vec::new();
+    for i in 0..2 {
+        let p = dir.path(&format!("part{i}.json"));
+        let shard = format!("{i}/2");
+        let out =
+            crate::common::cli::run(&[&args[..], &["--shard", &shard, "--json", &p]].concat());
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        assert_eq!(read_json(&p)["study"], json!("multi-target"));
+        parts.push(p);
+    }
+    let merged = dir.path("merged.json");
+    let out = crate::common::cli::run(&["merge", &parts[0], &parts[1], "--json", &merged]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let (mut a, mut b) = (read_json(&whole), read_json(&merged));
+    for d in [&mut a, &mut b] {
+        let o = d.as_object_mut().unwrap();
+        o.remove("wall_time_s");
+        o.remove("threads");
+    }
+    assert_eq!(a, b);
+    // The document is the library's study of the same configuration.
+    let cfg: scatterloc::study::MultiStudyConfig =
+        serde_json::from_value(a["config"].clone()).unwrap();
+    let sums = scatterloc::study::MultiStudy::run_range(
+        &cfg,
+        0..3,
+        &mut scatterloc::study::Sequential::new(),
+        &mut |_, _| {},
+    )
+    .unwrap();
+    let doc = serde_json::to_value(scatterloc::study::multi_study_doc(&cfg, &sums)).unwrap();
+    for (k, v) in doc.as_object().unwrap() {
+        assert_eq!(&a[k], v, "{k}");
+    }
+    assert_eq!(a["methods"][0]["method"], json!("pmb"));
+    assert_eq!(a["t_s"].as_array().unwrap().len(), 20);
+    // Named errors.
+    fails(
+        &["montecarlo", "--targets", "9", "--runs", "2"],
+        &["walkers", "5"],
+    );
+    fails(
+        &["montecarlo", "--targets", "2", "--filters", "ekf,ukf"],
+        &["--filters", "not with --targets"],
+    );
+    fails(
+        &["montecarlo", "--targets", "2", "--runs", "0"],
+        &["--runs"],
+    );
+}

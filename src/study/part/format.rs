@@ -23,8 +23,11 @@ pub const MAX_PART_CONFIG_BYTES: usize = 4 << 20;
 pub const MAX_TIMING_ENTRIES: usize = 16;
 
 /// Study kinds and the unit their shards split.
-pub(super) const STUDIES: [(&str, &str); 2] =
-    [("montecarlo", "chunks"), ("mtl-roc", "realisations")];
+pub(super) const STUDIES: [(&str, &str); 3] = [
+    ("montecarlo", "chunks"),
+    ("mtl-roc", "realisations"),
+    ("multi-target", "runs"),
+];
 
 /// The `software` of a part file: parts of one study must come from the same build version.
 pub fn software() -> String {

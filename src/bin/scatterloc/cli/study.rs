@@ -73,6 +73,12 @@ pub struct MontecarloArgs {
     /// prediction and its calibration: docs/benchmarks.md "Cost model"); > 0.
     #[arg(long, value_name = "H", value_parser = finite)]
     pub max_cpu_hours: Option<f64>,
+    /// Several people (1..=5, issue 41): N walkers (crossing, side by side, standing), the PMB
+    /// tracker and the GNN baseline scored by GOSPA per scan against the known-association bound
+    /// [default scenario: sensors2019 with a second transmitter; runs 100, dt 0.1, duration 10,
+    /// process noise 0.5] (docs/multi-target.md).
+    #[arg(long, value_name = "N", value_parser = whole)]
+    pub targets: Option<usize>,
 }
 
 /// `scatterloc pcrlb`.

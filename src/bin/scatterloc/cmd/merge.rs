@@ -22,6 +22,9 @@ pub fn merge(args: &MergeArgs) -> Result<(), CliError> {
         "montecarlo" => {
             super::montecarlo::merge_parts(&set, reader, &args.json, args.out.as_deref())
         }
+        "multi-target" => {
+            super::multi_study::merge_multi(&set, reader, &args.json, args.out.as_deref())
+        }
         _ => super::mtl::merge_roc(&set, reader, &args.json, args.out.as_deref()),
     }
 }

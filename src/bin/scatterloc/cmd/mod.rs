@@ -22,6 +22,7 @@ mod io;
 mod merge;
 mod montecarlo;
 mod mtl;
+mod multi_study;
 mod output;
 mod parts;
 mod plan;

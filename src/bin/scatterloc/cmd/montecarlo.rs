@@ -88,6 +88,9 @@ pub fn check_shards(args: &MontecarloArgs, shards: usize, threads: usize) -> Res
 
 /// `scatterloc montecarlo`.
 pub fn montecarlo(args: &MontecarloArgs) -> Result<(), CliError> {
+    if let Some(walkers) = args.targets {
+        return super::multi_study::multi_montecarlo(args, walkers);
+    }
     let study = study_of(args)?;
     let (threads, used) = threads(args.threads)?;
     let shard = shard::resolve(&args.shard)?;
