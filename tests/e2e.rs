@@ -155,6 +155,10 @@ mod nees;
 #[cfg(test)]
 #[path = "e2e/page_look.rs"]
 mod page_look;
+/// Issue 41 §2: "Several people" in the tracking view equals the CLI; off restores the view.
+#[cfg(test)]
+#[path = "e2e/page_multi.rs"]
+mod page_multi;
 /// Issue 38 §11: the page's channel track is consistent with its error (NEES band, 4 seeds).
 #[cfg(test)]
 #[path = "e2e/page_nees.rs"]

@@ -42,6 +42,10 @@ mod channel_settings;
 #[path = "wasm/replay.rs"]
 mod replay;
 
+/// Several people in the tracking view (`track_people`, `draw_people_chart`): the core's use case.
+#[path = "wasm/multi.rs"]
+mod multi;
+
 fn message(e: JsError) -> String {
     let v: JsValue = e.into();
     v.dyn_into::<js_sys::Error>()

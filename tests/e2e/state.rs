@@ -169,6 +169,8 @@ const FIELDS: &[&str] = &[
     "tracking.speed",
     "tracking.seed",
     "tracking.mc_filters",
+    "multi.walkers",
+    "multi.method",
     "mtl.p_u",
     "mtl.p_los",
     "view.map",
@@ -256,6 +258,18 @@ async fn set_everything(c: &Client) -> Result<(), String> {
     select(c, "track-particles", "2000").await?;
     select(c, "mc-runs", "50").await?;
     select(c, "track-speed", "2").await?;
+    quiet(c).await?;
+    // Several people (issue 41): the method, then two walkers (the view turns multi-target).
+    select(c, "multi-method", "gnn").await?;
+    select(c, "multi-walkers", "2").await?;
+    super::ui::poll(
+        c,
+        "return window.tracking.state().multi.state;",
+        180,
+        "several people",
+        |s| s == "done",
+    )
+    .await?;
     quiet(c).await?;
     // The current step: Play for a moment, then Pause.
     click(c, "track-play").await?;

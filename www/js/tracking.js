@@ -2,10 +2,13 @@
 // particle filter chosen), animates it over the CRLB map (play/pause, scrub, speed), lets the user
 // draw a trajectory (press = start, drag = where it is after the run's duration) and keeps the
 // Monte Carlo chart (montecarlo.js, the filters ticked) in step: every change of scenario, nodes or
-// trajectory re-simulates the track and restarts the Monte Carlo.
+// trajectory re-simulates the track and restarts the Monte Carlo. With "Several people" on
+// (multi.js) the same transport animates the multi-target run instead, and its GOSPA chart
+// takes the Monte Carlo's place.
 
 import { $, decimalIn, errorText, fillKeyValues, fixed, showError, clearError } from './dom.js';
 import { MonteCarlo } from './montecarlo.js';
+import { Multi } from './multi.js';
 import { drawTrack } from './track-draw.js';
 import { registerSection } from './state.js';
 import { choice, fields, inputNumber, number, shown } from './state-fields.js';
@@ -34,6 +37,7 @@ export class Tracking {
     this.frame = null;
     this.dragging = false;
     this.mc = new MonteCarlo(ctx.wasm, ctx.module, showError);
+    this.multi = new Multi(ctx, { onResult: () => this.multiArrived(), onError: showError });
     // URL options arrive checked (app.js): each choice one of its <select>'s values.
     for (const [id, v] of [['track-kind', this.kind], ['track-dt', opts.dt], ['track-seed', opts.tseed],
       ['track-ex', opts.ex], ['mc-runs', opts.runs], ['track-speed', opts.speed], ['track-filter', opts.filter],
@@ -45,6 +49,8 @@ export class Tracking {
     $('track-kind').addEventListener('change', () => { this.kind = $('track-kind').value; rerun(); });
     $('track-dt').addEventListener('change', rerun);
     $('track-seed').addEventListener('change', rerun);
+    $('multi-walkers').addEventListener('change', () => this.multiChanged());
+    $('multi-method').addEventListener('change', rerun);
     $('track-filter').addEventListener('change', rerun);
     $('track-particles').addEventListener('change', rerun);
     for (const f of FILTERS) $(`mc-${f}`).addEventListener('change', () => this.startMc());
@@ -79,7 +85,59 @@ export class Tracking {
   }
 
   /** The animated track's filter, `EKF`, `UKF` or `PF` (the one chosen until a track exists). */
-  filterName() { return (this.data ? this.data.filter : $('track-filter').value).toUpperCase(); }
+  filterName() {
+    if (this.multi.on) return $('multi-method').value.toUpperCase();
+    return (this.data ? this.data.filter : $('track-filter').value).toUpperCase();
+  }
+
+  /** Entries of the run animated: the multi-target run's scans, or the track's steps. */
+  entries() {
+    if (this.multi.on) return this.multi.entries();
+    return this.track ? this.track.entries() : 0;
+  }
+
+  /** "Several people" switched on or off: the view changes, the run starts or the single view returns. */
+  multiChanged() {
+    document.body.classList.toggle('multi-on', this.multi.on);
+    this.pause();
+    if (!this.multi.on) {
+      this.multi.cancel();
+      this.frame = null;
+    }
+    this.panelChanged();
+    if (!this.multi.on) this.mc.drawChart();
+  }
+
+  /** The multi-target run of the panel's walkers, method and seed (in the worker, multi.js). */
+  rerunMulti() {
+    this.mc.cancel();
+    this.frame = null; // no single-target markers, iso-delays or inset
+    try {
+      const seed = decimalIn($('track-seed').value, 'seed', SEED_RANGE);
+      $('track-seed').classList.remove('invalid');
+      if (this.failed) clearError();
+      this.failed = false;
+      this.multi.start({
+        scenario: this.ctx.app.scenario_json(), walkers: Number($('multi-walkers').value),
+        method: $('multi-method').value, seed,
+      });
+    } catch (e) {
+      $('track-seed').classList.toggle('invalid', /seed/.test(errorText(e)));
+      showError(errorText(e));
+      this.failed = true;
+    }
+    this.step = 0;
+    $('track-scrub').max = '0';
+    $('track-filter-label').textContent = this.filterName();
+    this.show();
+  }
+
+  /** A multi-target document arrived: the transport spans its scans; the map and read-out show it. */
+  multiArrived() {
+    if (!this.active() || !this.multi.on) return;
+    $('track-scrub').max = String(this.entries() - 1);
+    this.seek(Math.min(this.step, this.entries() - 1));
+  }
 
   /** The filters ticked for the Monte Carlo, in the order EKF, UKF, PF (at least the EKF). */
   mcFilters() {
@@ -103,6 +161,10 @@ export class Tracking {
    */
   rerun() {
     if (!this.active()) return;
+    if (this.multi.on) {
+      this.rerunMulti();
+      return;
+    }
     try {
       const p = this.params();
       const track = this.ctx.app.simulate_track(JSON.stringify({
@@ -131,7 +193,7 @@ export class Tracking {
   }
 
   startMc() {
-    if (!this.active() || !this.p) return;
+    if (!this.active() || !this.p || this.multi.on) return;
     const p = this.p;
     const runs = Number($('mc-runs').value);
     const filters = this.mcFilters();
@@ -144,10 +206,10 @@ export class Tracking {
 
   /** Shows step `n` (frame from the core, read-outs, redraw). */
   seek(n, redraw = true) {
-    if (!this.track) return;
-    this.step = Math.max(0, Math.min(n, this.track.entries() - 1));
+    if (!this.entries()) return;
+    this.step = Math.max(0, Math.min(n, this.entries() - 1));
     this.pos = this.step;
-    this.frame = this.track.frame(this.step);
+    this.frame = this.multi.on ? null : this.track.frame(this.step);
     this.show();
     if (redraw) this.redraw();
   }
@@ -155,8 +217,8 @@ export class Tracking {
   redraw() { this.ctx.changed({ frame: true }); }
 
   play() {
-    if (!this.track) return;
-    if (this.step >= this.track.entries() - 1) this.seek(0);
+    if (!this.entries()) return;
+    if (this.step >= this.entries() - 1) this.seek(0);
     this.playing = true;
     this.last = performance.now();
     requestAnimationFrame(this.tickFn);
@@ -169,11 +231,12 @@ export class Tracking {
   }
 
   tick(now) {
-    if (!this.playing || !this.track) return;
+    if (!this.playing || !this.entries()) return;
     const speed = Number($('track-speed').value);
-    this.pos += ((now - this.last) / 1000) * speed / this.p.dt_s;
+    const dt = this.multi.on ? this.multi.doc.dt_s : this.p.dt_s;
+    this.pos += ((now - this.last) / 1000) * speed / dt;
     this.last = now;
-    const end = this.track.entries() - 1;
+    const end = this.entries() - 1;
     const n = Math.min(Math.floor(this.pos), end);
     if (n >= end) this.playing = false;
     if (n !== this.step) this.seek(n); else this.show();
@@ -187,11 +250,12 @@ export class Tracking {
     } else {
       this.pause();
       this.mc.cancel();
+      this.multi.cancel();
     }
   }
 
   /** Pointer hooks from interact.js: in "draw" mode a press on the map starts a trajectory. */
-  wantsDraw() { return this.active() && this.kind === 'custom'; }
+  wantsDraw() { return this.active() && this.kind === 'custom' && !this.multi.on; }
 
   drawStart(m) {
     this.dragging = true;
@@ -221,6 +285,10 @@ export class Tracking {
   /** The layer drawn under the markers (see draw.js drawScene). */
   overlay(ctx, view) {
     const magnify = Number($('track-ex').value);
+    if (this.multi.on) {
+      this.layer = this.multi.draw(ctx, view, this.step, magnify);
+      return;
+    }
     let drawn = null;
     if (this.kind === 'custom') {
       const v = this.p && this.p.kind === 'custom' ? this.p : null;
@@ -231,8 +299,8 @@ export class Tracking {
 
   /** Points the zoom inset should not hide, weighted: the truth path, a drawn arrow, the nodes. */
   avoidPoints() {
-    const pts = this.data ? [...this.data.truth] : [];
-    if (this.kind === 'custom') {
+    const pts = this.multi.on ? this.multi.avoidPoints() : this.data ? [...this.data.truth] : [];
+    if (this.kind === 'custom' && !this.multi.on) {
       const d = this.drawn;
       pts.push([d.x0, d.y0, 10], [d.x1, d.y1, 10]);
     }
@@ -244,10 +312,16 @@ export class Tracking {
   /** Transport controls and the step read-out (labels from the core). */
   show() {
     const f = this.frame;
-    const n = this.track ? this.track.entries() - 1 : 0;
+    const n = Math.max(0, this.entries() - 1);
     $('track-play').textContent = this.playing ? '❚❚ Pause' : '▶ Play';
     $('track-play').dataset.playing = this.playing ? '1' : '0';
     $('track-scrub').value = String(this.step);
+    if (this.multi.on) {
+      const m = this.multi;
+      $('track-time').textContent = m.doc ? `t = ${fixed(m.timeAt(this.step), 2)} s / ${fixed(m.timeAt(n), 2)} s · scan ${this.step}/${n}` : 't = –';
+      fillKeyValues($('track-info'), m.rows(this.step));
+      return;
+    }
     if (!f || !this.data) return;
     const tEnd = this.data.t_s[n];
     $('track-time').textContent = `t = ${fixed(f.t_s, 2)} s / ${fixed(tEnd, 2)} s · step ${f.step}/${n}`;
@@ -280,7 +354,7 @@ export class Tracking {
       mcMs: mc.ms, mcComputeMs: mc.computeMs, mcDone: mc.done, mcTotal: mc.total,
       mcElapsedMs: mc.elapsedMs, mcEtaMs: mc.etaMs,
       mcSuperseded: mc.superseded, chartSeries: mc.series, drawn: { ...this.drawn },
-      layer: this.layer || null,
+      layer: this.layer || null, multi: this.multi.snapshot(),
     };
   }
 }
@@ -327,6 +401,22 @@ export function registerTrackingState(tracking, wasm) {
       tracking.drawn = { ...v.drawn };
       tracking.rerun(); // (only in the tracking view)
       tracking.redraw();
+    },
+  });
+  // Several people (issue 41): the walkers ('off' or 1–5) and the method; optional, so a state
+  // saved before it opens as before (walkers off).
+  registerSection('multi', {
+    optional: true,
+    get: () => ({ walkers: $('multi-walkers').value, method: $('multi-method').value }),
+    check: (v) => {
+      fields(v, 'state.multi', ['walkers', 'method']);
+      choice(v.walkers, 'state.multi.walkers', 'multi-walkers');
+      choice(v.method, 'state.multi.method', 'multi-method');
+    },
+    apply: (v) => {
+      $('multi-walkers').value = v.walkers;
+      $('multi-method').value = v.method;
+      tracking.multiChanged();
     },
   });
 }

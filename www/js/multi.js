@@ -1,0 +1,249 @@
+// Several people in the tracking view (issue 41 §2): the panel's "Several people" block (walkers
+// off or 1–5, the method PMB or GNN), the run in a Web Worker (multi-worker.js: the core's
+// track_people simulates the walkers, tracks their delay scans and scores the track, as the CLI's
+// simulate-walk --walkers then track --targets auto --truth), the map layer (every true path
+// thin, every labelled track in its own colour with its label and its current 1σ ellipse) and
+// the GOSPA chart (the core's curve figure, draw_people_chart). tracking.js owns the animation
+// step and asks this file what to draw at it; "off" leaves the single-target view as it was.
+
+import { $, errorText, fitCanvas, fixed } from './dom.js';
+import { C, FONT_B, FULL, clipTo, ellipsePath, linkColor, placeLabel, polyline } from './draw.js';
+import { JobWorker } from './workers.js';
+
+export class Multi {
+  /**
+   * @param {object} ctx - app.js ctx (module, wasm); @param {object} o - {onResult() (a new
+   * document arrived), onError(message)}.
+   */
+  constructor(ctx, { onResult, onError }) {
+    this.ctx = ctx;
+    this.onResult = onResult;
+    this.onError = onError;
+    this.state = 'off'; // 'running' | 'done' | 'stopped' | 'error' | 'off'
+    this.params = null;
+    this.text = null; // the last document's JSON text
+    this.doc = null; // … parsed
+    this.ms = null; // post to result, ms (the page's timer)
+    this.computeMs = null; // the worker's own time for it
+    this.error = null;
+    this.superseded = 0; // running jobs replaced by a newer one or cancelled
+    this.series = 0; // GOSPA points the chart drew
+    this.layer = null; // what the map layer drew last
+    this.worker = new JobWorker(new URL('./multi-worker.js', import.meta.url), ctx.module, {
+      staleMs: 0, // one synchronous wasm call: a newer job or Stop terminates the worker
+      lazy: true,
+      onResult: (m) => this.receive(m),
+      onError: (message, gen) => {
+        if (gen === undefined || gen === this.worker.gen) this.fail(`Several people: ${message}`);
+      },
+    });
+    $('multi-stop').addEventListener('click', () => this.stop());
+    new ResizeObserver(() => this.drawChart()).observe($('multi-chart').parentElement);
+  }
+
+  /** Whether the block is on (walkers chosen, not "off"). */
+  get on() { return $('multi-walkers').value !== 'off'; }
+
+  /** The number of scans of the document shown (0 without one). */
+  entries() { return this.doc ? this.doc.track.t_s.length : 0; }
+
+  /** Starts a run: {scenario (JSON text), walkers, method, seed}. */
+  start(params) {
+    if (this.state === 'running') this.superseded += 1;
+    this.params = params;
+    this.state = 'running';
+    this.error = null;
+    // A new run clears the old one at once (map, chart, read-out): no old track under its status.
+    this.text = null;
+    this.doc = null;
+    this.t0 = performance.now();
+    this.worker.post(params);
+    this.drawChart();
+    this.show();
+  }
+
+  /** Stop: the running job's worker is terminated (nothing is shown until the next run). */
+  stop() {
+    if (this.state !== 'running') return;
+    this.superseded += 1;
+    this.worker.cancel();
+    this.state = 'stopped';
+    this.show();
+  }
+
+  /** Off (or leaving the view): drops any job. */
+  cancel() {
+    if (this.state === 'running') this.superseded += 1;
+    this.worker.cancel();
+    this.state = this.on ? 'stopped' : 'off';
+    this.show();
+  }
+
+  receive(m) {
+    if (m.gen !== this.worker.gen) return;
+    this.ms = performance.now() - this.t0;
+    this.computeMs = m.ms;
+    this.text = m.text;
+    this.doc = JSON.parse(m.text);
+    this.state = 'done';
+    this.drawChart();
+    this.show();
+    this.onResult();
+  }
+
+  fail(message) {
+    this.state = 'error';
+    this.error = message;
+    this.show();
+    this.onError(message);
+  }
+
+  /** The GOSPA chart at the canvas' CSS size times the device pixel ratio. */
+  drawChart() {
+    const canvas = $('multi-chart');
+    const r = canvas.getBoundingClientRect();
+    if (r.width < 10 || r.height < 10) return;
+    fitCanvas(canvas);
+    const d = this.doc;
+    const title = 'GOSPA per scan';
+    const sub = d ? `${d.walkers} walkers, ${d.track.method.toUpperCase()}, seed ${d.seed}, `
+      + `${d.track.t_s.length} scans of ${d.dt_s} s` : '';
+    try {
+      this.series = this.ctx.wasm.draw_people_chart(canvas, this.text || '', title, sub);
+    } catch (e) {
+      this.series = 0;
+      this.onError(`GOSPA chart: ${errorText(e)}`);
+    }
+    Object.assign(canvas.dataset, { series: String(this.series), title, subtitle: sub });
+  }
+
+  /** The status line and Stop. */
+  show() {
+    const el = $('multi-status');
+    const p = this.params;
+    const what = p ? `${p.walkers} walker${p.walkers === 1 ? '' : 's'} · ${p.method.toUpperCase()}` : '';
+    const d = this.doc;
+    let text = {
+      off: 'off: the single-target view',
+      running: `${what} · running…`,
+      stopped: `${what} · stopped (change a setting to run again)`,
+      error: `${what} · failed`,
+    }[this.state] || '';
+    if (this.state === 'done' && d) {
+      const s = d.score;
+      text = `${what} · ${d.track.t_s.length} scans in ${fixed(this.ms, 0)} ms (worker ${fixed(this.computeMs, 0)} ms)`
+        + ` · mean GOSPA ${this.ctx.wasm.format_length(s.mean_gospa_m, 3)}, ${s.switches} label switch`
+        + `${s.switches === 1 ? '' : 'es'}, cardinality error ${fixed(s.mean_cardinality_error, 2)}`;
+    }
+    el.textContent = text;
+    Object.assign(el.dataset, {
+      state: this.state, generation: String(this.worker.gen), ms: this.ms === null ? '' : String(this.ms),
+    });
+    $('multi-stop').disabled = this.state !== 'running';
+  }
+
+  /** The scan's time, s. */
+  timeAt(step) { return this.doc ? this.doc.track.t_s[step] : 0; }
+
+  /** The read-out rows at scan `step`: each reported target, then the GOSPA. */
+  rows(step) {
+    const d = this.doc;
+    if (!d) return [];
+    const len = (v) => this.ctx.wasm.format_length(v, 3);
+    const rows = d.track.targets[step].map((t, i) => {
+      const e = d.ellipses[step][i];
+      return [`Track ${t.label}`, `${fixed(t.state[0], 3)}, ${fixed(t.state[1], 3)} m · 1σ ${e ? len(e.a) : '–'}`, ''];
+    });
+    rows.push(['True people', String(d.truth.targets[step].length), '']);
+    rows.push([`GOSPA (c = ${len(d.score.c_m)})`, len(d.score.gospa_m[step]), '']);
+    return rows;
+  }
+
+  /** The colour of the track with `label`: its place among the document's tracks (label order). */
+  colour(label) {
+    const i = this.doc.track.tracks.findIndex((t) => t.label === label);
+    return linkColor(Math.max(0, i));
+  }
+
+  /** Every true path, [[x, y], …] per person (label order). */
+  truthPaths() {
+    const paths = new Map();
+    for (const scan of this.doc.truth.targets) {
+      for (const t of scan) {
+        if (!paths.has(t.label)) paths.set(t.label, []);
+        paths.get(t.label).push([t.state[0], t.state[1]]);
+      }
+    }
+    return [...paths.values()];
+  }
+
+  /**
+   * The map layer at scan `step` (ellipses magnified by `magnify`): true paths thin, each track
+   * up to the step in its colour with its label and current 1σ ellipse. Returns what was drawn:
+   * {step, truth: [[x, y]…] per person, tracks: [{label, colour, state, ellipse, points}]}.
+   */
+  draw(ctx, view, step, magnify) {
+    const d = this.doc;
+    this.layer = { step, truth: [], tracks: [] };
+    if (!d) return this.layer;
+    step = Math.min(step, d.track.t_s.length - 1);
+    this.layer.step = step;
+    clipTo(ctx, view.rect);
+    ctx.lineJoin = 'round';
+    ctx.setLineDash([4, 4]);
+    ctx.lineWidth = 1;
+    ctx.strokeStyle = 'rgba(255,255,255,0.7)';
+    for (const path of this.truthPaths()) {
+      polyline(ctx, view, path, false); ctx.stroke();
+      this.layer.truth.push(path);
+    }
+    ctx.setLineDash([]);
+    const taken = [];
+    for (const tr of d.track.tracks) {
+      const colour = this.colour(tr.label);
+      // The track's estimates up to the step, split where it was not reported.
+      const runs = [[]];
+      for (let k = tr.first_scan; k <= Math.min(step, tr.last_scan); k++) {
+        const t = d.track.targets[k].find((x) => x.label === tr.label);
+        if (t) runs[runs.length - 1].push([t.state[0], t.state[1]]);
+        else if (runs[runs.length - 1].length) runs.push([]);
+      }
+      ctx.strokeStyle = colour;
+      ctx.lineWidth = 2;
+      for (const r of runs) if (r.length > 1) { polyline(ctx, view, r, false); ctx.stroke(); }
+      const i = d.track.targets[step].findIndex((x) => x.label === tr.label);
+      if (i < 0) continue;
+      const t = d.track.targets[step][i];
+      const e = d.ellipses[step][i];
+      if (e) {
+        ellipsePath(ctx, view, e, magnify);
+        ctx.globalAlpha = 0.2; ctx.fillStyle = colour; ctx.fill(); ctx.globalAlpha = 1;
+        ctx.lineWidth = 2; ctx.strokeStyle = colour; ctx.stroke();
+      }
+      const p = view.toPixel(t.state[0], t.state[1]);
+      ctx.beginPath(); ctx.arc(p.x, p.y, 4, 0, FULL);
+      ctx.fillStyle = colour; ctx.fill();
+      ctx.font = FONT_B;
+      ctx.fillStyle = colour;
+      const box = placeLabel(ctx, `#${t.label}`, p, view.rect, taken, [[7, -6, 'left', 'bottom'],
+        [-7, -6, 'right', 'bottom'], [7, 6, 'left', 'top'], [-7, 6, 'right', 'top']], C.halo);
+      this.layer.tracks.push({ label: t.label, colour, state: t.state, ellipse: e, points: runs.flat(), box });
+    }
+    ctx.restore();
+    return this.layer;
+  }
+
+  /** Points the zoom inset should not hide: the true paths. */
+  avoidPoints() { return this.doc ? this.truthPaths().flat().map((p) => [p[0], p[1], 10]) : []; }
+
+  /** Test and console hook (the document itself as `doc`): tracking.js state().multi. */
+  snapshot() {
+    return {
+      on: this.on, walkers: $('multi-walkers').value, method: $('multi-method').value, state: this.state,
+      generation: this.worker.gen, ms: this.ms, computeMs: this.computeMs, superseded: this.superseded,
+      restarts: this.worker.restarts, error: this.error, scans: this.entries(), series: this.series,
+      params: this.params ? { walkers: this.params.walkers, method: this.params.method, seed: this.params.seed } : null,
+      doc: this.doc, layer: this.layer,
+    };
+  }
+}
