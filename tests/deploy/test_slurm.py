@@ -29,6 +29,8 @@ MC = ["montecarlo", "--trajectory", "all", "--runs", "64", "--noise-runs", "2", 
       "--duration", "3", "--filters", "ekf,ukf", "--seed", "5"]
 # A small [A] Fig. 4 sweep: 8 realisations.
 ROC = ["mtl", "roc", "--experiment", "vb", "--realizations", "8", "--seed", "2"]
+# Several people (issue 41): 2 walkers, 8 runs of 2 s, PMB and GNN.
+MULTI = ["montecarlo", "--targets", "2", "--runs", "8", "--duration", "2", "--seed", "3"]
 
 
 @pytest.fixture(scope="module", autouse=True)
@@ -49,14 +51,14 @@ def reference(cli: Path, tmp_path_factory: pytest.TempPathFactory) -> dict[str, 
     """The unsharded runs of the two studies: (JSON, PNG figure) each, computed once."""
     work = tmp_path_factory.mktemp("unsharded")
     out = {}
-    for name, study in (("mc", MC), ("roc", ROC)):
+    for name, study in (("mc", MC), ("roc", ROC), ("multi", MULTI)):
         r = run([str(cli), *study, "--json", f"{name}.json", "--out", f"{name}.png"], work)
         assert r.returncode == 0, r.stderr
         out[name] = (load(work / f"{name}.json"), (work / f"{name}.png").read_bytes())
     return out
 
 
-@pytest.mark.parametrize("study, name", [(MC, "mc"), (ROC, "roc")])
+@pytest.mark.parametrize("study, name", [(MC, "mc"), (ROC, "roc"), (MULTI, "multi")])
 def test_array_and_merge_equal_the_unsharded_run(
     cli: Path, tmp_path: Path, reference: dict, study: list[str], name: str
 ):

@@ -67,6 +67,10 @@ fn study_of(args: &MontecarloArgs) -> Result<MonteCarloStudy, CliError> {
 /// without running it (`slurm submit`, issue 37): the study's flags, and the predicted CPU time
 /// of the costliest shard against `--max-cpu-hours`.
 pub fn check_shards(args: &MontecarloArgs, shards: usize, threads: usize) -> Result<(), CliError> {
+    if let Some(walkers) = args.targets {
+        // The multi-target study: its configuration as each shard checks it.
+        return super::multi_study::multi_config(args, walkers).map(drop);
+    }
     let study = study_of(args)?;
     let links = study.track.model.link_count();
     let runs = (0..study.track.trajectories.len())
