@@ -242,12 +242,16 @@ fn write_result(
                 marker,
             })
             .collect();
+        // The axis shows the tracking after the first second (3× its largest value); the
+        // start-up transient above it is clipped (its values are in the JSON).
         let hi = xy
             .iter()
             .flatten()
+            .filter(|p| p.0 >= 1.0 || d.t_s.len() <= 10)
             .map(|p| p.1)
             .filter(|v| v.is_finite())
-            .fold(1e-6, f64::max);
+            .fold(1e-6, f64::max)
+            * 3.0;
         let c = &d.config;
         let opts = CurveChartOptions {
             title: format!(
@@ -265,7 +269,7 @@ fn write_result(
             x_desc: "time (s)".into(),
             y_desc: "GOSPA (m)".into(),
             x_range: (0.0, d.t_s.last().copied().unwrap_or(1.0).max(1e-9)),
-            y_range: (0.0, hi * 1.05),
+            y_range: (0.0, hi),
             legend: SeriesLabelPosition::UpperRight,
         };
         files.figure(
