@@ -24,6 +24,13 @@ mod basics;
 #[path = "cli/cir.rs"]
 mod cir;
 
+/// The crossing walkers of issue 41 §3 (shared with the library's tests).
+#[path = "common/crossing.rs"]
+mod crossing;
+
+#[path = "cli/cir_multi.rs"]
+mod cir_multi;
+
 #[cfg(feature = "npz")]
 #[path = "cli/csi.rs"]
 mod csi;

@@ -13,6 +13,13 @@ mod common;
 #[path = "tracking/check11.rs"]
 mod check11;
 
+/// The crossing walkers of issue 41 §3 (shared with the CLI's tests).
+#[path = "common/crossing.rs"]
+mod crossing;
+
+#[path = "tracking/cir_multi.rs"]
+mod cir_multi;
+
 #[path = "tracking/ekf.rs"]
 mod ekf;
 

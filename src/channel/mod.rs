@@ -33,8 +33,8 @@ pub use paths::{PathTracker, PathTrackerConfig, TrackedPath};
 pub use recording::{Layout, Pulse, Recording};
 pub use simulate::{
     simulate_recording, Body, ChannelScene, ChannelTruth, Clock, ClockState, PathKind,
-    PointScatterer, Simulated, SimulationRequest, TruePath, Walk, Wall,
-    DEFAULT_CALIBRATION_DURATION_S, DEFAULT_DT_S, DEFAULT_SUBCARRIERS,
+    PointScatterer, Simulated, SimulationRequest, SimulationTruth, TruePath, Walk, Walker, Wall,
+    DEFAULT_CALIBRATION_DURATION_S, DEFAULT_DT_S, DEFAULT_SUBCARRIERS, MAX_OTHER_WALKERS,
 };
 pub use snapshot::{DelayEstimate, Snapshot};
 pub use stream::{

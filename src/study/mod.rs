@@ -45,6 +45,10 @@ pub use channel::{
     StaticMode, BACKGROUND_MAX_PATHS, DEFAULT_PROCESS_NOISE, DEFAULT_SEED, EXTENT_SIGMA_M,
     LIVE_REPLAY_SNAPSHOTS, LOS_WITHIN_DB, RECURSIVE_CLUSTER_DB,
 };
+pub use channel::{
+    cir_track_multi, recording_measurements, recording_multi_settings, uniform_step, walkers_truth,
+    RECORDING_CLUTTER, RECORDING_CLUTTER_WINDOW_S, RECORDING_DETECTION, RECORDING_EXTENT_SIGMA_M,
+};
 pub use cost::{check_cost, track_cpu_s, MAX_CPU_S, PAGE_STUDY_CPU_S, PAGE_TRACK_CPU_S};
 pub use drive::{Driver, Sequential};
 pub use filters::{particle_chunks, FilterResults, FilterRun, FilterStudy};

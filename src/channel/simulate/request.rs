@@ -4,8 +4,8 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::synthesize::synthesize;
-use super::{ChannelScene, ChannelTruth};
+use super::synthesize::{synthesize, synthesize_all};
+use super::{ChannelScene, ChannelTruth, SimulationTruth};
 use crate::channel::Recording;
 use crate::error::{Cancel, Error, Result};
 use crate::measure::Model;
@@ -59,6 +59,9 @@ pub struct Simulated {
     pub calibration: Recording,
     /// The truth of the walk.
     pub truth: ChannelTruth,
+    /// The states `[x, y, vx, vy]` per snapshot of each further walker of the scene
+    /// ([`ChannelScene::others`], issue 41; empty without).
+    pub others: alloc::vec::Vec<alloc::vec::Vec<[f64; 4]>>,
     /// The scene simulated (overrides applied).
     pub scene: ChannelScene,
 }
@@ -117,8 +120,9 @@ impl SimulationRequest {
     /// area), [`Error::Cancelled`].
     pub fn run(&self, scenario: &Scenario, model: &Model, cancel: Cancel) -> Result<Simulated> {
         let (scene, empty) = self.scenes()?;
-        let (recording, truth) = synthesize(scenario, model, &scene, true, self.seed, true, cancel)
-            .map_err(|e| self.attribute(e))?;
+        let (recording, truth, others) =
+            synthesize_all(scenario, model, &scene, true, self.seed, true, cancel)
+                .map_err(|e| self.attribute(e))?;
         let (calibration, _) = synthesize(scenario, model, &empty, false, self.seed, true, cancel)
             .map_err(|e| match e {
                 Error::Cancelled => e,
@@ -131,8 +135,20 @@ impl SimulationRequest {
             recording,
             calibration,
             truth,
+            others,
             scene,
         })
+    }
+}
+
+impl Simulated {
+    /// The truth as `cir simulate` writes it (`truth.json`): the [`ChannelTruth`]'s keys, and
+    /// `others` with further walkers.
+    pub fn truth_file(&self) -> SimulationTruth {
+        SimulationTruth {
+            truth: self.truth.clone(),
+            others: self.others.clone(),
+        }
     }
 }
 

@@ -1,5 +1,6 @@
-//! The scene of a simulated recording: walls, point scatterers, the walker's body and walk, and
-//! the sounder settings (subcarriers, snapshot interval, dynamic range).
+//! The scene of a simulated recording: walls, point scatterers, the walker's body and walk, any
+//! further walkers ([`Walker`], issue 41), and the sounder settings (subcarriers, snapshot
+//! interval, dynamic range).
 
 use alloc::format;
 use alloc::vec;
@@ -68,6 +69,72 @@ impl Default for Body {
     }
 }
 
+impl Body {
+    /// Checks the fields; errors name `field` + `.centres`, `.radius_m`, `.correlation`,
+    /// `.shadow_radius_m`, `.shadow_loss_db`.
+    pub fn validate(&self, field: &str) -> Result<()> {
+        let name = |f: &str| format!("{field}.{f}");
+        if !(1..=MAX_BODY_CENTRES).contains(&self.centres) {
+            return Err(Error::InvalidFile {
+                field: name("centres"),
+                reason: format!(
+                    "{} centres; 1 to {MAX_BODY_CENTRES} are allowed",
+                    self.centres
+                ),
+            });
+        }
+        let range = |f: &str, v: f64, lo: f64, hi: f64, allowed| {
+            if v.is_finite() && (lo..=hi).contains(&v) {
+                Ok(())
+            } else {
+                Err(Error::OutOfRange {
+                    field: name(f),
+                    value: v,
+                    allowed,
+                })
+            }
+        };
+        range("radius_m", self.radius_m, 0.0, 10.0, "0 to 10 m")?;
+        range(
+            "correlation",
+            self.correlation,
+            0.0,
+            0.999_999,
+            "0 to 0.999999",
+        )?;
+        range(
+            "shadow_radius_m",
+            self.shadow_radius_m,
+            0.0,
+            10.0,
+            "0 to 10 m",
+        )?;
+        range(
+            "shadow_loss_db",
+            self.shadow_loss_db,
+            0.0,
+            200.0,
+            "0 to 200 dB",
+        )
+    }
+}
+
+/// A further walker of a scene (issue 41: several people in a recording): its own walk and
+/// body, simulated exactly as the main walker — its body paths direct and via the walls, its
+/// own fluctuations (an rng stream per walker), shadowing the LoS and wall paths.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Walker {
+    /// The walker's body (default [`Body::default`]).
+    #[serde(default)]
+    pub body: Body,
+    /// The walker's walk.
+    pub walk: Walk,
+}
+
+/// Most further walkers of a scene ([`ChannelScene::others`]; five people in all).
+pub const MAX_OTHER_WALKERS: usize = 4;
+
 /// [S]'s snapshot interval `T_g`, s.
 pub const DEFAULT_DT_S: f64 = 2.048e-3;
 /// Default number of subcarriers N.
@@ -98,6 +165,9 @@ pub struct ChannelScene {
     pub body: Body,
     /// The walker's walk.
     pub walk: Walk,
+    /// Further walkers (up to four, `MAX_OTHER_WALKERS`; none by default, and then not written).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub others: Vec<Walker>,
     /// Number of frequency bins N (C1), spacing `B/N`.
     #[serde(default = "default_subcarriers")]
     pub subcarriers: usize,
@@ -248,8 +318,15 @@ impl ChannelScene {
             check_point(&format!("scene.scatterers[{i}].position_m"), &s.position_m)?;
             RCS_M2.check(&format!("scene.scatterers[{i}].rcs_m2"), s.rcs_m2)?;
         }
-        let b = &self.body;
-        too_many("scene.body.centres", b.centres, 1, MAX_BODY_CENTRES)?;
+        too_many("scene.body.centres", self.body.centres, 1, MAX_BODY_CENTRES)?;
+        self.body.validate("scene.body")?;
+        self.walk.validate("scene.walk")?;
+        too_many("scene.others", self.others.len(), 0, MAX_OTHER_WALKERS)?;
+        for (i, w) in self.others.iter().enumerate() {
+            w.body.validate(&format!("scene.others[{i}].body"))?;
+            w.walk.validate(&format!("scene.others[{i}].walk"))?;
+        }
+        too_many("scene.subcarriers", self.subcarriers, 2, MAX_SUBCARRIERS)?;
         let range = |field: &str, v: f64, lo: f64, hi: f64, allowed| {
             if v.is_finite() && (lo..=hi).contains(&v) {
                 Ok(())
@@ -261,30 +338,6 @@ impl ChannelScene {
                 })
             }
         };
-        range("scene.body.radius_m", b.radius_m, 0.0, 10.0, "0 to 10 m")?;
-        range(
-            "scene.body.correlation",
-            b.correlation,
-            0.0,
-            0.999_999,
-            "0 to 0.999999",
-        )?;
-        range(
-            "scene.body.shadow_radius_m",
-            b.shadow_radius_m,
-            0.0,
-            10.0,
-            "0 to 10 m",
-        )?;
-        range(
-            "scene.body.shadow_loss_db",
-            b.shadow_loss_db,
-            0.0,
-            200.0,
-            "0 to 200 dB",
-        )?;
-        self.walk.validate("scene.walk")?;
-        too_many("scene.subcarriers", self.subcarriers, 2, MAX_SUBCARRIERS)?;
         check_positive("scene.dt_s", self.dt_s)?;
         range("scene.dt_s", self.dt_s, 1e-9, 1e3, "1e-9 to 1000 s")?;
         if let Some(d) = self.duration_s {
@@ -332,6 +385,7 @@ impl ChannelScene {
                 speed_mps: 1.4,
                 turn_radius_m: 2.5,
             },
+            others: Vec::new(),
             subcarriers: DEFAULT_SUBCARRIERS,
             dt_s: DEFAULT_DT_S,
             duration_s: None,

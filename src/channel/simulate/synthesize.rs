@@ -13,21 +13,21 @@ use alloc::vec;
 use alloc::vec::Vec;
 
 use super::geometry::Line;
-use super::rays::{body_centre, body_paths, passes_near, static_rays, LinkBudget, StaticRay};
+use super::rays::{static_rays, LinkBudget, StaticRay};
 use super::signal::{add_path, apply_clock, cis_neg, complex_normal};
+use super::walkers::movers;
 use super::{ChannelScene, ChannelTruth, ClockState, PathKind, TruePath};
 use crate::channel::{Layout, Recording};
 use crate::error::limits::MAX_CHANNEL_SAMPLES;
 use crate::error::{check_len, limits, Cancel, Error, Result};
-use crate::math::{db_to_linear, dbm_to_watt, sqrt, Complex, Real, Vec2, SPEED_OF_LIGHT};
+use crate::math::{db_to_linear, dbm_to_watt, sqrt, Complex, Real, SPEED_OF_LIGHT};
 use crate::measure::{noise_power_w, rng, Model};
 use crate::scenario::Scenario;
 
-/// rng streams: the noise of a recording with the walker, of the empty-area calibration
-/// recording, and the body's fluctuations.
+/// rng streams: the noise of a recording with the walker and of the empty-area calibration
+/// recording (the bodies' fluctuations: [`super::walkers`]).
 const STREAM_NOISE: u64 = 0x25_01;
 const STREAM_NOISE_EMPTY: u64 = 0x25_02;
-const STREAM_BODY: u64 = 0x25_03;
 /// rng streams of the receivers' clocks (C10): the walk's and the empty area's.
 const STREAM_CLOCK: u64 = 0x36_01;
 const STREAM_CLOCK_EMPTY: u64 = 0x36_02;
@@ -100,6 +100,9 @@ pub fn simulate_recording(
     )
 }
 
+/// Per further walker, its `[x, y, vx, vy]` per snapshot.
+pub(super) type WalkerStates = Vec<Vec<[Real; 4]>>;
+
 /// [`simulate_recording`], optionally without the additive noise (`noise_var` then still
 /// gives the σ² the noisy version would use); `cancel` is asked once per snapshot.
 pub(super) fn synthesize(
@@ -111,6 +114,23 @@ pub(super) fn synthesize(
     add_noise: bool,
     cancel: Cancel,
 ) -> Result<(Recording, ChannelTruth)> {
+    synthesize_all(scenario, model, scene, with_person, seed, add_noise, cancel)
+        .map(|(r, t, _)| (r, t))
+}
+
+/// [`synthesize`] with the states `[x, y, vx, vy]` of each further walker
+/// ([`ChannelScene::others`], issue 41) per snapshot (none without the walkers,
+/// `with_person = false`). A scene without further walkers gives [`synthesize`]'s recording and
+/// truth bit for bit.
+pub(super) fn synthesize_all(
+    scenario: &Scenario,
+    model: &Model,
+    scene: &ChannelScene,
+    with_person: bool,
+    seed: u64,
+    add_noise: bool,
+    cancel: Cancel,
+) -> Result<(Recording, ChannelTruth, WalkerStates)> {
     scene.validate()?;
     check_len(
         "model.network.transmitters",
@@ -122,9 +142,15 @@ pub(super) fn synthesize(
         scenario.receivers.len(),
         model.network.receivers.len(),
     )?;
-    let path = scene.walk.compile()?;
-    let duration = scene.duration_s.unwrap_or_else(|| path.duration_s());
     let links = &model.network.links;
+    let mut walkers = movers(scene, links.len(), scenario.target.rcs_m2, seed)?;
+    // The longest walk (the main walker's without further walkers).
+    let duration = scene.duration_s.unwrap_or_else(|| {
+        walkers
+            .iter()
+            .map(|w| w.path.duration_s())
+            .fold(walkers[0].path.duration_s(), Real::max)
+    });
     let n_bins = scene.subcarriers;
     let per_snapshot = links.len() * n_bins;
     let steps = duration / scene.dt_s * (1.0 + 1e-12);
@@ -184,14 +210,13 @@ pub(super) fn synthesize(
     )?;
     let (mut entries, mut work) = (0usize, 0u64);
 
-    let body = &scene.body;
-    let k_centres = body.centres;
-    let rcs_centre = scenario.target.rcs_m2 / k_centres as Real;
-    let shadow_amp = sqrt(db_to_linear(-body.shadow_loss_db));
-    let rho = body.correlation;
-    let innov = sqrt(1.0 - rho * rho);
-    let mut body_rng = rng(seed, STREAM_BODY);
-    let mut fluct = vec![Complex::new(0.0, 0.0); links.len() * k_centres];
+    let k_centres = scene.body.centres;
+    let mut others: WalkerStates = if with_person {
+        vec![Vec::with_capacity(snapshots); scene.others.len()]
+    } else {
+        Vec::new()
+    };
+    let mut at = Vec::with_capacity(walkers.len());
 
     let clock = scene.clock.as_ref();
     let mut clock_rng = rng(
@@ -216,15 +241,16 @@ pub(super) fn synthesize(
         cancel.check()?;
         let t = s as Real * scene.dt_s;
         t_s.push(t);
-        let walker = with_person.then(|| path.state_and_heading(t));
-        if let Some((st, _)) = walker {
-            states.push(st);
-        }
-        // The body's fluctuations: AR(1), the first snapshot a fresh draw.
+        at.clear();
         if with_person {
-            for g in fluct.iter_mut() {
-                let w = complex_normal(&mut body_rng);
-                *g = if s == 0 { w } else { *g * rho + w * innov };
+            at.extend(walkers.iter().map(|w| w.path.state_and_heading(t)));
+            states.push(at[0].0);
+            for (o, a) in others.iter_mut().zip(&at[1..]) {
+                o.push(a.0);
+            }
+            // The bodies' fluctuations (each walker its own stream).
+            for w in walkers.iter_mut() {
+                w.draw(s);
             }
         }
         let mut snap_paths = Vec::with_capacity(links.len());
@@ -234,18 +260,18 @@ pub(super) fn synthesize(
             let mut truth = Vec::new();
             let mut los_shadowed = false;
             for ray in &statics[p] {
-                let shade = match walker {
-                    Some((st, _)) if ray.shadowable => passes_near(
-                        &ray.points[..ray.npoints],
-                        Vec2::new(st[0], st[1]),
-                        body.shadow_radius_m,
-                    ),
-                    _ => false,
-                };
+                // Shadowed by any walker, by each one it passes.
+                let mut shade = false;
+                let mut a = 1.0;
+                for (w, (st, _)) in walkers.iter().zip(&at) {
+                    if let Some(f) = w.shade(ray, st) {
+                        shade = true;
+                        a *= f;
+                    }
+                }
                 if ray.kind == PathKind::Los {
                     los_shadowed = shade;
                 }
-                let a = if shade { shadow_amp } else { 1.0 };
                 let power = ray.power * a * a;
                 truth.push(TruePath {
                     kind: ray.kind,
@@ -255,39 +281,27 @@ pub(super) fn synthesize(
                 let alpha = cis_neg(fc * ray.delay) * (sqrt(ray.power) * a * ray.sign);
                 add_path(h, alpha, ray.delay, f0, df);
             }
-            if let Some((st, head)) = walker {
-                let centre = Vec2::new(st[0], st[1]);
-                scratch.clear();
-                body_paths(
-                    lb,
-                    &lines,
-                    centre,
-                    scenario.target.rcs_m2,
-                    scene.double_reflections,
-                    &mut scratch,
-                );
-                truth.extend(scratch.iter().map(|&(kind, delay_s, power_w, _)| TruePath {
-                    kind,
-                    delay_s,
-                    power_w,
-                }));
-                for k in 0..k_centres {
-                    let ck = body_centre(centre, head, k, k_centres, body.radius_m);
-                    scratch.clear();
-                    body_paths(
+            // Every walker's paths; the work bound counts `1 + K` sets of one centre's paths
+            // per walker (one set without the walkers).
+            let mut rays = statics[p].len();
+            if with_person {
+                for (w, &a) in walkers.iter().zip(&at) {
+                    let per_centre = w.add(
                         lb,
                         &lines,
-                        ck,
-                        rcs_centre,
+                        a,
+                        p,
+                        scenario.target.rcs_m2,
                         scene.double_reflections,
+                        [fc, f0, df],
+                        h,
+                        &mut truth,
                         &mut scratch,
                     );
-                    let g = fluct[p * k_centres + k];
-                    for &(_, tau, power, sign) in &scratch {
-                        let alpha = cis_neg(fc * tau) * g * (sqrt(power) * sign);
-                        add_path(h, alpha, tau, f0, df);
-                    }
+                    rays += w.rays(per_centre);
                 }
+            } else {
+                rays += 1 + k_centres;
             }
             if let Some(c) = clock {
                 let st = apply_clock(c, s, &mut gain_db[p], &mut clock_rng, h, f0, df);
@@ -301,7 +315,6 @@ pub(super) fn synthesize(
             for tp in &truth {
                 max_power[p] = Real::max(max_power[p], tp.power_w);
             }
-            let rays = statics[p].len() + (1 + k_centres) * scratch.len().max(1);
             entries = entries.saturating_add(truth.len());
             work = work.saturating_add((rays as u64).saturating_mul(n_bins as u64));
             budget.check(entries, s + 1)?;
@@ -354,5 +367,5 @@ pub(super) fn synthesize(
         shadowed,
         clock: clock_truth,
     };
-    Ok((recording, truth))
+    Ok((recording, truth, others))
 }

@@ -1,6 +1,7 @@
 //! What the simulator knows of a recording it made ([`ChannelTruth`]): per snapshot the walker's
 //! state, per link the true paths ([`TruePath`], [`PathKind`]) and whether the walker shadows the
-//! LoS, and what each receiver's clock did ([`ClockState`], C10).
+//! LoS, and what each receiver's clock did ([`ClockState`], C10); with further walkers (issue 41)
+//! their states beside it ([`SimulationTruth`]).
 
 use alloc::vec::Vec;
 
@@ -64,4 +65,18 @@ pub struct ClockState {
     pub phase_rad: f64,
     /// Gain `|g|`, dB.
     pub gain_db: f64,
+}
+
+/// The truth of a simulation as `cir simulate` writes it (`truth.json`): the [`ChannelTruth`]'s
+/// keys and, with further walkers ([`super::ChannelScene::others`], issue 41), `others`: per
+/// further walker its `[x, y, vx, vy]` per snapshot (not written when there are none, so the
+/// file of a single walker is the [`ChannelTruth`]'s).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SimulationTruth {
+    /// The main walker's truth and every link's paths (of every walker).
+    #[serde(flatten)]
+    pub truth: ChannelTruth,
+    /// Per further walker, its state per snapshot.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub others: Vec<Vec<[f64; 4]>>,
 }

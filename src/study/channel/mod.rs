@@ -8,7 +8,8 @@
 //! tracks, delays absolute or relative to the direct path, C10) ([`estimate_recording`], one
 //! driver job per link, or [`EstimationRun`] in slices); the track ([`cir_track`]) starts by
 //! itself, detects its loss and restarts (C11) with any filter; [`LiveFront`] + [`LiveRun`]
-//! run the same chain frame by frame, as frames arrive (issue 40 §3).
+//! run the same chain frame by frame, as frames arrive (issue 40 §3); [`cir_track_multi`]
+//! tracks several people of a recording from the same estimates (issue 41 §2).
 //!
 //! ```
 //! use scatterloc::channel::{simulate_recording, ChannelScene};
@@ -41,6 +42,7 @@ mod direct;
 mod estimates;
 mod front;
 mod live;
+mod multi;
 mod request;
 mod settings;
 mod track;
@@ -55,6 +57,10 @@ pub use front::{
     RECURSIVE_CLUSTER_DB,
 };
 pub use live::{LiveFront, LiveRun, LiveState, LIVE_REPLAY_SNAPSHOTS};
+pub use multi::{
+    cir_track_multi, recording_measurements, recording_multi_settings, uniform_step, walkers_truth,
+    RECORDING_CLUTTER, RECORDING_CLUTTER_WINDOW_S, RECORDING_DETECTION, RECORDING_EXTENT_SIGMA_M,
+};
 pub use request::{
     ChannelRequest, DelayReference, DelaySigma, FrontEndConfig, StaticMode, DEFAULT_PROCESS_NOISE,
     DEFAULT_SEED, EXTENT_SIGMA_M,

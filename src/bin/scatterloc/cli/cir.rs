@@ -4,7 +4,7 @@
 use clap::{Args, Subcommand, ValueEnum};
 
 use super::filters::{FilterName, FilterSettings};
-use super::values::{finite, seed, whole, Association};
+use super::values::{finite, probability, seed, whole, Association, MultiMethod, TargetsMode};
 
 /// `scatterloc cir SUBCOMMAND`.
 #[allow(clippy::large_enum_variant)]
@@ -37,6 +37,11 @@ pub enum CirCommand {
     /// area, then a new start. --out TRACK.json: {t_s, states (null outside segments),
     /// covariances, links_used, delays_used_s, sigmas_used_s, choices, static_removed, start,
     /// segments [{first, last, end, …}], front_end, calibration, error (with --truth)}.
+    /// With --targets auto: several people, every snapshot's estimates a scan of the
+    /// multi-target tracker (docs/multi-target.md); --out TRACK.json: {method, settings, t_s,
+    /// targets [scan][{label, state, covariance, existence}], tracks [{label, first_scan, …}],
+    /// static_removed, extent_sigma_m, score (with --truth: cir simulate's truth.json with
+    /// `others`)}.
     Track(CirTrackArgs),
     /// Convert a Wi-Fi CSI tool's file to a recording (.npz, docs/recording.md).
     ///
@@ -310,6 +315,41 @@ pub struct CirTrackArgs {
     /// Seed of the particle filter's particles [default: 1] (--filter pf only).
     #[arg(long, value_name = "N", value_parser = seed)]
     pub seed: Option<u64>,
+    /// Several people: `auto` tracks every person the estimates show, with births, deaths and
+    /// a stable label per person (docs/multi-target.md) [--extent-sigma-m default: 0.3].
+    #[arg(
+        long,
+        value_name = "auto",
+        ignore_case = true,
+        conflicts_with = "follow"
+    )]
+    pub targets: Option<TargetsMode>,
+    /// The multi-target tracker: pmb (belief propagation) or gnn (baseline) [default: pmb]
+    /// (--targets auto only).
+    #[arg(
+        long,
+        value_name = "pmb|gnn",
+        ignore_case = true,
+        hide_possible_values = true
+    )]
+    pub method: Option<MultiMethod>,
+    /// Detection probability of a person per link and snapshot [default: 0.7, the front end's
+    /// on simulated recordings] (--targets auto).
+    #[arg(long, value_name = "P", value_parser = probability)]
+    pub detection_probability: Option<f64>,
+    /// Mean clutter delays per link and snapshot [default: 4.5] (--targets auto).
+    #[arg(long, value_name = "N", value_parser = finite)]
+    pub clutter: Option<f64>,
+    /// Width of the delay window clutter is spread over, ns [default: 175] (--targets auto).
+    #[arg(long, value_name = "NS", value_parser = finite)]
+    pub clutter_window_ns: Option<f64>,
+    /// Expected new people per snapshot over the scenario's area [default: 0.01] (--targets
+    /// auto).
+    #[arg(long, value_name = "R", value_parser = finite)]
+    pub birth_rate: Option<f64>,
+    /// GOSPA cut-off c of the score against --truth, m [default: 1] (--targets auto).
+    #[arg(long, value_name = "M", value_parser = finite)]
+    pub gospa_c: Option<f64>,
     #[command(flatten)]
     pub settings: FilterSettings,
     #[command(flatten)]

@@ -1,16 +1,19 @@
 //! `scatterloc cir simulate|estimate|track`: the channel front end (issues 25, 36; spec
 //! channel-estimation.md). Flags → the core's [`ChannelRequest`] (every default and check is
-//! there) → [`scatterloc::study::estimate_recording`] and [`scatterloc::study::cir_track`],
-//! the simulator [`scatterloc::channel::simulate_recording`] → files written all or none.
+//! there) → [`scatterloc::study::estimate_recording`] and [`scatterloc::study::cir_track`]
+//! (several people with `--targets auto`: `cir_multi`), the simulator
+//! [`scatterloc::channel::simulate_recording`] (a scene's further walkers too) → files written
+//! all or none.
 
 use scatterloc::channel::{Recording, SimulationRequest};
 use scatterloc::error::Cancel;
-use scatterloc::formats::{CalibrationSnapshots, Detections, Measurements, Truth};
+use scatterloc::formats::{CalibrationSnapshots, Detections, Truth};
 use scatterloc::native::Parallel;
 use scatterloc::present::{estimates_doc, track_doc, track_errors};
 use scatterloc::study::{
-    cir_track as track_recording, delays_only, estimate_recording, ChannelRequest, ChannelStatics,
-    DelayReference, FrontEndConfig, RecordingEstimates, StaticMode, DEFAULT_PROCESS_NOISE,
+    cir_track as track_recording, delays_only, estimate_recording, recording_measurements,
+    uniform_step, ChannelRequest, ChannelStatics, DelayReference, FrontEndConfig,
+    RecordingEstimates, StaticMode, DEFAULT_PROCESS_NOISE,
 };
 use scatterloc::track::ConstantVelocity;
 use scatterloc::{npz, Model, Scenario};
@@ -25,6 +28,10 @@ use crate::cli::{
     ReferenceName, SigmaSource, StaticsName,
 };
 use crate::failure::CliError;
+
+/// `cir track --targets auto` (several people, issue 41).
+#[path = "cir_multi.rs"]
+mod cir_multi;
 
 /// Reads the recording `--flag PATH` (.npz, docs/recording.md, or a CSI tool's file read as
 /// `csi` says), checked against `model`.
@@ -282,22 +289,7 @@ pub fn cir_estimate(args: &CirEstimateArgs) -> Result<(), CliError> {
         files.json("snapshots", p, &doc)?;
     }
     if let (Some(p), Some((dt, q))) = (&args.measurements, measurements) {
-        let doc = Measurements {
-            dt_s: dt,
-            process_noise: q,
-            initial_state: None,
-            initial_covariance: None,
-            initial_snapshot: Some(Measurements::raw_step(&snaps[0])),
-            sigma_s: None,
-            steps: None,
-            raw_steps: Some(
-                snaps[1..]
-                    .iter()
-                    .map(|s| Measurements::raw_step(s))
-                    .collect(),
-            ),
-        };
-        files.json("measurements", p, &doc)?;
+        files.json("measurements", p, &recording_measurements(&snaps, dt, q))?;
     }
     if let Some(p) = &args.detections_out {
         let d = Detections::from_paths(&model.network.links, &est.t_s, &est.recorded, &est.paths);
@@ -325,20 +317,8 @@ pub fn cir_estimate(args: &CirEstimateArgs) -> Result<(), CliError> {
 /// The uniform step of `t_s` (within 1e-6 relative), checked as a CV model with `q`, for
 /// `--measurements` (a measurements file has one `dt_s`).
 fn uniform_dt(t_s: &[f64], q: f64) -> Result<(f64, f64), CliError> {
-    if t_s.len() < 2 {
-        return Err(CliError::usage(
-            "--measurements: the recording has fewer than 2 snapshots",
-        ));
-    }
-    let dt = (t_s[t_s.len() - 1] - t_s[0]) / (t_s.len() - 1) as f64;
-    if let Some(k) = (1..t_s.len()).find(|&k| ((t_s[k] - t_s[k - 1]) - dt).abs() > 1e-6 * dt) {
-        return Err(CliError::usage(format!(
-            "--measurements: the recording's snapshots are not uniform in time (t_s[{k}] − \
-             t_s[{}] = {} s, the mean step is {dt} s); a measurements file has one dt_s",
-            k - 1,
-            t_s[k] - t_s[k - 1]
-        )));
-    }
+    let dt = uniform_step(t_s)
+        .map_err(|e| at_flag("measurements", format_args!("the recording's {e}")))?;
     // `q` is the flag's; the step is the recording's.
     ConstantVelocity::validated(dt, q).map_err(|e| match e.field() {
         Some("dt_s") => at_flag(
@@ -362,6 +342,10 @@ pub fn cir_track(args: &CirTrackArgs) -> Result<(), CliError> {
             ))
         }
     };
+    if args.targets.is_some() {
+        return cir_multi::cir_track_several(args, cir, out);
+    }
+    cir_multi::multi_flags_need_targets(args)?;
     one_stdin(&[
         ("scenario", Some(&args.scenario)),
         ("cir", Some(cir)),
@@ -552,7 +536,8 @@ pub fn cir_simulate(args: &CirSimulateArgs) -> Result<(), CliError> {
                 scatterloc::Error::Cancelled => super::study::cancelled(),
                 e => fail(e),
             })?;
-        let (rec, cal, truth) = (sim.recording, sim.calibration, sim.truth);
+        let truth = sim.truth_file();
+        let (rec, cal) = (sim.recording, sim.calibration);
         let enc = |r: &Recording| {
             npz::write_recording(r).map_err(|e| CliError::output(format!("--out-dir: {e}")))
         };

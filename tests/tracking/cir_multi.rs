@@ -1,0 +1,243 @@
+//! Issue 41 §3, "a recording": two simulated walkers who cross, at the signal level — the
+//! channel simulator with a further walker (`ChannelScene::others`), the front end of `cir
+//! track` (background subtraction against the empty area's recording, C5–C10) and the
+//! multi-target tracker ([`cir_track_multi`], PMB, [`recording_multi_settings`]). Both walkers
+//! are tracked after the first second (GOSPA with c = 1 m: the localisation part per assigned
+//! walker below c/2, a walker missed in at most a third of the scans) and their labels are kept
+//! through the crossing (`track::multi::score_run`'s switches per walker over the scans from a
+//! second before the first walker passes the crossing point to a second after the second one
+//! does) in at least 9 of 10 seeds. The scene: [`crate::crossing`].
+//!
+//! Measured (debug build, 2026-12-07; per seed 1–10: mean GOSPA m after the first second,
+//! localisation RMS per assigned walker m, scans with a walker missed / 154, switches of
+//! walkers 0 and 1 after the first second, in the crossing): 1: 0.617, 0.382, 38, [0, 0],
+//! [0, 0]; 2: 0.466, 0.289, 0, [0, 1], [0, 0]; 3: 0.491, 0.372, 2, [0, 0], [0, 0]; 4: 0.381,
+//! 0.288, 3, [0, 0], [0, 0]; 5: 0.428, 0.330, 7, [0, 0], [0, 0]; 6: 0.545, 0.377, 18, [0, 0],
+//! [0, 0]; 7: 0.515, 0.360, 22, [0, 0], [0, 0]; 8: 0.533, 0.380, 9, [1, 1], [1, 1]; 9: 0.423,
+//! 0.325, 3, [0, 0], [0, 0]; 10: 0.610, 0.370, 18, [0, 2], [0, 0] — kept through the crossing
+//! in 9 of 10 (seed 8 swaps the labels there); the switches of seeds 2 and 10 are a duplicate
+//! track of walker 1 in the first 1.5 s that dies out. With the body–wall double reflections
+//! on, the tracker confirms 3–7 targets (their echoes) on seeds 1–3.
+
+use scatterloc::channel::{ChannelScene, SimulationRequest};
+use scatterloc::error::Cancel;
+use scatterloc::scenario::presets;
+use scatterloc::study::{
+    cir_track_multi, estimate_recording, recording_multi_settings, walkers_truth, ChannelRequest,
+    ChannelStatics, MultiTrackOutput, MultiTruth, RecordingEstimates, Sequential,
+    RECORDING_CLUTTER, RECORDING_DETECTION, RECORDING_EXTENT_SIGMA_M,
+};
+use scatterloc::track::multi::{score_run, RunScore, StepScore, TargetEstimate, Truth};
+use scatterloc::track::GospaConfig;
+use scatterloc::{Model, Scenario};
+use std::ops::Range;
+
+/// GOSPA's cut-off, m.
+const C_M: f64 = 1.0;
+/// Snapshots in a second (20 Hz; the first is not scored: a birth needs a few scans).
+const SECOND: usize = 20;
+
+/// The crossing scene ([`crate::crossing`]).
+fn crossing_scene() -> ChannelScene {
+    serde_json::from_value(crate::crossing::crossing_scene()).unwrap()
+}
+
+/// The sensors2019 scenario and its model.
+fn scenario() -> (Scenario, Model) {
+    let s = presets::preset("sensors2019").unwrap();
+    let m = Model::new(&s).unwrap();
+    (s, m)
+}
+
+/// A simulated seed through the front end.
+struct Front {
+    statics: ChannelStatics,
+    est: RecordingEstimates,
+    truth: MultiTruth,
+}
+
+/// Simulates `seed` and estimates it as `cir track` does (its default request, the empty
+/// area's recording).
+fn front(scenario: &Scenario, model: &Model, seed: u64) -> Front {
+    let sim = SimulationRequest {
+        scene: Some(crossing_scene()),
+        seed,
+        ..SimulationRequest::default()
+    }
+    .run(scenario, model, Cancel::NEVER)
+    .unwrap();
+    assert_eq!(sim.others.len(), 1);
+    let req = ChannelRequest::default();
+    let (statics, est) = estimate_recording(
+        model,
+        scenario.radio.bandwidth_hz,
+        &sim.recording,
+        Some(&sim.calibration),
+        &req.front_end(sim.recording.synchronized),
+        &mut Sequential::new(),
+        &|_| {},
+    )
+    .unwrap();
+    let truth = walkers_truth(&sim.truth.t_s, &sim.truth.states, &sim.others).unwrap();
+    Front {
+        statics,
+        est,
+        truth,
+    }
+}
+
+/// The multi-target track of `f` with the recording's defaults.
+fn track(scenario: &Scenario, model: &Model, f: &Front) -> MultiTrackOutput {
+    cir_track_multi(
+        model,
+        &scenario.area_m,
+        &f.statics.calibration,
+        &f.est,
+        &recording_multi_settings(model.link_count()),
+        ChannelRequest::default().process_noise,
+        RECORDING_EXTENT_SIGMA_M,
+        Cancel::NEVER,
+    )
+    .unwrap()
+}
+
+/// The core's score of `out` against `truth` over the scans `range` (c = 1 m, p = 2).
+fn score(out: &MultiTrackOutput, truth: &MultiTruth, range: Range<usize>) -> RunScore {
+    let est: Vec<Vec<TargetEstimate>> = out.targets[range.clone()]
+        .iter()
+        .map(|s| {
+            s.iter()
+                .map(|t| TargetEstimate {
+                    label: t.label,
+                    state: t.state.into(),
+                    covariance: scatterloc::math::Mat4::from_fn(|i, j| t.covariance[i][j]),
+                    existence: t.existence,
+                })
+                .collect()
+        })
+        .collect();
+    let t = Truth {
+        steps: truth.to_truth().steps[range].to_vec(),
+    };
+    score_run(&t, &est, &GospaConfig { c: C_M, p: 2.0 }).unwrap()
+}
+
+/// The scans of the crossing: from a second before the first walker is nearest the crossing
+/// point to a second after the second one is.
+fn crossing_scans(truth: &MultiTruth) -> Range<usize> {
+    let [cx, cy] = crate::crossing::CROSSING_M;
+    let nearest = |w: usize| {
+        (0..truth.t_s.len())
+            .min_by(|&a, &b| {
+                let d = |k: usize| {
+                    let s = truth.targets[k][w].state;
+                    (s[0] - cx).hypot(s[1] - cy)
+                };
+                d(a).total_cmp(&d(b))
+            })
+            .unwrap()
+    };
+    let (a, b) = (nearest(0).min(nearest(1)), nearest(0).max(nearest(1)));
+    a.saturating_sub(SECOND)..(b + SECOND + 1).min(truth.t_s.len())
+}
+
+/// Walkers missed in a step: each costs `c²/2` of the missed part (α = 2).
+fn missed(x: &StepScore) -> f64 {
+    (x.missed * 2.0 / (C_M * C_M)).round()
+}
+
+/// Checks one seed: one scan per snapshot, two walkers in every truth scan; after the first
+/// second the localisation RMS per assigned walker below c/2 and a walker missed in at most a
+/// third of the scans. Returns whether the labels were kept through the crossing (no switch of
+/// either walker over [`crossing_scans`]).
+fn check_seed(scenario: &Scenario, model: &Model, seed: u64) -> bool {
+    let f = front(scenario, model, seed);
+    let out = track(scenario, model, &f);
+    assert_eq!(out.t_s, f.truth.t_s, "one scan per snapshot");
+    assert!(f.truth.targets.iter().all(|t| t.len() == 2));
+    let s = score(&out, &f.truth, SECOND..out.t_s.len());
+    let scans = s.steps.len();
+    let mean = s.steps.iter().map(|x| x.gospa).sum::<f64>() / scans as f64;
+    let assigned: f64 = s.steps.iter().map(|x| 2.0 - missed(x)).sum();
+    let loc = (s.steps.iter().map(|x| x.localisation).sum::<f64>() / assigned).sqrt();
+    let missed_scans = s.steps.iter().filter(|x| missed(x) > 0.0).count();
+    let per_walker = |r: &RunScore| -> Vec<usize> {
+        (0..2u64)
+            .map(|t| r.switches.get(&t).copied().unwrap_or(0))
+            .collect()
+    };
+    let window = crossing_scans(&f.truth);
+    let crossing = per_walker(&score(&out, &f.truth, window.clone()));
+    eprintln!(
+        "seed {seed}: mean GOSPA {mean:.3} m, localisation {loc:.3} m, a walker missed in \
+         {missed_scans}/{scans} scans, switches after 1 s {:?}, in the crossing (scans \
+         {window:?}) {crossing:?}, labels {}",
+        per_walker(&s),
+        out.tracks.len()
+    );
+    assert!(loc < 0.5 * C_M, "seed {seed}: localisation {loc} m");
+    assert!(
+        3 * missed_scans <= scans,
+        "seed {seed}: a walker missed in {missed_scans} of {scans} scans"
+    );
+    crossing.iter().all(|&k| k == 0)
+}
+
+/// Issue 41 §3: ten seeds, both walkers tracked after the first second in every seed and
+/// their labels kept through the crossing in at least nine (measured: all but seed 8; ≈ 5 s in
+/// a debug build).
+#[test]
+fn labels_are_kept_through_the_crossing_in_nine_of_ten_seeds() {
+    let (s, m) = scenario();
+    let kept = (1..=10).filter(|&seed| check_seed(&s, &m, seed)).count();
+    assert!(kept >= 9, "labels kept in {kept} of 10 seeds");
+}
+
+/// What the front end gives the tracker on seed 1, against the recording defaults: per walker
+/// and link the share of snapshots with an estimate (not static) within 1.5 ns of its
+/// bistatic delay is at most [`RECORDING_DETECTION`] on average and not far below it, and the
+/// estimates that are neither static nor within 1.5 ns of a walker, per link and snapshot, are
+/// fewer than [`RECORDING_CLUTTER`] (measured: P_D 0.52–0.71 per walker and link, mean 0.63;
+/// 1.45 such estimates per link and snapshot, 1.29 of them within 1.5 ns of no true path at
+/// all; without the body–wall double reflections).
+#[test]
+fn the_front_end_detects_and_clutters_as_the_defaults_say() {
+    let (scenario, model) = scenario();
+    let f = front(&scenario, &model, 1);
+    let links = model.link_count();
+    let (mut hits, mut clutter) = (0usize, 0usize);
+    for k in 0..f.est.len() {
+        let snap = f.est.snapshot(k);
+        for (p, list) in snap.iter().enumerate() {
+            let free: Vec<f64> = list
+                .iter()
+                .map(|e| e.delay_s)
+                .filter(|d| !f.statics.calibration.links[p].is_static(*d))
+                .collect();
+            let direct: Vec<f64> = f.truth.targets[k]
+                .iter()
+                .map(|t| {
+                    let r = scatterloc::math::Vec2::new(t.state[0], t.state[1]);
+                    model.network.delay(p, r)
+                })
+                .collect();
+            hits += direct
+                .iter()
+                .filter(|t| free.iter().any(|d| (d - *t).abs() < 1.5e-9))
+                .count();
+            clutter += free
+                .iter()
+                .filter(|d| !direct.iter().any(|t| (*d - t).abs() < 1.5e-9))
+                .count();
+        }
+    }
+    let link_scans = (f.est.len() * links) as f64;
+    let pd = hits as f64 / (2.0 * link_scans);
+    let per_scan = clutter as f64 / link_scans;
+    eprintln!("P_D {pd:.3}, clutter {per_scan:.3} per link and snapshot");
+    assert!(
+        (RECORDING_DETECTION - 0.2..=RECORDING_DETECTION).contains(&pd),
+        "P_D {pd}"
+    );
+    assert!(per_scan > 0.0 && per_scan < RECORDING_CLUTTER, "{per_scan}");
+}
