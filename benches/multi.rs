@@ -4,8 +4,9 @@
 //! one scan of the PMB tracker and of the GNN baseline on the people scenario (2 Tx × 4 Rx, 5
 //! walkers, P_D = 0.9, 5 clutter delays per link, 10 Hz), timed over the 80 scans after the
 //! first 20 (every target confirmed: the steady state), so the time per element is the time per
-//! scan including the birth search on the scan's free delays; and the birth search alone on a
-//! scan with no track (every delay free).
+//! scan including the birth search on the scan's free delays (over the walk region, 1221 cells,
+//! and over the scenario's whole area, 21 900 cells); and the birth search alone on a scan with
+//! no track (every delay free).
 //!
 //! Run: `cargo bench --bench multi` (shorter: `-- --warm-up-time 1 --measurement-time 3`).
 
@@ -35,10 +36,21 @@ fn benches(c: &mut Criterion) {
         None,
     )
     .unwrap();
+    // Births over the whole scenario area (37.5 m × 36 m, 21 900 cells): the CLI's default.
+    let area_grid = BirthGrid::new(
+        &model,
+        DelayBirth::new(people_layout().area_m, model.link_count()),
+        None,
+    )
+    .unwrap();
     let trackers = [
         (
             "pmb",
             MultiTracker::Pmb(Pmb::new(cfg, Births::Delays(grid.clone())).unwrap()),
+        ),
+        (
+            "pmb_births_over_the_area",
+            MultiTracker::Pmb(Pmb::new(cfg, Births::Delays(area_grid.clone())).unwrap()),
         ),
         (
             "gnn",
@@ -69,6 +81,9 @@ fn benches(c: &mut Criterion) {
         .collect();
     c.bench_function("birth_search_5_walkers_8_links", |b| {
         b.iter(|| black_box(grid.search(&model, black_box(&free), None).len()))
+    });
+    c.bench_function("birth_search_5_walkers_8_links_over_the_area", |b| {
+        b.iter(|| black_box(area_grid.search(&model, black_box(&free), None).len()))
     });
 }
 

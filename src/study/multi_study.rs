@@ -468,7 +468,7 @@ pub struct MultiStudyDoc {
 pub fn multi_study_doc(cfg: &MultiStudyConfig, s: &MultiSums) -> MultiStudyDoc {
     let n = (s.runs.max(1)) as f64;
     let mean = |v: &[ExactSum]| v.iter().map(|x| x.value() / n).collect::<Vec<f64>>();
-    let first = ((1.0 / cfg.dt_s).round() as usize).min(cfg.steps);
+    let first = (crate::math::round(1.0 / cfg.dt_s) as usize).min(cfg.steps);
     let bound_after: f64 = s.bound[first..].iter().map(|b| b.value()).sum();
     let methods: Vec<MethodDoc> = s
         .methods

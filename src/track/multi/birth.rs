@@ -127,6 +127,10 @@ pub struct BirthGrid {
     delay: Vec<Real>,
     /// `cells × links`: tolerance, s.
     tolerance: Vec<Real>,
+    /// Per link, the cells in increasing order of their delay, and those delays.
+    by_delay: Vec<(Vec<u32>, Vec<Real>)>,
+    /// Per link, the largest tolerance of any cell, s.
+    max_tolerance: Vec<Real>,
 }
 
 /// A proposed new target: its fix, the fix's covariance, the delay used per link (index into
@@ -186,12 +190,36 @@ impl BirthGrid {
                 }
             }
         }
+        // Per link, the cells sorted by delay: a free delay's candidate cells are one range.
+        let n = cells.len();
+        let by_delay = (0..links)
+            .map(|p| {
+                let mut order: Vec<u32> = (0..n as u32).collect();
+                order.sort_by(|&a, &b| {
+                    delay[a as usize * links + p].total_cmp(&delay[b as usize * links + p])
+                });
+                let d = order
+                    .iter()
+                    .map(|&c| delay[c as usize * links + p])
+                    .collect();
+                (order, d)
+            })
+            .collect();
+        let max_tolerance = (0..links)
+            .map(|p| {
+                (0..n)
+                    .map(|c| tolerance[c * links + p])
+                    .fold(0.0, Real::max)
+            })
+            .collect();
         Ok(BirthGrid {
             settings,
             cells,
             links,
             delay,
             tolerance,
+            by_delay,
+            max_tolerance,
         })
     }
 
@@ -222,6 +250,8 @@ impl BirthGrid {
             .collect();
         let mut births = Vec::new();
         let mut tried = vec![false; self.cells.len()];
+        let mut counts = vec![0u16; self.cells.len()];
+        let mut seen = vec![0u16; self.cells.len()];
         let mut refinements = 0;
         while births.len() < s.max_per_scan && refinements < s.max_candidates {
             let links_with_free = sorted.iter().filter(|v| !v.is_empty()).count();
@@ -229,10 +259,13 @@ impl BirthGrid {
                 break;
             }
             // The best untried cell: most links with a free delay in tolerance, then the
-            // smallest sum of squared normalised misfits.
+            // smallest sum of squared normalised misfits. Cells are counted first through each
+            // link's delay order (a free delay's cells are one range), so only cells that reach
+            // `min_links` are scored.
+            self.count_hits(&sorted, &mut counts, &mut seen);
             let mut best: Option<(usize, usize, Real)> = None;
-            for (c, _) in self.cells.iter().enumerate() {
-                if tried[c] {
+            for c in 0..self.cells.len() {
+                if tried[c] || (counts[c] as usize) < s.min_links {
                     continue;
                 }
                 let (mut count, mut misfit) = (0usize, 0.0);
@@ -278,6 +311,29 @@ impl BirthGrid {
             }
         }
         births
+    }
+
+    /// `counts[c]` = the links with a free delay within cell `c`'s tolerance (`seen` marks the
+    /// link a cell was last counted for, so two delays of one link count once).
+    fn count_hits(&self, sorted: &[Vec<(Real, usize)>], counts: &mut [u16], seen: &mut [u16]) {
+        counts.iter_mut().for_each(|v| *v = 0);
+        seen.iter_mut().for_each(|v| *v = 0);
+        for (p, list) in sorted.iter().enumerate() {
+            let (order, delays) = &self.by_delay[p];
+            let m = self.max_tolerance[p];
+            for &(d, _) in list {
+                let lo = delays.partition_point(|&x| x < d - m);
+                let hi = delays.partition_point(|&x| x <= d + m);
+                for &c in &order[lo..hi] {
+                    let c = c as usize;
+                    let k = c * self.links + p;
+                    if seen[c] != p as u16 + 1 && (d - self.delay[k]).abs() <= self.tolerance[k] {
+                        seen[c] = p as u16 + 1;
+                        counts[c] = counts[c].saturating_add(1);
+                    }
+                }
+            }
+        }
     }
 
     fn refine(
