@@ -46,6 +46,9 @@ pub struct MultiSettings {
     pub survival: f64,
     /// A target is reported above this existence (default 0.5).
     pub existence_threshold: f64,
+    /// Association marginals exact in clusters of at most this many tracks and delays, loopy
+    /// BP beyond (default 6; 0 = BP everywhere; at most 8).
+    pub exact_cluster: usize,
 }
 
 impl Default for MultiSettings {
@@ -61,6 +64,7 @@ impl Default for MultiSettings {
             birth_min_links: None,
             survival: 0.99,
             existence_threshold: 0.5,
+            exact_cluster: 6,
         }
     }
 }
@@ -216,6 +220,7 @@ pub fn multi_tracker(
     let cfg = MultiConfig {
         survival: settings.survival,
         existence_threshold: settings.existence_threshold,
+        exact_cluster: settings.exact_cluster,
         ..MultiConfig::new(motion)
     };
     let mut birth = DelayBirth::new(settings.birth_region.unwrap_or(*area), links);

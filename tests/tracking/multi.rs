@@ -7,9 +7,10 @@
 use scatterloc::math::{Mat4, Real, Vec2, Vec4};
 use scatterloc::measure::{rng, uniform01};
 use scatterloc::track::multi::{
-    bp_marginals, exact_marginals, kalman_update, map_cardinality, people_layout, people_region,
-    BirthGrid, Births, DelayBirth, DelayLinks, Detection, MultiConfig, Pmb, PositionSensor,
-    MAX_BP_ITERATIONS, MAX_DETECTIONS_PER_SENSOR,
+    bp_marginals, clustered_marginals, exact_marginals, kalman_update, map_cardinality,
+    people_layout, people_region, BirthGrid, Births, DelayBirth, DelayLinks, Detection,
+    MultiConfig, Pmb, PositionSensor, MAX_BP_ITERATIONS, MAX_DETECTIONS_PER_SENSOR,
+    MAX_EXACT_CLUSTER,
 };
 use scatterloc::track::ConstantVelocity;
 use scatterloc::Model;
@@ -63,6 +64,51 @@ fn bp_is_exact_on_trees_and_close_on_loops() {
     // Loopy BP is approximate on loops; measured worst error over 300 random 3 × 4 problems.
     assert!(worst_loop < 0.15, "loopy BP error {worst_loop}");
     println!("loopy BP worst marginal error over 300 problems: {worst_loop:.4}");
+}
+
+#[test]
+fn clustered_marginals_are_exact_per_small_cluster_and_bp_on_a_large_one() {
+    // Block-diagonal weights: clusters of 2 × 3 and 3 × 2 (and an unlinked track and measurement)
+    // enumerate exactly, so the whole equals the exact marginals of the whole problem.
+    for seed in 0..200u64 {
+        let (n, m) = (6, 6);
+        let a = random_psi(2, 3, seed);
+        let b = random_psi(3, 2, seed + 7000);
+        let mut psi = vec![0.0; n * m];
+        for i in 0..2 {
+            for j in 0..3 {
+                psi[i * m + j] = a[i * 3 + j];
+            }
+        }
+        for i in 0..3 {
+            for j in 0..2 {
+                psi[(i + 2) * m + j + 3] = b[i * 2 + j];
+            }
+        }
+        let (c, ex) = (
+            clustered_marginals(&psi, n, m, 6),
+            exact_marginals(&psi, n, m),
+        );
+        for (x, y) in c
+            .track
+            .iter()
+            .zip(&ex.track)
+            .chain(c.free.iter().zip(&ex.free))
+        {
+            assert!((x - y).abs() < 1e-12, "seed {seed}: {x} vs {y}");
+        }
+    }
+    // One cluster larger than the exact limit (6, and the cap MAX_EXACT_CLUSTER), or exact = 0:
+    // loopy BP on it, bit for bit.
+    for (k, exact) in [(7, 6), (MAX_EXACT_CLUSTER + 1, usize::MAX), (3, 0)] {
+        let psi: Vec<Real> = (0..k * k).map(|v| 1.0 + (v % 5) as Real).collect();
+        let (c, bp) = (
+            clustered_marginals(&psi, k, k, exact),
+            bp_marginals(&psi, k, k),
+        );
+        assert_eq!(c.track, bp.track);
+        assert_eq!(c.free, bp.free);
+    }
 }
 
 #[test]

@@ -179,3 +179,82 @@ pub fn gnn_assignment(cost: &[Option<Real>], n: usize, m: usize) -> Vec<Option<u
         .map(|(i, j)| j.filter(|&j| j < m && cost[i * m + j].is_some_and(|v| v < 0.0)))
         .collect()
 }
+
+/// Most tracks or measurements of a cluster whose marginals [`clustered_marginals`] may
+/// enumerate exactly (at most 8! · 2⁸ associations; larger clusters go to [`bp_marginals`]).
+pub const MAX_EXACT_CLUSTER: usize = 8;
+
+/// The marginals by clusters: the tracks and measurements linked by gated pairs (`ψ > 0`) form
+/// independent clusters; a cluster of at most `exact` tracks and `exact` measurements (capped at
+/// [`MAX_EXACT_CLUSTER`]) is enumerated exactly ([`exact_marginals`]), a larger one runs loopy
+/// BP (`exact = 0`: BP everywhere). Tracks and measurements outside every pair are unassociated
+/// / free with probability 1.
+pub fn clustered_marginals(psi: &[Real], n: usize, m: usize, exact: usize) -> Marginals {
+    let exact = exact.min(MAX_EXACT_CLUSTER);
+    // Union–find over n tracks then m measurements.
+    let mut parent: Vec<usize> = (0..n + m).collect();
+    fn root(parent: &mut [usize], mut x: usize) -> usize {
+        while parent[x] != x {
+            parent[x] = parent[parent[x]];
+            x = parent[x];
+        }
+        x
+    }
+    for i in 0..n {
+        for j in 0..m {
+            if psi[i * m + j] > 0.0 {
+                let (a, b) = (root(&mut parent, i), root(&mut parent, n + j));
+                if a != b {
+                    parent[a.max(b)] = a.min(b);
+                }
+            }
+        }
+    }
+    let mut track = vec![0.0; n * (m + 1)];
+    let mut free = vec![1.0; m];
+    for i in 0..n {
+        track[i * (m + 1)] = 1.0;
+    }
+    let (mut iterations, mut converged) = (0, true);
+    let mut done = vec![false; n + m];
+    for start in 0..n {
+        let r = root(&mut parent, start);
+        if done[r] {
+            continue;
+        }
+        done[r] = true;
+        let rows: Vec<usize> = (0..n).filter(|&i| root(&mut parent, i) == r).collect();
+        let cols: Vec<usize> = (0..m).filter(|&j| root(&mut parent, n + j) == r).collect();
+        if cols.is_empty() {
+            continue;
+        }
+        let (cn, cm) = (rows.len(), cols.len());
+        let sub: Vec<Real> = rows
+            .iter()
+            .flat_map(|&i| cols.iter().map(move |&j| psi[i * m + j]))
+            .collect();
+        let mg = if cn <= exact && cm <= exact {
+            exact_marginals(&sub, cn, cm)
+        } else {
+            bp_marginals(&sub, cn, cm)
+        };
+        iterations += mg.iterations;
+        converged &= mg.converged;
+        for (a, &i) in rows.iter().enumerate() {
+            let row = &mut track[i * (m + 1)..(i + 1) * (m + 1)];
+            row[0] = mg.track[a * (cm + 1)];
+            for (b, &j) in cols.iter().enumerate() {
+                row[j + 1] = mg.track[a * (cm + 1) + b + 1];
+            }
+        }
+        for (b, &j) in cols.iter().enumerate() {
+            free[j] = mg.free[b];
+        }
+    }
+    Marginals {
+        track,
+        free,
+        iterations,
+        converged,
+    }
+}

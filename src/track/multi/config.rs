@@ -35,6 +35,10 @@ pub struct MultiConfig {
     pub prune: Real,
     /// Most Bernoullis kept (default 200, at most [`MAX_TRACKS`]).
     pub max_bernoullis: usize,
+    /// Association marginals are enumerated exactly in clusters of at most this many tracks and
+    /// measurements, loopy BP beyond (default 6; 0 = BP everywhere; at most
+    /// [`crate::track::multi::MAX_EXACT_CLUSTER`]).
+    pub exact_cluster: usize,
 }
 
 impl MultiConfig {
@@ -47,6 +51,7 @@ impl MultiConfig {
             existence_threshold: 0.5,
             prune: 1e-4,
             max_bernoullis: 200,
+            exact_cluster: 6,
         }
     }
 
@@ -71,6 +76,14 @@ impl MultiConfig {
             return Err(Error::NotPositive {
                 field: "gate".into(),
                 value: self.gate,
+            });
+        }
+        if self.exact_cluster > crate::track::multi::MAX_EXACT_CLUSTER {
+            return Err(Error::SizeLimit {
+                field: "exact_cluster",
+                value: self.exact_cluster,
+                min: 0,
+                max: crate::track::multi::MAX_EXACT_CLUSTER,
             });
         }
         if self.max_bernoullis == 0 || self.max_bernoullis > MAX_TRACKS {

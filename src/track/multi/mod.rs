@@ -17,7 +17,8 @@ mod sensors;
 mod sim;
 
 pub use association::{
-    bp_marginals, exact_marginals, gnn_assignment, Marginals, BP_TOLERANCE, MAX_BP_ITERATIONS,
+    bp_marginals, clustered_marginals, exact_marginals, gnn_assignment, Marginals, BP_TOLERANCE,
+    MAX_BP_ITERATIONS, MAX_EXACT_CLUSTER,
 };
 pub use birth::{BirthFix, BirthGrid, DelayBirth, MAX_BIRTH_CELLS};
 pub use config::{

@@ -1,14 +1,16 @@
 //! The multi-target tracker of issue 41: a Poisson multi-Bernoulli (PMB) filter with the
 //! track-oriented marginal update (TOMB/P; Williams, IEEE TAES 51(3), 2015) whose association
-//! marginals come from loopy belief propagation ([`bp_marginals`]), one sensor (link) after the
-//! other as in Meyer et al. (IEEE TSP 65(13), 2017): per scan the cost is linear in sensors and
-//! in gated (track, measurement) pairs.
+//! marginals are computed per cluster of gated pairs ([`clustered_marginals`]): exactly for a
+//! cluster of at most `exact_cluster` (default 6) tracks and measurements, by loopy belief propagation
+//! ([`crate::track::multi::bp_marginals`]) beyond; one sensor (link) after the other as in Meyer
+//! et al. (IEEE TSP 65(13), 2017): per scan the cost is linear in sensors and in gated
+//! (track, measurement) pairs for bounded clusters.
 //!
 //! - Each target is a [`Bernoulli`]: existence `r`, a Gaussian on `[x, y, vx, vy]` moved by the
 //!   CV model (E7) with survival `p_S`, and a label kept for its life.
 //! - Sensor `s` with measurements `z_1 … z_m`: `ψ_ij = r_i P_D 𝒩(z_j; ẑ_i, S_ij) /
 //!   ((1 − r_i P_D)(λ_c f_c + e_j))` inside the gate, where `e_j = P_D ∫ λ_u(x) 𝒩(z_j; h(x), R)`
-//!   is the undetected targets' share (position sensors). BP gives `p_i0`, `p_ij` and each
+//!   is the undetected targets' share (position sensors). The marginals are `p_i0`, `p_ij` and each
 //!   measurement's free probability `q_j`.
 //! - Bernoulli `i` becomes the moment match of "missed" (`r_i(1 − P_D)/(1 − r_i P_D)`, weight
 //!   `p_i0`) and "produced `z_j`" (existence 1, the EKF update, weight `p_ij`).
@@ -24,7 +26,7 @@ use alloc::vec::Vec;
 
 use crate::error::Result;
 use crate::math::{exp, Mat4, Real, Vec4};
-use crate::track::multi::association::bp_marginals;
+use crate::track::multi::association::clustered_marginals;
 use crate::track::multi::birth::BirthGrid;
 use crate::track::multi::gaussian::{by_weight_desc, kalman_update, moment_match, Bernoulli};
 use crate::track::multi::sensors::{Detection, MeasurementModel};
@@ -200,7 +202,7 @@ impl Pmb {
                 }
             }
         }
-        let marg = bp_marginals(&psi, n, m);
+        let marg = clustered_marginals(&psi, n, m, self.config.exact_cluster);
         self.last_bp_iterations += marg.iterations;
         for (i, b) in self.bernoullis.iter_mut().enumerate() {
             let row = &marg.track[i * (m + 1)..(i + 1) * (m + 1)];
