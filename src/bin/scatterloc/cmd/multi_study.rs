@@ -19,7 +19,7 @@ use scatterloc::study::{
 use scatterloc::track::multi::people_layout;
 
 use super::io::{emit, emit_summary};
-use super::output::{check_writable, Figure, Format, OutputSet};
+use super::output::{result_outputs, Figure, FigureOut, OutputSet};
 use super::parts::PartReader;
 use super::shard;
 use super::study::{flag_error, load_layout, run_with_bar, threads};
@@ -115,7 +115,7 @@ pub fn multi_montecarlo(args: &MontecarloArgs, walkers: usize) -> Result<(), Cli
         let part = PartFile::new("multi-target", &cfg, &doc, &timing, &sums);
         return shard::write_part(&path, &part, &Counted { runs: sums.runs });
     }
-    let (figure, json) = outputs(args.out.as_deref(), args.json.as_deref())?;
+    let (figure, json) = result_outputs(args.out.as_deref(), args.json.as_deref())?;
     let (sums, wall) = run(&cfg, 0..cfg.runs, threads, &format!("{walkers} walkers"))?;
     write_result(&multi_study_doc(&cfg, &sums), wall, used, json, figure)
 }
@@ -129,31 +129,8 @@ pub fn merge_multi(
 ) -> Result<(), CliError> {
     let (cfg, sums, wall, threads) = MultiStudy::merge(set, &mut |p| reader.load(p))
         .map_err(|e| CliError::usage(e.to_string()))?;
-    let (figure, json) = outputs(out, Some(json))?;
+    let (figure, json) = result_outputs(out, Some(json))?;
     write_result(&multi_study_doc(&cfg, &sums), wall, threads, json, figure)
-}
-
-type FigureOut<'a> = Option<(&'a str, Format)>;
-
-fn outputs<'a>(
-    out: Option<&'a str>,
-    json: Option<&'a str>,
-) -> Result<(FigureOut<'a>, Option<&'a str>), CliError> {
-    let figure = match out {
-        Some(p) => Some((p, Format::of("out", p, &[Format::Svg, Format::Png])?)),
-        None => None,
-    };
-    let json = match json {
-        Some(p) => Format::of("json", p, &[Format::Json]).map(|_| Some(p))?,
-        None => None,
-    };
-    if let Some((p, _)) = figure {
-        check_writable("out", p)?;
-    }
-    if let Some(p) = json {
-        check_writable("json", p)?;
-    }
-    Ok((figure, json))
 }
 
 /// The `--json` document: the study's result with the run's wall time and threads.

@@ -452,3 +452,28 @@ pub fn write_figure(
     out.figure(flag, path, format, size, figure)?;
     out.commit()
 }
+
+/// A figure to write: its path and format (`--out`).
+pub type FigureOut<'a> = Option<(&'a str, Format)>;
+
+/// `--out` and `--json` of a result: formats checked, both writable.
+pub fn result_outputs<'a>(
+    out: Option<&'a str>,
+    json: Option<&'a str>,
+) -> Result<(FigureOut<'a>, Option<&'a str>), CliError> {
+    let figure = match out {
+        Some(p) => Some((p, Format::of("out", p, &[Format::Svg, Format::Png])?)),
+        None => None,
+    };
+    let json = match json {
+        Some(p) => Format::of("json", p, &[Format::Json]).map(|_| Some(p))?,
+        None => None,
+    };
+    if let Some((p, _)) = figure {
+        check_writable("out", p)?;
+    }
+    if let Some(p) = json {
+        check_writable("json", p)?;
+    }
+    Ok((figure, json))
+}

@@ -3,6 +3,7 @@
 //! realisations) or whole, and the merge of its part files.
 
 use super::*;
+use super::super::output::{result_outputs, FigureOut};
 
 /// Runs the realisations `range` of `cfg` on `threads` threads under the shared progress bar
 /// ([`run_with_bar`]) labelled `label`; Ctrl-C stops it with exit status 130. Returns the tally
@@ -209,31 +210,6 @@ fn roc_config(f: &RocFlags) -> Result<ExperimentConfig, CliError> {
         f.max_candidates,
     )
     .map_err(|e| core_error(&e, "mtl roc"))
-}
-
-/// A figure to write: its path and format.
-type FigureOut<'a> = Option<(&'a str, Format)>;
-
-/// `--out` and `--json` of a result: formats checked, both writable.
-fn result_outputs<'a>(
-    out: Option<&'a str>,
-    json: Option<&'a str>,
-) -> Result<(FigureOut<'a>, Option<&'a str>), CliError> {
-    let figure = match out {
-        Some(p) => Some((p, Format::of("out", p, &[Format::Svg, Format::Png])?)),
-        None => None,
-    };
-    let json = match json {
-        Some(p) => Format::of("json", p, &[Format::Json]).map(|_| Some(p))?,
-        None => None,
-    };
-    if let Some((p, _)) = figure {
-        check_writable("out", p)?;
-    }
-    if let Some(p) = json {
-        check_writable("json", p)?;
-    }
-    Ok((figure, json))
 }
 
 /// The validated experiment of `mtl roc`'s flags (errors name the flags); `slurm submit`
