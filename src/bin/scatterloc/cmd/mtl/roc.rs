@@ -2,8 +2,8 @@
 //! table, JSON and a figure; sharded (`--shard I/N`: a part file of the tally of its
 //! realisations) or whole, and the merge of its part files.
 
-use super::*;
 use super::super::output::{result_outputs, FigureOut};
+use super::*;
 
 /// Runs the realisations `range` of `cfg` on `threads` threads under the shared progress bar
 /// ([`run_with_bar`]) labelled `label`; Ctrl-C stops it with exit status 130. Returns the tally
