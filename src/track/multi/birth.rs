@@ -8,6 +8,12 @@
 //! gate of it. The delays used are removed and the search repeats, at most
 //! `max_per_scan` births and `max_candidates` refinements per scan (the stated bounds).
 //!
+//! Cost: the cells a free delay reaches are one range of its link's cells sorted by delay, so
+//! the links per cell are counted once per scan; a birth takes away one delay per link and
+//! only the cells those reached are recounted; only cells that reach `min_links` are scored
+//! (the same fixes, bit for bit, as scoring every cell at every refinement: the unit test's
+//! reference).
+//!
 //! The snapshot solver of \[A\] (`mtl`) handles blocking with its own planar inputs; this
 //! search is its one-target-at-a-time, gated counterpart on the tracker's model.
 
@@ -249,9 +255,15 @@ impl BirthGrid {
             })
             .collect();
         let mut births = Vec::new();
-        let mut tried = vec![false; self.cells.len()];
+        // Counted once per scan; a birth removes its delays and only their cells are recounted.
         let mut counts = vec![0u16; self.cells.len()];
-        let mut seen = vec![0u16; self.cells.len()];
+        self.count_hits(&sorted, &mut counts);
+        // The cells that reach `min_links`, in cell order (so ties go to the first cell, as a
+        // scan over every cell would); counts only fall, so the list only shrinks.
+        let mut candidates: Vec<u32> = (0..self.cells.len() as u32)
+            .filter(|&c| counts[c as usize] as usize >= s.min_links)
+            .collect();
+        let mut tried = vec![false; candidates.len()];
         let mut refinements = 0;
         while births.len() < s.max_per_scan && refinements < s.max_candidates {
             let links_with_free = sorted.iter().filter(|v| !v.is_empty()).count();
@@ -259,34 +271,22 @@ impl BirthGrid {
                 break;
             }
             // The best untried cell: most links with a free delay in tolerance, then the
-            // smallest sum of squared normalised misfits. Cells are counted first through each
-            // link's delay order (a free delay's cells are one range), so only cells that reach
-            // `min_links` are scored.
-            self.count_hits(&sorted, &mut counts, &mut seen);
+            // smallest sum of squared normalised misfits.
             let mut best: Option<(usize, usize, Real)> = None;
-            for c in 0..self.cells.len() {
-                if tried[c] || (counts[c] as usize) < s.min_links {
+            for (i, &c) in candidates.iter().enumerate() {
+                if tried[i] {
                     continue;
                 }
-                let (mut count, mut misfit) = (0usize, 0.0);
-                for (p, list) in sorted.iter().enumerate() {
-                    let k = c * self.links + p;
-                    if let Some(d) = nearest(list, self.delay[k]) {
-                        let e = (d - self.delay[k]) / self.tolerance[k];
-                        if e.abs() <= 1.0 {
-                            count += 1;
-                            misfit += e * e;
-                        }
-                    }
-                }
+                let (count, misfit) = self.score(&sorted, c as usize);
                 if count >= s.min_links
                     && best.is_none_or(|(_, bc, bm)| count > bc || (count == bc && misfit < bm))
                 {
-                    best = Some((c, count, misfit));
+                    best = Some((i, count, misfit));
                 }
             }
-            let Some((c, _, _)) = best else { break };
-            tried[c] = true;
+            let Some((i, _, _)) = best else { break };
+            let c = candidates[i] as usize;
+            tried[i] = true;
             refinements += 1;
             let r0 = self.cells[c];
             // The nearest free delay per link at the cell, then LM on them.
@@ -304,34 +304,77 @@ impl BirthGrid {
                     }
                 }
                 for (p, v) in sorted.iter_mut().enumerate() {
+                    // A birth uses at most one delay per link.
+                    let removed = v.iter().find(|(_, i)| used[p][*i]).map(|e| e.0);
                     v.retain(|(_, i)| !used[p][*i]);
+                    if let Some(d) = removed {
+                        self.uncount(p, d, v, &mut counts);
+                    }
                 }
                 births.push(fix);
-                tried.iter_mut().for_each(|t| *t = false);
+                candidates.retain(|&c| counts[c as usize] as usize >= s.min_links);
+                tried.clear();
+                tried.resize(candidates.len(), false);
             }
         }
         births
     }
 
-    /// `counts[c]` = the links with a free delay within cell `c`'s tolerance (`seen` marks the
-    /// link a cell was last counted for, so two delays of one link count once).
-    fn count_hits(&self, sorted: &[Vec<(Real, usize)>], counts: &mut [u16], seen: &mut [u16]) {
-        counts.iter_mut().for_each(|v| *v = 0);
-        seen.iter_mut().for_each(|v| *v = 0);
+    /// Links with a free delay within cell `c`'s tolerance and the sum of their squared
+    /// normalised misfits (the nearest delay per link).
+    fn score(&self, sorted: &[Vec<(Real, usize)>], c: usize) -> (usize, Real) {
+        let (mut count, mut misfit) = (0usize, 0.0);
         for (p, list) in sorted.iter().enumerate() {
-            let (order, delays) = &self.by_delay[p];
-            let m = self.max_tolerance[p];
+            let k = c * self.links + p;
+            if let Some(d) = nearest(list, self.delay[k]) {
+                let e = (d - self.delay[k]) / self.tolerance[k];
+                if e.abs() <= 1.0 {
+                    count += 1;
+                    misfit += e * e;
+                }
+            }
+        }
+        (count, misfit)
+    }
+
+    /// The cells within tolerance of free delay `d` on link `p`: one range of the link's delay
+    /// order, checked cell by cell.
+    fn cells_of(&self, p: usize, d: Real) -> impl Iterator<Item = usize> + '_ {
+        let (order, delays) = &self.by_delay[p];
+        let m = self.max_tolerance[p];
+        let lo = delays.partition_point(|&x| x < d - m);
+        let hi = delays.partition_point(|&x| x <= d + m);
+        order[lo..hi].iter().map(|&c| c as usize).filter(move |&c| {
+            let k = c * self.links + p;
+            (d - self.delay[k]).abs() <= self.tolerance[k]
+        })
+    }
+
+    /// `counts[c]` = the links with a free delay within cell `c`'s tolerance (a link's mark
+    /// per cell, so two delays of one link count once).
+    fn count_hits(&self, sorted: &[Vec<(Real, usize)>], counts: &mut [u16]) {
+        let mut seen = vec![0u32; self.cells.len()];
+        for (p, list) in sorted.iter().enumerate() {
             for &(d, _) in list {
-                let lo = delays.partition_point(|&x| x < d - m);
-                let hi = delays.partition_point(|&x| x <= d + m);
-                for &c in &order[lo..hi] {
-                    let c = c as usize;
-                    let k = c * self.links + p;
-                    if seen[c] != p as u16 + 1 && (d - self.delay[k]).abs() <= self.tolerance[k] {
-                        seen[c] = p as u16 + 1;
+                for c in self.cells_of(p, d) {
+                    if seen[c] != p as u32 + 1 {
+                        seen[c] = p as u32 + 1;
                         counts[c] = counts[c].saturating_add(1);
                     }
                 }
+            }
+        }
+    }
+
+    /// Link `p`'s delay `d` was used by a birth (`left`: the link's free delays now, sorted):
+    /// a cell it reached loses the link unless a delay left still reaches it.
+    fn uncount(&self, p: usize, d: Real, left: &[(Real, usize)], counts: &mut [u16]) {
+        for c in self.cells_of(p, d) {
+            let k = c * self.links + p;
+            let still = nearest(left, self.delay[k])
+                .is_some_and(|e| (e - self.delay[k]).abs() <= self.tolerance[k]);
+            if !still {
+                counts[c] = counts[c].saturating_sub(1);
             }
         }
     }
@@ -421,3 +464,7 @@ fn nearest_entry(v: &[(Real, usize)], t: Real) -> Option<(Real, usize)> {
         .min_by(|&a, &b| (v[a].0 - t).abs().total_cmp(&(v[b].0 - t).abs()))
         .map(|k| v[k])
 }
+
+#[cfg(test)]
+#[path = "birth_tests.rs"]
+mod tests;
