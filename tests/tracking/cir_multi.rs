@@ -6,7 +6,8 @@
 //! walker below c/2, a walker missed in at most a third of the scans) and their labels are kept
 //! through the crossing (`track::multi::score_run`'s switches per walker over the scans from a
 //! second before the first walker passes the crossing point to a second after the second one
-//! does) in at least 9 of 10 seeds. The scene: [`crate::crossing`].
+//! does) — the issue asks for 90 % of seeds; measured 17 of 20 (the test guards that level).
+//! The scene: [`crate::crossing`].
 //!
 //! Measured (debug build, 2026-12-07; per seed 1–10: mean GOSPA m after the first second,
 //! localisation RMS per assigned walker m, scans with a walker missed / 154, switches of
@@ -14,9 +15,11 @@
 //! [0, 0]; 2: 0.466, 0.289, 0, [0, 1], [0, 0]; 3: 0.491, 0.372, 2, [0, 0], [0, 0]; 4: 0.381,
 //! 0.288, 3, [0, 0], [0, 0]; 5: 0.428, 0.330, 7, [0, 0], [0, 0]; 6: 0.545, 0.377, 18, [0, 0],
 //! [0, 0]; 7: 0.515, 0.360, 22, [0, 0], [0, 0]; 8: 0.533, 0.380, 9, [1, 1], [1, 1]; 9: 0.423,
-//! 0.325, 3, [0, 0], [0, 0]; 10: 0.610, 0.370, 18, [0, 2], [0, 0] — kept through the crossing
-//! in 9 of 10 (seed 8 swaps the labels there); the switches of seeds 2 and 10 are a duplicate
-//! track of walker 1 in the first 1.5 s that dies out. With the body–wall double reflections
+//! 0.325, 3, [0, 0], [0, 0]; 10: 0.610, 0.370, 18, [0, 2], [0, 0] (loopy BP everywhere). How
+//! the crossing fails (seeds 8, 10, 13 with the default marginals): near the closest approach
+//! (≈ 0.8 m) a track's estimate sits 0.3–0.5 m off its walker, between the two bodies; on seed 8
+//! it stalls there, is pulled onto the other walker and the first walker gets a new label; on
+//! seed 13 the two estimates are each nearer the other walker for a few scans. With the body–wall double reflections
 //! on, the tracker confirms 3–7 targets (their echoes) on seeds 1–3.
 
 use scatterloc::channel::{ChannelScene, SimulationRequest};
@@ -187,22 +190,21 @@ fn check_seed(scenario: &Scenario, model: &Model, seed: u64, exact: usize) -> bo
     crossing.iter().all(|&k| k == 0)
 }
 
-/// Issue 41 §3: ten seeds, both walkers tracked after the first second in every seed, and
-/// their labels kept through the crossing. The issue asks for at least nine of ten. Measured
-/// (2026-12-07): 8 of 10 with the tracker's default marginals (exact per cluster of ≤ 6; seeds
-/// 8 and 10 switch), 9 of 10 with loopy BP everywhere (`exact_cluster = 0`; seed 8). The miss
-/// is stated in docs/multi-target.md; this test guards the measured level for both (≈ 6 s in a
-/// debug build).
+/// Issue 41 §3: twenty seeds, both walkers tracked after the first second in every seed, and
+/// their labels kept through the crossing. The issue asks for at least 90 % of seeds. Measured
+/// (2026-12-07): 17 of 20 (85 %; seeds 8, 10 and 13 switch; 8 of the first 10) with the
+/// tracker's default marginals (exact per cluster of ≤ 6), 17 of 20 with loopy BP everywhere
+/// (`exact_cluster = 0`; seeds 8, 13 and 14; 9 of the first 10). The miss is stated in
+/// docs/multi-target.md with its cause; this test guards the measured level for both.
 #[test]
 fn labels_are_kept_through_the_crossing_in_most_seeds() {
     let (s, m) = scenario();
-    let kept = (1..=10).filter(|&seed| check_seed(&s, &m, seed, 6)).count();
-    assert!(
-        kept >= 8,
-        "exact clusters: labels kept in {kept} of 10 seeds"
-    );
-    let kept = (1..=10).filter(|&seed| check_seed(&s, &m, seed, 0)).count();
-    assert!(kept >= 9, "loopy BP: labels kept in {kept} of 10 seeds");
+    for (exact, what) in [(6, "exact clusters"), (0, "loopy BP")] {
+        let kept = (1..=20)
+            .filter(|&seed| check_seed(&s, &m, seed, exact))
+            .count();
+        assert!(kept >= 17, "{what}: labels kept in {kept} of 20 seeds");
+    }
 }
 
 /// What the front end gives the tracker on seed 1, against the recording defaults: per walker
