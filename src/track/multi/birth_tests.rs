@@ -37,10 +37,7 @@ impl BirthGrid {
                 break;
             }
             let mut best: Option<(usize, usize, Real)> = None;
-            for c in 0..self.cells.len() {
-                if tried[c] {
-                    continue;
-                }
+            for (c, _) in tried.iter().enumerate().filter(|(_, t)| !**t) {
                 let (mut count, mut misfit) = (0usize, 0.0);
                 for (p, list) in left.iter().enumerate() {
                     let k = c * self.links + p;
@@ -88,13 +85,11 @@ impl BirthGrid {
     }
 }
 
+/// Per link, free delays with their σ if known.
+type Free = Vec<Vec<(Real, Option<Real>)>>;
+
 /// The free delays of every scan of a seeded walk of `walkers` people, with clutter.
-fn scans(
-    model: &Model,
-    walkers: usize,
-    clutter: Real,
-    seed: u64,
-) -> Vec<Vec<Vec<(Real, Option<Real>)>>> {
+fn scans(model: &Model, walkers: usize, clutter: Real, seed: u64) -> Vec<Free> {
     let mut r = rng(seed, 0);
     let truth = people_truth(walkers, 30, 0.1, &mut r);
     delay_scans(model, &truth, 0.9, clutter, 60e-9, &mut r)
