@@ -159,6 +159,10 @@ mod page_look;
 #[cfg(test)]
 #[path = "e2e/page_multi.rs"]
 mod page_multi;
+/// Issue 41 §2: Save figure and Export data with "Several people" on.
+#[cfg(test)]
+#[path = "e2e/page_multi_export.rs"]
+mod page_multi_export;
 /// Issue 38 §11: the page's channel track is consistent with its error (NEES band, 4 seeds).
 #[cfg(test)]
 #[path = "e2e/page_nees.rs"]

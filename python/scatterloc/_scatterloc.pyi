@@ -368,8 +368,9 @@ def track_multi(
 
 def simulate_people(
     scenario: _ScenarioLike,
-    walkers: int,
+    walkers: Optional[int] = None,
     *,
+    paths: Optional[Union[ArrayLike, Sequence[Sequence[float]]]] = None,
     duration_s: float = 10.0,
     dt_s: float = 0.1,
     process_noise: float = 0.5,

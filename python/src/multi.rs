@@ -13,13 +13,13 @@ use scatterloc::formats::{CalibrationResult, Measurements};
 use scatterloc::scenario::parse_json;
 use scatterloc::study::{
     score_multi, simulate_people as core_simulate_people, track_multi as core_track_multi,
-    walk_region, MultiSettings, MultiTrackOutput, MultiTruth, DEFAULT_PROCESS_NOISE,
+    walk_region, MultiSettings, MultiTrackOutput, MultiTruth, Walkers, DEFAULT_PROCESS_NOISE,
 };
 use scatterloc::track::gating::Calibration;
 use scatterloc::track::multi::MultiKind;
 use scatterloc::track::{step_count, ConstantVelocity, MAX_STEPS};
 
-use crate::convert::{array, path_string, to_json_text, to_python, JsonDoc};
+use crate::convert::{array, f64_array, path_string, to_json_text, to_python, JsonDoc};
 use crate::detections::PyDetections;
 use crate::errors::{arg_error, Core};
 use crate::run::{run_job, run_quick};
@@ -334,19 +334,23 @@ pub fn track_multi(
 /// issue 41 (the central half of the area when the area does not hold it) for `duration_s` at
 /// `dt_s` (one scan at t₀ and one per step), each link detecting each person with
 /// `detection_probability` plus `clutter` false delays per scan, the measurements' process noise
-/// `process_noise` (m²/s³); seeded by `seed`. Returns `(measurements, truth)`: the dicts of the
-/// CLI's `measurements.json` (`initial_snapshot` and `raw_steps`; `track_multi` takes it) and
-/// `truth.json` (per scan the labelled targets present).
+/// `process_noise` (m²/s³); seeded by `seed`. `paths` (a numpy `(n, 4)` array or a list of
+/// `(x0, y0, x1, y1)`, m; 1 … 5 rows) replaces the planned walkers by one walker per drawn path,
+/// walking the straight line at constant velocity over the run (`simulate-walk --path`);
+/// `walkers` may then be left out, else it must equal the rows. Returns `(measurements,
+/// truth)`: the dicts of the CLI's `measurements.json` (`initial_snapshot` and `raw_steps`;
+/// `track_multi` takes it) and `truth.json` (per scan the labelled targets present).
 #[pyfunction]
 #[pyo3(signature = (
-    scenario, walkers, *, duration_s = 10.0, dt_s = 0.1, process_noise = 0.5,
-    detection_probability = 0.9, clutter = 5.0, seed = 1
+    scenario, walkers = None, *, paths = None, duration_s = 10.0, dt_s = 0.1,
+    process_noise = 0.5, detection_probability = 0.9, clutter = 5.0, seed = 1
 ))]
 #[allow(clippy::too_many_arguments)]
 pub fn simulate_people<'py>(
     py: Python<'py>,
     scenario: &Bound<'py, PyAny>,
-    walkers: usize,
+    walkers: Option<usize>,
+    paths: Option<&Bound<'py, PyAny>>,
     duration_s: f64,
     dt_s: f64,
     process_noise: f64,
@@ -354,6 +358,7 @@ pub fn simulate_people<'py>(
     clutter: f64,
     seed: u64,
 ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+    let walkers = walkers_arg(walkers, paths)?;
     let sc = scenario_arg(scenario)?;
     ConstantVelocity::validated(dt_s, process_noise).py()?;
     // The scans: one at t₀ and one per step of the duration (the CLI's rule).
@@ -384,7 +389,7 @@ pub fn simulate_people<'py>(
         core_simulate_people(
             model,
             &region,
-            walkers,
+            walkers.clone(),
             steps + 1,
             dt_s,
             process_noise,
@@ -393,4 +398,38 @@ pub fn simulate_people<'py>(
         )
     })?;
     Ok((to_python(py, &m)?, to_python(py, &truth)?))
+}
+
+/// The walkers of `simulate_people`: the drawn `paths` (rows `x0, y0, x1, y1`; `walkers`, if
+/// given, their count) or the `walkers` count. The library checks the count and the paths.
+fn walkers_arg(walkers: Option<usize>, paths: Option<&Bound<'_, PyAny>>) -> PyResult<Walkers> {
+    let Some(p) = paths.filter(|p| !p.is_none()) else {
+        return walkers
+            .map(Walkers::Count)
+            .ok_or_else(|| arg_error("walkers", "missing: give walkers (1 … 5) or paths"));
+    };
+    // Room for more rows than the library allows, so that it names the count.
+    let a = f64_array(p, "paths", 4 * 64)?;
+    let rows = match a.shape.as_slice() {
+        [0] => 0,
+        [n, 4] => *n,
+        s => {
+            return Err(arg_error(
+                "paths",
+                format!("shape {s:?}: expected (n, 4) rows x0, y0, x1, y1"),
+            ))
+        }
+    };
+    if let Some(n) = walkers.filter(|&n| n != rows) {
+        return Err(arg_error(
+            "walkers",
+            format!("{n} walkers but {rows} paths (leave walkers out)"),
+        ));
+    }
+    Ok(Walkers::Drawn(
+        a.data
+            .chunks_exact(4)
+            .map(|q| ([q[0], q[1]], [q[2], q[3]]))
+            .collect(),
+    ))
 }

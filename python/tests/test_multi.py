@@ -1,6 +1,6 @@
 """Several targets (issue 41): `track_multi` against the CLI's `track --targets auto` (bit for
 bit, PMB and GNN, with and without truth, settings, calibration, detections),
-`simulate_people` against the CLI's `simulate-walk --walkers` files, the score's GOSPA per scan
+`simulate_people` against the CLI's `simulate-walk --walkers` and `--path` files, the score's GOSPA per scan
 against Stone Soup's `GOSPAMetric` (an independent implementation) and its label switches and
 cardinality error recomputed from Stone Soup's assignment and the counts, and bad input."""
 
@@ -52,6 +52,35 @@ def test_simulate_people_equals_cli(cli, seed):
     m, t = sl.simulate_people(s, 2, seed=seed + 10, **kw)
     assert_bitwise(m, cli.file(mpath))
     assert_bitwise(t, cli.file(tpath))
+
+
+def test_simulate_people_drawn_paths_equal_cli(cli):
+    people_scenario(cli)
+    s = sl.Scenario(str(cli.cwd / "s.json"))
+    paths = np.array([[1.0, 2.0, 8.5, 7.25], [-0.5, 6.0, 9.0, 1.5], [4.0, 4.0, 4.0, 4.0]])
+    flags = [a for p in paths for a in ("--path", ",".join(repr(float(x)) for x in p))]
+    cli.run("simulate-walk", "--scenario", "s.json", "--out-dir", "d", "--seed", "6", *flags)
+    cm, ct = cli.file("d/measurements.json"), cli.file("d/truth.json")
+    # A numpy (n, 4) array, a list of 4-tuples, and with walkers equal to the rows: the CLI's files.
+    for kw in (dict(paths=paths), dict(paths=[tuple(p) for p in paths.tolist()]),
+               dict(walkers=3, paths=paths)):
+        m, t = sl.simulate_people(s, seed=6, **kw)  # type: ignore[arg-type]
+        assert_bitwise(m, cm)
+        assert_bitwise(t, ct)
+    first, last = t["targets"][0], t["targets"][-1]
+    assert [x["label"] for x in first] == [0, 1, 2]
+    for i, p in enumerate(paths):
+        assert np.allclose(first[i]["state"][:2], p[:2], rtol=0, atol=1e-12)
+        assert np.allclose(last[i]["state"][:2], p[2:], rtol=0, atol=1e-12)
+    # Bad paths are named.
+    for kw, field in ((dict(paths=np.zeros((6, 4))), "paths"), (dict(paths=[]), "paths"),
+                      (dict(paths=np.zeros((2, 3))), "paths"),
+                      (dict(paths=[[0.0, 1.0, 2.0, float("nan")]]), "paths[0].y1"),
+                      (dict(paths=[[0.0, 1.0, 2.0, 1e9]]), "paths[0].y1"),
+                      (dict(walkers=2, paths=paths), "walkers"), (dict(), "walkers")):
+        with pytest.raises(sl.ScatterlocError) as e:
+            sl.simulate_people(s, seed=6, **kw)  # type: ignore[arg-type]
+        assert e.value.field == field, (kw, e.value.field, str(e.value))
 
 
 def test_track_multi_equals_cli(cli):

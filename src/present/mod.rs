@@ -6,7 +6,8 @@
 //! its compiled model, kept in step), and the channel front end's delay and track-error figures
 //! ([`DelayFigure`], [`TrackErrorView`], [`ErrorStats`]), and the documents of the
 //! single-snapshot use cases ([`CrlbDoc`], [`FixDoc`]) the CLI prints and the Python package
-//! returns. Pure `no_std` functions of the core's results:
+//! returns, and a several-people run's map view and data file ([`people_map_view`],
+//! [`people_data_text`]). Pure `no_std` functions of the core's results:
 //! no maths of their own beyond layout.
 
 mod channel_figure;
@@ -14,6 +15,7 @@ mod channel_files;
 mod channel_view;
 mod colormap;
 mod free_z_docs;
+mod multi_view;
 mod plan_view;
 mod scene;
 mod session;
@@ -36,6 +38,10 @@ pub use colormap::{
     colorbar_rgba, fill_rgba, render_rgba, viridis, LogScale, LINK_RGB, UNBOUNDED_RGB,
 };
 pub use free_z_docs::{sym3, CrlbFreeZDoc, FixFreeZDoc};
+pub use multi_view::{
+    people_csv_header, people_data_text, people_doc_from_json, people_map_view, PeopleMapView,
+    PeopleRun, PeopleTrackView,
+};
 pub use plan_view::{
     area_of, run_plan, run_plan_with, PlanHistoryJson, PlanImprovementJson, PlanJson,
     PlanObjectiveJson, PlanPathJson, PlanProgressJson, PlanRequest, DEFAULT_PLAN_BUDGET,

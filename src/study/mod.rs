@@ -59,7 +59,7 @@ pub use montecarlo::{
 pub use multi::{
     lives, multi_scans, multi_tracker, score_multi, simulate_people, track_multi, walk_region,
     LabelledTrack, MultiScoreDoc, MultiSettings, MultiTrackOutput, MultiTruth, TargetDoc,
-    TruthTarget,
+    TruthTarget, Walkers,
 };
 pub use multi_study::{
     known_association_bound, multi_study_doc, MethodDoc, MethodSums, MultiStudy, MultiStudyConfig,

@@ -351,29 +351,78 @@ impl MultiTruth {
     }
 }
 
-/// Several people walking in `model`'s network ([`people_truth_in`](crate::track::multi::people_truth_in)
-/// over `region`) and their delay scans: the measurements file (`raw_steps`, the first scan as
-/// `initial_snapshot`, process noise `process_noise`) and the truth. Seeded.
+/// Who walks in [`simulate_people`]: a count of the planned walkers
+/// ([`people_truth_in`](crate::track::multi::people_truth_in): crossing, side by side, one
+/// standing still a while) or drawn paths ([`people_truth_drawn`](crate::track::multi::people_truth_drawn):
+/// straight lines walked at constant velocity over the run).
+#[derive(Debug, Clone, PartialEq)]
+pub enum Walkers {
+    /// The first `n` planned walkers (1 ..= 5).
+    Count(usize),
+    /// One walker per drawn path `([x0, y0], [x1, y1])`, m (1 ..= 5 paths).
+    Drawn(Vec<crate::track::multi::DrawnPath>),
+}
+
+impl Walkers {
+    /// How many people walk.
+    pub fn count(&self) -> usize {
+        match self {
+            Walkers::Count(n) => *n,
+            Walkers::Drawn(p) => p.len(),
+        }
+    }
+
+    /// Checks the count (1 ..= 5, [`Error::SizeLimit`] `walkers`) or the drawn paths
+    /// ([`check_drawn_paths`](crate::track::multi::check_drawn_paths)).
+    pub fn check(&self) -> Result<()> {
+        match self {
+            Walkers::Count(n) if !(1..=crate::track::multi::MAX_WALKERS).contains(n) => {
+                Err(Error::SizeLimit {
+                    field: "walkers",
+                    value: *n,
+                    min: 1,
+                    max: crate::track::multi::MAX_WALKERS,
+                })
+            }
+            Walkers::Count(_) => Ok(()),
+            Walkers::Drawn(p) => crate::track::multi::check_drawn_paths(p),
+        }
+    }
+}
+
+impl From<usize> for Walkers {
+    fn from(n: usize) -> Self {
+        Walkers::Count(n)
+    }
+}
+
+impl From<Vec<crate::track::multi::DrawnPath>> for Walkers {
+    fn from(p: Vec<crate::track::multi::DrawnPath>) -> Self {
+        Walkers::Drawn(p)
+    }
+}
+
+/// Several people walking in `model`'s network and their delay scans: the measurements file
+/// (`raw_steps`, the first scan as `initial_snapshot`, process noise `process_noise`) and the
+/// truth. `walkers` is a count (the planned walkers,
+/// [`people_truth_in`](crate::track::multi::people_truth_in) over `region`) or drawn paths
+/// ([`Walkers::Drawn`]: straight lines in scenario coordinates, `region` unused); the scans
+/// are [`delay_scans`](crate::track::multi::delay_scans) of that truth. Seeded: the same seed
+/// gives the same scans for the same truth.
 #[allow(clippy::too_many_arguments)]
 pub fn simulate_people(
     model: &Model,
     region: &Area,
-    walkers: usize,
+    walkers: impl Into<Walkers>,
     steps: usize,
     dt_s: f64,
     process_noise: f64,
     settings: &MultiSettings,
     seed: u64,
 ) -> Result<(Measurements, MultiTruth)> {
+    let walkers = walkers.into();
     crate::track::ConstantVelocity::validated(dt_s, process_noise)?;
-    if !(1..=5).contains(&walkers) {
-        return Err(Error::SizeLimit {
-            field: "walkers",
-            value: walkers,
-            min: 1,
-            max: 5,
-        });
-    }
+    walkers.check()?;
     if !(2..=crate::track::MAX_STEPS).contains(&steps) {
         return Err(Error::SizeLimit {
             field: "steps",
@@ -391,7 +440,10 @@ pub fn simulate_people(
         None,
     )?;
     let mut r = crate::measure::rng(seed, 0);
-    let truth = crate::track::multi::people_truth_in(region, walkers, steps, dt_s, &mut r);
+    let truth = match &walkers {
+        Walkers::Count(n) => crate::track::multi::people_truth_in(region, *n, steps, dt_s, &mut r),
+        Walkers::Drawn(p) => crate::track::multi::people_truth_drawn(p, steps, dt_s)?,
+    };
     let scans = crate::track::multi::delay_scans(
         model,
         &truth,

@@ -1,12 +1,12 @@
-//! `track --targets auto` and `simulate-walk --walkers` (issue 41): the CLI prints the library's
-//! documents (study::track_multi, score_multi, simulate_people) bit for bit, and refuses bad
-//! input with one named line.
+//! `track --targets auto` and `simulate-walk --walkers`/`--path` (issue 41): the CLI prints the
+//! library's documents (study::track_multi, score_multi, simulate_people) bit for bit, and
+//! refuses bad input with one named line.
 
 use crate::common::cli::{fails, ok_json, ok_json_line, read_json, TempDir};
 use scatterloc::error::Cancel;
 use scatterloc::formats::Measurements;
 use scatterloc::study::{
-    score_multi, simulate_people, track_multi, walk_region, MultiSettings, MultiTruth,
+    score_multi, simulate_people, track_multi, walk_region, MultiSettings, MultiTruth, Walkers,
 };
 use scatterloc::track::multi::{people_layout, MultiKind};
 use scatterloc::Model;
@@ -90,6 +90,95 @@ fn walkers_and_their_multi_target_track_are_the_librarys() {
             assert!(doc["score"]["mean_gospa_m"].as_f64().unwrap() < 0.1);
         }
     }
+}
+
+#[test]
+fn drawn_paths_are_walked_end_to_end_and_bad_ones_are_refused() {
+    let dir = TempDir::new();
+    let s = people_scenario(&dir);
+    let out = dir.path("drawn");
+    let paths = [[1.0, 2.0, 8.5, 7.25], [-0.5, 6.0, 9.0, 1.5]];
+    let flags: Vec<String> = paths
+        .iter()
+        .map(|p| format!("{},{},{},{}", p[0], p[1], p[2], p[3]))
+        .collect();
+    let summary = ok_json(&[
+        "simulate-walk",
+        "--scenario",
+        &s,
+        "--out-dir",
+        &out,
+        "--path",
+        &flags[0],
+        "--path",
+        &flags[1],
+        "--seed",
+        "4",
+    ]);
+    assert_eq!(summary["walkers"], json!(2));
+    assert_eq!(summary["steps"], json!(101));
+    let truth = read_json(&format!("{out}/truth.json"));
+    let targets = truth["targets"].as_array().unwrap();
+    assert_eq!(targets.len(), 101);
+    for (k, ends) in [(0, [0, 1]), (100, [2, 3])] {
+        let scan = targets[k].as_array().unwrap();
+        assert_eq!(scan.len(), 2);
+        for (i, p) in paths.iter().enumerate() {
+            assert_eq!(scan[i]["label"], json!(i));
+            for (c, e) in ends.iter().enumerate() {
+                let x = scan[i]["state"][c].as_f64().unwrap();
+                assert!(
+                    (x - p[*e]).abs() <= 1e-12,
+                    "scan {k} walker {i}: {x} vs {}",
+                    p[*e]
+                );
+            }
+        }
+    }
+    // The files are the library's for the same paths and seed.
+    let scenario = people_layout();
+    let model = Model::new(&scenario).unwrap();
+    let drawn: Vec<_> = paths.iter().map(|p| ([p[0], p[1]], [p[2], p[3]])).collect();
+    let (m, t) = simulate_people(
+        &model,
+        &walk_region(&scenario.area_m),
+        Walkers::Drawn(drawn),
+        101,
+        0.1,
+        0.5,
+        &MultiSettings::default(),
+        4,
+    )
+    .unwrap();
+    assert_eq!(truth, serde_json::to_value(&t).unwrap());
+    assert_eq!(
+        read_json(&format!("{out}/measurements.json")),
+        serde_json::to_value(&m).unwrap()
+    );
+    // --walkers equal to the paths is accepted; a different one, six paths, three numbers
+    // and a far coordinate are refused, naming the flag.
+    let base = ["simulate-walk", "--scenario", &s, "--out-dir", &out];
+    let args = |extra: &[&str]| -> Vec<String> {
+        base.iter().chain(extra).map(|x| x.to_string()).collect()
+    };
+    let a = args(&["--walkers", "1", "--path", &flags[0]]);
+    ok_json(&a.iter().map(String::as_str).collect::<Vec<_>>());
+    let refused = |extra: &[&str], needles: &[&str]| {
+        let a = args(extra);
+        fails(&a.iter().map(String::as_str).collect::<Vec<_>>(), needles);
+    };
+    refused(
+        &["--walkers", "3", "--path", &flags[0], "--path", &flags[1]],
+        &["--walkers 3", "2 --path"],
+    );
+    let six: Vec<&str> = (0..6).flat_map(|_| ["--path", "1,2,3,4"]).collect();
+    refused(&six, &["--path", "paths", "6", "1..=5"]);
+    refused(&["--path", "1,2,3"], &["--path", "x0,y0,x1,y1"]);
+    refused(&["--path", "1,2,3,nan"], &["--path", "x0,y0,x1,y1"]);
+    refused(
+        &["--path", "1,2,3,1e9"],
+        &["--path", "paths[0].y1", "out of range"],
+    );
 }
 
 #[test]

@@ -171,6 +171,7 @@ const FIELDS: &[&str] = &[
     "tracking.mc_filters",
     "multi.walkers",
     "multi.method",
+    "multi.paths",
     "mtl.p_u",
     "mtl.p_los",
     "view.map",
@@ -259,7 +260,7 @@ async fn set_everything(c: &Client) -> Result<(), String> {
     select(c, "mc-runs", "50").await?;
     select(c, "track-speed", "2").await?;
     quiet(c).await?;
-    // Several people (issue 41): the method, then two walkers (the view turns multi-target).
+    // Several people (issue 41): the method, then two walkers (the view turns multi-target) …
     select(c, "multi-method", "gnn").await?;
     select(c, "multi-walkers", "2").await?;
     super::ui::poll(
@@ -267,6 +268,20 @@ async fn set_everything(c: &Client) -> Result<(), String> {
         "return window.tracking.state().multi.state;",
         180,
         "several people",
+        |s| s == "done",
+    )
+    .await?;
+    quiet(c).await?;
+    // … then a drawn walker's path (the walkers "drawn", one press-drag on the map).
+    select(c, "multi-walkers", "drawn").await?;
+    quiet(c).await?;
+    let a = empty_at(c, 0.35, 0.4).await?;
+    drag_on_plot(c, a, &[(70.0, 40.0, 200)]).await?;
+    super::ui::poll(
+        c,
+        "const m = window.tracking.state().multi; return m.paths.length === 1 ? m.state : 'drawing';",
+        180,
+        "a drawn walker",
         |s| s == "done",
     )
     .await?;

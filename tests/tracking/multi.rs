@@ -1,16 +1,20 @@
 //! The multi-target tracker's parts against independent references: loopy BP against the
 //! exact marginals (exact on trees, close on loops), the Kalman update against the
 //! information-form closed form, the MAP cardinality against enumeration, the birth search on
-//! noise-free delays; named errors for bad scans; and the studies of issue 41 §3 at a size a
+//! noise-free delays; drawn walkers against their closed form and their delay scans; named
+//! errors for bad scans and bad drawn paths; and the studies of issue 41 §3 at a size a
 //! debug build runs (the full sizes are `multi_studies::*_full`, release).
 
+use scatterloc::error::Error;
+use scatterloc::formats::{RawEstimate, RawStep};
 use scatterloc::math::{Mat4, Real, Vec2, Vec4};
 use scatterloc::measure::{rng, uniform01};
+use scatterloc::study::{simulate_people, MultiSettings, Walkers};
 use scatterloc::track::multi::{
-    bp_marginals, clustered_marginals, exact_marginals, kalman_update, map_cardinality,
-    people_layout, people_region, BirthGrid, Births, DelayBirth, DelayLinks, Detection,
-    MultiConfig, Pmb, PositionSensor, MAX_BP_ITERATIONS, MAX_DETECTIONS_PER_SENSOR,
-    MAX_EXACT_CLUSTER,
+    bp_marginals, check_drawn_paths, clustered_marginals, delay_scans, exact_marginals,
+    kalman_update, map_cardinality, people_layout, people_region, people_truth_drawn, BirthGrid,
+    Births, DelayBirth, DelayLinks, Detection, DrawnPath, MultiConfig, Pmb, PositionSensor,
+    MAX_BP_ITERATIONS, MAX_DETECTIONS_PER_SENSOR, MAX_EXACT_CLUSTER, MAX_WALKERS,
 };
 use scatterloc::track::ConstantVelocity;
 use scatterloc::Model;
@@ -328,4 +332,127 @@ fn people_at_debug_size() {
             "seed {seed}: cardinality errors {card}"
         );
     }
+}
+
+#[test]
+fn drawn_walkers_walk_their_lines_and_give_the_delay_scans_of_their_truth() {
+    // Three drawn paths (one of them a person standing still: start = end), 101 scans at 0.1 s.
+    let paths: Vec<DrawnPath> = vec![
+        ([1.0, 2.0], [8.0, 7.5]),
+        ([-3.5, 4.25], [6.0, -1.0]),
+        ([5.0, 5.0], [5.0, 5.0]),
+    ];
+    let (steps, dt) = (101, 0.1);
+    let truth = people_truth_drawn(&paths, steps, dt).unwrap();
+    assert_eq!(truth.steps.len(), steps);
+    let total = (steps - 1) as Real * dt;
+    let near = |x: Real, want: Real| (x - want).abs() <= 1e-12 * (1.0 + want.abs());
+    for (k, scan) in truth.steps.iter().enumerate() {
+        assert_eq!(scan.len(), 3, "scan {k}");
+        // The closed form: a + (b − a) k / (n − 1), velocity (b − a) / ((n − 1) T).
+        let f = k as Real / (steps - 1) as Real;
+        for (i, (label, x)) in scan.iter().enumerate() {
+            let (a, b) = paths[i];
+            assert_eq!(*label, i as u64);
+            for c in 0..2 {
+                let want = a[c] + (b[c] - a[c]) * f;
+                assert!(near(x[c], want), "scan {k} walker {i}: {} vs {want}", x[c]);
+                let v = (b[c] - a[c]) / total;
+                assert!(
+                    near(x[2 + c], v),
+                    "scan {k} walker {i}: v {} vs {v}",
+                    x[2 + c]
+                );
+                // Constant velocity: the same number at every scan.
+                assert_eq!(x[2 + c], truth.steps[0][i].1[2 + c]);
+            }
+        }
+    }
+    // The use case: the same truth, and the delay scans of that truth for the same seed.
+    let scenario = people_layout();
+    let model = Model::new(&scenario).unwrap();
+    let settings = MultiSettings::default();
+    let (m, t) = simulate_people(
+        &model,
+        &people_region(),
+        paths.clone(),
+        steps,
+        dt,
+        0.5,
+        &settings,
+        7,
+    )
+    .unwrap();
+    assert_eq!(t.to_truth(), truth);
+    let mut r = rng(7, 0);
+    let scans = delay_scans(
+        &model,
+        &truth,
+        settings.detection_probability,
+        settings.clutter,
+        settings.clutter_window_s,
+        &mut r,
+    );
+    let delays = |s: &RawStep| -> Vec<Vec<Real>> {
+        s.iter()
+            .map(|l| {
+                l.iter()
+                    .map(|e| match e {
+                        RawEstimate::Pair([d, _]) => *d,
+                        RawEstimate::WithSigma([d, _, _]) => *d,
+                    })
+                    .collect()
+            })
+            .collect()
+    };
+    let from_scans = |s: &Vec<Vec<Detection>>| -> Vec<Vec<Real>> {
+        s.iter()
+            .map(|l| l.iter().map(|d| d.value[0]).collect())
+            .collect()
+    };
+    let mut got = vec![delays(m.initial_snapshot.as_ref().unwrap())];
+    got.extend(m.raw_steps.as_ref().unwrap().iter().map(delays));
+    let want: Vec<_> = scans.iter().map(from_scans).collect();
+    assert_eq!(got.len(), steps);
+    assert_eq!(got, want, "the delay scans of the drawn truth, bit for bit");
+    assert!(want.iter().flatten().flatten().count() > steps * 8 * 3 / 2);
+}
+
+#[test]
+fn bad_drawn_paths_are_named() {
+    let ok = ([1.0, 2.0], [3.0, 4.0]);
+    let size = |e: Error| match e {
+        Error::SizeLimit { field, value, .. } => (field, value),
+        e => panic!("{e}"),
+    };
+    assert_eq!(
+        size(people_truth_drawn(&[], 10, 0.1).unwrap_err()),
+        ("paths", 0)
+    );
+    assert_eq!(size(check_drawn_paths(&[ok; 6]).unwrap_err()), ("paths", 6));
+    assert!(check_drawn_paths(&[ok; MAX_WALKERS]).is_ok());
+    let field = |e: Error| e.field().map(String::from);
+    let nan = [ok, ([1.0, Real::NAN], [3.0, 4.0])];
+    let e = people_truth_drawn(&nan, 10, 0.1).unwrap_err();
+    assert!(matches!(e, Error::NonFinite { .. }), "{e}");
+    assert_eq!(field(e).as_deref(), Some("paths[1].y0"));
+    let far = [([1.0, 2.0], [3.0, 1e8])];
+    let e = check_drawn_paths(&far).unwrap_err();
+    assert!(matches!(e, Error::OutOfRange { .. }), "{e}");
+    assert_eq!(field(e).as_deref(), Some("paths[0].y1"));
+    let e = people_truth_drawn(&[ok], 10, 0.0).unwrap_err();
+    assert!(matches!(e, Error::NotPositive { .. }), "{e}");
+    // Through the use case: the paths' errors, and the count's.
+    let model = Model::new(&people_layout()).unwrap();
+    let s = MultiSettings::default();
+    let run = |w: Walkers| simulate_people(&model, &people_region(), w, 10, 0.1, 0.5, &s, 1);
+    assert_eq!(size(run(Walkers::Drawn(vec![])).unwrap_err()), ("paths", 0));
+    assert_eq!(
+        size(run(Walkers::Drawn(vec![ok; 6])).unwrap_err()),
+        ("paths", 6)
+    );
+    assert_eq!(size(run(Walkers::Count(6)).unwrap_err()), ("walkers", 6));
+    assert_eq!(size(run(Walkers::Count(0)).unwrap_err()), ("walkers", 0));
+    let e = run(Walkers::Drawn(far.to_vec())).unwrap_err();
+    assert_eq!(field(e).as_deref(), Some("paths[0].y1"));
 }

@@ -118,3 +118,104 @@ fn track_people_names_bad_input() {
     let e = run("{", json!({"walkers": 2, "method": "pmb", "seed": 1}));
     assert!(!e.is_empty());
 }
+
+/// Save figure and Export data of a run (issue 41 §2): the map from `people_map_svg` holds every
+/// track's legend entry and the label of every target at the last scan, the GOSPA chart its
+/// legend, the CSV every number of the document bit for bit and the JSON its truth, track and
+/// score; bad input throws the function's named message.
+#[wasm_bindgen_test]
+fn people_figures_and_data_come_from_the_document() {
+    let scenario = presets::sensors2019().to_json();
+    let request = json!({"walkers": 2, "method": "pmb", "seed": 2}).to_string();
+    let text = ok(wasm::track_people(&scenario, &request));
+    let doc: Value = serde_json::from_str(&text).unwrap();
+
+    let svg = ok(wasm::people_map_svg(
+        &scenario, &text, 800, 0, 1000, 2.0, "",
+    ));
+    let texts = super::svg::svg_texts("people map", &svg);
+    let tracks = doc["track"]["tracks"].as_array().unwrap();
+    assert!(!tracks.is_empty());
+    for t in tracks {
+        let legend = format!("track #{}", t["label"]);
+        assert_eq!(super::svg::count(&texts, &legend), 1, "{legend}");
+    }
+    let last = doc["track"]["targets"].as_array().unwrap().last().unwrap();
+    for t in last.as_array().unwrap() {
+        let label = format!("#{}", t["label"]);
+        assert_eq!(super::svg::count(&texts, &label), 1, "{label}");
+    }
+    let chart = ok(wasm::people_chart_svg(&text, "GOSPA per scan", "", 800, 0));
+    let texts = super::svg::svg_texts("GOSPA chart", &chart);
+    let legend = doc["gospa_label"].as_str().unwrap();
+    assert_eq!(super::svg::count(&texts, legend), 1, "{legend}");
+
+    let csv = ok(wasm::people_data_text(&text, "csv"));
+    let bits = |s: &str| s.parse::<f64>().unwrap().to_bits();
+    let num = |v: &Value| v.as_f64().unwrap().to_bits();
+    let mut rows = 0;
+    for line in csv.lines().skip(1) {
+        let f: Vec<&str> = line.split(',').collect();
+        let k: usize = f[0].parse().unwrap();
+        let part = if f[2] == "truth" { "truth" } else { "track" };
+        let t = doc[part]["targets"][k]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|t| t["label"].as_u64() == Some(f[3].parse().unwrap()))
+            .unwrap();
+        assert_eq!(bits(f[1]), num(&doc[part]["t_s"][k]), "{line}");
+        for j in 0..4 {
+            assert_eq!(bits(f[4 + j]), num(&t["state"][j]), "{line}");
+        }
+        if part == "track" {
+            for c in 0..16 {
+                assert_eq!(
+                    bits(f[9 + c]),
+                    num(&t["covariance"][c / 4][c % 4]),
+                    "{line}"
+                );
+            }
+        }
+        rows += 1;
+    }
+    let count = |v: &Value| -> usize {
+        v.as_array()
+            .unwrap()
+            .iter()
+            .map(|s| s.as_array().unwrap().len())
+            .sum()
+    };
+    assert_eq!(
+        rows,
+        count(&doc["truth"]["targets"]) + count(&doc["track"]["targets"])
+    );
+    let data: Value = serde_json::from_str(&ok(wasm::people_data_text(&text, "json"))).unwrap();
+    for key in ["truth", "track", "score"] {
+        assert_eq!(data[key], doc[key], "{key}");
+    }
+
+    let m = err(wasm::people_data_text(&text, "xml"));
+    assert!(
+        m.starts_with("people_data_text: invalid JSON: format: \"xml\""),
+        "{m}"
+    );
+    let m = err(wasm::people_data_text("{}", "csv"));
+    assert!(m.starts_with("people_data_text: invalid JSON"), "{m}");
+    let m = err(wasm::people_map_svg(&scenario, &text, 800, 0, 0, 0.0, ""));
+    assert!(m.starts_with("people_map_svg: magnify"), "{m}");
+    let m = err(wasm::people_map_svg(&scenario, &text, 50, 0, 0, 1.0, ""));
+    assert!(m.starts_with("people_map_svg: width"), "{m}");
+    let m = err(wasm::people_map_svg(
+        &scenario,
+        &text,
+        800,
+        0,
+        0,
+        1.0,
+        "{\"zoom\": 2}",
+    ));
+    assert!(m.contains("zoom"), "{m}");
+    let m = err(wasm::people_chart_svg("[", "t", "", 800, 0));
+    assert!(m.starts_with("people_chart_svg: invalid JSON"), "{m}");
+}

@@ -2,7 +2,10 @@
 // tracking views): the CRLB map on screen, its grid and values, written by the core
 // (map_data_text); the track (tracking view): time, truth, the filter's estimate and covariance,
 // written by the core (Track.data_text); the Monte Carlo curves (tracking view): t, the RMSE of
-// each filter, the PCRLB bound, the runs counted and failed, from the core's result JSON. Every
+// each filter, the PCRLB bound, the runs counted and failed, from the core's result JSON. With
+// "Several people" on (multi.js), "track" is the run's people (people_data_text: CSV, a row per
+// true person and per reported target per scan; JSON, the truth, track and score) in
+// `<scenario>-tracking-people.<ext>`, and the Monte Carlo curves (not shown then) are off. Every
 // number is the core's, written so that it reads back as the same double. Files are named
 // `<scenario>-<view>-<what>.<ext>`.
 
@@ -22,8 +25,27 @@ export class DataExport {
   constructor(ctx) {
     this.ctx = ctx;
     this.dryRun = false;
-    this.last = null; // {name, type, size, text, mode, what, format}
+    this.last = null; // {name, type, size, text, mode, what, format, people}
+    this.mode = null;
     $('data-save').addEventListener('click', () => this.save());
+  }
+
+  /** The "Several people" run when it is on in the tracking view, else null. */
+  people() {
+    const { st, tracking } = this.ctx;
+    const multi = tracking && tracking.multi;
+    return st.mode === 'tracking' && multi && multi.on ? multi : null;
+  }
+
+  /** With several people: "track" is their data, the Monte Carlo curves are off. */
+  refresh() {
+    const what = $('data-what');
+    const people = !!this.people();
+    const mc = what.querySelector('option[value="mc"]');
+    mc.hidden = this.mode !== 'tracking' || people;
+    mc.disabled = mc.hidden;
+    if (mc.disabled && what.value === 'mc') what.value = this.mode === 'tracking' ? 'track' : 'map';
+    what.querySelector('option[value="track"]').textContent = people ? 'People (tracks and truth)' : 'Track';
   }
 
   /** Shows the choices of `mode`: the track and the Monte Carlo curves only in tracking. */
@@ -36,6 +58,8 @@ export class DataExport {
       if (o.disabled && what.value === v) what.value = 'map';
     }
     $('data-export').hidden = mode === 'mtl';
+    this.mode = mode;
+    this.refresh();
   }
 
   /** The text of data `what` ('map' | 'track' | 'mc') as `format` ('csv' | 'json'). */
@@ -47,6 +71,12 @@ export class DataExport {
         window: st.mapWindow, nx: st.res, ny: st.res, scenario: app.scenario().name, format,
       }));
     }
+    const people = this.people();
+    if (people && what === 'track') {
+      if (!people.text) throw new Error('no multi-target run yet');
+      return wasm.people_data_text(people.text, format);
+    }
+    if (people && what === 'mc') throw new Error('no Monte Carlo curves with several people on');
     if (what === 'track') {
       if (!tracking.track) throw new Error('no track simulated yet');
       return tracking.track.data_text(format);
@@ -65,9 +95,10 @@ export class DataExport {
     const what = $('data-what').value;
     const format = $('data-format').value;
     try {
+      const people = !!this.people() && what === 'track';
       const text = this.text(what, format);
       const type = format === 'csv' ? 'text/csv' : 'application/json';
-      const name = `${slug(app.scenario().name)}-${st.mode}-${what}.${format}`;
+      const name = `${slug(app.scenario().name)}-${st.mode}-${people ? 'people' : what}.${format}`;
       const blob = new Blob([text], { type });
       const a = document.createElement('a');
       a.href = URL.createObjectURL(blob);
@@ -77,7 +108,7 @@ export class DataExport {
       if (!this.dryRun) a.click();
       a.remove();
       setTimeout(() => URL.revokeObjectURL(a.href), 10_000);
-      this.last = { name, type, size: blob.size, text, mode: st.mode, what, format };
+      this.last = { name, type, size: blob.size, text, mode: st.mode, what, format, people };
       $('data-save').dataset.saved = name;
     } catch (e) {
       showError(`Export data: ${errorText(e)}`);

@@ -3,8 +3,12 @@
 // tracking_chart_svg, mtl_scene_svg): the map, the nodes, the target's snapshot or the track, and
 // the colour bar; the multi-target scene with its ranges, detections and targets. Each SVG shows
 // the window on screen (zoom.js). Files are named `<scenario>-<view>-<figure>.<ext>`, e.g.
-// sensors2019-snapshot-map.svg, sensors2019-tracking-rmse.svg, multi-target-scene.svg. Nothing
-// here runs until the button is pressed (the drag stays as fast as it was).
+// sensors2019-snapshot-map.svg, sensors2019-tracking-rmse.svg, multi-target-scene.svg. With
+// "Several people" on (tracking view, multi.js), the map is the run's map at the scan shown
+// (people_map_svg: nodes, true paths, labelled tracks, 1σ ellipses) and the chart its GOSPA chart
+// (people_chart_svg, "GOSPA chart"); PNG is the map canvas or #multi-chart as they are; files
+// <scenario>-tracking-people-map.<ext>, <scenario>-tracking-people-gospa.<ext>. Nothing here runs
+// until the button is pressed (the drag stays as fast as it was).
 
 import { $, errorText, showError } from './dom.js';
 import { DataExport } from './data-export.js';
@@ -29,6 +33,23 @@ export class FigureExport {
     this.count = 0;
     $('figure-save').addEventListener('click', () => this.save());
     this.data = new DataExport(ctx); // "Export data" (data-export.js)
+    this.mode = null;
+    // "Several people" on or off changes the chart choice's label and the data choices.
+    $('multi-walkers').addEventListener('change', () => this.relabel());
+  }
+
+  /** The "Several people" run when it is on in the tracking view, else null. */
+  people() {
+    const { st, tracking } = this.ctx;
+    const multi = tracking && tracking.multi;
+    return st.mode === 'tracking' && multi && multi.on ? multi : null;
+  }
+
+  /** The chart choice's label ("GOSPA chart" with several people) and the data choices. */
+  relabel() {
+    const rmse = $('figure-what').querySelector('option[value="rmse"]');
+    rmse.textContent = this.people() ? 'GOSPA chart' : 'RMSE chart';
+    this.data.refresh();
   }
 
   /** Shows the choices of `mode`: the RMSE chart only in tracking. */
@@ -40,12 +61,14 @@ export class FigureExport {
     if (rmse.disabled && what.value === 'rmse') what.value = 'map';
     what.querySelector('option[value="map"]').textContent = mode === 'mtl' ? 'Scene' : 'Map';
     this.data.setMode(mode);
+    this.relabel();
   }
 
   /** The file name of figure `what` ('map' | 'rmse') of the current view. */
   fileName(what, ext) {
     const { app, st } = this.ctx;
     if (st.mode === 'mtl') return `multi-target-scene.${ext}`;
+    if (this.people()) return `${slug(app.scenario().name)}-tracking-people-${what === 'rmse' ? 'gospa' : 'map'}.${ext}`;
     return `${slug(app.scenario().name)}-${st.mode}-${what}.${ext}`;
   }
 
@@ -55,11 +78,12 @@ export class FigureExport {
     const what = st.mode === 'tracking' ? $('figure-what').value : 'map';
     const format = $('figure-format').value;
     const t0 = performance.now();
+    this.relabel();
     try {
       // The RMSE chart of a study still running is labelled partial (chartText), here and on the canvas.
-      const partial = what === 'rmse' ? this.ctx.tracking.mc.chartText().partial : '';
+      const partial = what === 'rmse' && !this.people() ? this.ctx.tracking.mc.chartText().partial : '';
       const blob = format === 'svg' ? this.svg(what) : await this.png(what);
-      this.download(blob, this.fileName(what, format), { mode: st.mode, what, format, ms: performance.now() - t0, partial });
+      this.download(blob, this.fileName(what, format), { mode: st.mode, what, format, ms: performance.now() - t0, partial, people: !!this.people() });
     } catch (e) {
       showError(`Save figure: ${errorText(e)}`);
       console.error(e);
@@ -73,6 +97,8 @@ export class FigureExport {
       const text = wasm.mtl_scene_svg(JSON.stringify(mtl.scene), SVG_WIDTH, 0, JSON.stringify({ window: Array.from(mtl.view.area) }));
       return new Blob([text], { type: 'image/svg+xml' });
     }
+    const people = this.people();
+    if (people) return new Blob([this.peopleSvg(people, what)], { type: 'image/svg+xml' });
     const res = Number($('resolution').value) || 256;
     const options = { window: Array.from(view.area), res };
     // A locked colour range (colour-lock.js) colours the figure as the canvas.
@@ -94,9 +120,25 @@ export class FigureExport {
     return new Blob([text], { type: 'image/svg+xml' });
   }
 
+  /** The SVG text of the several-people figure `what` ('map' | 'rmse': the GOSPA chart). */
+  peopleSvg(multi, what) {
+    const { wasm, view, tracking } = this.ctx;
+    if (!multi.text || !multi.params) throw new Error('no multi-target run yet');
+    if (what === 'rmse') {
+      const c = $('multi-chart').dataset; // the canvas chart's title and subtitle (multi.js)
+      return wasm.people_chart_svg(multi.text, c.title || 'GOSPA per scan', c.subtitle || '', SVG_WIDTH, CHART_HEIGHT);
+    }
+    const magnify = Number($('track-ex').value) || 1;
+    return wasm.people_map_svg(multi.params.scenario, multi.text, SVG_WIDTH, 0, tracking.step, magnify,
+      JSON.stringify({ window: Array.from(view.area) }));
+  }
+
   /** The canvas of figure `what` as it is, as a PNG Blob. */
   png(what) {
-    const canvas = what === 'rmse' ? $('track-chart') : $('plot');
+    const people = this.people();
+    if (people && !people.text) return Promise.reject(new Error('no multi-target run yet'));
+    const chart = people ? $('multi-chart') : $('track-chart');
+    const canvas = what === 'rmse' ? chart : $('plot');
     return new Promise((resolve, reject) => {
       canvas.toBlob((b) => (b ? resolve(b) : reject(new Error('the canvas gave no image'))), 'image/png');
     });

@@ -71,7 +71,7 @@ export function attachPointer(ctx) {
       else if (ctx.plan && ctx.plan.wantsRoi()) readout.textContent = 'Press and drag on the map to draw the region of interest';
       else readout.textContent = st.mode !== 'tracking'
         ? 'Move over the map to read the bound · drag Tx/Rx markers · click to place a target, drag it to move it · ? for help'
-        : `Move over the map to read the bound · drag Tx/Rx markers${ctx.tracking.wantsDraw() ? ' · press and drag to draw a trajectory' : ''}`;
+        : `Move over the map to read the bound · drag Tx/Rx markers${ctx.tracking.wantsDraw() ? ` · ${ctx.tracking.drawHint()}` : ''}`;
       return;
     }
     const m = view.toMetre(p.x, p.y);

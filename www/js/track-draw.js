@@ -1,6 +1,6 @@
 // Drawing of a simulated track over the CRLB map (all numbers from the wasm core's Track): the
 // truth path, the filter's track (EKF, UKF or PF) with its 1σ covariance ellipses (magnified by a labelled factor), and
-// the arrow of a drawn trajectory. The current step's markers, iso-delay ellipses and the zoom
+// the arrow of a drawn trajectory (and the arrows of the several-people view's drawn paths). The current step's markers, iso-delay ellipses and the zoom
 // inset are drawn by draw.js from the snapshot-shaped frame.
 
 import { C, FONT_B, FULL, clipTo, ellipsePath, placeLabel, polyline } from './draw.js';
@@ -50,6 +50,26 @@ function drawArrow(ctx, view, d) {
   // Above right of the arrow's head, else where it fits inside the plot.
   return placeLabel(ctx, d.label, b, view.rect, [], [[8, -6, 'left', 'bottom'], [-8, -6, 'right', 'bottom'],
     [8, 8, 'left', 'top'], [-8, 8, 'right', 'top']]);
+}
+
+/**
+ * Drawn walker paths (the several-people view, multi.js): per path {x0, y0, x1, y1} (m) a start
+ * ring and an arrow to its end, as the single drawn trajectory's, each labelled with its walker's
+ * label (its place, 0 first). Returns the paths drawn, [[x0, y0, x1, y1], …] m.
+ */
+export function drawPathArrows(ctx, view, paths) {
+  clipTo(ctx, view.rect);
+  const taken = [];
+  paths.forEach((d, i) => {
+    drawArrow(ctx, view, { ...d, label: '' });
+    ctx.font = FONT_B;
+    ctx.fillStyle = ARROW;
+    const a = view.toPixel(d.x0, d.y0);
+    placeLabel(ctx, `walker ${i}`, a, view.rect, taken, [[8, 8, 'left', 'top'], [-8, 8, 'right', 'top'],
+      [8, -8, 'left', 'bottom'], [-8, -8, 'right', 'bottom']]);
+  });
+  ctx.restore();
+  return paths.map((d) => [d.x0, d.y0, d.x1, d.y1]);
 }
 
 /**

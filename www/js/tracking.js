@@ -4,14 +4,15 @@
 // Monte Carlo chart (montecarlo.js, the filters ticked) in step: every change of scenario, nodes or
 // trajectory re-simulates the track and restarts the Monte Carlo. With "Several people" on
 // (multi.js) the same transport animates the multi-target run instead, and its GOSPA chart
-// takes the Monte Carlo's place.
+// takes the Monte Carlo's place; with its walkers "drawn", a press-drag on the map adds a walker's
+// path and the run restarts when the drag ends.
 
 import { $, decimalIn, errorText, fillKeyValues, fixed, showError, clearError } from './dom.js';
 import { MonteCarlo } from './montecarlo.js';
-import { Multi } from './multi.js';
+import { MAX_PATHS, Multi } from './multi.js';
 import { drawTrack } from './track-draw.js';
 import { registerSection } from './state.js';
-import { choice, fields, inputNumber, number, shown } from './state-fields.js';
+import { choice, fields, inputNumber, isObject, number, shown } from './state-fields.js';
 
 /** The run's duration, s: the scenarios of spec §9.4 last 10 s (a drawn trajectory too). */
 export const DURATION_S = 10;
@@ -49,7 +50,8 @@ export class Tracking {
     $('track-kind').addEventListener('change', () => { this.kind = $('track-kind').value; rerun(); });
     $('track-dt').addEventListener('change', rerun);
     $('track-seed').addEventListener('change', rerun);
-    $('multi-walkers').addEventListener('change', () => this.multiChanged());
+    $('multi-walkers').addEventListener('change', () => { this.multi.walkersChosen(); this.multiChanged(); });
+    $('multi-clear').addEventListener('click', () => { this.multi.clearPaths(); this.multiChanged(); });
     $('multi-method').addEventListener('change', rerun);
     $('track-filter').addEventListener('change', rerun);
     $('track-particles').addEventListener('change', rerun);
@@ -117,10 +119,15 @@ export class Tracking {
       $('track-seed').classList.remove('invalid');
       if (this.failed) clearError();
       this.failed = false;
-      this.multi.start({
-        scenario: this.ctx.app.scenario_json(), walkers: Number($('multi-walkers').value),
-        method: $('multi-method').value, seed,
-      });
+      const m = this.multi;
+      if (m.drawing && !m.paths.length) {
+        m.waitForPaths();
+      } else {
+        m.start({
+          scenario: this.ctx.app.scenario_json(), walkers: m.walkers(),
+          ...(m.drawing ? { paths: m.pathRows() } : {}), method: $('multi-method').value, seed,
+        });
+      }
     } catch (e) {
       $('track-seed').classList.toggle('invalid', /seed/.test(errorText(e)));
       showError(errorText(e));
@@ -254,17 +261,30 @@ export class Tracking {
     }
   }
 
-  /** Pointer hooks from interact.js: in "draw" mode a press on the map starts a trajectory. */
-  wantsDraw() { return this.active() && this.kind === 'custom' && !this.multi.on; }
+  /**
+   * Pointer hooks from interact.js: in "draw" mode a press on the map starts a trajectory (with
+   * "Several people" on and its walkers "drawn": a walker's path).
+   */
+  wantsDraw() { return this.active() && (this.multi.on ? this.multi.drawing : this.kind === 'custom'); }
+
+  /** What a press-drag on the map does in draw mode (the hover hint). */
+  drawHint() { return this.multi.on ? 'press and drag to draw a walker\'s path' : 'press and drag to draw a trajectory'; }
 
   drawStart(m) {
     this.dragging = true;
     this.pause();
-    this.drawn = { x0: m.x, y0: m.y, x1: m.x, y1: m.y };
+    if (this.multi.on) this.multi.pathStart(m);
+    else this.drawn = { x0: m.x, y0: m.y, x1: m.x, y1: m.y };
     this.redraw();
   }
 
   drawMove(m) {
+    if (this.dragging && this.multi.on) {
+      // The arrow follows; the run (about 100 ms) waits for the drag's end.
+      this.multi.pathMove(m);
+      this.redraw();
+      return;
+    }
     if (!this.dragging || (m.x === this.drawn.x1 && m.y === this.drawn.y1)) return;
     this.drawn = { ...this.drawn, x1: m.x, y1: m.y };
     // The particle filter's track costs tens of ms: it follows the arrow once the drag ends.
@@ -274,6 +294,12 @@ export class Tracking {
   }
 
   drawEnd(m) {
+    if (this.dragging && this.multi.on) {
+      this.dragging = false;
+      if (this.multi.pathEnd(m)) this.panelChanged();
+      else this.redraw();
+      return;
+    }
     this.drawMove(m);
     this.dragging = false;
     if ($('track-filter').value === 'pf' && (this.drawn.x1 !== this.drawn.x0 || this.drawn.y1 !== this.drawn.y0)) {
@@ -403,19 +429,35 @@ export function registerTrackingState(tracking, wasm) {
       tracking.redraw();
     },
   });
-  // Several people (issue 41): the walkers ('off' or 1–5) and the method; optional, so a state
-  // saved before it opens as before (walkers off).
+  // Several people (issue 41): the walkers ('off', 1–5 or 'drawn'), the method and the drawn
+  // paths ([[x0, y0, x1, y1], …] m, at most MAX_PATHS, each end a point the core takes); optional,
+  // so a state saved before it opens as before (walkers off), and a state saved before the drawn
+  // paths opens with none.
+  const multi = tracking.multi;
   registerSection('multi', {
     optional: true,
-    get: () => ({ walkers: $('multi-walkers').value, method: $('multi-method').value }),
+    get: () => ({ walkers: $('multi-walkers').value, method: $('multi-method').value, paths: multi.pathRows() }),
     check: (v) => {
-      fields(v, 'state.multi', ['walkers', 'method']);
+      fields(v, 'state.multi', isObject(v) && 'paths' in v ? ['walkers', 'method', 'paths'] : ['walkers', 'method']);
       choice(v.walkers, 'state.multi.walkers', 'multi-walkers');
       choice(v.method, 'state.multi.method', 'multi-method');
+      const p = v.paths ?? [];
+      if (!Array.isArray(p) || p.length > MAX_PATHS) {
+        throw new Error(`state.multi.paths: ${shown(p)} is not a list of at most ${MAX_PATHS} paths [x0, y0, x1, y1]`);
+      }
+      p.forEach((q, i) => {
+        const path = `state.multi.paths[${i}]`;
+        if (!Array.isArray(q) || q.length !== 4) throw new Error(`${path}: ${shown(q)} is not [x0, y0, x1, y1]`);
+        q.forEach((x, j) => number(x, `${path}[${j}]`));
+        wasm.check_point(`${path}.start`, q[0], q[1]);
+        wasm.check_point(`${path}.end`, q[2], q[3]);
+      });
     },
     apply: (v) => {
+      multi.paths = (v.paths ?? []).map(([x0, y0, x1, y1]) => ({ x0, y0, x1, y1 }));
       $('multi-walkers').value = v.walkers;
       $('multi-method').value = v.method;
+      multi.walkersChosen();
       tracking.multiChanged();
     },
   });

@@ -8,6 +8,7 @@
 //! [`draw_curves`] draws the ROC and missed-detection curves of the multi-target experiments.
 //! [`draw_delays`] and [`draw_track_errors`] draw the channel front end's figures (\[S\] Figs. 4–6).
 //! [`draw_mtl_scene`] draws a multi-target scene and its view (the page's multi-target view).
+//! [`draw_people_map`] and [`draw_gospa_chart`] draw a several-people run (issue 41 §2).
 
 mod channel;
 mod clip;
@@ -15,6 +16,7 @@ mod layout;
 mod map;
 mod overlay;
 mod panel;
+mod people;
 mod plan;
 mod raster;
 mod roc;
@@ -35,6 +37,9 @@ pub use map::{
 };
 pub use overlay::{MapOverlay, OverlayLine, OverlayMark, OverlayMarkKind, OverlayPath};
 pub use panel::{check_area, ChartNode, MapData, NodeKind};
+pub use people::{
+    draw_gospa_chart, draw_people_map, people_rgb, people_titles, PeopleChartOptions,
+};
 pub use plan::{
     draw_plan_maps, plan_caption, plan_chart_size, PlanChartOptions, PlanPanel, PlanPath,
 };

@@ -6,19 +6,12 @@ use serde::Deserialize;
 use wasm_bindgen::prelude::*;
 
 use super::json::{to_js, CrlbJs, NodesJs, SnapshotJs};
-use super::{err, point, settings, window};
+use super::{err, now_ms, point, settings, window};
 use crate::localize::{crlb_at, crlb_map, Grid};
 use crate::present::simulate_snapshot;
 use crate::present::Session;
 use crate::scenario::Area;
 use crate::{scenario::presets, Scenario};
-
-#[wasm_bindgen]
-extern "C" {
-    /// `performance.now()`, ms (window or worker).
-    #[wasm_bindgen(js_namespace = performance, js_name = now)]
-    fn performance_now() -> f64;
-}
 
 /// The settings of `App.compute_map_in` (JSON: `{window, nx, ny}`, every field required,
 /// unknown ones refused).
@@ -268,9 +261,9 @@ impl App {
     ) -> Result<f64, JsError> {
         let grid = Grid::new(area, nx, ny).map_err(err)?;
         let mut buf = vec![0.0; out.length() as usize];
-        let t0 = performance_now();
+        let t0 = now_ms();
         crlb_map(self.session.model(), &grid, &mut buf).map_err(err)?;
-        let ms = performance_now() - t0;
+        let ms = now_ms() - t0;
         out.copy_from(&buf);
         Ok(ms)
     }

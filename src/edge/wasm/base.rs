@@ -107,3 +107,19 @@ pub(super) fn point(x: f64, y: f64) -> Result<Vec2, JsError> {
     limits::COORDINATE_M.check("y", y).map_err(err)?;
     Ok(Vec2::new(x, y))
 }
+
+/// Milliseconds from the worker's (or page's) `performance.now()` (`Date.now()` without one):
+/// the one clock of the bindings' own timings.
+pub(super) fn now_ms() -> f64 {
+    let g = js_sys::global();
+    js_sys::Reflect::get(&g, &JsValue::from_str("performance"))
+        .ok()
+        .and_then(|p| {
+            let f: js_sys::Function = js_sys::Reflect::get(&p, &JsValue::from_str("now"))
+                .ok()?
+                .dyn_into()
+                .ok()?;
+            f.call0(&p).ok()?.as_f64()
+        })
+        .unwrap_or_else(js_sys::Date::now)
+}

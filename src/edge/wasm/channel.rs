@@ -56,6 +56,7 @@ pub use simulate::{simulate_channel, SimulatedChannel};
 
 use super::base::err;
 use super::json::to_js;
+use super::now_ms;
 use super::MAX_FIGURE_PX;
 use crate::chart::{
     delays_size, draw_delays, draw_track_errors, scenario_nodes, track_errors_size,
@@ -105,21 +106,6 @@ fn scenario_and_model(json: &str) -> Result<(Scenario, Model), JsError> {
     let s = Scenario::from_json(json).map_err(named("scenario"))?;
     let m = Model::new(&s).map_err(named("scenario"))?;
     Ok((s, m))
-}
-
-/// Milliseconds from the worker's (or page's) `performance.now()` (`Date.now()` without one).
-fn now_ms() -> f64 {
-    let g = js_sys::global();
-    js_sys::Reflect::get(&g, &JsValue::from_str("performance"))
-        .ok()
-        .and_then(|p| {
-            let f: js_sys::Function = js_sys::Reflect::get(&p, &JsValue::from_str("now"))
-                .ok()?
-                .dyn_into()
-                .ok()?;
-            f.call0(&p).ok()?.as_f64()
-        })
-        .unwrap_or_else(js_sys::Date::now)
 }
 
 /// The parts of `TRACK.json` the map overlay reads (other keys are ignored).

@@ -19,7 +19,8 @@
 //! chart code), `recording.rs` (`read_recording_summary`: a dropped `.npz` channel recording),
 //! `channel.rs` (the channel view: `simulate_channel`, `ChannelJob` run in a Web Worker,
 //! `ChannelFigures`), `multi.rs` (several people in the tracking view: `track_people`, run in a
-//! Web Worker, and `draw_people_chart`, its GOSPA chart).
+//! Web Worker, and `draw_people_chart`, its GOSPA chart), `multi_export.rs` (its Save figure and
+//! Export data: `people_map_svg`, `people_chart_svg`, `people_data_text`).
 
 mod app;
 mod base;
@@ -30,6 +31,7 @@ mod json;
 mod montecarlo;
 mod mtl;
 mod multi;
+mod multi_export;
 mod plan;
 mod recording;
 mod render;
@@ -37,7 +39,7 @@ mod tracking;
 
 pub use app::App;
 pub use base::{check_point, check_rect, preset_json, preset_names, start};
-use base::{err, point, settings, window};
+use base::{err, now_ms, point, settings, window};
 pub use channel::ChannelReplay;
 pub use channel::{
     channel_recording_summary, channel_settings, check_channel_truth, simulate_channel,
@@ -51,6 +53,7 @@ pub use multi::{
     draw_people_chart, track_people, PEOPLE_DT_S, PEOPLE_DURATION_S, PEOPLE_GOSPA_C_M,
     PEOPLE_PROCESS_NOISE,
 };
+pub use multi_export::{people_chart_svg, people_data_text, people_map_svg};
 pub use plan::{plan_field_ranges, plan_network};
 pub use recording::read_recording_summary;
 pub use render::{

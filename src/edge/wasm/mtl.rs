@@ -5,16 +5,9 @@
 
 use wasm_bindgen::prelude::*;
 
-use super::err;
 use super::json::{to_js, MtlViewJs};
+use super::{err, now_ms};
 use crate::present::{mtl_view_cached, MtlScene, ViewCache};
-
-#[wasm_bindgen]
-extern "C" {
-    /// `performance.now()`, ms (window or worker).
-    #[wasm_bindgen(js_namespace = performance, js_name = now)]
-    fn performance_now() -> f64;
-}
 
 /// The default scene (the V-B setting, [`MtlScene::vb`]) as JSON.
 #[wasm_bindgen]
@@ -74,11 +67,11 @@ impl MtlSession {
 }
 
 fn view_json(scene_json: &str, cache: &mut ViewCache) -> Result<JsValue, JsError> {
-    let t0 = performance_now();
+    let t0 = now_ms();
     let scene = MtlScene::from_json(scene_json).map_err(err)?;
     let view = mtl_view_cached(&scene, cache).map_err(err)?;
     to_js(&MtlViewJs {
         view: &view,
-        compute_ms: performance_now() - t0,
+        compute_ms: now_ms() - t0,
     })
 }

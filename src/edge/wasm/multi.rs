@@ -10,21 +10,21 @@
 use alloc::string::String;
 use alloc::vec::Vec;
 
-use plotters::prelude::{IntoDrawingArea, SeriesLabelPosition};
+use plotters::prelude::IntoDrawingArea;
 use plotters_canvas::CanvasBackend;
 use serde::{Deserialize, Serialize};
 use wasm_bindgen::prelude::*;
 use web_sys::HtmlCanvasElement;
 
 use super::json::to_json;
-use super::{err, settings};
-use crate::chart::{draw_curves, CurveChartOptions, CurveSeries, LineKind, Marker};
+use super::{err, now_ms, settings};
+use crate::chart::draw_gospa_chart;
 use crate::error::{Cancel, Error};
 use crate::math::{Mat4, Vec4};
 use crate::present::{format_length_m, position_ellipse, EllipseView};
 use crate::study::{
     score_multi, simulate_people, track_multi, walk_region, MultiScoreDoc, MultiSettings,
-    MultiTrackOutput, MultiTruth,
+    MultiTrackOutput, MultiTruth, Walkers,
 };
 use crate::track::multi::MultiKind;
 use crate::{Model, Scenario};
@@ -38,13 +38,17 @@ pub const PEOPLE_PROCESS_NOISE: f64 = 0.5;
 /// GOSPA's cut-off `c`, m (the CLI's `track --gospa-c` default).
 pub const PEOPLE_GOSPA_C_M: f64 = 1.0;
 
-/// The settings of [`track_people`] (JSON: `{walkers, method, seed, settings?}`; unknown fields
-/// refused).
+/// The settings of [`track_people`] (JSON: `{walkers?, paths?, method, seed, settings?}`;
+/// unknown fields refused).
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct PeopleRequest {
-    /// People walking (1 … 5).
-    walkers: usize,
+    /// People walking on the planned paths (1 … 5); with `paths`, absent or their count.
+    #[serde(default)]
+    walkers: Option<usize>,
+    /// Drawn paths `[x0, y0, x1, y1]`, m (1 … 5): one walker each, instead of the plans.
+    #[serde(default)]
+    paths: Option<Vec<[f64; 4]>>,
     /// `pmb` or `gnn`.
     method: String,
     /// The simulation's seed.
@@ -73,32 +77,50 @@ struct PeopleDoc<'a> {
     score: &'a MultiScoreDoc,
     ellipses: Vec<Vec<Option<EllipseView>>>,
     gospa_label: String,
+    timing_ms: TimingJs,
+}
+
+/// Where [`track_people`]'s time went, ms (the worker's `performance.now()`): the simulation
+/// of the walk and its delay scans, the tracking (the birth grid included), the score and
+/// ellipses.
+#[derive(Serialize)]
+struct TimingJs {
+    simulate: f64,
+    track: f64,
+    score: f64,
 }
 
 /// Simulates and tracks several people on scenario JSON `scenario_json` (schema v1) for
-/// `request_json`, one object (JSON text): `{walkers (1 … 5), method ("pmb" | "gnn"), seed,
-/// settings?}` (`settings`: the fields of [`MultiSettings`], each optional, the CLI's defaults;
+/// `request_json`, one object (JSON text): `{walkers (1 … 5), paths?, method ("pmb" | "gnn"),
+/// seed, settings?}` (`paths`: drawn walker paths `[[x0, y0, x1, y1], …]` in m, 1 … 5, each
+/// walked in a straight line at constant velocity over the run instead of the planned walkers
+/// — the CLI's `simulate-walk --path`; `walkers` may then be left out, else it must equal their
+/// count; `settings`: the fields of [`MultiSettings`], each optional, the CLI's defaults;
 /// `method` replaces its `method`). The walk lasts [`PEOPLE_DURATION_S`] at [`PEOPLE_DT_S`]
 /// with process noise [`PEOPLE_PROCESS_NOISE`] over the scenario's walk region; the score's `c`
 /// is [`PEOPLE_GOSPA_C_M`]. Returns JSON text: `{walkers, seed, dt_s, region_m: {x, y}, truth
 /// (the CLI's truth.json), track (the CLI's `track --targets auto` document), score (its
 /// `score`), ellipses (per scan, per reported target in `track.targets`' order, the 1σ position
-/// ellipse `{cx, cy, a, b, angle}` or null), gospa_label (the chart's legend)}`. Throws the
-/// core's named error on bad input.
+/// ellipse `{cx, cy, a, b, angle}` or null), gospa_label (the chart's legend), timing_ms
+/// (`{simulate, track, score}`, ms)}`. Throws the core's named error on bad input.
 #[wasm_bindgen]
 pub fn track_people(scenario_json: &str, request_json: &str) -> Result<String, JsError> {
     let scenario = Scenario::from_json(scenario_json).map_err(err)?;
     let model = Model::new(&scenario).map_err(err)?;
     let PeopleRequest {
         walkers,
+        paths,
         method,
         seed,
         settings: given,
     } = settings("settings", request_json)?;
+    let walkers = people_walkers(walkers, paths).map_err(err)?;
+    let count = walkers.count();
     let mut cfg = given.unwrap_or_default();
     cfg.method = MultiKind::parse(&method).map_err(err)?;
     let steps = crate::track::step_count(PEOPLE_DURATION_S, PEOPLE_DT_S) + 1;
     let region = walk_region(&scenario.area_m);
+    let t0 = now_ms();
     let (measurements, truth) = simulate_people(
         &model,
         &region,
@@ -110,6 +132,7 @@ pub fn track_people(scenario_json: &str, request_json: &str) -> Result<String, J
         seed,
     )
     .map_err(err)?;
+    let t1 = now_ms();
     let track = track_multi(
         &model,
         &scenario.area_m,
@@ -119,6 +142,7 @@ pub fn track_people(scenario_json: &str, request_json: &str) -> Result<String, J
         Cancel::NEVER,
     )
     .map_err(err)?;
+    let t2 = now_ms();
     let score = score_multi(&track, &truth, PEOPLE_GOSPA_C_M).map_err(err)?;
     let ellipses = track
         .targets
@@ -134,7 +158,7 @@ pub fn track_people(scenario_json: &str, request_json: &str) -> Result<String, J
         .collect();
     let gospa_label = gospa_label(score.c_m, score.mean_gospa_m);
     to_json(&PeopleDoc {
-        walkers,
+        walkers: count,
         seed,
         dt_s: PEOPLE_DT_S,
         region_m: RegionJs {
@@ -146,7 +170,35 @@ pub fn track_people(scenario_json: &str, request_json: &str) -> Result<String, J
         score: &score,
         ellipses,
         gospa_label,
+        timing_ms: TimingJs {
+            simulate: t1 - t0,
+            track: t2 - t1,
+            score: now_ms() - t2,
+        },
     })
+}
+
+/// The walkers of a request: its drawn `paths` (`walkers`, if given, must be their count) or
+/// its `walkers` count; neither is [`Error::InvalidFile`] `walkers`.
+fn people_walkers(walkers: Option<usize>, paths: Option<Vec<[f64; 4]>>) -> Result<Walkers, Error> {
+    match (walkers, paths) {
+        (_, Some(p)) => {
+            if let Some(n) = walkers.filter(|&n| n != p.len()) {
+                return Err(Error::InvalidFile {
+                    field: "walkers".into(),
+                    reason: alloc::format!("{n} walkers but {} drawn paths", p.len()),
+                });
+            }
+            let w = Walkers::Drawn(p.iter().map(|q| ([q[0], q[1]], [q[2], q[3]])).collect());
+            w.check()?;
+            Ok(w)
+        }
+        (Some(n), None) => Ok(Walkers::Count(n)),
+        (None, None) => Err(Error::InvalidFile {
+            field: "walkers".into(),
+            reason: "missing: give walkers (1 … 5) or drawn paths".into(),
+        }),
+    }
 }
 
 /// The chart's legend: `GOSPA (c = 1 m, p = 2), mean 0.123 m`.
@@ -177,7 +229,7 @@ struct ChartScore {
 }
 
 /// Draws the GOSPA of a [`track_people`] document per scan against time (the core's curve
-/// figure, [`draw_curves`]; the legend gives the mean) onto `canvas` at its pixel size, with a
+/// figure, [`draw_gospa_chart`]; the legend gives the mean) onto `canvas` at its pixel size, with a
 /// `title` and optional `subtitle`; `""` as the document draws empty axes. Returns the points
 /// drawn. Throws on a malformed document or a drawing failure.
 #[wasm_bindgen]
@@ -187,58 +239,35 @@ pub fn draw_people_chart(
     title: &str,
     subtitle: &str,
 ) -> Result<u32, JsError> {
-    let (points, label) = if doc_json.trim().is_empty() {
-        (Vec::new(), String::new())
+    let (t_s, gospa, label) = if doc_json.trim().is_empty() {
+        (Vec::new(), Vec::new(), String::new())
     } else {
         let d: ChartDoc = serde_json::from_str(doc_json).map_err(|e| {
             err(Error::Parse {
                 message: e.to_string(),
             })
         })?;
-        let p: Vec<(f64, f64)> = d
-            .track
-            .t_s
+        let g: Vec<f64> = d
+            .score
+            .gospa_m
             .iter()
-            .zip(&d.score.gospa_m)
-            .map(|(&t, g)| (t, g.unwrap_or(f64::NAN)))
+            .map(|g| g.unwrap_or(f64::NAN))
             .collect();
-        (p, d.gospa_label)
-    };
-    let finite = || points.iter().filter(|p| p.0.is_finite() && p.1.is_finite());
-    let t_end = finite().map(|p| p.0).fold(0.0, f64::max);
-    let top = finite().map(|p| p.1).fold(0.0, f64::max);
-    let opts = CurveChartOptions {
-        title: title.into(),
-        subtitle: (!subtitle.is_empty()).then(|| subtitle.into()),
-        x_desc: "time t (s)".into(),
-        y_desc: "GOSPA (m)".into(),
-        x_range: (
-            0.0,
-            if t_end > 0.0 {
-                t_end
-            } else {
-                PEOPLE_DURATION_S
-            },
-        ),
-        y_range: (0.0, if top > 0.0 { 1.1 * top } else { 1.0 }),
-        legend: SeriesLabelPosition::UpperRight,
-    };
-    let series = [CurveSeries {
-        label,
-        points: &points,
-        colour: 0,
-        line: LineKind::Solid,
-        marker: Marker::None,
-    }];
-    let shown = if points.is_empty() {
-        &[][..]
-    } else {
-        &series[..]
+        (d.track.t_s, g, d.gospa_label)
     };
     let root = CanvasBackend::with_canvas_object(canvas)
         .ok_or_else(|| JsError::new("chart: the canvas has no 2-D context"))?
         .into_drawing_area();
-    draw_curves(&root, shown, &opts).map_err(|e| JsError::new(&e.to_string()))?;
+    let drawn = draw_gospa_chart(
+        &root,
+        &t_s,
+        &gospa,
+        &label,
+        title,
+        subtitle,
+        PEOPLE_DURATION_S,
+    )
+    .map_err(|e| JsError::new(&e.to_string()))?;
     root.present().map_err(|e| JsError::new(&e.to_string()))?;
-    Ok(finite().count() as u32)
+    Ok(drawn)
 }

@@ -33,6 +33,7 @@ pub use sensors::{
     check_detection, DelayLinks, Detection, MeasurementModel, Observation, PositionSensor,
 };
 pub use sim::{
-    delay_scans, people_layout, people_region, people_truth, people_truth_in, poisson,
-    position_scans, williams15, williams15_truth, Truth, Williams15,
+    check_drawn_paths, delay_scans, people_layout, people_region, people_truth, people_truth_drawn,
+    people_truth_in, poisson, position_scans, williams15, williams15_truth, DrawnPath, Truth,
+    Williams15, MAX_WALKERS,
 };

@@ -5,9 +5,12 @@
 //! probability `P_D`, Gaussian noise, Poisson clutter uniform over the region or the delay
 //! window. Seeded: a scan depends on the seed only.
 
+use alloc::format;
 use alloc::vec;
 use alloc::vec::Vec;
 
+use crate::error::limits::COORDINATE_M;
+use crate::error::{check_positive, Error, Result};
 use crate::math::{exp, sqrt, Mat4, Real, Vec2, Vec4};
 use crate::measure::{standard_normal, uniform01, Model, Rng};
 use crate::scenario::{presets, Area, Pattern, Scenario, Transmitter};
@@ -228,7 +231,7 @@ pub fn people_truth_in(
                 + (p[1] - base.y[0]) * (region.y[1] - region.y[0]) / (base.y[1] - base.y[0]),
         )
     };
-    let w = walkers.clamp(1, 5);
+    let w = walkers.clamp(1, MAX_WALKERS);
     let jitter = |rng: &mut Rng| Vec2::new(0.2 * standard_normal(rng), 0.2 * standard_normal(rng));
     let mut paths: Vec<(Vec2, Vec2, Real)> = plans[..w]
         .iter()
@@ -243,6 +246,56 @@ pub fn people_truth_in(
         let side = Vec2::new(0.0, 0.7);
         paths[3] = (paths[2].0 + side, paths[2].1 + side, 0.0);
     }
+    walk(&paths, steps, dt_s)
+}
+
+/// The most walkers a run holds (the plans of [`people_truth_in`], the drawn paths of
+/// [`people_truth_drawn`]).
+pub const MAX_WALKERS: usize = 5;
+
+/// A walker's drawn path: its start `[x0, y0]` and end `[x1, y1]`, m.
+pub type DrawnPath = ([Real; 2], [Real; 2]);
+
+/// Checks drawn walker paths: 1 ..= [`MAX_WALKERS`] of them ([`Error::SizeLimit`] `paths`),
+/// every coordinate finite and in [`COORDINATE_M`] ([`Error::NonFinite`] or
+/// [`Error::OutOfRange`] naming `paths[i].x0` … `paths[i].y1`).
+pub fn check_drawn_paths(paths: &[DrawnPath]) -> Result<()> {
+    if !(1..=MAX_WALKERS).contains(&paths.len()) {
+        return Err(Error::SizeLimit {
+            field: "paths",
+            value: paths.len(),
+            min: 1,
+            max: MAX_WALKERS,
+        });
+    }
+    for (i, (a, b)) in paths.iter().enumerate() {
+        for (name, v) in [("x0", a[0]), ("y0", a[1]), ("x1", b[0]), ("y1", b[1])] {
+            COORDINATE_M.check(&format!("paths[{i}].{name}"), v)?;
+        }
+    }
+    Ok(())
+}
+
+/// Walkers on drawn paths (labels `0..n` in the order given): walker `i` walks the straight
+/// line from its start to its end at constant velocity over the run, `(steps − 1) dt_s` (the
+/// convention of the single-target drawn trajectory: press = start, release = where it is at
+/// the end), so at scan `k` it is at `a + (b − a) k dt_s / ((steps − 1) dt_s)` with velocity
+/// `(b − a) / ((steps − 1) dt_s)`. Checked by [`check_drawn_paths`]; `dt_s` must be > 0
+/// ([`Error::NotPositive`]).
+pub fn people_truth_drawn(paths: &[DrawnPath], steps: usize, dt_s: Real) -> Result<Truth> {
+    check_drawn_paths(paths)?;
+    check_positive("dt_s", dt_s)?;
+    let paths: Vec<(Vec2, Vec2, Real)> = paths
+        .iter()
+        .map(|(a, b)| (Vec2::new(a[0], a[1]), Vec2::new(b[0], b[1]), 0.0))
+        .collect();
+    Ok(walk(&paths, steps, dt_s))
+}
+
+/// Walkers on straight paths `(start, end, still)` over `steps` scans at `dt_s`: each stands at
+/// its start for the fraction `still` of the run, then walks to its end at constant velocity,
+/// arriving at the last scan.
+fn walk(paths: &[(Vec2, Vec2, Real)], steps: usize, dt_s: Real) -> Truth {
     let total = (steps.max(2) - 1) as Real * dt_s;
     let steps = (0..steps)
         .map(|k| {

@@ -86,6 +86,10 @@ pub struct TrackArgs {
     /// GOSPA cut-off c of the score against --truth, m [default: 1] (--targets auto).
     #[arg(long, value_name = "M", value_parser = finite)]
     pub gospa_c: Option<f64>,
+    /// Map of the labelled tracks at the last scan, with the --truth paths if given (.svg or
+    /// .png; the page's "Several people" figure) (--targets auto).
+    #[arg(long, value_name = "FIG.{svg,png}")]
+    pub figure: Option<String>,
 }
 
 /// `scatterloc calibrate`.
@@ -154,4 +158,28 @@ pub struct SimulateWalkArgs {
     /// Detection probability per link and scan of --walkers [default: 0.9].
     #[arg(long, value_name = "P", value_parser = probability)]
     pub detection_probability: Option<f64>,
+    /// A drawn walker path, m (repeatable, 1..=5): one walker walks the straight line from
+    /// (x0, y0) to (x1, y1) at constant velocity over the run, instead of the planned walkers
+    /// of --walkers; implies --walkers = the number of paths (a different --walkers is refused).
+    #[arg(
+        long = "path",
+        value_name = "X0,Y0,X1,Y1",
+        value_parser = walker_path,
+        allow_hyphen_values = true
+    )]
+    pub path: Vec<[f64; 4]>,
+}
+
+/// `--path x0,y0,x1,y1`: four finite numbers, comma-separated.
+pub fn walker_path(v: &str) -> Result<[f64; 4], String> {
+    let parts: Vec<&str> = v.split(',').collect();
+    let bad = || format!("expected x0,y0,x1,y1 (four finite numbers, m), got '{v}'");
+    if parts.len() != 4 {
+        return Err(bad());
+    }
+    let mut out = [0.0; 4];
+    for (o, p) in out.iter_mut().zip(&parts) {
+        *o = finite(p).map_err(|_| bad())?;
+    }
+    Ok(out)
 }

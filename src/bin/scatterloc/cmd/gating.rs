@@ -7,7 +7,7 @@
 use std::path::Path;
 
 use scatterloc::formats::{CalibrationResult, CalibrationSnapshots, Measurements, Truth};
-use scatterloc::study::{simulate_people, MultiSettings};
+use scatterloc::study::{simulate_people, MultiSettings, Walkers};
 use scatterloc::track::gating::{Calibration, ClusterConfig, WalkRequest, WalkSimulation};
 use scatterloc::track::ConstantVelocity;
 use scatterloc::Model;
@@ -117,8 +117,8 @@ pub fn simulate_walk(args: &SimulateWalkArgs) -> Result<(), CliError> {
     if dir.is_empty() {
         return Err(CliError::usage("--out-dir: the path is empty".to_string()));
     }
-    if let Some(walkers) = args.walkers {
-        return simulate_walkers(args, &scenario, &model, walkers);
+    if args.walkers.is_some() || !args.path.is_empty() {
+        return simulate_walkers(args, &scenario, &model);
     }
     if args.detection_probability.is_some() {
         return Err(CliError::usage(
@@ -204,14 +204,29 @@ fn write_walk(dir: &str, sim: WalkSimulation) -> Result<(usize, usize), CliError
     Ok(summary)
 }
 
-/// `simulate-walk --walkers N`: the library's [`simulate_people`] → measurements.json (raw
-/// scans) and truth.json (several labelled targets).
+/// `simulate-walk --walkers N` or `--path x0,y0,x1,y1 …`: the library's [`simulate_people`]
+/// (the planned walkers, or one per drawn path) → measurements.json (raw scans) and truth.json
+/// (several labelled targets).
 fn simulate_walkers(
     args: &SimulateWalkArgs,
     scenario: &scatterloc::Scenario,
     model: &scatterloc::Model,
-    walkers: usize,
 ) -> Result<(), CliError> {
+    let walkers = match (args.walkers, args.path.len()) {
+        (Some(n), 0) => Walkers::Count(n),
+        (Some(n), k) if n != k => {
+            return Err(CliError::usage(format!(
+                "--walkers {n}: {k} --path given (--path implies --walkers {k}; leave --walkers out)"
+            )));
+        }
+        _ => Walkers::Drawn(
+            args.path
+                .iter()
+                .map(|p| ([p[0], p[1]], [p[2], p[3]]))
+                .collect(),
+        ),
+    };
+    let count = walkers.count();
     if args.calibration_snapshots.is_some() || args.start.is_some() {
         return Err(CliError::usage(
             "--calibration-snapshots/--start: not with --walkers (no static paths are simulated; \
@@ -239,7 +254,11 @@ fn simulate_walkers(
         &settings,
         args.seed.unwrap_or(1),
     )
-    .map_err(flag_error)?;
+    .map_err(|e| match e.field() {
+        // The drawn paths' errors name `paths[i].x0` …: shown after the flag that gave them.
+        Some(f) if f.starts_with("paths") => at_flag("path", e),
+        _ => flag_error(e),
+    })?;
     let dir = args.out_dir.as_str();
     let created = prepare_out_dir(dir)?;
     let mut files = OutputSet::new();
@@ -253,7 +272,7 @@ fn simulate_walkers(
     written?;
     emit_json(&serde_json::json!({
         "steps": steps,
-        "walkers": walkers,
+        "walkers": count,
         "region_m": {"x": region.x, "y": region.y},
         "detection_probability": settings.detection_probability,
         "clutter_per_link": settings.clutter,

@@ -33,6 +33,7 @@ mod slurm;
 mod study;
 mod track;
 mod track_fig;
+mod track_people_fig;
 
 pub use cir::{cir_estimate, cir_simulate, cir_track};
 pub use cir_convert::cir_convert;

@@ -26,6 +26,7 @@ use super::io::{emit, model_of, one_stdin, read_input, read_json_file, read_scen
 use super::output::{check_writable, Format};
 use super::study::{cost_refused, run_with_bar};
 use super::track_fig::{read_truth, write_track_figure, TrackSeries};
+use super::track_people_fig::write_people_figure;
 use crate::cli::{Association, FilterName, MultiMethod, TrackArgs};
 use crate::failure::CliError;
 
@@ -190,6 +191,7 @@ fn multi_flags_need_targets(args: &TrackArgs) -> Result<(), CliError> {
         ("--clutter-window-ns", args.clutter_window_ns.is_some()),
         ("--birth-rate", args.birth_rate.is_some()),
         ("--gospa-c", args.gospa_c.is_some()),
+        ("--figure", args.figure.is_some()),
     ];
     if args.targets.is_some() {
         // The single-target flags do not apply.
@@ -225,6 +227,14 @@ fn track_several(
     bad: impl Fn(&dyn std::fmt::Display) -> CliError,
 ) -> Result<(), CliError> {
     multi_flags_need_targets(args)?;
+    let figure = match args.figure.as_deref() {
+        Some(p) => {
+            let f = Format::of("figure", p, &[Format::Svg, Format::Png])?;
+            check_writable("figure", p)?;
+            Some((p, f))
+        }
+        None => None,
+    };
     let mut settings = MultiSettings::default();
     if let Some(k) = args.method {
         settings.method = match k {
@@ -262,10 +272,11 @@ fn track_several(
     })?;
     let mut doc =
         serde_json::to_value(&out).map_err(|e| CliError::output(format!("encoding JSON: {e}")))?;
+    let mut truth_read: Option<MultiTruth> = None;
     if let Some(path) = args.truth.as_deref() {
-        let truth: MultiTruth = read_json_file("truth", path)?;
+        let truth: &MultiTruth = truth_read.insert(read_json_file("truth", path)?);
         let c = args.gospa_c.unwrap_or(1.0);
-        let score = score_multi(&out, &truth, c).map_err(|e| match with_flag(&e) {
+        let score = score_multi(&out, truth, c).map_err(|e| match with_flag(&e) {
             Some(text) => CliError::usage(text),
             None => in_file("truth", path, e),
         })?;
@@ -273,6 +284,9 @@ fn track_several(
             .map_err(|e| CliError::output(format!("encoding JSON: {e}")))?;
     } else if args.gospa_c.is_some() {
         return Err(CliError::usage("--gospa-c: only with --truth (the score)"));
+    }
+    if let Some((path, format)) = figure {
+        write_people_figure(path, format, scenario, &out, truth_read.as_ref())?;
     }
     let text =
         serde_json::to_string(&doc).map_err(|e| CliError::output(format!("encoding JSON: {e}")))?;
