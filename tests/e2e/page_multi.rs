@@ -122,6 +122,16 @@ fn several_people_equal_the_cli_and_off_restores_the_view() {
                       mcShown: document.getElementById('track-chart').offsetParent !== null };",
         )
         .await?;
+        // Five walkers (issue 41's speed case, 5 targets × 8 links): their timing.
+        let gen5 = generation(c).await?;
+        select(c, "multi-walkers", "5").await?;
+        let run5 = wait_multi(c, gen5).await?;
+        let five = js(
+            c,
+            "const d = window.tracking.state().multi.doc; \
+             return { walkers: d.walkers, scans: d.track.t_s.length, timing: d.timing_ms };",
+        )
+        .await?;
         // Off: the single-target view as it was.
         select(c, "multi-walkers", "off").await?;
         wait_tracking(c, 120, |s| {
@@ -132,6 +142,7 @@ fn several_people_equal_the_cli_and_off_restores_the_view() {
         let after = single_view(c).await?;
         Ok(json!({
             "run": run, "doc": doc, "params": params, "scenario": scenario, "last": last,
+            "run5": run5, "five": five,
             "before": before, "after": after, "banner": banner(c).await?,
             "errors": console_errors(c).await?,
         }))
@@ -150,6 +161,17 @@ fn several_people_equal_the_cli_and_off_restores_the_view() {
         part("track") / scans,
         part("score")
     );
+    let five = &o["five"];
+    let track5 = five["timing"]["track"].as_f64().unwrap_or(f64::NAN);
+    let scans5 = five["scans"].as_f64().unwrap_or(f64::NAN);
+    println!(
+        "e2e: several people (5 walkers, PMB, {scans5} scans) on the page: {:.0} ms in the \
+         worker; tracking {track5:.1} ms ({:.3} ms per scan)",
+        o["run5"]["computeMs"].as_f64().unwrap_or(f64::NAN),
+        track5 / scans5
+    );
+    assert_eq!(o["run5"]["state"], "done", "{}", o["run5"]);
+    assert_eq!(five["walkers"], 5);
     // The parts are timed inside the worker's call: each ≥ 0, together within its time.
     let parts = part("simulate") + part("track") + part("score");
     assert!(
