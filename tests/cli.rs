@@ -38,6 +38,9 @@ mod csi;
 #[path = "cli/detections.rs"]
 mod detections;
 
+#[path = "cli/doppler.rs"]
+mod doppler;
+
 #[path = "cli/filters.rs"]
 mod filters;
 

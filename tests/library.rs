@@ -16,6 +16,9 @@ mod bad_input;
 #[path = "library/bounds.rs"]
 mod bounds;
 
+#[path = "library/doppler.rs"]
+mod doppler;
+
 #[path = "library/map_kernel.rs"]
 mod map_kernel;
 

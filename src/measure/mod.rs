@@ -1,14 +1,20 @@
 //! The measurement model of one scatterer: bistatic geometry, the one home of range, delay and
 //! their gradients (E1, E3, and the range function (M1) of the multi-target layer), iso-delay and
 //! covariance ellipses (spec §2), the Tx antenna pattern (§9.3), the link budget that sets each
-//! link's SNR and delay standard deviation `σ_τ` (E8) in [`Model`], and seeded noise draws (E2).
+//! link's SNR and delay standard deviation `σ_τ` (E8) in [`Model`], the range rate and a CPI's
+//! Doppler information (`doppler.rs`, D1–D7), and seeded noise draws (E2).
 
+mod doppler;
 mod ellipse;
 mod geometry;
 mod model;
 mod pattern;
 mod simulate;
 
+pub use doppler::{
+    range_rate, range_rate_gradient, state_fisher, Cpi, DEFAULT_RANGE_RATE_FLOOR_MPS,
+    MAX_CPI_SNAPSHOTS,
+};
 pub use ellipse::Ellipse;
 pub use geometry::{
     bistatic_delay, bistatic_range, bistatic_range_dz, delay_gradient, iso_delay_ellipse,

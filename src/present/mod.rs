@@ -14,6 +14,7 @@ mod channel_figure;
 mod channel_files;
 mod channel_view;
 mod colormap;
+mod doppler_docs;
 mod free_z_docs;
 mod multi_view;
 mod plan_view;
@@ -37,6 +38,7 @@ pub use channel_view::{
 pub use colormap::{
     colorbar_rgba, fill_rgba, render_rgba, viridis, LogScale, LINK_RGB, UNBOUNDED_RGB,
 };
+pub use doppler_docs::{CpiDoc, DopplerDoc, RangeRateDoc};
 pub use free_z_docs::{sym3, CrlbFreeZDoc, FixFreeZDoc};
 pub use multi_view::{
     people_csv_header, people_data_text, people_doc_from_json, people_map_view, PeopleMapView,

@@ -37,7 +37,7 @@ pub use montecarlo::{
     PartialSums, StudySums, CHUNK_TRAJECTORIES, MAX_RUNS, MAX_STEPS,
 };
 pub use motion::ConstantVelocity;
-pub use pcrlb::{nominal_pcrlb_rmse, pcrlb_rmse, PosteriorInformation};
+pub use pcrlb::{nominal_pcrlb_rmse, nominal_pcrlb_state, pcrlb_rmse, PosteriorInformation};
 pub use pf::{
     kernel_bandwidth, ParticleFilter, PfConfig, PfUpdate, MAX_PARTICLES, PROPOSAL_INFLATION,
 };

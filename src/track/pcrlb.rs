@@ -53,6 +53,27 @@ impl PosteriorInformation {
         Ok(())
     }
 
+    /// One step of (E9) with the expected Fisher matrix of the whole state `mean_fisher`
+    /// (position and velocity: the delay and range-rate information of
+    /// [`state_fisher`](crate::measure::state_fisher), D7). Fails as [`Self::step`].
+    pub fn step_state(&mut self, motion: &ConstantVelocity, mean_fisher: &Mat4) -> Result<()> {
+        let bound = spd_inverse(&self.information).ok_or_else(|| Error::NotPositiveDefinite {
+            field: "pcrlb.information".into(),
+        })?;
+        let predicted = motion.propagate_covariance(&bound);
+        let info = spd_inverse(&predicted).ok_or_else(|| Error::NotPositiveDefinite {
+            field: "pcrlb.prediction".into(),
+        })? + mean_fisher;
+        self.information = (info + info.transpose()) * 0.5;
+        Ok(())
+    }
+
+    /// `√([F_B⁻¹]₃₃ + [F_B⁻¹]₄₄)`, the bound on the velocity's RMS error, m/s; `None` if
+    /// singular.
+    pub fn velocity_rmse(&self) -> Option<Real> {
+        self.bound().map(|b| sqrt(b[(2, 2)] + b[(3, 3)]))
+    }
+
     /// The bound `F_B⁻¹` on the state error covariance; `None` if singular.
     pub fn bound(&self) -> Option<Mat4> {
         spd_inverse(&self.information)
@@ -103,6 +124,39 @@ pub fn nominal_pcrlb_rmse(
         .map(|n| fisher(model, r0 + (n as Real * motion.dt_s) * v))
         .collect();
     pcrlb_rmse(motion, initial_covariance, &fishers)
+}
+
+/// The nominal PCRLB with the CPI's delay and, with `doppler`, range-rate information
+/// (issue 42 §1): (E9) with `F̃` the [`state_fisher`](crate::measure::state_fisher) (D7) at the
+/// noise-free path of the prior mean `x̄₀`, for `steps` steps. Returns per step `n = 0 … steps`
+/// the position and velocity RMSE bounds (m, m/s; `None` once singular).
+pub fn nominal_pcrlb_state(
+    model: &Model,
+    motion: &ConstantVelocity,
+    mean_state: &Vec4,
+    initial_covariance: &Mat4,
+    cpi: &crate::measure::Cpi,
+    doppler: bool,
+    steps: usize,
+) -> Result<Vec<Option<(Real, Real)>>> {
+    let mut fb = PosteriorInformation::new(initial_covariance)?;
+    let both = |fb: &PosteriorInformation| fb.position_rmse().zip(fb.velocity_rmse());
+    let mut out = Vec::with_capacity(steps + 1);
+    out.push(both(&fb));
+    let v = Vec2::new(mean_state[2], mean_state[3]);
+    for n in 1..=steps {
+        let r = Vec2::new(mean_state[0], mean_state[1]) + (n as Real * motion.dt_s) * v;
+        let x = Vec4::new(r.x, r.y, v.x, v.y);
+        let f = crate::measure::state_fisher(model, &x, cpi, doppler);
+        match fb.step_state(motion, &f) {
+            Ok(()) => out.push(both(&fb)),
+            Err(_) => {
+                out.resize(steps + 1, None);
+                break;
+            }
+        }
+    }
+    Ok(out)
 }
 
 #[cfg(test)]

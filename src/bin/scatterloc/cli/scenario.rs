@@ -29,6 +29,22 @@ pub struct CrlbArgs {
     /// With --free-z: the target's height Z, metres [default: the scenario's target.height_m].
     #[arg(long, value_name = "Z", value_parser = finite, requires = "free_z")]
     pub height: Option<f64>,
+    /// Adds `doppler`: the bound on position and velocity over one coherent processing
+    /// interval from every link's delay and range rate (docs/doppler.md, D1–D7).
+    #[arg(long, conflicts_with = "free_z")]
+    pub doppler: bool,
+    /// With --doppler: the target's velocity VX,VY, m/s (the range rates' gradients depend on it).
+    #[arg(long, value_name = "VX,VY", value_parser = xy, requires = "doppler", default_value = "0,0")]
+    pub velocity: [f64; 2],
+    /// With --doppler: snapshots N in the CPI.
+    #[arg(long, value_name = "N", requires = "doppler", default_value_t = 16)]
+    pub cpi: usize,
+    /// With --doppler: the snapshots' spacing T, seconds (default: a 2.048 ms sounder frame).
+    #[arg(long, value_name = "T", value_parser = finite, requires = "doppler", default_value_t = 2.048e-3)]
+    pub cpi_spacing_s: f64,
+    /// With --doppler: the floor on the range rate's σ, m/s (D5: a body's limbs move).
+    #[arg(long, value_name = "F", value_parser = finite, requires = "doppler", default_value_t = scatterloc::measure::DEFAULT_RANGE_RATE_FLOOR_MPS)]
+    pub range_rate_floor: f64,
 }
 
 /// `scatterloc crlb-map`.

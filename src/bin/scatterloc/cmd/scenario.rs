@@ -5,7 +5,8 @@ use serde::Deserialize;
 use scatterloc::formats::Sigma;
 use scatterloc::localize::{locate as lm_locate, locate_free_z, DelayMeasurements, LmConfig};
 use scatterloc::math::Vec3;
-use scatterloc::present::{CrlbDoc, CrlbFreeZDoc, FixDoc, FixFreeZDoc};
+use scatterloc::measure::Cpi;
+use scatterloc::present::{CrlbDoc, CrlbFreeZDoc, DopplerDoc, FixDoc, FixFreeZDoc};
 use scatterloc::{scenario::presets, Vec2};
 
 use super::flags::{at_flag, in_file};
@@ -28,7 +29,20 @@ pub fn crlb(args: &CrlbArgs) -> Result<(), CliError> {
         return emit_json(&CrlbFreeZDoc::at(&s, &model, args.at, height));
     }
     let doc = CrlbDoc::at(&s, &model, args.at).map_err(|e| at_flag("scenario", e))?;
-    emit_json(&doc)
+    if !args.doppler {
+        return emit_json(&doc);
+    }
+    let cpi = Cpi::new(
+        s.radio.carrier_hz,
+        args.cpi,
+        args.cpi_spacing_s,
+        args.range_rate_floor,
+    )
+    .map_err(|e| CliError::usage(e.to_string()))?;
+    let mut out = serde_json::to_value(&doc).map_err(|e| CliError::usage(e.to_string()))?;
+    out["doppler"] = serde_json::to_value(DopplerDoc::at(&model, args.at, args.velocity, &cpi))
+        .map_err(|e| CliError::usage(e.to_string()))?;
+    emit_json(&out)
 }
 
 /// The `--delays` file of `locate`.

@@ -1,0 +1,101 @@
+//! The snapshot bound with Doppler at a point (issue 42 §1, `scatterloc crlb --doppler`): over
+//! one CPI, the Fisher information of position and velocity from every link's delay and range
+//! rate ([`state_fisher`], D7), its inverse, and per link the range rate and its σ (D1, D5) —
+//! beside the same CPI's delay-only bound, which says nothing of the velocity.
+
+use alloc::vec::Vec;
+
+use serde::Serialize;
+
+use crate::math::{sqrt, Mat4, Real, Vec2, Vec4};
+use crate::measure::{range_rate, state_fisher, Cpi, Model};
+
+/// The CPI as written in the document.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct CpiDoc {
+    /// `N`.
+    pub snapshots: usize,
+    /// `T`, s.
+    pub spacing_s: Real,
+    /// `λ`, m.
+    pub wavelength_m: Real,
+    /// `σ_floor`, m/s.
+    pub floor_mps: Real,
+}
+
+/// One link's range rate and its σ.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct RangeRateDoc {
+    /// `ṙ_p`, m/s (D1).
+    pub range_rate_mps: Real,
+    /// Its σ over the CPI, m/s (D5); `None` when unbounded (one snapshot).
+    pub sigma_range_rate_mps: Option<Real>,
+}
+
+/// The bound at a point and velocity with and without the range rates.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct DopplerDoc {
+    /// The CPI.
+    pub cpi: CpiDoc,
+    /// The velocity the range rates are taken at, m/s.
+    pub velocity_mps: [Real; 2],
+    /// `√(tr P_rr)` with delays and range rates, m; `None` if singular.
+    pub position_rmse_m: Option<Real>,
+    /// `√(tr P_vv)` with delays and range rates, m/s; `None` if singular.
+    pub velocity_rmse_mps: Option<Real>,
+    /// `√(tr F_rr⁻¹)` from the CPI's delays alone (`N` × E8), m; `None` if singular. The delays
+    /// of one CPI bound no velocity.
+    pub delay_only_position_rmse_m: Option<Real>,
+    /// The 4×4 Fisher matrix of `[x, y, vx, vy]` with both (D7), rows.
+    pub fim: [[Real; 4]; 4],
+    /// Per link, in scenario link order.
+    pub links: Vec<RangeRateDoc>,
+}
+
+/// `(√(P₀₀ + P₁₁), √(P₂₂ + P₃₃))` of `F⁻¹`, or `None` when `F` is not positive definite.
+fn bounds(f: &Mat4) -> Option<(Real, Real)> {
+    let p = nalgebra::Cholesky::new(*f)?.inverse();
+    let (a, b) = (p[(0, 0)] + p[(1, 1)], p[(2, 2)] + p[(3, 3)]);
+    (a.is_finite() && b.is_finite() && a > 0.0 && b > 0.0).then(|| (sqrt(a), sqrt(b)))
+}
+
+impl DopplerDoc {
+    /// The bound of `model` at `at` moving at `velocity` over `cpi`.
+    pub fn at(model: &Model, at: [Real; 2], velocity: [Real; 2], cpi: &Cpi) -> DopplerDoc {
+        let r = Vec2::new(at[0], at[1]);
+        let v = Vec2::new(velocity[0], velocity[1]);
+        let x = Vec4::new(r.x, r.y, v.x, v.y);
+        let f = state_fisher(model, &x, cpi, true);
+        let both = bounds(&f);
+        let delay = state_fisher(model, &x, cpi, false);
+        let fp = delay.fixed_view::<2, 2>(0, 0).into_owned();
+        let delay_only = nalgebra::Cholesky::new(fp)
+            .map(|c| c.inverse())
+            .map(|p| p[(0, 0)] + p[(1, 1)])
+            .filter(|t| t.is_finite() && *t > 0.0)
+            .map(sqrt);
+        let links = (0..model.link_count())
+            .map(|p| {
+                let s = cpi.sigma_range_rate(model.snr(p, r));
+                RangeRateDoc {
+                    range_rate_mps: range_rate(&model.network, p, r, v),
+                    sigma_range_rate_mps: s.is_finite().then_some(s),
+                }
+            })
+            .collect();
+        DopplerDoc {
+            cpi: CpiDoc {
+                snapshots: cpi.snapshots,
+                spacing_s: cpi.spacing_s,
+                wavelength_m: cpi.wavelength_m,
+                floor_mps: cpi.floor_mps,
+            },
+            velocity_mps: velocity,
+            position_rmse_m: both.map(|b| b.0),
+            velocity_rmse_mps: both.map(|b| b.1),
+            delay_only_position_rmse_m: delay_only,
+            fim: core::array::from_fn(|i| core::array::from_fn(|j| f[(i, j)])),
+            links,
+        }
+    }
+}

@@ -1,0 +1,97 @@
+//! `crlb --doppler` (issue 42 §1): the CLI prints `crlb`'s document plus the library's
+//! `DopplerDoc` (the bound on position and velocity over one CPI from delays and range rates,
+//! docs/doppler.md), bit for bit; the delay-only position bound of the CPI is `crlb`'s divided
+//! by √N; the velocity is bounded only with Doppler; bad CPI flags are named usage errors.
+
+use serde_json::json;
+
+use scatterloc::measure::Cpi;
+use scatterloc::present::DopplerDoc;
+use scatterloc::Model;
+
+use crate::common::cli::{fails, ok_json, TempDir};
+
+#[test]
+fn crlb_doppler_prints_the_librarys_document() {
+    let dir = TempDir::new();
+    let s = scatterloc::scenario::presets::sensors2019();
+    let f = dir.write_text("s.json", &s.to_json());
+    let model = Model::new(&s).unwrap();
+    for (at, v, n, t, floor) in [
+        ([10.0, 0.0], [1.0, 0.5], 16usize, 2.048e-3, 0.1),
+        ([-3.0, 7.5], [0.0, 0.0], 4, 0.05, 0.0),
+        ([20.0, 10.0], [-1.2, 0.3], 64, 1e-3, 0.3),
+    ] {
+        let (at_s, v_s) = (format!("{},{}", at[0], at[1]), format!("{},{}", v[0], v[1]));
+        let (n_s, t_s, f_s) = (n.to_string(), t.to_string(), floor.to_string());
+        let got = ok_json(&[
+            "crlb",
+            "--scenario",
+            &f,
+            "--at",
+            &at_s,
+            "--doppler",
+            "--velocity",
+            &v_s,
+            "--cpi",
+            &n_s,
+            "--cpi-spacing-s",
+            &t_s,
+            "--range-rate-floor",
+            &f_s,
+        ]);
+        let plain = ok_json(&["crlb", "--scenario", &f, "--at", &at_s]);
+        let cpi = Cpi::new(s.radio.carrier_hz, n, t, floor).unwrap();
+        let want = serde_json::to_value(DopplerDoc::at(&model, at, v, &cpi)).unwrap();
+        assert_eq!(got["doppler"], want);
+        // `crlb`'s own keys are unchanged.
+        let mut rest = got.clone();
+        rest.as_object_mut().unwrap().remove("doppler");
+        assert_eq!(rest, plain);
+        // The CPI's delays alone: N snapshots of E8, so √N below one snapshot's bound.
+        let one = plain["rmse_bound_m"].as_f64().unwrap();
+        let cpi_delay = want["delay_only_position_rmse_m"].as_f64().unwrap();
+        assert!((cpi_delay * (n as f64).sqrt() - one).abs() <= 1e-12 * one);
+        // Doppler only adds information; it bounds the velocity.
+        assert!(want["position_rmse_m"].as_f64().unwrap() <= cpi_delay * (1.0 + 1e-12));
+        assert!(want["velocity_rmse_mps"].as_f64().unwrap() > 0.0);
+    }
+}
+
+#[test]
+fn bad_doppler_flags_are_named() {
+    let dir = TempDir::new();
+    let s = scatterloc::scenario::presets::sensors2019();
+    let f = dir.write_text("s.json", &s.to_json());
+    let base = ["crlb", "--scenario", f.as_str(), "--at", "10,0"];
+    let with = |extra: &[&str]| -> Vec<String> {
+        base.iter().chain(extra).map(|s| s.to_string()).collect()
+    };
+    for (extra, needle) in [
+        (vec!["--doppler", "--cpi", "0"], "cpi.snapshots"),
+        (vec!["--doppler", "--cpi-spacing-s", "0"], "cpi.spacing_s"),
+        (
+            vec!["--doppler", "--range-rate-floor", "-1"],
+            "cpi.floor_mps",
+        ),
+        (vec!["--doppler", "--velocity", "1,nan"], "velocity"),
+        (vec!["--velocity", "1,0"], "--doppler"),
+        (vec!["--doppler", "--free-z"], "--free-z"),
+    ] {
+        let args = with(&extra);
+        let refs: Vec<&str> = args.iter().map(|s| s.as_str()).collect();
+        fails(&refs, &[needle]);
+    }
+    // One snapshot: no Doppler information, the velocity unbounded (null), never NaN.
+    let one = ok_json(
+        &with(&["--doppler", "--cpi", "1"])
+            .iter()
+            .map(|s| s.as_str())
+            .collect::<Vec<_>>(),
+    );
+    assert_eq!(one["doppler"]["velocity_rmse_mps"], json!(null));
+    assert_eq!(
+        one["doppler"]["links"][0]["sigma_range_rate_mps"],
+        json!(null)
+    );
+}
