@@ -11,7 +11,7 @@ masked). Long work releases the GIL, runs on all cores, reports ``progress(done,
 stops on Ctrl-C (``KeyboardInterrupt``).
 
 Scenario and snapshot
-    :class:`Scenario`, :func:`crlb`, :func:`crlb_map`, :func:`locate`
+    :class:`Scenario`, :func:`crlb`, :func:`crlb_doppler`, :func:`crlb_map`, :func:`locate`
 Tracking
     :func:`track`, :func:`calibrate`, :func:`montecarlo`, :func:`pcrlb`
 Planning and multi-target
@@ -52,6 +52,7 @@ from ._scatterloc import (
     calibrate,
     cir_track,
     crlb,
+    crlb_doppler,
     crlb_map,
     estimate,
     estimate_recording,
@@ -95,6 +96,7 @@ __all__ = [
     "calibrate",
     "cir_track",
     "crlb",
+    "crlb_doppler",
     "crlb_map",
     "estimate",
     "estimate_recording",

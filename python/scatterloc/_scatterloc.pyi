@@ -41,6 +41,7 @@ __all__ = [
     "calibrate",
     "cir_track",
     "crlb",
+    "crlb_doppler",
     "crlb_map",
     "estimate",
     "estimate_recording",
@@ -188,6 +189,18 @@ class Crlb:
     def to_dicts(self) -> list[dict[str, Any]]: ...
 
 def crlb(scenario: _ScenarioLike, points: ArrayLike) -> Crlb: ...
+
+def crlb_doppler(
+    scenario: _ScenarioLike,
+    point_m: ArrayLike,
+    velocity_mps: Optional[ArrayLike] = None,
+    *,
+    cpi: int = 16,
+    cpi_spacing_s: float = 2.048e-3,
+    range_rate_floor: float = 0.1,
+) -> dict[str, Any]:
+    """The bound on position and velocity over one CPI from delays and range rates."""
+    ...
 
 def gospa(truth: ArrayLike, estimates: ArrayLike, *, c: float, p: float = 2.0) -> dict[str, Any]:
     """GOSPA (alpha = 2) between true positions and estimates, (n, 2) in metres."""

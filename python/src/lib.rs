@@ -30,6 +30,7 @@ mod channel;
 mod convert;
 mod csi;
 mod detections;
+mod doppler;
 mod errors;
 mod gospa;
 mod mtl;
@@ -70,6 +71,7 @@ fn _scatterloc(m: &Bound<'_, PyModule>) -> PyResult<()> {
     for f in [
         wrap_pyfunction!(gospa::gospa, m)?,
         wrap_pyfunction!(snapshot::crlb, m)?,
+        wrap_pyfunction!(doppler::crlb_doppler, m)?,
         wrap_pyfunction!(snapshot::crlb_map, m)?,
         wrap_pyfunction!(snapshot::locate, m)?,
         wrap_pyfunction!(tracking::track, m)?,

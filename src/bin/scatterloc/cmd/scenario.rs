@@ -39,10 +39,18 @@ pub fn crlb(args: &CrlbArgs) -> Result<(), CliError> {
         args.range_rate_floor,
     )
     .map_err(|e| CliError::usage(e.to_string()))?;
-    let mut out = serde_json::to_value(&doc).map_err(|e| CliError::usage(e.to_string()))?;
-    out["doppler"] = serde_json::to_value(DopplerDoc::at(&model, args.at, args.velocity, &cpi))
-        .map_err(|e| CliError::usage(e.to_string()))?;
-    emit_json(&out)
+    emit_json(&WithDoppler {
+        crlb: &doc,
+        doppler: DopplerDoc::at(&model, args.at, args.velocity, &cpi),
+    })
+}
+
+/// `crlb --doppler`'s document: `crlb`'s keys, then `doppler`.
+#[derive(serde::Serialize)]
+struct WithDoppler<'a> {
+    #[serde(flatten)]
+    crlb: &'a CrlbDoc,
+    doppler: DopplerDoc,
 }
 
 /// The `--delays` file of `locate`.
