@@ -150,6 +150,10 @@ mod page_heights;
 #[cfg(test)]
 #[path = "common/nees.rs"]
 mod nees;
+/// Issue 41 §2: "People: several" in the channel view equals `cir track --targets auto`.
+#[cfg(test)]
+#[path = "e2e/page_channel_multi.rs"]
+mod page_channel_multi;
 /// Issue 38, a first-time user's look: the multi-target view in its theme's colours, the zoom
 /// inset's title clear of its ×, the channel panel without sideways scrolling.
 #[cfg(test)]

@@ -41,8 +41,8 @@ pub use colormap::{
 pub use doppler_docs::{CpiDoc, DopplerDoc, RangeRateDoc};
 pub use free_z_docs::{sym3, CrlbFreeZDoc, FixFreeZDoc};
 pub use multi_view::{
-    people_csv_header, people_data_text, people_doc_from_json, people_map_view, PeopleMapView,
-    PeopleRun, PeopleTrackView,
+    people_csv_header, people_data_text, people_doc_from_json, people_map_view, track_ellipses,
+    PeopleMapView, PeopleRun, PeopleTrackView,
 };
 pub use plan_view::{
     area_of, run_plan, run_plan_with, PlanHistoryJson, PlanImprovementJson, PlanJson,

@@ -95,6 +95,25 @@ fn invalid(field: String, reason: &str) -> Error {
     }
 }
 
+/// The 1σ position ellipse of every reported target of `track`, per scan in `track.targets`'
+/// order (`None` where the covariance has none): the page's ellipses of a multi-target run, in
+/// the tracking view and the channel view alike.
+pub fn track_ellipses(track: &MultiTrackOutput) -> Vec<Vec<Option<crate::present::EllipseView>>> {
+    track
+        .targets
+        .iter()
+        .map(|scan| {
+            scan.iter()
+                .map(|t| {
+                    let cov = Mat4::from_fn(|i, j| t.covariance[i][j]);
+                    position_ellipse(&Vec4::from(t.state), &cov, 1.0)
+                        .map(crate::present::EllipseView::from)
+                })
+                .collect()
+        })
+        .collect()
+}
+
 /// Reads a several-people document — JSON text with `truth` (the CLI's truth.json), `track`
 /// (`track --targets auto`'s document) and `score` (its score), other keys ignored, as the
 /// page's `track_people` returns — and checks its shape: one entry of `t_s` per scan of the

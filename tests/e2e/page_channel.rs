@@ -57,7 +57,7 @@ fn preset(dir: &Path) {
 
 /// Chooses `path` in the file input `id` (chromedriver types the path, as a user picks it) and
 /// waits until the view has read it (`key` of the state names it, or the banner shows).
-async fn choose(c: &Client, id: &str, path: &Path, key: &str) -> Result<String, String> {
+pub(crate) async fn choose(c: &Client, id: &str, path: &Path, key: &str) -> Result<String, String> {
     js(c, "document.getElementById('error-close').click()").await?;
     let name = path.file_name().unwrap().to_string_lossy().into_owned();
     c.find(Locator::Id(id))

@@ -191,6 +191,7 @@ const FIELDS: &[&str] = &[
     "channel.statics",
     "channel.delay_reference",
     "channel.background_time_s",
+    "channel.targets",
     "channel.calibration",
     "channel.empty_from_s",
     "channel.empty_to_s",
@@ -316,6 +317,9 @@ async fn set_everything(c: &Client) -> Result<(), String> {
     // The statics and the delay reference (issue 36).
     select(c, "chan-statics", "clusters").await?;
     select(c, "chan-delay-ref", "los").await?;
+    quiet(c).await?;
+    // Several people (issue 41 §2).
+    select(c, "chan-targets", "several").await?;
     quiet(c).await?;
     select(c, "chan-cal-source", "range").await?;
     quiet(c).await?;

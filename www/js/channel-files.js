@@ -28,7 +28,7 @@ export const INPUTS = [
 ];
 /** The panel's choices: [setting key, select id]. */
 export const CHOICES = [['filter', 'chan-filter'], ['calibration', 'chan-cal-source'], ['statics', 'chan-statics'],
-  ['delay_reference', 'chan-delay-ref'], ['speed', 'chan-speed']];
+  ['delay_reference', 'chan-delay-ref'], ['speed', 'chan-speed'], ['targets', 'chan-targets']];
 
 /** A file's bytes, checked against `max` before reading; throws naming `what` and the file. */
 async function readBytes(file, max, what) {

@@ -5,10 +5,10 @@
 //
 //   import { ChannelJobs, ChannelStopped } from './channel-job.js';
 //   const jobs = new ChannelJobs(module); // the page's compiled wasm module (optional: compiled here)
-//   const r = await jobs.start({ scenario, recording, calibration, truth }, settings,
+//   const r = await jobs.start({ scenario, recording, calibration, truth, targets }, settings,
 //     (p) => console.log(p.phase, p.done, p.total));
-//   // r: {summary, timings, estimates, track, figure, errors (texts), ms (in the worker),
-//   //     wallMs (start() to the result)}
+//   // r: {summary, timings, estimates, track, figure, errors, people (texts; people null
+//   //     unless targets: 'auto'), ms (in the worker), wallMs (start() to the result)}
 //   const s = await jobs.simulate(scenario, { duration_s: 6, dt_s: 0.02 });
 //   // s: {recording: Uint8Array, calibration: Uint8Array, truth, scene (texts), summary}
 //   jobs.stop();
@@ -16,7 +16,8 @@
 // `scenario` is the scenario JSON text; `recording`/`calibration` the .npz files' bytes
 // (Uint8Array or ArrayBuffer; copied to the worker, never transferred, so the caller keeps them);
 // `calibration: null` uses settings.calibration_range_s, or without one a background learnt from
-// the recording itself; `truth` the truth file's text or null; `settings` the core's
+// the recording itself; `truth` the truth file's text or null; `targets` 'one' (the default) or
+// 'auto' (several people too: ChannelJob.set_targets); `settings` the core's
 // ChannelRequest as an object (its JSON field names: max_paths, pfa, statics, delay_reference, …).
 // Errors reject with an Error whose message is the core's named message.
 
@@ -97,13 +98,13 @@ export class ChannelJobs {
   }
 
   /**
-   * Estimates and tracks a recording: files {scenario, recording, calibration?, truth?},
+   * Estimates and tracks a recording: files {scenario, recording, calibration?, truth?, targets?},
    * settings (see the file comment), onProgress({phase, done, total}). Resolves to the result.
    */
   start(files, settings = {}, onProgress = null) {
     return this.post({
       kind: 'run', scenario: files.scenario, recording: files.recording,
-      calibration: files.calibration ?? null, truth: files.truth ?? null, settings,
+      calibration: files.calibration ?? null, truth: files.truth ?? null, targets: files.targets ?? 'one', settings,
     }, onProgress);
   }
 
@@ -134,5 +135,5 @@ function resultOf(m, t0) {
     };
   }
   const { summary, timings, estimates, track, figure, errors, ms } = m;
-  return { summary, timings, estimates, track, figure, errors, ms, wallMs };
+  return { summary, timings, estimates, track, figure, errors, people: m.people ?? null, ms, wallMs };
 }

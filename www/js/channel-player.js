@@ -1,11 +1,27 @@
 // The channel view's player (a part of the Channel class, channel.js): the time cursor (the
 // slider, Play and its speed), the read-outs of the cursor's snapshot, the map layer (the
-// segments up to the cursor, the ellipses, the links, the 1σ: channel-draw.js), the delay and
+// segments up to the cursor, the ellipses, the links, the 1σ: channel-draw.js; several people's
+// labelled tracks: people-draw.js), the delay and
 // error charts drawn by the core's chart code with the cursor over them, and Save.
 
 import { $, clip, errorText, fillKeyValues, fitCanvas, fixed, showError } from './dom.js';
 import { drawChannel, drawCursor, drawSegments, lossName } from './channel-draw.js';
 import { slug } from './export.js';
+import { drawPeople, peopleColour } from './people-draw.js';
+
+/** The read-out rows of several people at snapshot `k`: each reported track, then the people. */
+function peopleRows(doc, k) {
+  const step = Math.min(k, doc.track.t_s.length - 1);
+  const rows = doc.track.targets[step].map((t, i) => {
+    const e = doc.ellipses[step][i];
+    return [`Track #${t.label}`, `${fixed(t.state[0], 3)}, ${fixed(t.state[1], 3)} m · 1σ ${e ? `${fixed(e.a, 3)} × ${fixed(e.b, 3)} m` : '—'}`, 'fix'];
+  });
+  if (!rows.length) rows.push(['Tracks', 'none reported', '']);
+  rows.push(['Labelled tracks', String(doc.track.tracks.length), '']);
+  if (doc.truth) rows.push(['True people', String(doc.truth.targets[step].length), '']);
+  if (doc.score) rows.push([`GOSPA (c = ${fixed(doc.score.c_m, 2)} m)`, `${fixed(doc.score.gospa_m[step], 3)} m`, '']);
+  return rows;
+}
 
 /** The player part of the Channel class (channel.js mixes it in). */
 export const channelPlayer = {
@@ -110,6 +126,11 @@ export const channelPlayer = {
     const truth = this.truthAt(this.step);
     const e = ov.sigma_ellipse;
     const seg = this.segmentAt(this.step);
+    const people = this.result.people;
+    if (people) {
+      fillKeyValues($('chan-info'), peopleRows(people, this.step));
+      return;
+    }
     const rows = [
       [`${(tr.filter || this.result.settings.filter).toUpperCase()} estimate`, ov.state ? m2(ov.state) : seg.text, 'fix'],
       ['Segment', ov.segment === null || ov.segment === undefined ? '—'
@@ -156,6 +177,18 @@ export const channelPlayer = {
     }
     // A node moved (or the scenario changed) since the run: say so before drawing it stale.
     this.showStale(true);
+    const people = this.result.people;
+    if (people) {
+      // Several people: every labelled track with its label and 1σ ellipse, and the true paths.
+      const stale = this.stale.length > 0;
+      if (stale) ctx.globalAlpha = 0.45;
+      this.peopleLayer = drawPeople(ctx, view, people, this.step, 1, (label) => peopleColour(people, label));
+      ctx.globalAlpha = 1;
+      const l = this.peopleLayer;
+      this.drawn = { step: this.step, people: l.tracks.length, labels: l.tracks.map((t) => t.label), truth_paths: l.truth.length, stale };
+      return;
+    }
+    this.peopleLayer = null;
     const truth = this.truthAt(0) ? this.truth.data.states.map((s) => [s[0], s[1]]) : null;
     this.drawn = drawChannel(ctx, view, {
       overlay: this.overlay(this.step), truth, step: this.step, nodes: this.ctx.st.nodes,

@@ -14,12 +14,12 @@ export const SIMULATE_SETTINGS = { duration_s: 15, dt_s: 0.05 };
 
 /** The settings a run depends on (a change after a run says so). */
 const RUN_KEYS = ['filter', 'particles', 'seed', 'process_noise', 'p_fa', 'max_paths', 'extent_sigma_m',
-  'statics', 'delay_reference', 'background_time_s', 'calibration', 'empty_from_s', 'empty_to_s'];
+  'statics', 'delay_reference', 'background_time_s', 'calibration', 'empty_from_s', 'empty_to_s', 'targets'];
 /** The run's settings as the status line names them when they change. */
 const RUN_LABELS = {
   filter: 'filter', particles: 'particles', seed: 'seed', process_noise: 'q', p_fa: 'P_fa', max_paths: 'max paths',
   extent_sigma_m: 'extent σ', statics: 'statics', delay_reference: 'delays', background_time_s: 'background τ',
-  calibration: 'empty area', empty_from_s: 'empty from', empty_to_s: 'empty to',
+  calibration: 'empty area', empty_from_s: 'empty from', empty_to_s: 'empty to', targets: 'people',
 };
 
 /**
@@ -66,6 +66,21 @@ export function segmentsText(segments) {
 }
 
 /**
+ * Several people as the status line names them (the worker's people document): "3 labelled
+ * tracks (#0, #1, #4, PMB)", and with a truth "· mean GOSPA 0.21 m, 0 label switches".
+ */
+export function peopleText(p) {
+  const n = p.track.tracks.length;
+  const labels = p.track.tracks.map((t) => `#${t.label}`).join(', ');
+  let text = `${n} labelled track${n === 1 ? '' : 's'}${n ? ` (${labels}, ${p.track.method.toUpperCase()})` : ` (${p.track.method.toUpperCase()})`}`;
+  if (p.score) {
+    const s = p.score;
+    text += ` · mean GOSPA ${fixed(s.mean_gospa_m, 2)} m, ${s.switches} label switch${s.switches === 1 ? '' : 'es'}`;
+  }
+  return text;
+}
+
+/**
  * The phases of a run in order: [phase, name in the status line, share of the progress bar].
  * The worker reports estimate (link-snapshots), track, figure (links) and results (its texts
  * being written); the page load (reading them into ChannelFigures) and draw (the charts). The
@@ -99,6 +114,11 @@ export const channelRun = {
     $('chan-simulate').addEventListener('click', () => this.simulate());
     $('chan-run').addEventListener('click', () => this.run());
     $('chan-stop').addEventListener('click', () => this.stop());
+    // One person or several (a page setting: the worker's job is told with set_targets).
+    $('chan-targets').addEventListener('change', () => {
+      this.s = { ...this.s, targets: $('chan-targets').value };
+      this.showStale();
+    });
   },
 
   /**
@@ -262,6 +282,7 @@ export const channelRun = {
         scenario, recording: rec.bytes,
         calibration,
         truth: truthText,
+        targets: used.targets === 'several' ? 'auto' : 'one',
       }, settings, (p) => this.onProgress(p));
       await this.receive(r, { settings: used, truthText, calibration, scenario, names, rec }, t0);
       this.running = null;
@@ -341,7 +362,8 @@ export const channelRun = {
     this.overlays.clear();
     this.runs += 1;
     this.result = {
-      track: JSON.parse(r.track), texts: { track: r.track, figure: r.figure, errors: r.errors, estimates: r.estimates },
+      track: JSON.parse(r.track), texts: { track: r.track, figure: r.figure, errors: r.errors, estimates: r.estimates, people: r.people },
+      people: r.people ? JSON.parse(r.people) : null,
       timings: { ...r.timings, results_ms: r.ms - sumTimings(r.timings), load_ms: loadMs }, summary: r.summary, ms: r.ms,
       workerWallMs: r.wallMs, wallMs: r.wallMs, ...meta,
     };
@@ -374,6 +396,7 @@ export const channelRun = {
     const s = (ms) => `${fixed(ms / 1000, 2)} s`;
     let text = `Done in ${s(r.wallMs)}: read ${s(t.parse_ms)}, statics and paths ${s(t.estimate_ms)}, `
       + `track ${s(t.track_ms)}, figures ${s(t.figure_ms)}, results and charts ${s((r.wallMs - sumTimings(t)))} · ${this.staticsText()}`;
+    if (r.people) return `${text} · ${peopleText(r.people)}`;
     text += ` · ${segmentsText(r.track.segments)}`;
     const e = r.track.error;
     if (e) text += ` · error median ${fixed(e.median_m, 2)} m, 90 % ${fixed(e.p90_m, 2)} m`;

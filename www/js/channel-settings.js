@@ -5,7 +5,7 @@
 // their defaults and ranges from the core's table (wasm channel_settings, read once after
 // app.js has initialised the module): a new setting or a new default is written in the core
 // only. The page's own settings (where the empty area comes from, the link shown, the cursor,
-// the playback speed) are listed here. Nothing here touches the DOM.
+// the playback speed, one person or several) are listed here. Nothing here touches the DOM.
 
 import { clip, decimal } from './dom.js';
 import { channel_settings } from '../pkg/scatterloc.js';
@@ -15,6 +15,11 @@ import { channel_settings } from '../pkg/scatterloc.js';
  * background is learnt from the recording itself), or a time range of the recording.
  */
 export const CALIBRATION_SOURCES = ['file', 'range'];
+/**
+ * How many people a run tracks: 'one' (the single-target track, `cir track`) or 'several'
+ * (also the labelled tracks of `cir track --targets auto`, drawn on the map instead).
+ */
+export const CHANNEL_TARGETS = ['one', 'several'];
 /** The playback speeds of the transport's <select>. */
 export const CHANNEL_SPEEDS = [0.25, 0.5, 1, 2, 4];
 
@@ -28,6 +33,7 @@ const AUTO = 'auto';
 
 /** The page's own settings (the same shape as channelFields'). */
 const PAGE_FIELDS = [
+  ['targets', 'choice', 'one', { values: CHANNEL_TARGETS }],
   ['calibration', 'choice', 'file', { values: CALIBRATION_SOURCES }],
   ['empty_from_s', 'number', 0, { min: 0, max: 1e9, allowed: '0 … 1000000000 s' }],
   ['empty_to_s', 'number', 1, { min: 0, max: 1e9, allowed: '0 … 1000000000 s' }],

@@ -7,7 +7,8 @@
 // Jobs (besides worker-loop.js' own {type, gen}):
 //   {kind: 'run', scenario: text, recording: Uint8Array | ArrayBuffer (.npz bytes),
 //    calibration: Uint8Array | ArrayBuffer | null (.npz; null: settings.calibration_range_s,
-//    or without one a background learnt from the recording), truth: text | null, settings:
+//    or without one a background learnt from the recording), truth: text | null, targets:
+//    'one' | 'auto' (several people too: ChannelJob.set_targets; absent: one), settings:
 //    object (the core's ChannelRequest, see src/edge/wasm/channel/job.rs)}
 //   {kind: 'simulate', scenario: text, settings: object (the core's SimulationRequest)}
 //   {kind: 'replay', scenario, recording, calibration, settings (as 'run'), speed: number (1×
@@ -24,7 +25,7 @@
 //   run:      {type: 'result', gen, ms, kind: 'run', summary: object, timings: {parse_ms,
 //              estimate_ms, track_ms, figure_ms}, estimates: text (EST.json),
 //              track: text (TRACK.json), figure: text (the delay figure's data), errors: text
-//              (the error view)}
+//              (the error view), people: text (ChannelJob.people_json) | null (one person)}
 //   replay:   {type: 'result', gen, ms, kind: 'replay', frames}
 //   simulate: {type: 'result', gen, ms, kind: 'simulate', recording: ArrayBuffer, calibration:
 //              ArrayBuffer, truth: text, scene: text, summary: object} (the buffers are
@@ -44,6 +45,8 @@ async function run(m, { progress, pause }) {
   const job = new ChannelJob(m.scenario, bytesOf(m.recording), bytesOf(m.calibration),
     m.truth ?? undefined, JSON.stringify(m.settings ?? {}));
   try {
+    const several = m.targets === 'auto';
+    if (several) job.set_targets('auto');
     for (;;) {
       const p = job.step(SLICE_MS);
       if (p.finished) break;
@@ -61,6 +64,7 @@ async function run(m, { progress, pause }) {
         track: job.track_json(),
         figure: job.figure_json(),
         errors: job.errors_json(),
+        people: several ? job.people_json() : null,
       },
     };
   } finally {

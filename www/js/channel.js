@@ -11,7 +11,9 @@
 // ([S] Fig. 4) and the error over time, each with the time cursor; over the error chart the
 // segments are marked (the gaps shaded, each loss with its reason: channel-draw.js
 // drawSegments); the map shows the segments up to the cursor, the iso-delay ellipses of the
-// delays used, the links used and the filter's 1σ (channel-draw.js). Files are read with
+// delays used, the links used and the filter's 1σ (channel-draw.js); with "People: several"
+// it shows every labelled track of the recording (as `cir track --targets auto`) with its label
+// and 1σ ellipse instead (people-draw.js). Files are read with
 // File.arrayBuffer() and go to the worker only: nothing leaves the machine.
 //
 // The Channel class is composed of its parts: channel-files.js (the files and the settings
@@ -164,10 +166,25 @@ export class Channel {
       workerMs: r ? r.ms : null,
       settings: this.settings(),
       replay: this.replayState(),
+      people: this.peopleState(),
     };
   }
 
-  /** The result's texts (TRACK.json, EST.json, the figure and error views) for the tests, or null. */
+  /**
+   * The several people of the result shown (null without): {labels (the labelled tracks' labels),
+   * scans, layer (what the map drew last: {step, truth, tracks: [{label, colour, state, ellipse,
+   * points, box}]})}; the document itself is texts().people.
+   */
+  peopleState() {
+    const p = this.result && this.result.people;
+    if (!p) return null;
+    return { labels: p.track.tracks.map((t) => t.label), scans: p.track.t_s.length, layer: this.peopleLayer || null };
+  }
+
+  /**
+   * The result's texts (TRACK.json, EST.json, the figure and error views, and the people
+   * document of a run with several people, else null) for the tests, or null.
+   */
   texts() {
     return this.result ? { ...this.result.texts } : null;
   }
@@ -175,6 +192,7 @@ export class Channel {
 
 // The parts' methods (each file's concern) on the one class, so the view is one object for app.js and the hooks.
 Object.assign(Channel.prototype, channelFiles, channelRun, channelPlayer, channelReplay);
+/** The panel's inputs from this.s (channel-files.js), and the People select (one or several). */
 /** The settings' keys (for the state helper's documentation and tests; after the wasm start). */
 export function channelSettingKeys() {
   return channelFields().map((f) => f[0]);

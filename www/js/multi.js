@@ -9,7 +9,7 @@
 // step and asks this file what to draw at it; "off" leaves the single-target view as it was.
 
 import { $, errorText, fitCanvas, fixed } from './dom.js';
-import { C, FONT_B, FULL, clipTo, ellipsePath, linkColor, placeLabel, polyline } from './draw.js';
+import { drawPeople, peopleColour, peopleTruthPaths } from './people-draw.js';
 import { drawPathArrows } from './track-draw.js';
 import { JobWorker } from './workers.js';
 
@@ -241,27 +241,16 @@ export class Multi {
   }
 
   /** The colour of the track with `label`: its place among the document's tracks (label order). */
-  colour(label) {
-    const i = this.doc.track.tracks.findIndex((t) => t.label === label);
-    return linkColor(Math.max(0, i));
-  }
+  colour(label) { return peopleColour(this.doc, label); }
 
   /** Every true path, [[x, y], …] per person (label order). */
-  truthPaths() {
-    const paths = new Map();
-    for (const scan of this.doc.truth.targets) {
-      for (const t of scan) {
-        if (!paths.has(t.label)) paths.set(t.label, []);
-        paths.get(t.label).push([t.state[0], t.state[1]]);
-      }
-    }
-    return [...paths.values()];
-  }
+  truthPaths() { return peopleTruthPaths(this.doc); }
 
   /**
-   * The map layer at scan `step` (ellipses magnified by `magnify`): true paths thin, each track
-   * up to the step in its colour with its label and current 1σ ellipse. Returns what was drawn:
-   * {step, truth: [[x, y]…] per person, tracks: [{label, colour, state, ellipse, points}]}.
+   * The map layer at scan `step` (ellipses magnified by `magnify`): the drawn paths, then the
+   * people (people-draw.js: true paths thin, each track up to the step in its colour with its
+   * label and current 1σ ellipse). Returns what was drawn: {step, truth: [[x, y]…] per person,
+   * tracks: [{label, colour, state, ellipse, points}], paths}.
    */
   draw(ctx, view, step, magnify) {
     const d = this.doc;
@@ -272,50 +261,7 @@ export class Multi {
       this.layer.paths = drawPathArrows(ctx, view, shown);
     }
     if (!d) return this.layer;
-    step = Math.min(step, d.track.t_s.length - 1);
-    this.layer.step = step;
-    clipTo(ctx, view.rect);
-    ctx.lineJoin = 'round';
-    ctx.setLineDash([4, 4]);
-    ctx.lineWidth = 1;
-    ctx.strokeStyle = 'rgba(255,255,255,0.7)';
-    for (const path of this.truthPaths()) {
-      polyline(ctx, view, path, false); ctx.stroke();
-      this.layer.truth.push(path);
-    }
-    ctx.setLineDash([]);
-    const taken = [];
-    for (const tr of d.track.tracks) {
-      const colour = this.colour(tr.label);
-      // The track's estimates up to the step, split where it was not reported.
-      const runs = [[]];
-      for (let k = tr.first_scan; k <= Math.min(step, tr.last_scan); k++) {
-        const t = d.track.targets[k].find((x) => x.label === tr.label);
-        if (t) runs[runs.length - 1].push([t.state[0], t.state[1]]);
-        else if (runs[runs.length - 1].length) runs.push([]);
-      }
-      ctx.strokeStyle = colour;
-      ctx.lineWidth = 2;
-      for (const r of runs) if (r.length > 1) { polyline(ctx, view, r, false); ctx.stroke(); }
-      const i = d.track.targets[step].findIndex((x) => x.label === tr.label);
-      if (i < 0) continue;
-      const t = d.track.targets[step][i];
-      const e = d.ellipses[step][i];
-      if (e) {
-        ellipsePath(ctx, view, e, magnify);
-        ctx.globalAlpha = 0.2; ctx.fillStyle = colour; ctx.fill(); ctx.globalAlpha = 1;
-        ctx.lineWidth = 2; ctx.strokeStyle = colour; ctx.stroke();
-      }
-      const p = view.toPixel(t.state[0], t.state[1]);
-      ctx.beginPath(); ctx.arc(p.x, p.y, 4, 0, FULL);
-      ctx.fillStyle = colour; ctx.fill();
-      ctx.font = FONT_B;
-      ctx.fillStyle = colour;
-      const box = placeLabel(ctx, `#${t.label}`, p, view.rect, taken, [[7, -6, 'left', 'bottom'],
-        [-7, -6, 'right', 'bottom'], [7, 6, 'left', 'top'], [-7, 6, 'right', 'top']], C.halo);
-      this.layer.tracks.push({ label: t.label, colour, state: t.state, ellipse: e, points: runs.flat(), box });
-    }
-    ctx.restore();
+    this.layer = { ...drawPeople(ctx, view, d, step, magnify, (label) => this.colour(label)), paths: this.layer.paths };
     return this.layer;
   }
 

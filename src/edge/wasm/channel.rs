@@ -45,6 +45,8 @@ mod job;
 mod live;
 /// The checks at open: a recording's links, a truth file's times.
 mod open;
+/// Several people in a channel run: `cir track --targets auto`'s labelled tracks.
+mod people;
 /// `simulate_channel`: the simulation use case.
 mod simulate;
 

@@ -20,8 +20,7 @@ use super::json::to_json;
 use super::{err, now_ms, settings};
 use crate::chart::draw_gospa_chart;
 use crate::error::{Cancel, Error};
-use crate::math::{Mat4, Vec4};
-use crate::present::{format_length_m, position_ellipse, EllipseView};
+use crate::present::{format_length_m, track_ellipses, EllipseView};
 use crate::study::{
     score_multi, simulate_people, track_multi, walk_region, MultiScoreDoc, MultiSettings,
     MultiTrackOutput, MultiTruth, Walkers,
@@ -144,18 +143,7 @@ pub fn track_people(scenario_json: &str, request_json: &str) -> Result<String, J
     .map_err(err)?;
     let t2 = now_ms();
     let score = score_multi(&track, &truth, PEOPLE_GOSPA_C_M).map_err(err)?;
-    let ellipses = track
-        .targets
-        .iter()
-        .map(|scan| {
-            scan.iter()
-                .map(|t| {
-                    let cov = Mat4::from_fn(|i, j| t.covariance[i][j]);
-                    position_ellipse(&Vec4::from(t.state), &cov, 1.0).map(EllipseView::from)
-                })
-                .collect()
-        })
-        .collect();
+    let ellipses = track_ellipses(&track);
     let gospa_label = gospa_label(score.c_m, score.mean_gospa_m);
     to_json(&PeopleDoc {
         walkers: count,

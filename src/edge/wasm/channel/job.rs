@@ -2,7 +2,9 @@
 //! Web Worker, `www/js/channel-worker.js`), through the core's channel chain: the settings are
 //! the core's [`ChannelRequest`] (its JSON, field for field), the estimation one
 //! [`EstimationRun`] (statics and estimates in the same run, as `cir estimate`), the track
-//! [`cir_track`], the files [`estimates_doc`] and [`track_doc`] (as the CLI writes them).
+//! [`cir_track`], the files [`estimates_doc`] and [`track_doc`] (as the CLI writes them); with
+//! several people on ([`ChannelJob::set_targets`]) also the labelled tracks of `cir track
+//! --targets auto` (`people.rs`).
 
 use alloc::format;
 use alloc::string::String;
@@ -11,6 +13,7 @@ use alloc::vec::Vec;
 use serde::Serialize;
 use wasm_bindgen::prelude::*;
 
+use super::people::{parse_targets, people_doc, truth_others, PeopleDoc};
 use super::{check_size, named, now_ms, scenario_and_model, MAX_CHANNEL_PARTICLE_STEPS};
 use crate::channel::ResponseMap;
 use crate::channel::{Band, Recording};
@@ -128,6 +131,7 @@ struct SummaryJs {
     statics: &'static str,
     delay_reference: &'static str,
     truth: bool,
+    targets: &'static str,
 }
 
 /// The empty area of `ChannelJob.summary()`.
@@ -146,6 +150,12 @@ pub struct ChannelJob {
     empty: Option<Recording>,
     empty_source: &'static str,
     truth: Option<Truth>,
+    /// The truth file's further walkers (`others`), or the error reading them (raised only
+    /// when several people are tracked).
+    others: Result<Vec<Vec<[f64; 4]>>, Error>,
+    /// Whether the labelled tracks of several people are made too (`set_targets("auto")`).
+    several: bool,
+    people: Option<PeopleDoc>,
     req: ChannelRequest,
     cfg: FrontEndConfig,
     phase: Phase,
@@ -218,14 +228,14 @@ impl ChannelJob {
             .empty_area(file.as_ref(), &rec)
             .map_err(err)?
             .map(alloc::borrow::Cow::into_owned);
-        let truth = match truth_json {
+        let (truth, others) = match truth_json {
             Some(text) => {
                 check_size("truth", text.len(), MAX_PAGE_TEXT_BYTES as u64).map_err(err)?;
                 let t = Truth::from_json(&text).map_err(named("truth"))?;
                 t.check_times(&rec.t_s).map_err(named("truth"))?;
-                Some(t)
+                (Some(t), truth_others(&text))
             }
-            None => None,
+            None => (None, Ok(Vec::new())),
         };
         let bw = scenario.radio.bandwidth_hz;
         // The empty area's own checks first, so its problems are named as its.
@@ -247,6 +257,9 @@ impl ChannelJob {
             empty,
             empty_source,
             truth,
+            others,
+            several: false,
+            people: None,
             req,
             cfg,
             phase: Phase::Estimate,
@@ -260,6 +273,21 @@ impl ChannelJob {
             band: None,
             timings,
         })
+    }
+
+    /// How many people the run tracks: `"one"` (the default: the single-target track of `cir
+    /// track`) or `"auto"` (several people: after the single-target track, also the labelled
+    /// tracks `cir track --targets auto` makes with its defaults, [`ChannelJob::people_json`]).
+    /// Throws `targets: "…" is not one of one, auto`, or once the track has been made.
+    pub fn set_targets(&mut self, targets: &str) -> Result<(), JsError> {
+        let several = parse_targets(targets).map_err(err)?;
+        if self.phase != Phase::Estimate {
+            return Err(JsError::new(
+                "ChannelJob.set_targets: the track is made already (set it before stepping)",
+            ));
+        }
+        self.several = several;
+        Ok(())
     }
 
     /// Runs work for about `budget_ms` ms (at least one unit: a few snapshots of one link while
@@ -311,7 +339,8 @@ impl ChannelJob {
     /// ("cfr" | "cir"), samples_per_link, duration_s, synchronized (the recording's flag, or
     /// null), calibration: {source: "file" | "range" | "none" (a background learnt from the
     /// recording itself), snapshots (of the empty area; 0 for "none")}, statics ("background"
-    /// | "clusters"), delay_reference ("absolute" | "los", resolved), truth: bool}`.
+    /// | "clusters"), delay_reference ("absolute" | "los", resolved), truth: bool, targets:
+    /// "one" | "auto"}`.
     pub fn summary(&self) -> Result<JsValue, JsError> {
         let r = &self.rec;
         to_js(&SummaryJs {
@@ -328,12 +357,14 @@ impl ChannelJob {
             statics: self.cfg.statics.name(),
             delay_reference: self.cfg.delay_reference.name(),
             truth: self.truth.is_some(),
+            targets: if self.several { "auto" } else { "one" },
         })
     }
 
     /// Time spent per phase in this job, ms (wall clock in the worker, `performance.now()`):
-    /// `{parse_ms (reading and checking the files), estimate_ms (statics and paths), track_ms,
-    /// figure_ms}` (0 for a phase not run yet).
+    /// `{parse_ms (reading and checking the files), estimate_ms (statics and paths), track_ms
+    /// (with several people, their labelled tracks too), figure_ms}` (0 for a phase not run
+    /// yet).
     pub fn timings(&self) -> Result<JsValue, JsError> {
         to_js(&self.timings)
     }
@@ -367,6 +398,23 @@ impl ChannelJob {
         let error = self.truth.as_ref().and(view.stats);
         let doc = track_doc(track, &self.req, &self.cfg, st, est, error).map_err(err)?;
         to_json(&doc)
+    }
+
+    /// The people of a run with several people (`set_targets("auto")`) as JSON text: `{track
+    /// (the document `cir track --targets auto --out` writes without its additions: {method,
+    /// settings, t_s, targets: [scan][{label, state, covariance, …}], tracks: [{label,
+    /// first_scan, last_scan, …}], static_removed}), extent_sigma_m, statics, delay_reference
+    /// (its additions), ellipses: [scan][the 1σ ellipse {cx, cy, a, b, angle} | null per
+    /// reported target], truth: {t_s, targets} | null (label 0 the truth file's walker, i + 1
+    /// its `others[i]`), score: {c_m, gospa_m, mean_gospa_m, switches, …} | null (with a truth,
+    /// GOSPA c = 1 m)}`. Throws with one person, or before the `"track"` phase is done.
+    pub fn people_json(&self) -> Result<String, JsError> {
+        if !self.several {
+            return Err(JsError::new(
+                "ChannelJob.people_json: one person is tracked (set_targets(\"auto\") for several)",
+            ));
+        }
+        to_json(self.people.as_ref().ok_or_else(|| pending("people_json"))?)
     }
 
     /// The delay figure's data ([S] Fig. 4) as JSON text: `{t_range_s: [t0, t1],
@@ -441,6 +489,20 @@ impl ChannelJob {
                     .unwrap_or_default();
                 let view = track_errors(&track.t_s, &track.states, &truth_states)
                     .map_err(named("truth"))?;
+                if self.several {
+                    let others = self.others.clone().map_err(named("truth"))?;
+                    let doc = people_doc(
+                        &self.model,
+                        &self.scenario.area_m,
+                        st,
+                        est,
+                        &self.req,
+                        &self.cfg,
+                        self.truth.as_ref().map(|t| (t, others.as_slice())),
+                    )
+                    .map_err(|(what, e)| named(what)(e))?;
+                    self.people = Some(doc);
+                }
                 self.track = Some(track);
                 self.view = Some(view);
                 self.phase = Phase::Figure;
