@@ -6,19 +6,18 @@ use crate::math::{sqrt, Mat2, Real, Vec2, PI, SPEED_OF_LIGHT};
 use crate::measure::Ellipse;
 use crate::measure::{Model, SNR_DISTANCE_FLOOR_M};
 
+mod doppler_map;
 mod free_z;
 mod grid;
 mod map;
 mod simd;
 
+pub use doppler_map::{doppler_map, MapQuantity};
 pub use free_z::{bound3_from_fisher, crlb_free_z, fisher_free_z, Bound3, CrlbFreeZ};
 pub use grid::{Grid, MAX_GRID_CELLS, MAX_GRID_SIDE};
 pub use map::{crlb_map, crlb_map_rows, crlb_map_rows_with, crlb_map_scalar};
 
-/// A Fisher matrix whose reciprocal condition number `λ_min/λ_max` is below this is treated as
-/// singular: the position is unbounded along some direction (collinear or too few informative
-/// links, a point on a baseline with too few other links).
-pub const SINGULAR_RCOND: Real = 1e-12;
+pub use crate::math::SINGULAR_RCOND;
 
 /// The bound at one point when the Fisher matrix is invertible.
 #[derive(Debug, Clone, Copy, PartialEq)]

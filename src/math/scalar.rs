@@ -32,6 +32,13 @@ pub const REFERENCE_TEMPERATURE_K: Real = 290.0;
 /// π.
 pub const PI: Real = core::f64::consts::PI;
 
+/// A Fisher matrix whose reciprocal condition number `λ_min/λ_max` is below this is treated as
+/// singular: the position is unbounded along some direction (collinear or too few informative
+/// links, a point on a baseline with too few other links). The one rule of every bound: the
+/// snapshot CRLB (`localize`) and the bound with Doppler (`measure::state_bounds`, on the
+/// matrix scaled to a unit diagonal).
+pub const SINGULAR_RCOND: Real = 1e-12;
+
 /// Square root.
 #[inline(always)]
 pub fn sqrt(x: Real) -> Real {

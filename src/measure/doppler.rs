@@ -14,7 +14,7 @@
 //! the PCRLB with Doppler.
 
 use crate::error::{Error, Result};
-use crate::math::{sqrt, Mat2, Mat4, Real, Vec2, Vec4, PI, SPEED_OF_LIGHT};
+use crate::math::{sqrt, Mat2, Mat4, Real, Vec2, Vec4, PI, SINGULAR_RCOND, SPEED_OF_LIGHT};
 use crate::measure::{unit_from_dz, Model, Network};
 
 /// The default floor on the range rate's σ, m/s (D5): a walking person's torso speed swings
@@ -161,4 +161,24 @@ pub fn state_fisher(model: &Model, x: &Vec4, cpi: &Cpi, doppler: bool) -> Mat4 {
         }
     }
     f
+}
+
+/// The bounds of a state Fisher matrix `F` (D7): `(√(P₀₀ + P₁₁), √(P₂₂ + P₃₃))` of `P = F⁻¹`, m
+/// and m/s, or `None` when `F` is singular: a diagonal entry not positive, or the matrix scaled
+/// to a unit diagonal (units apart) with `λ_min/λ_max` below [`SINGULAR_RCOND`] (one link's range
+/// rate cannot bound a 2-D velocity). Unbounded, never NaN.
+pub fn state_bounds(f: &Mat4) -> Option<(Real, Real)> {
+    let d: [Real; 4] = core::array::from_fn(|i| f[(i, i)]);
+    if d.iter().any(|v| !(v.is_finite() && *v > 0.0)) {
+        return None;
+    }
+    let scaled = Mat4::from_fn(|i, j| f[(i, j)] / sqrt(d[i] * d[j]));
+    let e = scaled.symmetric_eigenvalues();
+    let (lo, hi) = (e.min(), e.max());
+    if lo.is_nan() || lo <= SINGULAR_RCOND * hi {
+        return None;
+    }
+    let p = nalgebra::Cholesky::new(*f)?.inverse();
+    let (a, b) = (p[(0, 0)] + p[(1, 1)], p[(2, 2)] + p[(3, 3)]);
+    (a.is_finite() && b.is_finite() && a > 0.0 && b > 0.0).then(|| (sqrt(a), sqrt(b)))
 }

@@ -7,8 +7,8 @@ use alloc::vec::Vec;
 
 use serde::Serialize;
 
-use crate::math::{sqrt, Mat4, Real, Vec2, Vec4};
-use crate::measure::{range_rate, state_fisher, Cpi, Model};
+use crate::math::{sqrt, Real, Vec2, Vec4};
+use crate::measure::{range_rate, state_bounds, state_fisher, Cpi, Model};
 
 /// The CPI as written in the document.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -52,13 +52,6 @@ pub struct DopplerDoc {
     pub links: Vec<RangeRateDoc>,
 }
 
-/// `(√(P₀₀ + P₁₁), √(P₂₂ + P₃₃))` of `F⁻¹`, or `None` when `F` is not positive definite.
-fn bounds(f: &Mat4) -> Option<(Real, Real)> {
-    let p = nalgebra::Cholesky::new(*f)?.inverse();
-    let (a, b) = (p[(0, 0)] + p[(1, 1)], p[(2, 2)] + p[(3, 3)]);
-    (a.is_finite() && b.is_finite() && a > 0.0 && b > 0.0).then(|| (sqrt(a), sqrt(b)))
-}
-
 impl DopplerDoc {
     /// The bound of `model` at `at` moving at `velocity` over `cpi`.
     pub fn at(model: &Model, at: [Real; 2], velocity: [Real; 2], cpi: &Cpi) -> DopplerDoc {
@@ -66,7 +59,7 @@ impl DopplerDoc {
         let v = Vec2::new(velocity[0], velocity[1]);
         let x = Vec4::new(r.x, r.y, v.x, v.y);
         let f = state_fisher(model, &x, cpi, true);
-        let both = bounds(&f);
+        let both = state_bounds(&f);
         let delay = state_fisher(model, &x, cpi, false);
         let fp = delay.fixed_view::<2, 2>(0, 0).into_owned();
         let delay_only = nalgebra::Cholesky::new(fp)

@@ -57,9 +57,9 @@ pub use montecarlo::{
     MonteCarloStudy, PcrlbMeta, RunTime, TrackStudy, FAILED_NOTE,
 };
 pub use multi::{
-    lives, multi_scans, multi_tracker, score_multi, simulate_people, track_multi, walk_region,
-    LabelledTrack, MultiScoreDoc, MultiSettings, MultiTrackOutput, MultiTruth, TargetDoc,
-    TruthTarget, Walkers,
+    lives, multi_scans, multi_tracker, score_multi, simulate_people, track_multi,
+    track_multi_clocked, walk_region, LabelledTrack, MultiScoreDoc, MultiSettings, MultiTiming,
+    MultiTrackOutput, MultiTruth, TargetDoc, TruthTarget, Walkers,
 };
 pub use multi_study::{
     known_association_bound, multi_study_doc, MethodDoc, MethodSums, MultiStudy, MultiStudyConfig,

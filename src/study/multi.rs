@@ -246,6 +246,30 @@ pub fn track_multi(
     settings: &MultiSettings,
     cancel: Cancel,
 ) -> Result<MultiTrackOutput> {
+    track_multi_clocked(model, area, m, calibration, settings, cancel, &|| 0.0).map(|r| r.0)
+}
+
+/// Where [`track_multi_clocked`]'s time went, in the units of its clock.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MultiTiming {
+    /// Building the tracker (the birth grid: once per model) and reading the scans.
+    pub setup: f64,
+    /// Tracking the scans.
+    pub scans: f64,
+}
+
+/// [`track_multi`] timed by `clock` (e.g. milliseconds from the front end's timer): the same
+/// output, and the time of the setup and of the scans.
+pub fn track_multi_clocked(
+    model: &Model,
+    area: &Area,
+    m: &Measurements,
+    calibration: Option<&Calibration>,
+    settings: &MultiSettings,
+    cancel: Cancel,
+    clock: &dyn Fn() -> f64,
+) -> Result<(MultiTrackOutput, MultiTiming)> {
+    let t0 = clock();
     let links = model.link_count();
     let motion = m.motion()?;
     let sigmas = m.sigmas(links)?;
@@ -258,6 +282,7 @@ pub fn track_multi(
     )?;
     let mut tracker = multi_tracker(model, area, motion, settings, sigmas.as_deref())?;
     let (scans, static_removed) = multi_scans(m, links, calibration)?;
+    let t1 = clock();
     let mut targets = Vec::with_capacity(scans.len());
     let mut t_s = Vec::with_capacity(scans.len());
     for (k, scan) in scans.iter().enumerate() {
@@ -271,15 +296,20 @@ pub fn track_multi(
         targets.push(tracker.estimates().iter().map(TargetDoc::from).collect());
         t_s.push(k as f64 * m.dt_s);
     }
+    let timing = MultiTiming {
+        setup: t1 - t0,
+        scans: clock() - t1,
+    };
     let tracks = lives(&targets);
-    Ok(MultiTrackOutput {
+    let out = MultiTrackOutput {
         method: tracker.name().into(),
         settings: *settings,
         t_s,
         targets,
         tracks,
         static_removed,
-    })
+    };
+    Ok((out, timing))
 }
 
 /// Each label's life from the per-scan reports.

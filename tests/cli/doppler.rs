@@ -95,3 +95,103 @@ fn bad_doppler_flags_are_named() {
         json!(null)
     );
 }
+
+#[test]
+fn crlb_map_with_doppler_is_the_librarys_map() {
+    use scatterloc::localize::{doppler_map, Grid, MapQuantity};
+    let dir = TempDir::new();
+    let s = scatterloc::scenario::presets::sensors2019();
+    let f = dir.write_text("s.json", &s.to_json());
+    let model = Model::new(&s).unwrap();
+    let grid = Grid::new(s.area_m, 12, 9).unwrap();
+    let cpi = Cpi::new(s.radio.carrier_hz, 8, 5e-3, 0.05).unwrap();
+    let v = scatterloc::Vec2::new(0.8, 0.6);
+    for (quantity, q, key) in [
+        ("position", MapQuantity::Position, "rmse_bound_m"),
+        ("velocity", MapQuantity::Velocity, "velocity_rmse_bound_mps"),
+    ] {
+        let out = dir.path(&format!("{quantity}.json"));
+        let summary = ok_json(&[
+            "crlb-map",
+            "--scenario",
+            &f,
+            "--out",
+            &out,
+            "--nx",
+            "12",
+            "--ny",
+            "9",
+            "--quantity",
+            quantity,
+            "--doppler",
+            "--velocity",
+            "0.8,0.6",
+            "--cpi",
+            "8",
+            "--cpi-spacing-s",
+            "5e-3",
+            "--range-rate-floor",
+            "0.05",
+        ]);
+        assert_eq!(summary["kernel"], "doppler");
+        let doc: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
+        let mut want = vec![0.0; grid.len()];
+        doppler_map(&model, &grid, &cpi, v, q, &mut want).unwrap();
+        let got: Vec<f64> = doc[key]
+            .as_array()
+            .unwrap()
+            .iter()
+            .flat_map(|row| row.as_array().unwrap().iter().map(|x| x.as_f64().unwrap()))
+            .collect();
+        assert_eq!(got, want, "{quantity}");
+        let unit = if quantity == "velocity" { "mps" } else { "m" };
+        assert_eq!(
+            summary[format!("min_{unit}")].as_f64().unwrap(),
+            want.iter().copied().fold(f64::INFINITY, f64::min)
+        );
+    }
+    // The velocity figure's colour bar reads in m/s.
+    let svg = dir.path("v.svg");
+    ok_json(&[
+        "crlb-map",
+        "--scenario",
+        &f,
+        "--out",
+        &svg,
+        "--nx",
+        "24",
+        "--ny",
+        "24",
+        "--quantity",
+        "velocity",
+        "--doppler",
+    ]);
+    let text = std::fs::read_to_string(&svg).unwrap();
+    assert!(text.contains("m/s") && text.contains("Velocity CRLB with Doppler"));
+    // Velocity needs --doppler; the Doppler flags need it too.
+    fails(
+        &[
+            "crlb-map",
+            "--scenario",
+            &f,
+            "--out",
+            &dir.path("x.json"),
+            "--quantity",
+            "velocity",
+        ],
+        &["--doppler"],
+    );
+    fails(
+        &[
+            "crlb-map",
+            "--scenario",
+            &f,
+            "--out",
+            &dir.path("x.json"),
+            "--cpi",
+            "4",
+        ],
+        &["--doppler"],
+    );
+}

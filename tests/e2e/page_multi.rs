@@ -152,26 +152,34 @@ fn several_people_equal_the_cli_and_off_restores_the_view() {
     let scans = o["run"]["scans"].as_f64().unwrap_or(f64::NAN);
     println!(
         "e2e: several people (3 walkers, PMB, {scans} scans) on the page: {:.0} ms post to \
-         result, {:.0} ms in the worker; simulation {:.1} ms, tracking {:.1} ms ({:.3} ms per \
-         scan), score {:.1} ms",
+         result, {:.0} ms in the worker; simulation {:.1} ms, tracking {:.1} ms = setup (birth \
+         grid) {:.1} ms + scans {:.1} ms ({:.3} ms per scan), score {:.1} ms",
         o["run"]["ms"].as_f64().unwrap_or(f64::NAN),
         o["run"]["computeMs"].as_f64().unwrap_or(f64::NAN),
         part("simulate"),
         part("track"),
-        part("track") / scans,
+        part("setup"),
+        part("scans"),
+        part("scans") / scans,
         part("score")
     );
     let five = &o["five"];
-    let track5 = five["timing"]["track"].as_f64().unwrap_or(f64::NAN);
+    let t5 = |k: &str| five["timing"][k].as_f64().unwrap_or(f64::NAN);
     let scans5 = five["scans"].as_f64().unwrap_or(f64::NAN);
     println!(
         "e2e: several people (5 walkers, PMB, {scans5} scans) on the page: {:.0} ms in the \
-         worker; tracking {track5:.1} ms ({:.3} ms per scan)",
+         worker; tracking {:.1} ms = setup {:.1} ms + scans {:.1} ms ({:.3} ms per scan)",
         o["run5"]["computeMs"].as_f64().unwrap_or(f64::NAN),
-        track5 / scans5
+        t5("track"),
+        t5("setup"),
+        t5("scans"),
+        t5("scans") / scans5
     );
     assert_eq!(o["run5"]["state"], "done", "{}", o["run5"]);
     assert_eq!(five["walkers"], 5);
+    // Setup and scans are the tracking's parts.
+    assert!(part("setup") >= 0.0 && part("scans") >= 0.0);
+    assert!(part("setup") + part("scans") <= part("track") + 1e-6);
     // The parts are timed inside the worker's call: each ≥ 0, together within its time.
     let parts = part("simulate") + part("track") + part("score");
     assert!(

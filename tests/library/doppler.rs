@@ -330,3 +330,75 @@ fn doppler_tightens_the_pcrlb_on_the_s_scenarios() {
         );
     }
 }
+
+#[test]
+fn the_doppler_map_is_the_bound_at_every_cell() {
+    use scatterloc::localize::{doppler_map, Grid, MapQuantity};
+    use scatterloc::measure::state_bounds;
+    for (model, area) in presets() {
+        let grid = Grid::new(
+            scatterloc::scenario::Area {
+                x: area[0],
+                y: area[1],
+            },
+            17,
+            13,
+        )
+        .unwrap();
+        let cpi = Cpi::new(5.2e9, 16, 2.048e-3, 0.1).unwrap();
+        let v = Vec2::new(1.0, -0.4);
+        let mut pos = vec![0.0; grid.len()];
+        let mut vel = vec![0.0; grid.len()];
+        doppler_map(&model, &grid, &cpi, v, MapQuantity::Position, &mut pos).unwrap();
+        doppler_map(&model, &grid, &cpi, v, MapQuantity::Velocity, &mut vel).unwrap();
+        for j in 0..grid.ny {
+            for i in 0..grid.nx {
+                let x = Vec4::new(grid.x(i), grid.y(j), v.x, v.y);
+                let want = state_bounds(&state_fisher(&model, &x, &cpi, true));
+                let k = j * grid.nx + i;
+                match want {
+                    Some((p, w)) => {
+                        assert_eq!(pos[k], p);
+                        assert_eq!(vel[k], w);
+                        // Doppler never loosens the delays' bound (16 × E8).
+                        let d = scatterloc::localize::crlb_at(&model, Vec2::new(x[0], x[1]));
+                        if let Some(b) = d.bound {
+                            assert!(p <= b.rmse_m / 4.0 * (1.0 + 1e-9), "cell {i},{j}");
+                        }
+                    }
+                    None => assert!(pos[k] == Real::INFINITY && vel[k] == Real::INFINITY),
+                }
+            }
+        }
+        // A wrong output length and a non-finite velocity are named.
+        let mut short = vec![0.0; 3];
+        let e = doppler_map(&model, &grid, &cpi, v, MapQuantity::Position, &mut short);
+        assert!(e.unwrap_err().to_string().contains("doppler map output"));
+        let e = doppler_map(
+            &model,
+            &grid,
+            &cpi,
+            Vec2::new(Real::NAN, 0.0),
+            MapQuantity::Velocity,
+            &mut pos,
+        );
+        assert!(e.unwrap_err().to_string().contains("velocity"));
+    }
+    // One link: one range rate cannot bound a 2-D velocity: unbounded, not NaN.
+    let mut s = preset("sensors2019").unwrap();
+    s.links = scatterloc::scenario::LinkSpec::List(vec![["Tx".to_string(), "Rx1".to_string()]]);
+    let model = Model::new(&s).unwrap();
+    let grid = Grid::new(s.area_m, 4, 4).unwrap();
+    let cpi = Cpi::new(5.2e9, 16, 2.048e-3, 0.1).unwrap();
+    let mut vel = vec![0.0; grid.len()];
+    doppler_map(
+        &model,
+        &grid,
+        &cpi,
+        Vec2::new(1.0, 0.0),
+        MapQuantity::Velocity,
+        &mut vel,
+    )
+    .unwrap();
+    assert!(vel.iter().all(|v| *v == Real::INFINITY));
+}

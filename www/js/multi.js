@@ -212,7 +212,7 @@ export class Multi {
       const s = d.score;
       const n = d.track.t_s.length;
       text = `${what} · ${n} scans in ${fixed(this.ms, 0)} ms (worker ${fixed(this.computeMs, 0)} ms; `
-        + `tracking ${fixed(d.timing_ms.track, 0)} ms, ${fixed(d.timing_ms.track / n, 2)} ms per scan)`
+        + `tracking ${fixed(d.timing_ms.scans / n, 2)} ms per scan after a ${fixed(d.timing_ms.setup, 0)} ms setup)`
         + ` · mean GOSPA ${this.ctx.wasm.format_length(s.mean_gospa_m, 3)}, ${s.switches} label switch`
         + `${s.switches === 1 ? '' : 'es'}, cardinality error ${fixed(s.mean_cardinality_error, 2)}`;
     }

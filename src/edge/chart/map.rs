@@ -43,6 +43,8 @@ pub struct ChartOptions {
     pub scale: Option<LogScale>,
     /// Label of the colour bar.
     pub colorbar_label: String,
+    /// Follows every colour-bar length label: `""` for metres, `"/s"` for a speed map.
+    pub value_suffix: String,
 }
 
 impl Default for ChartOptions {
@@ -52,6 +54,7 @@ impl Default for ChartOptions {
             subtitle: None,
             scale: None,
             colorbar_label: "RMSE bound √(σx² + σy²)".to_string(),
+            value_suffix: String::new(),
         }
     }
 }
@@ -178,6 +181,7 @@ fn draw_map_figure<DB: DrawingBackend>(
         &opts.colorbar_label,
         &lay.font,
         clamped,
+        &opts.value_suffix,
     )?;
     Ok((
         ChartSummary {

@@ -337,12 +337,13 @@ pub(crate) fn draw_colorbar<DB: DrawingBackend>(
     label: &str,
     font: &Fonts,
 ) -> Result<(), ChartError> {
-    draw_colorbar_marked(area, scale, has_unbounded, label, font, [false; 2])
+    draw_colorbar_marked(area, scale, has_unbounded, label, font, [false; 2], "")
 }
 
 /// [`draw_colorbar`] of a fixed scale that values pass: `clamped` = [some below `min`, some
 /// above `max`] (drawn in the end colour); each such end is labelled `≤ min` or `≥ max` (its
-/// tick labels too near that end left out).
+/// tick labels too near that end left out). `suffix` follows every length label (`"/s"` makes
+/// `5 cm` read `5 cm/s`: a speed).
 pub(crate) fn draw_colorbar_marked<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     scale: Option<&LogScale>,
@@ -350,6 +351,7 @@ pub(crate) fn draw_colorbar_marked<DB: DrawingBackend>(
     label: &str,
     font: &Fonts,
     clamped: [bool; 2],
+    suffix: &str,
 ) -> Result<(), ChartError> {
     let s = font.ticks / 20.0;
     let (w, h) = area.dim_in_pixel();
@@ -394,7 +396,7 @@ pub(crate) fn draw_colorbar_marked<DB: DrawingBackend>(
         ];
         for (on, y, mark, v) in ends {
             if on {
-                let text = alloc::format!("{mark} {}", format_length_m(v, 3));
+                let text = alloc::format!("{mark} {}{suffix}", format_length_m(v, 3));
                 let x = bar_w + (11.0 * s) as i32;
                 area.draw_text(&text, &tick_font, (x, y))
                     .map_err(chart_err)?;
@@ -412,7 +414,8 @@ pub(crate) fn draw_colorbar_marked<DB: DrawingBackend>(
             ))
             .map_err(chart_err)?;
             if major {
-                area.draw_text(&t.label, &tick_font, (bar_w + len + (4.0 * s) as i32, y))
+                let text = alloc::format!("{}{suffix}", t.label);
+                area.draw_text(&text, &tick_font, (bar_w + len + (4.0 * s) as i32, y))
                     .map_err(chart_err)?;
             }
         }

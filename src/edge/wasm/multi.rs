@@ -22,7 +22,7 @@ use crate::chart::draw_gospa_chart;
 use crate::error::{Cancel, Error};
 use crate::present::{format_length_m, track_ellipses, EllipseView};
 use crate::study::{
-    score_multi, simulate_people, track_multi, walk_region, MultiScoreDoc, MultiSettings,
+    score_multi, simulate_people, track_multi_clocked, walk_region, MultiScoreDoc, MultiSettings,
     MultiTrackOutput, MultiTruth, Walkers,
 };
 use crate::track::multi::MultiKind;
@@ -80,12 +80,14 @@ struct PeopleDoc<'a> {
 }
 
 /// Where [`track_people`]'s time went, ms (the worker's `performance.now()`): the simulation
-/// of the walk and its delay scans, the tracking (the birth grid included), the score and
-/// ellipses.
+/// of the walk and its delay scans, the tracking — of it the setup (the birth grid, built once
+/// per model, and reading the scans) and the scans themselves — and the score and ellipses.
 #[derive(Serialize)]
 struct TimingJs {
     simulate: f64,
     track: f64,
+    setup: f64,
+    scans: f64,
     score: f64,
 }
 
@@ -101,7 +103,7 @@ struct TimingJs {
 /// (the CLI's truth.json), track (the CLI's `track --targets auto` document), score (its
 /// `score`), ellipses (per scan, per reported target in `track.targets`' order, the 1σ position
 /// ellipse `{cx, cy, a, b, angle}` or null), gospa_label (the chart's legend), timing_ms
-/// (`{simulate, track, score}`, ms)}`. Throws the core's named error on bad input.
+/// (`{simulate, track, setup, scans, score}`, ms; `setup` and `scans` are `track`'s parts)}`. Throws the core's named error on bad input.
 #[wasm_bindgen]
 pub fn track_people(scenario_json: &str, request_json: &str) -> Result<String, JsError> {
     let scenario = Scenario::from_json(scenario_json).map_err(err)?;
@@ -132,13 +134,14 @@ pub fn track_people(scenario_json: &str, request_json: &str) -> Result<String, J
     )
     .map_err(err)?;
     let t1 = now_ms();
-    let track = track_multi(
+    let (track, clocked) = track_multi_clocked(
         &model,
         &scenario.area_m,
         &measurements,
         None,
         &cfg,
         Cancel::NEVER,
+        &now_ms,
     )
     .map_err(err)?;
     let t2 = now_ms();
@@ -161,6 +164,8 @@ pub fn track_people(scenario_json: &str, request_json: &str) -> Result<String, J
         timing_ms: TimingJs {
             simulate: t1 - t0,
             track: t2 - t1,
+            setup: clocked.setup,
+            scans: clocked.scans,
             score: now_ms() - t2,
         },
     })

@@ -27,7 +27,7 @@ pub use cir::{
 pub use filters::{FilterName, FilterSettings};
 pub use mtl::{MtlCommand, MtlLocateArgs, RocArgs, Table2Args};
 pub use plan::PlanArgs;
-pub use scenario::{CrlbArgs, CrlbMapArgs, LocateArgs, PresetArgs};
+pub use scenario::{CrlbArgs, CrlbMapArgs, DopplerArgs, LocateArgs, PresetArgs};
 pub use shard::{MergeArgs, ShardArgs};
 pub use slurm::{SlurmCommand, SubmitArgs};
 pub use study::{MontecarloArgs, PcrlbArgs, StudyArgs};

@@ -29,22 +29,9 @@ pub struct CrlbArgs {
     /// With --free-z: the target's height Z, metres [default: the scenario's target.height_m].
     #[arg(long, value_name = "Z", value_parser = finite, requires = "free_z")]
     pub height: Option<f64>,
-    /// Adds `doppler`: the bound on position and velocity over one coherent processing
-    /// interval from every link's delay and range rate (docs/doppler.md, D1–D7).
-    #[arg(long, conflicts_with = "free_z")]
-    pub doppler: bool,
-    /// With --doppler: the target's velocity VX,VY, m/s (the range rates' gradients depend on it).
-    #[arg(long, value_name = "VX,VY", value_parser = xy, requires = "doppler", default_value = "0,0")]
-    pub velocity: [f64; 2],
-    /// With --doppler: snapshots N in the CPI.
-    #[arg(long, value_name = "N", requires = "doppler", default_value_t = 16)]
-    pub cpi: usize,
-    /// With --doppler: the snapshots' spacing T, seconds (default: a 2.048 ms sounder frame).
-    #[arg(long, value_name = "T", value_parser = finite, requires = "doppler", default_value_t = 2.048e-3)]
-    pub cpi_spacing_s: f64,
-    /// With --doppler: the floor on the range rate's σ, m/s (D5: a body's limbs move).
-    #[arg(long, value_name = "F", value_parser = finite, requires = "doppler", default_value_t = scatterloc::measure::DEFAULT_RANGE_RATE_FLOOR_MPS)]
-    pub range_rate_floor: f64,
+    /// The Doppler flags (`--doppler` and its CPI).
+    #[command(flatten)]
+    pub doppler: DopplerArgs,
 }
 
 /// `scatterloc crlb-map`.
@@ -83,6 +70,13 @@ pub struct CrlbMapArgs {
     /// Figure title [default: the scenario's name and the bound plotted].
     #[arg(long, value_name = "TEXT")]
     pub title: Option<String>,
+    /// What the map shows: `position` (the RMSE bound, m) or `velocity` (the velocity's RMSE
+    /// bound, m/s; needs --doppler).
+    #[arg(long, value_parser = ["position", "velocity"], default_value = "position")]
+    pub quantity: String,
+    /// The Doppler flags: with --doppler the bounds include every link's range rate.
+    #[command(flatten)]
+    pub doppler: DopplerArgs,
 }
 
 /// `scatterloc locate`.
@@ -98,4 +92,26 @@ pub struct LocateArgs {
     /// at the scenario's target height; "initial_m" may then be [x, y, z]; docs/rooms-3d.md).
     #[arg(long)]
     pub free_z: bool,
+}
+
+/// `--doppler` and its CPI, shared by `crlb` and `crlb-map` (docs/doppler.md, D1–D7).
+#[derive(Debug, Args)]
+pub struct DopplerArgs {
+    /// The bound from every link's delay and range rate over one coherent processing interval
+    /// (CPI); `crlb` adds the document `doppler`, `crlb-map` maps it (see --quantity).
+    #[arg(long = "doppler")]
+    pub on: bool,
+    /// With --doppler: the target's velocity VX,VY, m/s (the range rates' gradients depend on it).
+    #[arg(long, value_name = "VX,VY", value_parser = xy, requires = "on", default_value = "0,0")]
+    pub velocity: [f64; 2],
+    /// With --doppler: snapshots N in the CPI.
+    #[arg(long, value_name = "N", requires = "on", default_value_t = 16)]
+    pub cpi: usize,
+    /// With --doppler: the snapshots' spacing T, seconds (default: a 2.048 ms sounder frame).
+    #[arg(long, value_name = "T", value_parser = finite, requires = "on", default_value_t = 2.048e-3)]
+    pub cpi_spacing_s: f64,
+    /// With --doppler: the floor on the range rate's σ, m/s (D5: a body's limbs move).
+    #[arg(long, value_name = "F", value_parser = finite, requires = "on",
+          default_value_t = scatterloc::measure::DEFAULT_RANGE_RATE_FLOOR_MPS)]
+    pub range_rate_floor: f64,
 }

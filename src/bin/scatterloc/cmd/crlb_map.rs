@@ -11,10 +11,10 @@ use scatterloc::chart::{
     check_area, crlb_map_svg, default_titles, draw_crlb_map, scenario_nodes, suggested_size,
 };
 use scatterloc::chart::{ChartError, ChartNode, ChartOptions, MapData, MapOverlay};
-use scatterloc::localize::Grid;
+use scatterloc::localize::{doppler_map, Grid, MapQuantity};
 use scatterloc::native::{crlb_map_parallel, fast_path};
 use scatterloc::scenario::Area;
-use scatterloc::{Error, Scenario};
+use scatterloc::{Error, Scenario, Vec2};
 
 use super::flags::at_flag;
 use super::io::{emit_summary, model_of, read_scenario};
@@ -77,20 +77,70 @@ pub fn crlb_map(args: &CrlbMapArgs) -> Result<(), CliError> {
     // Before the work: a FIFO, link or device at --out is refused now (issue 24).
     check_writable("out", out)?;
 
+    let velocity = args.quantity == "velocity";
+    if velocity && !args.doppler.on {
+        return Err(CliError::usage(
+            "--quantity velocity: needs --doppler (delays alone bound no velocity)".to_string(),
+        ));
+    }
+    let cpi = match args.doppler.on {
+        true => Some(super::scenario::cpi_of(&args.doppler, &s)?),
+        false => None,
+    };
+
     let t0 = Instant::now();
     let mut values = vec![0.0; grid.len()];
-    crlb_map_parallel(&model, &grid, &mut values, 0)
-        .map_err(|e| CliError::output(e.to_string()))?;
+    match &cpi {
+        Some(cpi) => {
+            let quantity = if velocity {
+                MapQuantity::Velocity
+            } else {
+                MapQuantity::Position
+            };
+            let [vx, vy] = args.doppler.velocity;
+            doppler_map(&model, &grid, cpi, Vec2::new(vx, vy), quantity, &mut values)
+                .map_err(|e| CliError::usage(e.to_string()))?;
+        }
+        None => crlb_map_parallel(&model, &grid, &mut values, 0)
+            .map_err(|e| CliError::output(e.to_string()))?,
+    }
     let compute_ms = t0.elapsed().as_secs_f64() * 1e3;
+    // A speed map's labels: m/s, its colour bar's lengths read as speeds.
+    let unit = if velocity { "mps" } else { "m" };
 
     let t1 = Instant::now();
     match format {
-        Format::Json => write_json(out, &grid, &values)?,
+        Format::Json => write_json(out, &grid, &values, velocity)?,
         Format::Svg | Format::Png => {
             let (title, subtitle) = default_titles(&s, &grid);
+            let (title, label, suffix) = match (&cpi, velocity) {
+                (None, _) => (title, ChartOptions::default().colorbar_label, ""),
+                (Some(_), false) => (
+                    "Position CRLB with Doppler".to_string(),
+                    "RMSE bound √(σx² + σy²)".to_string(),
+                    "",
+                ),
+                (Some(_), true) => (
+                    "Velocity CRLB with Doppler".to_string(),
+                    "velocity RMSE bound √(σvx² + σvy²)".to_string(),
+                    "/s",
+                ),
+            };
+            let subtitle = match &cpi {
+                Some(c) => format!(
+                    "{subtitle} · CPI {} × {} ms, v = ({}, {}) m/s",
+                    c.snapshots,
+                    c.spacing_s * 1e3,
+                    args.doppler.velocity[0],
+                    args.doppler.velocity[1]
+                ),
+                None => subtitle,
+            };
             let opts = ChartOptions {
                 title: args.title.clone().unwrap_or(title),
                 subtitle: Some(subtitle),
+                colorbar_label: label,
+                value_suffix: suffix.to_string(),
                 ..ChartOptions::default()
             };
             let figure = MapFigure {
@@ -117,10 +167,10 @@ pub fn crlb_map(args: &CrlbMapArgs) -> Result<(), CliError> {
         "x_range_m": area.x,
         "y_range_m": area.y,
         "compute_ms": round3(compute_ms),
-        "kernel": fast_path().name(),
+        "kernel": if cpi.is_some() { "doppler" } else { fast_path().name() },
         "write_ms": round3(write_ms),
-        "min_m": min,
-        "max_m": max,
+        format!("min_{unit}"): min,
+        format!("max_{unit}"): max,
         "unbounded_cells": values.iter().filter(|v| !v.is_finite()).count(),
     });
     emit_summary(&summary.to_string())
@@ -152,14 +202,22 @@ struct MapJson<'a> {
     x_m: Vec<f64>,
     y_m: Vec<f64>,
     /// Rows of `nx` values; serde_json writes the `+∞` of unbounded cells as `null`.
-    rmse_bound_m: Vec<&'a [f64]>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    rmse_bound_m: Option<Vec<&'a [f64]>>,
+    /// The same for `--quantity velocity`, m/s.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    velocity_rmse_bound_mps: Option<Vec<&'a [f64]>>,
 }
 
-fn write_json(path: &str, grid: &Grid, values: &[f64]) -> Result<(), CliError> {
+fn write_json(path: &str, grid: &Grid, values: &[f64], velocity: bool) -> Result<(), CliError> {
+    let rows = Some(values.chunks(grid.nx).collect());
+    let (rmse_bound_m, velocity_rmse_bound_mps) =
+        if velocity { (None, rows) } else { (rows, None) };
     let doc = MapJson {
         x_m: (0..grid.nx).map(|i| grid.x(i)).collect(),
         y_m: (0..grid.ny).map(|j| grid.y(j)).collect(),
-        rmse_bound_m: values.chunks(grid.nx).collect(),
+        rmse_bound_m,
+        velocity_rmse_bound_mps,
     };
     write_json_file("out", path, &doc)
 }

@@ -7,11 +7,11 @@ use scatterloc::localize::{locate as lm_locate, locate_free_z, DelayMeasurements
 use scatterloc::math::Vec3;
 use scatterloc::measure::Cpi;
 use scatterloc::present::{CrlbDoc, CrlbFreeZDoc, DopplerDoc, FixDoc, FixFreeZDoc};
-use scatterloc::{scenario::presets, Vec2};
+use scatterloc::{scenario::presets, Scenario, Vec2};
 
 use super::flags::{at_flag, in_file};
 use super::io::{emit, emit_json, model_of, one_stdin, read_json_file, read_scenario};
-use crate::cli::{CrlbArgs, LocateArgs, PresetArgs};
+use crate::cli::{CrlbArgs, DopplerArgs, LocateArgs, PresetArgs};
 use crate::failure::CliError;
 
 /// `scatterloc preset NAME`.
@@ -22,6 +22,11 @@ pub fn preset(args: &PresetArgs) -> Result<(), CliError> {
 
 /// `scatterloc crlb --scenario S --at X,Y`.
 pub fn crlb(args: &CrlbArgs) -> Result<(), CliError> {
+    if args.free_z && args.doppler.on {
+        return Err(CliError::usage(
+            "--doppler: not with --free-z (the bound with Doppler is planar)".to_string(),
+        ));
+    }
     let s = read_scenario(&args.scenario)?;
     let model = model_of(&s)?;
     if args.free_z {
@@ -29,20 +34,25 @@ pub fn crlb(args: &CrlbArgs) -> Result<(), CliError> {
         return emit_json(&CrlbFreeZDoc::at(&s, &model, args.at, height));
     }
     let doc = CrlbDoc::at(&s, &model, args.at).map_err(|e| at_flag("scenario", e))?;
-    if !args.doppler {
+    if !args.doppler.on {
         return emit_json(&doc);
     }
-    let cpi = Cpi::new(
-        s.radio.carrier_hz,
-        args.cpi,
-        args.cpi_spacing_s,
-        args.range_rate_floor,
-    )
-    .map_err(|e| CliError::usage(e.to_string()))?;
+    let cpi = cpi_of(&args.doppler, &s)?;
     emit_json(&WithDoppler {
         crlb: &doc,
-        doppler: DopplerDoc::at(&model, args.at, args.velocity, &cpi),
+        doppler: DopplerDoc::at(&model, args.at, args.doppler.velocity, &cpi),
     })
+}
+
+/// The CPI of the `--doppler` flags on `s`'s carrier; a bad setting is a usage error naming it.
+pub(super) fn cpi_of(d: &DopplerArgs, s: &Scenario) -> Result<Cpi, CliError> {
+    Cpi::new(
+        s.radio.carrier_hz,
+        d.cpi,
+        d.cpi_spacing_s,
+        d.range_rate_floor,
+    )
+    .map_err(|e| CliError::usage(e.to_string()))
 }
 
 /// `crlb --doppler`'s document: `crlb`'s keys, then `doppler`.
