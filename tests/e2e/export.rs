@@ -19,14 +19,14 @@ use super::svg::{count, svg_texts};
 use super::ui::{click, mc_done, wait_tracking};
 use super::{console_errors, js, open, settle, with_browser};
 
-const PNG_SIGNATURE: [u8; 8] = [0x89, b'P', b'N', b'G', 0x0d, 0x0a, 0x1a, 0x0a];
+pub(super) const PNG_SIGNATURE: [u8; 8] = [0x89, b'P', b'N', b'G', 0x0d, 0x0a, 0x1a, 0x0a];
 
 /// One saved file: the hook's record and the content read through the download link.
 #[derive(Debug)]
 pub(super) struct Saved {
     pub(super) info: Value,
     pub(super) text: String,
-    head: Vec<u8>,
+    pub(super) head: Vec<u8>,
 }
 
 /// Chooses `what` and `format` in the selects, clicks Save figure and waits for the file.

@@ -8,7 +8,7 @@
 //! bit for bit; the Monte Carlo curves are off while several people are on. Off gives the labels
 //! back.
 
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use fantoccini::Client;
 use serde_json::{json, Value};
@@ -20,69 +20,7 @@ use super::svg::{count, svg_texts};
 use super::ui::{banner, click, poll, select, temp_dir, wait_tracking};
 use super::{console_errors, js, open, settle, with_browser};
 
-const PNG_SIGNATURE: [u8; 8] = [0x89, b'P', b'N', b'G', 0x0d, 0x0a, 0x1a, 0x0a];
-
-/// One saved figure: the hook's record, its text and its first bytes.
-struct Saved {
-    info: Value,
-    text: String,
-    head: Vec<u8>,
-}
-
-/// Chooses `what` and `format`, clicks Save figure and reads the file through its link.
-async fn save(c: &Client, what: &str, format: &str) -> Result<Saved, String> {
-    let count_js = "return Number(document.getElementById('figure-save').dataset.count || 0)";
-    let before = js(c, count_js).await?.as_u64().unwrap_or(0);
-    js(
-        c,
-        &format!(
-            "document.getElementById('figure-what').value = '{what}'; \
-             document.getElementById('figure-format').value = '{format}';"
-        ),
-    )
-    .await?;
-    click(c, "figure-save").await?;
-    let t0 = Instant::now();
-    let info = loop {
-        let got = js(
-            c,
-            "return { info: window.figureExport.last(), \
-                      count: Number(document.getElementById('figure-save').dataset.count || 0) }",
-        )
-        .await?;
-        if got["info"]["href"].is_string() && got["count"].as_u64() == Some(before + 1) {
-            break got["info"].clone();
-        }
-        let errors = console_errors(c).await?;
-        let b = banner(c).await?;
-        if !errors.is_empty() || !b.is_empty() || t0.elapsed() > Duration::from_secs(30) {
-            return Err(format!(
-                "no file saved ({what}, {format}); errors {errors:?}, banner {b:?}"
-            ));
-        }
-        tokio::time::sleep(Duration::from_millis(25)).await;
-    };
-    let content = c
-        .execute_async(
-            "const done = arguments[arguments.length - 1]; \
-             fetch(window.figureExport.last().href) \
-               .then((r) => r.arrayBuffer()) \
-               .then((b) => done({ text: new TextDecoder().decode(b), \
-                                   head: Array.from(new Uint8Array(b.slice(0, 8))) }), \
-                     (e) => done({ error: String(e) }));",
-            vec![],
-        )
-        .await
-        .map_err(|e| e.to_string())?;
-    if let Some(e) = content.get("error") {
-        return Err(format!("reading the download link: {e}"));
-    }
-    Ok(Saved {
-        info,
-        text: content["text"].as_str().unwrap_or_default().to_string(),
-        head: serde_json::from_value(content["head"].clone()).map_err(|e| e.to_string())?,
-    })
-}
+use super::export::{save, Saved, PNG_SIGNATURE};
 
 /// The labels of the figure and data choices.
 const CHOICES: &str = "const o = (s, v) => document.querySelector(`#${s} option[value=\"${v}\"]`); \

@@ -111,21 +111,25 @@ fn parse_options<T: serde::de::DeserializeOwned + Default>(
     })
 }
 
+/// `v` within `min..=MAX_FIGURE_PX`, else the named size error of `field`: every exported
+/// figure's pixel check.
+pub(super) fn figure_px(field: &'static str, v: u32, min: u32) -> crate::Result<u32> {
+    if (min..=MAX_FIGURE_PX).contains(&v) {
+        Ok(v)
+    } else {
+        Err(Error::SizeLimit {
+            field,
+            value: v as usize,
+            min: min as usize,
+            max: MAX_FIGURE_PX as usize,
+        })
+    }
+}
+
 /// `(width, height)` checked: width in `200..=MAX_FIGURE_PX`, height 0 (fit the plot: the
 /// chart's `suggested_size`) or in `150..=MAX_FIGURE_PX`.
 fn figure_size(area: Option<&Area>, width: u32, height: u32) -> crate::Result<(u32, u32)> {
-    let check = |field: &'static str, v: u32, min: u32| {
-        if (min..=MAX_FIGURE_PX).contains(&v) {
-            Ok(v)
-        } else {
-            Err(Error::SizeLimit {
-                field,
-                value: v as usize,
-                min: min as usize,
-                max: MAX_FIGURE_PX as usize,
-            })
-        }
-    };
+    let check = figure_px;
     let w = check("width", width, 200)?;
     match (height, area) {
         (0, Some(a)) => Ok(suggested_size(a, w)),

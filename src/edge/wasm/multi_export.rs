@@ -22,24 +22,10 @@ use crate::error::{Error, Result};
 use crate::present::{people_data_text as data_text, people_doc_from_json, people_map_view};
 use crate::Scenario;
 
-use super::MAX_FIGURE_PX;
+use super::export::figure_px;
 
 fn fail(func: &str, e: impl core::fmt::Display) -> JsError {
     JsError::new(&alloc::format!("{func}: {e}"))
-}
-
-/// `v` within `min..=MAX_FIGURE_PX`, else the named size error of `field`.
-fn px(field: &'static str, v: u32, min: u32) -> Result<u32> {
-    if (min..=MAX_FIGURE_PX).contains(&v) {
-        Ok(v)
-    } else {
-        Err(Error::SizeLimit {
-            field,
-            value: v as usize,
-            min: min as usize,
-            max: MAX_FIGURE_PX as usize,
-        })
-    }
 }
 
 /// The SVG text of `size` px that `draw` writes through plotters' SVG backend.
@@ -115,11 +101,11 @@ pub fn people_map_svg(
         Some(w) => window(w).map_err(|e| fail(F, e))?,
         None => scenario.area_m,
     };
-    let w = px("width", width, 200).map_err(|e| fail(F, e))?;
+    let w = figure_px("width", width, 200).map_err(|e| fail(F, e))?;
     let size = if height == 0 {
         suggested_size(&area, w)
     } else {
-        (w, px("height", height, 150).map_err(|e| fail(F, e))?)
+        (w, figure_px("height", height, 150).map_err(|e| fail(F, e))?)
     };
     let (title, subtitle) = people_titles(&scenario.name, &run.track, &run.truth, &view, magnify);
     let chart_opts = PeopleChartOptions {
@@ -195,11 +181,11 @@ pub fn people_chart_svg(
     height: u32,
 ) -> core::result::Result<String, JsError> {
     const F: &str = "people_chart_svg";
-    let w = px("width", width, 200).map_err(|e| fail(F, e))?;
+    let w = figure_px("width", width, 200).map_err(|e| fail(F, e))?;
     let h = if height == 0 {
         (w * 3 / 5).max(150)
     } else {
-        px("height", height, 150).map_err(|e| fail(F, e))?
+        figure_px("height", height, 150).map_err(|e| fail(F, e))?
     };
     render_svg(F, (w, h), |root| {
         draw_people_doc_chart(root, doc_text, title, subtitle)
