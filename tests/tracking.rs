@@ -20,6 +20,9 @@ mod crossing;
 #[path = "tracking/cir_multi.rs"]
 mod cir_multi;
 
+#[path = "tracking/doppler.rs"]
+mod doppler;
+
 #[path = "tracking/ekf.rs"]
 mod ekf;
 

@@ -259,6 +259,20 @@ pub const VELOCITY_M_S: Range = Range {
     allowed: "-1e6 to 1e6 m/s",
 };
 
+/// A measured bistatic range rate: ±2·10⁶ m/s (twice [`VELOCITY_M_S`]: `|ṙ| ≤ 2|v|`, D1).
+pub const RANGE_RATE_M_S: Range = Range {
+    min: -2e6,
+    max: 2e6,
+    allowed: "-2e6 to 2e6 m/s",
+};
+
+/// A range-rate standard deviation: 10⁻⁶ m/s to 10⁶ m/s.
+pub const RANGE_RATE_SIGMA_M_S: Range = Range {
+    min: 1e-6,
+    max: 1e6,
+    allowed: "1e-6 to 1e6 m/s",
+};
+
 /// A bistatic range (path length) of multi-target localization, and the clutter's `r_max`:
 /// `0 … 10⁸ m`. Nodes and targets within [`COORDINATE_M`] give paths below 5.7·10⁷ m; far larger
 /// ranges gave ellipses with infinite axes.

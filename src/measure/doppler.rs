@@ -108,32 +108,80 @@ impl Cpi {
     }
 }
 
+/// One link seen from a scatterer at `r` moving at `v`, from one evaluation of the link's unit
+/// vectors: the bistatic range (E1), its gradient (E3, times `c`), the range rate (D1) and its
+/// position gradient (D3), and the geometry the link budget (E8) reads. The one home of the
+/// delay-and-Doppler rows of every tracker.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LinkMotion {
+    /// `c·τ_p(r) = d_T + d_R` (3-D distances), m.
+    pub range_m: Real,
+    /// `û_T + û_R = c∇τ_p = ∂ṙ/∂v` (D3), 1.
+    pub range_gradient: Vec2,
+    /// `ṙ_p = (û_T + û_R)·v`, m/s (D1).
+    pub range_rate_mps: Real,
+    /// `∂ṙ/∂r = P_T v/d_T + P_R v/d_R`, 1/s (D3).
+    pub rate_gradient_r: Vec2,
+    /// `û_T`, the direction the transmitter's pattern is read in.
+    pub unit_tx: Vec2,
+    /// `d_T`, `d_R`, m.
+    pub distances_m: (Real, Real),
+}
+
+impl LinkMotion {
+    /// Link `p` of `network` seen from `r` moving at `v` (a node closer than
+    /// [`UNIT_VECTOR_MIN_DISTANCE_M`](crate::measure::UNIT_VECTOR_MIN_DISTANCE_M) adds nothing
+    /// to the gradients).
+    #[inline]
+    pub fn new(network: &Network, p: usize, r: Vec2, v: Vec2) -> LinkMotion {
+        let (tx, rx) = network.link_nodes(p);
+        let (zt, zr) = network.link_dz(p);
+        let (ut, dt) = unit_from_dz(tx, zt, r);
+        let (ur, dr) = unit_from_dz(rx, zr, r);
+        let mut rate_gradient_r = Vec2::zeros();
+        for (u, d) in [(ut, dt), (ur, dr)] {
+            if u != Vec2::zeros() {
+                rate_gradient_r += (v - u * u.dot(&v)) / d;
+            }
+        }
+        let g = ut + ur;
+        LinkMotion {
+            range_m: dt + dr,
+            range_gradient: g,
+            range_rate_mps: g.dot(&v),
+            rate_gradient_r,
+            unit_tx: ut,
+            distances_m: (dt, dr),
+        }
+    }
+
+    /// The link's per-snapshot SNR (E8) from this geometry.
+    #[inline]
+    pub fn snr(&self, model: &Model, p: usize) -> Real {
+        let tx = model.network.links[p].tx;
+        let gain = model.patterns[tx].gain_toward(self.unit_tx);
+        model.snr_from_geometry(p, gain, self.distances_m.0, self.distances_m.1)
+    }
+
+    /// The range rate's row of the state Jacobian, `[∂ṙ/∂r, ∂ṙ/∂v]` (D3).
+    #[inline]
+    pub fn rate_row(&self) -> Vec4 {
+        let (a, b) = (self.rate_gradient_r, self.range_gradient);
+        Vec4::new(a.x, a.y, b.x, b.y)
+    }
+}
+
 /// `ṙ_p(r, v) = (û_T + û_R)·v`, m/s (D1).
 pub fn range_rate(network: &Network, p: usize, r: Vec2, v: Vec2) -> Real {
-    let (tx, rx) = network.link_nodes(p);
-    let (zt, zr) = network.link_dz(p);
-    let (ut, _) = unit_from_dz(tx, zt, r);
-    let (ur, _) = unit_from_dz(rx, zr, r);
-    (ut + ur).dot(&v)
+    LinkMotion::new(network, p, r, v).range_rate_mps
 }
 
 /// The gradients of [`range_rate`]: `(∂ṙ/∂r, ∂ṙ/∂v) = (P_T v/d_T + P_R v/d_R, û_T + û_R)`,
 /// 1/s and 1 (D3; `P = I − ûûᵀ` with the 3-D distance `d`; a node closer than
 /// [`UNIT_VECTOR_MIN_DISTANCE_M`](crate::measure::UNIT_VECTOR_MIN_DISTANCE_M) adds nothing).
 pub fn range_rate_gradient(network: &Network, p: usize, r: Vec2, v: Vec2) -> (Vec2, Vec2) {
-    let (tx, rx) = network.link_nodes(p);
-    let (zt, zr) = network.link_dz(p);
-    let mut dr = Vec2::zeros();
-    let mut dv = Vec2::zeros();
-    for (node, dz) in [(tx, zt), (rx, zr)] {
-        let (u, d) = unit_from_dz(node, dz, r);
-        if u == Vec2::zeros() {
-            continue;
-        }
-        dr += (v - u * u.dot(&v)) / d;
-        dv += u;
-    }
-    (dr, dv)
+    let m = LinkMotion::new(network, p, r, v);
+    (m.rate_gradient_r, m.range_gradient)
 }
 
 /// The Fisher information of the state `x = [r, v]` from one scan (D7):

@@ -12,8 +12,8 @@ mod pattern;
 mod simulate;
 
 pub use doppler::{
-    range_rate, range_rate_gradient, state_bounds, state_fisher, Cpi, DEFAULT_RANGE_RATE_FLOOR_MPS,
-    MAX_CPI_SNAPSHOTS,
+    range_rate, range_rate_gradient, state_bounds, state_fisher, Cpi, LinkMotion,
+    DEFAULT_RANGE_RATE_FLOOR_MPS, MAX_CPI_SNAPSHOTS,
 };
 pub use ellipse::Ellipse;
 pub use geometry::{

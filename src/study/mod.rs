@@ -22,10 +22,13 @@
 //!   PMB tracker or the GNN baseline ([`MultiTrackOutput`], issue 41).
 //! - [`MultiStudy`]: the multi-target Monte Carlo (PMB and GNN against the known-association
 //!   bound, GOSPA per scan; sharded as `multi-target` parts).
+//! - [`DopplerStudy`]: a filter with and without the range rates of each scan's CPI against the
+//!   PCRLB of each (issue 42).
 //! - [`PartSet`], [`PartFile`]: the part file format (`scatterloc-part`, version 2, with a digest of its sums) and what `merge` checks.
 
 mod channel;
 mod cost;
+mod doppler;
 mod drive;
 mod filters;
 mod montecarlo;
@@ -50,6 +53,7 @@ pub use channel::{
     RECORDING_CLUTTER, RECORDING_CLUTTER_WINDOW_S, RECORDING_DETECTION, RECORDING_EXTENT_SIGMA_M,
 };
 pub use cost::{check_cost, track_cpu_s, MAX_CPU_S, PAGE_STUDY_CPU_S, PAGE_TRACK_CPU_S};
+pub use doppler::{DopplerArm, DopplerResult, DopplerStudy, MAX_DOPPLER_RUNS};
 pub use drive::{Driver, Sequential};
 pub use filters::{particle_chunks, FilterResults, FilterRun, FilterStudy};
 pub use montecarlo::{

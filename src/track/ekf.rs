@@ -39,6 +39,7 @@ use crate::track::shared::{
 use crate::track::{ConstantVelocity, Filter, MeasurementNoise, PredictedDelay, UpdateSummary};
 
 mod batch;
+mod doppler;
 mod links;
 
 pub(crate) use batch::update_lanes;
@@ -154,6 +155,16 @@ impl Filter for Ekf {
         noise: MeasurementNoise,
     ) -> Result<UpdateSummary> {
         Ekf::update(self, model, z, noise, None)
+    }
+
+    fn update_doppler(
+        &mut self,
+        model: &Model,
+        z: &[Option<Real>],
+        noise: MeasurementNoise,
+        rates: &crate::track::RangeRates,
+    ) -> Result<UpdateSummary> {
+        Ekf::update_doppler(self, model, z, noise, rates)
     }
 
     fn state(&self) -> &Vec4 {

@@ -11,11 +11,12 @@ use alloc::string::{String, ToString};
 use alloc::vec::Vec;
 
 use crate::error::{Error, Result};
-use crate::math::{Mat4, Real, Vec2, Vec4};
-use crate::measure::{Model, Rng};
+use crate::math::{sqrt, Mat4, Real, Vec2, Vec4};
+use crate::measure::{LinkMotion, Model, Rng};
 use crate::track::shared::{rolled_back, spd_quadratic_form};
 use crate::track::{ConstantVelocity, Ekf, MeasurementNoise, PredictedDelay, UpdateSummary};
 use crate::track::{ParticleFilter, PfConfig, Ukf, UkfParams};
+use crate::track::{PredictedRate, RangeRates, RateNoise};
 
 /// The filter seam: what every tracker of the delay model does, on the CV motion model (E7) and
 /// the delay measurement model (E1, `σ_p` from E8 or given).
@@ -83,6 +84,43 @@ pub trait Filter: Clone {
         noise: MeasurementNoise,
     ) -> Result<UpdateSummary>;
 
+    /// Update with delays `z` (s) and range rates `rates` (m/s), `None` = missing, one per link
+    /// (issue 42 §3; D1, D3, D5): a link may give either or both. On error the filter is
+    /// unchanged; a rate or its σ out of range is named (`range_rates[p]`,
+    /// `range_rate_sigma_mps[p]`).
+    fn update_doppler(
+        &mut self,
+        model: &Model,
+        z: &[Option<Real>],
+        noise: MeasurementNoise,
+        rates: &RangeRates,
+    ) -> Result<UpdateSummary>;
+
+    /// Each link's predicted range rate `ṙ_p(x̂⁻)` (D1) and innovation σ `√(h P hᵀ + σ_ṙ²)`,
+    /// `h = [∂ṙ/∂r, ∂ṙ/∂v]` (D3) at the estimate, with `σ_ṙ` from `noise` there (`+∞` where
+    /// it is: no Doppler information). Gating and association read them beside
+    /// [`Filter::predicted_delays`]. `Fixed` noise of the wrong length is
+    /// [`Error::LengthMismatch`].
+    fn predicted_range_rates(&self, model: &Model, noise: RateNoise) -> Result<Vec<PredictedRate>> {
+        if let RateNoise::Fixed(s) = noise {
+            crate::error::check_len("range_rate_sigma_mps", model.link_count(), s.len())?;
+        }
+        let x = self.state();
+        let (r, v) = (Vec2::new(x[0], x[1]), Vec2::new(x[2], x[3]));
+        let p = self.covariance();
+        Ok((0..model.link_count())
+            .map(|link| {
+                let g = LinkMotion::new(&model.network, link, r, v);
+                let sigma = noise.sigma(model, link, &g);
+                let h = g.rate_row();
+                PredictedRate {
+                    range_rate_mps: g.range_rate_mps,
+                    innovation_sigma_mps: sqrt(h.dot(&(p * h)) + sigma * sigma),
+                }
+            })
+            .collect())
+    }
+
     /// The estimate `x̂ = [x, y, vx, vy]`, m and m/s.
     fn state(&self) -> &Vec4;
 
@@ -114,6 +152,22 @@ pub trait Filter: Clone {
             f.update(model, z, noise)
         })
     }
+}
+
+/// Predict then update with delays and range rates ([`Filter::update_doppler`]); on error the
+/// filter is left as before the step.
+pub fn step_doppler<F: Filter>(
+    filter: &mut F,
+    motion: &ConstantVelocity,
+    model: &Model,
+    z: &[Option<Real>],
+    noise: MeasurementNoise,
+    rates: &RangeRates,
+) -> Result<UpdateSummary> {
+    rolled_back(filter, |f| {
+        f.predict(motion);
+        f.update_doppler(model, z, noise, rates)
+    })
 }
 
 /// The tracker a study or a track runs: the EKF (spec §6), the UKF or the bootstrap particle
@@ -304,6 +358,20 @@ impl Filter for Tracker {
             Tracker::Ekf(f) => Filter::update(f, model, z, noise),
             Tracker::Ukf(f) => Filter::update(f, model, z, noise),
             Tracker::Pf(f) => Filter::update(f.as_mut(), model, z, noise),
+        }
+    }
+
+    fn update_doppler(
+        &mut self,
+        model: &Model,
+        z: &[Option<Real>],
+        noise: MeasurementNoise,
+        rates: &RangeRates,
+    ) -> Result<UpdateSummary> {
+        match self {
+            Tracker::Ekf(f) => f.update_doppler(model, z, noise, rates),
+            Tracker::Ukf(f) => f.update_doppler(model, z, noise, rates),
+            Tracker::Pf(f) => f.update_doppler(model, z, noise, rates).map(|u| u.summary),
         }
     }
 

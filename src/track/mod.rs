@@ -9,6 +9,7 @@
 //! that scores a multi-target estimate (issue 41).
 
 mod cost;
+mod doppler;
 mod ekf;
 mod filter;
 pub mod gating;
@@ -27,9 +28,10 @@ pub use cost::{
     step_ns, EKF_NS, EKF_NS_PER_LINK, PF_NS_PER_LINK3, PF_NS_PER_PARTICLE, PF_NS_PER_PARTICLE_LINK,
     PF_NS_PER_PARTICLE_LINK2, UKF_NS, UKF_NS_PER_LINK, UKF_NS_PER_LINK2, UKF_NS_PER_LINK3,
 };
+pub use doppler::{PredictedRate, RangeRates, RateNoise};
 pub(crate) use ekf::update_lanes;
 pub use ekf::Ekf;
-pub use filter::{Filter, FilterKind, FilterSettings, Tracker};
+pub use filter::{step_doppler, Filter, FilterKind, FilterSettings, Tracker};
 pub use gospa::{gospa, Gospa, GospaConfig, MAX_GOSPA_POINTS};
 pub use montecarlo::{
     finish, pcrlb_from_sums, run_chunk, run_chunk_in, run_filter_chunk, run_filter_chunk_in,

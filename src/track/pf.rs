@@ -39,6 +39,7 @@ use rand::Rng as _;
 use crate::error::{Error, Result};
 use crate::math::{exp, ln, sqrt, Mat4, Real, Vec2, Vec4, SPEED_OF_LIGHT};
 use crate::measure::{Model, Rng};
+use crate::track::doppler::{check_rates, rows as doppler_rows, RangeRates, Row};
 use crate::track::shared::{
     check_covariance, check_state, check_update, first_input_error, link_sigmas, predict_gaussian,
     rolled_back, Ldl4, NO_UPDATE,
@@ -211,7 +212,34 @@ impl ParticleFilter {
         z: &[Option<Real>],
         noise: MeasurementNoise,
     ) -> Result<PfUpdate> {
-        let m = check_update(model, z, noise)?;
+        self.update_with(model, z, noise, None)
+    }
+
+    /// Update with delays `z` and range rates `rates` (issue 42 §3): the likelihood of each
+    /// particle is the product over the delay rows (E1) and the range-rate rows (D1, `σ_ṙ` from
+    /// `rates.noise` at the weighted mean of the predicted particles); the regularised filter's
+    /// first proposal is the EKF's delay-and-Doppler update. Otherwise as [`Self::update`].
+    pub fn update_doppler(
+        &mut self,
+        model: &Model,
+        z: &[Option<Real>],
+        noise: MeasurementNoise,
+        rates: &RangeRates,
+    ) -> Result<PfUpdate> {
+        self.update_with(model, z, noise, Some(rates))
+    }
+
+    /// [`Self::update`] (`rates` `None`) or [`Self::update_doppler`].
+    fn update_with(
+        &mut self,
+        model: &Model,
+        z: &[Option<Real>],
+        noise: MeasurementNoise,
+        rates: Option<&RangeRates>,
+    ) -> Result<PfUpdate> {
+        let measured = Measured::new(model, z, noise, rates, &self.state)?;
+        let (zc, info) = (&measured.z[..], &measured.info[..]);
+        let m = zc.len();
         let n = self.particles.len();
         if m == 0 {
             return Ok(PfUpdate {
@@ -220,50 +248,17 @@ impl ParticleFilter {
                 resampled: false,
             });
         }
-        let used: Vec<usize> = (0..z.len()).filter(|&p| z[p].is_some()).collect();
-        let r_pred = self.position();
-        if let Some(e) = first_input_error(model, z, noise, r_pred) {
-            return Err(e);
-        }
-        // Range domain: c·z and the information 1/(cσ_p)².
-        let zc: Vec<Real> = used
-            .iter()
-            .map(|&p| SPEED_OF_LIGHT * z[p].unwrap_or_default())
-            .collect();
-        let info: Vec<Real> = used
-            .iter()
-            .map(|&p| {
-                let s = SPEED_OF_LIGHT * noise.sigma(model, p, r_pred);
-                1.0 / (s * s)
-            })
-            .collect();
         let mut q = vec![0.0; n];
-        range_pass(
-            model,
-            &used,
-            &zc,
-            &info,
-            &self.particles,
-            &mut self.ranges,
-            &mut q,
-        );
+        measured.pass(model, &self.particles, &mut self.ranges, &mut q);
         // The NIS of the predicted particles, before any redraw.
-        let nis = self.nis(&zc, &info, m);
+        let nis = self.nis(zc, info, m);
         let proposal = match self.gaussian {
-            Some(g) if self.config.regularized => self.first_proposal(model, z, noise, g),
+            Some(g) if self.config.regularized => self.first_proposal(model, z, noise, rates, g),
             _ => None,
         };
         let mut log_w = self.log_weights.clone();
         if let Some((particles, extra, _)) = &proposal {
-            range_pass(
-                model,
-                &used,
-                &zc,
-                &info,
-                particles,
-                &mut self.ranges,
-                &mut q,
-            );
+            measured.pass(model, particles, &mut self.ranges, &mut q);
             // The cloud was unweighted: ln p(z|x) + ln prior(x) − ln q(x) (constants cancel).
             for ((l, qj), e) in log_w.iter_mut().zip(&q).zip(extra) {
                 *l = -0.5 * qj + e;
@@ -303,7 +298,10 @@ impl ParticleFilter {
             self.resample();
         }
         Ok(PfUpdate {
-            summary: UpdateSummary { nis, links_used: m },
+            summary: UpdateSummary {
+                nis,
+                links_used: measured.links,
+            },
             ess: e,
             resampled,
         })
@@ -334,13 +332,17 @@ impl ParticleFilter {
         model: &Model,
         z: &[Option<Real>],
         noise: MeasurementNoise,
+        rates: Option<&RangeRates>,
         (mean, covariance): (Vec4, Mat4),
     ) -> Option<(Vec<Vec4>, Vec<Real>, Rng)> {
         let mut ekf = Ekf {
             state: mean,
             covariance,
         };
-        ekf.update(model, z, noise, None).ok()?;
+        match rates {
+            None => ekf.update(model, z, noise, None).ok()?,
+            Some(rates) => ekf.update_doppler(model, z, noise, rates).ok()?,
+        };
         let pq = (ekf.covariance + ekf.covariance.transpose()) * (0.5 * PROPOSAL_INFLATION);
         let l = nalgebra::Cholesky::new(pq)?.l();
         let prior = Ldl4::new(&covariance)?;
@@ -493,6 +495,90 @@ impl ParticleFilter {
 
 /// Every particle's range on each used link (E1, into `ranges`, `N × m`) and
 /// `q_j = Σ_links (z − h(x_j))² / σ_p²` in the range domain (into `q`).
+/// The measurements of one update as the particle passes read them: the delay-only update's
+/// used links (ranges from each node's distance once), or the delay-and-Doppler rows; the
+/// measured values `z` (range domain) and their information `1/σ²`.
+struct Measured {
+    used: Vec<usize>,
+    rows: Option<Vec<(usize, Row)>>,
+    z: Vec<Real>,
+    info: Vec<Real>,
+    /// Links that gave a measurement.
+    links: usize,
+}
+
+impl Measured {
+    /// The update's measurements after its checks (`σ` at the weighted mean `x̂⁻`).
+    fn new(
+        model: &Model,
+        z: &[Option<Real>],
+        noise: MeasurementNoise,
+        rates: Option<&RangeRates>,
+        mean: &Vec4,
+    ) -> Result<Measured> {
+        let r_pred = Vec2::new(mean[0], mean[1]);
+        if let Some(rates) = rates {
+            check_rates(model, z, noise, rates, r_pred)?;
+            let mut rows = Vec::new();
+            let links = doppler_rows(model, mean, z, noise, rates, |p, row| rows.push((p, row)))?;
+            return Ok(Measured {
+                used: Vec::new(),
+                z: rows.iter().map(|(_, r)| r.z).collect(),
+                info: rows.iter().map(|(_, r)| r.w).collect(),
+                rows: Some(rows),
+                links,
+            });
+        }
+        let m = check_update(model, z, noise)?;
+        let used: Vec<usize> = (0..z.len()).filter(|&p| z[p].is_some()).collect();
+        if m > 0 {
+            if let Some(e) = first_input_error(model, z, noise, r_pred) {
+                return Err(e);
+            }
+        }
+        // Range domain: c·z and the information 1/(cσ_p)².
+        let zc = used
+            .iter()
+            .map(|&p| SPEED_OF_LIGHT * z[p].unwrap_or_default())
+            .collect();
+        let info = used
+            .iter()
+            .map(|&p| {
+                let s = SPEED_OF_LIGHT * noise.sigma(model, p, r_pred);
+                1.0 / (s * s)
+            })
+            .collect();
+        Ok(Measured {
+            used,
+            rows: None,
+            z: zc,
+            info,
+            links: m,
+        })
+    }
+
+    /// Each particle's `Σ w (z − h(x_j))²` into `q` and its predicted values into `ranges`
+    /// (`N × m`).
+    fn pass(&self, model: &Model, particles: &[Vec4], ranges: &mut Vec<Real>, q: &mut [Real]) {
+        let Some(rows) = &self.rows else {
+            return range_pass(model, &self.used, &self.z, &self.info, particles, ranges, q);
+        };
+        let m = rows.len();
+        ranges.clear();
+        ranges.resize(particles.len() * m, 0.0);
+        for (j, x) in particles.iter().enumerate() {
+            let mut s = 0.0;
+            for (k, (p, row)) in rows.iter().enumerate() {
+                let h = row.value_at(model, *p, x);
+                ranges[j * m + k] = h;
+                let e = row.z - h;
+                s += e * e * row.w;
+            }
+            q[j] = s;
+        }
+    }
+}
+
 fn range_pass(
     model: &Model,
     used: &[usize],
@@ -621,6 +707,16 @@ impl Filter for ParticleFilter {
         noise: MeasurementNoise,
     ) -> Result<UpdateSummary> {
         ParticleFilter::update(self, model, z, noise).map(|u| u.summary)
+    }
+
+    fn update_doppler(
+        &mut self,
+        model: &Model,
+        z: &[Option<Real>],
+        noise: MeasurementNoise,
+        rates: &RangeRates,
+    ) -> Result<UpdateSummary> {
+        ParticleFilter::update_doppler(self, model, z, noise, rates).map(|u| u.summary)
     }
 
     fn state(&self) -> &Vec4 {

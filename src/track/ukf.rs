@@ -50,6 +50,8 @@ use crate::track::{ConstantVelocity, Filter, MeasurementNoise, PredictedDelay, U
 /// State dimension `n`.
 const N: usize = 4;
 
+mod doppler;
+
 /// The scaled unscented transform's parameters (spec §1 \[choice\]: α = 1, β = 2, κ = 0).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct UkfParams {
@@ -354,6 +356,16 @@ impl Filter for Ukf {
             nis: x.1,
             links_used: m,
         })
+    }
+
+    fn update_doppler(
+        &mut self,
+        model: &Model,
+        z: &[Option<Real>],
+        noise: MeasurementNoise,
+        rates: &crate::track::RangeRates,
+    ) -> Result<UpdateSummary> {
+        Ukf::update_doppler(self, model, z, noise, rates)
     }
 
     fn state(&self) -> &Vec4 {

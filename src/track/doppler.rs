@@ -1,0 +1,200 @@
+//! Delay and Doppler in the trackers (issue 42 §3; docs/doppler.md D1, D3, D5, D8): one scan's
+//! range rates ([`RangeRates`]) and where their σ comes from ([`RateNoise`]), their checks, and
+//! the measurement rows every filter's delay-and-Doppler update reads — each present delay as
+//! the range row `[û_T + û_R, 0]` (E1, E3, in the range domain like the delay-only update) and
+//! each present range rate as the row `[∂ṙ/∂r, ∂ṙ/∂v]` (D3), both from one evaluation of the
+//! link ([`LinkMotion`]). A link may give either or both. A static path has `ṙ = 0`, so the range
+//! rate is also the gate's strongest cue against walls (see the multi-target sensors).
+
+use alloc::format;
+
+use crate::error::{check_len, limits, Error, Result};
+use crate::math::{Real, Vec2, Vec4, SPEED_OF_LIGHT};
+use crate::measure::{Cpi, LinkMotion, Model};
+use crate::track::shared::{first_input_error, positive_finite, range_information_per_snr};
+use crate::track::MeasurementNoise;
+
+/// Where the range rates' noise `σ_ṙ,p` comes from.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum RateNoise<'a> {
+    /// Fixed `σ_ṙ` per link, m/s (an estimator's own σ).
+    Fixed(&'a [Real]),
+    /// `σ_ṙ` of the CPI (D5) at the link's SNR at the predicted position.
+    Cpi(Cpi),
+    /// `σ_ṙ` of the CPI at the link's SNR at a given position (the oracle option).
+    CpiAt(Cpi, Vec2),
+}
+
+impl RateNoise<'_> {
+    /// `σ_ṙ` of link `p` for a filter at `r_pred` whose link geometry there is `geometry`
+    /// (`+∞` where the CPI holds no Doppler information: that rate is then not used).
+    #[inline]
+    pub fn sigma(&self, model: &Model, p: usize, geometry: &LinkMotion) -> Real {
+        match *self {
+            RateNoise::Fixed(s) => s[p],
+            RateNoise::Cpi(c) => c.sigma_range_rate(geometry.snr(model, p)),
+            RateNoise::CpiAt(c, r) => c.sigma_range_rate(model.snr(p, r)),
+        }
+    }
+}
+
+/// One scan's measured range rates, m/s (one per link in scenario link order, `None` =
+/// missing), and their noise.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RangeRates<'a> {
+    /// `ṙ_p`, m/s.
+    pub rates_mps: &'a [Option<Real>],
+    /// Where `σ_ṙ,p` comes from.
+    pub noise: RateNoise<'a>,
+}
+
+/// The filter's predicted range rate of one link, `ṙ_p(x̂⁻)` (D1), and its innovation σ
+/// `√(H_p P H_pᵀ + σ_ṙ²)` (D3), m/s; `+∞` σ where the rate carries no information.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PredictedRate {
+    /// `ṙ_p(x̂⁻)`, m/s.
+    pub range_rate_mps: Real,
+    /// `√S_pp`, m/s.
+    pub innovation_sigma_mps: Real,
+}
+
+impl PredictedRate {
+    /// `|ṙ − ṙ_p(x̂⁻)| / √S_pp` (0 when the σ is infinite).
+    pub fn normalized_innovation(&self, rate_mps: Real) -> Real {
+        (rate_mps - self.range_rate_mps).abs() / self.innovation_sigma_mps
+    }
+}
+
+/// One measurement row in the range domain: whether it is a range rate (else a range), the
+/// measured value `z` (m or m/s), `h` (a row of the state Jacobian at `x̂⁻`), the information
+/// `w = 1/σ²` and the innovation `ν = z − h(x̂⁻)`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Row {
+    pub rate: bool,
+    pub z: Real,
+    pub h: Vec4,
+    pub w: Real,
+    pub nu: Real,
+}
+
+impl Row {
+    /// This row's measurement function at the state `x` on link `p`: the range (E1) or the
+    /// range rate (D1).
+    #[inline]
+    pub fn value_at(&self, model: &Model, p: usize, x: &Vec4) -> Real {
+        let g = LinkMotion::new(
+            &model.network,
+            p,
+            Vec2::new(x[0], x[1]),
+            Vec2::new(x[2], x[3]),
+        );
+        if self.rate {
+            g.range_rate_mps
+        } else {
+            g.range_m
+        }
+    }
+}
+
+/// The checks of a delay-and-Doppler update at the predicted position `r`: the delays as the
+/// delay-only update checks them ([`first_input_error`]), then `rates` of one entry per link
+/// (`LengthMismatch` of `range_rates`), `Fixed` rate noise of one σ per link (`LengthMismatch`
+/// of `range_rate_sigma_mps`), each rate within [`limits::RANGE_RATE_M_S`] and each given σ
+/// within [`limits::RANGE_RATE_SIGMA_M_S`] (`OutOfRange` naming the entry).
+pub(crate) fn check_rates(
+    model: &Model,
+    z: &[Option<Real>],
+    noise: MeasurementNoise,
+    rates: &RangeRates,
+    r: Vec2,
+) -> Result<()> {
+    let n = model.link_count();
+    check_len("measurement", n, z.len())?;
+    noise.check_links(n)?;
+    if let Some(e) = first_input_error(model, z, noise, r) {
+        return Err(e);
+    }
+    check_len("range_rates", n, rates.rates_mps.len())?;
+    if let RateNoise::Fixed(s) = rates.noise {
+        check_len("range_rate_sigma_mps", n, s.len())?;
+    }
+    for (p, rate) in rates.rates_mps.iter().enumerate() {
+        let Some(rate) = *rate else { continue };
+        limits::RANGE_RATE_M_S.check(&format!("range_rates[{p}]"), rate)?;
+        if let RateNoise::Fixed(s) = rates.noise {
+            limits::RANGE_RATE_SIGMA_M_S.check(&format!("range_rate_sigma_mps[{p}]"), s[p])?;
+        }
+    }
+    Ok(())
+}
+
+/// The rows of one update linearised at `x` (after [`check_rates`]), in link order, a link's
+/// delay before its rate: `row(p, row)` for each. A rate whose σ is not finite and positive
+/// carries no information and is skipped. The number of links that gave a row.
+#[inline]
+pub(crate) fn rows(
+    model: &Model,
+    x: &Vec4,
+    z: &[Option<Real>],
+    noise: MeasurementNoise,
+    rates: &RangeRates,
+    mut row: impl FnMut(usize, Row),
+) -> Result<usize> {
+    let (r, v) = (Vec2::new(x[0], x[1]), Vec2::new(x[2], x[3]));
+    let info_per_snr = range_information_per_snr(model);
+    let mut links = 0;
+    for p in 0..model.link_count() {
+        let (zp, rate) = (z[p], rates.rates_mps[p]);
+        if zp.is_none() && rate.is_none() {
+            continue;
+        }
+        let g = LinkMotion::new(&model.network, p, r, v);
+        let mut used = false;
+        if let Some(tau) = zp {
+            let w = match noise {
+                MeasurementNoise::AtPrediction => info_per_snr * g.snr(model, p),
+                _ => {
+                    let s = SPEED_OF_LIGHT * noise.sigma(model, p, r);
+                    1.0 / (s * s)
+                }
+            };
+            if !(positive_finite(w)) {
+                return Err(Error::InvalidSigma {
+                    link: p,
+                    value: noise.sigma(model, p, r),
+                });
+            }
+            let h = Vec4::new(g.range_gradient.x, g.range_gradient.y, 0.0, 0.0);
+            let z = SPEED_OF_LIGHT * tau;
+            row(
+                p,
+                Row {
+                    rate: false,
+                    z,
+                    h,
+                    w,
+                    nu: z - g.range_m,
+                },
+            );
+            used = true;
+        }
+        if let Some(rate) = rate {
+            let s = rates.noise.sigma(model, p, &g);
+            if positive_finite(s) {
+                row(
+                    p,
+                    Row {
+                        rate: true,
+                        z: rate,
+                        h: g.rate_row(),
+                        w: 1.0 / (s * s),
+                        nu: rate - g.range_rate_mps,
+                    },
+                );
+                used = true;
+            }
+        }
+        links += usize::from(used);
+    }
+    Ok(links)
+}
