@@ -41,6 +41,9 @@ mod multi;
 #[path = "tracking/multi_studies.rs"]
 mod multi_studies;
 
+#[path = "tracking/multi_doppler.rs"]
+mod multi_doppler;
+
 #[path = "tracking/gospa.rs"]
 mod gospa;
 

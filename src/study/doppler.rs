@@ -109,7 +109,7 @@ impl DopplerStudy {
             let scans = self.scans(model, &truth, &mut g);
             let start = self.mean_state;
             for (d, acc) in arms.iter_mut().enumerate() {
-                let filter_rng = rng(self.seed ^ 0x5EED_D0_99_1E, (2 * k + d) as u64);
+                let filter_rng = rng(self.seed ^ 0x005E_EDD0_991E, (2 * k + d) as u64);
                 let mut f = Tracker::new(self.filter, start, self.initial_covariance, filter_rng)?;
                 acc.run(model, &mut f, &truth, &scans, d == 1, self);
             }
@@ -161,7 +161,7 @@ impl DopplerStudy {
                     delays.push(Some(model.network.delay(p, r) + s * standard_normal(g)));
                     let sr = self.cpi.sigma_range_rate(m.snr(model, p));
                     let e = standard_normal(g);
-                    rates.push(sr.is_finite().then(|| m.range_rate_mps + sr * e));
+                    rates.push(sr.is_finite().then_some(m.range_rate_mps + sr * e));
                 }
                 Scan { delays, rates }
             })

@@ -47,12 +47,11 @@ fn covariance(g: &mut Rng) -> Mat4 {
     a * a.transpose() + Mat4::from_diagonal(&Vec4::new(1e-3, 1e-3, 1e-2, 1e-2))
 }
 
+/// One scan: delays (s) and range rates (m/s) per link, `None` = missing, and their σ.
+struct Measured(Vec<Option<Real>>, Vec<Option<Real>>, Vec<Real>, Vec<Real>);
+
 /// Measurements near the truth `x` (within a few σ), some links missing one or both.
-fn measurements(
-    model: &Model,
-    x: &Vec4,
-    g: &mut Rng,
-) -> (Vec<Option<Real>>, Vec<Option<Real>>, Vec<Real>, Vec<Real>) {
+fn measurements(model: &Model, x: &Vec4, g: &mut Rng) -> Measured {
     let (r, v) = (Vec2::new(x[0], x[1]), Vec2::new(x[2], x[3]));
     let n = model.link_count();
     let sd: Vec<Real> = (0..n).map(|_| 1e-10 * (1.0 + uniform01(g))).collect();
@@ -69,7 +68,7 @@ fn measurements(
                 .then(|| range_rate(&model.network, p, r, v) + sr[p] * (2.0 * uniform01(g) - 1.0))
         })
         .collect();
-    (z, rates, sd, sr)
+    Measured(z, rates, sd, sr)
 }
 
 /// The reference: one batch update in the range domain, linearised at `x`: rows
@@ -156,7 +155,7 @@ fn ekf_doppler_update_equals_the_batch_kalman_update() {
         let mut g = rng(seed, 99);
         for (model, x, _) in cases(seed, 20) {
             let p = covariance(&mut g);
-            let (z, rates, sd, sr) = measurements(&model, &x, &mut g);
+            let Measured(z, rates, sd, sr) = measurements(&model, &x, &mut g);
             let mut f = Ekf::new(x, p).unwrap();
             let given = RangeRates {
                 rates_mps: &rates,
@@ -188,7 +187,7 @@ fn ekf_rate_noise_from_the_cpi() {
     let mut g = rng(5, 1);
     for (model, x, fc) in cases(5, 10) {
         let p = covariance(&mut g);
-        let (z, rates, sd, _) = measurements(&model, &x, &mut g);
+        let Measured(z, rates, sd, _) = measurements(&model, &x, &mut g);
         let cpi = Cpi::new(fc, 16, 2.048e-3, 0.1).unwrap();
         let r = Vec2::new(x[0], x[1]);
         let sr: Vec<Real> = (0..model.link_count())
@@ -231,7 +230,7 @@ fn without_rates_every_filter_is_its_delay_only_self() {
     let mut g = rng(11, 1);
     for (model, x, fc) in cases(11, 6) {
         let p = covariance(&mut g);
-        let (z, _, _, _) = measurements(&model, &x, &mut g);
+        let Measured(z, ..) = measurements(&model, &x, &mut g);
         let none = vec![None; model.link_count()];
         let rates = RangeRates {
             rates_mps: &none,
@@ -276,12 +275,10 @@ fn reference_ukf(
     model: &Model,
     x: &Vec4,
     p: &Mat4,
-    z: &[Option<Real>],
-    rates: &[Option<Real>],
-    sd: &[Real],
-    sr: &[Real],
+    scan: &Measured,
     params: UkfParams,
 ) -> (Vec4, Mat4) {
+    let Measured(z, rates, sd, sr) = scan;
     let n = 4.0;
     let lambda = params.alpha * params.alpha * (n + params.kappa) - n;
     let l = (p * (n + lambda)).cholesky().unwrap().l();
@@ -363,19 +360,20 @@ fn ukf_doppler_update_equals_the_unscented_transform() {
         let mut g = rng(seed, 17);
         for (model, x, _) in cases(seed, 10) {
             let p = covariance(&mut g);
-            let (z, rates, sd, sr) = measurements(&model, &x, &mut g);
+            let scan = measurements(&model, &x, &mut g);
+            let Measured(z, rates, sd, sr) = &scan;
             let mut f = Ukf::new(x, p, params).unwrap();
             f.update_doppler(
                 &model,
-                &z,
-                MeasurementNoise::Fixed(&sd),
+                z,
+                MeasurementNoise::Fixed(sd),
                 &RangeRates {
-                    rates_mps: &rates,
-                    noise: RateNoise::Fixed(&sr),
+                    rates_mps: rates,
+                    noise: RateNoise::Fixed(sr),
                 },
             )
             .unwrap();
-            let (xw, pw) = reference_ukf(&model, &x, &p, &z, &rates, &sd, &sr, params);
+            let (xw, pw) = reference_ukf(&model, &x, &p, &scan, params);
             close_state("x", &f.state, &xw, &pw, 1e-8);
             close_cov("P", &f.covariance, &pw, 1e-8);
         }
@@ -544,6 +542,7 @@ fn summarize(name: &str, arm: &DopplerArm) -> (Real, Real, Real) {
 /// side); on 3 seeds. 200 runs × 30 steps (3 s) per case here;
 /// docs/doppler.md has the 10 s tables.
 #[test]
+#[allow(clippy::approx_constant)] // spec §9.4's table: (1.2247, −0.7071) as printed
 fn monte_carlo_rmse_is_within_the_pcrlb_with_and_without_doppler() {
     let p0 = scatterloc::track::paper_initial_covariance();
     for (name, weaker_db, x0) in [

@@ -111,15 +111,15 @@ impl Gnn {
         let mut free: Vec<Vec<(Real, Option<Real>)>> = vec![Vec::new(); scan.len()];
         let mut taken_all: Vec<Vec<bool>> = vec![Vec::new(); scan.len()];
         for (s, dets) in scan.iter().enumerate() {
-            let lc = model.clutter_intensity(s);
             let (n, m) = (self.tracks.len(), dets.len());
             let mut cost = vec![None; n * m];
             let mut updated = vec![None; n * m];
             for (i, t) in self.tracks.iter().enumerate() {
                 for (j, d) in dets.iter().enumerate() {
-                    let obs = model.observe(s, &t.state, d.sigma);
+                    let obs = model.observe_detection(s, &t.state, d);
                     if let Some(u) = kalman_update(&t.state, &t.covariance, &obs, &d.value) {
                         if u.distance2 <= self.config.gate {
+                            let lc = model.clutter_intensity_of(s, d);
                             // −ln(P_D 𝒩 / (λ_c f_c (1 − P_D))): negative when the pair beats
                             // "missed and clutter".
                             let c = -(ln(pd / (1.0 - pd)) + u.log_likelihood - ln(lc));

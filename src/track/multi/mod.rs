@@ -31,9 +31,10 @@ pub use pmb::{map_cardinality, Births, Pmb, MAX_UNDETECTED_COMPONENTS};
 pub use score::{score_run, RunScore, StepScore};
 pub use sensors::{
     check_detection, DelayLinks, Detection, MeasurementModel, Observation, PositionSensor,
+    CLUTTER_RATE_SPAN_MPS,
 };
 pub use sim::{
-    check_drawn_paths, delay_scans, people_layout, people_region, people_truth, people_truth_drawn,
-    people_truth_in, poisson, position_scans, williams15, williams15_truth, DrawnPath, Truth,
-    Williams15, MAX_WALKERS,
+    check_drawn_paths, delay_rate_scans, delay_scans, people_layout, people_region, people_truth,
+    people_truth_drawn, people_truth_in, poisson, position_scans, williams15, williams15_truth,
+    DrawnPath, Truth, Williams15, MAX_WALKERS,
 };

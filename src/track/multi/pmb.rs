@@ -163,14 +163,13 @@ impl Pmb {
     ) -> Vec<Real> {
         let (n, m) = (self.bernoullis.len(), dets.len());
         let pd = model.detection_probability();
-        let lc = model.clutter_intensity(s);
         // The undetected targets' share of each measurement (position births).
         let mut e = vec![0.0; m];
         let mut born: Vec<Vec<(Real, Vec4, Mat4)>> = vec![Vec::new(); m];
         if !self.undetected.is_empty() {
             for (j, d) in dets.iter().enumerate() {
                 for c in &self.undetected {
-                    let obs = model.observe(s, &c.state, d.sigma);
+                    let obs = model.observe_detection(s, &c.state, d);
                     if let Some(u) = kalman_update(&c.state, &c.covariance, &obs, &d.value) {
                         let w = pd * c.weight * exp(u.log_likelihood);
                         if w > 0.0 {
@@ -187,12 +186,13 @@ impl Pmb {
             let obs0 = model.observe(s, &b.state, None);
             let r = b.existence;
             for (j, d) in dets.iter().enumerate() {
-                let obs = match d.sigma {
-                    Some(_) => model.observe(s, &b.state, d.sigma),
-                    None => obs0,
+                let obs = match (d.sigma, d.rate_sigma) {
+                    (None, None) => obs0,
+                    _ => model.observe_detection(s, &b.state, d),
                 };
                 if let Some(u) = kalman_update(&b.state, &b.covariance, &obs, &d.value) {
                     if u.distance2 <= self.config.gate {
+                        let lc = model.clutter_intensity_of(s, d);
                         let w = r * pd * exp(u.log_likelihood) / ((1.0 - r * pd) * (lc + e[j]));
                         if w.is_finite() && w > 0.0 {
                             psi[i * m + j] = w;
@@ -232,6 +232,7 @@ impl Pmb {
         }
         for j in 0..m {
             if e[j] > 0.0 {
+                let lc = model.clutter_intensity_of(s, &dets[j]);
                 let r = marg.free[j] * e[j] / (lc + e[j]);
                 if r > self.config.prune {
                     let (x, p) = moment_match(&born[j]);

@@ -8,16 +8,19 @@ use alloc::vec::Vec;
 
 use crate::error::{Error, Result};
 use crate::math::{Real, Vec2, Vec4};
-use crate::measure::Model;
+use crate::measure::{LinkMotion, Model};
 
 /// One detection of a sensor: `value[..dim]` (a delay in s, or a position in m) and, if its
-/// estimator gave one, its own σ (delays only; it replaces the model's noise).
+/// estimator gave one, its own σ (delays only; it replaces the model's noise). A delay may carry
+/// its range rate (issue 42 §3): then `value[1]` is `ṙ` in m/s and `rate_sigma` its σ.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Detection {
     /// The measured value (first `dim` components used).
     pub value: [Real; 2],
     /// Its standard deviation, if known (units of `value`).
     pub sigma: Option<Real>,
+    /// With a range rate in `value[1]`: its σ, m/s.
+    pub rate_sigma: Option<Real>,
 }
 
 impl Detection {
@@ -26,6 +29,21 @@ impl Detection {
         Detection {
             value: [delay_s, 0.0],
             sigma: sigma_s,
+            rate_sigma: None,
+        }
+    }
+
+    /// A delay (s, optional σ in s) with its range rate `ṙ` and σ_ṙ, m/s (D1, D5).
+    pub fn delay_rate(
+        delay_s: Real,
+        sigma_s: Option<Real>,
+        rate_mps: Real,
+        rate_sigma_mps: Real,
+    ) -> Detection {
+        Detection {
+            value: [delay_s, rate_mps],
+            sigma: sigma_s,
+            rate_sigma: Some(rate_sigma_mps),
         }
     }
 
@@ -34,6 +52,7 @@ impl Detection {
         Detection {
             value: [p.x, p.y],
             sigma: None,
+            rate_sigma: None,
         }
     }
 }
@@ -59,6 +78,17 @@ pub trait MeasurementModel {
     fn observe(&self, sensor: usize, x: &Vec4, sigma: Option<Real>) -> Observation;
     /// The clutter intensity `λ_c f_c` of `sensor` (per unit measurement volume).
     fn clutter_intensity(&self, sensor: usize) -> Real;
+    /// The observation of `sensor` at `x` for detection `d` (its own σ; with a range rate, the
+    /// rate as a second component, D1 and D3). By default [`Self::observe`] with `d.sigma`.
+    fn observe_detection(&self, sensor: usize, x: &Vec4, d: &Detection) -> Observation {
+        self.observe(sensor, x, d.sigma)
+    }
+    /// The clutter intensity of `sensor` in `d`'s measurement space (per s, or per s·m/s with a
+    /// range rate). By default [`Self::clutter_intensity`].
+    fn clutter_intensity_of(&self, sensor: usize, d: &Detection) -> Real {
+        let _ = d;
+        self.clutter_intensity(sensor)
+    }
     /// `P_D`.
     fn detection_probability(&self) -> Real;
     /// The delay network behind the sensors and its fixed σ per link, if the sensors are the
@@ -113,7 +143,14 @@ pub struct DelayLinks<'a> {
     pub clutter_intensity: Real,
     /// Fixed σ per link, s (`None`: E8 at the state).
     pub sigma_s: Option<Vec<Real>>,
+    /// The span of clutter range rates, m/s (clutter rates uniform over it): divides the
+    /// clutter intensity of a detection with a range rate.
+    pub clutter_rate_span_mps: Real,
 }
+
+/// The default span of clutter range rates: ±3 m/s (a walker's bistatic range rate is at most
+/// twice its speed).
+pub const CLUTTER_RATE_SPAN_MPS: Real = 6.0;
 
 impl<'a> DelayLinks<'a> {
     /// The links of `model` with `P_D`, `clutter` delays per link and scan uniform over a
@@ -154,6 +191,7 @@ impl<'a> DelayLinks<'a> {
             // A floor keeps the likelihood ratio finite with no clutter at all.
             clutter_intensity: (clutter / window_s).max(1e-3 / window_s),
             sigma_s,
+            clutter_rate_span_mps: CLUTTER_RATE_SPAN_MPS,
         })
     }
 }
@@ -191,6 +229,29 @@ impl MeasurementModel for DelayLinks<'_> {
     }
     fn clutter_intensity(&self, _sensor: usize) -> Real {
         self.clutter_intensity
+    }
+    fn observe_detection(&self, p: usize, x: &Vec4, d: &Detection) -> Observation {
+        let mut obs = self.observe(p, x, d.sigma);
+        if let Some(s) = d.rate_sigma {
+            let m = LinkMotion::new(
+                &self.model.network,
+                p,
+                Vec2::new(x[0], x[1]),
+                Vec2::new(x[2], x[3]),
+            );
+            let h = m.rate_row();
+            obs.dim = 2;
+            obs.value[1] = m.range_rate_mps;
+            obs.jacobian[1] = [h[0], h[1], h[2], h[3]];
+            obs.noise[1] = s * s;
+        }
+        obs
+    }
+    fn clutter_intensity_of(&self, _sensor: usize, d: &Detection) -> Real {
+        match d.rate_sigma {
+            Some(_) => self.clutter_intensity / self.clutter_rate_span_mps,
+            None => self.clutter_intensity,
+        }
     }
     fn detection_probability(&self) -> Real {
         self.detection

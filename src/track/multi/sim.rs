@@ -331,6 +331,44 @@ pub fn delay_scans(
     window_s: Real,
     rng: &mut Rng,
 ) -> Vec<Vec<Vec<Detection>>> {
+    scans_of(model, truth, detection, clutter, window_s, None, rng)
+}
+
+/// [`delay_scans`] with each detection's range rate (issue 42 §3): a target's is `ṙ_p` of its
+/// true state (D1) plus noise of σ `rate_sigma_mps`, a clutter detection's uniform over
+/// [`CLUTTER_RATE_SPAN_MPS`](crate::track::multi::CLUTTER_RATE_SPAN_MPS) about 0 (the
+/// detections carry `rate_sigma_mps` as their σ). The same stream gives the same delays as
+/// [`delay_scans`] only without rates (the rates take draws).
+pub fn delay_rate_scans(
+    model: &Model,
+    truth: &Truth,
+    detection: Real,
+    clutter: Real,
+    window_s: Real,
+    rate_sigma_mps: Real,
+    rng: &mut Rng,
+) -> Vec<Vec<Vec<Detection>>> {
+    scans_of(
+        model,
+        truth,
+        detection,
+        clutter,
+        window_s,
+        Some(rate_sigma_mps),
+        rng,
+    )
+}
+
+fn scans_of(
+    model: &Model,
+    truth: &Truth,
+    detection: Real,
+    clutter: Real,
+    window_s: Real,
+    rate_sigma: Option<Real>,
+    rng: &mut Rng,
+) -> Vec<Vec<Vec<Detection>>> {
+    let span = crate::track::multi::CLUTTER_RATE_SPAN_MPS;
     let links = model.link_count();
     truth
         .steps
@@ -344,12 +382,27 @@ pub fn delay_scans(
                             let r = Vec2::new(x[0], x[1]);
                             let s = model.sigma_delay(p, r);
                             let tau = model.network.delay(p, r) + s * standard_normal(rng);
-                            d.push(Detection::delay(tau, None));
+                            d.push(match rate_sigma {
+                                None => Detection::delay(tau, None),
+                                Some(sr) => {
+                                    let v = Vec2::new(x[2], x[3]);
+                                    let rate = crate::measure::range_rate(&model.network, p, r, v);
+                                    let rate = rate + sr * standard_normal(rng);
+                                    Detection::delay_rate(tau, None, rate, sr)
+                                }
+                            });
                         }
                     }
                     let lo = model.network.los_delay(p);
                     for _ in 0..poisson(clutter, rng) {
-                        d.push(Detection::delay(lo + window_s * uniform01(rng), None));
+                        let tau = lo + window_s * uniform01(rng);
+                        d.push(match rate_sigma {
+                            None => Detection::delay(tau, None),
+                            Some(sr) => {
+                                let rate = span * (uniform01(rng) - 0.5);
+                                Detection::delay_rate(tau, None, rate, sr)
+                            }
+                        });
                     }
                     d
                 })
