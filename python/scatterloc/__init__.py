@@ -12,6 +12,9 @@ stops on Ctrl-C (``KeyboardInterrupt``).
 
 Scenario and snapshot
     :class:`Scenario`, :func:`crlb`, :func:`crlb_doppler`, :func:`crlb_map`, :func:`locate`
+Delay and Doppler (docs/doppler.md)
+    :func:`crlb_doppler`, :func:`doppler_map` (the bound over a grid), :func:`range_rates`
+    (and their Jacobian), :func:`sigma_range_rates` (a CPI's sigma)
 Tracking
     :func:`track`, :func:`calibrate`, :func:`montecarlo`, :func:`pcrlb`
 Planning and multi-target
@@ -25,7 +28,8 @@ Detections (JSON lines, docs/detections.md)
     :class:`Detections`, :func:`read_detections`, :func:`write_detections`,
     ``Paths.to_detections()``; :func:`track` takes them
 Stone Soup
-    :mod:`scatterloc.stonesoup` (``BistaticDelayModel``; needs ``pip install scatterloc[stonesoup]``)
+    :mod:`scatterloc.stonesoup` (``BistaticDelayModel``, ``BistaticDelayDopplerModel``; needs
+    ``pip install scatterloc[stonesoup]``)
 
 Docs: ``docs/python.md`` in the repository.
 """
@@ -54,6 +58,7 @@ from ._scatterloc import (
     crlb,
     crlb_doppler,
     crlb_map,
+    doppler_map,
     estimate,
     estimate_recording,
     gospa,
@@ -64,7 +69,9 @@ from ._scatterloc import (
     plan,
     read_csi,
     read_detections,
+    range_rates,
     read_recording,
+    sigma_range_rates,
     simulate_people,
     simulate_recording,
     track,
@@ -98,6 +105,7 @@ __all__ = [
     "crlb",
     "crlb_doppler",
     "crlb_map",
+    "doppler_map",
     "estimate",
     "estimate_recording",
     "gospa",
@@ -108,7 +116,9 @@ __all__ = [
     "plan",
     "read_csi",
     "read_detections",
+    "range_rates",
     "read_recording",
+    "sigma_range_rates",
     "simulate_people",
     "simulate_recording",
     "track",

@@ -43,6 +43,7 @@ __all__ = [
     "crlb",
     "crlb_doppler",
     "crlb_map",
+    "doppler_map",
     "estimate",
     "estimate_recording",
     "gospa",
@@ -53,7 +54,9 @@ __all__ = [
     "plan",
     "read_csi",
     "read_detections",
+    "range_rates",
     "read_recording",
+    "sigma_range_rates",
     "simulate_people",
     "simulate_recording",
     "track",
@@ -200,6 +203,37 @@ def crlb_doppler(
     range_rate_floor: float = 0.1,
 ) -> dict[str, Any]:
     """The bound on position and velocity over one CPI from delays and range rates."""
+    ...
+
+def doppler_map(
+    scenario: _ScenarioLike,
+    nx: int = 256,
+    ny: int = 256,
+    window: Optional[_Window] = None,
+    *,
+    velocity_mps: Optional[ArrayLike] = None,
+    cpi: int = 16,
+    cpi_spacing_s: float = 2.048e-3,
+    range_rate_floor: float = 0.1,
+    quantity: Literal["position", "velocity"] = "position",
+) -> _F64:
+    """The position (m) or velocity (m/s) bound with Doppler over a grid, (ny, nx); inf where
+    unbounded."""
+    ...
+
+def range_rates(scenario: _ScenarioLike, states: ArrayLike) -> tuple[_F64, _F64]:
+    """Range rates (..., L), m/s, and their Jacobian (..., L, 4) for states [x, y, vx, vy]."""
+    ...
+
+def sigma_range_rates(
+    scenario: _ScenarioLike,
+    points: ArrayLike,
+    *,
+    cpi: int = 16,
+    cpi_spacing_s: float = 2.048e-3,
+    range_rate_floor: float = 0.1,
+) -> _F64:
+    """The CPI's range-rate sigma per link (..., L), m/s; inf for one snapshot."""
     ...
 
 def gospa(truth: ArrayLike, estimates: ArrayLike, *, c: float, p: float = 2.0) -> dict[str, Any]:

@@ -10,6 +10,7 @@
 //! - `output`: the one atomic file writer (`write_recording`, `Scenario.save`), as the CLI's.
 //! - `scenario`: `Scenario` (the core's `present::Session`).
 //! - `snapshot`: `crlb`, `crlb_map`, `locate`.
+//! - `doppler`: `crlb_doppler`, `doppler_map`, `range_rates`, `sigma_range_rates` (issue 42).
 //! - `tracking`: `track`, `calibrate` and the filter settings.
 //! - `studies`: `montecarlo`, `pcrlb`.
 //! - `planning`: `plan`.
@@ -72,6 +73,9 @@ fn _scatterloc(m: &Bound<'_, PyModule>) -> PyResult<()> {
         wrap_pyfunction!(gospa::gospa, m)?,
         wrap_pyfunction!(snapshot::crlb, m)?,
         wrap_pyfunction!(doppler::crlb_doppler, m)?,
+        wrap_pyfunction!(doppler::doppler_map, m)?,
+        wrap_pyfunction!(doppler::range_rates, m)?,
+        wrap_pyfunction!(doppler::sigma_range_rates, m)?,
         wrap_pyfunction!(snapshot::crlb_map, m)?,
         wrap_pyfunction!(snapshot::locate, m)?,
         wrap_pyfunction!(tracking::track, m)?,

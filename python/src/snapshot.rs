@@ -270,18 +270,7 @@ pub fn crlb_map(
     components: bool,
 ) -> PyResult<CrlbMap> {
     let sc = scenario_arg(scenario)?;
-    let area = match window {
-        Some((x0, x1, y0, y1)) => {
-            let a = Area {
-                x: [x0, x1],
-                y: [y0, y1],
-            };
-            a.validate().py()?;
-            a
-        }
-        None => sc.scenario().area_m,
-    };
-    let grid = Grid::new(area, nx, ny).py()?;
+    let (grid, area) = grid_arg(&sc, nx, ny, window)?;
     crate::run::check_threads(threads)?;
     let model = sc.model();
     let cells = grid.len();
@@ -337,6 +326,29 @@ pub fn crlb_map(
         extent: (area.x[0], area.x[1], area.y[0], area.y[1]),
         compute_s: secs,
     })
+}
+
+/// The `nx × ny` grid of cell centres over `window` (`(x_min, x_max, y_min, y_max)`, m; default
+/// the scenario's area) and its area, checked as `scatterloc crlb-map` checks them (`crlb_map`,
+/// `doppler_map`).
+pub fn grid_arg(
+    sc: &PyScenario,
+    nx: usize,
+    ny: usize,
+    window: Option<(f64, f64, f64, f64)>,
+) -> PyResult<(Grid, Area)> {
+    let area = match window {
+        Some((x0, x1, y0, y1)) => {
+            let a = Area {
+                x: [x0, x1],
+                y: [y0, y1],
+            };
+            a.validate().py()?;
+            a
+        }
+        None => sc.scenario().area_m,
+    };
+    Ok((Grid::new(area, nx, ny).py()?, area))
 }
 
 /// A Levenberg–Marquardt fix (returned by `locate`).
