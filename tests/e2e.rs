@@ -154,6 +154,10 @@ mod nees;
 #[cfg(test)]
 #[path = "e2e/page_channel_multi.rs"]
 mod page_channel_multi;
+/// Issue 42 §1/§5: the snapshot view's Doppler maps (position and velocity bounds) equal the CLI's.
+#[cfg(test)]
+#[path = "e2e/page_doppler.rs"]
+mod page_doppler;
 /// Issue 38, a first-time user's look: the multi-target view in its theme's colours, the zoom
 /// inset's title clear of its ×, the channel panel without sideways scrolling.
 #[cfg(test)]

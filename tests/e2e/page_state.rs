@@ -78,6 +78,8 @@ async fn set_view_settings(c: &Client, view: &str) -> Result<(), String> {
             select(c, "plan-objective", "coverage").await?;
             select(c, "plan-move", "all").await?;
             type_in(c, "plan-budget", "500").await?;
+            select(c, "doppler-on", "on").await?;
+            type_in(c, "doppler-vx", "0.5").await?;
             click(c, "zoom-in").await?;
         }
         "tracking" => {
@@ -136,7 +138,7 @@ async fn set_view_settings(c: &Client, view: &str) -> Result<(), String> {
 /// The state sections that hold `view`'s own settings (they must differ from the defaults).
 fn sections_of(view: &str) -> &'static [&'static str] {
     match view {
-        "snapshot" => &["scenario", "grid", "plan", "view"],
+        "snapshot" => &["scenario", "grid", "doppler", "plan", "view"],
         "tracking" => &["tracking", "view"],
         "mtl" => &["mtl", "view"],
         _ => &["channel", "view"],

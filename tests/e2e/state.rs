@@ -149,6 +149,12 @@ const FIELDS: &[&str] = &[
     "target.point.y",
     "target.point.seed",
     "target.next_seed",
+    "doppler.on",
+    "doppler.snapshots",
+    "doppler.spacing_ms",
+    "doppler.floor_mps",
+    "doppler.vx_mps",
+    "doppler.vy_mps",
     "plan.roi",
     "plan.move",
     "plan.objective",
@@ -241,6 +247,18 @@ async fn set_everything(c: &Client) -> Result<(), String> {
     quiet(c).await?;
     // The zoom window.
     click(c, "zoom-in").await?;
+    quiet(c).await?;
+    // Doppler (issue 42): on, with every field typed.
+    select(c, "doppler-on", "on").await?;
+    for (id, v) in [
+        ("doppler-n", "32"),
+        ("doppler-t", "1.024"),
+        ("doppler-floor", "0.2"),
+        ("doppler-vx", "-0.75"),
+        ("doppler-vy", "1.5"),
+    ] {
+        type_in(c, id, v).await?;
+    }
     quiet(c).await?;
     // Tracking: a drawn trajectory and every setting.
     click(c, "mode-tracking").await?;

@@ -12,6 +12,7 @@ import { attachState } from './state.js';
 import { registerHooks } from './hooks.js';
 import { View } from './view.js';
 import { MapView, registerMapState } from './map.js';
+import { Doppler, registerDopplerState } from './doppler.js';
 import { Panel, registerScenarioState } from './panel.js';
 import { attachPointer, hitNode } from './interact.js';
 import { attachKeyboard } from './keyboard.js';
@@ -265,6 +266,8 @@ export async function start() {
 
   const ctx = { app, wasm, module, st, view, changed };
   const map = new MapView(ctx);
+  const doppler = new Doppler(ctx); // the Doppler control and the velocity map (doppler.js)
+  ctx.doppler = doppler;
   ctx.placeTarget = (x, y) => map.placeTarget(x, y);
   ctx.resample = () => map.resample();
   ctx.clearTarget = () => map.clearTarget();
@@ -300,6 +303,7 @@ export async function start() {
     mtl.setActive(st.mode === 'mtl');
     channel.setActive(st.mode === 'channel');
     figures.setMode(st.mode);
+    doppler.sync();
     zoom.show();
     if (st.mode !== 'snapshot') {
       plan.cancel('view changed');
@@ -367,6 +371,7 @@ export async function start() {
   registerColoursState(map.lock);
   registerScenarioState({ app, wasm, st, plan, ctx, homeFor });
   registerMapState(ctx); // grid, target
+  registerDopplerState(doppler, ctx);
   registerPlanState(plan, ctx);
   registerTrackingState(tracking, wasm);
   registerMtlState(mtl, wasm);
@@ -400,7 +405,7 @@ export async function start() {
   $('share-close').addEventListener('click', () => { $('share').hidden = true; });
 
   registerHooks({
-    app, wasm, view, st, setMode, panel, tracking, mtl, map, plan, link, figures, zoom, channel,
+    app, wasm, view, st, setMode, panel, tracking, mtl, map, plan, link, figures, zoom, channel, doppler,
     isIdle: () => !scheduled && !map.busy(),
     pageState: pageState.hooks(),
     help, theme,

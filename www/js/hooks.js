@@ -59,6 +59,10 @@
 //                            restore(obj) -> null | the banner's message; history() -> {index,
 //                            length, pending, busy}; undo(); redo(); dirty(); lastSaved() -> {name,
 //                            text} of the last "Save state"; setDryRun(bool)
+//   window.doppler           the Doppler control (doppler.js): state() -> {on, shown, kernel ('delay' |
+//                            'doppler': the map's), settings, error, velocityRange, colourBar (the
+//                            velocity map's)}; maps() -> {kernel, res, window, position, velocity
+//                            (the last maps' values, or null)}
 //   window.help              the Help dialog (help.js): open(), close(), isOpen()
 //   window.theme             the colour theme (theme.js): get() -> 'dark' | 'light'; set('dark' |
 //                            'light' | null (follow the system)); colors() (the canvas' colours)
@@ -163,6 +167,7 @@ export function registerHooks(p) {
     },
     help: p.help,
     theme: p.theme,
+    doppler: p.doppler.hooks(),
     importScenarioText: (text, name) => p.panel.importText(text, name),
     channel: {
       state: () => p.channel.state(),

@@ -9,7 +9,9 @@
 // predicted to fit FRAME_MS is computed on the main thread at the chosen resolution. A costlier
 // one is computed at once at the largest resolution that fits (shown as such in #map-ms) and,
 // unless a drag is going on, at full resolution in a worker (map-worker.js; a new edit replaces
-// it, workers.js); a drag's end asks for the full map.
+// it, workers.js); a drag's end asks for the full map. With Doppler on (doppler.js, ctx.doppler)
+// the same logic runs the Doppler kernel (the position bound into st.values, the velocity bound
+// into st.velValues), its cost per cell·link learnt apart from the delay kernel's.
 
 import { $, fixed, showError } from './dom.js';
 import { Zoom } from './view.js';
@@ -37,6 +39,8 @@ export class MapView {
       barCanvas: makeBarCanvas(wasm.colorbar_rgba(256)),
       unboundedColor: `rgb(${rgb[0]},${rgb[1]},${rgb[2]})`,
       values: null,
+      velValues: null, // the velocity bound (m/s) of a map with Doppler, else null (doppler.js)
+      mapKernel: 'delay', // the kernel of st.values: 'delay' or 'doppler'
       mapWindow: null, // the window [x0, x1, y0, y1] (m) the values were computed for
       image: null,
       range: null,
@@ -51,7 +55,7 @@ export class MapView {
     ctx.st.colourLock = this.lock;
     // The zoom inset's drag handle, × and "Show zoom inset" (inset.js).
     ctx.st.insetControls = new InsetControls(ctx.view.canvas, () => ctx.changed({ draw: true }));
-    this.nsPerCellLink = null; // learnt from every map computed (null: none yet)
+    this.costs = {}; // per kernel ('delay', 'doppler'): {ns (per cell·link), links}, learnt from every map
     this.worker = new JobWorker(new URL('./map-worker.js', import.meta.url), ctx.module, {
       staleMs: 0,
       onResult: (m) => this.receive(m),
@@ -62,6 +66,17 @@ export class MapView {
   /** The resolution chosen in #resolution (cells per side). */
   fullRes() {
     return Number($('resolution').value) || 256;
+  }
+
+  /** The Doppler settings of the next map (doppler.js job(): null for the delay-only map). */
+  dopplerJob() {
+    return this.ctx.doppler ? this.ctx.doppler.job() : null;
+  }
+
+  /** The kernel cost per cell·link learnt for the kernel of the next map, ns (null: none yet). */
+  get nsPerCellLink() {
+    const c = this.costs[this.dopplerJob() ? 'doppler' : 'delay'];
+    return c ? c.ns : null;
   }
 
   /** Predicted main-thread kernel time of an n × n map with `links` links, ms. */
@@ -77,20 +92,22 @@ export class MapView {
     const { app } = this.ctx;
     const n = this.fullRes();
     const links = app.link_count();
-    if (this.nsPerCellLink === null || this.predictMs(n, links) <= FRAME_MS) {
+    const doppler = this.dopplerJob();
+    const ns = this.nsPerCellLink;
+    if (ns === null || this.predictMs(n, links) <= FRAME_MS) {
       this.worker.cancel();
-      this.show(n, this.run(n, links), 'main');
+      this.show(n, this.run(n, links, doppler), 'main');
       return;
     }
-    const fit = Math.floor(Math.sqrt((FRAME_MS * 1e6) / (links * this.nsPerCellLink)));
+    const fit = Math.floor(Math.sqrt((FRAME_MS * 1e6) / (links * ns)));
     const r = Math.max(MIN_RES, Math.min(n, fit));
-    const ms = this.run(r, links);
+    const ms = this.run(r, links, doppler);
     if (dragging) {
       this.worker.cancel();
       this.show(r, ms, 'drag');
     } else {
       this.jobLinks = links;
-      this.worker.post({ scenario: app.scenario_json(), n, window: Array.from(this.ctx.view.area) });
+      this.worker.post({ scenario: app.scenario_json(), n, window: Array.from(this.ctx.view.area), doppler });
       this.show(r, ms, 'preview');
     }
   }
@@ -100,20 +117,27 @@ export class MapView {
     return this.worker.pending;
   }
 
-  /** Computes an n × n map on this thread into the state; returns the kernel time, ms. */
-  run(n, links) {
+  /**
+   * Computes an n × n map on this thread into the state (with `doppler`, doppler.js job()'s
+   * settings: the position and velocity bounds with Doppler); returns the kernel time, ms.
+   */
+  run(n, links, doppler = null) {
     const { app, st } = this.ctx;
-    this.resize(n);
+    this.resize(n, !!doppler);
     const [x0, x1, y0, y1] = this.ctx.view.area;
-    const ms = app.compute_map_in(JSON.stringify({ window: [x0, x1, y0, y1], nx: n, ny: n }), st.values);
+    const grid = { window: [x0, x1, y0, y1], nx: n, ny: n };
+    const ms = doppler
+      ? app.compute_doppler_maps_in(JSON.stringify({ ...grid, ...doppler }), st.values, st.velValues)
+      : app.compute_map_in(JSON.stringify(grid), st.values);
     st.mapWindow = [x0, x1, y0, y1];
-    this.learn(n, links, ms);
+    st.mapKernel = doppler ? 'doppler' : 'delay';
+    this.learn(n, links, ms, st.mapKernel);
     this.paint();
     return ms;
   }
 
-  /** The state's buffers for an n × n map. */
-  resize(n) {
+  /** The state's buffers for an n × n map (and the velocity map's, `doppler`). */
+  resize(n, doppler = false) {
     const { st } = this.ctx;
     if (!st.values || st.res !== n) {
       st.values = new Float64Array(n * n);
@@ -122,6 +146,8 @@ export class MapView {
       st.mapCanvas.height = n;
       st.res = n;
     }
+    if (!doppler) st.velValues = null;
+    else if (!st.velValues || st.velValues.length !== n * n) st.velValues = new Float64Array(n * n);
   }
 
   /** Colours st.values into the map image (on the locked colour range, if any). */
@@ -131,6 +157,7 @@ export class MapView {
     st.range = r.range;
     st.clamped = r.clamped;
     st.mapCanvas.getContext('2d').putImageData(st.image, 0, 0);
+    if (this.ctx.doppler) this.ctx.doppler.paint();
   }
 
   /**
@@ -160,21 +187,24 @@ export class MapView {
    * the first map of a new link count replaces the estimate (a few links cost more per link
    * than many), later ones are averaged in.
    */
-  learn(n, links, ms) {
+  learn(n, links, ms, kernel) {
     const v = (Math.max(ms, 0.05) * 1e6) / (n * n * Math.max(1, links));
-    const fresh = this.nsPerCellLink === null || links !== this.learntLinks;
-    this.nsPerCellLink = fresh ? v : 0.5 * this.nsPerCellLink + 0.5 * v;
-    this.learntLinks = links;
+    const c = this.costs[kernel];
+    const fresh = !c || links !== c.links;
+    this.costs[kernel] = { ns: fresh ? v : 0.5 * c.ns + 0.5 * v, links };
   }
 
   /** The worker's full-resolution map (only the newest job's is shown). */
   receive(m) {
     if (m.gen !== this.worker.gen) return;
     const { st } = this.ctx;
-    this.resize(m.n);
+    const doppler = !!m.velocity;
+    this.resize(m.n, doppler);
     st.values = m.values;
+    st.velValues = doppler ? m.velocity : null;
     st.mapWindow = m.window;
-    this.learn(m.n, this.jobLinks, m.kernelMs);
+    st.mapKernel = doppler ? 'doppler' : 'delay';
+    this.learn(m.n, this.jobLinks, m.kernelMs, st.mapKernel);
     this.paint();
     this.show(m.n, m.kernelMs, 'worker');
     this.ctx.changed({ draw: true });
@@ -253,6 +283,7 @@ export class MapView {
   /** Redraws the canvas (see drawScene). */
   draw() {
     drawScene(this.ctx.view, this.ctx.st, this.ctx.wasm);
+    if (this.ctx.doppler) this.ctx.doppler.draw();
   }
 }
 
@@ -272,7 +303,7 @@ function drawFlipped(ctx, image, x, y, w, h, quality) {
  * it was computed for (st.mapWindow): until a new window's map arrives, the last one is drawn
  * where it lies in the new window.
  */
-function drawMap(ctx, view, st) {
+export function drawMap(ctx, view, st) {
   if (!st.mapCanvas || !st.mapWindow) return;
   const [x0, x1, y0, y1] = st.mapWindow;
   const a = view.toPixel(x0, y1);
@@ -282,7 +313,7 @@ function drawMap(ctx, view, st) {
   ctx.restore();
 }
 
-function drawColorbar(ctx, view, st, w) {
+export function drawColorbar(ctx, view, st, w, suffix = '') {
   const r = view.rect;
   const bx = r.x + r.w + 18;
   const bw = 14;
@@ -300,8 +331,8 @@ function drawColorbar(ctx, view, st, w) {
   const lockedScale = st.colourLock ? st.colourLock.scale() : null;
   const clamped = st.clamped || [0, 0];
   const ends = [
-    { on: !!lockedScale && clamped[0] > 0, y: r.y + r.h, text: `≤ ${w.format_length(min, 3)}`, base: 'bottom' },
-    { on: !!lockedScale && clamped[1] > 0, y: r.y, text: `≥ ${w.format_length(max, 3)}`, base: 'top' },
+    { on: !!lockedScale && clamped[0] > 0, y: r.y + r.h, text: `≤ ${w.format_length(min, 3)}${suffix}`, base: 'bottom' },
+    { on: !!lockedScale && clamped[1] > 0, y: r.y, text: `≥ ${w.format_length(max, 3)}${suffix}`, base: 'top' },
   ];
   const drawnTicks = [];
   // The figures' algorithm (core colorbar_ticks): labels thinned to the bar's height, minor
@@ -312,8 +343,9 @@ function drawColorbar(ctx, view, st, w) {
     const len = t.label ? 5 : 3;
     ctx.beginPath(); ctx.moveTo(bx + bw, y); ctx.lineTo(bx + bw + len, y); ctx.stroke();
     const label = t.label && !ends.some((e) => e.on && Math.abs(e.y - y) < 14);
-    if (label) ctx.fillText(t.label, bx + bw + 8, y);
-    drawnTicks.push({ value_m: t.value_m, frac: t.frac, label: label ? t.label : '' });
+    // `suffix`: '/s' on a velocity map's lengths (the figures' ChartOptions.value_suffix).
+    if (label) ctx.fillText(`${t.label}${suffix}`, bx + bw + 8, y);
+    drawnTicks.push({ value_m: t.value_m, frac: t.frac, label: label ? `${t.label}${suffix}` : '' });
   }
   for (const e of ends.filter((x) => x.on)) {
     ctx.textBaseline = e.base;
@@ -335,7 +367,7 @@ function drawColorbar(ctx, view, st, w) {
 }
 
 /** Tx–Rx baselines (dashed), then the node markers (`n` = App.nodes()). */
-function drawNetwork(ctx, view, n, selected) {
+export function drawNetwork(ctx, view, n, selected) {
   ctx.setLineDash([4, 4]);
   ctx.strokeStyle = C.baseline;
   ctx.lineWidth = 1;

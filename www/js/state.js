@@ -19,7 +19,7 @@
 // and an undo keeps them as they are.
 //
 // Each view registers its own section (its `register…State`, called by app.js in the order of
-// restoring: channel, colours, scenario, grid, target, plan, tracking, mtl, view, mode); the
+// restoring: channel, colours, scenario, grid, target, doppler, plan, tracking, mtl, view, mode); the
 // checks read values with state-fields.js.
 
 import { clip, errorText, showError, clearError, $ } from './dom.js';

@@ -20,12 +20,14 @@
 //! `channel.rs` (the channel view: `simulate_channel`, `ChannelJob` run in a Web Worker,
 //! `ChannelFigures`), `multi.rs` (several people in the tracking view: `track_people`, run in a
 //! Web Worker, and `draw_people_chart`, its GOSPA chart), `multi_export.rs` (its Save figure and
-//! Export data: `people_map_svg`, `people_chart_svg`, `people_data_text`).
+//! Export data: `people_map_svg`, `people_chart_svg`, `people_data_text`), `doppler.rs`
+//! (`App.compute_doppler_maps_in`: the position and velocity bounds with Doppler over a window).
 
 mod app;
 mod base;
 mod channel;
 mod chart;
+mod doppler;
 mod export;
 mod json;
 mod montecarlo;
