@@ -19,6 +19,9 @@ mod bounds;
 #[path = "library/doppler.rs"]
 mod doppler;
 
+#[path = "library/channel_doppler.rs"]
+mod channel_doppler;
+
 #[path = "library/map_kernel.rs"]
 mod map_kernel;
 

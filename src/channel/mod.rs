@@ -11,6 +11,7 @@
 
 mod background;
 mod band;
+mod doppler;
 mod estimate;
 mod fft;
 mod paths;
@@ -23,6 +24,9 @@ pub use background::{
     AlignMode, Alignment, JointAlignment, LinkBackground, DEFAULT_BACKGROUND_TIME_S,
 };
 pub use band::{Band, ResponseMap};
+pub use doppler::{
+    ml_frequency, path_rate, RateEstimate, DOPPLER_OVERSAMPLING, DOPPLER_REFINE_STEPS,
+};
 pub use estimate::{
     fisher_matrix, EstimateWork, Estimator, EstimatorConfig, PathEstimate, SnapshotEstimate, Stop,
     MERGE_FRACTION,
@@ -33,8 +37,9 @@ pub use paths::{PathTracker, PathTrackerConfig, TrackedPath};
 pub use recording::{Layout, Pulse, Recording};
 pub use simulate::{
     simulate_recording, Body, ChannelScene, ChannelTruth, Clock, ClockState, PathKind,
-    PointScatterer, Simulated, SimulationRequest, SimulationTruth, TruePath, Walk, Walker, Wall,
-    DEFAULT_CALIBRATION_DURATION_S, DEFAULT_DT_S, DEFAULT_SUBCARRIERS, MAX_OTHER_WALKERS,
+    PointScatterer, SceneCpi, Simulated, SimulationRequest, SimulationTruth, TruePath, Walk,
+    Walker, Wall, DEFAULT_CALIBRATION_DURATION_S, DEFAULT_DT_S, DEFAULT_SUBCARRIERS,
+    MAX_OTHER_WALKERS, MAX_SCENE_CPI_SNAPSHOTS,
 };
 pub use snapshot::{DelayEstimate, Snapshot};
 pub use stream::{

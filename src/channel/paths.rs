@@ -197,6 +197,30 @@ impl Track {
         let off = 0.5 * (out[0][1] + out[1][0]);
         self.p = [[out[0][0], off], [off, out[1][1]]];
     }
+
+    /// Measurement update with a delay rate `τ̇ = ṙ/c` of variance `r` (issue 42 §2: the CPI's
+    /// Doppler, `H = [0, 1]`): the same Joseph form with the roles of the states swapped.
+    fn update_rate(&mut self, z: Real, r: Real) {
+        self.swap();
+        self.update(z, r);
+        self.swap();
+    }
+
+    /// Swaps `τ` and `τ̇` (state and covariance).
+    fn swap(&mut self) {
+        self.x.swap(0, 1);
+        let [[a, b], [_, d]] = self.p;
+        self.p = [[d, b], [b, a]];
+    }
+
+    /// Both updates of an estimate: its delay, then its range rate if it has one.
+    fn update_with(&mut self, e: &PathEstimate) {
+        self.update(e.delay_s, e.sigma_s * e.sigma_s);
+        if let Some(rate) = e.range_rate {
+            let s = rate.sigma_mps / SPEED_OF_LIGHT;
+            self.update_rate(rate.range_rate_mps / SPEED_OF_LIGHT, s * s);
+        }
+    }
 }
 
 /// The path tracker of one link (C6). It does not own the estimator: [`PathTracker::step`]
@@ -315,7 +339,7 @@ impl PathTracker {
         for (ei, e) in paths.iter().enumerate() {
             if let Some(ti) = track_of[ei] {
                 let track = &mut self.tracks[ti];
-                track.update(e.delay_s, e.sigma_s * e.sigma_s);
+                track.update_with(e);
                 track.snr = e.snr;
             }
         }
@@ -348,10 +372,18 @@ impl PathTracker {
             let id = self.next_id;
             self.next_id = self.next_id.saturating_add(1);
             let confirmed = m <= 1;
+            // A CPI's Doppler starts the track's delay rate (issue 42 §2).
+            let (rate, var) = match e.range_rate {
+                Some(r) => {
+                    let s = r.sigma_mps / SPEED_OF_LIGHT;
+                    (r.range_rate_mps / SPEED_OF_LIGHT, s * s)
+                }
+                None => (0.0, rate_var),
+            };
             self.tracks.push(Track {
                 id,
-                x: [e.delay_s, 0.0],
-                p: [[e.sigma_s * e.sigma_s, 0.0], [0.0, rate_var]],
+                x: [e.delay_s, rate],
+                p: [[e.sigma_s * e.sigma_s, 0.0], [0.0, var]],
                 t_s,
                 hits: 1,
                 misses: 0,

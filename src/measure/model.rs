@@ -31,6 +31,8 @@ pub struct Model {
     pub beta2: Real,
     /// Receiver noise power `P_n`, W.
     pub noise_power_w: Real,
+    /// The carrier `f_c`, Hz (the Doppler's wavelength `λ = c/f_c`, D2).
+    pub carrier_hz: Real,
 }
 
 /// Whether two patterns are the same beam up to its boresight (both parabolic, same beamwidth
@@ -174,6 +176,7 @@ impl Model {
             snr_scale,
             beta2: s.radio.bandwidth_hz * s.radio.bandwidth_hz / 12.0,
             noise_power_w: pn,
+            carrier_hz: fc,
         })
     }
 

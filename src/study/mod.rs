@@ -43,10 +43,10 @@ pub use channel::{
     channel_settings, channel_settings_json, cir_track, delays_only, direct_paths, estimate_link,
     estimate_recording, prepare, BoundCounts, Bounds, ChannelRequest, ChannelSetting,
     ChannelStatics, CirStart, CirTrackOutput, DelayReference, DelaySigma, EstimationRun,
-    FrontEndConfig, LinkDirectPath, LinkEstimates, LinkFront, LinkStatics, LinkStaticsInfo,
-    LiveFront, LiveRun, LiveState, Prepared, RecordingEstimates, SegmentDoc, SettingKind,
-    StaticMode, BACKGROUND_MAX_PATHS, DEFAULT_PROCESS_NOISE, DEFAULT_SEED, EXTENT_SIGMA_M,
-    LIVE_REPLAY_SNAPSHOTS, LOS_WITHIN_DB, RECURSIVE_CLUSTER_DB,
+    FrontEndConfig, FrontEndCpi, LinkDirectPath, LinkEstimates, LinkFront, LinkStatics,
+    LinkStaticsInfo, LiveFront, LiveRun, LiveState, Prepared, RecordingEstimates, SegmentDoc,
+    SettingKind, StaticMode, BACKGROUND_MAX_PATHS, DEFAULT_PROCESS_NOISE, DEFAULT_SEED,
+    EXTENT_SIGMA_M, LIVE_REPLAY_SNAPSHOTS, LOS_WITHIN_DB, RECURSIVE_CLUSTER_DB,
 };
 pub use channel::{
     cir_track_multi, recording_measurements, recording_multi_settings, uniform_step, walkers_truth,

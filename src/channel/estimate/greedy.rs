@@ -246,6 +246,7 @@ impl Estimator {
                     alpha: a,
                     sigma_s: s,
                     snr,
+                    range_rate: None,
                 }
             })
             .collect::<Vec<PathEstimate>>();

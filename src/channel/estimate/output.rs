@@ -21,6 +21,8 @@ pub struct PathEstimate {
     pub sigma_s: Real,
     /// Fitted integrated SNR `Σ|P|²·|α̂|²/σ̂²` (C3: `N|α̂|²/σ̂²` for `P = 1`), linear.
     pub snr: Real,
+    /// Its range rate over the scan's CPI, when the front end read one (issue 42 §2).
+    pub range_rate: Option<crate::channel::RateEstimate>,
 }
 
 impl PathEstimate {

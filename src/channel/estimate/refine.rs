@@ -10,7 +10,7 @@ use super::estimator::fold;
 use super::residual::Phasor;
 use super::{kernels, linalg};
 use crate::channel::{EstimateWork, Estimator};
-use crate::error::limits;
+use crate::error::{check_len, limits, Error, Result};
 use crate::math::{sqrt, Complex, Real, PI};
 
 #[cfg(doc)]
@@ -358,6 +358,31 @@ impl Estimator {
         }
         (grad.iter().all(|v| v.is_finite()) && hess.iter().all(|v| v.is_finite()))
             .then_some((grad, hess))
+    }
+
+    /// The joint least-squares amplitudes `α̂` of paths at the fixed `delays` (s) in the response
+    /// `h`: C5's amplitude step without a delay search, what a CPI's Doppler is read from in
+    /// each of its snapshots (issue 42 §2). Zeros when the delays make the fit singular (two
+    /// equal). Errors: `h` of the wrong length ([`Error::LengthMismatch`]) or not finite, a
+    /// delay not finite.
+    pub fn amplitudes_at(&mut self, h: &[Complex], delays: &[Real]) -> Result<Vec<Complex>> {
+        check_len("response", self.band.len(), h.len())?;
+        if h.iter().any(|v| !(v.re.is_finite() && v.im.is_finite())) {
+            return Err(Error::NonFinite {
+                field: "response".into(),
+            });
+        }
+        if delays.iter().any(|t| !t.is_finite()) {
+            return Err(Error::NonFinite {
+                field: "delays".into(),
+            });
+        }
+        let mut paths: Vec<(Real, Complex)> = delays
+            .iter()
+            .map(|&t| (t, Complex::new(0.0, 0.0)))
+            .collect();
+        self.joint_ls(h, &mut paths);
+        Ok(paths.into_iter().map(|p| p.1).collect())
     }
 
     /// Joint least squares of all amplitudes at fixed delays; `resid` ← `h − Ĥ`.

@@ -12,6 +12,7 @@ fn pe(delay_s: Real, sigma_s: Real, snr: Real) -> PathEstimate {
         alpha: Complex::new(1.0, 0.0),
         sigma_s,
         snr,
+        range_rate: None,
     }
 }
 

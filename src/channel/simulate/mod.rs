@@ -22,8 +22,8 @@ mod walkers;
 
 pub use request::{Simulated, SimulationRequest, DEFAULT_CALIBRATION_DURATION_S};
 pub use scene::{
-    Body, ChannelScene, Clock, PointScatterer, Walker, Wall, DEFAULT_DT_S, DEFAULT_SUBCARRIERS,
-    MAX_OTHER_WALKERS,
+    Body, ChannelScene, Clock, PointScatterer, SceneCpi, Walker, Wall, DEFAULT_DT_S,
+    DEFAULT_SUBCARRIERS, MAX_OTHER_WALKERS, MAX_SCENE_CPI_SNAPSHOTS,
 };
 pub use synthesize::simulate_recording;
 pub use truth::{ChannelTruth, ClockState, PathKind, SimulationTruth, TruePath};

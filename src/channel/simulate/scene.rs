@@ -191,6 +191,58 @@ pub struct ChannelScene {
     /// AGC gain steps and phase noise (`None`: a synchronised sounder).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub clock: Option<Clock>,
+    /// Coherent processing intervals (issue 42 §2): each scan, `dt_s` apart, is a burst of
+    /// snapshots (`None`: one snapshot per scan). The walk's recording only; the empty area's
+    /// stays one snapshot per scan.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cpi: Option<SceneCpi>,
+}
+
+/// Most snapshots of a scene's CPI.
+pub const MAX_SCENE_CPI_SNAPSHOTS: usize = 1024;
+
+/// A burst of `snapshots` snapshots `spacing_s` apart starting at each scan time `k·dt_s`: the
+/// phase progression of every moving path over it is the Doppler the front end measures
+/// (docs/doppler.md D1–D2). The body's fluctuation keeps its correlation `ρ` per `dt_s`, so
+/// over a gap `Δt` it is `ρ^(Δt/dt_s)`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneCpi {
+    /// Snapshots per scan, `N` (1 … [`MAX_SCENE_CPI_SNAPSHOTS`]).
+    pub snapshots: usize,
+    /// Their spacing `T`, s; `(N − 1)·T < dt_s`.
+    pub spacing_s: f64,
+}
+
+impl SceneCpi {
+    /// Checks the fields against the scan interval `dt_s` (errors name `scene.cpi.*`).
+    pub fn validate(&self, dt_s: f64) -> Result<()> {
+        too_many(
+            "scene.cpi.snapshots",
+            self.snapshots,
+            1,
+            MAX_SCENE_CPI_SNAPSHOTS,
+        )?;
+        check_positive("scene.cpi.spacing_s", self.spacing_s)?;
+        let span = (self.snapshots - 1) as f64 * self.spacing_s;
+        if span.is_nan() || span >= dt_s {
+            return Err(Error::OutOfRange {
+                field: "scene.cpi.spacing_s".into(),
+                value: self.spacing_s,
+                allowed:
+                    "(snapshots − 1)·spacing_s below scene.dt_s (a burst ends before the next scan)",
+            });
+        }
+        Ok(())
+    }
+
+    /// The time of snapshot `s` of a recording with scans `dt_s` apart, and the gap since the
+    /// previous snapshot (`None` for the first).
+    pub fn time_of(&self, s: usize, dt_s: f64) -> (f64, Option<f64>) {
+        let n = self.snapshots;
+        let t = |s: usize| (s / n) as f64 * dt_s + (s % n) as f64 * self.spacing_s;
+        (t(s), s.checked_sub(1).map(|q| t(s) - t(q)))
+    }
 }
 
 /// What a receiver without the transmitter's clock does to each snapshot of a link (C10),
@@ -349,6 +401,9 @@ impl ChannelScene {
         if let Some(c) = &self.clock {
             c.validate()?;
         }
+        if let Some(c) = &self.cpi {
+            c.validate(self.dt_s)?;
+        }
         Ok(())
     }
 
@@ -393,6 +448,7 @@ impl ChannelScene {
             second_order: true,
             double_reflections: true,
             clock: None,
+            cpi: None,
         }
     }
 }

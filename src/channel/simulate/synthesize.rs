@@ -164,7 +164,13 @@ pub(super) fn synthesize_all(
     if steps >= cap as Real {
         return Err(too_big(usize::MAX));
     }
-    let snapshots = steps as usize + 1;
+    // A CPI (the walk only) makes each scan a burst of its snapshots.
+    let cpi = scene.cpi.filter(|_| with_person);
+    let per_scan = cpi.map_or(1, |c| c.snapshots);
+    let snapshots = match (steps as usize + 1).checked_mul(per_scan) {
+        Some(s) => s,
+        None => return Err(too_big(usize::MAX)),
+    };
     match snapshots.checked_mul(per_snapshot) {
         Some(t) if t <= cap => {}
         _ => return Err(too_big(snapshots)),
@@ -239,7 +245,10 @@ pub(super) fn synthesize_all(
 
     for s in 0..snapshots {
         cancel.check()?;
-        let t = s as Real * scene.dt_s;
+        let (t, gap) = match cpi {
+            None => (s as Real * scene.dt_s, None),
+            Some(c) => c.time_of(s, scene.dt_s),
+        };
         t_s.push(t);
         at.clear();
         if with_person {
@@ -250,7 +259,7 @@ pub(super) fn synthesize_all(
             }
             // The bodies' fluctuations (each walker its own stream).
             for w in walkers.iter_mut() {
-                w.draw(s);
+                w.draw(s, gap.map(|g| g / scene.dt_s));
             }
         }
         let mut snap_paths = Vec::with_capacity(links.len());

@@ -76,15 +76,20 @@ impl<'a> Mover<'a> {
         }
     }
 
-    /// The body's fluctuations of snapshot `s`: AR(1), the first snapshot a fresh draw.
-    pub(super) fn draw(&mut self, s: usize) {
+    /// The body's fluctuations of snapshot `s`: AR(1), the first snapshot a fresh draw. `gap`
+    /// (a CPI's snapshots) is the time since the previous snapshot in scan intervals: the
+    /// correlation is then `ρ^gap` (`None`: `ρ`, one scan).
+    pub(super) fn draw(&mut self, s: usize, gap: Option<Real>) {
+        let (rho, innov) = match gap {
+            None => (self.rho, self.innov),
+            Some(g) => {
+                let r = crate::math::pow(self.rho, g);
+                (r, sqrt(1.0 - r * r))
+            }
+        };
         for g in self.fluct.iter_mut() {
             let w = complex_normal(&mut self.rng);
-            *g = if s == 0 {
-                w
-            } else {
-                *g * self.rho + w * self.innov
-            };
+            *g = if s == 0 { w } else { *g * rho + w * innov };
         }
     }
 

@@ -81,7 +81,7 @@ fn a_further_walker_adds_its_own_paths_only() {
     let mut scale: Real = 0.0;
     for s in 0..t2.t_s.len() {
         for w in walkers.iter_mut() {
-            w.draw(s);
+            w.draw(s, None);
         }
         let t = t2.t_s[s];
         let at = walkers[1].path.state_and_heading(t);

@@ -125,6 +125,7 @@ fn the_front_ends_paths_are_written_with_their_snr_in_db_and_sigma() {
             alpha: Complex::new(0.3, -0.4),
             sigma_s,
             snr,
+            range_rate: None,
         },
         track_id: 0,
         confirmed: true,

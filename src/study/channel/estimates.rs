@@ -11,7 +11,7 @@ use crate::error::{Cancel, Error, Result};
 use crate::math::Real;
 use crate::measure::Model;
 use crate::study::channel::front::{baselines, BandMap, LinkEstimates, LinkFront, LinkStatics};
-use crate::study::channel::FrontEndConfig;
+use crate::study::channel::{FrontEndConfig, FrontEndCpi};
 use crate::study::Driver;
 use crate::track::gating::{Calibration, LinkCalibration};
 
@@ -135,6 +135,33 @@ pub struct Prepared {
     pub(super) band: BandMap,
     empty_band: Option<BandMap>,
     baseline_s: Vec<Real>,
+    carrier_hz: Real,
+    /// Scans of the recording (its snapshots over the CPI's).
+    scans: usize,
+}
+
+/// The scans of `rec` under `cfg`: every snapshot, or with a CPI of `N` snapshots their count
+/// over `N` ([`Error::InvalidFile`] of `cpi_snapshots` when `N` does not divide it).
+pub fn scan_count(rec: &Recording, cfg: &FrontEndConfig) -> Result<usize> {
+    let n = FrontEndCpi::per_scan(cfg.cpi);
+    let s = rec.t_s.len();
+    if !s.is_multiple_of(n) {
+        return Err(Error::InvalidFile {
+            field: "cpi_snapshots".into(),
+            reason: alloc::format!(
+                "the recording's {s} snapshots are not whole CPIs of {n} snapshots"
+            ),
+        });
+    }
+    Ok(s / n)
+}
+
+/// The time of each scan: its CPI's middle snapshot's (index `N/2`), or each snapshot's.
+pub fn scan_times(rec: &Recording, cfg: &FrontEndConfig) -> Vec<Real> {
+    let n = FrontEndCpi::per_scan(cfg.cpi);
+    (0..rec.t_s.len() / n)
+        .map(|k| rec.t_s[k * n + n / 2])
+        .collect()
 }
 
 /// Checks `rec` (and `empty`) ([`Recording::validate`], their links on `model` — the same
@@ -173,11 +200,14 @@ pub fn prepare(
         None => None,
     };
     let baseline_s = baselines(model, rec)?;
+    let scans = scan_count(rec, cfg)?;
     Ok(Prepared {
         map,
         band,
         empty_band,
         baseline_s,
+        carrier_hz: model.carrier_hz,
+        scans,
     })
 }
 
@@ -196,7 +226,12 @@ impl Prepared {
             _ => None,
         };
         let statics = LinkStatics::build(e, rec, &self.band, link, &self.baseline_s, cfg, cancel)?;
-        LinkFront::new(rec, &self.band, link, cfg, statics)
+        Ok(LinkFront::new(rec, &self.band, link, cfg, statics)?.with_carrier(self.carrier_hz))
+    }
+
+    /// Scans of the recording.
+    pub fn scans(&self) -> usize {
+        self.scans
     }
 
     /// Recorded links.
@@ -216,9 +251,9 @@ fn link_run(
     progress: &(dyn Fn(usize) + Sync),
 ) -> Result<(LinkStatics, LinkEstimates)> {
     let mut front = p.link(rec, empty, link, cfg, cancel)?;
-    // Cancel and progress every 64 snapshots (well under 0.1 s of work).
+    // Cancel and progress every 64 scans (well under 0.1 s of work).
     const EVERY: usize = 64;
-    for s in 0..rec.t_s.len() {
+    for s in 0..p.scans {
         if s % EVERY == 0 {
             cancel.check()?;
             if s > 0 {
@@ -227,7 +262,7 @@ fn link_run(
         }
         front.step(rec, &p.band.1, cancel)?;
     }
-    let len = rec.t_s.len();
+    let len = p.scans;
     progress(len - EVERY * (len.saturating_sub(1) / EVERY));
     Ok(front.finish())
 }
@@ -235,14 +270,14 @@ fn link_run(
 /// The statics and estimates of every recorded link, assembled over `model`'s links.
 fn assemble(
     model: &Model,
-    rec: &Recording,
+    t_s: Vec<Real>,
     map: &[usize],
     results: Vec<(LinkStatics, LinkEstimates)>,
 ) -> (ChannelStatics, RecordingEstimates) {
     let n = model.link_count();
-    let snapshots = rec.t_s.len();
+    let snapshots = t_s.len();
     let mut est = RecordingEstimates {
-        t_s: rec.t_s.clone(),
+        t_s,
         recorded: vec![false; n],
         paths: vec![vec![Vec::new(); n]; snapshots],
         noise_var: vec![vec![0.0; n]; snapshots],
@@ -300,7 +335,7 @@ pub fn estimate_recording(
         &mut |r| results.push(r),
         &mut |_| {},
     )?;
-    Ok(assemble(model, rec, &p.map, results))
+    Ok(assemble(model, scan_times(rec, cfg), &p.map, results))
 }
 
 /// The paths of every snapshot of recorded link `link` of `rec` alone (C5 + C6), without a
@@ -326,7 +361,8 @@ pub fn estimate_link(
     };
     let statics = LinkStatics::none(cfg.delay_reference, 0.0);
     let mut front = LinkFront::new(rec, &band, link, &cfg, statics)?;
-    for s in 0..rec.t_s.len() {
+    let scans = scan_count(rec, &cfg)?;
+    for s in 0..scans {
         if s % 64 == 0 {
             cancel.check()?;
             if s > 0 {
@@ -335,7 +371,7 @@ pub fn estimate_link(
         }
         front.step(rec, &band.1, cancel)?;
     }
-    let len = rec.t_s.len();
+    let len = scans;
     progress(len - 64 * (len.saturating_sub(1) / 64));
     let (_, out) = front.finish();
     Ok((out.paths, out.noise_var))
@@ -368,10 +404,10 @@ impl EstimationRun {
         let prepared = prepare(model, bandwidth_hz, rec, empty, cfg)?;
         Ok(EstimationRun {
             results: Vec::with_capacity(prepared.links()),
+            snapshots: prepared.scans(),
             prepared,
             cfg: *cfg,
             current: None,
-            snapshots: rec.t_s.len(),
         })
     }
 
@@ -430,6 +466,11 @@ impl EstimationRun {
         if !self.is_done() {
             return Err(Error::Cancelled);
         }
-        Ok(assemble(model, rec, &self.prepared.map, self.results))
+        Ok(assemble(
+            model,
+            scan_times(rec, &self.cfg),
+            &self.prepared.map,
+            self.results,
+        ))
     }
 }

@@ -35,13 +35,14 @@
 
 use alloc::vec::Vec;
 
+use crate::channel::path_rate;
 use crate::channel::{
     Alignment, Band, EstimateWork, Estimator, EstimatorConfig, LinkBackground, PathEstimate,
     PathTracker, Recording, ResponseMap, SnapshotEstimate, TrackedPath,
 };
 use crate::error::{limits, Cancel, Error, Result};
 use crate::math::{db_to_linear, floor, log10, sqrt, Complex, Real, SPEED_OF_LIGHT};
-use crate::study::channel::{DelayReference, FrontEndConfig, StaticMode};
+use crate::study::channel::{DelayReference, FrontEndConfig, FrontEndCpi, StaticMode};
 use crate::track::gating::{AmplitudeClusterConfig, DelayEstimate, LinkCalibration, StaticCluster};
 
 /// Most paths of the background's own fit (its static clusters).
@@ -362,7 +363,11 @@ pub struct LinkFront {
     background_time_s: Real,
     h: Vec<Complex>,
     r: Vec<Complex>,
-    /// What came out.
+    /// The CPI (issue 42 §2) and the carrier's wavelength, m (`None`: no Doppler is read, e.g.
+    /// a link estimated without its scenario).
+    cpi: Option<FrontEndCpi>,
+    wavelength_m: Option<Real>,
+    /// What came out (one entry per scan).
     pub out: LinkEstimates,
 }
 
@@ -386,11 +391,22 @@ impl LinkFront {
             statics,
             h: Vec::new(),
             r: Vec::new(),
-            out: LinkEstimates::with_capacity(rec.snapshot_count()),
+            cpi: cfg.cpi,
+            wavelength_m: None,
+            out: LinkEstimates::with_capacity(
+                rec.snapshot_count() / FrontEndCpi::per_scan(cfg.cpi),
+            ),
         })
     }
 
-    /// Snapshots done.
+    /// The carrier whose wavelength turns a CPI's Doppler into range rates (D2): without it no
+    /// range rate is read.
+    pub fn with_carrier(mut self, carrier_hz: Real) -> LinkFront {
+        self.wavelength_m = Some(SPEED_OF_LIGHT / carrier_hz);
+        self
+    }
+
+    /// Scans done (snapshots without a CPI).
     pub fn done(&self) -> usize {
         self.out.paths.len()
     }
@@ -405,14 +421,26 @@ impl LinkFront {
         (self.statics, self.out)
     }
 
-    /// Estimates the next snapshot of the link; `cancel` is asked inside the estimator
+    /// Estimates the next scan of the link (a snapshot, or with a CPI its snapshots: module
+    /// docs of [`FrontEndCpi`]); `cancel` is asked inside the estimator
     /// ([`Estimator::estimate_floored`]).
     pub fn step(&mut self, rec: &Recording, map: &ResponseMap, cancel: Cancel) -> Result<()> {
-        let s = self.out.paths.len();
+        let k = self.out.paths.len();
+        let n = FrontEndCpi::per_scan(self.cpi);
+        let mid = |k: usize| k * n + n / 2;
+        let s = mid(k);
         let estimated = map.fill(rec, s, self.link, &mut self.h)?;
-        let prev = s.checked_sub(1).map(|p| rec.t_s[p]);
+        let prev = k.checked_sub(1).map(|p| rec.t_s[mid(p)]);
+        let burst = match (self.cpi, self.wavelength_m) {
+            (Some(_), Some(_)) => Some(Burst {
+                rec,
+                map,
+                first: k * n,
+            }),
+            _ => None,
+        };
         let (tracked, used, align, work) =
-            self.estimate_filled(s, rec.t_s[s], prev, estimated, cancel)?;
+            self.estimate_filled_cpi(k, rec.t_s[s], prev, estimated, burst, cancel)?;
         self.out.paths.push(tracked);
         self.out.noise_var.push(used);
         self.out.alignment.push(align);
@@ -433,19 +461,24 @@ impl LinkFront {
     ) -> Result<LinkSnapshot> {
         self.h.clear();
         self.h.extend_from_slice(h);
-        self.estimate_filled(s, t_s, prev_t_s, None, cancel)
+        self.estimate_filled_cpi(s, t_s, prev_t_s, None, None, cancel)
     }
 
-    /// Estimates snapshot `s` (at `t_s`, the previous at `prev_t_s`) of the response in
-    /// `self.h`; `estimated` the map's out-of-band noise estimate.
-    fn estimate_filled(
+    /// Estimates scan `s` (at `t_s`, the previous at `prev_t_s`) of the response in `self.h`;
+    /// `estimated` the map's out-of-band noise estimate; with a `burst`, each path's range rate
+    /// over the scan's CPI.
+    fn estimate_filled_cpi(
         &mut self,
         s: usize,
         t_s: Real,
         prev_t_s: Option<Real>,
         estimated: Option<Real>,
+        burst: Option<Burst>,
         cancel: Cancel,
     ) -> Result<LinkSnapshot> {
+        let cpi = self.cpi;
+        let wavelength = self.wavelength_m;
+        let link = self.link;
         let nv = self.given.or(estimated);
         let lambda = match prev_t_s {
             Some(t0) if s > 0 => {
@@ -495,6 +528,23 @@ impl LinkFront {
                         e = estimator.estimate_floored(r, nvr, &seeds, power, cancel)?;
                         e.work = merge_work(first, e.work);
                     }
+                    if let (Some(b), Some(c), Some(l)) = (&burst, cpi, wavelength) {
+                        rates(
+                            &mut e,
+                            b,
+                            c,
+                            l,
+                            link,
+                            |h, r| {
+                                let a = bg.align(h)?;
+                                bg.residual(h, &a, r)?;
+                                Ok(())
+                            },
+                            estimator,
+                            false,
+                            span,
+                        )?;
+                    }
                     if recursive && s > 0 {
                         bg.update(lambda, nv.unwrap_or(0.0), &a);
                     }
@@ -506,7 +556,26 @@ impl LinkFront {
                         Reference::PerSnapshot { .. } => &[],
                         _ => seeds,
                     };
-                    estimator.estimate_floored(h, nv, seeds, mean_power(h), cancel)?
+                    let mut e = estimator.estimate_floored(h, nv, seeds, mean_power(h), cancel)?;
+                    if let (Some(b), Some(c), Some(l)) = (&burst, cpi, wavelength) {
+                        let per_snapshot = matches!(reference, Reference::PerSnapshot { .. });
+                        rates(
+                            &mut e,
+                            b,
+                            c,
+                            l,
+                            link,
+                            |h, r| {
+                                r.clear();
+                                r.extend_from_slice(h);
+                                Ok(())
+                            },
+                            estimator,
+                            per_snapshot,
+                            span,
+                        )?;
+                    }
+                    e
                 }
             };
             used = e.noise_var;
@@ -515,6 +584,70 @@ impl LinkFront {
         })?;
         Ok((tracked, used, align, work))
     }
+}
+
+/// A scan's CPI: the recording, its map and the scan's first snapshot.
+struct Burst<'a> {
+    rec: &'a Recording,
+    map: &'a ResponseMap,
+    first: usize,
+}
+
+/// Each path of the scan's estimate `e` (delays in the estimator's time base) gets its range
+/// rate over the CPI `burst` (issue 42 §2, [`FrontEndCpi`]): per snapshot of the burst its
+/// response through `residual` (the background's residual, or the response itself), the paths'
+/// amplitudes at their delays ([`Estimator::amplitudes_at`]) — with `per_snapshot` each
+/// referred to the direct path's phase (a receiver without the transmitter's clock turns every
+/// snapshot's carrier phase; the direct path does not move) — and [`path_rate`] at the path's
+/// SNR.
+#[allow(clippy::too_many_arguments)]
+fn rates(
+    e: &mut SnapshotEstimate,
+    burst: &Burst,
+    cpi: FrontEndCpi,
+    wavelength_m: Real,
+    link: usize,
+    mut residual: impl FnMut(&mut Vec<Complex>, &mut Vec<Complex>) -> Result<()>,
+    estimator: &mut Estimator,
+    per_snapshot: bool,
+    span: Real,
+) -> Result<()> {
+    if e.paths.is_empty() {
+        return Ok(());
+    }
+    let delays: Vec<Real> = e.paths.iter().map(|p| p.delay_s).collect();
+    let los = if per_snapshot {
+        los_of(&e.paths, span).and_then(|l| delays.iter().position(|d| *d == l.delay_s))
+    } else {
+        None
+    };
+    let n = cpi.snapshots;
+    let mut alpha = vec![Vec::with_capacity(n); delays.len()];
+    let mut t = Vec::with_capacity(n);
+    let (mut h, mut r) = (Vec::new(), Vec::new());
+    for s in burst.first..burst.first + n {
+        burst.map.fill(burst.rec, s, link, &mut h)?;
+        residual(&mut h, &mut r)?;
+        let mut a = estimator.amplitudes_at(&r, &delays)?;
+        if let Some(l) = los {
+            let ref_phase = a[l];
+            let m = ref_phase.norm();
+            if m > 0.0 {
+                let rot = ref_phase.conj() / m;
+                for v in a.iter_mut() {
+                    *v *= rot;
+                }
+            }
+        }
+        for (list, v) in alpha.iter_mut().zip(a) {
+            list.push(v);
+        }
+        t.push(burst.rec.t_s[s]);
+    }
+    for (p, a) in e.paths.iter_mut().zip(&alpha) {
+        p.range_rate = path_rate(&t, a, p.snr, wavelength_m, cpi.floor_mps)?;
+    }
+    Ok(())
 }
 
 /// One link-snapshot's output: its tracked paths, the noise variance used, its alignment, the
@@ -585,6 +718,7 @@ mod tests {
             alpha: Complex::new(amp, 0.0),
             sigma_s: 1e-11,
             snr: 1e4,
+            range_rate: None,
         }
     }
 

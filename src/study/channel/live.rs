@@ -81,6 +81,13 @@ impl LiveFront {
         cfg: &FrontEndConfig,
     ) -> Result<(ChannelStatics, LiveFront)> {
         cfg.validate()?;
+        if let Some(c) = cfg.cpi {
+            return Err(Error::OutOfRange {
+                field: "cpi_snapshots".into(),
+                value: c.snapshots as Real,
+                allowed: "1 for a live run (a CPI's Doppler is read from recordings only)",
+            });
+        }
         let rec = header.recording(first_t_s, first.to_vec());
         let p = prepare(model, bandwidth_hz, &rec, empty, cfg)?;
         let n = model.link_count();

@@ -62,8 +62,8 @@ pub use multi::{
     RECORDING_CLUTTER, RECORDING_CLUTTER_WINDOW_S, RECORDING_DETECTION, RECORDING_EXTENT_SIGMA_M,
 };
 pub use request::{
-    ChannelRequest, DelayReference, DelaySigma, FrontEndConfig, StaticMode, DEFAULT_PROCESS_NOISE,
-    DEFAULT_SEED, EXTENT_SIGMA_M,
+    ChannelRequest, DelayReference, DelaySigma, FrontEndConfig, FrontEndCpi, StaticMode,
+    DEFAULT_PROCESS_NOISE, DEFAULT_SEED, EXTENT_SIGMA_M,
 };
 pub use settings::{channel_settings, channel_settings_json, Bounds, ChannelSetting, SettingKind};
 pub use track::{cir_track, CirStart, CirTrackOutput, SegmentDoc};

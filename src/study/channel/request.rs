@@ -148,6 +148,50 @@ pub struct FrontEndConfig {
     pub background_time_s: Real,
     /// Which delays come out.
     pub delay_reference: DelayReference,
+    /// Each scan a CPI of consecutive snapshots whose paths' range rates are read (issue 42
+    /// §2; `None`: every snapshot a scan, no Doppler).
+    pub cpi: Option<FrontEndCpi>,
+}
+
+/// The front end's coherent processing interval (issue 42 §2): every `snapshots` consecutive
+/// snapshots of a recording are one scan; the paths are estimated in its middle snapshot
+/// (index `snapshots / 2`, whose time is the scan's), their amplitudes fitted at those delays
+/// in every snapshot of it, and each path's range rate read from their phase progression
+/// (`channel::path_rate`, D9), its σ with the floor `floor_mps` (D5).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FrontEndCpi {
+    /// Snapshots per scan, `N` (2 … [`measure::MAX_CPI_SNAPSHOTS`](crate::measure::MAX_CPI_SNAPSHOTS)).
+    pub snapshots: usize,
+    /// The floor on each range rate's σ, m/s.
+    pub floor_mps: Real,
+}
+
+impl FrontEndCpi {
+    /// Checks the fields (`cpi_snapshots` in 2 … `MAX_CPI_SNAPSHOTS`, `range_rate_floor_mps`
+    /// finite and ≥ 0).
+    pub fn validate(&self) -> Result<()> {
+        if !(2..=crate::measure::MAX_CPI_SNAPSHOTS).contains(&self.snapshots) {
+            return Err(Error::SizeLimit {
+                field: "cpi_snapshots",
+                value: self.snapshots,
+                min: 2,
+                max: crate::measure::MAX_CPI_SNAPSHOTS,
+            });
+        }
+        if !(self.floor_mps.is_finite() && self.floor_mps >= 0.0) {
+            return Err(Error::OutOfRange {
+                field: "range_rate_floor_mps".into(),
+                value: self.floor_mps,
+                allowed: "a finite floor ≥ 0 m/s",
+            });
+        }
+        Ok(())
+    }
+
+    /// Snapshots per scan of an optional CPI (1 without one).
+    pub fn per_scan(cpi: Option<FrontEndCpi>) -> usize {
+        cpi.map_or(1, |c| c.snapshots)
+    }
 }
 
 impl Default for FrontEndConfig {
@@ -158,6 +202,7 @@ impl Default for FrontEndConfig {
             statics: StaticMode::default(),
             background_time_s: DEFAULT_BACKGROUND_TIME_S,
             delay_reference: DelayReference::default(),
+            cpi: None,
         }
     }
 }
@@ -178,6 +223,9 @@ impl FrontEndConfig {
     pub fn validate(&self) -> Result<()> {
         self.estimator.validate()?;
         self.paths.validate()?;
+        if let Some(c) = &self.cpi {
+            c.validate()?;
+        }
         limits::BACKGROUND_TIME_S.check("background_time_s", self.background_time_s)
     }
 }
@@ -228,6 +276,11 @@ pub struct ChannelRequest {
     /// With `sigma = estimator`: the scatterer's extent as path length (m), added in
     /// quadrature to each estimate's σ̂ (default 0.2).
     pub extent_sigma_m: Real,
+    /// Snapshots per scan: each scan a coherent processing interval whose paths' range rates
+    /// the front end reads (issue 42 §2; `None` or 1: no Doppler).
+    pub cpi_snapshots: Option<usize>,
+    /// The floor on each range rate's σ, m/s (default 0.1, D5).
+    pub range_rate_floor_mps: Real,
     /// Start, loss and restart (C11; not settable from the page or the CLI yet).
     #[serde(skip)]
     pub segments: SegmentConfig,
@@ -254,6 +307,8 @@ impl Default for ChannelRequest {
             association: AssociationRule::Gated,
             sigma: DelaySigma::Estimator,
             extent_sigma_m: EXTENT_SIGMA_M,
+            cpi_snapshots: None,
+            range_rate_floor_mps: crate::measure::DEFAULT_RANGE_RATE_FLOOR_MPS,
             segments: SegmentConfig::default(),
         }
     }
@@ -289,6 +344,13 @@ impl ChannelRequest {
             statics: self.statics,
             background_time_s: self.background_time_s,
             delay_reference: reference,
+            cpi: match self.cpi_snapshots {
+                None | Some(1) => None,
+                Some(snapshots) => Some(FrontEndCpi {
+                    snapshots,
+                    floor_mps: self.range_rate_floor_mps,
+                }),
+            },
         }
     }
 
