@@ -18,6 +18,14 @@ diffraction) and writes per scene, under ``tests/data/raytraced/<scene>/``:
 - ``truth.json``     the walker's states, the per-link noise variance, the generator's settings
                      and, per snapshot and link, the traced echo of the body and the LoS.
 
+With ``--cpi [N,T]`` it traces instead only coherent-processing-interval bursts of the ``open``
+walk (issue 42): at each scan start t_k of ``--cpi-scans``, N snapshots at t_k + n T (default
+16 at 2.048 ms), the body moved to the walk's position at each instant, and writes
+``open/walk-cpi.npz`` (the re-traced bursts), ``open/walk-cpi-doppler.npz`` (Sionna's own time
+evolution: each scan's first trace with every path turned by its Doppler phase
+e^{j 2 pi f_D n T}), ``open/walk-cpi-paths.npz`` (every body path: delay, coefficient, depth,
+Doppler) and ``open/truth-cpi.json`` (states, geometric and traced range rates); see run_cpi.
+
 Signal model (spec channel-estimation.md C1/C3). Sionna's ``Paths.a`` is the passband path
 coefficient of isotropic, vertically polarised single-element antennas (|a|^2 = path gain) and
 ``Paths.tau`` the absolute delay; the baseband coefficient (what ``Paths.cir`` returns) is
@@ -54,6 +62,8 @@ How to run
     DRJIT_LIBLLVM_PATH=/usr/lib/x86_64-linux-gnu/libLLVM-19.so \\
         .tools/sionna/bin/python scripts/raytrace/generate.py [--scenes open,room] [--out DIR]
     .tools/sionna/bin/python scripts/raytrace/generate.py --report   # statistics of written files
+    scripts/raytrace/run.sh --cpi                 # only the CPI bursts of open (~5 minutes)
+    scripts/raytrace/run.sh --cpi --report        # only the CPI checks, from the written files
 
 Run time (measured 2026-12-06 on this project's 2-core CPU machine, no GPU): 11-14 minutes for
 both scenes (678 s and 838 s in two runs): open 189-220 s (201 snapshots, ~1 s each), room
@@ -275,11 +285,9 @@ SCENES = {"open": open_scene, "room": room_scene}
 # Walk
 # =================================================================================================
 
-def walk_states(speed, waypoints, stop_at, stop_s, dt=DT):
-    """Piecewise-linear walk at `speed` through `waypoints`, standing still `stop_s` seconds at
-    waypoints[stop_at]. Snapshots at t = k dt from 0 to the end (inclusive when it falls on the
-    grid). Velocity: that of the leg containing t in [start, end); 0 during the stop; the last
-    leg's at the final point."""
+def walk_legs(speed, waypoints, stop_at, stop_s):
+    """The walk's legs [(t_start, t_end, p_start, velocity)] and its duration: piecewise-linear at
+    `speed` through `waypoints`, standing still `stop_s` seconds at waypoints[stop_at]."""
     legs = []  # (t_start, t_end, p_start, velocity)
     t = 0.0
     for i in range(len(waypoints) - 1):
@@ -290,14 +298,26 @@ def walk_states(speed, waypoints, stop_at, stop_s, dt=DT):
         d = float(np.linalg.norm(p1 - p0))
         legs.append((t, t + d / speed, p0, (p1 - p0) / d * speed))
         t += d / speed
-    total = t
+    return legs, t
+
+
+def walk_state_at(legs, tk):
+    """[x, y, vx, vy] at time tk: the position on the leg containing tk in [start, end) (the last
+    leg past the end) and that leg's velocity (0 during the stop)."""
+    leg = next((lg for lg in legs if lg[0] <= tk < lg[1]), legs[-1])
+    p = leg[2] + leg[3] * (tk - leg[0])
+    return [p[0], p[1], leg[3][0], leg[3][1]]
+
+
+def walk_states(speed, waypoints, stop_at, stop_s, dt=DT):
+    """Piecewise-linear walk at `speed` through `waypoints`, standing still `stop_s` seconds at
+    waypoints[stop_at]. Snapshots at t = k dt from 0 to the end (inclusive when it falls on the
+    grid). Velocity: that of the leg containing t in [start, end); 0 during the stop; the last
+    leg's at the final point."""
+    legs, total = walk_legs(speed, waypoints, stop_at, stop_s)
     n = int(math.floor(total / dt + 1e-9)) + 1
     t_s = np.arange(n) / round(1 / dt)
-    states = []
-    for tk in t_s:
-        leg = next((lg for lg in legs if lg[0] <= tk < lg[1]), legs[-1])
-        p = leg[2] + leg[3] * (tk - leg[0])
-        states.append([p[0], p[1], leg[3][0], leg[3][1]])
+    states = [walk_state_at(legs, tk) for tk in t_s]
     return t_s, np.array(states), total
 
 
@@ -376,13 +396,17 @@ class Tracer:
         self.scene.add(self.body)
         self.body_id = int(self.body.object_id)
 
-    def move_body(self, x, y):
+    def move_body(self, x, y, vx=None, vy=None):
         # SceneObject.position is the centre of the bounding box: the base on the ground is z = 0
         self.body.position = self.mi.Point3f(float(x), float(y), BODY_HEIGHT / 2)
+        if vx is not None:
+            # only the paths' Doppler shifts (Paths.doppler) depend on it, not a or tau
+            self.body.velocity = self.mi.Vector3f(float(vx), float(vy), 0.0)
 
-    def trace(self):
+    def trace(self, doppler=False):
         """Traces the current geometry; returns per receiver (link (0, l)) a dict of numpy arrays
-        over the valid paths: a (complex128 passband coefficient), tau, phi_t, kind flags."""
+        over the valid paths: a (complex128 passband coefficient), tau, phi_t, kind flags, and
+        with `doppler` Sionna's Doppler shift of each path (Hz, from the objects' velocities)."""
         rt = self.rt
         paths = self.solver(self.scene, max_depth=self.max_depth,
                             max_num_paths_per_src=MAX_PATHS_PER_SRC,
@@ -397,6 +421,7 @@ class Tracer:
         if valid.ndim == 5:
             valid = valid[:, 0, :, 0, :]
         inter = np.asarray(paths.interactions.numpy())             # [depth, rx, tx, P]
+        fd = np.asarray(paths.doppler.numpy(), np.float64) if doppler else None
         objs = np.asarray(paths.objects.numpy())
         out = []
         for l in range(a.shape[0]):
@@ -418,6 +443,8 @@ class Tracer:
                             diffuse=(it == rt.constants.InteractionType.DIFFUSE).any(0),
                             body=on_body.any(0), body_specular=(on_body & spec).any(0),
                             depth=hit.sum(0)))
+            if fd is not None:
+                out[-1]["doppler"] = fd[l, 0, m]
         return out
 
 
@@ -438,15 +465,19 @@ def link_cfr(p, tx, g_rx):
     return alpha, h
 
 
-def trace_snapshot(tracer, scn):
+def trace_snapshot(tracer, scn, body_paths=False):
     """Traces the current geometry: CFR [links, N] and per-link facts about the paths.
 
     Paths with a specular reflection on the body are left out (counted in `dropped`): a facet
     of the faceted cylinder reflects like an infinite flat mirror in the image method, 15-20 dB
     above the glint of a curved body and only when a facet happens to line up, so they came
-    and went between snapshots as 30-40 dB spikes. The body contributes its diffuse field."""
+    and went between snapshots as 30-40 dB spikes. The body contributes its diffuse field.
+
+    With `body_paths`, each link's dict also holds the kept body-touching paths: `body_tau`,
+    `body_alpha` (the coefficients that enter H, sqrt(W)), `body_depth`, `body_doppler` (Hz), and
+    all kept paths (`kept`, with their Doppler shifts)."""
     tx = scn["transmitters"][0]
-    res = tracer.trace()
+    res = tracer.trace(doppler=body_paths)
     cfr = np.zeros((len(res), N_BINS), np.complex128)
     info = []
     for l, p0 in enumerate(res):
@@ -476,6 +507,10 @@ def trace_snapshot(tracer, scn):
             _, h_direct = link_cfr({k: v[direct] for k, v in p.items()}, tx, g_rx)
             d.update(direct_echo_m=float(p["tau"][i] * C),
                      direct_echo_power_w=float(np.mean(np.abs(h_direct) ** 2)))
+        if body_paths:
+            b = p["body"]
+            d.update(body_tau=p["tau"][b], body_alpha=alpha[b], body_depth=p["depth"][b],
+                     body_doppler=p["doppler"][b], kept=p)
         info.append(d)
     return cfr, info
 
@@ -488,12 +523,14 @@ def links_array(scn):
     return np.array([[0, l] for l in range(len(scn["receivers"]))], np.int64)
 
 
-def save_npz(path, t_s, scn, cfr, noise_var=None):
+def save_npz(path, t_s, scn, cfr, noise_var=None, extra=None):
     arrays = dict(t_s=np.asarray(t_s, np.float64), links=links_array(scn),
                   cfr=np.ascontiguousarray(cfr.astype(np.complex64)),
                   freq_hz=FREQ_HZ.astype(np.float64))
     if noise_var is not None:
         arrays["noise_var"] = np.asarray(noise_var, np.float64)
+    if extra:
+        arrays.update(extra)
     np.savez_compressed(path, **arrays)
 
 
@@ -630,6 +667,321 @@ def run_scene(name, out_root, mesh_dir, samples, max_depth, limit=None):
 
 
 # =================================================================================================
+# CPI bursts (issue 42): N snapshots T apart at K scan times of the `open` walk
+# =================================================================================================
+
+CPI_SNAPSHOTS = 16             # N, snapshots per coherent processing interval
+CPI_SPACING_S = 2.048e-3       # T: max unambiguous |range rate| lambda / (2 T) = 14.1 m/s
+# scan start times (s): first leg (x 4 -> 12 at y = 2), second leg (y 2 -> 8 at x = 12), the stop
+# at b (10-12 s: zero Doppler), the third leg (b -> c); every CPI lies inside one leg
+CPI_SCANS = (0.5, 2.0, 3.5, 5.0, 6.5, 8.0, 9.5, 11.0, 13.0, 15.0)
+CPI_OUT = "walk-cpi"
+# |geometric - Sionna Doppler| bound of the check: 1/17 of the CPI's range-rate resolution
+# lambda / (N T) = 1.76 m/s. The echo comes off the body's surface (up to 0.2 m sideways and
+# 0.9 m up or down from the centre), which turns the unit vectors by a few degrees.
+CPI_TOL_MPS = 0.1
+# bound for the range rate estimated from walk-cpi-doppler.npz itself (walk - empty, matched to
+# the direct echo's delay, pulse-pair): 1/7 of the resolution; the CFR also holds the body's
+# multi-bounce paths (via the ground: another Doppler) and the shadowed static paths
+CPI_CFR_TOL_MPS = 0.25
+
+
+def cpi_names(out_name):
+    """(recording, per-path file, truth file, Doppler-synthesised recording) names for
+    --cpi-out NAME."""
+    stem = out_name[len("walk"):] if out_name.startswith("walk") else "-" + out_name
+    return (f"{out_name}.npz", f"{out_name}-paths.npz", f"truth{stem}.json",
+            f"{out_name}-doppler.npz")
+
+
+def geometric_range_rate(txp, rxp, state):
+    """Bistatic range rate d(|p - tx| + |p - rx|)/dt of the body's centre p = (x, y, 0.9 m) moving
+    at (vx, vy, 0), nodes at (x, y, 1.0 m): v . (u_tx + u_rx), u the 3-D unit vectors from the
+    nodes to p."""
+    p = np.array([state[0], state[1], BODY_HEIGHT / 2])
+    v = np.array([state[2], state[3], 0.0])
+    u_t = (p - txp) / np.linalg.norm(p - txp)
+    u_r = (p - rxp) / np.linalg.norm(p - rxp)
+    return float(v @ (u_t + u_r))
+
+
+def cpi_traced_rates(n_cpi, spacing, snap, link, tau, alpha, depth, doppler, n_links, n_snap):
+    """Per scan and link, from the traced single-bounce (Tx -> body -> Rx) paths, in m/s:
+
+    - `fd`:  c (tau_{N-1} - tau_0) / ((N - 1) T), tau_n the delay of the strongest single-bounce
+             body path of snapshot n: the finite difference across the CPI;
+    - `fd_step`: the median over the N - 1 steps of c (tau_{n+1} - tau_n) / T (skips most of the
+             steps where the strongest path changes from one Monte Carlo sample to another);
+    - `centroid`: least-squares slope over the CPI of c times the power-weighted mean delay of
+             those paths (snapshots without one left out);
+    - `doppler`: -lambda times the power-weighted mean of Sionna's Doppler shift (Paths.doppler,
+             from the body's velocity) over those paths in the N snapshots;
+    - `phase`: -lambda / (2 pi T) arg sum_n z_{n+1} conj(z_n), z_n = sum of their alpha (the
+             carrier-phased coefficients that enter H): the Doppler of the direct echo as the
+             re-traced recording holds it (pulse-pair estimate).
+    Each [K][links], None where a scan has too few such paths."""
+    lam = C / CARRIER_HZ
+    k_scans = n_snap // n_cpi
+    keys = ("fd", "fd_step", "centroid", "doppler", "phase")
+    out = {k: [[None] * n_links for _ in range(k_scans)] for k in keys}
+    direct = depth == 1
+    for l in range(n_links):
+        strongest = np.full(n_snap, np.nan)
+        centroid = np.full(n_snap, np.nan)
+        z = np.zeros(n_snap, np.complex128)
+        for s in range(n_snap):
+            m = np.flatnonzero((snap == s) & (link == l) & direct)
+            if len(m):
+                al = alpha[m].astype(np.complex128)
+                pw = np.abs(al) ** 2
+                ta = tau[m].astype(np.float64)
+                strongest[s] = ta[np.argmax(pw)]
+                centroid[s] = np.sum(pw * ta) / np.sum(pw)
+                z[s] = al.sum()
+        t_rel = np.arange(n_cpi) * spacing
+        for k in range(k_scans):
+            sl = slice(k * n_cpi, (k + 1) * n_cpi)
+            if not np.isnan(strongest[sl][[0, -1]]).any():
+                out["fd"][k][l] = float((strongest[sl][-1] - strongest[sl][0]) * C
+                                        / ((n_cpi - 1) * spacing))
+            steps = np.diff(strongest[sl]) * C / spacing
+            steps = steps[~np.isnan(steps)]
+            if len(steps):
+                out["fd_step"][k][l] = float(np.median(steps))
+            ok = ~np.isnan(centroid[sl])
+            if ok.sum() >= 2:
+                out["centroid"][k][l] = float(np.polyfit(t_rel[ok], centroid[sl][ok] * C, 1)[0])
+            m = np.flatnonzero((snap >= k * n_cpi) & (snap < (k + 1) * n_cpi) & (link == l)
+                               & direct)
+            if len(m):
+                pw = np.abs(alpha[m].astype(np.complex128)) ** 2
+                out["doppler"][k][l] = float(-lam * np.sum(pw * doppler[m]) / np.sum(pw))
+            zz = z[sl]
+            r1 = np.sum(zz[1:] * np.conj(zz[:-1]))
+            if abs(r1) > 0:
+                out["phase"][k][l] = float(-lam * np.angle(r1) / (2 * np.pi * spacing))
+    return out
+
+
+CPI_FIELDS = (("fd", "traced_range_rate_mps", "delay FD of the strongest path"),
+              ("fd_step", "traced_range_rate_step_mps", "median step FD of the strongest path"),
+              ("centroid", "traced_centroid_range_rate_mps", "slope of the delay centroid"),
+              ("doppler", "sionna_doppler_range_rate_mps", "Sionna Doppler"),
+              ("phase", "echo_phase_range_rate_mps", "echo phase"))
+
+
+def run_cpi(out_root, mesh_dir, samples, max_depth, n_cpi, spacing, scans, out_name):
+    """Traces the `open` walk in CPI bursts: at each scan start t_k, N snapshots at t_k + n T with
+    the body moved to the walk's position at that instant (velocity: the leg's). Writes
+    open/<out_name>.npz, open/<out_name>-paths.npz and open/truth-cpi.json (cpi_names)."""
+    spec = SCENES["open"]()
+    scn = spec["scenario"]
+    out = os.path.join(out_root, "open")
+    legs, total = walk_legs(**spec["walk"])
+    if n_cpi < 2 or not spacing > 0 or not scans:
+        raise SystemExit("--cpi: need N >= 2 snapshots, a spacing T > 0 and at least one scan")
+    burst = (n_cpi - 1) * spacing
+    for k, t0 in enumerate(scans):
+        if not 0 <= t0 or t0 + burst >= total:
+            raise SystemExit(f"--cpi-scans: scan {t0} s is outside the walk [0, {total:.3f}) s")
+        if k and t0 <= scans[k - 1] + burst:
+            raise SystemExit(f"--cpi-scans: scan {t0} s starts before scan {scans[k - 1]} s ends")
+        leg_of = [next(i for i, lg in enumerate(legs) if lg[0] <= t < lg[1])
+                  for t in (t0, t0 + burst)]
+        if leg_of[0] != leg_of[1]:
+            raise SystemExit(f"--cpi-scans: the CPI at {t0} s spans a turn of the walk")
+    os.makedirs(out, exist_ok=True)
+    t_s = np.array([t0 + n * spacing for t0 in scans for n in range(n_cpi)])
+    states = np.array([walk_state_at(legs, t) for t in t_s])
+    t_start = time.time()
+    tracer = Tracer(spec, mesh_dir, samples, max_depth)
+    tracer.add_body()
+    n_links = len(scn["receivers"])
+    cfr = np.zeros((len(t_s), n_links, N_BINS), np.complex128)
+    # Sionna's own time evolution (Paths.cir/cfr with num_time_steps): the scan's first trace,
+    # each path's coefficient turned by e^{j 2 pi f_D,i n T} (delays fixed)
+    cfr_dop = np.zeros_like(cfr)
+    tx = scn["transmitters"][0]
+    info = []
+    cols = {k: [] for k in ("snapshot", "link", "tau_s", "alpha", "depth", "doppler_hz")}
+    for s, st in enumerate(states):
+        tracer.move_body(*st)
+        cfr[s], inf = trace_snapshot(tracer, scn, body_paths=True)
+        if s % n_cpi == 0:
+            for l, d in enumerate(inf):
+                g_rx = 10 ** (scn["receivers"][l]["gain_dbi"] / 10)
+                for n in range(n_cpi):
+                    p = dict(d["kept"])
+                    p["a"] = p["a"] * np.exp(2j * np.pi * p["doppler"] * (n * spacing))
+                    _, cfr_dop[s + n, l] = link_cfr(p, tx, g_rx)
+        for d in inf:
+            del d["kept"]
+        info.append(inf)
+        for l, d in enumerate(inf):
+            nb = len(d["body_tau"])
+            cols["snapshot"].append(np.full(nb, s, np.uint16))
+            cols["link"].append(np.full(nb, l, np.uint8))
+            cols["tau_s"].append(d["body_tau"].astype(np.float32))   # Sionna's float32
+            cols["alpha"].append(d["body_alpha"].astype(np.complex64))
+            cols["depth"].append(d["body_depth"].astype(np.uint8))
+            cols["doppler_hz"].append(d["body_doppler"].astype(np.float32))
+        if s % n_cpi == 0 or s == len(states) - 1:
+            print(f"[cpi] {s + 1}/{len(states)} t={t_s[s]:.6f} s ({time.time() - t_start:.0f} s "
+                  f"elapsed) body paths {[len(d['body_tau']) for d in inf]}", flush=True)
+    elapsed = time.time() - t_start
+    paths = {k: np.concatenate(v) for k, v in cols.items()}
+
+    rec_name, paths_name, truth_name, dop_name = cpi_names(out_name)
+    cpi_keys = dict(cpi_snapshots=np.int64(n_cpi), cpi_spacing_s=np.float64(spacing))
+    save_npz(os.path.join(out, rec_name), t_s, scn, cfr, extra=cpi_keys)
+    save_npz(os.path.join(out, dop_name), t_s, scn, cfr_dop, extra=cpi_keys)
+    np.savez_compressed(os.path.join(out, paths_name), **paths)
+
+    txp = np.array([*scn["transmitters"][0]["position_m"], NODE_Z])
+    rxps = [np.array([*r["position_m"], NODE_Z]) for r in scn["receivers"]]
+    centre_t = [t0 + burst / 2 for t0 in scans]
+    scan_states = [walk_state_at(legs, t) for t in centre_t]
+    geo = [[round(geometric_range_rate(txp, r, st), 6) for r in rxps] for st in scan_states]
+    tr = cpi_traced_rates(n_cpi, spacing, paths["snapshot"], paths["link"], paths["tau_s"],
+                          paths["alpha"], paths["depth"], paths["doppler_hz"], n_links, len(t_s))
+    rnd = lambda rows: [[r6(v) for v in row] for row in rows]
+    pn = noise_power_w(scn)
+    gen = generator_info(tracer, spec)
+    gen["cpi"] = {"snapshots": n_cpi, "spacing_s": spacing, "scan_start_s": list(scans),
+                  "body_velocity": "set on the body (SceneObject.velocity) for Paths.doppler; "
+                                   "it does not change a or tau"}
+    truth = {
+        "t_s": [round(float(t), 9) for t in t_s],
+        "states": [[round(float(v), 9) for v in st] for st in states],
+        "cpi_snapshots": n_cpi,
+        "cpi_spacing_s": spacing,
+        "scan_start_s": list(scans),
+        "scan_centre_s": [round(t, 9) for t in centre_t],
+        "scan_states": [[round(float(v), 9) for v in st] for st in scan_states],
+        "noise_var_w": [N_BINS * pn] * n_links,
+        "range_rate_point": "body centre (x, y, 0.9 m), nodes at 1.0 m, 3-D unit vectors, at the "
+                            "scan's centre time t_k + (N - 1) T / 2",
+        "range_rate_mps": geo,
+        **{field: rnd(tr[key]) for key, field, _ in CPI_FIELDS},
+        "body_paths_file": paths_name,
+        "direct_echo_tau_s": [[None if d["direct_echo_m"] is None else d["direct_echo_m"] / C
+                               for d in inf] for inf in info],
+        "direct_echo_m": [[r6(d["direct_echo_m"]) for d in inf] for inf in info],
+        "direct_echo_power_w": [[d["direct_echo_power_w"] for d in inf] for inf in info],
+        "echo_m": [[r6(d["echo_m"]) for d in inf] for inf in info],
+        "los_m": [[r6(d["los_m"]) for d in inf] for inf in info],
+        "paths": [[d["paths"] for d in inf] for inf in info],
+        "body_paths": [[d["body_paths"] for d in inf] for inf in info],
+        "body_specular_dropped": [[d["dropped"] for d in inf] for inf in info],
+        "generator": gen,
+    }
+    dump_json(os.path.join(out, truth_name), truth)
+    digest = hashlib.sha256(cfr.astype(np.complex64).tobytes()).hexdigest()[:16]
+    print(f"[cpi] done in {elapsed:.1f} s; {len(t_s)} snapshots; cfr sha256 {digest}", flush=True)
+    return elapsed
+
+
+def report_cpi(out_root, out_name=CPI_OUT, tol=CPI_TOL_MPS):
+    """Checks open/<out_name>.npz and its truth: layout, and the range rates recomputed here (the
+    geometric one from the states, the traced ones from the per-path file) against the stored
+    values and each other. Returns the number of failed checks."""
+    rec_name, paths_name, truth_name, dop_name = cpi_names(out_name)
+    d = os.path.join(out_root, "open")
+    rec = np.load(os.path.join(d, rec_name))
+    paths = np.load(os.path.join(d, paths_name))
+    truth = json.load(open(os.path.join(d, truth_name)))
+    scn = SCENES["open"]()["scenario"]
+    n_cpi, spacing = int(rec["cpi_snapshots"]), float(rec["cpi_spacing_s"])
+    t_s, cfr = rec["t_s"], rec["cfr"]
+    fails = []
+
+    def check(ok, what):
+        print(f"  [{'ok' if ok else 'FAIL'}] {what}")
+        if not ok:
+            fails.append(what)
+
+    n_links = len(scn["receivers"])
+    k_scans = len(t_s) // n_cpi
+    print(f"== open/{rec_name}: K = {k_scans} scans x N = {n_cpi} snapshots, T = "
+          f"{spacing * 1e3:.3f} ms; cfr {cfr.dtype} {list(cfr.shape)}; {paths_name}: "
+          f"{len(paths['tau_s'])} body paths")
+    check(cfr.dtype == np.complex64 and cfr.shape == (k_scans * n_cpi, n_links, N_BINS),
+          "cfr complex64 [K N, 4, 241]")
+    check(bool(np.all(np.diff(t_s) > 0)), "t_s strictly increasing")
+    check(bool(np.allclose(np.diff(t_s.reshape(k_scans, n_cpi), axis=1), spacing, rtol=0,
+                           atol=1e-12)), "T apart within each CPI")
+    check(bool(np.array_equal(rec["freq_hz"], FREQ_HZ))
+          and rec["links"].tolist() == links_array(scn).tolist(), "freq_hz and links as walk.npz")
+    txp = np.array([*scn["transmitters"][0]["position_m"], NODE_Z])
+    rxps = [np.array([*r["position_m"], NODE_Z]) for r in scn["receivers"]]
+    geo = np.array([[geometric_range_rate(txp, r, st) for r in rxps]
+                    for st in truth["scan_states"]])
+    check(bool(np.allclose(geo, np.array(truth["range_rate_mps"]), atol=1e-6)),
+          "range_rate_mps recomputed from scan_states")
+    tr = cpi_traced_rates(n_cpi, spacing, paths["snapshot"], paths["link"], paths["tau_s"],
+                          paths["alpha"], paths["depth"], paths["doppler_hz"], n_links, len(t_s))
+    arr = lambda rows: np.array([[np.nan if v is None else v for v in row] for row in rows], float)
+    for key, field, _ in CPI_FIELDS:
+        check(bool(np.allclose(arr(tr[key]), arr(truth[field]), atol=2e-6, equal_nan=True)),
+              f"{field} recomputed from {paths_name}")
+    lam = C / CARRIER_HZ
+    print(f"range rates (m/s) per scan and link; lambda / (2T) = {lam / (2 * spacing):.2f}, "
+          f"resolution lambda / (N T) = {lam / (n_cpi * spacing):.2f}")
+    print("scan  t_c (s)   vx, vy   | per link: geometric / Sionna Doppler / delay centroid / "
+          "echo phase / delay FD of the strongest path")
+    rows = {k: arr(tr[k]) for k in tr}
+    for k in range(k_scans):
+        st = truth["scan_states"][k]
+        cells = "  ".join("/".join(f"{v:+.2f}" for v in (
+            geo[k, l], rows["doppler"][k, l], rows["centroid"][k, l], rows["phase"][k, l],
+            rows["fd"][k, l])) for l in range(n_links))
+        print(f"{k:2d} {truth['scan_centre_s'][k]:8.4f} {st[2]:+.2f},{st[3]:+.2f} | {cells}")
+    for key, _, label in CPI_FIELDS:
+        dev = np.abs(rows[key] - geo)
+        print(f"|geometric - {label}|: max {np.nanmax(dev):.3f} m/s, median "
+              f"{np.nanmedian(dev):.3f}, rms {np.sqrt(np.nanmean(dev ** 2)):.3f}; within 0.1 / "
+              f"0.5 m/s: {np.sum(dev <= 0.1)} / {np.sum(dev <= 0.5)} of "
+              f"{np.sum(~np.isnan(dev))} scan-links")
+    dev = np.abs(rows["doppler"] - geo)
+    check(bool(np.all(dev <= tol)),
+          f"|geometric - Sionna Doppler| <= {tol} m/s (max {np.nanmax(dev):.3f})")
+    # the recordings themselves: walk minus the empty area (open/empty.npz), Hann window, matched
+    # to the direct echo's delay (mean over the CPI), pulse-pair over the N snapshots
+    empty = np.load(os.path.join(d, "empty.npz"))["cfr"].astype(np.complex128).mean(0)
+    dop = np.load(os.path.join(d, dop_name))
+    check(dop["cfr"].shape == cfr.shape and np.array_equal(dop["t_s"], t_s)
+          and int(dop["cpi_snapshots"]) == n_cpi, f"{dop_name}: same layout as {rec_name}")
+    win = np.hanning(N_BINS + 2)[1:-1]
+    echo = arr(truth["direct_echo_m"])
+    for label, h in ((rec_name, cfr), (dop_name, dop["cfr"])):
+        est = np.full(geo.shape, np.nan)
+        for k in range(k_scans):
+            for l in range(n_links):
+                r = echo[k * n_cpi:(k + 1) * n_cpi, l]
+                if np.isnan(r).all():
+                    continue
+                steer = np.exp(2j * np.pi * FREQ_HZ * np.nanmean(r) / C) * win
+                y = (h[k * n_cpi:(k + 1) * n_cpi, l].astype(np.complex128) - empty[l]) @ steer
+                est[k, l] = -lam * np.angle(np.sum(y[1:] * np.conj(y[:-1]))) / (2 * np.pi
+                                                                                * spacing)
+        dev = np.abs(est - geo)
+        print(f"{label}: range rate from the CFR (walk - empty at the echo's delay, pulse-pair) "
+              f"- geometric: max {np.nanmax(dev):.3f} m/s, median {np.nanmedian(dev):.3f}; "
+              f"within {tol} m/s: {np.sum(dev <= tol)}/{np.sum(~np.isnan(dev))}, within 0.5 m/s: "
+              f"{np.sum(dev <= 0.5)}")
+        print("  " + "; ".join(" ".join(f"{v:+.2f}" for v in row) for row in est))
+        if label == dop_name:
+            check(bool(np.all(dev <= CPI_CFR_TOL_MPS)), f"{dop_name}: CFR range rate within "
+                  f"{CPI_CFR_TOL_MPS} m/s of the geometric one (max {np.nanmax(dev):.3f})")
+    still = np.array([st[2] == 0 and st[3] == 0 for st in truth["scan_states"]])
+    if still.any():
+        zero = np.concatenate([rows[k][still].ravel() for k in rows])
+        check(bool(np.all(np.abs(zero) <= 1e-9)),
+              "the scans in the stop: every traced range rate is 0 (|.| <= 1e-9 m/s)")
+    return len(fails)
+
+
+# =================================================================================================
 # Report (statistics of the written corpus, for the README)
 # =================================================================================================
 
@@ -732,8 +1084,33 @@ def main():
     ap.add_argument("--max-depth", type=int, default=MAX_DEPTH)
     ap.add_argument("--limit", type=int, default=None, help="trace only the first N snapshots")
     ap.add_argument("--report", action="store_true", help="only print the corpus statistics")
+    ap.add_argument("--cpi", nargs="?", const=f"{CPI_SNAPSHOTS},{CPI_SPACING_S}", default=None,
+                    metavar="N,T", help="trace only CPI bursts of the open walk: N snapshots "
+                    f"T s apart per scan (default {CPI_SNAPSHOTS},{CPI_SPACING_S}); with "
+                    "--report, only check the written bursts")
+    ap.add_argument("--cpi-scans", default=",".join(str(t) for t in CPI_SCANS), metavar="T0,..",
+                    help="start times (s) of the CPI scans")
+    ap.add_argument("--cpi-out", default=CPI_OUT, metavar="NAME",
+                    help="writes open/NAME.npz, open/NAME-paths.npz and the truth file "
+                    "(walk-cpi: truth-cpi.json)")
     args = ap.parse_args()
     names = args.scenes.split(",")
+    if args.cpi is not None:
+        try:
+            n_cpi, spacing = args.cpi.split(",")
+            n_cpi, spacing = int(n_cpi), float(spacing)
+            scans = [float(t) for t in args.cpi_scans.split(",")]
+        except ValueError:
+            raise SystemExit(f"--cpi N,T / --cpi-scans T0,..: cannot parse {args.cpi!r} / "
+                             f"{args.cpi_scans!r}")
+        if not args.report:
+            mesh_dir = tempfile.mkdtemp(prefix="scatterloc-raytrace-")
+            try:
+                run_cpi(args.out, mesh_dir, args.samples, args.max_depth, n_cpi, spacing, scans,
+                        args.cpi_out)
+            finally:
+                shutil.rmtree(mesh_dir, ignore_errors=True)
+        return 1 if report_cpi(args.out, args.cpi_out) else 0
     if not args.report:
         mesh_dir = tempfile.mkdtemp(prefix="scatterloc-raytrace-")
         try:
@@ -744,6 +1121,9 @@ def main():
         finally:
             shutil.rmtree(mesh_dir, ignore_errors=True)
     report(args.out, names)
+    if "open" in names and os.path.exists(os.path.join(args.out, "open",
+                                                       cpi_names(args.cpi_out)[0])):
+        return 1 if report_cpi(args.out, args.cpi_out) else 0
 
 
 if __name__ == "__main__":
