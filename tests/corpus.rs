@@ -433,3 +433,84 @@ fn c12_9_los_on_the_ray_traced_open_area() {
         assert!(st.p90 <= 0.35, "seed {seed}: 90 % {}", st.p90);
     }
 }
+
+/// Issue 42 §2 on data no one here wrote: the open scene's CPI bursts
+/// (`open/walk-cpi-doppler.npz`: 10 scans of 16 snapshots 2.048 ms apart, every path turned by
+/// the Doppler Sionna RT computes for it, diffuse scattering included) with the thermal noise
+/// added (3 seeds), through the front end with `cpi_snapshots = 16` and the empty area's
+/// background. Per scan and link the estimate nearest the walker's bistatic delay (within
+/// 1.5 ns) carries a range rate, compared with Sionna's own (`sionna_doppler_range_rate_mps` of
+/// `truth-cpi.json`, the body's strongest single-bounce path): at least 30 of the 40 link-scans,
+/// every error below 0.15 m/s, normalised RMS at most 1.
+///
+/// The re-traced bursts (`walk-cpi.npz`) are not used: Sionna's deterministic ray launch moves a
+/// diffuse path's hit point along its fixed ray as the body moves, so their phases do not carry
+/// the body's Doppler (tests/data/raytraced/README.md, "CPI bursts").
+#[test]
+fn the_front_end_reads_sionnas_doppler() {
+    let dir = format!("{}/tests/data/raytraced/open", env!("CARGO_MANIFEST_DIR"));
+    let s = scene("open");
+    let walk =
+        npz::read_recording(&std::fs::read(format!("{dir}/walk-cpi-doppler.npz")).unwrap())
+            .unwrap();
+    let truth: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(format!("{dir}/truth-cpi.json")).unwrap())
+            .unwrap();
+    let states: Vec<[Real; 4]> = serde_json::from_value(truth["scan_states"].clone()).unwrap();
+    let sionna: Vec<Vec<Real>> =
+        serde_json::from_value(truth["sionna_doppler_range_rate_mps"].clone()).unwrap();
+    let req = ChannelRequest {
+        cpi_snapshots: Some(16),
+        ..ChannelRequest::default()
+    };
+    for seed in 1..=3 {
+        let w = noisy(&walk, &s.noise_var_w, 0.0, seed);
+        let e = noisy(&s.empty, &s.noise_var_w, 0.0, 100 + seed);
+        let (_, est) = estimate_recording(
+            &s.model,
+            s.scenario.radio.bandwidth_hz,
+            &w,
+            Some(&e),
+            &req.front_end(w.synchronized),
+            &mut Sequential::new(),
+            &|_| {},
+        )
+        .unwrap();
+        assert_eq!(est.len(), 10);
+        let (mut errs, mut z2) = (Vec::new(), 0.0);
+        for (k, x) in states.iter().enumerate() {
+            let r = scatterloc::math::Vec2::new(x[0], x[1]);
+            for (p, sionna_rate) in sionna[k].iter().enumerate() {
+                let tau = s.model.network.delay(p, r);
+                let Some(best) = est.paths[k][p]
+                    .iter()
+                    .filter(|t| (t.estimate.delay_s - tau).abs() < 1.5e-9)
+                    .max_by(|a, b| a.estimate.snr.total_cmp(&b.estimate.snr))
+                else {
+                    continue;
+                };
+                let Some(rate) = best.estimate.range_rate else {
+                    continue;
+                };
+                let e = rate.range_rate_mps - sionna_rate;
+                z2 += (e / rate.sigma_mps).powi(2);
+                errs.push(e.abs());
+            }
+        }
+        errs.sort_by(|a, b| a.total_cmp(b));
+        let n = errs.len();
+        eprintln!(
+            "seed {seed}: {n} of 40 link-scans with a walker rate; |error| median {:.3}, 90th \
+             percentile {:.3}, max {:.3} m/s; normalised RMS {:.2}",
+            errs[n / 2],
+            errs[n * 9 / 10],
+            errs[n - 1],
+            (z2 / n as Real).sqrt()
+        );
+        // Measured (3 seeds): 35–36 of 40, median 0.007 m/s, max 0.083 m/s, normalised RMS
+        // 0.26: the floor of 0.1 m/s dominates σ̂ at these SNRs (19–40 dB).
+        assert!(n >= 30, "seed {seed}: {n}");
+        assert!(errs[n - 1] < 0.15, "seed {seed}: max {}", errs[n - 1]);
+        assert!((z2 / n as Real).sqrt() <= 1.0, "seed {seed}");
+    }
+}

@@ -18,8 +18,11 @@ mod tests;
 pub use read::{read_recording, read_recording_within};
 pub use write::write_recording;
 
-/// The arrays a recording may hold (docs/recording.md), in the order they are written.
-pub const ARRAYS: [&str; 12] = [
+/// The arrays a recording may hold (docs/recording.md), in the order they are written. The
+/// last two describe a recording made in coherent processing intervals (issue 42 §2): checked
+/// on reading (`cpi_snapshots` an integer ≥ 1 dividing the snapshots, `cpi_spacing_s` > 0), not
+/// kept — the front end takes the CPI from its settings (`cpi_snapshots`).
+pub const ARRAYS: [&str; 14] = [
     "t_s",
     "links",
     "cfr",
@@ -32,4 +35,6 @@ pub const ARRAYS: [&str; 12] = [
     "pulse_spacing_s",
     "noise_var",
     "synchronized",
+    "cpi_snapshots",
+    "cpi_spacing_s",
 ];

@@ -299,6 +299,23 @@ pub fn read_recording_within(bytes: &[u8], max_bytes: u64) -> Result<Recording> 
         }
         None => None,
     };
+    if let Some(a) = m.get("cpi_snapshots") {
+        a.expect_shape(&[], "a scalar")?;
+        let n = a.ints(&[1, 2, 4, 8], "an integer")?[0];
+        if n < 1 || t_s.len() % n as usize != 0 {
+            return Err(invalid(
+                "cpi_snapshots",
+                format!("{n} does not divide the {} snapshots", t_s.len()),
+            ));
+        }
+    }
+    if let Some(a) = m.get("cpi_spacing_s") {
+        a.expect_shape(&[], "a scalar")?;
+        let v = a.f64s()?[0];
+        if !(v.is_finite() && v > 0.0) {
+            return Err(invalid("cpi_spacing_s", format!("{v} is not a positive time")));
+        }
+    }
     let rec = Recording {
         t_s,
         links,
