@@ -450,9 +450,8 @@ fn c12_9_los_on_the_ray_traced_open_area() {
 fn the_front_end_reads_sionnas_doppler() {
     let dir = format!("{}/tests/data/raytraced/open", env!("CARGO_MANIFEST_DIR"));
     let s = scene("open");
-    let walk =
-        npz::read_recording(&std::fs::read(format!("{dir}/walk-cpi-doppler.npz")).unwrap())
-            .unwrap();
+    let walk = npz::read_recording(&std::fs::read(format!("{dir}/walk-cpi-doppler.npz")).unwrap())
+        .unwrap();
     let truth: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(format!("{dir}/truth-cpi.json")).unwrap())
             .unwrap();

@@ -313,7 +313,10 @@ pub fn read_recording_within(bytes: &[u8], max_bytes: u64) -> Result<Recording> 
         a.expect_shape(&[], "a scalar")?;
         let v = a.f64s()?[0];
         if !(v.is_finite() && v > 0.0) {
-            return Err(invalid("cpi_spacing_s", format!("{v} is not a positive time")));
+            return Err(invalid(
+                "cpi_spacing_s",
+                format!("{v} is not a positive time"),
+            ));
         }
     }
     let rec = Recording {
