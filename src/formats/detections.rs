@@ -462,7 +462,8 @@ impl Detections {
     /// per snapshot `s` (time `t_s[s]`) one line per recorded link `p` (`links[p]`,
     /// `recorded[p]`) with every path of `paths[s][p]` (confirmed or not, as
     /// `Measurements::raw_step` takes them): delay (s), SNR `10·log10` of the fitted
-    /// integrated SNR (C3; `null` when not > 0) and σ̂_τ (s; `null` when not finite and > 0).
+    /// integrated SNR (C3; `null` when not > 0), σ̂_τ (s; `null` when not finite and > 0), and
+    /// the Doppler `f̂_D` (Hz) when the front end read one for every path of the line (a CPI).
     pub fn from_paths(
         links: &[LinkIndex],
         t_s: &[Real],
@@ -501,7 +502,12 @@ impl Detections {
                                 })
                                 .collect(),
                         ),
-                        doppler_hz: None,
+                        // The CPI's Doppler (issue 42 §2) when every path of the line has one.
+                        doppler_hz: list
+                            .iter()
+                            .map(|p| p.estimate.range_rate.map(|r| r.doppler_hz))
+                            .collect::<Option<Vec<Real>>>()
+                            .filter(|d| !d.is_empty()),
                     })
                     .collect(),
             })

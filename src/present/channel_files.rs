@@ -34,6 +34,9 @@ pub struct PathDoc {
     pub track: u32,
     /// Whether the path track is confirmed.
     pub confirmed: bool,
+    /// The range rate over the scan's CPI and its σ, m/s (issue 42 §2; absent without a CPI).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub range_rate_mps: Option<[Real; 2]>,
 }
 
 /// A snapshot's alignment to the background in `EST.json` (C9 step 2).
@@ -142,6 +145,10 @@ pub fn estimates_doc<'a>(
                                     .then(|| 10.0 * log10(t.estimate.snr)),
                                 track: t.track_id,
                                 confirmed: t.confirmed,
+                                range_rate_mps: t
+                                    .estimate
+                                    .range_rate
+                                    .map(|r| [r.range_rate_mps, r.sigma_mps]),
                             })
                             .collect()
                     })

@@ -62,8 +62,8 @@ pub use montecarlo::{
 };
 pub use multi::{
     lives, multi_scans, multi_tracker, score_multi, simulate_people, track_multi,
-    track_multi_clocked, walk_region, LabelledTrack, MultiScoreDoc, MultiSettings, MultiTiming,
-    MultiTrackOutput, MultiTruth, TargetDoc, TruthTarget, Walkers,
+    track_multi_clocked, track_scans, walk_region, LabelledTrack, MultiScoreDoc, MultiSettings,
+    MultiTiming, MultiTrackOutput, MultiTruth, Scans, TargetDoc, TruthTarget, Walkers,
 };
 pub use multi_study::{
     known_association_bound, multi_study_doc, MethodDoc, MethodSums, MultiStudy, MultiStudyConfig,

@@ -273,6 +273,44 @@ pub fn track_multi_clocked(
     let links = model.link_count();
     let motion = m.motion()?;
     let sigmas = m.sigmas(links)?;
+    let (scans, static_removed) = multi_scans(m, links, calibration)?;
+    let scans = Scans {
+        scans: &scans,
+        static_removed,
+        dt_s: m.dt_s,
+    };
+    track_scans(
+        model, area, motion, sigmas, scans, settings, cancel, clock, t0,
+    )
+}
+
+/// Scans of detections ready for a multi-target tracker: per scan and link the detections
+/// (delays, with a range rate where the front end read one: issue 42 §3), what the static
+/// clusters removed from each scan, and the scan interval, s.
+#[derive(Debug, Clone)]
+pub struct Scans<'a> {
+    /// Per scan, per link, the detections.
+    pub scans: &'a [Scan],
+    /// Per scan, the estimates the static clusters removed.
+    pub static_removed: Vec<usize>,
+    /// Scan interval, s.
+    pub dt_s: f64,
+}
+
+/// The tracker of `settings` over `scans` (the loop of [`track_multi_clocked`], whose setup
+/// time is counted from `t0`): the estimates of every scan, the labels' lives.
+#[allow(clippy::too_many_arguments)]
+pub fn track_scans(
+    model: &Model,
+    area: &Area,
+    motion: crate::track::ConstantVelocity,
+    sigmas: Option<Vec<f64>>,
+    scans: Scans,
+    settings: &MultiSettings,
+    cancel: Cancel,
+    clock: &dyn Fn() -> f64,
+    t0: f64,
+) -> Result<(MultiTrackOutput, MultiTiming)> {
     let sensors = DelayLinks::new(
         model,
         settings.detection_probability,
@@ -281,7 +319,11 @@ pub fn track_multi_clocked(
         sigmas.clone(),
     )?;
     let mut tracker = multi_tracker(model, area, motion, settings, sigmas.as_deref())?;
-    let (scans, static_removed) = multi_scans(m, links, calibration)?;
+    let Scans {
+        scans,
+        static_removed,
+        dt_s,
+    } = scans;
     let t1 = clock();
     let mut targets = Vec::with_capacity(scans.len());
     let mut t_s = Vec::with_capacity(scans.len());
@@ -294,7 +336,7 @@ pub fn track_multi_clocked(
                 reason: alloc::format!("{e}"),
             })?;
         targets.push(tracker.estimates().iter().map(TargetDoc::from).collect());
-        t_s.push(k as f64 * m.dt_s);
+        t_s.push(k as f64 * dt_s);
     }
     let timing = MultiTiming {
         setup: t1 - t0,

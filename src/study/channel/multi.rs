@@ -18,8 +18,10 @@ use crate::math::{sqrt, Real, SPEED_OF_LIGHT};
 use crate::measure::Model;
 use crate::scenario::Area;
 use crate::study::channel::RecordingEstimates;
-use crate::study::{track_multi, MultiSettings, MultiTrackOutput, MultiTruth, TruthTarget};
+use crate::study::{track_scans, MultiSettings, MultiTrackOutput, MultiTruth, Scans, TruthTarget};
 use crate::track::gating::Calibration;
+use crate::track::multi::{Detection, Scan};
+use crate::track::ConstantVelocity;
 
 /// `P_D` per link of a walker in a recording's estimates, the default of
 /// [`recording_multi_settings`]: on the crossing walkers of `tests/tracking/cir_multi.rs`
@@ -112,10 +114,13 @@ pub fn uniform_step(t_s: &[Real]) -> Result<Real> {
     Ok(dt)
 }
 
-/// Tracks the people of a recording from its estimates (module docs): every snapshot a scan,
-/// each estimate's σ̂ widened by `extent_sigma_m / c` (0: as estimated), the statics' clusters
-/// `calibration` removing static delays, the CV model of intensity `process_noise`. The
-/// output's `t_s` are the recording's snapshot times. Asks `cancel` between scans.
+/// Tracks the people of a recording from its estimates (module docs): every snapshot (or CPI) a
+/// scan, each estimate's σ̂ widened by `extent_sigma_m / c` (0: as estimated), with its range
+/// rate and σ̂_ṙ where the front end read one over a CPI (issue 42 §3: a 2-D delay-and-rate
+/// detection), the statics' clusters `calibration` removing static delays, the CV model of
+/// intensity `process_noise`; the same scans `track_multi` would read from
+/// [`recording_measurements`]'s file, plus the rates. The output's `t_s` are the estimates'
+/// times. Asks `cancel` between scans.
 ///
 /// Errors: a non-uniform or too short recording (`t_s`), a negative or non-finite
 /// `extent_sigma_m`, and [`track_multi`]'s.
@@ -138,18 +143,72 @@ pub fn cir_track_multi(
         });
     }
     let dt = uniform_step(&est.t_s)?;
+    let motion = ConstantVelocity::validated(dt, process_noise)?;
+    let links = model.link_count();
+    calibration.check_links(links)?;
+    if est.len() > crate::track::MAX_STEPS {
+        return Err(Error::InvalidFile {
+            field: "t_s".into(),
+            reason: alloc::format!(
+                "{} scans, at most {} are allowed",
+                est.len(),
+                crate::track::MAX_STEPS
+            ),
+        });
+    }
     let extent_s = extent_sigma_m / SPEED_OF_LIGHT;
-    let snapshots: Vec<Snapshot> = (0..est.len())
-        .map(|k| {
-            let mut s = est.snapshot(k);
-            for e in s.iter_mut().flatten() {
-                e.sigma_s = e.sigma_s.map(|v| sqrt(v * v + extent_s * extent_s));
-            }
-            s
+    let mut removed = Vec::with_capacity(est.len());
+    let scans: Vec<Scan> = est
+        .paths
+        .iter()
+        .map(|snap| {
+            let mut gone = 0;
+            let scan = snap
+                .iter()
+                .take(links)
+                .enumerate()
+                .map(|(p, list)| {
+                    list.iter()
+                        .filter_map(|t| {
+                            let e = &t.estimate;
+                            if calibration.links[p].is_static(e.delay_s) {
+                                gone += 1;
+                                return None;
+                            }
+                            let s = Some(sqrt(e.sigma_s * e.sigma_s + extent_s * extent_s));
+                            Some(match e.range_rate {
+                                Some(r) => Detection::delay_rate(
+                                    e.delay_s,
+                                    s,
+                                    r.range_rate_mps,
+                                    r.sigma_mps,
+                                ),
+                                None => Detection::delay(e.delay_s, s),
+                            })
+                        })
+                        .collect()
+                })
+                .collect();
+            removed.push(gone);
+            scan
         })
         .collect();
-    let m = recording_measurements(&snapshots, dt, process_noise);
-    let mut out = track_multi(model, area, &m, Some(calibration), settings, cancel)?;
+    let scans = Scans {
+        scans: &scans,
+        static_removed: removed,
+        dt_s: dt,
+    };
+    let (mut out, _) = track_scans(
+        model,
+        area,
+        motion,
+        None,
+        scans,
+        settings,
+        cancel,
+        &|| 0.0,
+        0.0,
+    )?;
     out.t_s = est.t_s.clone();
     Ok(out)
 }
