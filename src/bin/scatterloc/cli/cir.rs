@@ -204,6 +204,16 @@ pub struct FrontEndArgs {
     /// Worker threads (0 = all cores) [default: 0].
     #[arg(long, value_name = "N", value_parser = whole)]
     pub threads: Option<usize>,
+    /// Each scan a CPI of N consecutive snapshots: the paths are estimated in its middle
+    /// snapshot and each path's range rate read from its phase over the CPI (issue 42; a
+    /// recording made in bursts, e.g. `cir simulate` with the scene's `cpi`) [default: 1, no
+    /// Doppler].
+    #[arg(long, value_name = "N", value_parser = whole)]
+    pub cpi_snapshots: Option<usize>,
+    /// Floor on each range rate's σ, m/s (a body's limbs do not move at one velocity)
+    /// [default: 0.1].
+    #[arg(long, value_name = "M/S", value_parser = finite)]
+    pub range_rate_floor: Option<f64>,
     #[command(flatten)]
     pub csi: CsiArgs,
 }

@@ -96,6 +96,10 @@ pub(super) fn request(
     if let Some([a, b]) = fe.calibration_range {
         r.calibration_range_s = Some([a, b]);
     }
+    r.cpi_snapshots = fe.cpi_snapshots;
+    if let Some(f) = fe.range_rate_floor {
+        r.range_rate_floor_mps = f;
+    }
     if let Some(t) = track {
         if let Some(f) = t.filter {
             r.filter = f.name().to_string();

@@ -10,7 +10,7 @@ use scatterloc::Error;
 use crate::failure::CliError;
 
 /// Core field → flag.
-const FLAGS: [(&str, &str); 59] = [
+const FLAGS: [(&str, &str); 61] = [
     // Tracking studies (`montecarlo`, `pcrlb`, `track`).
     ("runs", "--runs"),
     ("noise_runs", "--noise-runs"),
@@ -52,6 +52,8 @@ const FLAGS: [(&str, &str); 59] = [
     ("p_fa", "--pfa"),
     ("pfa", "--pfa"),
     ("background_time_s", "--background-time"),
+    ("cpi_snapshots", "--cpi-snapshots"),
+    ("range_rate_floor_mps", "--range-rate-floor"),
     ("calibration_range_s", "--calibration-range"),
     ("extent_sigma_m", "--extent-sigma-m"),
     ("filter", "--filter"),
