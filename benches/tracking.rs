@@ -8,6 +8,11 @@
 //! in an untimed summary on stderr, as ns per EKF step including truth sampling, measurement
 //! simulation and NEES.
 //!
+//! The same step with delay + Doppler (issue 42 §4): the same warm filter and delays plus one
+//! noisy range rate per link and step (D1; σ of a CPI of 16 snapshots 2.048 ms apart with a
+//! 0.1 m/s floor, D5, at the truth), the rates' σ fixed (`RateNoise::Fixed`) or from the CPI at
+//! the prediction (`RateNoise::Cpi`).
+//!
 //! Run: `cargo bench --bench tracking` (shorter: `-- --warm-up-time 1 --measurement-time 3`).
 
 use std::hint::black_box;
@@ -25,6 +30,7 @@ use scatterloc::track::{
     run_chunk, run_filter_chunk, run_truth_chunk, FilterKind, MonteCarloConfig, CHUNK_TRAJECTORIES,
 };
 use scatterloc::track::{Ekf, Filter, MeasurementNoise, ParticleFilter, PfConfig, Ukf, UkfParams};
+use scatterloc::track::{RangeRates, RateNoise};
 use scatterloc::{measure, scenario::presets, Model};
 
 const SEED: u64 = 2019;
@@ -42,6 +48,12 @@ struct StepSetup {
     z: Vec<Vec<Option<Real>>>,
     sigmas: Vec<Vec<Real>>,
     truth: Vec<Vec4>,
+    /// Noisy range rates per step and link (D1), m/s.
+    rates: Vec<Vec<Option<Real>>>,
+    /// Their σ at the truth (the CPI's, D5), m/s.
+    rate_sigmas: Vec<Vec<Real>>,
+    /// The CPI of the rates.
+    cpi: measure::Cpi,
 }
 
 fn step_setup() -> StepSetup {
@@ -71,7 +83,39 @@ fn step_setup() -> StepSetup {
             .unwrap();
     }
     let bench = WARM_STEPS + 1..;
+    let cpi = measure::Cpi::new(
+        presets::sensors2019().radio.carrier_hz,
+        16,
+        2.048e-3,
+        measure::DEFAULT_RANGE_RATE_FLOOR_MPS,
+    )
+    .unwrap();
+    let mut rate_noise = measure::rng(SEED, 2);
+    let rate_sigmas: Vec<Vec<Real>> = truth[bench.clone()]
+        .iter()
+        .map(|x| {
+            (0..model.link_count())
+                .map(|p| cpi.sigma_range_rate(model.snr(p, Vec2::new(x[0], x[1]))))
+                .collect()
+        })
+        .collect();
+    let rates = truth[bench.clone()]
+        .iter()
+        .zip(&rate_sigmas)
+        .map(|(x, sr)| {
+            let (r, v) = (Vec2::new(x[0], x[1]), Vec2::new(x[2], x[3]));
+            (0..model.link_count())
+                .map(|p| {
+                    let rate = measure::range_rate(&model.network, p, r, v);
+                    Some(rate + sr[p] * measure::standard_normal(&mut rate_noise))
+                })
+                .collect()
+        })
+        .collect();
     StepSetup {
+        rates,
+        rate_sigmas,
+        cpi,
         sigmas: truth[bench.clone()]
             .iter()
             .map(|x| model.sigma_delays(Vec2::new(x[0], x[1])))
@@ -96,6 +140,32 @@ impl StepSetup {
                 MeasurementNoise::AtPrediction
             };
             f.update(&self.model, black_box(z), noise, None).unwrap();
+        }
+        f
+    }
+
+    /// `BENCH_STEPS` consecutive predict + update steps with delays and range rates, R of the
+    /// delays from the link budget at the prediction, the rates' σ fixed or from the CPI.
+    fn track_doppler(&self, fixed_rates: bool) -> Ekf {
+        let mut f = self.ekf;
+        for ((z, rates), sr) in self.z.iter().zip(&self.rates).zip(&self.rate_sigmas) {
+            f.predict(&self.motion);
+            let noise = if fixed_rates {
+                RateNoise::Fixed(sr)
+            } else {
+                RateNoise::Cpi(self.cpi)
+            };
+            let rates = RangeRates {
+                rates_mps: black_box(rates),
+                noise,
+            };
+            f.update_doppler(
+                &self.model,
+                black_box(z),
+                MeasurementNoise::AtPrediction,
+                &rates,
+            )
+            .unwrap();
         }
         f
     }
@@ -146,6 +216,13 @@ fn benches(c: &mut Criterion) {
         worst = worst.max((f.position() - Vec2::new(x[0], x[1])).norm());
     }
     assert!(worst < 5e-3, "filter {worst} m off the truth");
+    // The same with range rates: all 4 links, near the truth.
+    for fixed in [true, false] {
+        let f = s.track_doppler(fixed);
+        let x = s.truth.last().unwrap();
+        let err = (f.position() - Vec2::new(x[0], x[1])).norm();
+        assert!(err < 5e-3, "doppler filter {err} m off the truth");
+    }
     eprintln!(
         "setup: scenario I, {BENCH_STEPS} steps of {PAPER_STEP_S} s after {WARM_STEPS}, largest position error {:.3} mm",
         worst * 1e3
@@ -158,6 +235,13 @@ fn benches(c: &mut Criterion) {
         b.iter(|| s.track(false))
     });
     g.bench_function("predict+update_R_fixed", |b| b.iter(|| s.track(true)));
+    // Issue 42 §4: delay + Doppler on the 4 links (≤ 250 ns asked).
+    g.bench_function("predict+update_doppler_rates_sigma_fixed", |b| {
+        b.iter(|| s.track_doppler(true))
+    });
+    g.bench_function("predict+update_doppler_rates_sigma_cpi", |b| {
+        b.iter(|| s.track_doppler(false))
+    });
     g.bench_function("predict_only", |b| {
         b.iter(|| {
             let mut f = s.ekf;

@@ -1,7 +1,7 @@
 //! End-to-end tests of the `scatterloc` binary, one module per command family: presets, CRLB,
 //! maps, locate, help and completions (`basics`), tracking studies (`tracking`, `montecarlo`,
 //! `filters`), the gating pipeline (`gating`), the Wi-Fi CSI files through `cir convert`/`cir estimate` (`csi`), the planner (`plan`), the multi-target commands
-//! (`mtl`), sharded studies and `merge` (`scale_out`), bounded, named bad input (`hardening`;
+//! (`mtl`), `track` with range rates in the measurement file (`track_doppler`, issue 42 §5), sharded studies and `merge` (`scale_out`), bounded, named bad input (`hardening`;
 //! issue 37's command-line items in `hardening3`), and the outputs of a fixed set of commands pinned to those of the binary before issue 23
 //! (`pinned`), and the output writer's guarantees: atomic, never through a link, a FIFO or a
 //! device, all-or-nothing, checked stdout (`outputs`, issue 24). Every module checks the "exit 2 + one stderr line naming the field" contract.
@@ -30,6 +30,9 @@ mod crossing;
 
 #[path = "cli/cir_multi.rs"]
 mod cir_multi;
+
+#[path = "cli/cir_doppler.rs"]
+mod cir_doppler;
 
 #[cfg(feature = "npz")]
 #[path = "cli/csi.rs"]
@@ -86,3 +89,6 @@ mod scale_out;
 
 #[path = "cli/tracking.rs"]
 mod tracking;
+
+#[path = "cli/track_doppler.rs"]
+mod track_doppler;

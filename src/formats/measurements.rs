@@ -1,18 +1,21 @@
 //! The measurements file of `track` (spec §6, §4): the CV model's step and intensity (E7), the
 //! start, an optional fixed delay σ and per step either one delay per link (`steps`, E1) or
 //! every link's `[delay, amplitude]` estimates (`raw_steps`, gated by E4 and associated by
-//! spec §4).
+//! spec §4). With `steps`, a file may also give per step one range rate per link
+//! (`range_rates_mps`, issue 42 §5; docs/doppler.md D1) and their σ: fixed
+//! (`range_rate_sigma_mps`) or from a CPI (`cpi`, D5) ([`RangeRateFields`]).
 
 use alloc::format;
-use alloc::string::String;
+use alloc::string::{String, ToString};
 use alloc::vec;
 use alloc::vec::Vec;
 
 use serde::{Deserialize, Serialize};
 
 use crate::channel::{DelayEstimate, Snapshot};
-use crate::error::{Error, Result};
+use crate::error::{limits, Error, Result};
 use crate::math::{Mat4, Real, Vec4};
+use crate::measure::{Cpi, DEFAULT_RANGE_RATE_FLOOR_MPS};
 use crate::scenario::parse_json;
 use crate::track::{ConstantVelocity, MAX_STEPS};
 
@@ -302,5 +305,240 @@ impl Measurements {
                     .collect()
             })
             .collect()
+    }
+}
+
+/// The keys of a measurements file that [`RangeRateFields`] reads.
+pub const RANGE_RATE_KEYS: [&str; 3] = ["range_rates_mps", "range_rate_sigma_mps", "cpi"];
+
+/// The optional range rates of a measurements file with `steps` (issue 42 §5; docs/doppler.md
+/// D1, D5): per step one range rate per link, and where their σ comes from — fixed
+/// (`range_rate_sigma_mps`, one or per link), or a CPI (`cpi`; absent: the caller's, e.g. the
+/// flags of `track`). Read beside the file's [`Measurements`] by
+/// [`Measurements::from_json_with_rates`]; checked against it by [`RangeRateFields::check`].
+#[derive(Debug, Clone, Default, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct RangeRateFields {
+    /// Per step, one range rate per link in scenario link order (`null` = missing), m/s.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub range_rates_mps: Option<Vec<Vec<Option<f64>>>>,
+    /// Fixed range-rate σ, one for all links or one per link, m/s.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub range_rate_sigma_mps: Option<Sigma>,
+    /// The CPI the rates were measured over: their σ from it at the prediction (D5).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cpi: Option<CpiFields>,
+}
+
+/// The `cpi` of a measurements file (D4, D5); the wavelength is the scenario's.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct CpiFields {
+    /// Snapshots `N` in the CPI.
+    pub snapshots: usize,
+    /// Their spacing `T`, s.
+    pub spacing_s: f64,
+    /// The floor on the range rate's σ, m/s [default: 0.1].
+    #[serde(default = "default_floor")]
+    pub floor_mps: f64,
+}
+
+/// [`DEFAULT_RANGE_RATE_FLOOR_MPS`].
+fn default_floor() -> f64 {
+    DEFAULT_RANGE_RATE_FLOOR_MPS
+}
+
+/// The σ of a file's range rates.
+#[derive(Debug, Clone, PartialEq)]
+pub enum RateSigma {
+    /// Fixed, one per link, m/s (`range_rate_sigma_mps`).
+    Fixed(Vec<f64>),
+    /// From the file's `cpi`.
+    Cpi(Cpi),
+    /// Neither given: the caller's CPI.
+    Unstated,
+}
+
+/// A file's range rates after [`RangeRateFields::check`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct CheckedRates<'a> {
+    /// Per step, one range rate per link (`None` = missing), m/s.
+    pub rates_mps: &'a [Vec<Option<f64>>],
+    /// Their σ.
+    pub sigma: RateSigma,
+}
+
+impl RateSigma {
+    /// The fixed σ per link, m/s, if the file gives them.
+    pub fn fixed(&self) -> Option<&[f64]> {
+        match self {
+            RateSigma::Fixed(s) => Some(s),
+            _ => None,
+        }
+    }
+
+    /// The file's CPI, if it gives one.
+    pub fn cpi(&self) -> Option<Cpi> {
+        match self {
+            RateSigma::Cpi(c) => Some(*c),
+            _ => None,
+        }
+    }
+}
+
+impl RangeRateFields {
+    /// Whether the file gives none of the fields.
+    pub fn is_empty(&self) -> bool {
+        self == &RangeRateFields::default()
+    }
+
+    /// Checks the fields against `m` for `links` links on a carrier of `carrier_hz`: `None`
+    /// without `range_rates_mps`. Errors name the field: `range_rate_sigma_mps` or `cpi`
+    /// without `range_rates_mps`, or both given; `range_rates_mps` with `raw_steps`, of another
+    /// step count than `steps`, or a step of another link count (`range_rates_mps[k]`); a rate
+    /// not finite or outside [`limits::RANGE_RATE_M_S`] (`range_rates_mps[k][p]`); a σ outside
+    /// [`limits::RANGE_RATE_SIGMA_M_S`] (`range_rate_sigma_mps[p]`; a list of another length:
+    /// [`Error::LengthMismatch`]); a bad CPI as [`Cpi::new`] names it (`cpi.snapshots`, …).
+    pub fn check(
+        &self,
+        m: &Measurements,
+        links: usize,
+        carrier_hz: f64,
+    ) -> Result<Option<CheckedRates<'_>>> {
+        let Some(rates) = &self.range_rates_mps else {
+            for (given, field) in [
+                (self.range_rate_sigma_mps.is_some(), "range_rate_sigma_mps"),
+                (self.cpi.is_some(), "cpi"),
+            ] {
+                if given {
+                    return Err(invalid(field, "only with range_rates_mps".into()));
+                }
+            }
+            return Ok(None);
+        };
+        let Some(steps) = &m.steps else {
+            return Err(invalid(
+                "range_rates_mps",
+                "only with steps (not raw_steps)".into(),
+            ));
+        };
+        if rates.len() != steps.len() {
+            return Err(invalid(
+                "range_rates_mps",
+                format!(
+                    "expected {} lists (one per step of steps), found {}",
+                    steps.len(),
+                    rates.len()
+                ),
+            ));
+        }
+        for (k, step) in rates.iter().enumerate() {
+            if step.len() != links {
+                return Err(invalid(
+                    format!("range_rates_mps[{k}]"),
+                    format!(
+                        "expected {links} range rates (one per link, null = missing), found {}",
+                        step.len()
+                    ),
+                ));
+            }
+            for (p, rate) in step.iter().enumerate() {
+                if let Some(v) = *rate {
+                    if !limits::RANGE_RATE_M_S.contains(v) {
+                        limits::RANGE_RATE_M_S.check(&format!("range_rates_mps[{k}][{p}]"), v)?;
+                    }
+                }
+            }
+        }
+        let sigma = match (&self.range_rate_sigma_mps, &self.cpi) {
+            (Some(_), Some(_)) => {
+                return Err(invalid(
+                    "cpi",
+                    "give at most one of range_rate_sigma_mps and cpi".into(),
+                ))
+            }
+            (Some(s), None) => RateSigma::Fixed(rate_sigmas(s, links)?),
+            (None, Some(c)) => {
+                RateSigma::Cpi(Cpi::new(carrier_hz, c.snapshots, c.spacing_s, c.floor_mps)?)
+            }
+            (None, None) => RateSigma::Unstated,
+        };
+        Ok(Some(CheckedRates {
+            rates_mps: rates,
+            sigma,
+        }))
+    }
+}
+
+/// `range_rate_sigma_mps` as one σ per link of `links`, each within
+/// [`limits::RANGE_RATE_SIGMA_M_S`].
+fn rate_sigmas(s: &Sigma, links: usize) -> Result<Vec<f64>> {
+    match s {
+        Sigma::One(v) => {
+            limits::RANGE_RATE_SIGMA_M_S.check("range_rate_sigma_mps", *v)?;
+            Ok(vec![*v; links])
+        }
+        Sigma::PerLink(v) if v.len() != links => Err(Error::LengthMismatch {
+            field: "range_rate_sigma_mps",
+            expected: links,
+            found: v.len(),
+        }),
+        Sigma::PerLink(v) => {
+            for (p, s) in v.iter().enumerate() {
+                limits::RANGE_RATE_SIGMA_M_S.check(&format!("range_rate_sigma_mps[{p}]"), *s)?;
+            }
+            Ok(v.clone())
+        }
+    }
+}
+
+impl Measurements {
+    /// Parses a measurements file that may carry range rates ([`RANGE_RATE_KEYS`]). A file
+    /// without them reads exactly as [`Measurements::from_json`] (the same value, the same
+    /// errors); with them, those keys are read as [`RangeRateFields`] and the rest as
+    /// [`Measurements`] (errors name the field: [`Error::Parse`]).
+    ///
+    /// # Example
+    ///
+    /// ```
+    /// use scatterloc::formats::Measurements;
+    ///
+    /// let base = r#""dt_s": 0.1, "process_noise": 0.1, "initial_state": [1, 2, 0, 0],
+    ///     "initial_covariance": [[0.1,0,0,0],[0,0.1,0,0],[0,0,0.01,0],[0,0,0,0.01]],
+    ///     "steps": [[3.0e-8, null]]"#;
+    /// // Without range rates: exactly `from_json`.
+    /// let (m, rates) = Measurements::from_json_with_rates(&format!("{{{base}}}")).unwrap();
+    /// assert_eq!(m, Measurements::from_json(&format!("{{{base}}}")).unwrap());
+    /// assert!(rates.is_empty() && rates.check(&m, 2, 5.8e9).unwrap().is_none());
+    /// // With them, checked against the steps: one list per step, one rate per link.
+    /// let text = format!(r#"{{{base}, "range_rates_mps": [[0.5, null]], "range_rate_sigma_mps": 0.2}}"#);
+    /// let (m, rates) = Measurements::from_json_with_rates(&text).unwrap();
+    /// let checked = rates.check(&m, 2, 5.8e9).unwrap().unwrap();
+    /// assert_eq!(checked.rates_mps, &[vec![Some(0.5), None]]);
+    /// assert_eq!(checked.sigma.fixed(), Some(&[0.2, 0.2][..]));
+    /// let e = rates.check(&m, 3, 5.8e9).unwrap_err();
+    /// assert!(e.to_string().starts_with("range_rates_mps[0]: expected 3 range rates"));
+    /// ```
+    pub fn from_json_with_rates(text: &str) -> Result<(Measurements, RangeRateFields)> {
+        let first = match Measurements::from_json(text) {
+            Ok(m) => return Ok((m, RangeRateFields::default())),
+            Err(e) => e,
+        };
+        let Ok(serde_json::Value::Object(mut rest)) = serde_json::from_str(text) else {
+            return Err(first);
+        };
+        if !RANGE_RATE_KEYS.iter().any(|k| rest.contains_key(*k)) {
+            return Err(first);
+        }
+        let mut rates = serde_json::Map::new();
+        for k in RANGE_RATE_KEYS {
+            if let Some(v) = rest.remove(k) {
+                rates.insert(k.into(), v);
+            }
+        }
+        // Numbers round-trip exactly (serde_json's float_roundtrip and shortest printing).
+        let fields: RangeRateFields = parse_json(&serde_json::Value::Object(rates).to_string())?;
+        let m = Measurements::from_json(&serde_json::Value::Object(rest).to_string())?;
+        Ok((m, fields))
     }
 }

@@ -17,7 +17,8 @@ mod truth;
 pub use calibration::{CalibrationResult, CalibrationSnapshots};
 pub use detections::{DelayUnit, DetectionFrame, DetectionLine, Detections};
 pub use measurements::{
-    one_list_per_link, Measurements, RawEstimate, RawStep, Sigma, Start, Steps,
+    one_list_per_link, CheckedRates, CpiFields, Measurements, RangeRateFields, RateSigma,
+    RawEstimate, RawStep, Sigma, Start, Steps, RANGE_RATE_KEYS,
 };
 pub use truth::Truth;
 

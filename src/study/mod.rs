@@ -75,7 +75,9 @@ pub use part::{
     PART_VERSION,
 };
 pub use roc::{RocConfig, RocStudy};
-pub use track::{track_measurements, track_measurements_in, TrackOutput, TrackRequest, TrackStart};
+pub use track::{
+    track_measurements, track_measurements_in, TrackDoppler, TrackOutput, TrackRequest, TrackStart,
+};
 
 #[cfg(test)]
 mod tests;

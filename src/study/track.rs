@@ -3,7 +3,10 @@
 //! a calibration (E4) and associated (§4) before each update — run through any tracker (the
 //! EKF, the UKF or the particle filter; [`crate::track::Filter`]), started from the file's
 //! `initial_state` or from the Levenberg–Marquardt fix of its `initial_snapshot`. The result
-//! ([`TrackOutput`]) is the document `scatterloc track` prints.
+//! ([`TrackOutput`]) is the document `scatterloc track` prints. With range rates in the file
+//! (`range_rates_mps`, issue 42 §5; docs/doppler.md D1, D5), [`TrackRequest::track_with_rates`]
+//! updates every step with delays and range rates ([`Filter::update_doppler`]) and reports the
+//! predicted range rates and their innovations ([`TrackDoppler`]).
 //!
 //! ```
 //! use scatterloc::formats::Measurements;
@@ -51,6 +54,7 @@ use crate::error::{check_every, Cancel, Error, Result};
 use crate::formats::{Measurements, RawStep, Start, Steps};
 use crate::math::{Mat4, Vec4};
 use crate::measure::{rng, Model};
+use crate::present::CpiDoc;
 use crate::scenario::Area;
 use crate::track::gating::{
     start_from_snapshot, AssociationRule, Calibration, Choice, GatedTracker, SegmentConfig,
@@ -58,6 +62,7 @@ use crate::track::gating::{
 };
 use crate::track::{step_ns, UpdateSummary};
 use crate::track::{ConstantVelocity, Ekf, Filter, FilterKind, MeasurementNoise, Tracker};
+use crate::track::{RangeRates, RateNoise};
 
 /// What a track runs on.
 #[derive(Debug, Clone, Copy)]
@@ -103,6 +108,29 @@ pub struct TrackOutput {
     /// `initial_snapshot` only: the LM fix that started the filter.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub start: Option<TrackStart>,
+    /// A file with `range_rates_mps` only: how its range rates were used.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub doppler: Option<TrackDoppler>,
+}
+
+/// How a track used its file's range rates (issue 42 §5).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct TrackDoppler {
+    /// Whether the updates used them (`false`: ignored, the delay-only track).
+    pub used: bool,
+    /// Where their σ came from: `fixed` (per link), `cpi` (D5 at the prediction) or `cpi_at`
+    /// (D5 at a given position).
+    pub sigma: &'static str,
+    /// The CPI of a `cpi` σ.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cpi: Option<CpiDoc>,
+    /// When used: per step, each link's predicted range rate `ṙ_p(x̂⁻)` after the predict
+    /// (D1), m/s.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub predicted_range_rates_mps: Option<Vec<Vec<f64>>>,
+    /// When used: per step, each link's innovation `ṙ_p − ṙ_p(x̂⁻)` (`null` = no rate), m/s.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub range_rate_innovations_mps: Option<Vec<Vec<Option<f64>>>>,
 }
 
 /// The start of a track from `initial_snapshot`.
@@ -132,6 +160,88 @@ pub fn track_measurements(req: &TrackRequest) -> Result<TrackOutput> {
 /// ([`check_every`] steps of [`step_ns`]) and stops with [`Error::Cancelled`] (issue 24: a
 /// 4096-link UKF step takes seconds, and a file may hold 10⁶ steps).
 pub fn track_measurements_in(req: &TrackRequest, cancel: Cancel) -> Result<TrackOutput> {
+    run(req, None, cancel)
+}
+
+impl TrackRequest<'_> {
+    /// [`track_measurements_in`] with range rates: `rates_mps` per step of the file's `steps`,
+    /// one per link (`None` = missing; e.g. a file's `range_rates_mps` read by
+    /// [`Measurements::from_json_with_rates`]), their σ from `noise`. With `use_rates` each
+    /// step predicts, records each link's predicted range rate and innovation, and updates with
+    /// delays and range rates ([`Filter::update_doppler`]); without, the track is the
+    /// delay-only one. The output's `doppler` says which. Rates with `raw_steps`, or of another
+    /// step or link count, are [`Error::InvalidFile`] of `range_rates_mps`.
+    pub fn track_with_rates(
+        &self,
+        rates_mps: &[Vec<Option<f64>>],
+        noise: RateNoise,
+        use_rates: bool,
+        cancel: Cancel,
+    ) -> Result<TrackOutput> {
+        let n = self.model.link_count();
+        let bad = |reason: alloc::string::String| Error::InvalidFile {
+            field: "range_rates_mps".into(),
+            reason,
+        };
+        let Some(steps) = &self.measurements.steps else {
+            return Err(bad("only with steps (not raw_steps)".into()));
+        };
+        if rates_mps.len() != steps.len() {
+            return Err(bad(format!(
+                "expected {} lists (one per step of steps), found {}",
+                steps.len(),
+                rates_mps.len()
+            )));
+        }
+        if let Some(k) = rates_mps.iter().position(|r| r.len() != n) {
+            return Err(Error::InvalidFile {
+                field: format!("range_rates_mps[{k}]"),
+                reason: format!(
+                    "expected {n} range rates (one per link, null = missing), found {}",
+                    rates_mps[k].len()
+                ),
+            });
+        }
+        let (sigma, cpi) = match noise {
+            RateNoise::Fixed(_) => ("fixed", None),
+            RateNoise::Cpi(c) => ("cpi", Some(c)),
+            RateNoise::CpiAt(c, _) => ("cpi_at", Some(c)),
+        };
+        let mut doc = TrackDoppler {
+            used: use_rates,
+            sigma,
+            cpi: cpi.map(|c| CpiDoc {
+                snapshots: c.snapshots,
+                spacing_s: c.spacing_s,
+                wavelength_m: c.wavelength_m,
+                floor_mps: c.floor_mps,
+            }),
+            predicted_range_rates_mps: None,
+            range_rate_innovations_mps: None,
+        };
+        let mut out = if use_rates {
+            let rates = StepRates { rates_mps, noise };
+            run(self, Some((&rates, &mut doc)), cancel)?
+        } else {
+            run(self, None, cancel)?
+        };
+        out.doppler = Some(doc);
+        Ok(out)
+    }
+}
+
+/// The range rates of a track's steps and their σ.
+struct StepRates<'a> {
+    rates_mps: &'a [Vec<Option<f64>>],
+    noise: RateNoise<'a>,
+}
+
+/// The track of `req`, with `rates` (and their document) on the plain form.
+fn run(
+    req: &TrackRequest,
+    rates: Option<(&StepRates, &mut TrackDoppler)>,
+    cancel: Cancel,
+) -> Result<TrackOutput> {
     let every = check_every(step_ns(req.filter, req.model.link_count()));
     let (model, m) = (req.model, req.measurements);
     let n = model.link_count();
@@ -165,13 +275,26 @@ pub fn track_measurements_in(req: &TrackRequest, cancel: Cancel) -> Result<Track
         choices: None,
         static_removed: None,
         start,
+        doppler: None,
     };
     let own = rng(req.seed, 0);
     let filter = Tracker::new(req.filter, ekf.state, ekf.covariance, own)?;
     match steps {
         Steps::Plain(steps) => {
             let at = Every { cancel, every };
-            plain(model, filter, &motion, noise, steps, m.dt_s, at, &mut out)?
+            match rates {
+                None => plain(model, filter, &motion, noise, steps, m.dt_s, at, &mut out)?,
+                Some((rates, doc)) => {
+                    let run = PlainRun {
+                        model,
+                        motion: &motion,
+                        noise,
+                        dt_s: m.dt_s,
+                        at,
+                    };
+                    run.with_rates(filter, steps, rates, doc, &mut out)?
+                }
+            }
         }
         Steps::Raw(raw) => {
             let tracker = GatedTracker::new(filter, model, cal, motion, noise, req.rule)?;
@@ -292,6 +415,69 @@ fn plain(
         record(out, filter.state(), filter.covariance(), k, dt_s, &summary);
     }
     Ok(())
+}
+
+/// What a plain track with range rates runs on.
+struct PlainRun<'a> {
+    model: &'a Model,
+    motion: &'a ConstantVelocity,
+    noise: MeasurementNoise<'a>,
+    dt_s: f64,
+    at: Every<'a>,
+}
+
+impl PlainRun<'_> {
+    /// The plain form with range rates: per step predict, the predicted range rates (D1) and
+    /// the innovations into `doc`, then the update with delays and range rates.
+    fn with_rates(
+        &self,
+        mut filter: Tracker,
+        steps: &[Vec<Option<f64>>],
+        rates: &StepRates,
+        doc: &mut TrackDoppler,
+        out: &mut TrackOutput,
+    ) -> Result<()> {
+        let (model, n) = (self.model, self.model.link_count());
+        let rate_noise = rates.noise;
+        let (mut predicted, mut innovations) = (
+            Vec::with_capacity(steps.len()),
+            Vec::with_capacity(steps.len()),
+        );
+        for (k, (z, r)) in steps.iter().zip(rates.rates_mps).enumerate() {
+            self.at.check(k)?;
+            Measurements::check_plain_step(k, z, n)?;
+            filter.predict(self.motion);
+            let field = || format!("steps[{k}]");
+            let pred = filter
+                .predicted_range_rates(model, rate_noise)
+                .map_err(|e| step_error(&field(), e))?;
+            innovations.push(
+                r.iter()
+                    .zip(&pred)
+                    .map(|(r, q)| r.map(|r| r - q.range_rate_mps))
+                    .collect(),
+            );
+            predicted.push(pred.iter().map(|q| q.range_rate_mps).collect());
+            let step_rates = RangeRates {
+                rates_mps: r,
+                noise: rate_noise,
+            };
+            let summary = filter
+                .update_doppler(model, z, self.noise, &step_rates)
+                .map_err(|e| step_error(&field(), e))?;
+            record(
+                out,
+                filter.state(),
+                filter.covariance(),
+                k,
+                self.dt_s,
+                &summary,
+            );
+        }
+        doc.predicted_range_rates_mps = Some(predicted);
+        doc.range_rate_innovations_mps = Some(innovations);
+        Ok(())
+    }
 }
 
 /// The raw form: every step (one list per each of `links` links) through the one gated loop

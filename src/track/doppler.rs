@@ -9,9 +9,11 @@
 use alloc::format;
 
 use crate::error::{check_len, limits, Error, Result};
-use crate::math::{Real, Vec2, Vec4, SPEED_OF_LIGHT};
-use crate::measure::{Cpi, LinkMotion, Model};
-use crate::track::shared::{first_input_error, positive_finite, range_information_per_snr};
+use crate::math::{Real, Vec2, Vec4, PI, SPEED_OF_LIGHT};
+use crate::measure::{sigma_delay_from_snr, Cpi, LinkMotion, Model};
+use crate::track::shared::{
+    first_input_error, information_from_sigma, positive_finite, range_information_per_snr,
+};
 use crate::track::MeasurementNoise;
 
 /// Where the range rates' noise `σ_ṙ,p` comes from.
@@ -101,6 +103,11 @@ impl Row {
 /// (`LengthMismatch` of `range_rates`), `Fixed` rate noise of one σ per link (`LengthMismatch`
 /// of `range_rate_sigma_mps`), each rate within [`limits::RANGE_RATE_M_S`] and each given σ
 /// within [`limits::RANGE_RATE_SIGMA_M_S`] (`OutOfRange` naming the entry).
+///
+/// A delay's σ from the link budget (`AtPrediction`, `At`) is checked by [`rows`] at the same
+/// position, in link order and with the same error, so the link budget is evaluated once per
+/// link and update. When every other check passes this returns at once (no field name is
+/// formatted); otherwise [`check_rates_named`] gives the first error in the order above.
 pub(crate) fn check_rates(
     model: &Model,
     z: &[Option<Real>],
@@ -111,6 +118,41 @@ pub(crate) fn check_rates(
     let n = model.link_count();
     check_len("measurement", n, z.len())?;
     noise.check_links(n)?;
+    let delays_ok = match noise {
+        // A given σ costs nothing to check: the delay-only update's own check.
+        MeasurementNoise::Fixed(_) => first_input_error(model, z, noise, r).is_none(),
+        _ => z.iter().flatten().all(|&t| limits::DELAY_S.contains(t)),
+    };
+    let sigmas = match rates.noise {
+        RateNoise::Fixed(s) => Some(s),
+        _ => None,
+    };
+    let ok = delays_ok
+        && rates.rates_mps.len() == n
+        && sigmas.is_none_or(|s| s.len() == n)
+        && rates.rates_mps.iter().enumerate().all(|(p, rate)| {
+            rate.is_none_or(|v| {
+                limits::RANGE_RATE_M_S.contains(v)
+                    && sigmas.is_none_or(|s| limits::RANGE_RATE_SIGMA_M_S.contains(s[p]))
+            })
+        });
+    if ok {
+        Ok(())
+    } else {
+        check_rates_named(model, z, noise, rates, r)
+    }
+}
+
+/// [`check_rates`] in full, naming the first bad field (also a delay's σ from the link budget).
+#[cold]
+fn check_rates_named(
+    model: &Model,
+    z: &[Option<Real>],
+    noise: MeasurementNoise,
+    rates: &RangeRates,
+    r: Vec2,
+) -> Result<()> {
+    let n = model.link_count();
     if let Some(e) = first_input_error(model, z, noise, r) {
         return Err(e);
     }
@@ -130,7 +172,10 @@ pub(crate) fn check_rates(
 
 /// The rows of one update linearised at `x` (after [`check_rates`]), in link order, a link's
 /// delay before its rate: `row(p, row)` for each. A rate whose σ is not finite and positive
-/// carries no information and is skipped. The number of links that gave a row.
+/// carries no information and is skipped. A delay's σ from the link budget that the delay-only
+/// update refuses ([`first_input_error`]'s test) is [`Error::InvalidSigma`] of its link, the
+/// first in link order. The link budget (E8) is evaluated at most once per link. The number of
+/// links that gave a row.
 #[inline]
 pub(crate) fn rows(
     model: &Model,
@@ -142,6 +187,9 @@ pub(crate) fn rows(
 ) -> Result<usize> {
     let (r, v) = (Vec2::new(x[0], x[1]), Vec2::new(x[2], x[3]));
     let info_per_snr = range_information_per_snr(model);
+    // `8π²β²`: the delay's information per SNR in the time domain (E8).
+    let delay_info_per_snr = 8.0 * PI * PI * model.beta2;
+    let mut tx_gain: Option<(usize, Real)> = None;
     let mut links = 0;
     for p in 0..model.link_count() {
         let (zp, rate) = (z[p], rates.rates_mps[p]);
@@ -149,19 +197,68 @@ pub(crate) fn rows(
             continue;
         }
         let g = LinkMotion::new(&model.network, p, r, v);
+        // The link's SNR at `r` once (the same bits as `g.snr(model, p)`, the transmitter's
+        // gain shared by the links of one transmitter).
+        let mut snr = None;
+        let mut snr_of = |g: &LinkMotion| {
+            *snr.get_or_insert_with(|| {
+                let tx = model.network.links[p].tx;
+                let gain = match tx_gain {
+                    Some((t, gain)) if t == tx => gain,
+                    _ => {
+                        let gain = model.patterns[tx].gain_toward(g.unit_tx);
+                        tx_gain = Some((tx, gain));
+                        gain
+                    }
+                };
+                model.snr_from_geometry(p, gain, g.distances_m.0, g.distances_m.1)
+            })
+        };
         let mut used = false;
         if let Some(tau) = zp {
-            let w = match noise {
-                MeasurementNoise::AtPrediction => info_per_snr * g.snr(model, p),
-                _ => {
-                    let s = SPEED_OF_LIGHT * noise.sigma(model, p, r);
-                    1.0 / (s * s)
+            let (w, sigma) = match noise {
+                MeasurementNoise::Fixed(_) => {
+                    let sigma = noise.sigma(model, p, r);
+                    let s = SPEED_OF_LIGHT * sigma;
+                    (1.0 / (s * s), sigma)
+                }
+                MeasurementNoise::AtPrediction => {
+                    let snr = snr_of(&g);
+                    // σ = 1/√(8π²β² SNR) is finite, > 0 and of finite information whenever
+                    // 8π²β² SNR lies in [1e-300, 1e300]; only outside is it formed and tested.
+                    let q = delay_info_per_snr * snr;
+                    if !(1e-300..=1e300).contains(&q) {
+                        let sigma = sigma_delay_from_snr(model.beta2, snr);
+                        if !delay_sigma_ok(sigma) {
+                            return Err(Error::InvalidSigma {
+                                link: p,
+                                value: sigma,
+                            });
+                        }
+                    }
+                    (info_per_snr * snr, Real::NAN)
+                }
+                MeasurementNoise::At(_) => {
+                    let sigma = noise.sigma(model, p, r);
+                    if !delay_sigma_ok(sigma) {
+                        return Err(Error::InvalidSigma {
+                            link: p,
+                            value: sigma,
+                        });
+                    }
+                    let s = SPEED_OF_LIGHT * sigma;
+                    (1.0 / (s * s), sigma)
                 }
             };
             if !(positive_finite(w)) {
                 return Err(Error::InvalidSigma {
                     link: p,
-                    value: noise.sigma(model, p, r),
+                    value: match noise {
+                        MeasurementNoise::AtPrediction => {
+                            sigma_delay_from_snr(model.beta2, snr_of(&g))
+                        }
+                        _ => sigma,
+                    },
                 });
             }
             let h = Vec4::new(g.range_gradient.x, g.range_gradient.y, 0.0, 0.0);
@@ -179,7 +276,10 @@ pub(crate) fn rows(
             used = true;
         }
         if let Some(rate) = rate {
-            let s = rates.noise.sigma(model, p, &g);
+            let s = match rates.noise {
+                RateNoise::Cpi(c) => c.sigma_range_rate(snr_of(&g)),
+                other => other.sigma(model, p, &g),
+            };
             if positive_finite(s) {
                 row(
                     p,
@@ -197,4 +297,11 @@ pub(crate) fn rows(
         links += usize::from(used);
     }
     Ok(links)
+}
+
+/// Whether a delay's σ from the link budget is one the delay-only update takes
+/// ([`first_input_error`]: finite, `> 0`, finite information).
+#[inline(always)]
+fn delay_sigma_ok(sigma: Real) -> bool {
+    positive_finite(sigma) && information_from_sigma(sigma).is_finite()
 }

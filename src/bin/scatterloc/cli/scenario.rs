@@ -94,11 +94,13 @@ pub struct LocateArgs {
     pub free_z: bool,
 }
 
-/// `--doppler` and its CPI, shared by `crlb` and `crlb-map` (docs/doppler.md, D1–D7).
+/// `--doppler` and its CPI, shared by `crlb`, `crlb-map` and `track` (docs/doppler.md, D1–D7;
+/// `track` reads only the CPI: the σ of the measurement file's range rates).
 #[derive(Debug, Args)]
 pub struct DopplerArgs {
     /// The bound from every link's delay and range rate over one coherent processing interval
-    /// (CPI); `crlb` adds the document `doppler`, `crlb-map` maps it (see --quantity).
+    /// (CPI); `crlb` adds the document `doppler`, `crlb-map` maps it (see --quantity); `track`
+    /// takes its range rates' sigma from this CPI.
     #[arg(long = "doppler")]
     pub on: bool,
     /// With --doppler: the target's velocity VX,VY, m/s (the range rates' gradients depend on it).

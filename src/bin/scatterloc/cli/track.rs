@@ -3,6 +3,7 @@
 use clap::Args;
 
 use super::filters::{FilterName, FilterSettings};
+use super::scenario::DopplerArgs;
 use super::values::{
     finite, probability, seed, whole, Association, MultiMethod, TargetsMode, WalkStart,
 };
@@ -54,6 +55,16 @@ pub struct TrackArgs {
     pub seed: Option<u64>,
     #[command(flatten)]
     pub settings: FilterSettings,
+    /// The range rates' CPI (issue 42; docs/doppler.md D5): with --doppler the rates of the
+    /// measurements file (range_rates_mps) take their sigma from the CPI of --cpi,
+    /// --cpi-spacing-s and --range-rate-floor instead of the file's cpi (a file that fixes
+    /// range_rate_sigma_mps is refused). Without --doppler: the file's cpi, else these defaults.
+    #[command(flatten)]
+    pub doppler: DopplerArgs,
+    /// Ignore the range rates of the measurements file: the delay-only track (the output's
+    /// doppler.used is false).
+    #[arg(long)]
+    pub no_doppler: bool,
     /// Refuse work predicted to take more than H CPU-hours [default: 24] (issue 24; the
     /// prediction and its calibration: docs/benchmarks.md "Cost model"); > 0.
     #[arg(long, value_name = "H", value_parser = finite)]

@@ -9,6 +9,10 @@
 //! weighted particles).
 //! `--detections D.jsonl` reads the JSON lines of docs/detections.md instead
 //! ([`scatterloc::formats::Detections`], converted to the raw form with `--process-noise`).
+//! A file with `steps` may carry range rates (`range_rates_mps`, issue 42 §5): then every step
+//! updates with delays and range rates ([`scatterloc::study::TrackRequest::track_with_rates`]),
+//! their σ fixed by the file or from a CPI (the file's `cpi`, or `--doppler --cpi ...`, the
+//! flags of `crlb --doppler`); `--no-doppler` ignores them.
 
 use scatterloc::error::Cancel;
 use scatterloc::formats::{Detections, Measurements, Steps};
@@ -18,6 +22,7 @@ use scatterloc::study::{
 };
 use scatterloc::track::gating::AssociationRule;
 use scatterloc::track::multi::MultiKind;
+use scatterloc::track::RateNoise;
 
 use super::filters::filter_kinds;
 use super::flags::{in_file, with_flag};
@@ -84,19 +89,35 @@ pub fn track(args: &TrackArgs) -> Result<(), CliError> {
     let scenario = read_scenario(&args.scenario)?;
     let bad = |e: &dyn std::fmt::Display| in_file(flag, mpath, e);
     let model = model_of(&scenario)?;
-    let m: Measurements = match &args.detections {
-        None => read_json_file("measurements", mpath)?,
-        Some(_) => {
-            let q = args.process_noise.unwrap_or(DEFAULT_PROCESS_NOISE);
-            Detections::from_text(&read_input(flag, mpath)?)
-                .and_then(|d| d.to_measurements(&model, q))
-                .map_err(|e| match with_flag(&e) {
-                    Some(text) => CliError::usage(text),
-                    None => bad(&e),
-                })?
+    let (m, fields) = match &args.detections {
+        None => {
+            let text = read_input("measurements", mpath)?;
+            Measurements::from_json_with_rates(&text).map_err(|e| parse_error(mpath, &e))?
         }
+        Some(_) => (
+            {
+                let q = args.process_noise.unwrap_or(DEFAULT_PROCESS_NOISE);
+                Detections::from_text(&read_input(flag, mpath)?)
+                    .and_then(|d| d.to_measurements(&model, q))
+                    .map_err(|e| match with_flag(&e) {
+                        Some(text) => CliError::usage(text),
+                        None => bad(&e),
+                    })?
+            },
+            Default::default(),
+        ),
     };
     let n = model.link_count();
+    // The range rates of the file, checked, and their σ (issue 42 §5).
+    let rates = fields.check(&m, n, model.carrier_hz).map_err(|e| bad(&e))?;
+    let file_sigma = rates.as_ref().and_then(|r| r.sigma.fixed());
+    doppler_flags(args, rates.is_some(), file_sigma.is_some())?;
+    let flags_cpi = super::scenario::cpi_of(&args.doppler, &scenario)?;
+    let rate_noise = match (file_sigma, rates.as_ref().and_then(|r| r.sigma.cpi())) {
+        (Some(s), _) => RateNoise::Fixed(s),
+        (None, Some(file)) if !args.doppler.on => RateNoise::Cpi(file),
+        _ => RateNoise::Cpi(flags_cpi),
+    };
     let rule = match args.association {
         None | Some(Association::Spec) => AssociationRule::Spec,
         Some(Association::Gated) => AssociationRule::Gated,
@@ -143,7 +164,15 @@ pub fn track(args: &TrackArgs) -> Result<(), CliError> {
     // Ctrl-C stops the track within milliseconds (issue 24): exit status 130, nothing written.
     let (res, _) = run_with_bar(steps, "steps", "track", |cancel, _| {
         let stop = || cancel.load(std::sync::atomic::Ordering::Relaxed);
-        track_measurements_in(&req, Cancel::when(&stop))
+        match &rates {
+            Some(r) => req.track_with_rates(
+                r.rates_mps,
+                rate_noise,
+                !args.no_doppler,
+                Cancel::when(&stop),
+            ),
+            None => track_measurements_in(&req, Cancel::when(&stop)),
+        }
     })?;
     let out = res.map_err(|e| bad(&e))?;
     if let Some((path, format)) = figure {
@@ -163,6 +192,8 @@ pub fn track(args: &TrackArgs) -> Result<(), CliError> {
                 "raw estimates gated (E4), association {}",
                 args.association.unwrap_or(Association::Spec).name()
             )
+        } else if out.doppler.as_ref().is_some_and(|d| d.used) {
+            "delays and range rates as given".to_string()
         } else {
             "delays as given".to_string()
         };
@@ -177,6 +208,48 @@ pub fn track(args: &TrackArgs) -> Result<(), CliError> {
     let text =
         serde_json::to_string(&out).map_err(|e| CliError::output(format!("encoding JSON: {e}")))?;
     emit(&text)
+}
+
+/// A measurements file's parse error as every JSON file's (`--measurements PATH: field: …`,
+/// as `read_json_file` words it).
+fn parse_error(path: &str, e: &scatterloc::Error) -> CliError {
+    CliError::usage(format!(
+        "--measurements {path}: {}",
+        e.to_string().replace(
+            "data did not match any variant of untagged enum Sigma",
+            "expected a number or a list of numbers (one per link)",
+        )
+    ))
+}
+
+/// The Doppler flags against the file: `--doppler` and `--no-doppler` need range rates in the
+/// file and exclude each other; `--doppler` (a CPI) is refused when the file fixes the rates'
+/// σ; `--velocity` is not for `track` (the filter estimates the velocity).
+fn doppler_flags(args: &TrackArgs, has_rates: bool, fixed_sigma: bool) -> Result<(), CliError> {
+    let d = &args.doppler;
+    if args.no_doppler && d.on {
+        return Err(CliError::usage(
+            "--no-doppler: not with --doppler (use the range rates or ignore them)",
+        ));
+    }
+    if d.on && d.velocity != [0.0, 0.0] {
+        return Err(CliError::usage(
+            "--velocity: not for track (the filter estimates the velocity)",
+        ));
+    }
+    for (flag, given) in [("--doppler", d.on), ("--no-doppler", args.no_doppler)] {
+        if given && !has_rates {
+            return Err(CliError::usage(format!(
+                "{flag}: only for a measurements file with range_rates_mps (this one has none)"
+            )));
+        }
+    }
+    if d.on && fixed_sigma {
+        return Err(CliError::usage(
+            "--doppler: the file fixes range_rate_sigma_mps (the rates' sigma); drop one of them",
+        ));
+    }
+    Ok(())
 }
 
 /// The flags of `--targets auto` given without it: a usage error naming them.
