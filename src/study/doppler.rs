@@ -4,15 +4,16 @@
 //! Fisher information over the runs' truths, D7), position and velocity RMSE and the mean NEES
 //! per step.
 //!
-//! Each scan is one CPI of `N` snapshots: its delays have E8's σ over `N` (`σ_τ/√N`, at the
-//! truth), its range rates D5's σ (at the truth, the floor included as noise: the filter's model
+//! Each scan is one CPI of `N` snapshots: its delays have E8's σ over `√N` (`σ_τ/√N`, at the
+//! truth; a delay drawn outside (0, 1] s is missing, and a link whose σ at the prediction is
+//! beyond [`limits::DELAY_SIGMA_S`] is left out of the update), its range rates D5's σ (at the truth, the floor included as noise: the filter's model
 //! is then exact). Run `k` draws its truth and both measurement sets from `rng(seed, k)`, so the
 //! two filters see the same data and a result depends on the seed only.
 
 use alloc::vec;
 use alloc::vec::Vec;
 
-use crate::error::{Error, Result};
+use crate::error::{limits, Error, Result};
 use crate::math::{sqrt, Mat4, Real, Vec2, Vec4};
 use crate::measure::{rng, standard_normal, state_fisher, Cpi, LinkMotion, Model};
 use crate::track::{
@@ -158,7 +159,10 @@ impl DopplerStudy {
                 for p in 0..links {
                     let m = LinkMotion::new(&model.network, p, r, v);
                     let s = model.sigma_delay(p, r) / root_n;
-                    delays.push(Some(model.network.delay(p, r) + s * standard_normal(g)));
+                    // A delay drawn at or below 0 (σ of the order of the delay: the truth far
+                    // outside the network) is no measurement.
+                    let d = model.network.delay(p, r) + s * standard_normal(g);
+                    delays.push(limits::DELAY_S.contains(d).then_some(d));
                     let sr = self.cpi.sigma_range_rate(m.snr(model, p));
                     let e = standard_normal(g);
                     rates.push(sr.is_finite().then_some(m.range_rate_mps + sr * e));
@@ -219,14 +223,24 @@ impl Acc {
             let sigmas: Vec<Real> = (0..model.link_count())
                 .map(|p| model.sigma_delay(p, r) / root_n)
                 .collect();
+            // A link whose σ at the prediction is beyond any delay σ (the truth far outside
+            // the network) carries nothing: its delay is left out.
+            let z: Vec<Option<Real>> = scan
+                .delays
+                .iter()
+                .zip(&sigmas)
+                .map(|(d, s)| d.filter(|_| limits::DELAY_SIGMA_S.contains(*s)))
+                .collect();
+            let sigmas: Vec<Real> = sigmas
+                .iter()
+                .map(|s| s.clamp(limits::DELAY_SIGMA_S.min, limits::DELAY_SIGMA_S.max))
+                .collect();
             let rates = RangeRates {
                 rates_mps: if doppler { &scan.rates } else { &none },
                 noise: RateNoise::Cpi(study.cpi),
             };
             let noise = MeasurementNoise::Fixed(&sigmas);
-            if f.update_doppler(model, &scan.delays, noise, &rates)
-                .is_err()
-            {
+            if f.update_doppler(model, &z, noise, &rates).is_err() {
                 self.failed += 1;
                 return;
             }

@@ -33,6 +33,7 @@
 // `!(x > 0.0)` is meant: a NaN must fail these checks as well.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+use alloc::vec;
 use alloc::vec::Vec;
 
 use crate::channel::path_rate;
@@ -631,7 +632,7 @@ fn rates(
         let mut a = estimator.amplitudes_at(&r, &delays)?;
         if let Some(l) = los {
             let ref_phase = a[l];
-            let m = ref_phase.norm();
+            let m = sqrt(ref_phase.norm_sqr());
             if m > 0.0 {
                 let rot = ref_phase.conj() / m;
                 for v in a.iter_mut() {
