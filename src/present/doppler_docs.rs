@@ -9,19 +9,7 @@ use serde::Serialize;
 
 use crate::math::{sqrt, Real, Vec2, Vec4};
 use crate::measure::{range_rate, state_bounds, state_fisher, Cpi, Model};
-
-/// The CPI as written in the document.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct CpiDoc {
-    /// `N`.
-    pub snapshots: usize,
-    /// `T`, s.
-    pub spacing_s: Real,
-    /// `λ`, m.
-    pub wavelength_m: Real,
-    /// `σ_floor`, m/s.
-    pub floor_mps: Real,
-}
+use crate::study::CpiDoc;
 
 /// One link's range rate and its σ.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -77,12 +65,7 @@ impl DopplerDoc {
             })
             .collect();
         DopplerDoc {
-            cpi: CpiDoc {
-                snapshots: cpi.snapshots,
-                spacing_s: cpi.spacing_s,
-                wavelength_m: cpi.wavelength_m,
-                floor_mps: cpi.floor_mps,
-            },
+            cpi: CpiDoc::from(cpi),
             velocity_mps: velocity,
             position_rmse_m: both.map(|b| b.0),
             velocity_rmse_mps: both.map(|b| b.1),

@@ -21,6 +21,30 @@ use crate::track::{
     RateNoise, Tracker, TruthSampler,
 };
 
+/// A CPI as the documents write it (`crlb --doppler`'s `doppler.cpi`, `track`'s `doppler.cpi`).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct CpiDoc {
+    /// `N`.
+    pub snapshots: usize,
+    /// `T`, s.
+    pub spacing_s: Real,
+    /// `λ`, m.
+    pub wavelength_m: Real,
+    /// `σ_floor`, m/s.
+    pub floor_mps: Real,
+}
+
+impl From<&Cpi> for CpiDoc {
+    fn from(c: &Cpi) -> CpiDoc {
+        CpiDoc {
+            snapshots: c.snapshots,
+            spacing_s: c.spacing_s,
+            wavelength_m: c.wavelength_m,
+            floor_mps: c.floor_mps,
+        }
+    }
+}
+
 /// Most runs of a Doppler study.
 pub const MAX_DOPPLER_RUNS: usize = 100_000;
 

@@ -53,7 +53,7 @@ pub use channel::{
     RECORDING_CLUTTER, RECORDING_CLUTTER_WINDOW_S, RECORDING_DETECTION, RECORDING_EXTENT_SIGMA_M,
 };
 pub use cost::{check_cost, track_cpu_s, MAX_CPU_S, PAGE_STUDY_CPU_S, PAGE_TRACK_CPU_S};
-pub use doppler::{DopplerArm, DopplerResult, DopplerStudy, MAX_DOPPLER_RUNS};
+pub use doppler::{CpiDoc, DopplerArm, DopplerResult, DopplerStudy, MAX_DOPPLER_RUNS};
 pub use drive::{Driver, Sequential};
 pub use filters::{particle_chunks, FilterResults, FilterRun, FilterStudy};
 pub use montecarlo::{

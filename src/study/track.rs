@@ -54,7 +54,7 @@ use crate::error::{check_every, Cancel, Error, Result};
 use crate::formats::{Measurements, RawStep, Start, Steps};
 use crate::math::{Mat4, Vec4};
 use crate::measure::{rng, Model};
-use crate::present::CpiDoc;
+use crate::study::CpiDoc;
 use crate::scenario::Area;
 use crate::track::gating::{
     start_from_snapshot, AssociationRule, Calibration, Choice, GatedTracker, SegmentConfig,
@@ -210,12 +210,7 @@ impl TrackRequest<'_> {
         let mut doc = TrackDoppler {
             used: use_rates,
             sigma,
-            cpi: cpi.map(|c| CpiDoc {
-                snapshots: c.snapshots,
-                spacing_s: c.spacing_s,
-                wavelength_m: c.wavelength_m,
-                floor_mps: c.floor_mps,
-            }),
+            cpi: cpi.as_ref().map(CpiDoc::from),
             predicted_range_rates_mps: None,
             range_rate_innovations_mps: None,
         };

@@ -33,10 +33,8 @@
 // `!(x > 0.0)` is meant: a NaN must fail these checks as well.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
-use alloc::vec;
 use alloc::vec::Vec;
 
-use crate::channel::path_rate;
 use crate::channel::{
     Alignment, Band, EstimateWork, Estimator, EstimatorConfig, LinkBackground, PathEstimate,
     PathTracker, Recording, ResponseMap, SnapshotEstimate, TrackedPath,
@@ -45,6 +43,10 @@ use crate::error::{limits, Cancel, Error, Result};
 use crate::math::{db_to_linear, floor, log10, sqrt, Complex, Real, SPEED_OF_LIGHT};
 use crate::study::channel::{DelayReference, FrontEndConfig, FrontEndCpi, StaticMode};
 use crate::track::gating::{AmplitudeClusterConfig, DelayEstimate, LinkCalibration, StaticCluster};
+
+mod cpi;
+
+use cpi::{rates, Burst};
 
 /// Most paths of the background's own fit (its static clusters).
 pub const BACKGROUND_MAX_PATHS: usize = 32;
@@ -585,70 +587,6 @@ impl LinkFront {
         })?;
         Ok((tracked, used, align, work))
     }
-}
-
-/// A scan's CPI: the recording, its map and the scan's first snapshot.
-struct Burst<'a> {
-    rec: &'a Recording,
-    map: &'a ResponseMap,
-    first: usize,
-}
-
-/// Each path of the scan's estimate `e` (delays in the estimator's time base) gets its range
-/// rate over the CPI `burst` (issue 42 §2, [`FrontEndCpi`]): per snapshot of the burst its
-/// response through `residual` (the background's residual, or the response itself), the paths'
-/// amplitudes at their delays ([`Estimator::amplitudes_at`]) — with `per_snapshot` each
-/// referred to the direct path's phase (a receiver without the transmitter's clock turns every
-/// snapshot's carrier phase; the direct path does not move) — and [`path_rate`] at the path's
-/// SNR.
-#[allow(clippy::too_many_arguments)]
-fn rates(
-    e: &mut SnapshotEstimate,
-    burst: &Burst,
-    cpi: FrontEndCpi,
-    wavelength_m: Real,
-    link: usize,
-    mut residual: impl FnMut(&mut Vec<Complex>, &mut Vec<Complex>) -> Result<()>,
-    estimator: &mut Estimator,
-    per_snapshot: bool,
-    span: Real,
-) -> Result<()> {
-    if e.paths.is_empty() {
-        return Ok(());
-    }
-    let delays: Vec<Real> = e.paths.iter().map(|p| p.delay_s).collect();
-    let los = if per_snapshot {
-        los_of(&e.paths, span).and_then(|l| delays.iter().position(|d| *d == l.delay_s))
-    } else {
-        None
-    };
-    let n = cpi.snapshots;
-    let mut alpha = vec![Vec::with_capacity(n); delays.len()];
-    let mut t = Vec::with_capacity(n);
-    let (mut h, mut r) = (Vec::new(), Vec::new());
-    for s in burst.first..burst.first + n {
-        burst.map.fill(burst.rec, s, link, &mut h)?;
-        residual(&mut h, &mut r)?;
-        let mut a = estimator.amplitudes_at(&r, &delays)?;
-        if let Some(l) = los {
-            let ref_phase = a[l];
-            let m = sqrt(ref_phase.norm_sqr());
-            if m > 0.0 {
-                let rot = ref_phase.conj() / m;
-                for v in a.iter_mut() {
-                    *v *= rot;
-                }
-            }
-        }
-        for (list, v) in alpha.iter_mut().zip(a) {
-            list.push(v);
-        }
-        t.push(burst.rec.t_s[s]);
-    }
-    for (p, a) in e.paths.iter_mut().zip(&alpha) {
-        p.range_rate = path_rate(&t, a, p.snr, wavelength_m, cpi.floor_mps)?;
-    }
-    Ok(())
 }
 
 /// One link-snapshot's output: its tracked paths, the noise variance used, its alignment, the
