@@ -13,7 +13,7 @@
 use alloc::vec;
 use alloc::vec::Vec;
 
-use crate::error::{limits, Error, Result};
+use crate::error::{limits, Cancel, Error, Result};
 use crate::math::{sqrt, Mat4, Real, Vec2, Vec4};
 use crate::measure::{rng, standard_normal, state_fisher, Cpi, LinkMotion, Model};
 use crate::track::{
@@ -71,7 +71,7 @@ pub struct DopplerStudy {
 }
 
 /// One arm's curves, one entry per step `0 … steps` (`None`: unbounded, or no run left).
-#[derive(Debug, Clone, PartialEq, Default)]
+#[derive(Debug, Clone, PartialEq, Default, serde::Serialize)]
 pub struct DopplerArm {
     /// Position RMSE over the runs, m.
     pub position_rmse_m: Vec<Real>,
@@ -89,7 +89,7 @@ pub struct DopplerArm {
 }
 
 /// Both arms of a [`DopplerStudy`].
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct DopplerResult {
     /// Delays only.
     pub delay_only: DopplerArm,
@@ -101,6 +101,17 @@ impl DopplerStudy {
     /// Runs the study on `model` (sequentially: `runs × steps × 2` filter steps). Named errors for a run
     /// count outside 1 … [`MAX_DOPPLER_RUNS`], no steps, or a bad prior.
     pub fn run(&self, model: &Model) -> Result<DopplerResult> {
+        self.run_with(model, Cancel::NEVER, &mut |_| {})
+    }
+
+    /// [`DopplerStudy::run`], asking `cancel` before each run ([`Error::Cancelled`]) and calling
+    /// `progress` with the runs done after each.
+    pub fn run_with(
+        &self,
+        model: &Model,
+        cancel: Cancel,
+        progress: &mut dyn FnMut(usize),
+    ) -> Result<DopplerResult> {
         if !(1..=MAX_DOPPLER_RUNS).contains(&self.runs) {
             return Err(Error::SizeLimit {
                 field: "runs",
@@ -124,6 +135,7 @@ impl DopplerStudy {
         let mut fisher = [vec![Mat4::zeros(); steps], vec![Mat4::zeros(); steps]];
         let mut truth = Vec::new();
         for k in 0..self.runs {
+            cancel.check()?;
             let mut g = rng(self.seed, k as u64);
             sampler.sample(steps, &mut g, &mut truth);
             for (n, x) in truth.iter().skip(1).enumerate() {
@@ -138,6 +150,7 @@ impl DopplerStudy {
                 let mut f = Tracker::new(self.filter, start, self.initial_covariance, filter_rng)?;
                 acc.run(model, &mut f, &truth, &scans, d == 1, self);
             }
+            progress(k + 1);
         }
         let mut out = arms.map(|a| a.finish());
         for (arm, f) in out.iter_mut().zip(&fisher) {

@@ -54,8 +54,8 @@ use crate::error::{check_every, Cancel, Error, Result};
 use crate::formats::{Measurements, RawStep, Start, Steps};
 use crate::math::{Mat4, Vec4};
 use crate::measure::{rng, Model};
-use crate::study::CpiDoc;
 use crate::scenario::Area;
+use crate::study::CpiDoc;
 use crate::track::gating::{
     start_from_snapshot, AssociationRule, Calibration, Choice, GatedTracker, SegmentConfig,
     SegmentEvent, SegmentSetup, SegmentTracker, START_SPEED_SIGMA_MPS,

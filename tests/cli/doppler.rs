@@ -195,3 +195,92 @@ fn crlb_map_with_doppler_is_the_librarys_map() {
         &["--doppler"],
     );
 }
+
+/// `montecarlo --doppler` (issue 42 §3): the JSON of each trajectory is the library's
+/// `DopplerStudy` (both arms, bit for bit) for the EKF and the UKF; the figure is written;
+/// flags of the classic study are refused by name (exit 2, nothing written).
+#[test]
+fn montecarlo_doppler_is_the_librarys_study() {
+    use scatterloc::study::DopplerStudy;
+    use scatterloc::track::{
+        paper_initial_covariance, ConstantVelocity, FilterKind, TrackScenario, UkfParams,
+    };
+    let dir = TempDir::new();
+    let s = scatterloc::scenario::presets::sensors2019();
+    let f = dir.write_text("s.json", &s.to_json());
+    let model = Model::new(&s).unwrap();
+    for (name, kind) in [
+        ("ekf", FilterKind::Ekf),
+        ("ukf", FilterKind::Ukf(UkfParams::default())),
+    ] {
+        let (json, fig) = (
+            dir.path(&format!("{name}.json")),
+            dir.path(&format!("{name}.svg")),
+        );
+        let summary = ok_json(&[
+            "montecarlo",
+            "--doppler",
+            "--scenario",
+            &f,
+            "--trajectory",
+            "II",
+            "--runs",
+            "12",
+            "--duration",
+            "0.5",
+            "--cpi",
+            "8",
+            "--cpi-spacing-s",
+            "0.003",
+            "--range-rate-floor",
+            "0.05",
+            "--filters",
+            name,
+            "--seed",
+            "5",
+            "--json",
+            &json,
+            "--out",
+            &fig,
+        ]);
+        assert_eq!(summary["doppler"][0]["trajectory"], "II");
+        let got: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+        let want = DopplerStudy {
+            motion: ConstantVelocity::new(0.1, 1.0),
+            mean_state: TrackScenario::II.mean_state(),
+            initial_covariance: paper_initial_covariance(),
+            cpi: Cpi::new(s.radio.carrier_hz, 8, 0.003, 0.05).unwrap(),
+            steps: 5,
+            runs: 12,
+            seed: 5,
+            filter: kind,
+        }
+        .run(&model)
+        .unwrap();
+        assert_eq!(
+            got[0]["delay_only"],
+            serde_json::to_value(&want.delay_only).unwrap()
+        );
+        assert_eq!(
+            got[0]["with_doppler"],
+            serde_json::to_value(&want.with_doppler).unwrap()
+        );
+        assert_eq!(got[0]["filter"], name);
+        assert!(std::fs::read_to_string(&fig)
+            .unwrap()
+            .contains("delays + Doppler"));
+    }
+    let out = dir.path("no.json");
+    for (extra, flag) in [
+        (vec!["--shard", "0/2"], "--shard"),
+        (vec!["--noise-runs", "3"], "--noise-runs"),
+        (vec!["--velocity", "1,0"], "--velocity"),
+        (vec!["--filters", "ekf,ukf"], "--filters"),
+    ] {
+        let mut args = vec!["montecarlo", "--doppler", "--runs", "2", "--json", &out];
+        args.extend(extra);
+        fails(&args, &[flag]);
+    }
+    assert!(!std::path::Path::new(&out).exists());
+}

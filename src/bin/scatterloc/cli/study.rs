@@ -79,6 +79,13 @@ pub struct MontecarloArgs {
     /// process noise 0.5] (docs/multi-target.md).
     #[arg(long, value_name = "N", value_parser = whole)]
     pub targets: Option<usize>,
+    /// With --doppler (issue 42): one filter (--filters, one name) tracks the same truths with
+    /// and without the range rates of each scan's CPI (--cpi, --cpi-spacing-s,
+    /// --range-rate-floor) against the PCRLB of each [defaults: dt 0.1, duration 3, process
+    /// noise 1, runs 200] (docs/doppler.md "Monte Carlo"). --json: per trajectory the curves of
+    /// both arms; --out: the position RMSE beside its bound, delays only and with Doppler.
+    #[command(flatten)]
+    pub doppler: super::DopplerArgs,
 }
 
 /// `scatterloc pcrlb`.

@@ -15,6 +15,7 @@ mod cir_convert;
 mod cir_fig;
 mod cir_follow;
 mod crlb_map;
+mod doppler_study;
 mod filters;
 mod flags;
 mod gating;

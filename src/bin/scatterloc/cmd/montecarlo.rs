@@ -92,6 +92,9 @@ pub fn check_shards(args: &MontecarloArgs, shards: usize, threads: usize) -> Res
 
 /// `scatterloc montecarlo`.
 pub fn montecarlo(args: &MontecarloArgs) -> Result<(), CliError> {
+    if args.doppler.on {
+        return super::doppler_study::doppler_montecarlo(args);
+    }
     if let Some(walkers) = args.targets {
         return super::multi_study::multi_montecarlo(args, walkers);
     }

@@ -64,9 +64,9 @@ fn encode<T: Serialize>(v: &T) -> Result<String, CliError> {
 
 /// The tracking figure ([S] Fig. 3; one or more trackers' labelled RMSE curves beside the
 /// PCRLB) as a [`Figure`].
-struct FiltersFigure<'a> {
-    panels: Vec<FiltersPanel<'a>>,
-    opts: &'a TrackingChartOptions,
+pub(super) struct FiltersFigure<'a> {
+    pub(super) panels: Vec<FiltersPanel<'a>>,
+    pub(super) opts: &'a TrackingChartOptions,
 }
 
 impl Figure for FiltersFigure<'_> {
