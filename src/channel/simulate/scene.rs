@@ -55,6 +55,28 @@ pub struct Body {
     pub shadow_radius_m: f64,
     /// Attenuation of a shadowed path, dB (≥ 0).
     pub shadow_loss_db: f64,
+    /// Micro-Doppler of the limbs (issue 42 §2; 0: off): every second centre (the limbs) swings
+    /// along the heading by `limb_swing_m · sin(2π gait_hz t + kπ/2)` about its place, so its
+    /// velocity adds `2π gait_hz limb_swing_m` at most to the body's — the sidebands of a
+    /// walker's Doppler (Chen 2011, the Boulic–Thalmann gait); m, 0 … 1.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub limb_swing_m: f64,
+    /// The gait's frequency, Hz (0 … 5; a walker's stride is about 1 Hz).
+    #[serde(default = "default_gait_hz", skip_serializing_if = "is_default_gait")]
+    pub gait_hz: f64,
+}
+
+/// A walking person's stride frequency, Hz.
+fn default_gait_hz() -> f64 {
+    1.0
+}
+
+fn is_zero(v: &f64) -> bool {
+    *v == 0.0
+}
+
+fn is_default_gait(v: &f64) -> bool {
+    *v == default_gait_hz()
 }
 
 impl Default for Body {
@@ -65,6 +87,8 @@ impl Default for Body {
             correlation: 0.9,
             shadow_radius_m: 0.3,
             shadow_loss_db: 15.0,
+            limb_swing_m: 0.0,
+            gait_hz: default_gait_hz(),
         }
     }
 }
@@ -115,7 +139,9 @@ impl Body {
             0.0,
             200.0,
             "0 to 200 dB",
-        )
+        )?;
+        range("limb_swing_m", self.limb_swing_m, 0.0, 1.0, "0 to 1 m")?;
+        range("gait_hz", self.gait_hz, 0.0, 5.0, "0 to 5 Hz")
     }
 }
 

@@ -299,6 +299,7 @@ pub(super) fn synthesize_all(
                         lb,
                         &lines,
                         a,
+                        t,
                         p,
                         scenario.target.rcs_m2,
                         scene.double_reflections,

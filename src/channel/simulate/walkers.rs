@@ -12,7 +12,7 @@ use super::signal::{add_path, cis_neg, complex_normal};
 use super::walk::Path;
 use super::{Body, ChannelScene, PathKind, TruePath};
 use crate::error::Result;
-use crate::math::{db_to_linear, sqrt, Complex, Real, Vec2};
+use crate::math::{db_to_linear, sin, sqrt, Complex, Real, Vec2, PI};
 use crate::measure::{rng, Rng};
 
 /// rng stream of the main walker's body fluctuations (the value it has always had).
@@ -104,7 +104,8 @@ impl<'a> Mover<'a> {
         .then_some(self.shadow_amp)
     }
 
-    /// Adds the walker's paths at state `st`, heading `head`, on link `p` (budget `lb`) to the
+    /// Adds the walker's paths at state `st`, heading `head`, time `t_s` (the limbs' swing), on
+    /// link `p` (budget `lb`) to the
     /// response `h` (bins `f0 + n·df`, carrier `fc`) and its truth (direct and via the walls,
     /// at the centre with the full `rcs_m2`); returns how many paths one centre has.
     #[allow(clippy::too_many_arguments)]
@@ -113,6 +114,7 @@ impl<'a> Mover<'a> {
         lb: &LinkBudget,
         lines: &[Line],
         (st, head): ([Real; 4], [Real; 2]),
+        t_s: Real,
         p: usize,
         rcs_m2: Real,
         double_reflections: bool,
@@ -130,8 +132,14 @@ impl<'a> Mover<'a> {
             delay_s,
             power_w,
         }));
+        let swing = self.body.limb_swing_m;
         for k in 0..k_centres {
-            let ck = body_centre(centre, head, k, k_centres, self.body.radius_m);
+            let mut ck = body_centre(centre, head, k, k_centres, self.body.radius_m);
+            if swing > 0.0 && k % 2 == 1 {
+                // A limb: swung along the heading (micro-Doppler, `Body::limb_swing_m`).
+                let phase = 2.0 * PI * self.body.gait_hz * t_s + 0.5 * PI * k as Real;
+                ck += Vec2::new(head[0], head[1]) * (swing * sin(phase));
+            }
             scratch.clear();
             body_paths(lb, lines, ck, self.rcs_centre, double_reflections, scratch);
             let g = self.fluct[p * k_centres + k];

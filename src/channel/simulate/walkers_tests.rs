@@ -104,6 +104,7 @@ fn a_further_walker_adds_its_own_paths_only() {
                 &lb,
                 &[],
                 at,
+                t,
                 p,
                 sc.target.rcs_m2,
                 true,
