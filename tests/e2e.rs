@@ -175,6 +175,10 @@ mod page_multi_export;
 #[cfg(test)]
 #[path = "e2e/page_nees.rs"]
 mod page_nees;
+/// Issue 42 §2: the channel view's CPI snapshots give the CLI's range rates (EST.json).
+#[cfg(test)]
+#[path = "e2e/page_channel_doppler.rs"]
+mod page_channel_doppler;
 /// Issue 40 §3: Replay, the recording through the live run, equals the batch run; Stop.
 #[cfg(test)]
 #[path = "e2e/page_replay.rs"]

@@ -85,10 +85,11 @@ fn channel_defaults_and_ranges_are_the_cores() {
     assert!(errors.is_empty(), "console errors: {errors:?}");
     for s in &table {
         let got = &defaults[page_key(s.key)];
-        let want = if s.default.is_null() {
-            json!("auto")
-        } else {
-            s.default.clone()
+        // No default: a choice shows `auto`, a number its lower end (cpi_snapshots: 1, off).
+        let want = match (&s.kind, s.default.is_null()) {
+            (SettingKind::Choice { .. }, true) => json!("auto"),
+            (SettingKind::Number(b) | SettingKind::Integer(b), true) => json!(b.min),
+            (_, false) => s.default.clone(),
         };
         let same = match (got.as_f64(), want.as_f64()) {
             (Some(a), Some(b)) => a == b,

@@ -398,6 +398,8 @@ fn channel_view_simulate_run_stop_scrub_save() {
         ("statics", json!("background")),
         ("delay_reference", json!("auto")),
         ("background_time_s", json!(10)),
+        ("cpi_snapshots", json!(1)),
+        ("range_rate_floor_mps", json!(0.1)),
         ("calibration", json!("file")),
     ] {
         assert_eq!(s[k], v, "setting {k}: {s}");

@@ -197,6 +197,8 @@ const FIELDS: &[&str] = &[
     "channel.statics",
     "channel.delay_reference",
     "channel.background_time_s",
+    "channel.cpi_snapshots",
+    "channel.range_rate_floor_mps",
     "channel.targets",
     "channel.calibration",
     "channel.empty_from_s",
@@ -329,6 +331,8 @@ async fn set_everything(c: &Client) -> Result<(), String> {
         ("chan-max-paths", "9"),
         ("chan-extent", "0.3"),
         ("chan-bg-time", "25"),
+        ("chan-cpi", "4"),
+        ("chan-rr-floor", "0.05"),
     ] {
         type_in(c, id, v).await?;
     }

@@ -23,6 +23,8 @@ export const INPUTS = [
   ['max_paths', 'chan-max-paths', 'max paths'],
   ['extent_sigma_m', 'chan-extent', 'extent σ'],
   ['background_time_s', 'chan-bg-time', 'background τ'],
+  ['cpi_snapshots', 'chan-cpi', 'CPI snapshots'],
+  ['range_rate_floor_mps', 'chan-rr-floor', 'range-rate floor'],
   ['empty_from_s', 'chan-empty-from', 'empty from'],
   ['empty_to_s', 'chan-empty-to', 'empty to'],
 ];

@@ -14,12 +14,12 @@ export const SIMULATE_SETTINGS = { duration_s: 15, dt_s: 0.05 };
 
 /** The settings a run depends on (a change after a run says so). */
 const RUN_KEYS = ['filter', 'particles', 'seed', 'process_noise', 'p_fa', 'max_paths', 'extent_sigma_m',
-  'statics', 'delay_reference', 'background_time_s', 'calibration', 'empty_from_s', 'empty_to_s', 'targets'];
+  'statics', 'delay_reference', 'background_time_s', 'cpi_snapshots', 'range_rate_floor_mps', 'calibration', 'empty_from_s', 'empty_to_s', 'targets'];
 /** The run's settings as the status line names them when they change. */
 const RUN_LABELS = {
   filter: 'filter', particles: 'particles', seed: 'seed', process_noise: 'q', p_fa: 'P_fa', max_paths: 'max paths',
   extent_sigma_m: 'extent σ', statics: 'statics', delay_reference: 'delays', background_time_s: 'background τ',
-  calibration: 'empty area', empty_from_s: 'empty from', empty_to_s: 'empty to', targets: 'people',
+  cpi_snapshots: 'CPI snapshots', range_rate_floor_mps: 'range-rate floor', calibration: 'empty area', empty_from_s: 'empty from', empty_to_s: 'empty to', targets: 'people',
 };
 
 /**
@@ -210,6 +210,10 @@ export const channelRun = {
       max_paths: s.max_paths, pfa: s.p_fa, filter: s.filter, process_noise: s.process_noise,
       extent_sigma_m: s.extent_sigma_m, statics: s.statics, background_time_s: s.background_time_s,
     };
+    // 1 snapshot per scan: no CPI (the request's default, as `cir estimate` without --cpi-snapshots).
+    if (s.cpi_snapshots > 1) {
+      Object.assign(out, { cpi_snapshots: s.cpi_snapshots, range_rate_floor_mps: s.range_rate_floor_mps });
+    }
     if (s.delay_reference !== 'auto') out.delay_reference = s.delay_reference;
     if (s.filter === 'pf') Object.assign(out, { particles: s.particles, seed: s.seed });
     if (s.calibration === 'range') out.calibration_range_s = [s.empty_from_s, s.empty_to_s];

@@ -46,6 +46,8 @@ const PAGE_FIELDS = [
 function allowedText({ min, max, integer, open }, unit, symbol) {
   if (integer) return `an integer ${min} … ${max}`;
   const u = unit ? ` ${unit}` : '';
+  // No upper end (the core's largest finite number): `σ_floor ≥ 0 m/s`.
+  if (max === Number.MAX_VALUE && !open[1]) return `${symbol} ${open[0] ? '>' : '≥'} ${min}${u}`;
   if (!open[0] && !open[1]) return `${min} … ${max}${u}`;
   return `${min} ${open[0] ? '<' : '≤'} ${symbol} ${open[1] ? '<' : '≤'} ${max}${u}`;
 }
@@ -63,9 +65,11 @@ function coreField(e) {
       : [key, 'choice', e.default, { values: e.values }];
   }
   const integer = e.kind === 'integer';
+  // A number whose default is none takes its lower end (cpi_snapshots: 1, no CPI).
+  const def = e.default ?? e.min;
   const range = { min: e.min, max: integer ? Math.min(e.max, Number.MAX_SAFE_INTEGER) : e.max, integer, open: e.open };
   range.allowed = allowedText(range, e.unit, e.symbol);
-  return [key, 'number', e.default, range];
+  return [key, 'number', def, range];
 }
 
 let fields = null;
@@ -74,7 +78,8 @@ let fields = null;
  * Every setting: [key, kind ('number' | 'choice'), default, check]. Numbers are checked with
  * `check` {min, max, integer, open: [lo open, hi open], allowed (text)}, choices with {values}.
  * The core's settings first (filter, particles, seed, process_noise, p_fa, max_paths,
- * extent_sigma_m, statics, delay_reference, background_time_s: the core's order), then the
+ * extent_sigma_m, statics, delay_reference, background_time_s, cpi_snapshots, range_rate_floor_mps:
+ * the core's order), then the
  * page's (PAGE_FIELDS).
  */
 export function channelFields() {

@@ -413,6 +413,12 @@ impl ChannelRequest {
     /// [`super::channel_settings`] lists for the page.
     pub fn check(&self) -> Result<()> {
         limits::FALSE_ALARM_PROBABILITY.check("pfa", self.pfa)?;
+        // The floor is checked with or without a CPI (as the CLI's flag is).
+        FrontEndCpi {
+            snapshots: 2,
+            floor_mps: self.range_rate_floor_mps,
+        }
+        .validate()?;
         self.front_end(None).validate()?;
         self.filter_kind()?;
         ConstantVelocity::validated(1.0, self.process_noise)?;

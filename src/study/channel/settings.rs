@@ -13,6 +13,7 @@ use serde_json::Value;
 
 use super::request::{ChannelRequest, DelayReference, StaticMode, DEFAULT_SEED};
 use crate::error::limits::{self, OpenRange, Range};
+use crate::measure::MAX_CPI_SNAPSHOTS;
 use crate::track::{FilterKind, PfConfig, UkfParams, MAX_PARTICLES};
 
 /// One setting of a [`ChannelRequest`] (JSON: `{key, kind, …the kind's fields, default,
@@ -108,7 +109,8 @@ impl Bounds {
 
 /// The settings of a [`ChannelRequest`] the page's channel view shows, in its panel's order:
 /// `filter`, `particles`, `seed`, `process_noise`, `pfa`, `max_paths`, `extent_sigma_m`,
-/// `statics`, `delay_reference`, `background_time_s` (the request's other fields — the UKF's
+/// `statics`, `delay_reference`, `background_time_s`, `cpi_snapshots`, `range_rate_floor_mps`
+/// (the request's other fields — the UKF's
 /// parameters, roughening, bootstrap, association, sigma — are the CLI's and Python's only).
 pub fn channel_settings() -> Vec<ChannelSetting> {
     let d = ChannelRequest::default();
@@ -186,6 +188,28 @@ pub fn channel_settings() -> Vec<ChannelSetting> {
             "background_time_s",
             SettingKind::Number(Bounds::closed(limits::BACKGROUND_TIME_S, "s", "τ_bg")),
             Value::from(d.background_time_s),
+            None,
+        ),
+        // 1 (or none) is no CPI; 2 … MAX_CPI_SNAPSHOTS are checked by `FrontEndCpi::validate`
+        // (whose error names the range 2 …, the off value 1 aside).
+        setting(
+            "cpi_snapshots",
+            SettingKind::Integer(Bounds::count(1, MAX_CPI_SNAPSHOTS as u64, "N")),
+            d.cpi_snapshots.map_or(Value::Null, Value::from),
+            None,
+        ),
+        // Checked with a CPI on (`FrontEndCpi::validate`): finite and ≥ 0, no upper end.
+        setting(
+            "range_rate_floor_mps",
+            SettingKind::Number(Bounds {
+                min: 0.0,
+                max: f64::MAX,
+                open: [false, false],
+                allowed: "a finite floor ≥ 0 m/s".into(),
+                unit: "m/s",
+                symbol: "σ_floor",
+            }),
+            Value::from(d.range_rate_floor_mps),
             None,
         ),
     ])

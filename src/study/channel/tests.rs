@@ -14,15 +14,19 @@ fn request(s: &ChannelSetting, v: Value) -> crate::Result<ChannelRequest> {
     if let Some(f) = s.filter {
         obj.insert("filter".to_string(), Value::from(f));
     }
+    // The floor is checked with a CPI on only (`FrontEndCpi::validate`).
+    if s.key == "range_rate_floor_mps" {
+        obj.insert("cpi_snapshots".to_string(), Value::from(2));
+    }
     obj.insert(s.key.to_string(), v);
     ChannelRequest::from_json(&Value::Object(obj).to_string())
 }
 
 /// `v` is refused naming the setting (a value the field's type cannot hold — a negative or
-/// too large count — is refused by the parser).
+/// too large count, a non-finite number, which JSON writes as `null` — is refused by the parser).
 fn refused(s: &ChannelSetting, v: Value) {
     let e = request(s, v.clone()).expect_err(&alloc::format!("{} = {v} accepted", s.key));
-    let unholdable = matches!(s.kind, SettingKind::Integer(_)) && !v.is_u64();
+    let unholdable = (matches!(s.kind, SettingKind::Integer(_)) && !v.is_u64()) || v.is_null();
     match e {
         Error::Parse { .. } if unholdable => {}
         e => assert_eq!(e.field(), Some(s.key), "{} = {v}: {e}", s.key),
@@ -51,6 +55,8 @@ fn settings_table_is_the_checks() {
         "max_paths",
         "extent_sigma_m",
         "background_time_s",
+        "cpi_snapshots",
+        "range_rate_floor_mps",
     ] {
         assert!(table.iter().any(|s| s.key == key), "{key} missing");
     }
@@ -131,4 +137,7 @@ fn settings_table_is_the_checks() {
         serde_json::json!(["ekf", "ukf", "pf"])
     );
     assert_eq!(entry("delay_reference")["default"], Value::Null);
+    assert_eq!(entry("cpi_snapshots")["default"], Value::Null);
+    assert_eq!(entry("cpi_snapshots")["kind"], "integer");
+    assert_eq!(entry("range_rate_floor_mps")["kind"], "number");
 }
