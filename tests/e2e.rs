@@ -150,6 +150,10 @@ mod page_heights;
 #[cfg(test)]
 #[path = "common/nees.rs"]
 mod nees;
+/// Issue 42 §2: the channel view's CPI snapshots give the CLI's range rates (EST.json).
+#[cfg(test)]
+#[path = "e2e/page_channel_doppler.rs"]
+mod page_channel_doppler;
 /// Issue 41 §2: "People: several" in the channel view equals `cir track --targets auto`.
 #[cfg(test)]
 #[path = "e2e/page_channel_multi.rs"]
@@ -175,10 +179,6 @@ mod page_multi_export;
 #[cfg(test)]
 #[path = "e2e/page_nees.rs"]
 mod page_nees;
-/// Issue 42 §2: the channel view's CPI snapshots give the CLI's range rates (EST.json).
-#[cfg(test)]
-#[path = "e2e/page_channel_doppler.rs"]
-mod page_channel_doppler;
 /// Issue 40 §3: Replay, the recording through the live run, equals the batch run; Stop.
 #[cfg(test)]
 #[path = "e2e/page_replay.rs"]

@@ -138,10 +138,13 @@ impl LinkMotion {
         let (zt, zr) = network.link_dz(p);
         let (ut, dt) = unit_from_dz(tx, zt, r);
         let (ur, dr) = unit_from_dz(rx, zr, r);
+        // `1/d` beside `û = (r − node)/d` (both from `d` alone), so `P v/d` is a product, not a
+        // second division after `û` (issue 42 §4: a shorter dependency chain per link).
+        let inv = [1.0 / dt, 1.0 / dr];
         let mut rate_gradient_r = Vec2::zeros();
-        for (u, d) in [(ut, dt), (ur, dr)] {
+        for (u, i) in [(ut, inv[0]), (ur, inv[1])] {
             if u != Vec2::zeros() {
-                rate_gradient_r += (v - u * u.dot(&v)) / d;
+                rate_gradient_r += (v - u * u.dot(&v)) * i;
             }
         }
         let g = ut + ur;

@@ -276,18 +276,27 @@ pub(crate) fn rows(
             used = true;
         }
         if let Some(rate) = rate {
-            let s = match rates.noise {
-                RateNoise::Cpi(c) => c.sigma_range_rate(snr_of(&g)),
-                other => other.sigma(model, p, &g),
+            // `1/σ_ṙ²`; the CPI's (D5) without forming its square root, the rate skipped where
+            // `σ_ṙ` is not finite and positive (no Doppler information).
+            let w = match rates.noise {
+                RateNoise::Cpi(c) => {
+                    let f = c.doppler_information(snr_of(&g));
+                    let var = c.wavelength_m * c.wavelength_m / f + c.floor_mps * c.floor_mps;
+                    (f > 0.0 && positive_finite(var)).then(|| 1.0 / var)
+                }
+                other => {
+                    let s = other.sigma(model, p, &g);
+                    positive_finite(s).then(|| 1.0 / (s * s))
+                }
             };
-            if positive_finite(s) {
+            if let Some(w) = w {
                 row(
                     p,
                     Row {
                         rate: true,
                         z: rate,
                         h: g.rate_row(),
-                        w: 1.0 / (s * s),
+                        w,
                         nu: rate - g.range_rate_mps,
                     },
                 );

@@ -1,20 +1,25 @@
 //! The EKF's delay-and-Doppler update (issue 42 §3; D3, D8; S17): the rows of
 //! [`rows`](crate::track::doppler) see the velocity, so the batch update of the [`ekf`](super)
-//! module runs in the full 4-D state instead of the position plane — the same push-through
-//! identity with `Π = I`: `M = Hᵀ R⁻¹ H`, `b = Hᵀ R⁻¹ ν`, `N = (I + M P⁻)⁻¹`,
-//! `x̂ = x̂⁻ + P⁻ N b`, Joseph form `P = P⁻ − P⁻ Z P⁻` with
-//! `Z = N M + (N M)ᵀ − N (M + M P⁻ M) Nᵀ`, and `NIS = νᵀ R⁻¹ ν − bᵀ P⁻ N b`. One 4 × 4 inverse,
-//! no `m × m` solve, no allocation. The covariance is computed as the equal
-//! `(I − A M) P⁻ (I − A M)ᵀ + A M Aᵀ` with `A = P⁻ N` (`K H = A M`), on its upper triangle, and
-//! `M` is accumulated on its upper triangle (issue 42 §4: fewer products, the same matrices up
-//! to rounding).
+//! module runs in the full 4-D state instead of the position plane — the posterior of
+//! `M = Hᵀ R⁻¹ H`, `b = Hᵀ R⁻¹ ν`: `P = (P⁻⁻¹ + M)⁻¹`, `x̂ = x̂⁻ + P b` and
+//! `NIS = νᵀ R⁻¹ ν − bᵀ P b`, the push-through identity's `P = P⁻ N`, `N = (I + M P⁻)⁻¹`.
+//!
+//! It is computed in factored form (issue 42 §4), no general inverse and no allocation:
+//! `P⁻ = L D Lᵀ` (`L` unit lower triangular, `D > 0` diagonal), each row `h` turned into
+//! `Lᵀ h` as it arrives so `Y = D⁻¹ + Lᵀ M L` is accumulated on its upper triangle, then
+//! `Y = K E Kᵀ` and, with `V = K⁻¹ Lᵀ`, `P = Vᵀ E⁻¹ V` (on its upper triangle; `P⁻ Y P⁻`-free).
+//! `Y` is `D^{-1/2} (I + D^{1/2} Lᵀ M L D^{1/2}) D^{-1/2}`, a matrix of eigenvalues ≥ 1 scaled
+//! by a diagonal, which elimination without pivoting does not feel: the factorisation is as
+//! well conditioned as the Joseph form's `N`, and the posterior is a sum of positive
+//! semidefinite terms `v_k v_kᵀ / e_k`, symmetric by construction and positive definite even
+//! when it is 10⁻⁶ of the prior. Its positive-definiteness is tested as before.
 
 use super::Ekf;
 use crate::error::{Error, Result};
 use crate::math::{Mat4, Real, Vec4};
 use crate::measure::Model;
 use crate::track::doppler::{check_rates, rows, RangeRates};
-use crate::track::shared::{Ldl4, NO_UPDATE};
+use crate::track::shared::{positive_finite, Ldl4, NO_UPDATE};
 use crate::track::{Filter, MeasurementNoise, UpdateSummary};
 
 impl Ekf {
@@ -31,24 +36,48 @@ impl Ekf {
         rates: &RangeRates,
     ) -> Result<UpdateSummary> {
         check_rates(model, z, noise, rates, self.position())?;
-        // `M = Hᵀ R⁻¹ H`, accumulated on its upper triangle (the lower is its mirror): a
-        // delay row `[g, 0]` touches the position block only.
-        let (mut u, mut b, mut chi2) = ([0.0; 10], Vec4::zeros(), 0.0);
+        let not_pd = || Error::NotPositiveDefinite {
+            field: "ekf.covariance".into(),
+        };
+        // `P⁻ = L D Lᵀ` of the symmetrised prior.
+        let c = &self.covariance;
+        let mut prior = [0.0; 10];
+        let mut k = 0;
+        for i in 0..4 {
+            for j in i..4 {
+                prior[k] = (c[(i, j)] + c[(j, i)]) * 0.5;
+                k += 1;
+            }
+        }
+        let prior = Ldl::new(&prior).ok_or_else(not_pd)?;
+        // `Y − D⁻¹ = Lᵀ M L = Σ w (Lᵀh)(Lᵀh)ᵀ` on its upper triangle; a delay row `[g, 0]`
+        // stays `[g₀ + l₁₀ g₁, g₁, 0, 0]` and touches 3 entries.
+        let l = &prior.l;
+        let (mut y, mut b, mut chi2) = ([0.0; 10], Vec4::zeros(), 0.0);
         let links = rows(model, &self.state, z, noise, rates, |_, row| {
             let h = row.h;
             let wh = h * row.w;
             if row.rate {
+                let t = Vec4::new(
+                    h[0] + l[0][1] * h[1] + l[0][2] * h[2] + l[0][3] * h[3],
+                    h[1] + l[1][2] * h[2] + l[1][3] * h[3],
+                    h[2] + l[2][3] * h[3],
+                    h[3],
+                );
+                let wt = t * row.w;
                 let mut k = 0;
                 for i in 0..4 {
                     for j in i..4 {
-                        u[k] += wh[i] * h[j];
+                        y[k] += wt[i] * t[j];
                         k += 1;
                     }
                 }
             } else {
-                u[0] += wh[0] * h[0];
-                u[1] += wh[0] * h[1];
-                u[4] += wh[1] * h[1];
+                let t0 = h[0] + l[0][1] * h[1];
+                let wt0 = t0 * row.w;
+                y[0] += wt0 * t0;
+                y[1] += wt0 * h[1];
+                y[4] += wh[1] * h[1];
             }
             b += wh * row.nu;
             chi2 += row.w * row.nu * row.nu;
@@ -56,21 +85,39 @@ impl Ekf {
         if links == 0 {
             return Ok(NO_UPDATE);
         }
-        let m = symmetric(&u);
-        let not_pd = || Error::NotPositiveDefinite {
-            field: "ekf.covariance".into(),
-        };
-        let p = (self.covariance + self.covariance.transpose()) * 0.5;
-        let n = (Mat4::identity() + m * p)
-            .try_inverse()
-            .ok_or_else(not_pd)?;
-        // `A = P⁻ N` (the information form's posterior), `K H = A M`; the Joseph form
-        // `(I − A M) P⁻ (I − A M)ᵀ + A M Aᵀ` is `P⁻ − P⁻ Z P⁻` of the module docs.
-        let a = p * n;
-        let am = a * m;
-        let t = Mat4::identity() - am;
-        let covariance = upper_sum(&(t * p), &t, &am, &a);
-        let gain = a * b;
+        for (i, k) in [0, 4, 7, 9].into_iter().enumerate() {
+            y[k] += prior.inv[i];
+        }
+        // `Y = K E Kᵀ`; `V = K⁻¹ Lᵀ` (rows `v_k`), `P = Σ_k v_k v_kᵀ / e_k`.
+        let post = Ldl::new(&y).ok_or_else(not_pd)?;
+        let kinv = post.unit_inverse();
+        let mut v = [[0.0; 4]; 4];
+        for (r, vr) in v.iter_mut().enumerate() {
+            for (j, vrj) in vr.iter_mut().enumerate() {
+                // `Σ_i K⁻¹[r][i] Lᵀ[i][j]` over `i ≤ min(r, j)`, both unit triangular.
+                let mut s = if r <= j { l[r][j] } else { kinv[r][j] };
+                for i in 0..r.min(j) {
+                    s += kinv[r][i] * l[i][j];
+                }
+                *vrj = s;
+            }
+        }
+        let v = Mat4::from_fn(|r, c| v[r][c]);
+        let w = Mat4::from_fn(|r, c| v[(r, c)] * post.inv[r]);
+        let mut u = [0.0; 10];
+        let mut k = 0;
+        for i in 0..4 {
+            for j in i..4 {
+                u[k] = v[(0, i)] * w[(0, j)]
+                    + v[(1, i)] * w[(1, j)]
+                    + v[(2, i)] * w[(2, j)]
+                    + v[(3, i)] * w[(3, j)];
+                k += 1;
+            }
+        }
+        let covariance = symmetric(&u);
+        // `x̂ − x̂⁻ = P b = Vᵀ E⁻¹ (V b)`, `bᵀ P b = Σ (V b)_k² / e_k`.
+        let gain = w.tr_mul(&(v * b));
         let state = self.state + gain;
         let nis = chi2 - b.dot(&gain);
         if state.iter().any(|v| !v.is_finite()) || Ldl4::new(&covariance).is_none() {
@@ -85,6 +132,58 @@ impl Ekf {
     }
 }
 
+/// `A = L D Lᵀ` of a symmetric 4 × 4 matrix given by its upper triangle (row by row), `L` unit
+/// lower triangular stored transposed (`l[j][i] = L_ij`, `j < i`), with `1/d_i`; `None` unless
+/// every pivot is finite and positive.
+struct Ldl {
+    l: [[Real; 4]; 4],
+    inv: [Real; 4],
+}
+
+impl Ldl {
+    #[inline(always)]
+    fn new(a: &[Real; 10]) -> Option<Ldl> {
+        let pivot = |d: Real| positive_finite(d).then(|| 1.0 / d);
+        let i0 = pivot(a[0])?;
+        let (l10, l20, l30) = (a[1] * i0, a[2] * i0, a[3] * i0);
+        let i1 = pivot(a[4] - l10 * a[1])?;
+        let a21 = a[5] - l20 * a[1];
+        let a31 = a[6] - l30 * a[1];
+        let (l21, l31) = (a21 * i1, a31 * i1);
+        let i2 = pivot(a[7] - l20 * a[2] - l21 * a21)?;
+        let a32 = a[8] - l30 * a[2] - l31 * a21;
+        let l32 = a32 * i2;
+        let i3 = pivot(a[9] - l30 * a[3] - l31 * a31 - l32 * a32)?;
+        Some(Ldl {
+            l: [
+                [1.0, l10, l20, l30],
+                [0.0, 1.0, l21, l31],
+                [0.0, 0.0, 1.0, l32],
+                [0.0, 0.0, 0.0, 1.0],
+            ],
+            inv: [i0, i1, i2, i3],
+        })
+    }
+
+    /// `L⁻¹` (unit lower triangular, `[r][c]`, `c < r` meaningful).
+    #[inline(always)]
+    fn unit_inverse(&self) -> [[Real; 4]; 4] {
+        let l = &self.l;
+        let n10 = -l[0][1];
+        let n21 = -l[1][2];
+        let n32 = -l[2][3];
+        let n20 = -l[0][2] - l[1][2] * n10;
+        let n31 = -l[1][3] - l[2][3] * n21;
+        let n30 = -l[0][3] - l[1][3] * n10 - l[2][3] * n20;
+        [
+            [1.0, 0.0, 0.0, 0.0],
+            [n10, 1.0, 0.0, 0.0],
+            [n20, n21, 1.0, 0.0],
+            [n30, n31, n32, 1.0],
+        ]
+    }
+}
+
 /// The symmetric matrix of upper triangle `u` (row by row: `m00 m01 m02 m03 m11 m12 …`).
 #[inline(always)]
 fn symmetric(u: &[Real; 10]) -> Mat4 {
@@ -94,27 +193,4 @@ fn symmetric(u: &[Real; 10]) -> Mat4 {
         u[2], u[5], u[7], u[8], //
         u[3], u[6], u[8], u[9],
     )
-}
-
-/// `X Yᵀ + V Wᵀ`, computed on the upper triangle and mirrored (the Joseph form's two terms,
-/// symmetric by construction).
-#[inline(always)]
-fn upper_sum(x: &Mat4, y: &Mat4, v: &Mat4, w: &Mat4) -> Mat4 {
-    let mut u = [0.0; 10];
-    let mut k = 0;
-    for i in 0..4 {
-        for j in i..4 {
-            let mut s = 0.0;
-            for l in 0..4 {
-                s += x[(i, l)] * y[(j, l)];
-            }
-            let mut q = 0.0;
-            for l in 0..4 {
-                q += v[(i, l)] * w[(j, l)];
-            }
-            u[k] = s + q;
-            k += 1;
-        }
-    }
-    symmetric(&u)
 }
