@@ -39,9 +39,19 @@ fn channel_settings_are_the_cores() {
             "extent_sigma_m",
             "statics",
             "delay_reference",
-            "background_time_s"
+            "background_time_s",
+            "cpi_snapshots",
+            "range_rate_floor_mps"
         ]
     );
+    // Issue 42: the CPI of the front end (off by default) and the floor on the rates' σ.
+    let cpi = entry("cpi_snapshots");
+    assert_eq!(cpi["kind"], "integer");
+    assert_eq!(cpi["default"], serde_json::Value::Null);
+    assert_eq!(cpi["max"], scatterloc::measure::MAX_CPI_SNAPSHOTS as f64);
+    let floor = entry("range_rate_floor_mps");
+    assert_eq!(floor["kind"], "number");
+    assert_eq!(floor["default"], d.range_rate_floor_mps);
     let pfa = entry("pfa");
     assert_eq!(pfa["kind"], "number");
     assert_eq!(pfa["default"], d.pfa);
