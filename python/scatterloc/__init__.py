@@ -16,7 +16,8 @@ Delay and Doppler (docs/doppler.md)
     :func:`crlb_doppler`, :func:`doppler_map` (the bound over a grid), :func:`range_rates`
     (and their Jacobian), :func:`sigma_range_rates` (a CPI's sigma)
 Tracking
-    :func:`track`, :func:`calibrate`, :func:`montecarlo`, :func:`pcrlb`
+    :func:`track` (with range rates: ``Track.doppler``, a :class:`TrackDoppler`),
+    :func:`calibrate`, :func:`montecarlo`, :func:`pcrlb`
 Planning and multi-target
     :func:`plan`, :func:`mtl_locate`, :func:`gospa` (the GOSPA metric), :func:`track_multi`
     (several people, PMB or GNN), :func:`simulate_people`
@@ -51,6 +52,7 @@ from ._scatterloc import (
     StaticCalibration,
     StudyResult,
     Track,
+    TrackDoppler,
     TrackStream,
     __version__,
     calibrate,
@@ -98,6 +100,7 @@ __all__ = [
     "StaticCalibration",
     "StudyResult",
     "Track",
+    "TrackDoppler",
     "TrackStream",
     "__version__",
     "calibrate",

@@ -35,6 +35,7 @@ __all__ = [
     "StaticCalibration",
     "StudyResult",
     "Track",
+    "TrackDoppler",
     "TrackStream",
     "__version__",
     "_bench",
@@ -339,8 +340,27 @@ class Track:
     def static_removed(self) -> Optional[_I64]: ...
     @property
     def start(self) -> Optional[dict[str, Any]]: ...
+    @property
+    def doppler(self) -> Optional[TrackDoppler]: ...
     def to_dict(self) -> dict[str, Any]: ...
     def __len__(self) -> int: ...
+
+@final
+class TrackDoppler:
+    """How a track used its range rates (issue 42 §5): whether, their σ, and per step the
+    predicted range rates and their innovations (m/s)."""
+
+    @property
+    def used(self) -> bool: ...
+    @property
+    def sigma(self) -> Literal["fixed", "cpi", "cpi_at"]: ...
+    @property
+    def cpi(self) -> Optional[dict[str, Any]]: ...
+    @property
+    def predicted_range_rates(self) -> Optional[_F64]: ...
+    @property
+    def range_rate_innovations(self) -> Optional[_Masked]: ...
+    def to_dict(self) -> dict[str, Any]: ...
 
 def track(
     scenario: _ScenarioLike,
@@ -365,6 +385,12 @@ def track(
     calibration: Optional[Union[StaticCalibration, Mapping[str, Any], _PathLike]] = None,
     association: Optional[Literal["spec", "gated"]] = None,
     max_cpu_hours: Optional[float] = None,
+    range_rates: Optional[ArrayLike] = None,
+    range_rate_sigma: Optional[Union[float, ArrayLike]] = None,
+    cpi: Optional[int] = None,
+    cpi_spacing_s: Optional[float] = None,
+    range_rate_floor: Optional[float] = None,
+    doppler: Optional[bool] = None,
 ) -> Track: ...
 
 @final

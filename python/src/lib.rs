@@ -11,7 +11,8 @@
 //! - `scenario`: `Scenario` (the core's `present::Session`).
 //! - `snapshot`: `crlb`, `crlb_map`, `locate`.
 //! - `doppler`: `crlb_doppler`, `doppler_map`, `range_rates`, `sigma_range_rates` (issue 42).
-//! - `tracking`: `track`, `calibrate` and the filter settings.
+//! - `tracking`: `track`, `calibrate` and the filter settings; `track_doppler`: range rates in
+//!   `track` (issue 42 §5).
 //! - `studies`: `montecarlo`, `pcrlb`.
 //! - `planning`: `plan`.
 //! - `mtl`: `mtl_locate`.
@@ -43,6 +44,7 @@ mod scenario;
 mod snapshot;
 mod stream;
 mod studies;
+mod track_doppler;
 mod tracking;
 
 use pyo3::prelude::*;
@@ -59,6 +61,7 @@ fn _scatterloc(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<snapshot::Fix>()?;
     m.add_class::<tracking::Track>()?;
     m.add_class::<tracking::StaticCalibration>()?;
+    m.add_class::<track_doppler::TrackDoppler>()?;
     m.add_class::<studies::Curves>()?;
     m.add_class::<studies::StudyResult>()?;
     m.add_class::<planning::Plan>()?;

@@ -1,7 +1,8 @@
 //! Tracking: `track` (a delay sequence, or raw estimates gated and associated, through the
 //! EKF, UKF or particle filter — the library's `study::track_measurements`, as `scatterloc
 //! track`) and `calibrate` (the static paths of the empty area, spec §4, as `scatterloc
-//! calibrate`), plus the filter settings shared with the studies.
+//! calibrate`), plus the filter settings shared with the studies. Range rates (issue 42 §5) in
+//! `track`: `track_doppler`.
 
 use pyo3::prelude::*;
 
@@ -20,6 +21,7 @@ use crate::detections::PyDetections;
 use crate::errors::{arg_error, Core};
 use crate::run::run_sized;
 use crate::scenario::{read_text, scenario_arg};
+use crate::track_doppler::{doppler_object, RateArgs, TrackDoppler};
 
 /// The filter settings of `track`, `cir_track` and `montecarlo` as given (None = not given):
 /// the library's [`FilterSettings`], which refuses a setting of a filter that is not run.
@@ -199,7 +201,8 @@ fn raw_step(obj: &Bound<'_, PyAny>, field: &str, links: usize) -> PyResult<RawSt
 
 /// A track (returned by `track`): per step (after its update) the time, the state and its
 /// covariance, the NIS and the links used; with raw estimates also the delays used, how each
-/// link was chosen and the static estimates removed.
+/// link was chosen and the static estimates removed; with range rates how they were used
+/// (`doppler`).
 #[pyclass(module = "scatterloc", frozen)]
 pub struct Track {
     /// `t_k = (k + 1) T`, s, shape (S,).
@@ -232,6 +235,10 @@ pub struct Track {
     /// `initial_snapshot` only: the LM fix that started the filter (a dict); else None.
     #[pyo3(get)]
     start: Py<PyAny>,
+    /// With range rates only: how they were used (`TrackDoppler`: the predicted range rates,
+    /// their innovations, the σ); else None.
+    #[pyo3(get)]
+    doppler: Option<Py<TrackDoppler>>,
     out: TrackOutput,
 }
 
@@ -251,8 +258,8 @@ impl Track {
     }
 }
 
-/// The Python object of a track.
-pub fn track_object(py: Python<'_>, out: TrackOutput) -> PyResult<Track> {
+/// The Python object of a track of `n` links.
+pub fn track_object(py: Python<'_>, out: TrackOutput, n: usize) -> PyResult<Track> {
     let s = out.t_s.len();
     let states: Vec<f64> = out.states.iter().flatten().copied().collect();
     let covs: Vec<f64> = out
@@ -291,6 +298,10 @@ pub fn track_object(py: Python<'_>, out: TrackOutput) -> PyResult<Track> {
         Some(st) => to_python(py, st)?.unbind(),
         None => py.None(),
     };
+    let doppler = match &out.doppler {
+        Some(d) => Some(Py::new(py, doppler_object(py, d, n)?)?),
+        None => None,
+    };
     Ok(Track {
         t: array(py, out.t_s.clone(), &[s])?.unbind(),
         states: array(py, states, &[s, 4])?.unbind(),
@@ -301,6 +312,7 @@ pub fn track_object(py: Python<'_>, out: TrackOutput) -> PyResult<Track> {
         choices,
         static_removed,
         start,
+        doppler,
         out,
     })
 }
@@ -318,10 +330,21 @@ pub fn track_object(py: Python<'_>, out: TrackOutput) -> PyResult<Track> {
 ///   associated (`association`: `"spec"` or `"gated"`); start from `initial_state` and
 ///   `initial_covariance`, or from the LM fix of `initial_snapshot` (one raw step at t₀);
 /// - a dict (a measurement file, as `json.load` gives it) or a path to one; the other
-///   measurement arguments must then be absent;
+///   measurement arguments must then be absent (a file with `range_rates_mps` is tracked with
+///   them, as `scatterloc track`);
 /// - `Detections` (docs/detections.md; `scatterloc track --detections`): the first frame
 ///   starts the track (`initial_snapshot`), the others are its raw steps, `dt` their mean
 ///   spacing; `process_noise` (default 1 m²/s³) is the only other measurement argument.
+///
+/// Range rates (issue 42 §5, docs/doppler.md D1, D5), with delays per step only: `range_rates`
+/// an array (S, L), m/s (NaN = missing), their σ fixed by `range_rate_sigma` (m/s, one or per
+/// link) or from a CPI at the prediction: `cpi` snapshots `cpi_spacing_s` apart with the floor
+/// `range_rate_floor` (m/s) (the names of `sigma_range_rates`; any of them given makes the
+/// CPI, the others at 16, 2.048e-3 s and 0.1 m/s; it overrides a file's `cpi` as `track
+/// --doppler --cpi ...`); neither: the file's `cpi`, else that default CPI. Every step then
+/// updates with delays and range rates; `doppler=False` ignores them (the delay-only track, as
+/// `--no-doppler`). The track's `doppler` says how they were used. `doppler` or a CPI argument
+/// without range rates, or a CPI beside a fixed σ, is an error naming the argument.
 ///
 /// `filter` settings (`ukf_alpha`, `ukf_beta`, `ukf_kappa`; `particles`, `roughening`,
 /// `bootstrap`, `seed`) apply to their filter only (an error otherwise, as the CLI's flags).
@@ -333,7 +356,8 @@ pub fn track_object(py: Python<'_>, out: TrackOutput) -> PyResult<Track> {
     initial_covariance = None, initial_snapshot = None, sigma = None, filter = "ekf",
     particles = None, roughening = None, bootstrap = None, seed = None, ukf_alpha = None,
     ukf_beta = None, ukf_kappa = None, calibration = None, association = None,
-    max_cpu_hours = None
+    max_cpu_hours = None, range_rates = None, range_rate_sigma = None, cpi = None,
+    cpi_spacing_s = None, range_rate_floor = None, doppler = None
 ))]
 #[allow(clippy::too_many_arguments)]
 pub fn track(
@@ -357,7 +381,21 @@ pub fn track(
     calibration: Option<&Bound<'_, PyAny>>,
     association: Option<&str>,
     max_cpu_hours: Option<f64>,
+    range_rates: Option<&Bound<'_, PyAny>>,
+    range_rate_sigma: Option<&Bound<'_, PyAny>>,
+    cpi: Option<i64>,
+    cpi_spacing_s: Option<f64>,
+    range_rate_floor: Option<f64>,
+    doppler: Option<bool>,
 ) -> PyResult<Track> {
+    let rate_args = RateArgs {
+        range_rates,
+        range_rate_sigma,
+        cpi,
+        cpi_spacing_s,
+        range_rate_floor,
+        doppler,
+    };
     let sc = scenario_arg(scenario)?;
     let model = sc.model();
     let n = model.link_count();
@@ -376,7 +414,8 @@ pub fn track(
         || measurements.cast::<pyo3::types::PyDict>().is_ok()
         || measurements.cast::<pyo3::types::PyString>().is_ok()
         || measurements.hasattr("__fspath__")?;
-    let m: Measurements = if is_file {
+    let (m, fields) = if is_file {
+        let numpy_rates = rate_args.given_numpy();
         let given = [
             ("dt", dt.is_some()),
             // Detections take the process noise (`track --detections --process-noise`).
@@ -388,6 +427,8 @@ pub fn track(
             ("initial_covariance", initial_covariance.is_some()),
             ("initial_snapshot", initial_snapshot.is_some()),
             ("sigma", sigma.is_some()),
+            numpy_rates[0],
+            numpy_rates[1],
         ];
         if let Some((f, _)) = given.iter().find(|(_, g)| *g) {
             return Err(arg_error(
@@ -401,14 +442,17 @@ pub fn track(
         }
         if let Some(d) = detections {
             let q = process_noise.unwrap_or(DEFAULT_PROCESS_NOISE);
-            d.get().d.to_measurements(model, q).py()?
+            (
+                d.get().d.to_measurements(model, q).py()?,
+                Default::default(),
+            )
         } else {
             let text = if measurements.cast::<pyo3::types::PyDict>().is_ok() {
                 to_json_text(measurements, "measurements")?
             } else {
                 read_text(&crate::convert::path_string(measurements)?, "measurements")?
             };
-            Measurements::from_json(text.trim_start_matches('\u{feff}')).py()?
+            Measurements::from_json_with_rates(text.trim_start_matches('\u{feff}')).py()?
         }
     } else {
         let dt = dt.ok_or_else(|| arg_error("dt", "required with delays or raw estimates"))?;
@@ -480,7 +524,9 @@ pub fn track(
         let initial_snapshot = initial_snapshot
             .map(|s| raw_step(s, "initial_snapshot", n))
             .transpose()?;
-        Measurements {
+        let rows = steps.as_ref().map_or(0, Vec::len);
+        let fields = rate_args.fields(steps.is_some(), rows, n)?;
+        let m = Measurements {
             dt_s: dt,
             process_noise: q,
             initial_state,
@@ -489,8 +535,13 @@ pub fn track(
             sigma_s,
             steps,
             raw_steps,
-        }
+        };
+        (m, fields)
     };
+    // The range rates (the file's, or the arguments'), checked, and the CPIs of their σ.
+    let carrier_hz = sc.scenario().radio.carrier_hz;
+    let rates = fields.check(&m, n, carrier_hz).py()?;
+    let (caller_cpi, default_cpi) = rate_args.cpis(rates.as_ref(), carrier_hz)?;
     let raw = m.raw_steps.is_some();
     if !raw && (calibration.is_some() || association.is_some()) {
         return Err(arg_error(
@@ -527,9 +578,18 @@ pub fn track(
         seed: seed.unwrap_or(1),
     };
     // A short track (the usual call in a loop) runs on this thread: no worker to start.
+    let use_rates = doppler != Some(false);
     let out = run_sized(py, predicted_s, steps, None, |job| {
         let stop = || job.cancelled();
-        track_measurements_in(&req, Cancel::when(&stop))
+        match &rates {
+            Some(r) => req.track_with_rates(
+                r.rates_mps,
+                r.sigma.noise(caller_cpi, default_cpi),
+                use_rates,
+                Cancel::when(&stop),
+            ),
+            None => track_measurements_in(&req, Cancel::when(&stop)),
+        }
     })?;
-    track_object(py, out)
+    track_object(py, out, n)
 }

@@ -17,7 +17,7 @@ use crate::error::{limits, Error, Result};
 use crate::math::{Mat4, Real, Vec4};
 use crate::measure::{Cpi, DEFAULT_RANGE_RATE_FLOOR_MPS};
 use crate::scenario::parse_json;
-use crate::track::{ConstantVelocity, MAX_STEPS};
+use crate::track::{ConstantVelocity, RateNoise, MAX_STEPS};
 
 /// One raw estimate of a measurements file: `[delay_s, amplitude]`, or `[delay_s, amplitude,
 /// sigma_s]` when the estimator gives the delay's standard deviation (`cir estimate` does, C5);
@@ -382,6 +382,38 @@ impl RateSigma {
         match self {
             RateSigma::Cpi(c) => Some(*c),
             _ => None,
+        }
+    }
+
+    /// Where the tracker takes the rates' σ from (`track`'s one rule, CLI and Python): the
+    /// file's fixed σ as given; else the `caller`'s CPI if given (`track --doppler --cpi …`),
+    /// else the file's `cpi`, else `default` (the CPI of the flags' defaults). A caller's CPI
+    /// beside a fixed σ is refused by the caller (the CLI and Python name it).
+    ///
+    /// # Example
+    ///
+    /// ```
+    /// use scatterloc::formats::RateSigma;
+    /// use scatterloc::measure::Cpi;
+    /// use scatterloc::track::RateNoise;
+    ///
+    /// let file = Cpi::new(5.8e9, 8, 1e-3, 0.1).unwrap();
+    /// let caller = Cpi::new(5.8e9, 32, 2e-3, 0.2).unwrap();
+    /// let default = Cpi::new(5.8e9, 16, 2.048e-3, 0.1).unwrap();
+    /// let fixed = RateSigma::Fixed(vec![0.3, 0.4]);
+    /// assert_eq!(fixed.noise(None, default), RateNoise::Fixed(&[0.3, 0.4]));
+    /// assert_eq!(fixed.noise(Some(caller), default), RateNoise::Fixed(&[0.3, 0.4]));
+    /// assert_eq!(RateSigma::Cpi(file).noise(None, default), RateNoise::Cpi(file));
+    /// assert_eq!(RateSigma::Cpi(file).noise(Some(caller), default), RateNoise::Cpi(caller));
+    /// assert_eq!(RateSigma::Unstated.noise(None, default), RateNoise::Cpi(default));
+    /// assert_eq!(RateSigma::Unstated.noise(Some(caller), default), RateNoise::Cpi(caller));
+    /// ```
+    pub fn noise(&self, caller: Option<Cpi>, default: Cpi) -> RateNoise<'_> {
+        match (self, caller) {
+            (RateSigma::Fixed(s), _) => RateNoise::Fixed(s),
+            (_, Some(c)) => RateNoise::Cpi(c),
+            (RateSigma::Cpi(file), None) => RateNoise::Cpi(*file),
+            (RateSigma::Unstated, None) => RateNoise::Cpi(default),
         }
     }
 }

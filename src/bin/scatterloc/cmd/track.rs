@@ -22,7 +22,6 @@ use scatterloc::study::{
 };
 use scatterloc::track::gating::AssociationRule;
 use scatterloc::track::multi::MultiKind;
-use scatterloc::track::RateNoise;
 
 use super::filters::filter_kinds;
 use super::flags::{in_file, with_flag};
@@ -113,11 +112,9 @@ pub fn track(args: &TrackArgs) -> Result<(), CliError> {
     let file_sigma = rates.as_ref().and_then(|r| r.sigma.fixed());
     doppler_flags(args, rates.is_some(), file_sigma.is_some())?;
     let flags_cpi = super::scenario::cpi_of(&args.doppler, &scenario)?;
-    let rate_noise = match (file_sigma, rates.as_ref().and_then(|r| r.sigma.cpi())) {
-        (Some(s), _) => RateNoise::Fixed(s),
-        (None, Some(file)) if !args.doppler.on => RateNoise::Cpi(file),
-        _ => RateNoise::Cpi(flags_cpi),
-    };
+    // The rates' σ: the file's fixed σ, else the flags' CPI with --doppler, else the file's
+    // CPI, else the flags' default CPI (one rule with Python's `track`).
+    let caller_cpi = args.doppler.on.then_some(flags_cpi);
     let rule = match args.association {
         None | Some(Association::Spec) => AssociationRule::Spec,
         Some(Association::Gated) => AssociationRule::Gated,
@@ -167,7 +164,7 @@ pub fn track(args: &TrackArgs) -> Result<(), CliError> {
         match &rates {
             Some(r) => req.track_with_rates(
                 r.rates_mps,
-                rate_noise,
+                r.sigma.noise(caller_cpi, flags_cpi),
                 !args.no_doppler,
                 Cancel::when(&stop),
             ),
