@@ -77,7 +77,7 @@ pub fn delay_figure_link(
         .map(|k| {
             estimates.paths[k][p]
                 .iter()
-                .map(|t| t.estimate.delay_estimate())
+                .map(|t| t.estimate)
                 .collect::<Vec<_>>()
         })
         .collect();

@@ -9,12 +9,16 @@
 use alloc::string::String;
 use alloc::vec::Vec;
 
-use crate::channel::{ChirpZ, DelayEstimate};
+use crate::channel::ChirpZ;
 use crate::error::limits::{DELAY_IMAGE_DR_DB, MAX_DELAY_IMAGE_COLS, MAX_DELAY_IMAGE_ROWS};
 use crate::error::{check_finite, check_len, Error, Result};
 use crate::math::{log10, sqrt, Complex, Real, SPEED_OF_LIGHT};
+
+mod points;
+
 use crate::study::CirTrackOutput;
 use crate::track::gating::LinkCalibration;
+pub use points::{delay_points, DelayPoint, DrawnEstimate};
 
 /// The delay profile of one link as an image: `db[j·cols + i]` is the power at range
 /// `r0_m + j·dr_m` (row `j`, ascending range) in the snapshot of column `i` (time `t_s[i]`),
@@ -275,17 +279,6 @@ fn to_db(
     }
 }
 
-/// One path estimate as drawn: its time, path length and amplitude.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct DelayPoint {
-    /// Snapshot time, s.
-    pub t_s: Real,
-    /// Path length `c·τ̂`, m.
-    pub range_m: Real,
-    /// `20·log10|α̂|`, dB (re 1 √W for recordings).
-    pub amplitude_db: Real,
-}
-
 /// A static cluster as drawn: a band at its mean path length, as wide as its 3σ gate (E4).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct StaticBand {
@@ -364,28 +357,6 @@ impl DelayFigure {
             links,
         }
     }
-}
-
-/// The estimates of one link over snapshots as points: `estimates[s]` is snapshot `s`'s list
-/// (at `t_s[s]`). Estimates with a non-finite delay or time, or a non-positive or non-finite
-/// amplitude, have no place on the figure and are left out.
-pub fn delay_points(t_s: &[Real], estimates: &[Vec<DelayEstimate>]) -> Vec<DelayPoint> {
-    t_s.iter()
-        .zip(estimates)
-        .flat_map(|(&t, list)| {
-            list.iter().filter_map(move |e| {
-                let ok = t.is_finite()
-                    && e.delay_s.is_finite()
-                    && e.amplitude.is_finite()
-                    && e.amplitude > 0.0;
-                ok.then(|| DelayPoint {
-                    t_s: t,
-                    range_m: SPEED_OF_LIGHT * e.delay_s,
-                    amplitude_db: 20.0 * log10(e.amplitude),
-                })
-            })
-        })
-        .collect()
 }
 
 /// The static clusters of one link's calibration as bands (mean ± 3σ, E4, as path lengths).

@@ -32,8 +32,8 @@ pub use channel_files::{
 };
 pub use channel_view::{
     delay_image, delay_points, quantile_pct, static_bands, suggest_range_m, track_errors,
-    DelayFigure, DelayImage, DelayPoint, ErrorStats, ImageConfig, ImageFloor, LinkDelays,
-    SegmentSpan, StaticBand, TrackErrorView, TruthCurve,
+    DelayFigure, DelayImage, DelayPoint, DrawnEstimate, ErrorStats, ImageConfig, ImageFloor,
+    LinkDelays, SegmentSpan, StaticBand, TrackErrorView, TruthCurve,
 };
 pub use colormap::{
     colorbar_rgba, fill_rgba, render_rgba, viridis, LogScale, LINK_RGB, UNBOUNDED_RGB,

@@ -1,4 +1,5 @@
 use super::*;
+use crate::channel::{DelayEstimate, PathEstimate, RateEstimate};
 use crate::math::{cos, sin, PI};
 use crate::track::gating::StaticCluster;
 
@@ -206,6 +207,7 @@ fn points_bands_and_ranges() {
     let p = delay_points(&t, &est);
     assert_eq!(p.len(), 1);
     assert!((p[0].range_m - 20.0).abs() < 1e-12 && (p[0].amplitude_db + 20.0).abs() < 1e-12);
+    assert_eq!(p[0].range_rate_mps, None);
     let cal = LinkCalibration {
         clusters: vec![StaticCluster {
             mean_s: 10.0 / SPEED_OF_LIGHT,
@@ -369,6 +371,7 @@ fn the_range_axis_is_robust_to_outliers() {
             t_s: k as Real * 0.05,
             range_m: 10.0 + 40.0 * (k % 100) as Real / 99.0,
             amplitude_db: -80.0,
+            range_rate_mps: None,
         })
         .collect();
     let clean = suggest_range_m(&p, &[], &[], Real::INFINITY);
@@ -380,6 +383,7 @@ fn the_range_axis_is_robust_to_outliers() {
         t_s: 3.0,
         range_m: 370.0,
         amplitude_db: -90.0,
+        range_rate_mps: None,
     });
     assert_eq!(suggest_range_m(&p, &[], &[], Real::INFINITY), clean);
     // A truth beyond the estimates still widens it (the truth is never an outlier).
@@ -390,4 +394,36 @@ fn the_range_axis_is_robust_to_outliers() {
     }];
     let r = suggest_range_m(&p, &[], &truth, Real::INFINITY);
     assert!((r[1] - 73.0).abs() < 1e-9, "{r:?}");
+}
+
+/// A front end's path estimates (issue 42 §2) keep their range rate and σ as points; a
+/// non-finite rate is dropped (the point stays), and the JSON of a point without a rate has no
+/// `range_rate_mps` key (figures made before Doppler read back unchanged).
+#[test]
+fn points_carry_the_range_rates() {
+    let path = |range_m: Real, rate: Option<(Real, Real)>| PathEstimate {
+        delay_s: range_m / SPEED_OF_LIGHT,
+        alpha: Complex::new(0.0, 0.01),
+        sigma_s: 1e-10,
+        snr: 100.0,
+        range_rate: rate.map(|(r, s)| RateEstimate {
+            range_rate_mps: r,
+            sigma_mps: s,
+            doppler_hz: -r / 0.05,
+        }),
+    };
+    let est = vec![vec![
+        path(20.0, Some((1.25, 0.125))),
+        path(30.0, None),
+        path(40.0, Some((Real::NAN, 0.1))),
+    ]];
+    let p = delay_points(&[0.5], &est);
+    assert_eq!(p.len(), 3);
+    assert_eq!(p[0].range_rate_mps, Some([1.25, 0.125]));
+    assert!((p[0].amplitude_db + 40.0).abs() < 1e-12);
+    assert_eq!((p[1].range_rate_mps, p[2].range_rate_mps), (None, None));
+    let json = serde_json::to_string(&p).unwrap();
+    assert_eq!(json.matches("range_rate_mps").count(), 1, "{json}");
+    let back: Vec<DelayPoint> = serde_json::from_str(&json).unwrap();
+    assert_eq!(back, p);
 }

@@ -14,7 +14,7 @@ use super::super::layout::{font_scale, frame_plot, segments, series_legend, titl
 use super::super::panel::{draw_axes, legend_entry, Chart};
 use super::super::{chart_err, register_fonts, ChartError, CURVE_PALETTE};
 use crate::math::Real;
-use crate::present::{linear_ticks, DelayFigure, DelayImage, LinkDelays, StaticBand};
+use crate::present::{linear_ticks, DelayFigure, DelayImage, DelayPoint, LinkDelays, StaticBand};
 
 use super::shared::{axis, centred_note, ChannelChartOptions, PlotBox, STATIC_RGB, TRUTH_RGB};
 
@@ -117,6 +117,37 @@ pub(super) fn estimate_rgb(statics: &[StaticBand], range_m: Real) -> RGBColor {
 /// The radius of an estimate's dot at font scale `s`, px.
 pub(super) fn estimate_radius(s: f64) -> i32 {
     (2.6 * s).round().max(1.0) as i32
+}
+
+/// Half the length of a range-rate tick at font scale `s`, px.
+pub(super) fn rate_tick_half_px(s: f64) -> Real {
+    (9.0 * s).max(3.0)
+}
+
+/// The range-rate tick of `e` (issue 42 §5) on a plot of `w × h` px spanning `[t0, t1] ×
+/// [r0, r1]`: the segment through `(t, c·τ)` with the slope `d(c·τ)/dt = ṙ`, `half_px` long on
+/// each side *on screen* (so a fast and a slow path get ticks of one length, their angle the
+/// rate), as data coordinates `[(t_a, r_a), (t_b, r_b)]`; `None` without a rate or on a
+/// degenerate plot.
+pub(super) fn rate_tick(
+    e: &DelayPoint,
+    [t0, t1]: [Real; 2],
+    [r0, r1]: [Real; 2],
+    (w, h): (Real, Real),
+    half_px: Real,
+) -> Option<[(Real, Real); 2]> {
+    let [rate, _] = e.range_rate_mps?;
+    // Pixels per second along t and per metre along r.
+    let (kt, kr) = (w / (t1 - t0), h / (r1 - r0));
+    let norm = crate::math::sqrt(kt * kt + rate * kr * (rate * kr));
+    if !(norm.is_finite() && norm > 0.0) {
+        return None;
+    }
+    let dt = half_px / norm;
+    Some([
+        (e.t_s - dt, e.range_m - rate * dt),
+        (e.t_s + dt, e.range_m + rate * dt),
+    ])
 }
 
 /// The `cols + 1` time edges of the image's columns: half-way between neighbouring columns'
@@ -315,9 +346,19 @@ fn draw_link<DB: DrawingBackend>(
     // The estimates: inside the axes as dots, beyond it (outliers the robust axis leaves out)
     // as triangles at its edge, one per few pixels of time.
     let radius = estimate_radius(s);
-    let inside = |e: &&crate::present::DelayPoint| {
-        (t0..=t1).contains(&e.t_s) && (r0..=r1).contains(&e.range_m)
-    };
+    let inside = |e: &&DelayPoint| (t0..=t1).contains(&e.t_s) && (r0..=r1).contains(&e.range_m);
+    let has_rates = link.estimates.iter().any(|e| e.range_rate_mps.is_some());
+    let tick_width = (1.6 * s).round().max(1.0) as u32;
+    if vector && has_rates {
+        let (w, h) = chart.plotting_area().dim_in_pixel();
+        let half = rate_tick_half_px(s);
+        let ticks = link.estimates.iter().filter(inside).filter_map(|e| {
+            let seg = rate_tick(e, [t0, t1], [r0, r1], (w as Real, h as Real), half)?;
+            let rgb = estimate_rgb(&link.statics, e.range_m);
+            Some(PathElement::new(seg, rgb.stroke_width(tick_width)))
+        });
+        chart.draw_series(ticks).map_err(chart_err)?;
+    }
     if vector {
         chart
             .draw_series(link.estimates.iter().filter(inside).map(|e| {
@@ -333,6 +374,21 @@ fn draw_link<DB: DrawingBackend>(
         legend_entry(&mut chart, "estimate", move |(x, y)| {
             Circle::new((x, y), radius + 1, ESTIMATE_RGB.filled())
         })?;
+        if has_rates {
+            let d = rate_tick_half_px(s) as i32 * 2 / 3;
+            legend_entry(
+                &mut chart,
+                "range rate ṙ = slope of the tick",
+                move |(x, y)| {
+                    EmptyElement::at((x, y))
+                        + PathElement::new(
+                            [(-d, d / 2), (d, -d / 2)],
+                            ESTIMATE_RGB.stroke_width(tick_width),
+                        )
+                        + Circle::new((0, 0), radius, ESTIMATE_RGB.filled())
+                },
+            )?;
+        }
         if link
             .estimates
             .iter()

@@ -13,7 +13,7 @@ use crate::present::{DelayFigure, DelayImage, LinkDelays, StaticBand};
 
 use super::delays::{
     column_edges, delays_scale, draw_delays_with, estimate_radius, estimate_rgb, grey, image_range,
-    Layers, STATIC_BAND_ALPHA,
+    rate_tick, rate_tick_half_px, Layers, STATIC_BAND_ALPHA,
 };
 use super::shared::{axis, ChannelChartOptions, STATIC_RGB};
 
@@ -53,6 +53,7 @@ pub fn delays_svg(
             _ => alloc::vec![255u8; 3 * w * h],
         };
         raster_bands(&mut rgb, (w, h), &link.statics, range);
+        raster_ticks(&mut rgb, (w, h), link, b.t_range_s, range, font_s);
         raster_estimates(
             &mut rgb,
             (w, h),
@@ -147,6 +148,67 @@ fn raster_estimates(
                 if cover > 0.0 {
                     let px = &mut rgb[3 * (y * w + x)..3 * (y * w + x) + 3];
                     for (c, v) in px.iter_mut().zip([r, g, b]) {
+                        *c = blend(*c, v, cover);
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// The range-rate ticks of the estimates inside the axes ([`rate_tick`], issue 42 §5) over
+/// `rgb` (a `w × h` plot spanning `[t0, t1] × [r0, r1]`, row 0 at `r1`), as the vector panel
+/// draws them: segments of the vector line's width, each pixel covered in proportion to its
+/// distance from the segment (anti-aliased), in the estimate's colour.
+fn raster_ticks(
+    rgb: &mut [u8],
+    (w, h): (usize, usize),
+    link: &LinkDelays,
+    [t0, t1]: [Real; 2],
+    [r0, r1]: [Real; 2],
+    font_s: f64,
+) {
+    let half_width = 0.5 * round(1.6 * font_s).max(1.0);
+    let half_px = rate_tick_half_px(font_s);
+    let px = |(t, r): (Real, Real)| {
+        (
+            (t - t0) / (t1 - t0) * w as Real,
+            (r1 - r) / (r1 - r0) * h as Real,
+        )
+    };
+    for e in &link.estimates {
+        if !((t0..=t1).contains(&e.t_s) && (r0..=r1).contains(&e.range_m)) {
+            continue;
+        }
+        let Some([a, b]) = rate_tick(e, [t0, t1], [r0, r1], (w as Real, h as Real), half_px) else {
+            continue;
+        };
+        let ((ax, ay), (bx, by)) = (px(a), px(b));
+        let RGBColor(cr, cg, cb) = estimate_rgb(&link.statics, e.range_m);
+        let reach = half_width + 1.0;
+        let (x0, x1) = (
+            (ax.min(bx) - reach).max(0.0) as usize,
+            ((ax.max(bx) + reach).max(0.0) as usize).min(w),
+        );
+        let (y0, y1) = (
+            (ay.min(by) - reach).max(0.0) as usize,
+            ((ay.max(by) + reach).max(0.0) as usize).min(h),
+        );
+        let (dx, dy) = (bx - ax, by - ay);
+        let len2 = dx * dx + dy * dy;
+        for y in y0..y1 {
+            for x in x0..x1 {
+                let (qx, qy) = (x as Real + 0.5 - ax, y as Real + 0.5 - ay);
+                let u = if len2 > 0.0 {
+                    ((qx * dx + qy * dy) / len2).clamp(0.0, 1.0)
+                } else {
+                    0.0
+                };
+                let (ex, ey) = (qx - u * dx, qy - u * dy);
+                let cover = (half_width + 0.5 - sqrt(ex * ex + ey * ey)).clamp(0.0, 1.0);
+                if cover > 0.0 {
+                    let p = &mut rgb[3 * (y * w + x)..3 * (y * w + x) + 3];
+                    for (c, v) in p.iter_mut().zip([cr, cg, cb]) {
                         *c = blend(*c, v, cover);
                     }
                 }

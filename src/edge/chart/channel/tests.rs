@@ -443,7 +443,7 @@ fn the_svg_embeds_each_image_as_one_png() {
 }
 
 /// A tiny standard base64 decoder (the test reads the PNGs the SVG embeds).
-fn unbase64(s: &str) -> Vec<u8> {
+pub(super) fn unbase64(s: &str) -> Vec<u8> {
     let val = |c: u8| match c {
         b'A'..=b'Z' => c - b'A',
         b'a'..=b'z' => c - b'a' + 26,
@@ -467,7 +467,7 @@ fn unbase64(s: &str) -> Vec<u8> {
 }
 
 /// The RGB pixels of an 8-bit RGB PNG written by `raster::encode_png` (filter 0 rows).
-fn png_rgb(png: &[u8]) -> (usize, usize, Vec<u8>) {
+pub(super) fn png_rgb(png: &[u8]) -> (usize, usize, Vec<u8>) {
     use std::io::Read;
     let w = u32::from_be_bytes(png[16..20].try_into().unwrap()) as usize;
     let h = u32::from_be_bytes(png[20..24].try_into().unwrap()) as usize;
