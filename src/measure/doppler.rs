@@ -128,6 +128,41 @@ pub struct LinkMotion {
     pub distances_m: (Real, Real),
 }
 
+/// One node of a link seen from a scatterer at `r` moving at `v`: the unit vector from the node
+/// to the scatterer, the 3-D distance and the node's term `P v/d` of `∂ṙ/∂r` (D3). A link's
+/// two nodes make its [`LinkMotion`]; the links of one transmitter share its view.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NodeMotion {
+    /// `û` (zero closer than
+    /// [`UNIT_VECTOR_MIN_DISTANCE_M`](crate::measure::UNIT_VECTOR_MIN_DISTANCE_M)).
+    pub unit: Vec2,
+    /// `d`, m.
+    pub distance_m: Real,
+    /// `(I − ûûᵀ) v/d`, 1/s (zero with a zero `û`).
+    pub rate_term: Vec2,
+}
+
+impl NodeMotion {
+    /// The node at `node` (vertical offset `dz`) seen from `r` moving at `v`.
+    #[inline(always)]
+    pub fn new(node: Vec2, dz: Real, r: Vec2, v: Vec2) -> NodeMotion {
+        let (unit, distance_m) = unit_from_dz(node, dz, r);
+        // `1/d` beside `û = (r − node)/d` (both from `d` alone), so `P v/d` is a product, not a
+        // second division after `û` (issue 42 §4: a shorter dependency chain per link).
+        let inv = 1.0 / distance_m;
+        let rate_term = if unit != Vec2::zeros() {
+            (v - unit * unit.dot(&v)) * inv
+        } else {
+            Vec2::zeros()
+        };
+        NodeMotion {
+            unit,
+            distance_m,
+            rate_term,
+        }
+    }
+}
+
 impl LinkMotion {
     /// Link `p` of `network` seen from `r` moving at `v` (a node closer than
     /// [`UNIT_VECTOR_MIN_DISTANCE_M`](crate::measure::UNIT_VECTOR_MIN_DISTANCE_M) adds nothing
@@ -136,25 +171,25 @@ impl LinkMotion {
     pub fn new(network: &Network, p: usize, r: Vec2, v: Vec2) -> LinkMotion {
         let (tx, rx) = network.link_nodes(p);
         let (zt, zr) = network.link_dz(p);
-        let (ut, dt) = unit_from_dz(tx, zt, r);
-        let (ur, dr) = unit_from_dz(rx, zr, r);
-        // `1/d` beside `û = (r − node)/d` (both from `d` alone), so `P v/d` is a product, not a
-        // second division after `û` (issue 42 §4: a shorter dependency chain per link).
-        let inv = [1.0 / dt, 1.0 / dr];
-        let mut rate_gradient_r = Vec2::zeros();
-        for (u, i) in [(ut, inv[0]), (ur, inv[1])] {
-            if u != Vec2::zeros() {
-                rate_gradient_r += (v - u * u.dot(&v)) * i;
-            }
-        }
-        let g = ut + ur;
+        LinkMotion::of_nodes(
+            &NodeMotion::new(tx, zt, r, v),
+            &NodeMotion::new(rx, zr, r, v),
+            v,
+        )
+    }
+
+    /// The link of the transmitter `t` and the receiver `r`, each [`NodeMotion::new`] at the
+    /// same point and the velocity `v`: the same bits as [`LinkMotion::new`].
+    #[inline(always)]
+    pub fn of_nodes(t: &NodeMotion, r: &NodeMotion, v: Vec2) -> LinkMotion {
+        let g = t.unit + r.unit;
         LinkMotion {
-            range_m: dt + dr,
+            range_m: t.distance_m + r.distance_m,
             range_gradient: g,
             range_rate_mps: g.dot(&v),
-            rate_gradient_r,
-            unit_tx: ut,
-            distances_m: (dt, dr),
+            rate_gradient_r: Vec2::zeros() + t.rate_term + r.rate_term,
+            unit_tx: t.unit,
+            distances_m: (t.distance_m, r.distance_m),
         }
     }
 

@@ -12,7 +12,7 @@ mod pattern;
 mod simulate;
 
 pub use doppler::{
-    range_rate, range_rate_gradient, state_bounds, state_fisher, Cpi, LinkMotion,
+    range_rate, range_rate_gradient, state_bounds, state_fisher, Cpi, LinkMotion, NodeMotion,
     DEFAULT_RANGE_RATE_FLOOR_MPS, MAX_CPI_SNAPSHOTS,
 };
 pub use ellipse::Ellipse;

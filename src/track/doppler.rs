@@ -10,7 +10,7 @@ use alloc::format;
 
 use crate::error::{check_len, limits, Error, Result};
 use crate::math::{Real, Vec2, Vec4, PI, SPEED_OF_LIGHT};
-use crate::measure::{sigma_delay_from_snr, Cpi, LinkMotion, Model};
+use crate::measure::{sigma_delay_from_snr, Cpi, LinkMotion, Model, NodeMotion};
 use crate::track::shared::{
     first_input_error, information_from_sigma, positive_finite, range_information_per_snr,
 };
@@ -189,30 +189,44 @@ pub(crate) fn rows(
     let info_per_snr = range_information_per_snr(model);
     // `8π²β²`: the delay's information per SNR in the time domain (E8).
     let delay_info_per_snr = 8.0 * PI * PI * model.beta2;
-    let mut tx_gain: Option<(usize, Real)> = None;
+    // The last transmitter seen from `r` and, once a link needed it, its gain toward `r`:
+    // shared by its links (the link order is Tx-fastest, spec §1; sensors2019's 4 links share
+    // one transmitter).
+    let mut tx_seen: Option<(usize, NodeMotion, Option<Real>)> = None;
+    let snr_needed =
+        matches!(noise, MeasurementNoise::AtPrediction) || matches!(rates.noise, RateNoise::Cpi(_));
     let mut links = 0;
     for p in 0..model.link_count() {
         let (zp, rate) = (z[p], rates.rates_mps[p]);
         if zp.is_none() && rate.is_none() {
             continue;
         }
-        let g = LinkMotion::new(&model.network, p, r, v);
+        let link = model.network.links[p];
+        let seen = match &mut tx_seen {
+            Some((t, seen, gain)) if *t == link.tx => (seen, gain),
+            slot => {
+                let node = model.network.transmitters[link.tx];
+                let dz = model.network.transmitters_dz[link.tx];
+                let seen = slot.insert((link.tx, NodeMotion::new(node, dz, r, v), None));
+                (&mut seen.1, &mut seen.2)
+            }
+        };
+        let rx = NodeMotion::new(
+            model.network.receivers[link.rx],
+            model.network.receivers_dz[link.rx],
+            r,
+            v,
+        );
+        let g = LinkMotion::of_nodes(seen.0, &rx, v);
         // The link's SNR at `r` once (the same bits as `g.snr(model, p)`, the transmitter's
-        // gain shared by the links of one transmitter).
-        let mut snr = None;
-        let mut snr_of = |g: &LinkMotion| {
-            *snr.get_or_insert_with(|| {
-                let tx = model.network.links[p].tx;
-                let gain = match tx_gain {
-                    Some((t, gain)) if t == tx => gain,
-                    _ => {
-                        let gain = model.patterns[tx].gain_toward(g.unit_tx);
-                        tx_gain = Some((tx, gain));
-                        gain
-                    }
-                };
-                model.snr_from_geometry(p, gain, g.distances_m.0, g.distances_m.1)
-            })
+        // gain shared by the links of one transmitter), where a σ needs it.
+        let snr = if snr_needed {
+            let gain = *seen
+                .1
+                .get_or_insert_with(|| model.patterns[link.tx].gain_toward(g.unit_tx));
+            model.snr_from_geometry(p, gain, g.distances_m.0, g.distances_m.1)
+        } else {
+            Real::NAN
         };
         let mut used = false;
         if let Some(tau) = zp {
@@ -223,7 +237,6 @@ pub(crate) fn rows(
                     (1.0 / (s * s), sigma)
                 }
                 MeasurementNoise::AtPrediction => {
-                    let snr = snr_of(&g);
                     // σ = 1/√(8π²β² SNR) is finite, > 0 and of finite information whenever
                     // 8π²β² SNR lies in [1e-300, 1e300]; only outside is it formed and tested.
                     let q = delay_info_per_snr * snr;
@@ -254,9 +267,7 @@ pub(crate) fn rows(
                 return Err(Error::InvalidSigma {
                     link: p,
                     value: match noise {
-                        MeasurementNoise::AtPrediction => {
-                            sigma_delay_from_snr(model.beta2, snr_of(&g))
-                        }
+                        MeasurementNoise::AtPrediction => sigma_delay_from_snr(model.beta2, snr),
                         _ => sigma,
                     },
                 });
@@ -280,9 +291,15 @@ pub(crate) fn rows(
             // `σ_ṙ` is not finite and positive (no Doppler information).
             let w = match rates.noise {
                 RateNoise::Cpi(c) => {
-                    let f = c.doppler_information(snr_of(&g));
+                    let f = c.doppler_information(snr);
                     let var = c.wavelength_m * c.wavelength_m / f + c.floor_mps * c.floor_mps;
                     (f > 0.0 && positive_finite(var)).then(|| 1.0 / var)
+                }
+                // Inline, not through `sigma`: a call there spills every live register of the
+                // row loop (issue 42 §4).
+                RateNoise::Fixed(s) => {
+                    let s = s[p];
+                    positive_finite(s).then(|| 1.0 / (s * s))
                 }
                 other => {
                     let s = other.sigma(model, p, &g);

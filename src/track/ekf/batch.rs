@@ -150,7 +150,7 @@ impl Ekf {
     /// Takes `state` and `covariance` if finite with a positive diagonal, else
     /// [`Error::NotPositiveDefinite`] (`ekf.covariance`) and the filter unchanged.
     #[inline(always)]
-    fn commit(
+    pub(super) fn commit(
         &mut self,
         state: Vec4,
         covariance: Mat4,
