@@ -60,7 +60,45 @@ def _error(field: str, message: str) -> ScatterlocError:
     return e
 
 
-class BistaticDelayModel(NonLinearGaussianMeasurement):  # type: ignore[misc]
+class _ScatterlocMeasurement(NonLinearGaussianMeasurement):  # type: ignore[misc]
+    """What both models share: keyword arguments only, a ``scenario`` (a
+    :class:`scatterloc.Scenario`, or what its constructor takes), R built from the sigmas
+    (never a given ``noise_covar``), and noise samples and likelihoods from ``covar`` and
+    ``logpdf``."""
+
+    @staticmethod
+    def _checked_arguments(
+        name: str, usage: str, covar_error: str, args: tuple[Any, ...], kwargs: dict[str, Any]
+    ) -> None:
+        """Checks model ``name``'s constructor arguments before Stone Soup's ``__init__``
+        (``usage``: the keywords named when positional ones are given; ``covar_error``: the
+        error for a given ``noise_covar``, which R is built from) and sets a placeholder
+        ``noise_covar`` in ``kwargs`` until the real R is known (the parent converts it)."""
+        if args:
+            raise TypeError(f"{name} takes keyword arguments ({usage})")
+        scenario = kwargs.get("scenario")
+        if scenario is None:
+            raise _error("scenario", "required")
+        if not isinstance(scenario, Scenario):
+            kwargs["scenario"] = Scenario(scenario)
+        if kwargs.get("noise_covar") is not None:
+            raise _error("noise_covar", covar_error)
+        kwargs["noise_covar"] = np.eye(1)
+
+    def rvs(self, num_samples: int = 1, **kwargs: Any) -> Union[StateVector, StateVectors]:
+        """Noise samples with covariance R."""
+        covar = self.covar(**kwargs)
+        noise = np.random.multivariate_normal(np.zeros(self.ndim_meas), covar, num_samples).T
+        if num_samples == 1:
+            return StateVector(noise)
+        return StateVectors(noise)
+
+    def pdf(self, state1: Any, state2: Any, **kwargs: Any) -> Any:
+        """Likelihood of measurement ``state1`` given state ``state2``."""
+        return np.exp(self.logpdf(state1, state2, **kwargs))
+
+
+class BistaticDelayModel(_ScatterlocMeasurement):
     r"""Bistatic propagation delays of a scatterer on a scatterloc scenario's links.
 
     For a state with position :math:`r = (x, y)` (the components ``mapping`` picks), the
@@ -94,44 +132,22 @@ class BistaticDelayModel(NonLinearGaussianMeasurement):  # type: ignore[misc]
     )
 
     def __init__(self, *args: Any, **kwargs: Any) -> None:
-        if args:
-            raise TypeError(
-                "BistaticDelayModel takes keyword arguments (scenario=..., sigma=..., links=...)"
-            )
-        scenario = kwargs.get("scenario")
-        if scenario is None:
-            raise _error("scenario", "required")
-        if not isinstance(scenario, Scenario):
-            kwargs["scenario"] = Scenario(scenario)
-        if kwargs.get("noise_covar") is not None:
-            raise _error("noise_covar", "set sigma instead (R is built from it)")
-        # A placeholder until the real R is known (the parent converts it).
-        kwargs["noise_covar"] = np.eye(1)
+        self._checked_arguments(
+            "BistaticDelayModel",
+            "scenario=..., sigma=..., links=...",
+            "set sigma instead (R is built from it)",
+            args,
+            kwargs,
+        )
         super().__init__(*args, **kwargs)
-        n = self.scenario.link_count
-        links = list(range(n)) if self.links is None else [int(p) for p in self.links]
-        for p in links:
-            if not 0 <= p < n:
-                raise _error("links", f"link {p} is not in 0..{n - 1}")
-        if len(set(links)) != len(links) or not links:
-            raise _error("links", "expected distinct link indices, at least one")
-        self._links = np.asarray(links, dtype=np.intp)
+        self._links = _link_list(self.links, self.scenario.link_count, "links", at_least_one=True)
         if len(self.mapping) != 2:
             raise _error("mapping", "expected the two position components (x, y)")
         self._linearisation: Optional[np.ndarray] = None
         if self.sigma is None:
             self.noise_covar = None
         else:
-            s = np.asarray(self.sigma, dtype=float)
-            if s.ndim > 1 or (s.ndim == 1 and s.size != len(links)):
-                raise _error(
-                    "sigma",
-                    f"expected one delay sigma or {len(links)} (one per measured link), "
-                    f"got shape {s.shape}",
-                )
-            s = np.broadcast_to(s, (len(links),))
-            if not np.all(np.isfinite(s) & (s > 0)):
-                raise _error("sigma", "every delay sigma must be a finite number > 0 s")
+            s = _fixed_sigmas(self.sigma, self._links.size, "sigma", "s", what="delay sigma")
             self.noise_covar = CovarianceMatrix(np.diag(s**2))
 
     @property
@@ -195,18 +211,6 @@ class BistaticDelayModel(NonLinearGaussianMeasurement):  # type: ignore[misc]
         s = self.scenario.sigma_delays(pos)[self._links]
         return CovarianceMatrix(np.diag(s**2))
 
-    def rvs(self, num_samples: int = 1, **kwargs: Any) -> Union[StateVector, StateVectors]:
-        """Noise samples with covariance R."""
-        covar = self.covar(**kwargs)
-        noise = np.random.multivariate_normal(np.zeros(self.ndim_meas), covar, num_samples).T
-        if num_samples == 1:
-            return StateVector(noise)
-        return StateVectors(noise)
-
-    def pdf(self, state1: Any, state2: Any, **kwargs: Any) -> Any:
-        """Likelihood of measurement ``state1`` given state ``state2``."""
-        return np.exp(self.logpdf(state1, state2, **kwargs))
-
     def logpdf(self, state1: Any, state2: Any, **kwargs: Any) -> Any:
         """Log-likelihood of measurement ``state1`` given state ``state2`` (Gaussian with R
         at ``state2`` for a link-budget R)."""
@@ -224,31 +228,36 @@ class BistaticDelayModel(NonLinearGaussianMeasurement):  # type: ignore[misc]
         return ll
 
 
-def _link_list(links: Optional[Sequence[int]], n: int, field: str) -> np.ndarray:
-    """``links`` (default: all ``n``) as checked distinct indices into the scenario's links."""
+def _link_list(
+    links: Optional[Sequence[int]], n: int, field: str, at_least_one: bool = False
+) -> np.ndarray:
+    """``links`` (default: all ``n``) as checked distinct indices into the scenario's links
+    (with ``at_least_one``, not none)."""
     out = list(range(n)) if links is None else [int(p) for p in links]
     for p in out:
         if not 0 <= p < n:
             raise _error(field, f"link {p} is not in 0..{n - 1}")
-    if len(set(out)) != len(out):
-        raise _error(field, "expected distinct link indices")
+    if len(set(out)) != len(out) or (at_least_one and not out):
+        need = ", at least one" if at_least_one else ""
+        raise _error(field, f"expected distinct link indices{need}")
     return np.asarray(out, dtype=np.intp)
 
 
-def _fixed_sigmas(sigma: Any, n: int, field: str, unit: str) -> np.ndarray:
-    """A fixed sigma (one for every link or one per link of ``n``), each finite and > 0."""
+def _fixed_sigmas(sigma: Any, n: int, field: str, unit: str, what: str = "sigma") -> np.ndarray:
+    """A fixed sigma (one for every link or one per link of ``n``), each finite and > 0
+    (``what``: the sigma's name in the errors)."""
     s = np.asarray(sigma, dtype=float)
     if s.ndim > 1 or (s.ndim == 1 and s.size != n):
         raise _error(
-            field, f"expected one sigma or {n} (one per measured link), got shape {s.shape}"
+            field, f"expected one {what} or {n} (one per measured link), got shape {s.shape}"
         )
     s = np.broadcast_to(s, (n,))
     if not np.all(np.isfinite(s) & (s > 0)):
-        raise _error(field, f"every sigma must be a finite number > 0 {unit}")
+        raise _error(field, f"every {what} must be a finite number > 0 {unit}")
     return np.array(s, dtype=float)
 
 
-class BistaticDelayDopplerModel(NonLinearGaussianMeasurement):  # type: ignore[misc]
+class BistaticDelayDopplerModel(_ScatterlocMeasurement):
     r"""Bistatic delays and range rates of a moving scatterer on a scatterloc scenario's links
     (issue 42, docs/doppler.md).
 
@@ -314,21 +323,13 @@ class BistaticDelayDopplerModel(NonLinearGaussianMeasurement):  # type: ignore[m
     )
 
     def __init__(self, *args: Any, **kwargs: Any) -> None:
-        if args:
-            raise TypeError(
-                "BistaticDelayDopplerModel takes keyword arguments (scenario=..., sigma=..., "
-                "sigma_range_rate=..., ...)"
-            )
-        scenario = kwargs.get("scenario")
-        if scenario is None:
-            raise _error("scenario", "required")
-        if not isinstance(scenario, Scenario):
-            kwargs["scenario"] = Scenario(scenario)
-        if kwargs.get("noise_covar") is not None:
-            raise _error(
-                "noise_covar", "set sigma and sigma_range_rate instead (R is built from them)"
-            )
-        kwargs["noise_covar"] = np.eye(1)
+        self._checked_arguments(
+            "BistaticDelayDopplerModel",
+            "scenario=..., sigma=..., sigma_range_rate=..., ...",
+            "set sigma and sigma_range_rate instead (R is built from them)",
+            args,
+            kwargs,
+        )
         super().__init__(*args, **kwargs)
         n = self.scenario.link_count
         self._delay_links = _link_list(self.delay_links, n, "delay_links")
@@ -464,18 +465,6 @@ class BistaticDelayDopplerModel(NonLinearGaussianMeasurement):  # type: ignore[m
             )
         s = self._sigmas(x[None, :])[:, 0]
         return CovarianceMatrix(np.diag(s**2))
-
-    def rvs(self, num_samples: int = 1, **kwargs: Any) -> Union[StateVector, StateVectors]:
-        """Noise samples with covariance R."""
-        covar = self.covar(**kwargs)
-        noise = np.random.multivariate_normal(np.zeros(self.ndim_meas), covar, num_samples).T
-        if num_samples == 1:
-            return StateVector(noise)
-        return StateVectors(noise)
-
-    def pdf(self, state1: Any, state2: Any, **kwargs: Any) -> Any:
-        """Likelihood of measurement ``state1`` given state ``state2``."""
-        return np.exp(self.logpdf(state1, state2, **kwargs))
 
     def logpdf(self, state1: Any, state2: Any, **kwargs: Any) -> Any:
         """Log-likelihood of measurement ``state1`` given state ``state2`` (Gaussian with R at

@@ -15,7 +15,7 @@ use crate::error::{Cancel, Error, Result};
 use crate::formats::{Measurements, RawEstimate, RawStep};
 use crate::measure::Model;
 use crate::scenario::Area;
-use crate::track::gating::Calibration;
+use crate::track::gating::{Calibration, LinkCalibration};
 use crate::track::multi::{
     BirthGrid, Births, DelayBirth, DelayLinks, Detection, Gnn, GnnManagement, MultiConfig,
     MultiKind, MultiTracker, Pmb, Scan, TargetEstimate,
@@ -186,26 +186,43 @@ pub fn multi_scans(
             .iter()
             .enumerate()
             .map(|(p, list)| {
-                list.iter()
-                    .filter_map(|e| {
-                        let (d, s) = match *e {
-                            RawEstimate::Pair([d, _]) => (d, None),
-                            RawEstimate::WithSigma([d, _, s]) => (d, Some(s)),
-                        };
-                        if calibration.is_some_and(|c| c.links[p].is_static(d)) {
-                            gone += 1;
-                            None
-                        } else {
-                            Some(Detection::delay(d, s))
-                        }
-                    })
-                    .collect()
+                let estimates = list.iter().map(|e| match *e {
+                    RawEstimate::Pair([d, _]) => (d, None, None),
+                    RawEstimate::WithSigma([d, _, s]) => (d, Some(s), None),
+                });
+                link_detections(estimates, calibration.map(|c| &c.links[p]), &mut gone)
             })
             .collect();
         scans.push(scan);
         removed.push(gone);
     }
     Ok((scans, removed))
+}
+
+/// One link's estimates of a scan as the multi-target tracker's detections (the step of
+/// [`multi_scans`] and of [`cir_track_multi`](crate::study::cir_track_multi)): each estimate
+/// `(delay, σ, rate)` (s; σ in s where there is one; the range rate and its σ `(ṙ, σ_ṙ)`, m/s,
+/// where the front end read one: issue 42 §3) is dropped, and counted in `gone`, where its
+/// delay lies in one of the link's static clusters `statics` (E4), else is a
+/// [`Detection::delay`], or a [`Detection::delay_rate`] with its rate.
+pub(crate) fn link_detections(
+    estimates: impl IntoIterator<Item = (f64, Option<f64>, Option<(f64, f64)>)>,
+    statics: Option<&LinkCalibration>,
+    gone: &mut usize,
+) -> Vec<Detection> {
+    estimates
+        .into_iter()
+        .filter_map(|(d, s, rate)| {
+            if statics.is_some_and(|c| c.is_static(d)) {
+                *gone += 1;
+                return None;
+            }
+            Some(match rate {
+                Some((r, r_sigma)) => Detection::delay_rate(d, s, r, r_sigma),
+                None => Detection::delay(d, s),
+            })
+        })
+        .collect()
 }
 
 /// The tracker of `settings` for `model` (`sigma_s`: the file's fixed σ per link).

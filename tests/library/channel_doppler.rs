@@ -3,12 +3,14 @@
 //! integrated SNR 15 and 20 dB), and the whole front end on a simulated CPI recording: each
 //! walker path's range rate against the truth's D1 with the σ the front end states.
 
-use scatterloc::channel::{ml_frequency, path_rate, ChannelScene, SceneCpi, SimulationRequest};
+use scatterloc::channel::{
+    ml_frequency, path_rate, ChannelScene, SceneCpi, Simulated, SimulationRequest, TrackedPath,
+};
 use scatterloc::error::Cancel;
 use scatterloc::math::{Complex, Real, Vec2, PI, SPEED_OF_LIGHT};
 use scatterloc::measure::{range_rate, rng, standard_normal, uniform01};
-use scatterloc::scenario::presets;
-use scatterloc::study::{estimate_recording, ChannelRequest, Sequential};
+use scatterloc::scenario::{presets, Scenario};
+use scatterloc::study::{estimate_recording, ChannelRequest, RecordingEstimates, Sequential};
 use scatterloc::Model;
 
 /// `ml_frequency` attains D4: N = 16 snapshots 2.048 ms apart, a random frequency in the band
@@ -120,42 +122,73 @@ fn the_front_end_reads_the_walkers_range_rates() {
     }
 }
 
-fn front_end_rates(quasi_static: bool) {
-    let s = presets::preset("sensors2019").unwrap();
-    let model = Model::new(&s).unwrap();
+/// The hangar's straight walk from (2, 4) m to (14, 7) m over `duration_s`, recorded in CPIs
+/// (16 snapshots 2.048 ms apart per 0.1 s scan) with the body `body` makes of the default one,
+/// simulated with `seed`, and its estimates through the front end with `cpi_snapshots = 16`.
+fn cpi_walk(
+    s: &Scenario,
+    model: &Model,
+    duration_s: Real,
+    body: impl Fn(&mut ChannelScene),
+    seed: u64,
+) -> (Simulated, RecordingEstimates) {
     let mut scene = ChannelScene::hangar();
     scene.walk.waypoints_m = vec![[2.0, 4.0], [14.0, 7.0]];
     scene.dt_s = 0.1;
-    scene.duration_s = Some(3.0);
-    if quasi_static {
-        scene.body.correlation = 0.9999;
-    }
+    scene.duration_s = Some(duration_s);
+    body(&mut scene);
     scene.cpi = Some(SceneCpi {
         snapshots: 16,
         spacing_s: 2.048e-3,
     });
-    for seed in 1..=2 {
-        let sim = SimulationRequest {
-            scene: Some(scene.clone()),
-            seed,
-            ..SimulationRequest::default()
+    let sim = SimulationRequest {
+        scene: Some(scene),
+        seed,
+        ..SimulationRequest::default()
+    }
+    .run(s, model, Cancel::NEVER)
+    .unwrap();
+    let req = ChannelRequest {
+        cpi_snapshots: Some(16),
+        ..ChannelRequest::default()
+    };
+    let (_, est) = estimate_recording(
+        model,
+        s.radio.bandwidth_hz,
+        &sim.recording,
+        Some(&sim.calibration),
+        &req.front_end(sim.recording.synchronized),
+        &mut Sequential::new(),
+        &|_| {},
+    )
+    .unwrap();
+    (sim, est)
+}
+
+/// The estimate of scan `k`, link `p` nearest the walker's true delay `tau`: of those within
+/// 1.5 ns of it, the strongest.
+fn walker_estimate(
+    est: &RecordingEstimates,
+    k: usize,
+    p: usize,
+    tau: Real,
+) -> Option<&TrackedPath> {
+    est.paths[k][p]
+        .iter()
+        .filter(|t| (t.estimate.delay_s - tau).abs() < 1.5e-9)
+        .max_by(|a, b| a.estimate.snr.total_cmp(&b.estimate.snr))
+}
+
+fn front_end_rates(quasi_static: bool) {
+    let s = presets::preset("sensors2019").unwrap();
+    let model = Model::new(&s).unwrap();
+    let body = |scene: &mut ChannelScene| {
+        if quasi_static {
+            scene.body.correlation = 0.9999;
         }
-        .run(&s, &model, Cancel::NEVER)
-        .unwrap();
-        let req = ChannelRequest {
-            cpi_snapshots: Some(16),
-            ..ChannelRequest::default()
-        };
-        let (_, est) = estimate_recording(
-            &model,
-            s.radio.bandwidth_hz,
-            &sim.recording,
-            Some(&sim.calibration),
-            &req.front_end(sim.recording.synchronized),
-            &mut Sequential::new(),
-            &|_| {},
-        )
-        .unwrap();
+    };
+    for seed in 1..=2 {
+        let (sim, est) = cpi_walk(&s, &model, 3.0, body, seed);
         assert_eq!(est.len(), sim.recording.t_s.len() / 16);
         let (mut z2, mut abs, mut found) = (0.0, Vec::new(), 0);
         for (k, tk) in est.t_s.iter().enumerate() {
@@ -165,11 +198,7 @@ fn front_end_rates(quasi_static: bool) {
             let (r, v) = (Vec2::new(x[0], x[1]), Vec2::new(x[2], x[3]));
             for p in 0..model.link_count() {
                 let tau = model.network.delay(p, r);
-                let Some(best) = est.paths[k][p]
-                    .iter()
-                    .filter(|t| (t.estimate.delay_s - tau).abs() < 1.5e-9)
-                    .max_by(|a, b| a.estimate.snr.total_cmp(&b.estimate.snr))
-                else {
+                let Some(best) = walker_estimate(&est, k, p, tau) else {
                     continue;
                 };
                 let Some(rate) = best.estimate.range_rate else {
@@ -219,48 +248,18 @@ fn limbs_spread_the_walkers_doppler() {
     let s = presets::preset("sensors2019").unwrap();
     let model = Model::new(&s).unwrap();
     let median_error = |swing: Real, seed: u64| -> Real {
-        let mut scene = ChannelScene::hangar();
-        scene.walk.waypoints_m = vec![[2.0, 4.0], [14.0, 7.0]];
-        scene.dt_s = 0.1;
-        scene.duration_s = Some(2.0);
-        scene.body.correlation = 0.9999;
-        scene.body.limb_swing_m = swing;
-        scene.cpi = Some(SceneCpi {
-            snapshots: 16,
-            spacing_s: 2.048e-3,
-        });
-        let sim = SimulationRequest {
-            scene: Some(scene),
-            seed,
-            ..SimulationRequest::default()
-        }
-        .run(&s, &model, Cancel::NEVER)
-        .unwrap();
-        let req = ChannelRequest {
-            cpi_snapshots: Some(16),
-            ..ChannelRequest::default()
+        let body = |scene: &mut ChannelScene| {
+            scene.body.correlation = 0.9999;
+            scene.body.limb_swing_m = swing;
         };
-        let (_, est) = estimate_recording(
-            &model,
-            s.radio.bandwidth_hz,
-            &sim.recording,
-            Some(&sim.calibration),
-            &req.front_end(sim.recording.synchronized),
-            &mut Sequential::new(),
-            &|_| {},
-        )
-        .unwrap();
+        let (sim, est) = cpi_walk(&s, &model, 2.0, body, seed);
         let mut errs = Vec::new();
         for k in 0..est.len() {
             let x = sim.truth.states[k * 16 + 8];
             let (r, v) = (Vec2::new(x[0], x[1]), Vec2::new(x[2], x[3]));
             for p in 0..model.link_count() {
                 let tau = model.network.delay(p, r);
-                let rate = est.paths[k][p]
-                    .iter()
-                    .filter(|t| (t.estimate.delay_s - tau).abs() < 1.5e-9)
-                    .max_by(|a, b| a.estimate.snr.total_cmp(&b.estimate.snr))
-                    .and_then(|t| t.estimate.range_rate);
+                let rate = walker_estimate(&est, k, p, tau).and_then(|t| t.estimate.range_rate);
                 if let Some(rate) = rate {
                     errs.push((rate.range_rate_mps - range_rate(&model.network, p, r, v)).abs());
                 }

@@ -13,8 +13,9 @@ use scatterloc::measure::{range_rate, range_rate_gradient, rng, uniform01, Cpi, 
 use scatterloc::scenario::presets::{preset, PRESET_NAMES};
 use scatterloc::study::{DopplerArm, DopplerStudy};
 use scatterloc::track::{
-    step_doppler, ConstantVelocity, Ekf, Filter, FilterKind, MeasurementNoise, ParticleFilter,
-    PfConfig, RangeRates, RateNoise, Tracker, Ukf, UkfParams,
+    paper_initial_covariance, step_doppler, ConstantVelocity, Ekf, Filter, FilterKind,
+    MeasurementNoise, ParticleFilter, PfConfig, RangeRates, RateNoise, TrackScenario, Tracker, Ukf,
+    UkfParams,
 };
 use scatterloc::{Error, Model};
 
@@ -526,6 +527,45 @@ fn summarize(name: &str, arm: &DopplerArm) -> (Real, Real, Real) {
     (pos, vel, nees)
 }
 
+/// The Monte Carlo cases: spec §9.4's [S] trajectories with the Tx 30 dB weaker, and scenario
+/// I with it 50 dB weaker (low SNR): name, the Tx's weakening in dB, x̄₀ (§9.4's table).
+fn monte_carlo_cases() -> [(&'static str, Real, Vec4); 4] {
+    [
+        ("I", 30.0, TrackScenario::I.mean_state()),
+        ("II", 30.0, TrackScenario::II.mean_state()),
+        ("III", 30.0, TrackScenario::III.mean_state()),
+        ("I, low SNR", 50.0, TrackScenario::I.mean_state()),
+    ]
+}
+
+/// A Monte Carlo case's model and study: sensors2019 with its transmitters `weaker_db` weaker;
+/// truths from `𝒩(x0, P(t₀))` (§9.5) with q = 1 m²/s³, `steps` scans 0.1 s apart each a CPI of
+/// 16 × 2.048 ms with a floor of 0.1 m/s, `runs` runs from `seed`, tracked by `filter`.
+fn monte_carlo_study(
+    weaker_db: Real,
+    x0: Vec4,
+    steps: usize,
+    runs: usize,
+    seed: u64,
+    filter: FilterKind,
+) -> (Model, DopplerStudy) {
+    let mut s = preset("sensors2019").unwrap();
+    for t in &mut s.transmitters {
+        t.power_dbm -= weaker_db;
+    }
+    let study = DopplerStudy {
+        motion: ConstantVelocity::new(0.1, 1.0),
+        mean_state: x0,
+        initial_covariance: paper_initial_covariance(),
+        cpi: Cpi::new(s.radio.carrier_hz, 16, 2.048e-3, 0.1).unwrap(),
+        steps,
+        runs,
+        seed,
+        filter,
+    };
+    (Model::new(&s).unwrap(), study)
+}
+
 /// The Monte Carlo study on the [S] scenarios (spec §9.4, P(t₀) of §9.5) with the Tx 30 dB
 /// weaker, q = 1 m²/s³, scans 0.1 s apart each a CPI of 16 × 2.048 ms, floor 0.1 m/s, plus a
 /// low-SNR case (Tx 50 dB weaker). Measured and asserted: in scenario I at both SNRs the EKF's
@@ -542,31 +582,10 @@ fn summarize(name: &str, arm: &DopplerArm) -> (Real, Real, Real) {
 /// side); on 3 seeds. 200 runs × 30 steps (3 s) per case here;
 /// docs/doppler.md has the 10 s tables.
 #[test]
-#[allow(clippy::approx_constant)] // spec §9.4's table: (1.2247, −0.7071) as printed
 fn monte_carlo_rmse_is_within_the_pcrlb_with_and_without_doppler() {
-    let p0 = scatterloc::track::paper_initial_covariance();
-    for (name, weaker_db, x0) in [
-        ("I", 30.0, Vec4::new(4.0, 1.0, 1.3927, 0.2456)),
-        ("II", 30.0, Vec4::new(-4.5, -2.0, 1.2247, -0.7071)),
-        ("III", 30.0, Vec4::new(-4.5, -8.5, 1.0, 1.0)),
-        ("I, low SNR", 50.0, Vec4::new(4.0, 1.0, 1.3927, 0.2456)),
-    ] {
-        let mut s = preset("sensors2019").unwrap();
-        for t in &mut s.transmitters {
-            t.power_dbm -= weaker_db;
-        }
-        let model = Model::new(&s).unwrap();
+    for (name, weaker_db, x0) in monte_carlo_cases() {
         for seed in 1..=3 {
-            let study = DopplerStudy {
-                motion: ConstantVelocity::new(0.1, 1.0),
-                mean_state: x0,
-                initial_covariance: p0,
-                cpi: Cpi::new(s.radio.carrier_hz, 16, 2.048e-3, 0.1).unwrap(),
-                steps: 30,
-                runs: 200,
-                seed,
-                filter: FilterKind::Ekf,
-            };
+            let (model, study) = monte_carlo_study(weaker_db, x0, 30, 200, seed, FilterKind::Ekf);
             let out = study.run(&model).unwrap();
             let (lo, hi) = nees_band(200);
             for (arm, label) in [
@@ -604,35 +623,13 @@ fn monte_carlo_rmse_is_within_the_pcrlb_with_and_without_doppler() {
 /// the truths by ≈ 18 m in 10 s, far into the network's poor geometry), measured in the docs.
 #[test]
 #[ignore = "full size: 4 cases × 500 runs × 100 scans × 2 arms × 2 filters (release)"]
-#[allow(clippy::approx_constant)] // spec §9.4's table: (1.2247, −0.7071) as printed
 fn monte_carlo_full() {
-    let p0 = scatterloc::track::paper_initial_covariance();
     let (lo, hi) = nees_band(500);
     eprintln!("NEES band for 500 runs: [{lo:.2}, {hi:.2}]");
     for filter in [FilterKind::Ekf, FilterKind::Ukf(UkfParams::default())] {
-        for (name, weaker_db, x0) in [
-            ("I", 30.0, Vec4::new(4.0, 1.0, 1.3927, 0.2456)),
-            ("II", 30.0, Vec4::new(-4.5, -2.0, 1.2247, -0.7071)),
-            ("III", 30.0, Vec4::new(-4.5, -8.5, 1.0, 1.0)),
-            ("I, low SNR", 50.0, Vec4::new(4.0, 1.0, 1.3927, 0.2456)),
-        ] {
-            let mut s = preset("sensors2019").unwrap();
-            for t in &mut s.transmitters {
-                t.power_dbm -= weaker_db;
-            }
-            let model = Model::new(&s).unwrap();
-            let out = DopplerStudy {
-                motion: ConstantVelocity::new(0.1, 1.0),
-                mean_state: x0,
-                initial_covariance: p0,
-                cpi: Cpi::new(s.radio.carrier_hz, 16, 2.048e-3, 0.1).unwrap(),
-                steps: 100,
-                runs: 500,
-                seed: 1,
-                filter,
-            }
-            .run(&model)
-            .unwrap();
+        for (name, weaker_db, x0) in monte_carlo_cases() {
+            let (model, study) = monte_carlo_study(weaker_db, x0, 100, 500, 1, filter);
+            let out = study.run(&model).unwrap();
             for (arm, label) in [
                 (&out.delay_only, "delay only"),
                 (&out.with_doppler, "Doppler"),

@@ -18,9 +18,10 @@ use crate::math::{sqrt, Real, SPEED_OF_LIGHT};
 use crate::measure::Model;
 use crate::scenario::Area;
 use crate::study::channel::RecordingEstimates;
+use crate::study::multi::link_detections;
 use crate::study::{track_scans, MultiSettings, MultiTrackOutput, MultiTruth, Scans, TruthTarget};
 use crate::track::gating::Calibration;
-use crate::track::multi::{Detection, Scan};
+use crate::track::multi::Scan;
 use crate::track::ConstantVelocity;
 
 /// `P_D` per link of a walker in a recording's estimates, the default of
@@ -168,25 +169,15 @@ pub fn cir_track_multi(
                 .take(links)
                 .enumerate()
                 .map(|(p, list)| {
-                    list.iter()
-                        .filter_map(|t| {
-                            let e = &t.estimate;
-                            if calibration.links[p].is_static(e.delay_s) {
-                                gone += 1;
-                                return None;
-                            }
-                            let s = Some(sqrt(e.sigma_s * e.sigma_s + extent_s * extent_s));
-                            Some(match e.range_rate {
-                                Some(r) => Detection::delay_rate(
-                                    e.delay_s,
-                                    s,
-                                    r.range_rate_mps,
-                                    r.sigma_mps,
-                                ),
-                                None => Detection::delay(e.delay_s, s),
-                            })
-                        })
-                        .collect()
+                    let estimates = list.iter().map(|t| {
+                        let e = &t.estimate;
+                        (
+                            e.delay_s,
+                            Some(sqrt(e.sigma_s * e.sigma_s + extent_s * extent_s)),
+                            e.range_rate.map(|r| (r.range_rate_mps, r.sigma_mps)),
+                        )
+                    });
+                    link_detections(estimates, Some(&calibration.links[p]), &mut gone)
                 })
                 .collect();
             removed.push(gone);

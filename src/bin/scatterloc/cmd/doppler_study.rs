@@ -9,15 +9,15 @@ use serde::Serialize;
 use scatterloc::chart::{tracking_size, FilterCurve, FiltersPanel, TrackingChartOptions};
 use scatterloc::error::Cancel;
 use scatterloc::study::{CpiDoc, DopplerResult, DopplerStudy};
-use scatterloc::track::{paper_initial_covariance, ConstantVelocity, TrackScenario};
+use scatterloc::track::{paper_initial_covariance, ConstantVelocity};
 use scatterloc::Model;
 
 use super::filters::filter_kinds;
 use super::output::{check_writable, Format, OutputSet};
 use super::report::FiltersFigure;
 use super::scenario::cpi_of;
-use super::study::{flag_error, load_layout, run_with_bar};
-use crate::cli::{FilterName, MontecarloArgs, Trajectory};
+use super::study::{flag_error, load_layout, run_with_bar, trajectories_of};
+use crate::cli::{FilterName, MontecarloArgs};
 use crate::failure::CliError;
 
 /// The scan interval of a Doppler study unless `--dt` is given, s (one CPI per scan).
@@ -68,12 +68,7 @@ pub fn doppler_montecarlo(args: &MontecarloArgs) -> Result<(), CliError> {
     let s = &args.study;
     let (_, scenario) = load_layout(s.preset.as_deref(), s.scenario.as_deref())?;
     let model = Model::new(&scenario).map_err(|e| super::flags::at_flag("scenario", e))?;
-    let trajectories = match s.trajectory {
-        None | Some(Trajectory::All) => TrackScenario::ALL.to_vec(),
-        Some(Trajectory::One) => vec![TrackScenario::I],
-        Some(Trajectory::Two) => vec![TrackScenario::II],
-        Some(Trajectory::Three) => vec![TrackScenario::III],
-    };
+    let trajectories = trajectories_of(s.trajectory);
     let dt = s.dt.unwrap_or(DOPPLER_DT_S);
     let q = s.process_noise.unwrap_or(DOPPLER_Q);
     let motion = ConstantVelocity::validated(dt, q).map_err(flag_error)?;

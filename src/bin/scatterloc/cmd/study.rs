@@ -55,18 +55,23 @@ pub fn cancelled() -> CliError {
 /// (`I`, `II`, `III` or `all`, the default), `--dt`, `--duration`, `--process-noise`.
 pub fn parse_study(args: &StudyArgs) -> Result<Study, CliError> {
     let (layout, scenario) = load_layout(args.preset.as_deref(), args.scenario.as_deref())?;
-    let trajectories = match args.trajectory {
-        None | Some(Trajectory::All) => TrackScenario::ALL.to_vec(),
-        Some(Trajectory::One) => vec![TrackScenario::I],
-        Some(Trajectory::Two) => vec![TrackScenario::II],
-        Some(Trajectory::Three) => vec![TrackScenario::III],
-    };
+    let trajectories = trajectories_of(args.trajectory);
     let dt = args.dt.unwrap_or(PAPER_STEP_S);
     let q = args.process_noise.unwrap_or(PAPER_INTENSITY);
     let motion = ConstantVelocity::validated(dt, q).map_err(flag_error)?;
     let duration = args.duration.unwrap_or(PAPER_DURATION_S);
     let steps = checked_steps(duration, dt)?;
     new_study(layout, scenario, trajectories, motion, steps)
+}
+
+/// The trajectories of `--trajectory` (`I`, `II`, `III`, or `all`, the default).
+pub fn trajectories_of(trajectory: Option<Trajectory>) -> Vec<TrackScenario> {
+    match trajectory {
+        None | Some(Trajectory::All) => TrackScenario::ALL.to_vec(),
+        Some(Trajectory::One) => vec![TrackScenario::I],
+        Some(Trajectory::Two) => vec![TrackScenario::II],
+        Some(Trajectory::Three) => vec![TrackScenario::III],
+    }
 }
 
 /// The node layout of `--preset NAME` (default `sensors2019`) or `--scenario FILE` (not both):
