@@ -46,6 +46,11 @@ mod replay;
 #[path = "wasm/multi.rs"]
 mod multi;
 
+/// Issue 42 §1: the bound with Doppler at a point (`App.doppler_at`) and the maps with Doppler
+/// as figures (`App.map_svg`'s `doppler`).
+#[path = "wasm/doppler.rs"]
+mod doppler;
+
 fn message(e: JsError) -> String {
     let v: JsValue = e.into();
     v.dyn_into::<js_sys::Error>()

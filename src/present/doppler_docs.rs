@@ -3,10 +3,13 @@
 //! rate ([`state_fisher`], D7), its inverse, and per link the range rate and its σ (D1, D5) —
 //! beside the same CPI's delay-only bound, which says nothing of the velocity.
 
+use alloc::format;
+use alloc::string::String;
 use alloc::vec::Vec;
 
 use serde::Serialize;
 
+use crate::localize::MapQuantity;
 use crate::math::{sqrt, Real, Vec2, Vec4};
 use crate::measure::{range_rate, state_bounds, state_fisher, Cpi, Model};
 use crate::study::CpiDoc;
@@ -73,5 +76,49 @@ impl DopplerDoc {
             fim: core::array::from_fn(|i| core::array::from_fn(|j| f[(i, j)])),
             links,
         }
+    }
+}
+
+/// The texts of a map figure with Doppler (`crlb-map --doppler --out f.svg` and the page's
+/// Save figure): title, subtitle, colour-bar label and the suffix of its length labels.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct DopplerMapText {
+    /// `Position CRLB with Doppler` or `Velocity CRLB with Doppler`.
+    pub title: String,
+    /// The delay-only map's subtitle, then `· CPI N × T ms, v = (vx, vy) m/s · σṙ floor F m/s`.
+    pub subtitle: String,
+    /// The colour bar's label.
+    pub colorbar_label: String,
+    /// `""` (m) for the position map, `"/s"` for the velocity map.
+    pub value_suffix: String,
+}
+
+impl DopplerMapText {
+    /// The texts of the `quantity` map over `cpi` at `velocity` (m/s), `subtitle` being the
+    /// delay-only figure's (`chart::default_titles`). The CPI and velocity part is the CLI's
+    /// (`T` printed as `spacing_s · 1000`), the floor follows it.
+    pub fn new(quantity: MapQuantity, cpi: &Cpi, velocity: [Real; 2], subtitle: &str) -> Self {
+        let (title, label, suffix) = match quantity {
+            MapQuantity::Position => ("Position", "RMSE bound √(σx² + σy²)", ""),
+            MapQuantity::Velocity => ("Velocity", "velocity RMSE bound √(σvx² + σvy²)", "/s"),
+        };
+        DopplerMapText {
+            title: format!("{title} CRLB with Doppler"),
+            subtitle: format!(
+                "{subtitle} · CPI {} × {} ms, v = ({}, {}) m/s{}",
+                cpi.snapshots,
+                cpi.spacing_s * 1e3,
+                velocity[0],
+                velocity[1],
+                Self::floor_clause(cpi)
+            ),
+            colorbar_label: label.into(),
+            value_suffix: suffix.into(),
+        }
+    }
+
+    /// The subtitle's last clause, ` · σṙ floor F m/s`.
+    pub fn floor_clause(cpi: &Cpi) -> String {
+        format!(" · σṙ floor {} m/s", cpi.floor_mps)
     }
 }

@@ -38,7 +38,7 @@ pub use channel_view::{
 pub use colormap::{
     colorbar_rgba, fill_rgba, render_rgba, viridis, LogScale, LINK_RGB, UNBOUNDED_RGB,
 };
-pub use doppler_docs::{DopplerDoc, RangeRateDoc};
+pub use doppler_docs::{DopplerDoc, DopplerMapText, RangeRateDoc};
 pub use free_z_docs::{sym3, CrlbFreeZDoc, FixFreeZDoc};
 pub use multi_view::{
     people_csv_header, people_data_text, people_doc_from_json, people_map_view, track_ellipses,

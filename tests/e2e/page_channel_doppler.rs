@@ -79,10 +79,11 @@ fn cpi_snapshots_give_the_cli_range_rates() {
         js(c, "document.getElementById('chan-run').click()").await?;
         wait_channel(c, 600, "run", |s| s["runs"] == 1 && s["running"].is_null()).await?;
         let text = js(c, "return window.channel.texts().estimates").await?;
-        Ok((settings, text, console_errors(c).await?))
+        let figure = js(c, "return window.channel.texts().figure").await?;
+        Ok((settings, text, figure, console_errors(c).await?))
     });
     let _ = std::fs::remove_dir_all(&dir);
-    let (settings, text, errors) = o;
+    let (settings, text, figure, errors) = o;
     assert!(errors.is_empty(), "console errors: {errors:?}");
     assert_eq!(settings["cpi_snapshots"], 8, "{settings}");
     let got: Value = serde_json::from_str(text.as_str().unwrap_or("null")).unwrap();
@@ -109,4 +110,27 @@ fn cpi_snapshots_give_the_cli_range_rates() {
         scans.len()
     );
     assert!(rated > 40, "{rated}");
+    // The delay picture draws them (issue 42 §5: a tick of slope ṙ through each estimate): its
+    // points carry the same `[ṙ, σ]` as EST.json's paths, link by link, in the same order.
+    let fig: Value = serde_json::from_str(figure.as_str().unwrap_or("null")).unwrap();
+    let links = fig["links"].as_array().expect("the figure's links");
+    let mut drawn = 0;
+    for (l, link) in links.iter().enumerate() {
+        let points = link["estimates"].as_array().unwrap();
+        let rates: Vec<&Value> = points
+            .iter()
+            .filter_map(|p| p.get("range_rate_mps"))
+            .collect();
+        let want: Vec<Value> = scans
+            .iter()
+            .flat_map(|scan| scan[l].as_array().unwrap().iter())
+            .filter_map(|w| w.get("range_rate_mps").cloned())
+            .collect();
+        assert_eq!(rates.len(), want.len(), "link {l}");
+        for (g, w) in rates.iter().zip(&want) {
+            assert_eq!(*g, w, "link {l}");
+        }
+        drawn += rates.len();
+    }
+    assert_eq!(drawn, rated);
 }

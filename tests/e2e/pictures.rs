@@ -871,8 +871,14 @@ fn data_exports_and_svg_map_image_equal_the_core() {
     for (k, row) in rows.iter().enumerate() {
         assert_eq!(num(&row[pc]), want[k], "PCRLB step {k}");
     }
+    // "Velocity map data" only in the snapshot view with Doppler on (page_doppler).
     assert_eq!(
         o["options"],
-        json!([["map", false], ["track", false], ["mc", false]])
+        json!([
+            ["map", false],
+            ["velocity", true],
+            ["track", false],
+            ["mc", false]
+        ])
     );
 }

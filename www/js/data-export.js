@@ -37,9 +37,25 @@ export class DataExport {
     return st.mode === 'tracking' && multi && multi.on ? multi : null;
   }
 
-  /** With several people: "track" is their data, the Monte Carlo curves are off. */
+  /**
+   * The Doppler settings of the snapshot view's maps (doppler.js job(): {cpi, velocity_mps})
+   * when they are shown, else null.
+   */
+  dopplerJob() {
+    const { st, doppler } = this.ctx;
+    return st.mode === 'snapshot' && doppler ? doppler.job() : null;
+  }
+
+  /**
+   * With several people: "track" is their data, the Monte Carlo curves are off. With Doppler
+   * shown: "Velocity map data" (the velocity bound beside the map).
+   */
   refresh() {
     const what = $('data-what');
+    const vel = what.querySelector('option[value="velocity"]');
+    vel.hidden = !this.dopplerJob();
+    vel.disabled = vel.hidden;
+    if (vel.disabled && what.value === 'velocity') what.value = 'map';
     const people = !!this.people();
     const mc = what.querySelector('option[value="mc"]');
     mc.hidden = this.mode !== 'tracking' || people;
@@ -65,11 +81,17 @@ export class DataExport {
   /** The text of data `what` ('map' | 'track' | 'mc') as `format` ('csv' | 'json'). */
   text(what, format) {
     const { app, wasm, st, tracking } = this.ctx;
-    if (what === 'map') {
-      if (!st.values || !st.mapWindow) throw new Error('no map computed yet');
-      return wasm.map_data_text(st.values, JSON.stringify({
-        window: st.mapWindow, nx: st.res, ny: st.res, scenario: app.scenario().name, format,
-      }));
+    if (what === 'map' || what === 'velocity') {
+      // With Doppler, the values are labelled as the bounds with Doppler they are (their CPI,
+      // velocity and floor); the velocity map's column is rmse_mps.
+      const job = this.dopplerJob();
+      const values = what === 'velocity' ? st.velValues : st.values;
+      if (!values || !st.mapWindow || (what === 'velocity' && !job)) throw new Error('no map computed yet');
+      // The values must be the kernel's the labels name (map.js st.mapKernel).
+      if (!!job !== (st.mapKernel === 'doppler')) throw new Error('the map is still being computed');
+      const settings = { window: st.mapWindow, nx: st.res, ny: st.res, scenario: app.scenario().name, format };
+      if (job) settings.doppler = { ...job, quantity: what === 'velocity' ? 'velocity' : 'position' };
+      return wasm.map_data_text(values, JSON.stringify(settings));
     }
     const people = this.people();
     if (people && what === 'track') {
@@ -98,7 +120,8 @@ export class DataExport {
       const people = !!this.people() && what === 'track';
       const text = this.text(what, format);
       const type = format === 'csv' ? 'text/csv' : 'application/json';
-      const name = `${slug(app.scenario().name)}-${st.mode}-${people ? 'people' : what}.${format}`;
+      const kind = this.dopplerJob() && (what === 'map' || what === 'velocity') ? `doppler-${what === 'map' ? 'position' : 'velocity'}` : what;
+      const name = `${slug(app.scenario().name)}-${st.mode}-${people ? 'people' : kind}.${format}`;
       const blob = new Blob([text], { type });
       const a = document.createElement('a');
       a.href = URL.createObjectURL(blob);

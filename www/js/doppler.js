@@ -4,7 +4,10 @@
 // second map beside it the velocity bound (m/s, its own colour bar), both over the window and
 // grid of the main map: map.js computes them through its one timing and resolution logic (the
 // core's App.compute_doppler_maps_in, the map worker for a costly map), this file holds the
-// fields, the page state's `doppler` section and the velocity map's drawing. Every number is
+// fields, the page state's `doppler` section and the velocity map's drawing. Its job() settings
+// also drive the map's hover read-out and pinned probe (interact.js, map.js: App.doppler_at, the
+// bounds at a point) and Save figure (export.js: "Map" and "Velocity map" with Doppler, as
+// `crlb-map --doppler --quantity position|velocity --out f.svg` draws them). Every number is
 // read strictly (dom.js decimalIn); a bad one is named in the banner and the last good settings
 // stay in use.
 
@@ -127,6 +130,8 @@ export class Doppler {
     $('doppler-head').hidden = !pair;
     view.resize();
     if (pair) this.view.resize();
+    // Save figure's "Velocity map" choice (export.js) exists only with the pair shown.
+    if (this.ctx.figures) this.ctx.figures.relabel();
     const want = pair ? 'doppler' : 'delay';
     this.ctx.changed(st.mapKernel !== want ? { map: true } : { draw: true });
   }

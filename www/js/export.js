@@ -7,8 +7,12 @@
 // "Several people" on (tracking view, multi.js), the map is the run's map at the scan shown
 // (people_map_svg: nodes, true paths, labelled tracks, 1σ ellipses) and the chart its GOSPA chart
 // (people_chart_svg, "GOSPA chart"); PNG is the map canvas or #multi-chart as they are; files
-// <scenario>-tracking-people-map.<ext>, <scenario>-tracking-people-gospa.<ext>. Nothing here runs
-// until the button is pressed (the drag stays as fast as it was).
+// <scenario>-tracking-people-map.<ext>, <scenario>-tracking-people-gospa.<ext>. With Doppler on
+// in the snapshot view (doppler.js), "Map" is the position bound with Doppler and "Velocity map"
+// the velocity bound, one figure per quantity as `crlb-map --doppler --quantity position|velocity
+// --out f.svg` draws them (App.map_svg's `doppler` option; PNG: #plot or #vel-plot as they are);
+// files <scenario>-snapshot-doppler-position.<ext>, <scenario>-snapshot-doppler-velocity.<ext>.
+// Nothing here runs until the button is pressed (the drag stays as fast as it was).
 
 import { $, errorText, showError } from './dom.js';
 import { DataExport } from './data-export.js';
@@ -45,10 +49,27 @@ export class FigureExport {
     return st.mode === 'tracking' && multi && multi.on ? multi : null;
   }
 
-  /** The chart choice's label ("GOSPA chart" with several people) and the data choices. */
+  /**
+   * The Doppler settings of the snapshot view's maps (doppler.js job(): {cpi, velocity_mps}) when
+   * they are shown, else null.
+   */
+  dopplerJob() {
+    const { st, doppler } = this.ctx;
+    return st.mode === 'snapshot' && doppler ? doppler.job() : null;
+  }
+
+  /**
+   * The chart choice's label ("GOSPA chart" with several people), the velocity map's choice
+   * (only with Doppler shown; doppler.js sync() calls this) and the data choices.
+   */
   relabel() {
-    const rmse = $('figure-what').querySelector('option[value="rmse"]');
+    const what = $('figure-what');
+    const rmse = what.querySelector('option[value="rmse"]');
     rmse.textContent = this.people() ? 'GOSPA chart' : 'RMSE chart';
+    const vel = what.querySelector('option[value="velocity"]');
+    vel.hidden = !this.dopplerJob();
+    vel.disabled = vel.hidden;
+    if (vel.disabled && what.value === 'velocity') what.value = 'map';
     this.data.refresh();
   }
 
@@ -64,10 +85,11 @@ export class FigureExport {
     this.relabel();
   }
 
-  /** The file name of figure `what` ('map' | 'rmse') of the current view. */
+  /** The file name of figure `what` ('map' | 'rmse' | 'velocity') of the current view. */
   fileName(what, ext) {
     const { app, st } = this.ctx;
     if (st.mode === 'mtl') return `multi-target-scene.${ext}`;
+    if (this.dopplerJob()) return `${slug(app.scenario().name)}-snapshot-doppler-${what === 'velocity' ? 'velocity' : 'position'}.${ext}`;
     if (this.people()) return `${slug(app.scenario().name)}-tracking-people-${what === 'rmse' ? 'gospa' : 'map'}.${ext}`;
     return `${slug(app.scenario().name)}-${st.mode}-${what}.${ext}`;
   }
@@ -75,15 +97,19 @@ export class FigureExport {
   /** Saves the figure chosen in #figure-what as #figure-format; errors go to the banner. */
   async save() {
     const { st } = this.ctx;
-    const what = st.mode === 'tracking' ? $('figure-what').value : 'map';
+    this.relabel();
+    const chosen = $('figure-what').value;
+    const doppler = !!this.dopplerJob();
+    const what = st.mode === 'tracking' || (doppler && chosen === 'velocity') ? chosen : 'map';
     const format = $('figure-format').value;
     const t0 = performance.now();
-    this.relabel();
     try {
       // The RMSE chart of a study still running is labelled partial (chartText), here and on the canvas.
       const partial = what === 'rmse' && !this.people() ? this.ctx.tracking.mc.chartText().partial : '';
       const blob = format === 'svg' ? this.svg(what) : await this.png(what);
-      this.download(blob, this.fileName(what, format), { mode: st.mode, what, format, ms: performance.now() - t0, partial, people: !!this.people() });
+      this.download(blob, this.fileName(what, format), {
+        mode: st.mode, what, format, ms: performance.now() - t0, partial, people: !!this.people(), doppler,
+      });
     } catch (e) {
       showError(`Save figure: ${errorText(e)}`);
       console.error(e);
@@ -114,7 +140,13 @@ export class FigureExport {
       const magnify = Number($('track-ex').value) || 1;
       text = tracking.track.map_svg(SVG_WIDTH, 0, tracking.step, magnify, JSON.stringify(options));
     } else {
-      if (st.target) options.target = { x: st.target.x, y: st.target.y, seed: st.target.seed };
+      // With Doppler: the map of `what` with the settings of the maps shown (the velocity map
+      // as its canvas: no target, its own colour range).
+      const job = this.dopplerJob();
+      const velocity = !!job && what === 'velocity';
+      if (job) options.doppler = { ...job, quantity: velocity ? 'velocity' : 'position' };
+      if (velocity) delete options.scale;
+      if (st.target && !velocity) options.target = { x: st.target.x, y: st.target.y, seed: st.target.seed };
       text = app.map_svg(SVG_WIDTH, 0, JSON.stringify(options));
     }
     return new Blob([text], { type: 'image/svg+xml' });
@@ -138,7 +170,7 @@ export class FigureExport {
     const people = this.people();
     if (people && !people.text) return Promise.reject(new Error('no multi-target run yet'));
     const chart = people ? $('multi-chart') : $('track-chart');
-    const canvas = what === 'rmse' ? chart : $('plot');
+    const canvas = what === 'rmse' ? chart : what === 'velocity' ? $('vel-plot') : $('plot');
     return new Promise((resolve, reject) => {
       canvas.toBlob((b) => (b ? resolve(b) : reject(new Error('the canvas gave no image'))), 'image/png');
     });

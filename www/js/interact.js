@@ -1,7 +1,8 @@
 // Mouse/pointer handling on the plot for the snapshot and tracking views: drag Tx/Rx markers,
 // click to place a target (snapshot mode), press-and-drag a trajectory (tracking mode, "draw") or
 // the Plan panel's region of interest (after "Draw ROI", plan.js), press-and-drag on empty map to
-// pan (zoom.js), hover read-out. A node drag cancels a running plan. pickNearest is the hit test
+// pan (zoom.js), hover read-out (with Doppler on in the snapshot view, the position and
+// velocity bounds with Doppler and the delay-only one: App.doppler_at). A node drag cancels a running plan. pickNearest is the hit test
 // of every view (mtl.js uses it too).
 
 import { $, errorText, fixed, showError, clearError } from './dom.js';
@@ -75,6 +76,20 @@ export function attachPointer(ctx) {
       return;
     }
     const m = view.toMetre(p.x, p.y);
+    // With Doppler shown (doppler.js), the bound of the main map and the velocity map beside it.
+    const job = ctx.doppler ? ctx.doppler.job() : null;
+    if (job) {
+      const d = app.doppler_at(m.x, m.y, JSON.stringify(job));
+      const bold = (t) => { const e = document.createElement('b'); e.textContent = t; return e; };
+      readout.replaceChildren(
+        `x = ${fixed(m.x, 2)} m, y = ${fixed(m.y, 2)} m  ·  with Doppler: position bound `, bold(d.position_label),
+        ', velocity bound ', bold(d.velocity_label),
+        `  ·  delays only ${d.delay_only_label}`,
+        d.bounded ? '' : '  ·  Fisher matrix singular here',
+        st.colourLock && d.position_rmse_m !== null ? st.colourLock.note(d.position_rmse_m) : '',
+      );
+      return;
+    }
     const c = app.crlb_at(m.x, m.y);
     readout.replaceChildren();
     const b = document.createElement('b');

@@ -94,6 +94,8 @@ export class MapView {
     const links = app.link_count();
     const doppler = this.dopplerJob();
     const ns = this.nsPerCellLink;
+    // The probe reads the bound of the map now wanted (with Doppler or not, its settings).
+    this.probe();
     if (ns === null || this.predictMs(n, links) <= FRAME_MS) {
       this.worker.cancel();
       this.show(n, this.run(n, links, doppler), 'main');
@@ -229,8 +231,12 @@ export class MapView {
 
   /**
    * The pinned probe (st.probe {x, y} m: a Shift+click on the map or the URL option
-   * `probe=x,y`): its bound into #probe's data-x, data-y, data-rmse-m and text; no probe pinned,
-   * #probe and its remove button are hidden.
+   * `probe=x,y`): its bound into #probe's data-x, data-y, data-rmse-m (the position bound shown,
+   * m; 'Infinity' where unbounded) and text; no probe pinned, #probe and its remove button are
+   * hidden. With Doppler shown (doppler.js), the bound of the main map: the position bound with
+   * delays and range rates (data-rmse-m), the velocity bound (data-velocity-mps, m/s) and the
+   * same CPI's delays alone (data-delay-only-m), the core's App.doppler_at (as `scatterloc crlb
+   * --doppler`); data-doppler says which ('on' / 'off'; off, the two Doppler attributes are '').
    */
   probe() {
     const { app, wasm, st } = this.ctx;
@@ -239,13 +245,25 @@ export class MapView {
     el.hidden = !pin;
     $('probe-clear').hidden = !pin;
     if (!pin) {
-      el.dataset.rmseM = '';
+      Object.assign(el.dataset, { rmseM: '', velocityMps: '', delayOnlyM: '', doppler: 'off' });
       el.textContent = 'probe –';
       return;
     }
+    const at = `probe (${fixed(pin.x, 2)}, ${fixed(pin.y, 2)}) m`;
+    const job = this.dopplerJob();
+    if (job) {
+      const d = app.doppler_at(pin.x, pin.y, JSON.stringify(job));
+      const num = (v) => String(v === null ? Infinity : v); // null: unbounded
+      Object.assign(el.dataset, {
+        x: String(pin.x), y: String(pin.y), rmseM: num(d.position_rmse_m),
+        velocityMps: num(d.velocity_rmse_mps), delayOnlyM: num(d.delay_only_position_rmse_m), doppler: 'on',
+      });
+      el.textContent = `${at}: ${d.position_label}, v ${d.velocity_label} with Doppler (delays only ${d.delay_only_label})`;
+      return;
+    }
     const rmse = app.rmse_at(pin.x, pin.y);
-    Object.assign(el.dataset, { x: String(pin.x), y: String(pin.y), rmseM: String(rmse) });
-    el.textContent = `probe (${fixed(pin.x, 2)}, ${fixed(pin.y, 2)}) m: ${wasm.format_length(rmse, 4)}`;
+    Object.assign(el.dataset, { x: String(pin.x), y: String(pin.y), rmseM: String(rmse), velocityMps: '', delayOnlyM: '', doppler: 'off' });
+    el.textContent = `${at}: ${wasm.format_length(rmse, 4)}`;
   }
 
   /** Pins the probe at (x, y) m (null: removes it). */

@@ -1,6 +1,8 @@
 //! The page's "Save figure" as SVG: the figures drawn by the same plotters chart code as the CLI
 //! ([`crate::chart`]) through plotters' SVG backend into a `String`. `App.map_svg` draws the CRLB
-//! map figure of the app's scenario (with a placed target's snapshot), `Track.map_svg` the map
+//! map figure of the app's scenario (with a placed target's snapshot; with its `doppler` option
+//! the position or velocity map with Doppler as `crlb-map --doppler --quantity … --out f.svg`
+//! draws it, titles from [`DopplerMapText`]), `Track.map_svg` the map
 //! with a simulated track, [`tracking_chart_svg`] the Monte Carlo RMSE chart of the tracking
 //! view (the canvas chart's [`draw_tracking_chart`](super::draw_tracking_chart) code) and
 //! [`mtl_scene_svg`] the multi-target scene ([`crate::chart::draw_mtl_scene`]). Every
@@ -12,6 +14,7 @@ use plotters::prelude::*;
 use serde::Deserialize;
 use wasm_bindgen::prelude::*;
 
+use super::doppler::{velocity, CpiSettings};
 use super::tracking::Track;
 use super::{settings, window, App};
 use crate::chart::{
@@ -19,8 +22,9 @@ use crate::chart::{
     ChartOptions, MapData, MapOverlay, SceneChartOptions,
 };
 use crate::error::{limits, Error};
-use crate::localize::{crlb_map, Grid};
-use crate::present::{mtl_view, MtlScene};
+use crate::localize::{crlb_map, doppler_map, Grid, MapQuantity};
+use crate::measure::Cpi;
+use crate::present::{mtl_view, DopplerMapText, MtlScene};
 use crate::present::{simulate_snapshot, LogScale};
 use crate::scenario::Area;
 use crate::{Model, Scenario, Vec2};
@@ -63,6 +67,55 @@ struct MapOptions {
     /// `≤`/`≥` on the colour bar); default the range of the map's finite values.
     #[serde(default)]
     scale: Option<[f64; 2]>,
+    /// The map with Doppler instead of the delay-only one (App.map_svg only).
+    #[serde(default)]
+    doppler: Option<DopplerOpt>,
+}
+
+/// A map with Doppler: `{cpi: {snapshots, spacing_ms, floor_mps}, velocity_mps: [vx, vy],
+/// quantity: "position" | "velocity"}` (every field required), as `App.compute_doppler_maps_in`.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct DopplerOpt {
+    cpi: CpiSettings,
+    velocity_mps: [f64; 2],
+    quantity: QuantityOpt,
+}
+
+/// `"position"` or `"velocity"` (`crlb-map --quantity`).
+#[derive(Deserialize, Clone, Copy)]
+#[serde(rename_all = "lowercase")]
+enum QuantityOpt {
+    Position,
+    Velocity,
+}
+
+/// What a map figure maps: the delay-only bound, or `quantity` with Doppler over `cpi` for a
+/// target moving at `velocity` (m/s).
+enum Kernel {
+    Delay,
+    Doppler {
+        cpi: Cpi,
+        velocity: Vec2,
+        quantity: MapQuantity,
+    },
+}
+
+impl Kernel {
+    /// The kernel of `opts` on the carrier `carrier_hz` (a bad CPI or velocity: the named error).
+    fn of(opts: &MapOptions, carrier_hz: f64) -> crate::Result<Kernel> {
+        let Some(d) = &opts.doppler else {
+            return Ok(Kernel::Delay);
+        };
+        Ok(Kernel::Doppler {
+            cpi: d.cpi.cpi(carrier_hz)?,
+            velocity: velocity("doppler.velocity_mps", d.velocity_mps)?,
+            quantity: match d.quantity {
+                QuantityOpt::Position => MapQuantity::Position,
+                QuantityOpt::Velocity => MapQuantity::Velocity,
+            },
+        })
+    }
 }
 
 /// The locked colour range `[min, max]` (m) as a scale: finite, `0 < min < max`, else the named
@@ -166,18 +219,39 @@ fn map_figure(
     }
     let size = figure_size(Some(&area), width, height).map_err(|e| fail(func, e))?;
     let grid = Grid::new(area, res, res).map_err(|e| fail(func, e))?;
+    let kernel = Kernel::of(opts, s.radio.carrier_hz).map_err(|e| fail(func, e))?;
     let mut values = vec![0.0; grid.len()];
-    crlb_map(model, &grid, &mut values).map_err(|e| fail(func, e))?;
     let (title, subtitle) = default_titles(s, &grid);
     let scale = match opts.scale {
         Some(v) => Some(locked_scale(v).map_err(|e| fail(func, e))?),
         None => None,
     };
-    let chart_opts = ChartOptions {
-        title: opts.title.clone().unwrap_or(title),
-        subtitle: Some(subtitle),
-        scale,
-        ..ChartOptions::default()
+    let chart_opts = match &kernel {
+        Kernel::Delay => {
+            crlb_map(model, &grid, &mut values).map_err(|e| fail(func, e))?;
+            ChartOptions {
+                title: opts.title.clone().unwrap_or(title),
+                subtitle: Some(subtitle),
+                scale,
+                ..ChartOptions::default()
+            }
+        }
+        Kernel::Doppler {
+            cpi,
+            velocity: v,
+            quantity,
+        } => {
+            doppler_map(model, &grid, cpi, *v, *quantity, &mut values)
+                .map_err(|e| fail(func, e))?;
+            let t = DopplerMapText::new(*quantity, cpi, [v.x, v.y], &subtitle);
+            ChartOptions {
+                title: opts.title.clone().unwrap_or(t.title),
+                subtitle: Some(t.subtitle),
+                scale,
+                colorbar_label: t.colorbar_label,
+                value_suffix: t.value_suffix,
+            }
+        }
     };
     let map = MapData {
         grid,
@@ -213,7 +287,12 @@ impl App {
     /// `width` 200 … 8000 px, `height` 0 (fit the plot) or 150 … 8000 px. `options_json`: `""`
     /// or `{window?: [x_min, x_max, y_min, y_max] (m; default the area), res?: cells per side
     /// (8 … 1024, default 256), title?: text, target?: {x, y, seed}, scale?: [min, max] (m, a
-    /// locked colour range)}`. The map is one embedded PNG image. Throws `map_svg: …`.
+    /// locked colour range; m/s on a velocity map), doppler?: {cpi: {snapshots, spacing_ms,
+    /// floor_mps}, velocity_mps: [vx, vy], quantity: "position" | "velocity"}}`. With `doppler`
+    /// the map is that bound with Doppler (issue 42 §1), titled, labelled and drawn as `crlb-map
+    /// --doppler --quantity … --out f.svg` draws it (`--cpi-spacing-s` = `spacing_ms / 1000`),
+    /// its subtitle also naming the σṙ floor ([`DopplerMapText`]). The map is one embedded PNG
+    /// image. Throws `map_svg: …`.
     pub fn map_svg(&self, width: u32, height: u32, options_json: &str) -> Result<String, JsError> {
         const F: &str = "map_svg";
         let opts: MapOptions = parse_options(F, options_json)?;
@@ -254,6 +333,12 @@ impl Track {
             return Err(fail(
                 F,
                 "target: a track's figure shows the track, not a target",
+            ));
+        }
+        if opts.doppler.is_some() {
+            return Err(fail(
+                F,
+                "doppler: a track's figure shows the delay-only map",
             ));
         }
         if !(magnify.is_finite() && magnify > 0.0) {
@@ -374,7 +459,7 @@ struct MapGridJs {
 #[derive(serde::Serialize)]
 struct MapDataJs<'a> {
     scenario: &'a str,
-    quantity: &'static str,
+    quantity: String,
     units: &'static str,
     grid: MapGridJs,
     x_m: Vec<f64>,
@@ -399,6 +484,10 @@ struct MapDataSettings {
     scenario: String,
     /// `csv` or `json`.
     format: String,
+    /// The map is a bound with Doppler (issue 42 §1): `{cpi, velocity_mps, quantity}` as
+    /// `map_svg`'s; absent: the delay-only snapshot bound.
+    #[serde(default)]
+    doppler: Option<DopplerOpt>,
 }
 
 /// The CRLB map `values` (m, row-major, row `j` at the `j`-th lowest y, as `App.compute_map_in`
@@ -409,7 +498,11 @@ struct MapDataSettings {
 /// grid: {x0, x1, y0, y1, nx, ny}, x_m: [centres], y_m: [centres], order: "row-major, y
 /// ascending", rmse_m: [nx·ny values, null where unbounded], unbounded}`. Every number is the
 /// core's, written so that it reads back as the same `f64`. Throws `map_data_text: …` (an
-/// unknown, missing or mistyped setting: `map_data_text: invalid JSON: …` naming it).
+/// unknown, missing or mistyped setting: `map_data_text: invalid JSON: …` naming it). With
+/// `doppler: {cpi: {snapshots, spacing_ms, floor_mps}, velocity_mps, quantity}` the values are
+/// that bound with Doppler (`App.compute_doppler_maps_in`'s): the JSON's `quantity` says so
+/// (the CPI, velocity and floor as the figure's subtitle writes them, [`DopplerMapText`]); a
+/// velocity map's column is `rmse_mps` (CSV) and its units `m/s`.
 #[wasm_bindgen]
 pub fn map_data_text(values: &[f64], settings_json: &str) -> Result<String, JsError> {
     const F: &str = "map_data_text";
@@ -419,8 +512,38 @@ pub fn map_data_text(values: &[f64], settings_json: &str) -> Result<String, JsEr
         ny,
         scenario,
         format,
+        doppler,
     } = settings(F, settings_json)?;
     let csv = data_format(F, &format)?;
+    // What the values are: the delay-only bound, or a bound with Doppler (its CPI checked).
+    let (quantity, units, column) = match &doppler {
+        None => (
+            String::from("CRLB RMSE bound sqrt(σx² + σy²) of a snapshot fix"),
+            "m",
+            "rmse_m",
+        ),
+        Some(d) => {
+            // The label reads N, T and the floor, not the wavelength: any positive carrier
+            // validates them.
+            let cpi = d.cpi.cpi(1.0).map_err(|e| fail(F, e))?;
+            let v = velocity("doppler.velocity_mps", d.velocity_mps).map_err(|e| fail(F, e))?;
+            let (what, units, column) = match d.quantity {
+                QuantityOpt::Position => ("position RMSE bound sqrt(σx² + σy²)", "m", "rmse_m"),
+                QuantityOpt::Velocity => {
+                    ("velocity RMSE bound sqrt(σvx² + σvy²)", "m/s", "rmse_mps")
+                }
+            };
+            let t = DopplerMapText::new(MapQuantity::Position, &cpi, [v.x, v.y], "");
+            (
+                format!(
+                    "CRLB {what} with delays and range rates (Doppler){}",
+                    t.subtitle
+                ),
+                units,
+                column,
+            )
+        }
+    };
     let area = window([x0, x1, y0, y1]).map_err(|e| fail(F, e))?;
     let grid = Grid::new(area, nx, ny).map_err(|e| fail(F, e))?;
     if values.len() != grid.len() {
@@ -434,7 +557,7 @@ pub fn map_data_text(values: &[f64], settings_json: &str) -> Result<String, JsEr
         ));
     }
     if csv {
-        let mut out = String::from("x_m,y_m,rmse_m\n");
+        let mut out = format!("x_m,y_m,{column}\n");
         for j in 0..ny {
             for i in 0..nx {
                 let v = values[j * nx + i];
@@ -445,8 +568,8 @@ pub fn map_data_text(values: &[f64], settings_json: &str) -> Result<String, JsEr
     }
     let doc = MapDataJs {
         scenario: &scenario,
-        quantity: "CRLB RMSE bound sqrt(σx² + σy²) of a snapshot fix",
-        units: "m",
+        quantity,
+        units,
         grid: MapGridJs {
             x0,
             x1,

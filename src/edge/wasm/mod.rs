@@ -21,7 +21,8 @@
 //! `ChannelFigures`), `multi.rs` (several people in the tracking view: `track_people`, run in a
 //! Web Worker, and `draw_people_chart`, its GOSPA chart), `multi_export.rs` (its Save figure and
 //! Export data: `people_map_svg`, `people_chart_svg`, `people_data_text`), `doppler.rs`
-//! (`App.compute_doppler_maps_in`: the position and velocity bounds with Doppler over a window).
+//! (`App.compute_doppler_maps_in`: the position and velocity bounds with Doppler over a window;
+//! `App.doppler_at`: both at one point, for the hover and the probe).
 
 mod app;
 mod base;

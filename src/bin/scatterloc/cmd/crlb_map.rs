@@ -13,6 +13,7 @@ use scatterloc::chart::{
 use scatterloc::chart::{ChartError, ChartNode, ChartOptions, MapData, MapOverlay};
 use scatterloc::localize::{doppler_map, Grid, MapQuantity};
 use scatterloc::native::{crlb_map_parallel, fast_path};
+use scatterloc::present::DopplerMapText;
 use scatterloc::scenario::Area;
 use scatterloc::{Error, Scenario, Vec2};
 
@@ -90,13 +91,13 @@ pub fn crlb_map(args: &CrlbMapArgs) -> Result<(), CliError> {
 
     let t0 = Instant::now();
     let mut values = vec![0.0; grid.len()];
+    let quantity = if velocity {
+        MapQuantity::Velocity
+    } else {
+        MapQuantity::Position
+    };
     match &cpi {
         Some(cpi) => {
-            let quantity = if velocity {
-                MapQuantity::Velocity
-            } else {
-                MapQuantity::Position
-            };
             let [vx, vy] = args.doppler.velocity;
             doppler_map(&model, &grid, cpi, Vec2::new(vx, vy), quantity, &mut values)
                 .map_err(|e| CliError::usage(e.to_string()))?;
@@ -113,34 +114,24 @@ pub fn crlb_map(args: &CrlbMapArgs) -> Result<(), CliError> {
         Format::Json => write_json(out, &grid, &values, velocity)?,
         Format::Svg | Format::Png => {
             let (title, subtitle) = default_titles(&s, &grid);
-            let (title, label, suffix) = match (&cpi, velocity) {
-                (None, _) => (title, ChartOptions::default().colorbar_label, ""),
-                (Some(_), false) => (
-                    "Position CRLB with Doppler".to_string(),
-                    "RMSE bound √(σx² + σy²)".to_string(),
-                    "",
+            // With Doppler, the texts the page's Save figure writes too (one home).
+            let (title, subtitle, label, suffix) = match &cpi {
+                None => (
+                    title,
+                    subtitle,
+                    ChartOptions::default().colorbar_label,
+                    String::new(),
                 ),
-                (Some(_), true) => (
-                    "Velocity CRLB with Doppler".to_string(),
-                    "velocity RMSE bound √(σvx² + σvy²)".to_string(),
-                    "/s",
-                ),
-            };
-            let subtitle = match &cpi {
-                Some(c) => format!(
-                    "{subtitle} · CPI {} × {} ms, v = ({}, {}) m/s",
-                    c.snapshots,
-                    c.spacing_s * 1e3,
-                    args.doppler.velocity[0],
-                    args.doppler.velocity[1]
-                ),
-                None => subtitle,
+                Some(c) => {
+                    let t = DopplerMapText::new(quantity, c, args.doppler.velocity, &subtitle);
+                    (t.title, t.subtitle, t.colorbar_label, t.value_suffix)
+                }
             };
             let opts = ChartOptions {
                 title: args.title.clone().unwrap_or(title),
                 subtitle: Some(subtitle),
                 colorbar_label: label,
-                value_suffix: suffix.to_string(),
+                value_suffix: suffix,
                 ..ChartOptions::default()
             };
             let figure = MapFigure {
