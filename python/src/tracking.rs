@@ -11,7 +11,8 @@ use scatterloc::formats::{
     CalibrationResult, CalibrationSnapshots, Measurements, RawEstimate, RawStep, Sigma,
 };
 use scatterloc::study::{
-    track_cpu_s, track_measurements_in, TrackOutput, TrackRequest, DEFAULT_PROCESS_NOISE, MAX_CPU_S,
+    track_cpu_s, track_doppler_cpu_s, track_measurements_in, TrackOutput, TrackRequest,
+    DEFAULT_PROCESS_NOISE, MAX_CPU_S,
 };
 use scatterloc::track::gating::{AssociationRule, Calibration, ClusterConfig};
 use scatterloc::track::{FilterKind, FilterSettings};
@@ -565,7 +566,13 @@ pub fn track(
     };
     let cal = calibration.map(|c| calibration_arg(c, n)).transpose()?;
     let steps = m.steps.as_ref().map_or(0, Vec::len) + m.raw_steps.as_ref().map_or(0, Vec::len);
-    let predicted_s = track_cpu_s(kind, n, steps);
+    let use_rates = doppler != Some(false);
+    // With range rates used, the step of the delay-and-Doppler update.
+    let predicted_s = if rates.is_some() && use_rates {
+        track_doppler_cpu_s(kind, n, steps)
+    } else {
+        track_cpu_s(kind, n, steps)
+    };
     scatterloc::study::check_cost("track", predicted_s, cpu_cap(max_cpu_hours)?).py()?;
     let area = sc.scenario().area_m;
     let req = TrackRequest {
@@ -578,7 +585,6 @@ pub fn track(
         seed: seed.unwrap_or(1),
     };
     // A short track (the usual call in a loop) runs on this thread: no worker to start.
-    let use_rates = doppler != Some(false);
     let out = run_sized(py, predicted_s, steps, None, |job| {
         let stop = || job.cancelled();
         match &rates {

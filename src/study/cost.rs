@@ -7,14 +7,15 @@
 //!   ([`FilterStudy::predicted_cpu_s`]); the truth simulation is part of the calibrated step
 //!   costs.
 //! - A track: `steps × step_ns(filter, links)` ([`track_cpu_s`]); gating and association add
-//!   per-estimate work that is small next to a filter step.
+//!   per-estimate work that is small next to a filter step. With range rates,
+//!   `steps × step_ns_doppler(filter, links)` ([`track_doppler_cpu_s`]).
 
 use core::ops::Range;
 
 use crate::error::{Error, Result};
 use crate::math::Real;
 use crate::study::FilterStudy;
-use crate::track::{step_ns, FilterKind};
+use crate::track::{step_ns, step_ns_doppler, FilterKind};
 
 /// The CLI's default cap on predicted work: one CPU-day (24 CPU-hours), s. The paper-scale
 /// studies of docs/reproduction.md (EKF + UKF ≈ 1 CPU-hour) fit; a full-mesh 64 × 64-node UKF
@@ -31,6 +32,12 @@ pub const PAGE_STUDY_CPU_S: Real = 600.0;
 /// Predicted CPU time of a track of `steps` steps by `filter` over `links` links, s.
 pub fn track_cpu_s(filter: FilterKind, links: usize, steps: usize) -> Real {
     steps as Real * step_ns(filter, links) * 1e-9
+}
+
+/// [`track_cpu_s`] of a track that updates on delays and range rates (issue 42 §3;
+/// [`step_ns_doppler`]).
+pub fn track_doppler_cpu_s(filter: FilterKind, links: usize, steps: usize) -> Real {
+    steps as Real * step_ns_doppler(filter, links) * 1e-9
 }
 
 /// `Ok` when `predicted_s` is within `limit_s`; else [`Error::TooLong`] naming `field` (the

@@ -52,7 +52,9 @@ pub use channel::{
     cir_track_multi, recording_measurements, recording_multi_settings, uniform_step, walkers_truth,
     RECORDING_CLUTTER, RECORDING_CLUTTER_WINDOW_S, RECORDING_DETECTION, RECORDING_EXTENT_SIGMA_M,
 };
-pub use cost::{check_cost, track_cpu_s, MAX_CPU_S, PAGE_STUDY_CPU_S, PAGE_TRACK_CPU_S};
+pub use cost::{
+    check_cost, track_cpu_s, track_doppler_cpu_s, MAX_CPU_S, PAGE_STUDY_CPU_S, PAGE_TRACK_CPU_S,
+};
 pub use doppler::{CpiDoc, DopplerArm, DopplerResult, DopplerStudy, MAX_DOPPLER_RUNS};
 pub use drive::{Driver, Sequential};
 pub use filters::{particle_chunks, FilterResults, FilterRun, FilterStudy};

@@ -47,6 +47,26 @@ pub const PF_NS_PER_PARTICLE_LINK2: Real = 1.1;
 /// (`L³/3`), ns.
 pub const PF_NS_PER_LINK3: Real = 0.16;
 
+/// EKF step with delays and range rates (issue 42 §3, D8), fixed part, ns: the factored 4-D
+/// update (two 4×4 `LDLᵀ`, the posterior's products) and the prediction.
+pub const EKF_DOPPLER_NS: Real = 130.0;
+/// EKF step with delays and range rates, per link (a delay row and a rate row from one
+/// evaluation of the link's geometry and link budget), ns. With [`EKF_DOPPLER_NS`]: 250 ns on 4
+/// links, the criterion bench's step (docs/benchmarks.md, "EKF step with Doppler"); the split
+/// between the two follows the operation counts (twice the delay-only rows per link).
+pub const EKF_DOPPLER_NS_PER_LINK: Real = 30.0;
+
+/// [`step_ns`] of a step that updates on delays and range rates (issue 42 §3): the EKF's own
+/// calibration ([`EKF_DOPPLER_NS`]); the UKF and the particle filter as with `2·links`
+/// measurement rows (each link gives a delay and a range rate: their `S` and NIS matrices are
+/// `2L × 2L`).
+pub fn step_ns_doppler(filter: FilterKind, links: usize) -> Real {
+    match filter {
+        FilterKind::Ekf => EKF_DOPPLER_NS + EKF_DOPPLER_NS_PER_LINK * links as Real,
+        other => step_ns(other, 2 * links),
+    }
+}
+
 /// The predicted CPU time of one step (predict, measurements, update, error and NEES) of
 /// `filter` with `links` links, ns (module docs).
 pub fn step_ns(filter: FilterKind, links: usize) -> Real {

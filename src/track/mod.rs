@@ -25,8 +25,9 @@ mod trajectory;
 mod ukf;
 
 pub use cost::{
-    step_ns, EKF_NS, EKF_NS_PER_LINK, PF_NS_PER_LINK3, PF_NS_PER_PARTICLE, PF_NS_PER_PARTICLE_LINK,
-    PF_NS_PER_PARTICLE_LINK2, UKF_NS, UKF_NS_PER_LINK, UKF_NS_PER_LINK2, UKF_NS_PER_LINK3,
+    step_ns, step_ns_doppler, EKF_DOPPLER_NS, EKF_DOPPLER_NS_PER_LINK, EKF_NS, EKF_NS_PER_LINK,
+    PF_NS_PER_LINK3, PF_NS_PER_PARTICLE, PF_NS_PER_PARTICLE_LINK, PF_NS_PER_PARTICLE_LINK2, UKF_NS,
+    UKF_NS_PER_LINK, UKF_NS_PER_LINK2, UKF_NS_PER_LINK3,
 };
 pub use doppler::{PredictedRate, RangeRates, RateNoise};
 pub(crate) use ekf::update_lanes;

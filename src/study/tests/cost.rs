@@ -50,3 +50,33 @@ fn predicted_cost_is_runs_times_steps_times_the_step_cost() {
     );
     assert!(check_cost("runs", MAX_CPU_S, MAX_CPU_S).is_ok());
 }
+
+/// With range rates (issue 42 §3) the UKF and the particle filter cost what `2L` measurement rows
+/// cost, and the EKF its own calibration: 250 ns on sensors2019's 4 links, the criterion bench's
+/// step (docs/benchmarks.md, "EKF step with Doppler"), twice and a bit the delay-only step.
+#[test]
+fn a_track_with_range_rates_costs_its_rows() {
+    use crate::track::{step_ns, step_ns_doppler};
+    let ukf = FilterKind::Ukf(UkfParams::default());
+    let pf = FilterKind::Pf(PfConfig {
+        particles: 500,
+        roughening: None,
+        regularized: true,
+    });
+    for links in [1, 4, 64, 1024] {
+        for kind in [ukf, pf] {
+            assert_eq!(step_ns_doppler(kind, links), step_ns(kind, 2 * links));
+            let (a, b) = (
+                track_doppler_cpu_s(kind, links, 100),
+                track_cpu_s(kind, 2 * links, 100),
+            );
+            assert!((a - b).abs() <= 1e-15 * b, "{a} vs {b}");
+        }
+        let (d, r) = (
+            step_ns_doppler(FilterKind::Ekf, links),
+            step_ns(FilterKind::Ekf, links),
+        );
+        assert!(d > 1.5 * r, "{links} links: {d} vs {r}");
+    }
+    assert_eq!(step_ns_doppler(FilterKind::Ekf, 4), 250.0);
+}

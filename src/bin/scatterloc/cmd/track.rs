@@ -17,8 +17,8 @@
 use scatterloc::error::Cancel;
 use scatterloc::formats::{Detections, Measurements, Steps};
 use scatterloc::study::{
-    score_multi, track_cpu_s, track_measurements_in, track_multi, MultiSettings, MultiTruth,
-    TrackRequest, DEFAULT_PROCESS_NOISE,
+    score_multi, track_cpu_s, track_doppler_cpu_s, track_measurements_in, track_multi,
+    MultiSettings, MultiTruth, TrackRequest, DEFAULT_PROCESS_NOISE,
 };
 use scatterloc::track::gating::AssociationRule;
 use scatterloc::track::multi::MultiKind;
@@ -138,9 +138,15 @@ pub fn track(args: &TrackArgs) -> Result<(), CliError> {
         Ok(Steps::Raw(r)) => r.len(),
         Err(_) => 0, // reported by the track itself
     };
+    // With range rates used, the step of the delay-and-Doppler update.
+    let cost = if rates.is_some() && !args.no_doppler {
+        track_doppler_cpu_s(kind, n, steps)
+    } else {
+        track_cpu_s(kind, n, steps)
+    };
     cost_refused(
         "track",
-        track_cpu_s(kind, n, steps),
+        cost,
         1,
         args.max_cpu_hours,
         &format!(
