@@ -83,6 +83,14 @@ pub struct DopplerArm {
     pub position_bound_m: Vec<Option<Real>>,
     /// PCRLB of the velocity, m/s.
     pub velocity_bound_mps: Vec<Option<Real>>,
+    /// The bound of each run's own truth, averaged: `√(mean_k tr P_k,rr)` with `P_k` the
+    /// recursion of E9 on run `k`'s Fisher information alone, m (`None` where any run's is
+    /// singular). Not a Bayesian bound: by Jensen it is ≥ the PCRLB of the mean information, and
+    /// it is what an efficient filter reaches on trajectories that spread into geometries of
+    /// unequal information (the diagnostic of docs/doppler.md, "Monte Carlo").
+    pub position_per_run_bound_m: Vec<Option<Real>>,
+    /// The same for the velocity, m/s.
+    pub velocity_per_run_bound_mps: Vec<Option<Real>>,
     /// Runs whose filter failed (an update error or a covariance without NEES); they are left
     /// out of the RMSE and NEES (empty when every run failed).
     pub failed_runs: usize,
@@ -133,14 +141,31 @@ impl DopplerStudy {
         let steps = self.steps;
         let mut arms = [Acc::new(steps), Acc::new(steps)];
         let mut fisher = [vec![Mat4::zeros(); steps], vec![Mat4::zeros(); steps]];
+        // Per arm and step: Σ_k tr P_k,rr and Σ_k tr P_k,vv of the runs' own recursions, and
+        // whether every run's stayed bounded.
+        let mut per_run = [
+            vec![(0.0, 0.0, true); steps + 1],
+            vec![(0.0, 0.0, true); steps + 1],
+        ];
         let mut truth = Vec::new();
         for k in 0..self.runs {
             cancel.check()?;
             let mut g = rng(self.seed, k as u64);
             sampler.sample(steps, &mut g, &mut truth);
-            for (n, x) in truth.iter().skip(1).enumerate() {
-                for (d, f) in fisher.iter_mut().enumerate() {
-                    f[n] += state_fisher(model, x, &self.cpi, d == 1);
+            for (d, (f, sums)) in fisher.iter_mut().zip(&mut per_run).enumerate() {
+                let mut own = PosteriorInformation::new(&self.initial_covariance)?;
+                add_bound(&mut sums[0], &own);
+                // Once a run's recursion fails, its later steps are unbounded too.
+                let mut alive = true;
+                for (n, x) in truth.iter().skip(1).enumerate() {
+                    let fx = state_fisher(model, x, &self.cpi, d == 1);
+                    f[n] += fx;
+                    alive = alive && own.step_state(&self.motion, &fx).is_ok();
+                    if alive {
+                        add_bound(&mut sums[n + 1], &own);
+                    } else {
+                        sums[n + 1].2 = false;
+                    }
                 }
             }
             let scans = self.scans(model, &truth, &mut g);
@@ -153,6 +178,15 @@ impl DopplerStudy {
             progress(k + 1);
         }
         let mut out = arms.map(|a| a.finish());
+        let runs = self.runs as Real;
+        for (arm, sums) in out.iter_mut().zip(&per_run) {
+            for &(p, v, ok) in sums {
+                arm.position_per_run_bound_m
+                    .push(ok.then(|| sqrt(p / runs)));
+                arm.velocity_per_run_bound_mps
+                    .push(ok.then(|| sqrt(v / runs)));
+            }
+        }
         for (arm, f) in out.iter_mut().zip(&fisher) {
             let mut fb = PosteriorInformation::new(&self.initial_covariance)?;
             arm.position_bound_m.push(fb.position_rmse());
@@ -306,7 +340,21 @@ impl Acc {
             mean_nees: self.nees.iter().filter(|_| ok).map(|s| s / n).collect(),
             position_bound_m: Vec::new(),
             velocity_bound_mps: Vec::new(),
+            position_per_run_bound_m: Vec::new(),
+            velocity_per_run_bound_mps: Vec::new(),
             failed_runs: self.failed,
         }
+    }
+}
+
+/// Adds `own`'s `tr P_rr` and `tr P_vv` (its bounds squared) to `sum`; an unbounded one marks
+/// the step unbounded.
+fn add_bound(sum: &mut (Real, Real, bool), own: &PosteriorInformation) {
+    match (own.position_rmse(), own.velocity_rmse()) {
+        (Some(p), Some(v)) => {
+            sum.0 += p * p;
+            sum.1 += v * v;
+        }
+        _ => sum.2 = false,
     }
 }

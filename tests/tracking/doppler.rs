@@ -516,14 +516,27 @@ fn summarize(name: &str, arm: &DopplerArm) -> (Real, Real, Real) {
     };
     let pos = ratio(&arm.position_rmse_m, &arm.position_bound_m);
     let vel = ratio(&arm.velocity_rmse_mps, &arm.velocity_bound_mps);
+    let own_pos = ratio(&arm.position_rmse_m, &arm.position_per_run_bound_m);
+    let own_vel = ratio(&arm.velocity_rmse_mps, &arm.velocity_per_run_bound_mps);
     let nees = arm.mean_nees[1..].iter().sum::<Real>() / (steps - 1) as Real;
     eprintln!(
-        "{name}: max RMSE/PCRLB position {pos:.3}, velocity {vel:.3}; mean NEES {nees:.3}; \
-         bound at the end {:.4} m, {:.4} m/s; failed {}",
+        "{name}: max RMSE/PCRLB position {pos:.3}, velocity {vel:.3}; over the runs' own bounds \
+         {own_pos:.3}, {own_vel:.3}; mean NEES {nees:.3}; bound at the end {:.4} m, {:.4} m/s \
+         (runs' own {:.4} m, {:.4} m/s); failed {}",
         arm.position_bound_m[steps - 1].unwrap(),
         arm.velocity_bound_mps[steps - 1].unwrap(),
+        arm.position_per_run_bound_m[steps - 1].unwrap(),
+        arm.velocity_per_run_bound_mps[steps - 1].unwrap(),
         arm.failed_runs
     );
+    // With Doppler the filter is efficient on each run's own trajectory (module docs of
+    // `DopplerArm::position_per_run_bound_m`): within 1.5× of the runs' own bounds in every case.
+    if name.ends_with("Doppler") {
+        assert!(
+            own_pos <= 1.5 && own_vel <= 1.5,
+            "{name}: over the runs' own bounds {own_pos} {own_vel}"
+        );
+    }
     (pos, vel, nees)
 }
 
@@ -576,6 +589,9 @@ fn monte_carlo_study(
 /// Doppler, 3–13× without) while the NEES stays consistent — with q = 1 m²/s³ the truths spread
 /// by metres into the poor geometry near the baselines, and the PCRLB of the mean Fisher
 /// information (E9) is then loose (Jensen), the drift spec check 11 documents at q = 0.01.
+/// Asserted instead (`summarize`): with Doppler the RMSE stays within 1.5× of the runs' own
+/// bounds averaged (`position_per_run_bound_m`; measured 1.03–1.15 in every case and seed), so
+/// the filter is efficient on the trajectories it is given.
 /// The mean NEES (averaged over the steps) is judged against the 95 % band of one
 /// step's mean over the `R` independent runs, `χ²_{4R}(0.025 | 0.975)/R` (the steps of a run
 /// are correlated; their average varies less than one step's, so this band is the lenient
