@@ -20,6 +20,6 @@ pub use shared::{ChannelChartOptions, PlotBox};
 pub use track_errors::{draw_track_errors, track_errors_size};
 
 #[cfg(all(test, not(target_arch = "wasm32")))]
-mod tests;
-#[cfg(all(test, not(target_arch = "wasm32")))]
 mod rate_tests;
+#[cfg(all(test, not(target_arch = "wasm32")))]
+mod tests;
