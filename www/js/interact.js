@@ -2,8 +2,8 @@
 // click to place a target (snapshot mode), press-and-drag a trajectory (tracking mode, "draw") or
 // the Plan panel's region of interest (after "Draw ROI", plan.js), press-and-drag on empty map to
 // pan (zoom.js), hover read-out (with Doppler on in the snapshot view, the position and
-// velocity bounds with Doppler and the delay-only one: App.doppler_at). A node drag cancels a running plan. pickNearest is the hit test
-// of every view (mtl.js uses it too).
+// velocity bounds with Doppler and the delay-only one: App.doppler_at). A node drag cancels a
+// running plan. pickNearest is the hit test of every view (mtl.js uses it too).
 
 import { $, errorText, fixed, showError, clearError } from './dom.js';
 
