@@ -18,6 +18,22 @@ use super::{console_errors, js, open, open_hash, session, settle};
 /// The page's last maps once the full-resolution map of `kernel` is shown and the page is idle:
 /// `{res, window, position, velocity}` with the values as the hex of their IEEE-754 bits (exact,
 /// `Infinity` included), plus the map's source and the velocity colour bar.
+/// Turns Doppler on with every field away from its default: N = 24, T = 1.5 ms, floor
+/// 0.05 m/s, v = (1.25, −0.5) m/s.
+async fn doppler_on(c: &fantoccini::Client) -> Result<(), String> {
+    select(c, "doppler-on", "on").await?;
+    for (id, v) in [
+        ("doppler-n", "24"),
+        ("doppler-t", "1.5"),
+        ("doppler-floor", "0.05"),
+        ("doppler-vx", "1.25"),
+        ("doppler-vy", "-0.5"),
+    ] {
+        type_in(c, id, v).await?;
+    }
+    Ok(())
+}
+
 async fn full_maps(c: &fantoccini::Client, kernel: &str) -> Result<Value, String> {
     let script = format!(
         "const s = window.mapState(); const d = window.doppler.maps(); \
@@ -81,16 +97,7 @@ fn page_doppler_maps_equal_the_cli() {
         let before = js(&c, "return window.doppler.state()").await?;
         let hidden0 = js(&c, "return document.getElementById('vel-plot').hidden").await?;
         // On, with every field away from its default, and a zoomed window.
-        select(&c, "doppler-on", "on").await?;
-        for (id, v) in [
-            ("doppler-n", "24"),
-            ("doppler-t", "1.5"),
-            ("doppler-floor", "0.05"),
-            ("doppler-vx", "1.25"),
-            ("doppler-vy", "-0.5"),
-        ] {
-            type_in(&c, id, v).await?;
-        }
+        doppler_on(&c).await?;
         click(&c, "zoom-in").await?;
         let full = full_maps(&c, "doppler").await?;
         let scenario = js(&c, "return window.app.scenario_json()").await?;
@@ -413,16 +420,7 @@ fn page_doppler_probe_hover_and_figure_match_the_cli() {
         js(&c, "window.figureExport.setDryRun(true);").await?;
         let probe_off = js(&c, PROBE).await?;
         let choice_off = js(&c, VELOCITY_CHOICE).await?;
-        select(&c, "doppler-on", "on").await?;
-        for (id, v) in [
-            ("doppler-n", "24"),
-            ("doppler-t", "1.5"),
-            ("doppler-floor", "0.05"),
-            ("doppler-vx", "1.25"),
-            ("doppler-vy", "-0.5"),
-        ] {
-            type_in(&c, id, v).await?;
-        }
+        doppler_on(&c).await?;
         let maps = full_maps(&c, "doppler").await?;
         let probe_on = js(&c, PROBE).await?;
         let choice_on = js(&c, VELOCITY_CHOICE).await?;

@@ -13,7 +13,7 @@ use scatterloc::track::{paper_initial_covariance, ConstantVelocity};
 use scatterloc::Model;
 
 use super::filters::filter_kinds;
-use super::output::{check_writable, Format, OutputSet};
+use super::output::{result_outputs, OutputSet};
 use super::report::FiltersFigure;
 use super::scenario::cpi_of;
 use super::study::{flag_error, load_layout, run_with_bar, trajectories_of};
@@ -86,20 +86,7 @@ pub fn doppler_montecarlo(args: &MontecarloArgs) -> Result<(), CliError> {
     let cpi = cpi_of(&args.doppler, &scenario)?;
     let runs = args.runs.unwrap_or(DOPPLER_RUNS);
     let seed = args.seed.unwrap_or(1);
-    let figure = match args.out.as_deref() {
-        Some(p) => Some((p, Format::of("out", p, &[Format::Svg, Format::Png])?)),
-        None => None,
-    };
-    let json = match args.json.as_deref() {
-        Some(p) => Format::of("json", p, &[Format::Json]).map(|_| Some(p))?,
-        None => None,
-    };
-    if let Some((p, _)) = figure {
-        check_writable("out", p)?;
-    }
-    if let Some(p) = json {
-        check_writable("json", p)?;
-    }
+    let (figure, json) = result_outputs(args.out.as_deref(), args.json.as_deref())?;
     let studies: Vec<DopplerStudy> = trajectories
         .iter()
         .map(|t| DopplerStudy {
